@@ -1,0 +1,177 @@
+//! Numbers exactly as written.
+//!
+//! The control gives meaning to the form of a number, not only to its value:
+//! `X100` and `X100.` are both 100 mm, but `R1=864` stores 0.864 while
+//! `R1=864.` stores 864, `F1.2` is m/min while `F1200` is mm/min, and digit
+//! limits count the digits that were written. So a number keeps its sign,
+//! its digits on both sides of the point, and whether a point was written.
+
+use std::fmt;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Sign {
+    Plus,
+    Minus,
+}
+
+/// A decimal number in its written form.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Decimal {
+    sign: Option<Sign>,
+    int_digits: u32,
+    leading_zeros: u32,
+    frac_digits: u32,
+    has_point: bool,
+    /// All digits as one integer (`12.50` → 1250); `None` past 38 digits.
+    mantissa: Option<u128>,
+}
+
+impl Decimal {
+    /// Reads `digits` (`[0-9]*(.[0-9]*)?`) with an optional written sign.
+    /// Returns `None` when there is no digit at all (`.` alone) or the text
+    /// has other characters.
+    pub fn parse(sign: Option<Sign>, digits: &str) -> Option<Decimal> {
+        let (int, frac) = match digits.split_once('.') {
+            Some((int, frac)) => (int, Some(frac)),
+            None => (digits, None),
+        };
+        let frac_text = frac.unwrap_or("");
+        let all_digits = |s: &str| s.bytes().all(|b| b.is_ascii_digit());
+        if int.len() + frac_text.len() == 0 || !all_digits(int) || !all_digits(frac_text) {
+            return None;
+        }
+        let mantissa = int
+            .bytes()
+            .chain(frac_text.bytes())
+            .try_fold(0u128, |acc, b| acc.checked_mul(10)?.checked_add(u128::from(b - b'0')));
+        Some(Decimal {
+            sign,
+            int_digits: int.len() as u32,
+            leading_zeros: int.bytes().take_while(|&b| b == b'0').count() as u32,
+            frac_digits: frac_text.len() as u32,
+            has_point: frac.is_some(),
+            mantissa,
+        })
+    }
+
+    /// The sign as written; `None` when no sign was written.
+    pub fn sign(&self) -> Option<Sign> {
+        self.sign
+    }
+
+    pub fn is_negative(&self) -> bool {
+        self.sign == Some(Sign::Minus) && self.mantissa != Some(0)
+    }
+
+    pub fn has_point(&self) -> bool {
+        self.has_point
+    }
+
+    /// Digits written before the point, leading zeros included.
+    pub fn int_digits(&self) -> u32 {
+        self.int_digits
+    }
+
+    /// Digits written before the point without leading zeros (`0.5` → 0,
+    /// `002500` → 4).
+    pub fn significant_int_digits(&self) -> u32 {
+        self.int_digits - self.leading_zeros
+    }
+
+    /// Digits written after the point.
+    pub fn frac_digits(&self) -> u32 {
+        self.frac_digits
+    }
+
+    /// The value scaled by `10^scale` as an exact integer (`1.25` at scale 3
+    /// is 1250). `None` if more than `scale` decimals were written with a
+    /// non-zero digit among the extra ones, or on overflow.
+    pub fn scaled(&self, scale: u32) -> Option<i128> {
+        let mantissa = i128::try_from(self.mantissa?).ok()?;
+        let magnitude = if scale >= self.frac_digits {
+            mantissa.checked_mul(10i128.checked_pow(scale - self.frac_digits)?)?
+        } else {
+            let divisor = 10i128.checked_pow(self.frac_digits - scale)?;
+            if mantissa % divisor != 0 {
+                return None;
+            }
+            mantissa / divisor
+        };
+        Some(if self.sign == Some(Sign::Minus) { -magnitude } else { magnitude })
+    }
+
+    /// The value as written (decimal point respected, no unit applied).
+    pub fn to_f64(&self) -> f64 {
+        let magnitude = match self.mantissa {
+            Some(m) => m as f64 / 10f64.powi(self.frac_digits as i32),
+            None => f64::INFINITY,
+        };
+        if self.sign == Some(Sign::Minus) { -magnitude } else { magnitude }
+    }
+}
+
+impl fmt::Display for Decimal {
+    /// Writes the number back in its written form (`-002.50` stays `-002.50`).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.sign {
+            Some(Sign::Plus) => f.write_str("+")?,
+            Some(Sign::Minus) => f.write_str("-")?,
+            None => {}
+        }
+        let width = (self.int_digits + self.frac_digits) as usize;
+        let digits = match self.mantissa {
+            Some(m) => format!("{m:0width$}"),
+            None => "9".repeat(width),
+        };
+        let (int, frac) = digits.split_at(self.int_digits as usize);
+        f.write_str(int)?;
+        if self.has_point {
+            write!(f, ".{frac}")?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dec(text: &str) -> Decimal {
+        let (sign, digits) = match text.as_bytes()[0] {
+            b'-' => (Some(Sign::Minus), &text[1..]),
+            b'+' => (Some(Sign::Plus), &text[1..]),
+            _ => (None, text),
+        };
+        Decimal::parse(sign, digits).unwrap()
+    }
+
+    #[test]
+    fn keeps_the_written_form() {
+        for text in ["0", "384.", ".12", "-0.864", "002500", "+10.000", "99999999", "-.5"] {
+            assert_eq!(dec(text).to_string(), text);
+        }
+        assert!(Decimal::parse(None, ".").is_none());
+        assert!(Decimal::parse(None, "").is_none());
+    }
+
+    #[test]
+    fn digit_counts() {
+        let d = dec("002500");
+        assert_eq!((d.int_digits(), d.significant_int_digits(), d.frac_digits()), (6, 4, 0));
+        assert!(!d.has_point());
+        let d = dec("0.250");
+        assert_eq!((d.int_digits(), d.significant_int_digits(), d.frac_digits()), (1, 0, 3));
+        assert!(d.has_point());
+    }
+
+    #[test]
+    fn scaling_is_exact() {
+        assert_eq!(dec("864").scaled(0), Some(864));
+        assert_eq!(dec("-0.864").scaled(3), Some(-864));
+        assert_eq!(dec("100.").scaled(3), Some(100_000));
+        assert_eq!(dec("1.0005").scaled(3), None);
+        assert_eq!(dec("1.2500").scaled(3), Some(1250));
+        assert_eq!(dec("1.5").to_f64(), 1.5);
+        assert!(!dec("-0").is_negative());
+    }
+}

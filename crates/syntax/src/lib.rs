@@ -1,0 +1,124 @@
+//! Lossless syntax trees for CNC partprograms.
+//!
+//! The tree holds every byte of the input: parsing never fails and
+//! `parse.syntax_node().to_string()` is always the input text. Problems are
+//! reported next to the tree as [`SyntaxError`]s with exact ranges.
+//!
+//! This crate knows the grammar of each [`Dialect`], not what codes mean:
+//! `G41` is a word with address `G` and value `41` here; the meaning of
+//! addresses, codes and parameters lives in the dialect catalogue and in the
+//! analysis.
+
+pub mod ast;
+mod decimal;
+pub mod encoding;
+mod error;
+mod green;
+mod lexer;
+mod parser;
+mod reparse;
+mod syntax_kind;
+
+use std::sync::Arc;
+
+use rowan::GreenNode;
+pub use rowan::{TextRange, TextSize};
+
+pub use crate::{
+    decimal::{Decimal, Sign},
+    error::{Severity, SyntaxError, SyntaxErrorKind},
+    parser::MAX_LINE_CHARS,
+    syntax_kind::{NcLanguage, SyntaxElement, SyntaxKind, SyntaxNode, SyntaxToken},
+};
+
+/// The programming language of a control.
+///
+/// Each dialect has its own lexer and parser over the shared [`SyntaxKind`]s.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[non_exhaustive]
+pub enum Dialect {
+    /// MEFI CNC836 / CNC846 / CNC856.
+    #[default]
+    Cnc8x6,
+}
+
+/// A replacement of `delete` (a range of the old text) by `insert`.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct TextEdit {
+    pub delete: TextRange,
+    pub insert: String,
+}
+
+impl TextEdit {
+    pub fn replace(delete: TextRange, insert: impl Into<String>) -> TextEdit {
+        TextEdit { delete, insert: insert.into() }
+    }
+
+    /// Applies the edit to `text`.
+    pub fn apply(&self, text: &mut String) {
+        text.replace_range(std::ops::Range::<usize>::from(self.delete), &self.insert);
+    }
+}
+
+/// The result of parsing: the green tree and the syntax errors.
+///
+/// Cheap to clone; equal parses compare equal, which incremental
+/// computations use to stop early.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Parse {
+    green: GreenNode,
+    errors: Arc<[SyntaxError]>,
+    dialect: Dialect,
+}
+
+impl Parse {
+    /// Parses a whole program.
+    pub fn new(text: &str, dialect: Dialect) -> Parse {
+        match dialect {
+            Dialect::Cnc8x6 => {
+                let (green, errors) = parser::parse_source_file(text);
+                Parse { green, errors: errors.into(), dialect }
+            }
+        }
+    }
+
+    /// Parses `new_text`, the result of applying `edit` to the text of this
+    /// parse, reusing every block the edit cannot have changed. The result
+    /// equals `Parse::new(new_text, dialect)`.
+    pub fn reparse(&self, edit: &TextEdit, new_text: &str) -> Parse {
+        match self.dialect {
+            Dialect::Cnc8x6 => reparse::reparse_blocks(self, edit, new_text)
+                .unwrap_or_else(|| Parse::new(new_text, self.dialect)),
+        }
+    }
+
+    pub fn dialect(&self) -> Dialect {
+        self.dialect
+    }
+
+    pub fn green(&self) -> &GreenNode {
+        &self.green
+    }
+
+    pub fn syntax_node(&self) -> SyntaxNode {
+        SyntaxNode::new_root(self.green.clone())
+    }
+
+    pub fn tree(&self) -> ast::SourceFile {
+        <ast::SourceFile as ast::AstNode>::cast(self.syntax_node()).expect("the root is a SOURCE_FILE")
+    }
+
+    /// Syntax errors sorted by position.
+    pub fn errors(&self) -> &[SyntaxError] {
+        &self.errors
+    }
+
+    /// The tree and the errors as text, for tests and `ncc parse`.
+    pub fn debug_dump(&self) -> String {
+        let mut dump = format!("{:#?}", self.syntax_node());
+        for error in self.errors.iter() {
+            dump.push_str(&format!("{error}\n"));
+        }
+        dump
+    }
+}

@@ -1,0 +1,691 @@
+//! The CNC8x6 parser.
+//!
+//! File layout, as the control reads it:
+//!
+//! ```text
+//! [preamble] [%number ["comment"]] {trivia} {block} [* {anything}]
+//! ```
+//!
+//! * Everything before the first `%` that is not inside a comment is the
+//!   preamble: the control skips it while loading.
+//! * A block starts at its `N` and runs until the next `N` outside a comment
+//!   (or `*`, or the end), across as many lines as it takes. Comment-only lines
+//!   and `/` therefore belong to the block that is open.
+//! * The first `*` outside a comment is the physical end; the control reads
+//!   nothing after it.
+//!
+//! Every `N` letter outside a comment starts a block: no value position of
+//! any word can hold a letter other than `R`. That makes block boundaries
+//! findable from any line start (comments never span lines), which the
+//! parallel parse and the incremental reparse both rely on.
+
+use std::ops::Range;
+
+use rowan::{GreenNode, NodeOrToken, TextRange, TextSize};
+
+use crate::{
+    SyntaxError, SyntaxErrorKind as E,
+    SyntaxKind::{self, *},
+    green::{self, GreenElement, WordCache},
+    lexer::{self, Token},
+};
+
+/// The control's limit on characters per line.
+pub const MAX_LINE_CHARS: usize = 80;
+
+/// Bodies larger than this are split at block boundaries and parsed in parallel.
+const PARALLEL_THRESHOLD: usize = 1 << 20;
+
+pub(crate) fn parse_source_file(text: &str) -> (GreenNode, Vec<SyntaxError>) {
+    parse_source_file_with(text, PARALLEL_THRESHOLD)
+}
+
+fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, Vec<SyntaxError>) {
+    let mut children: Vec<GreenElement> = Vec::new();
+    let mut errors = Vec::new();
+
+    let header = find_outside_comments(text, 0, b'%');
+    let body_start = match header {
+        Some(at) => {
+            if at > 0 {
+                let preamble = &text[..at];
+                children.push(NodeOrToken::Token(green::token(PREAMBLE, preamble)));
+                if !preamble.trim().is_empty() {
+                    errors.push(SyntaxError::new(
+                        E::IgnoredPreamble,
+                        range(0..at),
+                        "text before the program header `%` is skipped by the control",
+                    ));
+                }
+            }
+            let mut parser = Parser::new(text, at, text.len());
+            children.push(NodeOrToken::Node(parser.header()));
+            errors.append(&mut parser.errors);
+            parser.pos
+        }
+        None => 0,
+    };
+    let end = find_outside_comments(text, body_start, b'*').unwrap_or(text.len());
+
+    let (mut body, mut body_errors) = parse_body(text, body_start..end, parallel_threshold);
+    children.append(&mut body);
+    errors.append(&mut body_errors);
+
+    if end < text.len() {
+        let mut parser = Parser::new(text, end, text.len());
+        children.push(NodeOrToken::Node(parser.end()));
+        errors.append(&mut parser.errors);
+    }
+    let line_start = header.unwrap_or(0);
+    errors.extend(long_lines(text, line_start..end));
+    crate::error::sort_errors(&mut errors);
+    (green::node(SOURCE_FILE, children), errors)
+}
+
+/// File-level trivia, words without a block number, then blocks.
+fn parse_body(text: &str, body: Range<usize>, parallel_threshold: usize) -> (Vec<GreenElement>, Vec<SyntaxError>) {
+    let mut parser = Parser::new(text, body.start, body.end);
+    let mut children = Vec::new();
+    while let Some(token) = parser.peek() {
+        match token.kind {
+            WHITESPACE | NEWLINE | COMMENT => children.push(parser.bump_trivia(token)),
+            LETTER if parser.at_block_start() => break,
+            _ => children.push(NodeOrToken::Node(parser.block())),
+        }
+    }
+    let blocks_start = parser.pos;
+    let mut errors = std::mem::take(&mut parser.errors);
+    drop(parser);
+
+    if body.end - blocks_start < parallel_threshold {
+        let (mut blocks, mut block_errors) = parse_blocks(text, blocks_start..body.end);
+        children.append(&mut blocks);
+        errors.append(&mut block_errors);
+    } else {
+        use rayon::prelude::*;
+        let pieces = rayon::current_num_threads() * 4;
+        let mut bounds = vec![blocks_start];
+        for i in 1..pieces {
+            let target = blocks_start + (body.end - blocks_start) * i / pieces;
+            let at = next_block_start(text, target, body.end);
+            if at > *bounds.last().unwrap() && at < body.end {
+                bounds.push(at);
+            }
+        }
+        bounds.push(body.end);
+        let parts: Vec<_> = bounds
+            .par_windows(2)
+            .map(|w| parse_blocks(text, w[0]..w[1]))
+            .collect();
+        children.reserve(parts.iter().map(|(blocks, _)| blocks.len()).sum());
+        for (mut blocks, mut block_errors) in parts {
+            children.append(&mut blocks);
+            errors.append(&mut block_errors);
+        }
+    }
+    (children, errors)
+}
+
+/// Parses the blocks in `region`, which starts at a block's `N` and ends at
+/// a block start, at `*` or at the end of the text.
+pub(crate) fn parse_blocks(text: &str, region: Range<usize>) -> (Vec<GreenElement>, Vec<SyntaxError>) {
+    let (blocks, errors, _) = parse_blocks_until(text, region, |_| false);
+    (blocks, errors)
+}
+
+/// Like [`parse_blocks`], but stops early at the first block start for which
+/// `stop_at` holds. Returns where parsing stopped.
+pub(crate) fn parse_blocks_until(
+    text: &str,
+    region: Range<usize>,
+    stop_at: impl Fn(usize) -> bool,
+) -> (Vec<GreenElement>, Vec<SyntaxError>, usize) {
+    let mut parser = Parser::new(text, region.start, region.end);
+    let mut blocks = Vec::new();
+    while parser.pos < region.end {
+        let before = parser.pos;
+        blocks.push(NodeOrToken::Node(parser.block()));
+        if parser.pos == before || stop_at(parser.pos) {
+            break;
+        }
+    }
+    (blocks, parser.errors, parser.pos)
+}
+
+/// The first block start at or after the line holding `from`.
+fn next_block_start(text: &str, from: usize, limit: usize) -> usize {
+    let bytes = text.as_bytes();
+    let mut pos = match memchr::memchr2(b'\n', b'\r', &bytes[from..limit]) {
+        Some(i) => from + i,
+        None => return limit,
+    };
+    while pos < limit {
+        let token = lexer::token_at(text, pos);
+        if token.kind == LETTER && is_block_letter(bytes[pos]) {
+            return pos;
+        }
+        pos += token.len;
+    }
+    limit
+}
+
+pub(crate) fn is_block_letter(byte: u8) -> bool {
+    byte == b'N' || byte == b'n'
+}
+
+fn is_parameter_letter(byte: u8) -> bool {
+    byte == b'R' || byte == b'r'
+}
+
+/// The first `needle` byte at or after `from` that is not inside a comment.
+pub(crate) fn find_outside_comments(text: &str, from: usize, needle: u8) -> Option<usize> {
+    let bytes = text.as_bytes();
+    for candidate in memchr::memchr_iter(needle, &bytes[from..]).map(|i| from + i) {
+        let line_start = memchr::memrchr2(b'\n', b'\r', &bytes[from..candidate]).map_or(from, |i| from + i + 1);
+        let mut pos = line_start;
+        loop {
+            let token = lexer::token_at(text, pos);
+            if pos + token.len > candidate {
+                if token.kind != COMMENT {
+                    return Some(candidate);
+                }
+                break;
+            }
+            pos += token.len;
+        }
+    }
+    None
+}
+
+/// `line-too-long` for every line that starts or ends inside `region`,
+/// counting characters of the region only.
+pub(crate) fn long_lines(text: &str, region: Range<usize>) -> Vec<SyntaxError> {
+    let bytes = &text.as_bytes()[..region.end];
+    let mut errors = Vec::new();
+    let mut line_start = region.start;
+    let terminators = memchr::memchr2_iter(b'\n', b'\r', &bytes[region.start..]).map(|i| region.start + i);
+    for line_end in terminators.chain(std::iter::once(region.end)) {
+        if line_end < line_start {
+            // The `\n` of a `\r\n` pair.
+            continue;
+        }
+        if line_end - line_start > MAX_LINE_CHARS {
+            let line = &text[line_start..line_end];
+            let chars = line.chars().count();
+            if chars > MAX_LINE_CHARS {
+                let excess = line.char_indices().nth(MAX_LINE_CHARS).map_or(0, |(i, _)| i);
+                errors.push(SyntaxError::new(
+                    E::LineTooLong,
+                    range(line_start + excess..line_end),
+                    format!(
+                        "line is {chars} characters long; the control accepts at most {MAX_LINE_CHARS} per line (a block may continue on the next line)"
+                    ),
+                ));
+            }
+        }
+        line_start = line_end + 1;
+        if bytes.get(line_end) == Some(&b'\r') && bytes.get(line_end + 1) == Some(&b'\n') {
+            line_start += 1;
+        }
+    }
+    errors
+}
+
+fn range(r: Range<usize>) -> TextRange {
+    TextRange::new(TextSize::from(r.start as u32), TextSize::from(r.end as u32))
+}
+
+struct Parser<'a> {
+    text: &'a str,
+    pos: usize,
+    end: usize,
+    errors: Vec<SyntaxError>,
+    words: WordCache<'a>,
+    /// The number that ended the last word or assignment, while only
+    /// spaces follow it: a number after those spaces is a split number.
+    last_number: Option<Range<usize>>,
+}
+
+impl<'a> Parser<'a> {
+    fn new(text: &'a str, pos: usize, end: usize) -> Self {
+        Parser { text, pos, end, errors: Vec::new(), words: WordCache::default(), last_number: None }
+    }
+
+    fn token_at(&self, pos: usize) -> Option<Token> {
+        (pos < self.end).then(|| {
+            let token = lexer::token_at(self.text, pos);
+            Token { kind: token.kind, len: token.len.min(self.end - pos) }
+        })
+    }
+
+    fn peek(&self) -> Option<Token> {
+        self.token_at(self.pos)
+    }
+
+    fn byte_at(&self, pos: usize) -> u8 {
+        self.text.as_bytes()[pos]
+    }
+
+    fn skip_whitespace(&self, mut pos: usize) -> usize {
+        while let Some(Token { kind: WHITESPACE, len }) = self.token_at(pos) {
+            pos += len;
+        }
+        pos
+    }
+
+    fn kind_at(&self, pos: usize) -> Option<SyntaxKind> {
+        self.token_at(pos).map(|t| t.kind)
+    }
+
+    fn at_block_start(&self) -> bool {
+        self.kind_at(self.pos) == Some(LETTER) && is_block_letter(self.byte_at(self.pos))
+    }
+
+    fn error(&mut self, kind: E, r: Range<usize>, message: impl Into<String>) {
+        self.errors.push(SyntaxError::new(kind, range(r), message));
+    }
+
+    /// Consumes the next token as a green token.
+    fn bump(&mut self) -> GreenElement {
+        let token = self.peek().expect("bump past the end");
+        let text = &self.text[self.pos..self.pos + token.len];
+        self.pos += token.len;
+        NodeOrToken::Token(green::token(token.kind, text))
+    }
+
+    fn bump_trivia(&mut self, token: Token) -> GreenElement {
+        if token.kind == COMMENT && self.byte_at(self.pos) != b'"' {
+            let quote_len = self.text[self.pos..].chars().next().map_or(1, char::len_utf8);
+            self.error(
+                E::TypographicQuote,
+                self.pos..self.pos + quote_len,
+                "typographic quote: the control only knows the straight double quote `\"` for comments",
+            );
+        }
+        self.bump()
+    }
+
+    fn header(&mut self) -> GreenNode {
+        let start = self.pos;
+        let mut children = vec![self.bump()];
+        let value_at = self.skip_whitespace(self.pos);
+        if matches!(self.kind_at(value_at), Some(NUMBER | PLUS | MINUS)) {
+            self.value(&mut children);
+        } else {
+            self.error(
+                E::MissingProgramNumber,
+                start..start + 1,
+                "the program header `%` must be followed by the program number (1 to 999999), e.g. `%100`",
+            );
+        }
+        while let Some(token) = self.peek() {
+            match token.kind {
+                WHITESPACE | COMMENT => children.push(self.bump_trivia(token)),
+                _ => break,
+            }
+        }
+        green::node(HEADER, children)
+    }
+
+    /// A block: its `N` word, then everything up to the next `N`. Called at
+    /// anything else, it collects the words that lack their `N`.
+    fn block(&mut self) -> GreenNode {
+        let mut children = Vec::with_capacity(16);
+        if self.at_block_start() {
+            children.push(self.word());
+        } else {
+            self.missing_block_number();
+        }
+        while let Some(token) = self.peek() {
+            let item_start = self.pos;
+            let number_before = self.last_number.take();
+            let child = match token.kind {
+                WHITESPACE => {
+                    self.last_number = number_before;
+                    self.bump()
+                }
+                NEWLINE | COMMENT => self.bump_trivia(token),
+                LETTER if is_block_letter(self.byte_at(self.pos)) => break,
+                STAR => break,
+                LETTER if self.at_parameter_assignment(self.pos) => self.parameter_assignment(),
+                LETTER if self.foreign_text_len() > 0 => {
+                    let len = self.foreign_text_len();
+                    let text = &self.text[self.pos..self.pos + len];
+                    self.pos += len;
+                    self.error(
+                        E::UnexpectedCharacter,
+                        item_start..self.pos,
+                        format!("unexpected text `{text}`: an address letter must be followed by its value; text belongs in a comment `\"…\"`"),
+                    );
+                    NodeOrToken::Node(green::node(ERROR, [NodeOrToken::Token(green::token(ERROR_TOKEN, text))]))
+                }
+                LETTER | AMP => self.word(),
+                SLASH => self.block_skip(),
+                NUMBER => {
+                    let (kind, message, start) = match number_before {
+                        Some(number) => (
+                            E::SpaceInNumber,
+                            "space inside a number: the control rejects a value interrupted by spaces; join the digits".to_owned(),
+                            number.start,
+                        ),
+                        None => (
+                            E::NumberWithoutAddress,
+                            format!("number `{}` without an address letter", &self.text[self.pos..self.pos + token.len]),
+                            item_start,
+                        ),
+                    };
+                    let element = self.bump();
+                    self.error(kind, start..self.pos, message);
+                    NodeOrToken::Node(green::node(ERROR, [element]))
+                }
+                PLUS | MINUS => {
+                    let mut children = vec![self.bump()];
+                    if self.kind_at(self.pos) == Some(NUMBER) {
+                        children.push(self.bump());
+                    }
+                    self.error(E::SignWithoutAddress, item_start..self.pos, "signed value without an address letter");
+                    NodeOrToken::Node(green::node(ERROR, children))
+                }
+                EQ => self.error_token(E::MisplacedEquals, "`=` outside a parameter assignment; assignments read `R12=5.`"),
+                PERCENT => self.error_token(
+                    E::MisplacedPercent,
+                    "`%` starts a program only in the header at the top of the file",
+                ),
+                ERROR_TOKEN => {
+                    let text = &self.text[self.pos..self.pos + token.len];
+                    let message = if text.starts_with(',') {
+                        "unexpected `,`: the decimal separator is `.`".to_owned()
+                    } else {
+                        format!("unexpected `{text}`: outside comments only addresses, numbers, signs, `=`, `/`, `&` and spaces are allowed")
+                    };
+                    self.error_token(E::UnexpectedCharacter, message)
+                }
+                _ => unreachable!("token {:?} inside a block", token.kind),
+            };
+            children.push(child);
+        }
+        self.last_number = None;
+        green::node(BLOCK, children)
+    }
+
+    /// Length of a run of three or more letters none of which has a value,
+    /// like `MSG` or `comme`: foreign text, reported once rather than letter
+    /// by letter. The run stops before `N`, which always starts a block.
+    fn foreign_text_len(&self) -> usize {
+        let bytes = &self.text.as_bytes()[self.pos..self.end];
+        let run = bytes.iter().take_while(|&&b| b.is_ascii_alphabetic() && !is_block_letter(b)).count();
+        let last_has_value = run > 0 && self.at_value(self.skip_whitespace(self.pos + run));
+        let text_len = run - usize::from(last_has_value);
+        if text_len >= 3 { text_len } else { 0 }
+    }
+
+    fn missing_block_number(&mut self) {
+        let end = self.peek().map_or(self.pos, |t| self.pos + t.len);
+        self.error(
+            E::MissingBlockNumber,
+            self.pos..end,
+            "every block must begin with its block number `N`; these words belong to no block",
+        );
+    }
+
+    fn error_token(&mut self, kind: E, message: impl Into<String>) -> GreenElement {
+        let start = self.pos;
+        let element = self.bump();
+        self.error(kind, start..self.pos, message);
+        NodeOrToken::Node(green::node(ERROR, [element]))
+    }
+
+    /// A word: address letter (or `&`), optional spaces, value.
+    fn word(&mut self) -> GreenElement {
+        if let Some(word) = self.simple_word() {
+            return word;
+        }
+        let start = self.pos;
+        let mut children = vec![self.address_letter()];
+        let value_at = self.skip_whitespace(self.pos);
+        if self.at_value(value_at) {
+            self.value(&mut children);
+            if is_parameter_letter(self.byte_at(start)) {
+                let written = self.text[start..self.pos].to_owned();
+                self.error(
+                    E::ParameterWithoutAssignment,
+                    start..self.pos,
+                    format!("`{written}` assigns nothing: write `{written}=<value>` to set the parameter, or put it after an address (`X{written}`) to use it"),
+                );
+            }
+        } else {
+            let address = &self.text[start..start + 1];
+            let message = if is_block_letter(self.byte_at(start)) {
+                "block number missing: write it after `N`, e.g. `N10`".to_owned()
+            } else {
+                format!("address `{address}` has no value; write a number (`{address}0` for zero) or a parameter (`{address}R1`)")
+            };
+            self.error(E::MissingValue, start..start + 1, message);
+        }
+        NodeOrToken::Node(green::node(WORD, children))
+    }
+
+    /// The common case, uppercase letter, optional sign and a number,
+    /// served from the word cache. Block numbers are unique, so caching them
+    /// would only cost memory; `R` words need the general path's diagnostic.
+    fn simple_word(&mut self) -> Option<GreenElement> {
+        let bytes = &self.text.as_bytes()[..self.end];
+        let start = self.pos;
+        let letter = bytes[start];
+        if !letter.is_ascii_uppercase() || letter == b'N' || letter == b'R' {
+            return None;
+        }
+        let sign_len = usize::from(matches!(bytes.get(start + 1), Some(b'-' | b'+')));
+        let number_start = start + 1 + sign_len;
+        let int = bytes[number_start..].iter().take_while(|b| b.is_ascii_digit()).count();
+        let mut end = number_start + int;
+        if bytes.get(end) == Some(&b'.') {
+            end += 1;
+            end += bytes[end..].iter().take_while(|b| b.is_ascii_digit()).count();
+        }
+        if end - number_start - usize::from(end > number_start + int) == 0 {
+            return None;
+        }
+        self.pos = end;
+        self.last_number = Some(number_start..end);
+        Some(NodeOrToken::Node(self.words.simple_word(&self.text[start..end], sign_len)))
+    }
+
+    fn address_letter(&mut self) -> GreenElement {
+        let at = self.pos;
+        if self.byte_at(at).is_ascii_lowercase() {
+            let upper = self.byte_at(at).to_ascii_uppercase() as char;
+            self.error(
+                E::LowercaseAddress,
+                at..at + 1,
+                format!("lower-case address `{}`; the control's addresses are upper-case `{upper}`", self.byte_at(at) as char),
+            );
+        }
+        self.bump()
+    }
+
+    /// Whether a value (sign, number or parameter reference) starts at `pos`.
+    fn at_value(&self, pos: usize) -> bool {
+        match self.kind_at(pos) {
+            Some(PLUS | MINUS | NUMBER) => true,
+            Some(LETTER) => is_parameter_letter(self.byte_at(pos)) && !self.at_parameter_assignment(pos),
+            _ => false,
+        }
+    }
+
+    /// Parses `[spaces] [sign [spaces]] (number | parameter reference)` into
+    /// `children`; the caller checked [`Parser::at_value`].
+    fn value(&mut self, children: &mut Vec<GreenElement>) {
+        while self.kind_at(self.pos) == Some(WHITESPACE) {
+            children.push(self.bump());
+        }
+        if let Some(PLUS | MINUS) = self.kind_at(self.pos) {
+            let sign_start = self.pos;
+            if self.byte_at(sign_start) >= 0x80 {
+                self.error(
+                    E::TypographicMinus,
+                    sign_start..sign_start + 3,
+                    "typographic minus: the control only knows the ASCII minus `-`",
+                );
+            }
+            children.push(self.bump());
+            let digits_at = self.skip_whitespace(self.pos);
+            let value_follows = self.kind_at(digits_at) == Some(NUMBER)
+                || (self.kind_at(digits_at) == Some(LETTER) && is_parameter_letter(self.byte_at(digits_at)));
+            if !value_follows {
+                self.error(E::MissingValue, sign_start..self.pos, "sign without digits after it");
+                return;
+            }
+            if digits_at > self.pos {
+                self.error(
+                    E::SpaceAfterSign,
+                    sign_start..digits_at,
+                    "space between the sign and the digits: the control rejects it; write the sign next to the number",
+                );
+                while self.pos < digits_at {
+                    children.push(self.bump());
+                }
+            }
+        }
+        match self.kind_at(self.pos) {
+            Some(NUMBER) => children.push(self.number()),
+            Some(LETTER) => children.push(self.parameter_reference()),
+            _ => unreachable!("value() without a value"),
+        }
+    }
+
+    fn number(&mut self) -> GreenElement {
+        let start = self.pos;
+        let element = self.bump();
+        if self.text[start..self.pos].bytes().all(|b| b == b'.') {
+            self.error(E::NumberWithoutDigits, start..self.pos, "a number needs at least one digit (`0.` for zero)");
+        }
+        self.last_number = Some(start..self.pos);
+        element
+    }
+
+    /// `R` and the parameter number: the `R10` of `FR10`.
+    fn parameter_reference(&mut self) -> GreenElement {
+        let start = self.pos;
+        let mut children = vec![self.address_letter()];
+        let number_at = self.skip_whitespace(self.pos);
+        if self.kind_at(number_at) == Some(NUMBER) {
+            while self.pos < number_at {
+                children.push(self.bump());
+            }
+            children.push(self.number());
+        } else {
+            self.error(
+                E::MissingParameterNumber,
+                start..start + 1,
+                "`R` must be followed by the parameter number (0 to 95), e.g. `XR1`",
+            );
+        }
+        NodeOrToken::Node(green::node(PARAM_REF, children))
+    }
+
+    /// `R`, optional number, optional spaces, `=`.
+    fn at_parameter_assignment(&self, pos: usize) -> bool {
+        if self.kind_at(pos) != Some(LETTER) || !is_parameter_letter(self.byte_at(pos)) {
+            return false;
+        }
+        let mut at = self.skip_whitespace(pos + 1);
+        if let Some(Token { kind: NUMBER, len }) = self.token_at(at) {
+            at = self.skip_whitespace(at + len);
+        }
+        self.kind_at(at) == Some(EQ)
+    }
+
+    /// `R12=-0.864`, spaces allowed around `=`.
+    fn parameter_assignment(&mut self) -> GreenElement {
+        let start = self.pos;
+        let mut children = vec![self.address_letter()];
+        while self.kind_at(self.pos) == Some(WHITESPACE) {
+            children.push(self.bump());
+        }
+        if self.kind_at(self.pos) == Some(NUMBER) {
+            children.push(self.number());
+        } else {
+            self.error(
+                E::MissingParameterNumber,
+                start..start + 1,
+                "parameter number missing: assignments read `R12=5.`",
+            );
+        }
+        while self.kind_at(self.pos) == Some(WHITESPACE) {
+            children.push(self.bump());
+        }
+        let eq = self.pos;
+        children.push(self.bump());
+        let value_at = self.skip_whitespace(self.pos);
+        if self.at_value(value_at) {
+            self.value(&mut children);
+        } else {
+            self.error(E::MissingValue, start..eq + 1, "parameter assignment without a value after `=`");
+        }
+        NodeOrToken::Node(green::node(PARAM_ASSIGN, children))
+    }
+
+    /// `/`, and a digit directly after it (which the control ignores).
+    fn block_skip(&mut self) -> GreenElement {
+        let mut children = vec![self.bump()];
+        if self.kind_at(self.pos) == Some(NUMBER) {
+            children.push(self.bump());
+        }
+        NodeOrToken::Node(green::node(BLOCK_SKIP, children))
+    }
+
+    /// `*` and the rest of the file: comments and line breaks are kept as
+    /// such, anything else is text the control never reads.
+    fn end(&mut self) -> GreenNode {
+        let mut children = vec![self.bump()];
+        let mut ignored: Option<Range<usize>> = None;
+        while let Some(token) = self.peek() {
+            match token.kind {
+                WHITESPACE | NEWLINE | COMMENT => children.push(self.bump()),
+                _ => {
+                    let start = self.pos;
+                    let line_end = memchr::memchr2(b'\n', b'\r', &self.text.as_bytes()[start..])
+                        .map_or(self.text.len(), |i| start + i);
+                    children.push(NodeOrToken::Token(green::token(TRAILER, &self.text[start..line_end])));
+                    self.pos = line_end;
+                    let first = ignored.map_or(start, |r| r.start);
+                    ignored = Some(first..line_end);
+                }
+            }
+        }
+        if let Some(ignored) = ignored {
+            self.error(
+                E::TextAfterEnd,
+                ignored,
+                "text after the physical end `*` is never read by the control",
+            );
+        }
+        green::node(END, children)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parallel_parse_equals_sequential_parse() {
+        let mut text = String::from("leader\n%12 \"big\"\n\"before\"\nG90 X1\n");
+        let pieces = [
+            "N1 G1 X1.5 Y-2 \"c N2\"\n Y3\n",
+            "N2 R1=864 XR1 \u{201C}typo\n",
+            "N3 X36.  12 / Y 4.\r\n",
+            "N4 X1 N5 Y2 # 7\n\n",
+            "n6 comment text\n",
+        ];
+        for i in 0..2000 {
+            text.push_str(pieces[i % pieces.len()]);
+        }
+        text.push_str("* \"end\"\nN99\n");
+        let sequential = parse_source_file_with(&text, usize::MAX);
+        let parallel = parse_source_file_with(&text, 0);
+        assert_eq!(sequential, parallel);
+        assert_eq!(rowan::SyntaxNode::<crate::NcLanguage>::new_root(parallel.0).to_string(), text);
+    }
+}

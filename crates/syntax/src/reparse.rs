@@ -1,0 +1,201 @@
+//! Incremental reparsing: after an edit, reparse only the blocks it touched.
+//!
+//! Like rust-analyzer's block reparsing, but at CNC granularity: the blocks
+//! around the edit are reparsed from the new text until parsing reaches a
+//! block start that also started a block before the edit; the new blocks
+//! replace the old ones in the root node. Everything the edit could change
+//! beyond blocks (the header, the preamble, the physical end `*`, words
+//! before the first block) makes us return `None` and the caller parses the
+//! whole text again. A property test checks that the result always equals a
+//! full parse.
+
+use rowan::{NodeOrToken, TextRange, TextSize};
+
+use crate::{
+    Parse, SyntaxErrorKind, SyntaxKind, SyntaxNode, TextEdit,
+    error::sort_errors,
+    lexer::TYPOGRAPHIC_QUOTES,
+    parser::{self, is_block_letter},
+};
+
+pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Option<Parse> {
+    let root = old.syntax_node();
+    let old_len = root.text_range().end();
+    if edit.delete.end() > old_len
+        || new_text.len() != usize::from(old_len - edit.delete.len()) + edit.insert.len()
+    {
+        return None;
+    }
+    // `%` decides the preamble and `*` the physical end: both are global, and
+    // a quote or a line break can hide or reveal one on its line.
+    let global = |c: char| c == '%' || c == '*';
+    let deleted = root.text().slice(edit.delete);
+    if edit.insert.contains(global) || deleted.contains_char('%') || deleted.contains_char('*') {
+        return None;
+    }
+    let comment_delimiters = TYPOGRAPHIC_QUOTES.iter().map(|q| q.chars().next().unwrap()).chain(['"', '\n', '\r']);
+    let comments_changed = comment_delimiters.clone().any(|c| edit.insert.contains(c) || deleted.contains_char(c));
+    if comments_changed {
+        let start = usize::from(edit.delete.start());
+        let lines = line_start(new_text, start)..line_end(new_text, start + edit.insert.len(), new_text.len());
+        if new_text[lines].contains(global) {
+            return None;
+        }
+    }
+
+    let layout = Layout::of(&root);
+    let first_block = layout.first_block?;
+    let body_end = layout.body_end;
+    let (s, e) = (edit.delete.start(), edit.delete.end());
+    if s < first_block || e > body_end || body_end == first_block {
+        return None;
+    }
+
+    // The block just before the edit can grow (text appended to it) and the
+    // block after it can lose its `N`: both are reparsed.
+    let lo = s.max(first_block + TextSize::from(1)) - TextSize::from(1);
+    let first = block_at(&root, lo)?;
+    let last = if e < body_end { block_at(&root, e)? } else { block_at(&root, body_end - TextSize::from(1))? };
+    let region_start = first.text_range().start();
+    let old_region_end = last.text_range().end();
+
+    let delta = i64::from(u32::from(TextSize::of(edit.insert.as_str()))) - i64::from(u32::from(edit.delete.len()));
+    let shift = |offset: TextSize| TextSize::from((i64::from(u32::from(offset)) + delta) as u32);
+    let unshift = |offset: usize| TextSize::from((offset as i64 - delta) as u32);
+    let limit = usize::from(shift(body_end));
+    let start = usize::from(region_start);
+    if start >= limit || !is_block_letter(new_text.as_bytes()[start]) {
+        return None;
+    }
+
+    // Reparse until a block start that was a block start before the edit.
+    let min_end = usize::from(shift(old_region_end));
+    let (blocks, block_errors, stop) = parser::parse_blocks_until(new_text, start..limit, |at| {
+        at >= min_end && old_block_starts_at(&root, unshift(at), body_end)
+    });
+
+    let first_index = first.index();
+    let end_index = if stop >= limit {
+        layout.end_index
+    } else {
+        block_at(&root, unshift(stop))?.index()
+    };
+    let green = old.green.splice_children(first_index..end_index, blocks);
+
+    // Errors: block errors of the replaced region and line-length errors of
+    // every line touching it are recomputed; later errors move by `delta`.
+    let old_stop = unshift(stop);
+    let line_lo = line_start(new_text, start).max(layout.lines_from);
+    let line_hi = line_end(new_text, stop, limit);
+    let old_line_hi = unshift(line_hi);
+    let line_lo_size = TextSize::from(line_lo as u32);
+    let mut errors: Vec<_> = old
+        .errors()
+        .iter()
+        .filter(|error| {
+            let at = error.range.start();
+            let in_lines = at >= line_lo_size && at <= old_line_hi;
+            let in_blocks = at >= region_start && at < old_stop;
+            !(in_blocks || (error.kind == SyntaxErrorKind::LineTooLong && in_lines))
+        })
+        .map(|error| {
+            let mut error = error.clone();
+            if error.range.start() >= old_stop {
+                error.range = TextRange::new(shift(error.range.start()), shift(error.range.end()));
+            }
+            error
+        })
+        .collect();
+    errors.extend(block_errors);
+    errors.extend(parser::long_lines(new_text, line_lo..line_hi));
+    sort_errors(&mut errors);
+    Some(Parse { green, errors: errors.into(), dialect: old.dialect })
+}
+
+/// Where the blocks are among the children of the root.
+struct Layout {
+    /// Start of the first block that begins with its `N`.
+    first_block: Option<TextSize>,
+    /// Where the body ends: at `*`, or at the end of the text.
+    body_end: TextSize,
+    /// Index of the child after the last block.
+    end_index: usize,
+    /// Where line-length counting starts (the header, or the start).
+    lines_from: usize,
+}
+
+impl Layout {
+    fn of(root: &SyntaxNode) -> Layout {
+        let (body_end, end_index) = match root.last_child() {
+            Some(end) if end.kind() == SyntaxKind::END => (end.text_range().start(), end.index()),
+            _ => (root.text_range().end(), root.children_with_tokens().count()),
+        };
+        let mut first_block = None;
+        let mut lines_from = 0;
+        for child in root.children() {
+            match child.kind() {
+                SyntaxKind::HEADER => lines_from = usize::from(child.text_range().start()),
+                SyntaxKind::BLOCK if starts_with_block_number(&child) => {
+                    first_block = Some(child.text_range().start());
+                    break;
+                }
+                _ => {}
+            }
+        }
+        Layout { first_block, body_end, end_index, lines_from }
+    }
+}
+
+fn starts_with_block_number(block: &SyntaxNode) -> bool {
+    block
+        .first_token()
+        .is_some_and(|t| t.kind() == SyntaxKind::LETTER && is_block_letter(t.text().as_bytes()[0]))
+}
+
+/// The block child of the root that contains the character at `offset`.
+fn block_at(root: &SyntaxNode, offset: TextSize) -> Option<SyntaxNode> {
+    match root.child_or_token_at_range(TextRange::at(offset, TextSize::from(1)))? {
+        NodeOrToken::Node(node) if node.kind() == SyntaxKind::BLOCK && starts_with_block_number(&node) => Some(node),
+        _ => None,
+    }
+}
+
+fn old_block_starts_at(root: &SyntaxNode, offset: TextSize, body_end: TextSize) -> bool {
+    offset < body_end && block_at(root, offset).is_some_and(|block| block.text_range().start() == offset)
+}
+
+fn line_start(text: &str, at: usize) -> usize {
+    memchr::memrchr2(b'\n', b'\r', &text.as_bytes()[..at]).map_or(0, |i| i + 1)
+}
+
+fn line_end(text: &str, at: usize, limit: usize) -> usize {
+    memchr::memchr2(b'\n', b'\r', &text.as_bytes()[at..limit]).map_or(limit, |i| at + i)
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{Dialect, Parse, TextEdit, TextRange, TextSize};
+
+    #[test]
+    fn untouched_blocks_are_shared_with_the_old_tree() {
+        let text = "%1\nN10 X1\nN20 X2\nN30 X3\nN40 X4\nN50 X5\n*\n";
+        let old = Parse::new(text, Dialect::Cnc8x6);
+        let at = TextSize::from(text.find("X3").unwrap() as u32 + 1);
+        let edit = TextEdit::replace(TextRange::new(at, at + TextSize::from(1)), "7 Y8");
+        let mut new_text = text.to_owned();
+        edit.apply(&mut new_text);
+        let new = old.reparse(&edit, &new_text);
+        assert_eq!(new, Parse::new(&new_text, Dialect::Cnc8x6));
+
+        let blocks = |parse: &Parse| -> Vec<*const rowan::GreenNodeData> {
+            parse.green().children().filter_map(|c| c.into_node()).map(|n| n as *const _).collect()
+        };
+        let (old_blocks, new_blocks) = (blocks(&old), blocks(&new));
+        // Header, five blocks, end: only N30 is reparsed.
+        assert_eq!(old_blocks.len(), new_blocks.len());
+        for i in [0, 1, 2, 4, 5, 6] {
+            assert_eq!(old_blocks[i], new_blocks[i], "node {i} was rebuilt");
+        }
+        assert_ne!(old_blocks[3], new_blocks[3]);
+    }
+}

@@ -1,0 +1,64 @@
+//! Snapshot tests: every program in `test_data/parser` is parsed and its tree
+//! and errors compared with the `.rast` file next to it.
+//! Run with `UPDATE_EXPECT=1` to accept new output.
+
+use std::{fs, path::PathBuf};
+
+use ncc_syntax::{Dialect, Parse, TextEdit, TextRange, TextSize};
+
+fn fixtures() -> Vec<(PathBuf, String)> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("test_data/parser");
+    let mut files: Vec<_> = fs::read_dir(&dir)
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .filter(|path| path.extension().is_some_and(|ext| ext == "ncp"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 20, "fixtures missing in {}", dir.display());
+    files.into_iter().map(|path| {
+        let text = fs::read_to_string(&path).unwrap();
+        (path, text)
+    }).collect()
+}
+
+#[test]
+fn parser_snapshots() {
+    for (path, text) in fixtures() {
+        let parse = Parse::new(&text, Dialect::Cnc8x6);
+        assert_eq!(parse.syntax_node().to_string(), text, "{} does not round-trip", path.display());
+        let is_error_fixture = path.file_name().unwrap().to_str().unwrap().starts_with("error_");
+        let has_errors = parse.errors().iter().any(|e| e.severity() == ncc_syntax::Severity::Error);
+        assert_eq!(has_errors, is_error_fixture, "{}: error fixtures are named error_*", path.display());
+        expect_test::expect_file![path.with_extension("rast")].assert_eq(&parse.debug_dump());
+    }
+}
+
+/// Deleting each character, and inserting a few interesting ones at each
+/// position, reparses to the same result as a full parse.
+#[test]
+fn fixture_edits_reparse_like_full_parses() {
+    for (path, text) in fixtures() {
+        let parse = Parse::new(&text, Dialect::Cnc8x6);
+        let boundaries: Vec<usize> = (0..=text.len()).filter(|&i| text.is_char_boundary(i)).collect();
+        let mut edits = Vec::new();
+        for pair in boundaries.windows(2) {
+            edits.push(TextEdit::replace(range(pair[0], pair[1]), ""));
+        }
+        for &at in &boundaries {
+            for insert in ["N", "N5 ", "\"", "\n", " ", "X", "5", "R1=", "*", "%"] {
+                edits.push(TextEdit::replace(range(at, at), insert));
+            }
+        }
+        for edit in edits {
+            let mut new_text = text.clone();
+            edit.apply(&mut new_text);
+            let incremental = parse.reparse(&edit, &new_text);
+            let full = Parse::new(&new_text, Dialect::Cnc8x6);
+            assert_eq!(incremental, full, "{}: {edit:?}", path.display());
+        }
+    }
+}
+
+fn range(start: usize, end: usize) -> TextRange {
+    TextRange::new(TextSize::from(start as u32), TextSize::from(end as u32))
+}
