@@ -2,12 +2,11 @@
 //!
 //! A CAM program repeats the same few tokens millions of times. Tokens whose
 //! text is fixed (address letters, one space, line breaks, signs) are built
-//! once per process and shared; whole words are shared through a per-parse
-//! cache keyed by their text, because a word's subtree is a function of its
-//! text. Green nodes are immutable and reference counted, so sharing is
-//! invisible to every user of the tree.
-
-use std::sync::OnceLock;
+//! once per parser and shared; whole words are shared through a cache keyed
+//! by their text, because a word's subtree is a function of its text. Green
+//! nodes are immutable and reference counted, so sharing is invisible to
+//! every user of the tree. Each parser (and so each thread of a parallel
+//! parse) has its own set: threads never contend for one reference count.
 
 use rowan::{GreenNode, GreenToken, NodeOrToken};
 use rustc_hash::FxHashMap;
@@ -16,7 +15,14 @@ use crate::SyntaxKind::{self, *};
 
 pub(crate) type GreenElement = NodeOrToken<GreenNode, GreenToken>;
 
-struct SharedTokens {
+pub(crate) fn node(
+    kind: SyntaxKind,
+    children: impl IntoIterator<Item = GreenElement, IntoIter: ExactSizeIterator>,
+) -> GreenNode {
+    GreenNode::new(kind.into(), children)
+}
+
+pub(crate) struct GreenFactory<'a> {
     /// `A`–`Z` then `a`–`z`.
     letters: Vec<GreenToken>,
     space: GreenToken,
@@ -29,84 +35,111 @@ struct SharedTokens {
     slash: GreenToken,
     percent: GreenToken,
     star: GreenToken,
+    /// Simple words of up to eight bytes, keyed by their bytes packed into
+    /// an integer: hashing and comparing them is a multiply and a compare.
+    short_words: FxHashMap<u64, GreenNode>,
+    long_words: FxHashMap<&'a str, GreenNode>,
 }
 
-fn shared() -> &'static SharedTokens {
-    static SHARED: OnceLock<SharedTokens> = OnceLock::new();
-    SHARED.get_or_init(|| {
+impl<'a> GreenFactory<'a> {
+    pub(crate) fn new() -> Self {
+        let new = |kind: SyntaxKind, text: &str| GreenToken::new(kind.into(), text);
         let letters = (b'A'..=b'Z')
             .chain(b'a'..=b'z')
-            .map(|b| GreenToken::new(LETTER.into(), std::str::from_utf8(&[b]).unwrap()))
+            .map(|b| new(LETTER, std::str::from_utf8(&[b]).expect("ASCII")))
             .collect();
-        let token = |kind: SyntaxKind, text: &str| GreenToken::new(kind.into(), text);
-        SharedTokens {
+        GreenFactory {
             letters,
-            space: token(WHITESPACE, " "),
-            lf: token(NEWLINE, "\n"),
-            crlf: token(NEWLINE, "\r\n"),
-            plus: token(PLUS, "+"),
-            minus: token(MINUS, "-"),
-            eq: token(EQ, "="),
-            amp: token(AMP, "&"),
-            slash: token(SLASH, "/"),
-            percent: token(PERCENT, "%"),
-            star: token(STAR, "*"),
+            space: new(WHITESPACE, " "),
+            lf: new(NEWLINE, "\n"),
+            crlf: new(NEWLINE, "\r\n"),
+            plus: new(PLUS, "+"),
+            minus: new(MINUS, "-"),
+            eq: new(EQ, "="),
+            amp: new(AMP, "&"),
+            slash: new(SLASH, "/"),
+            percent: new(PERCENT, "%"),
+            star: new(STAR, "*"),
+            short_words: FxHashMap::default(),
+            long_words: FxHashMap::default(),
         }
-    })
-}
-
-/// A green token for `text`, shared when its text is one of the fixed ones.
-pub(crate) fn token(kind: SyntaxKind, text: &str) -> GreenToken {
-    let shared = shared();
-    let hit = match (kind, text.as_bytes()) {
-        (LETTER, [b @ b'A'..=b'Z']) => Some(&shared.letters[usize::from(b - b'A')]),
-        (LETTER, [b @ b'a'..=b'z']) => Some(&shared.letters[26 + usize::from(b - b'a')]),
-        (WHITESPACE, b" ") => Some(&shared.space),
-        (NEWLINE, b"\n") => Some(&shared.lf),
-        (NEWLINE, b"\r\n") => Some(&shared.crlf),
-        (PLUS, b"+") => Some(&shared.plus),
-        (MINUS, b"-") => Some(&shared.minus),
-        (EQ, _) => Some(&shared.eq),
-        (AMP, _) => Some(&shared.amp),
-        (SLASH, _) => Some(&shared.slash),
-        (PERCENT, _) => Some(&shared.percent),
-        (STAR, _) => Some(&shared.star),
-        _ => None,
-    };
-    match hit {
-        Some(token) => token.clone(),
-        None => GreenToken::new(kind.into(), text),
     }
-}
 
-pub(crate) fn node(kind: SyntaxKind, children: impl IntoIterator<Item = GreenElement, IntoIter: ExactSizeIterator>) -> GreenNode {
-    GreenNode::new(kind.into(), children)
-}
+    /// A green token for `text`, shared when its text is one of the fixed ones.
+    pub(crate) fn token(&self, kind: SyntaxKind, text: &str) -> GreenElement {
+        let shared = match (kind, text.as_bytes()) {
+            (LETTER, [letter]) => return self.letter(*letter),
+            (WHITESPACE, b" ") => &self.space,
+            (NEWLINE, b"\n") => &self.lf,
+            (NEWLINE, b"\r\n") => &self.crlf,
+            (PLUS, b"+") => &self.plus,
+            (MINUS, b"-") => &self.minus,
+            (EQ, _) => &self.eq,
+            (AMP, _) => &self.amp,
+            (SLASH, _) => &self.slash,
+            (PERCENT, _) => &self.percent,
+            (STAR, _) => &self.star,
+            _ => return NodeOrToken::Token(GreenToken::new(kind.into(), text)),
+        };
+        NodeOrToken::Token(shared.clone())
+    }
 
-/// Deduplicates simple words (`X12.5`, `G01`, `Z-1.018`) by their text.
-#[derive(Default)]
-pub(crate) struct WordCache<'a> {
-    words: FxHashMap<&'a str, GreenNode>,
-}
+    pub(crate) fn space(&self) -> GreenElement {
+        NodeOrToken::Token(self.space.clone())
+    }
 
-impl<'a> WordCache<'a> {
-    /// The `WORD` node for `text` = letter, optional sign, number.
-    pub(crate) fn simple_word(&mut self, text: &'a str, sign_len: usize) -> GreenNode {
-        if let Some(node) = self.words.get(text) {
-            return node.clone();
-        }
+    pub(crate) fn newline(&self) -> GreenElement {
+        NodeOrToken::Token(self.lf.clone())
+    }
+
+    /// The token of an ASCII letter.
+    pub(crate) fn letter(&self, letter: u8) -> GreenElement {
+        let index = match letter {
+            b'A'..=b'Z' => usize::from(letter - b'A'),
+            _ => 26 + usize::from(letter.to_ascii_lowercase() - b'a'),
+        };
+        NodeOrToken::Token(self.letters[index].clone())
+    }
+
+    /// The `WORD` node of `text` = upper-case letter, optional sign of
+    /// `sign_len` bytes, number.
+    pub(crate) fn simple_word(&mut self, text: &'a str, sign_len: usize) -> GreenElement {
+        let word = if text.len() <= 8 {
+            // Simple words hold no zero byte, so the padding cannot collide.
+            let mut key = [0u8; 8];
+            key[..text.len()].copy_from_slice(text.as_bytes());
+            match self.short_words.get(&u64::from_le_bytes(key)) {
+                Some(word) => word.clone(),
+                None => {
+                    let word = self.build_simple_word(text, sign_len);
+                    self.short_words.insert(u64::from_le_bytes(key), word.clone());
+                    word
+                }
+            }
+        } else {
+            match self.long_words.get(text) {
+                Some(word) => word.clone(),
+                None => {
+                    let word = self.build_simple_word(text, sign_len);
+                    self.long_words.insert(text, word.clone());
+                    word
+                }
+            }
+        };
+        NodeOrToken::Node(word)
+    }
+
+    fn build_simple_word(&self, text: &str, sign_len: usize) -> GreenNode {
         let (letter, rest) = text.split_at(1);
         let (sign, number) = rest.split_at(sign_len);
-        let letter = NodeOrToken::Token(token(LETTER, letter));
-        let number = NodeOrToken::Token(token(NUMBER, number));
-        let word = match sign {
+        let letter = self.letter(letter.as_bytes()[0]);
+        let number = self.token(NUMBER, number);
+        match sign {
             "" => node(WORD, [letter, number]),
             sign => {
                 let kind = if sign == "+" { PLUS } else { MINUS };
-                node(WORD, [letter, NodeOrToken::Token(token(kind, sign)), number])
+                node(WORD, [letter, self.token(kind, sign), number])
             }
-        };
-        self.words.insert(text, word.clone());
-        word
+        }
     }
 }

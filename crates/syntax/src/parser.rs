@@ -26,7 +26,7 @@ use rowan::{GreenNode, NodeOrToken, TextRange, TextSize};
 use crate::{
     SyntaxError, SyntaxErrorKind as E,
     SyntaxKind::{self, *},
-    green::{self, GreenElement, WordCache},
+    green::{self, GreenElement, GreenFactory},
     lexer::{self, Token},
 };
 
@@ -49,7 +49,7 @@ fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, 
         Some(at) => {
             if at > 0 {
                 let preamble = &text[..at];
-                children.push(NodeOrToken::Token(green::token(PREAMBLE, preamble)));
+                children.push(NodeOrToken::Token(rowan::GreenToken::new(PREAMBLE.into(), preamble)));
                 if !preamble.trim().is_empty() {
                     errors.push(SyntaxError::new(
                         E::IgnoredPreamble,
@@ -240,15 +240,25 @@ struct Parser<'a> {
     pos: usize,
     end: usize,
     errors: Vec<SyntaxError>,
-    words: WordCache<'a>,
+    green: GreenFactory<'a>,
     /// The number that ended the last word or assignment, while only
     /// spaces follow it: a number after those spaces is a split number.
     last_number: Option<Range<usize>>,
+    /// Reused for the children of each block.
+    block_children: Vec<GreenElement>,
 }
 
 impl<'a> Parser<'a> {
     fn new(text: &'a str, pos: usize, end: usize) -> Self {
-        Parser { text, pos, end, errors: Vec::new(), words: WordCache::default(), last_number: None }
+        Parser {
+            text,
+            pos,
+            end,
+            errors: Vec::new(),
+            green: GreenFactory::new(),
+            last_number: None,
+            block_children: Vec::with_capacity(32),
+        }
     }
 
     fn token_at(&self, pos: usize) -> Option<Token> {
@@ -290,7 +300,7 @@ impl<'a> Parser<'a> {
         let token = self.peek().expect("bump past the end");
         let text = &self.text[self.pos..self.pos + token.len];
         self.pos += token.len;
-        NodeOrToken::Token(green::token(token.kind, text))
+        self.green.token(token.kind, text)
     }
 
     fn bump_trivia(&mut self, token: Token) -> GreenElement {
@@ -330,13 +340,37 @@ impl<'a> Parser<'a> {
     /// A block: its `N` word, then everything up to the next `N`. Called at
     /// anything else, it collects the words that lack their `N`.
     fn block(&mut self) -> GreenNode {
-        let mut children = Vec::with_capacity(16);
+        let mut children = std::mem::take(&mut self.block_children);
         if self.at_block_start() {
-            children.push(self.word());
+            children.push(self.block_number());
         } else {
             self.missing_block_number();
         }
-        while let Some(token) = self.peek() {
+        loop {
+            // Fast paths for what CAM output is made of; each builds exactly
+            // the tree the general path below would.
+            match self.text.as_bytes()[..self.end].get(self.pos) {
+                None => break,
+                Some(b' ') if !matches!(self.text.as_bytes()[..self.end].get(self.pos + 1), Some(b' ' | b'\t')) => {
+                    children.push(self.green.space());
+                    self.pos += 1;
+                    continue;
+                }
+                Some(b'\n') => {
+                    children.push(self.green.newline());
+                    self.pos += 1;
+                    self.last_number = None;
+                    continue;
+                }
+                Some(b'A'..=b'Z') => {
+                    if let Some(word) = self.simple_word() {
+                        children.push(word);
+                        continue;
+                    }
+                }
+                _ => {}
+            }
+            let Some(token) = self.peek() else { break };
             let item_start = self.pos;
             let number_before = self.last_number.take();
             let child = match token.kind {
@@ -357,7 +391,7 @@ impl<'a> Parser<'a> {
                         item_start..self.pos,
                         format!("unexpected text `{text}`: an address letter must be followed by its value; text belongs in a comment `\"…\"`"),
                     );
-                    NodeOrToken::Node(green::node(ERROR, [NodeOrToken::Token(green::token(ERROR_TOKEN, text))]))
+                    NodeOrToken::Node(green::node(ERROR, [self.green.token(ERROR_TOKEN, text)]))
                 }
                 LETTER | AMP => self.word(),
                 SLASH => self.block_skip(),
@@ -405,7 +439,24 @@ impl<'a> Parser<'a> {
             children.push(child);
         }
         self.last_number = None;
-        green::node(BLOCK, children)
+        let block = green::node(BLOCK, children.drain(..));
+        self.block_children = children;
+        block
+    }
+
+    /// `N` and its digits, or the general word path for anything unusual.
+    fn block_number(&mut self) -> GreenElement {
+        let bytes = &self.text.as_bytes()[..self.end];
+        let start = self.pos;
+        let digits = bytes[start + 1..].iter().take_while(|b| b.is_ascii_digit()).count();
+        let plain = bytes[start] == b'N' && digits > 0 && bytes.get(start + 1 + digits) != Some(&b'.');
+        if !plain {
+            return self.word();
+        }
+        self.pos = start + 1 + digits;
+        self.last_number = Some(start + 1..self.pos);
+        let number = self.green.token(NUMBER, &self.text[start + 1..self.pos]);
+        NodeOrToken::Node(green::node(WORD, [self.green.letter(b'N'), number]))
     }
 
     /// Length of a run of three or more letters none of which has a value,
@@ -488,7 +539,7 @@ impl<'a> Parser<'a> {
         }
         self.pos = end;
         self.last_number = Some(number_start..end);
-        Some(NodeOrToken::Node(self.words.simple_word(&self.text[start..end], sign_len)))
+        Some(self.green.simple_word(&self.text[start..end], sign_len))
     }
 
     fn address_letter(&mut self) -> GreenElement {
@@ -647,7 +698,7 @@ impl<'a> Parser<'a> {
                     let start = self.pos;
                     let line_end = memchr::memchr2(b'\n', b'\r', &self.text.as_bytes()[start..])
                         .map_or(self.text.len(), |i| start + i);
-                    children.push(NodeOrToken::Token(green::token(TRAILER, &self.text[start..line_end])));
+                    children.push(self.green.token(TRAILER, &self.text[start..line_end]));
                     self.pos = line_end;
                     let first = ignored.map_or(start, |r| r.start);
                     ignored = Some(first..line_end);

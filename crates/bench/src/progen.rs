@@ -1,0 +1,203 @@
+//! A deterministic generator of surfacing programs, as a CAM system writes them.
+//!
+//! The tool zig-zags over a wavy surface in rows along X: many short linear
+//! moves in X, Y and Z, a semicircular turnaround arc at the end of each row
+//! (about every 50 blocks), a comment every 200 blocks, and a lift and
+//! return to the start when the part's Y extent is used up. The toolpath is
+//! produced once as [`Move`]s and written in either dialect, so both files
+//! describe exactly the same motion.
+
+use std::fmt::Write;
+
+/// The syntax to write.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Syntax {
+    /// MEFI CNC8x6: `%` header, `N` on every block, `"comments"`, `*` end.
+    Cnc8x6,
+    /// RS274/NGC as LinuxCNC and the `gcode` crate read it: `(comments)`, `M2`.
+    Ngc,
+}
+
+/// One step of the toolpath.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Move {
+    /// Set-up: offset, absolute, plane, spindle; then rapid to the point.
+    Start { x: f64, y: f64, z: f64, spindle_rpm: u32 },
+    Rapid { x: Option<f64>, y: Option<f64>, z: Option<f64> },
+    Linear { x: f64, y: f64, z: f64, feed: Option<u32> },
+    /// Arc in the XY plane to (`x`, `y`), centre at `i`, `j` from the start.
+    Arc { clockwise: bool, x: f64, y: f64, i: f64, j: f64 },
+    Comment(String),
+    End,
+}
+
+/// Rows are this many linear moves long, so an arc comes every ~50 blocks.
+const MOVES_PER_ROW: usize = 49;
+const STEP: f64 = 0.4;
+const TURN_RADIUS: f64 = 1.5;
+const Y_EXTENT: f64 = 600.0;
+const FEED: u32 = 2400;
+
+/// The toolpath of a program of exactly `blocks` blocks (at least 4).
+pub fn surfacing(blocks: usize) -> Vec<Move> {
+    let blocks = blocks.max(4);
+    let mut path = Toolpath { moves: Vec::with_capacity(blocks + blocks / 200 + 1), blocks: 0 };
+    path.push(Move::Start { x: 0.0, y: 0.0, z: 5.0, spindle_rpm: 8000 });
+    path.push(Move::Linear { x: 0.0, y: 0.0, z: surface(0.0, 0.0), feed: Some(FEED) });
+    let (mut x, mut y, mut row, mut along) = (0.0f64, 0.0f64, 0usize, 0usize);
+    while path.blocks < blocks - 2 {
+        if path.blocks % 200 == 0 {
+            path.moves.push(Move::Comment(format!("ROW {row} BLOCK {}", path.blocks)));
+        }
+        if along == MOVES_PER_ROW {
+            along = 0;
+            row += 1;
+            if y + 2.0 * TURN_RADIUS > Y_EXTENT {
+                // Start the next layer of passes from the origin.
+                path.push(Move::Rapid { x: None, y: None, z: Some(5.0) });
+                path.push(Move::Rapid { x: Some(0.0), y: Some(0.0), z: None });
+                (x, y, row) = (0.0, 0.0, 0);
+                path.push(Move::Linear { x, y, z: surface(x, y), feed: None });
+                continue;
+            }
+            // Rows alternate direction: turn counter-clockwise at the right
+            // end, clockwise at the left end.
+            let clockwise = row % 2 == 0;
+            path.push(Move::Arc { clockwise, x, y: y + 2.0 * TURN_RADIUS, i: 0.0, j: TURN_RADIUS });
+            y += 2.0 * TURN_RADIUS;
+            continue;
+        }
+        along += 1;
+        x += if row % 2 == 0 { STEP } else { -STEP };
+        path.push(Move::Linear { x, y, z: surface(x, y), feed: None });
+    }
+    path.push(Move::Rapid { x: None, y: None, z: Some(5.0) });
+    path.push(Move::End);
+    path.moves
+}
+
+struct Toolpath {
+    moves: Vec<Move>,
+    blocks: usize,
+}
+
+impl Toolpath {
+    fn push(&mut self, m: Move) {
+        self.blocks += 1;
+        self.moves.push(m);
+    }
+}
+
+/// The machined surface: gentle waves a CAM system would follow closely.
+fn surface(x: f64, y: f64) -> f64 {
+    -2.0 + 0.8 * (x / 7.0).sin() * (y / 11.0).cos() + 0.15 * ((x + y) / 3.0).sin()
+}
+
+/// Writes the toolpath as program text.
+pub fn write(moves: &[Move], syntax: Syntax) -> String {
+    let mut out = String::with_capacity(moves.len() * 34);
+    let mut n = 0u32;
+    if syntax == Syntax::Cnc8x6 {
+        out.push_str("%1 \"SURFACING\"\n");
+    }
+    for m in moves {
+        let block_start = out.len();
+        if syntax == Syntax::Cnc8x6 && !matches!(m, Move::Comment(_)) {
+            n += 1;
+            let _ = write!(out, "N{n} ");
+        }
+        match *m {
+            Move::Start { x, y, z, spindle_rpm } => {
+                let code = if syntax == Syntax::Cnc8x6 { "G00" } else { "G0" };
+                let _ = write!(out, "G54 G90 G17 {code} X{x:.3} Y{y:.3} Z{z:.3} M03 S{spindle_rpm}");
+            }
+            Move::Rapid { x, y, z } => {
+                out.push_str("G0");
+                for (letter, value) in [('X', x), ('Y', y), ('Z', z)] {
+                    if let Some(value) = value {
+                        let _ = write!(out, " {letter}{value:.3}");
+                    }
+                }
+            }
+            Move::Linear { x, y, z, feed } => {
+                let _ = write!(out, "G1 X{x:.3} Y{y:.3} Z{z:.3}");
+                if let Some(feed) = feed {
+                    let _ = write!(out, " F{feed}");
+                }
+            }
+            Move::Arc { clockwise, x, y, i, j } => {
+                let code = if clockwise { "G2" } else { "G3" };
+                let _ = write!(out, "{code} X{x:.3} Y{y:.3} I{i:.3} J{j:.3}");
+            }
+            Move::Comment(ref text) => match syntax {
+                Syntax::Cnc8x6 => {
+                    let _ = write!(out, "\"{text}\"");
+                }
+                Syntax::Ngc => {
+                    let _ = write!(out, "({text})");
+                }
+            },
+            Move::End => out.push_str(if syntax == Syntax::Cnc8x6 { "M30" } else { "M2" }),
+        }
+        debug_assert!(out.len() - block_start <= 80, "generated line too long");
+        out.push('\n');
+    }
+    if syntax == Syntax::Cnc8x6 {
+        out.push_str("*\n");
+    }
+    out
+}
+
+/// Counts the blocks of a generated program (comment lines excluded).
+pub fn block_count(moves: &[Move]) -> usize {
+    moves.iter().filter(|m| !matches!(m, Move::Comment(_))).count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exact_block_count_and_shape() {
+        for blocks in [4, 50, 1000, 12345] {
+            let moves = surfacing(blocks);
+            assert_eq!(block_count(&moves), blocks);
+        }
+        let moves = surfacing(1000);
+        let arcs = moves.iter().filter(|m| matches!(m, Move::Arc { .. })).count();
+        let comments = moves.iter().filter(|m| matches!(m, Move::Comment(_))).count();
+        assert!((15..=25).contains(&arcs), "{arcs} arcs");
+        assert_eq!(comments, 4);
+    }
+
+    #[test]
+    fn arcs_end_on_their_circle() {
+        let moves = surfacing(5000);
+        let mut at = (0.0, 0.0);
+        for m in &moves {
+            match *m {
+                Move::Linear { x, y, .. } => at = (x, y),
+                Move::Rapid { x, y, .. } => at = (x.unwrap_or(at.0), y.unwrap_or(at.1)),
+                Move::Arc { x, y, i, j, .. } => {
+                    let centre = (at.0 + i, at.1 + j);
+                    let r0 = (i * i + j * j).sqrt();
+                    let r1 = ((x - centre.0).powi(2) + (y - centre.1).powi(2)).sqrt();
+                    assert!((r0 - r1).abs() < 1e-9);
+                    at = (x, y);
+                }
+                _ => {}
+            }
+        }
+    }
+
+    #[test]
+    fn both_syntaxes_have_one_line_per_block() {
+        let moves = surfacing(500);
+        let cnc = write(&moves, Syntax::Cnc8x6);
+        let ngc = write(&moves, Syntax::Ngc);
+        assert!(cnc.starts_with("%1 \"SURFACING\"\nN1 G54 G90 G17 G00 X0.000 Y0.000 Z5.000 M03 S8000\n"));
+        assert!(cnc.ends_with("N500 M30\n*\n"));
+        assert!(ngc.ends_with("M2\n"));
+        assert_eq!(cnc.lines().count(), ngc.lines().count() + 2);
+    }
+}
