@@ -1,0 +1,56 @@
+//! `ncc`: the command line of the CNC partprogram toolchain.
+
+mod check;
+
+use std::{path::PathBuf, process::ExitCode};
+
+use clap::{Parser, Subcommand};
+
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
+#[derive(Parser)]
+#[command(name = "ncc", version, about = "Checker and toolchain for MEFI CNC8x6 partprograms")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Check partprograms and report every problem found.
+    ///
+    /// Directories are searched for partprograms (`*.NCP` and macrocycle
+    /// files `L<number>`), honouring `.gitignore`. Exit status: 0 when no
+    /// errors were found, 1 when some were, 2 when a path could not be read.
+    Check {
+        /// Files or directories to check.
+        #[arg(default_value = ".")]
+        paths: Vec<PathBuf>,
+        /// Output format.
+        #[arg(long, value_enum, default_value_t = check::Format::Human)]
+        format: check::Format,
+    },
+    /// Print the syntax tree of a partprogram (a debugging aid).
+    Parse {
+        /// The program to parse.
+        file: PathBuf,
+    },
+}
+
+fn main() -> ExitCode {
+    match Cli::parse().command {
+        Command::Check { paths, format } => check::run(&paths, format),
+        Command::Parse { file } => match check::read_program(&file) {
+            Ok(text) => {
+                let parse = ncc_syntax::Parse::new(&text, ncc_syntax::Dialect::Cnc8x6);
+                print!("{}", parse.debug_dump());
+                ExitCode::SUCCESS
+            }
+            Err(error) => {
+                eprintln!("error: {}: {error}", file.display());
+                ExitCode::from(2)
+            }
+        },
+    }
+}
