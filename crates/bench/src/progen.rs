@@ -22,11 +22,31 @@ pub enum Syntax {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Move {
     /// Set-up: offset, absolute, plane, spindle; then rapid to the point.
-    Start { x: f64, y: f64, z: f64, spindle_rpm: u32 },
-    Rapid { x: Option<f64>, y: Option<f64>, z: Option<f64> },
-    Linear { x: f64, y: f64, z: f64, feed: Option<u32> },
+    Start {
+        x: f64,
+        y: f64,
+        z: f64,
+        spindle_rpm: u32,
+    },
+    Rapid {
+        x: Option<f64>,
+        y: Option<f64>,
+        z: Option<f64>,
+    },
+    Linear {
+        x: f64,
+        y: f64,
+        z: f64,
+        feed: Option<u32>,
+    },
     /// Arc in the XY plane to (`x`, `y`), centre at `i`, `j` from the start.
-    Arc { clockwise: bool, x: f64, y: f64, i: f64, j: f64 },
+    Arc {
+        clockwise: bool,
+        x: f64,
+        y: f64,
+        i: f64,
+        j: f64,
+    },
     Comment(String),
     End,
 }
@@ -46,7 +66,7 @@ pub fn surfacing(blocks: usize) -> Vec<Move> {
     path.push(Move::Linear { x: 0.0, y: 0.0, z: surface(0.0, 0.0), feed: Some(FEED) });
     let (mut x, mut y, mut row, mut along) = (0.0f64, 0.0f64, 0usize, 0usize);
     while path.blocks < blocks - 2 {
-        if path.blocks % 200 == 0 {
+        if path.blocks.is_multiple_of(200) {
             path.moves.push(Move::Comment(format!("ROW {row} BLOCK {}", path.blocks)));
         }
         if along == MOVES_PER_ROW {

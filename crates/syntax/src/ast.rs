@@ -290,10 +290,7 @@ impl End {
 
     /// Text after `*` that is not a comment.
     pub fn ignored(&self) -> impl Iterator<Item = SyntaxToken> + use<> {
-        self.0
-            .children_with_tokens()
-            .filter_map(NodeOrToken::into_token)
-            .filter(|t| t.kind() == SyntaxKind::TRAILER)
+        self.0.children_with_tokens().filter_map(NodeOrToken::into_token).filter(|t| t.kind() == SyntaxKind::TRAILER)
     }
 }
 

@@ -115,13 +115,6 @@ pub(crate) fn sort_errors(errors: &mut [SyntaxError]) {
 
 impl fmt::Display for SyntaxError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{}[{}] {:?}: {}",
-            self.severity(),
-            self.kind.code(),
-            self.range,
-            self.message
-        )
+        write!(f, "{}[{}] {:?}: {}", self.severity(), self.kind.code(), self.range, self.message)
     }
 }

@@ -44,10 +44,8 @@ pub(crate) struct GreenFactory<'a> {
 impl<'a> GreenFactory<'a> {
     pub(crate) fn new() -> Self {
         let new = |kind: SyntaxKind, text: &str| GreenToken::new(kind.into(), text);
-        let letters = (b'A'..=b'Z')
-            .chain(b'a'..=b'z')
-            .map(|b| new(LETTER, std::str::from_utf8(&[b]).expect("ASCII")))
-            .collect();
+        let letters =
+            (b'A'..=b'Z').chain(b'a'..=b'z').map(|b| new(LETTER, std::str::from_utf8(&[b]).expect("ASCII"))).collect();
         GreenFactory {
             letters,
             space: new(WHITESPACE, " "),

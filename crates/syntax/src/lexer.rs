@@ -74,11 +74,7 @@ fn run_len(bytes: &[u8], pred: impl Fn(u8) -> bool) -> usize {
 /// `[0-9]* ('.' [0-9]*)?`: digits with at most one decimal point.
 fn number_len(bytes: &[u8]) -> usize {
     let int = run_len(bytes, |b| b.is_ascii_digit());
-    if bytes.get(int) == Some(&b'.') {
-        int + 1 + run_len(&bytes[int + 1..], |b| b.is_ascii_digit())
-    } else {
-        int
-    }
+    if bytes.get(int) == Some(&b'.') { int + 1 + run_len(&bytes[int + 1..], |b| b.is_ascii_digit()) } else { int }
 }
 
 /// A comment runs to its closing quote (included) or to the end of the line

@@ -87,8 +87,9 @@ impl Parse {
     /// equals `Parse::new(new_text, dialect)`.
     pub fn reparse(&self, edit: &TextEdit, new_text: &str) -> Parse {
         match self.dialect {
-            Dialect::Cnc8x6 => reparse::reparse_blocks(self, edit, new_text)
-                .unwrap_or_else(|| Parse::new(new_text, self.dialect)),
+            Dialect::Cnc8x6 => {
+                reparse::reparse_blocks(self, edit, new_text).unwrap_or_else(|| Parse::new(new_text, self.dialect))
+            }
         }
     }
 

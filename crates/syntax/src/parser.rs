@@ -113,10 +113,7 @@ fn parse_body(text: &str, body: Range<usize>, parallel_threshold: usize) -> (Vec
             }
         }
         bounds.push(body.end);
-        let parts: Vec<_> = bounds
-            .par_windows(2)
-            .map(|w| parse_blocks(text, w[0]..w[1]))
-            .collect();
+        let parts: Vec<_> = bounds.par_windows(2).map(|w| parse_blocks(text, w[0]..w[1])).collect();
         children.reserve(parts.iter().map(|(blocks, _)| blocks.len()).sum());
         for (mut blocks, mut block_errors) in parts {
             children.append(&mut blocks);
@@ -399,12 +396,16 @@ impl<'a> Parser<'a> {
                     let (kind, message, start) = match number_before {
                         Some(number) => (
                             E::SpaceInNumber,
-                            "space inside a number: the control rejects a value interrupted by spaces; join the digits".to_owned(),
+                            "space inside a number: the control rejects a value interrupted by spaces; join the digits"
+                                .to_owned(),
                             number.start,
                         ),
                         None => (
                             E::NumberWithoutAddress,
-                            format!("number `{}` without an address letter", &self.text[self.pos..self.pos + token.len]),
+                            format!(
+                                "number `{}` without an address letter",
+                                &self.text[self.pos..self.pos + token.len]
+                            ),
                             item_start,
                         ),
                     };
@@ -420,17 +421,18 @@ impl<'a> Parser<'a> {
                     self.error(E::SignWithoutAddress, item_start..self.pos, "signed value without an address letter");
                     NodeOrToken::Node(green::node(ERROR, children))
                 }
-                EQ => self.error_token(E::MisplacedEquals, "`=` outside a parameter assignment; assignments read `R12=5.`"),
-                PERCENT => self.error_token(
-                    E::MisplacedPercent,
-                    "`%` starts a program only in the header at the top of the file",
-                ),
+                EQ => self
+                    .error_token(E::MisplacedEquals, "`=` outside a parameter assignment; assignments read `R12=5.`"),
+                PERCENT => self
+                    .error_token(E::MisplacedPercent, "`%` starts a program only in the header at the top of the file"),
                 ERROR_TOKEN => {
                     let text = &self.text[self.pos..self.pos + token.len];
                     let message = if text.starts_with(',') {
                         "unexpected `,`: the decimal separator is `.`".to_owned()
                     } else {
-                        format!("unexpected `{text}`: outside comments only addresses, numbers, signs, `=`, `/`, `&` and spaces are allowed")
+                        format!(
+                            "unexpected `{text}`: outside comments only addresses, numbers, signs, `=`, `/`, `&` and spaces are allowed"
+                        )
                     };
                     self.error_token(E::UnexpectedCharacter, message)
                 }
@@ -509,7 +511,9 @@ impl<'a> Parser<'a> {
             let message = if is_block_letter(self.byte_at(start)) {
                 "block number missing: write it after `N`, e.g. `N10`".to_owned()
             } else {
-                format!("address `{address}` has no value; write a number (`{address}0` for zero) or a parameter (`{address}R1`)")
+                format!(
+                    "address `{address}` has no value; write a number (`{address}0` for zero) or a parameter (`{address}R1`)"
+                )
             };
             self.error(E::MissingValue, start..start + 1, message);
         }
@@ -549,7 +553,10 @@ impl<'a> Parser<'a> {
             self.error(
                 E::LowercaseAddress,
                 at..at + 1,
-                format!("lower-case address `{}`; the control's addresses are upper-case `{upper}`", self.byte_at(at) as char),
+                format!(
+                    "lower-case address `{}`; the control's addresses are upper-case `{upper}`",
+                    self.byte_at(at) as char
+                ),
             );
         }
         self.bump()
@@ -706,11 +713,7 @@ impl<'a> Parser<'a> {
             }
         }
         if let Some(ignored) = ignored {
-            self.error(
-                E::TextAfterEnd,
-                ignored,
-                "text after the physical end `*` is never read by the control",
-            );
+            self.error(E::TextAfterEnd, ignored, "text after the physical end `*` is never read by the control");
         }
         green::node(END, children)
     }

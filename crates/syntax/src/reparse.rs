@@ -21,9 +21,7 @@ use crate::{
 pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Option<Parse> {
     let root = old.syntax_node();
     let old_len = root.text_range().end();
-    if edit.delete.end() > old_len
-        || new_text.len() != usize::from(old_len - edit.delete.len()) + edit.insert.len()
-    {
+    if edit.delete.end() > old_len || new_text.len() != usize::from(old_len - edit.delete.len()) + edit.insert.len() {
         return None;
     }
     // `%` decides the preamble and `*` the physical end: both are global, and
@@ -75,11 +73,7 @@ pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Op
     });
 
     let first_index = first.index();
-    let end_index = if stop >= limit {
-        layout.end_index
-    } else {
-        block_at(&root, unshift(stop))?.index()
-    };
+    let end_index = if stop >= limit { layout.end_index } else { block_at(&root, unshift(stop))?.index() };
     let green = old.green.splice_children(first_index..end_index, blocks);
 
     // Errors: block errors of the replaced region and line-length errors of
@@ -147,9 +141,7 @@ impl Layout {
 }
 
 fn starts_with_block_number(block: &SyntaxNode) -> bool {
-    block
-        .first_token()
-        .is_some_and(|t| t.kind() == SyntaxKind::LETTER && is_block_letter(t.text().as_bytes()[0]))
+    block.first_token().is_some_and(|t| t.kind() == SyntaxKind::LETTER && is_block_letter(t.text().as_bytes()[0]))
 }
 
 /// The block child of the root that contains the character at `offset`.

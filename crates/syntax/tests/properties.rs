@@ -41,8 +41,9 @@ fn block_program() -> impl Strategy<Value = String> {
         Just("/".to_owned()),
         " ?\"[A-Z N]{0,8}\"?".prop_map(|c| c.replace('\n', "")),
     ];
-    let block = (1u32..9999, prop::collection::vec(word, 0..5), prop_oneof![Just("\n"), Just("\r\n"), Just("\n "), Just(" ")])
-        .prop_map(|(n, words, end)| format!("N{n} {}{end}", words.join(" ")));
+    let block =
+        (1u32..9999, prop::collection::vec(word, 0..5), prop_oneof![Just("\n"), Just("\r\n"), Just("\n "), Just(" ")])
+            .prop_map(|(n, words, end)| format!("N{n} {}{end}", words.join(" ")));
     (prop::collection::vec(block, 1..12), prop::bool::ANY)
         .prop_map(|(blocks, star)| format!("%1 \"T\"\n{}{}", blocks.concat(), if star { "*\n" } else { "" }))
 }

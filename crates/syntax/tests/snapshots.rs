@@ -15,10 +15,13 @@ fn fixtures() -> Vec<(PathBuf, String)> {
         .collect();
     files.sort();
     assert!(files.len() >= 20, "fixtures missing in {}", dir.display());
-    files.into_iter().map(|path| {
-        let text = fs::read_to_string(&path).unwrap();
-        (path, text)
-    }).collect()
+    files
+        .into_iter()
+        .map(|path| {
+            let text = fs::read_to_string(&path).unwrap();
+            (path, text)
+        })
+        .collect()
 }
 
 #[test]
