@@ -71,8 +71,16 @@ enum Command {
         #[arg(long, default_value_t = 3)]
         runs: usize,
     },
-    /// Parse a file once with ncc on one thread (for profilers).
-    ParseFile { path: PathBuf },
+    /// Parse a file once (for profilers such as perf or callgrind).
+    ParseFile {
+        path: PathBuf,
+        /// Threads for ncc.
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
+        /// Parse with the `gcode` crate instead (the file must be NGC).
+        #[arg(long)]
+        gcode: bool,
+    },
     /// Write a generated program.
     Generate {
         #[arg(long, default_value_t = 1_000_000)]
@@ -93,13 +101,19 @@ enum SyntaxArg {
 fn main() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::Parse { blocks, runs } => parse_benchmark(blocks, runs.max(1)),
-        Command::ParseFile { path } => {
+        Command::ParseFile { path, threads, gcode } => {
             let text = std::fs::read_to_string(&path)?;
-            let single = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
             let start = Instant::now();
-            let parse = single.install(|| Parse::new(&text, Dialect::Cnc8x6));
-            println!("{} errors in {:?}", parse.errors().len(), start.elapsed());
-            std::mem::forget(parse);
+            if gcode {
+                let program = gcode::parse(&text).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+                println!("{} blocks in {:?}", program.blocks.len(), start.elapsed());
+                std::mem::forget(program);
+            } else {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
+                let parse = pool.install(|| Parse::new(&text, Dialect::Cnc8x6));
+                println!("{} errors in {:?}", parse.errors().len(), start.elapsed());
+                std::mem::forget(parse);
+            }
             Ok(())
         }
         Command::Generate { blocks, syntax, output } => {

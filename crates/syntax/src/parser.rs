@@ -41,7 +41,7 @@ pub(crate) fn parse_source_file(text: &str) -> (GreenNode, Vec<SyntaxError>) {
 }
 
 fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, Vec<SyntaxError>) {
-    let mut children: Vec<GreenElement> = Vec::new();
+    let mut front: Vec<GreenElement> = Vec::new();
     let mut errors = Vec::new();
 
     let header = find_outside_comments(text, 0, b'%');
@@ -49,7 +49,7 @@ fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, 
         Some(at) => {
             if at > 0 {
                 let preamble = &text[..at];
-                children.push(NodeOrToken::Token(rowan::GreenToken::new(PREAMBLE.into(), preamble)));
+                front.push(NodeOrToken::Token(rowan::GreenToken::new(PREAMBLE.into(), preamble)));
                 if !preamble.trim().is_empty() {
                     errors.push(SyntaxError::new(
                         E::IgnoredPreamble,
@@ -59,7 +59,7 @@ fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, 
                 }
             }
             let mut parser = Parser::new(text, at, text.len());
-            children.push(NodeOrToken::Node(parser.header()));
+            front.push(NodeOrToken::Node(parser.header()));
             errors.append(&mut parser.errors);
             parser.pos
         }
@@ -67,60 +67,88 @@ fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, 
     };
     let end = find_outside_comments(text, body_start, b'*').unwrap_or(text.len());
 
-    let (mut body, mut body_errors) = parse_body(text, body_start..end, parallel_threshold);
-    children.append(&mut body);
-    errors.append(&mut body_errors);
-
-    if end < text.len() {
-        let mut parser = Parser::new(text, end, text.len());
-        children.push(NodeOrToken::Node(parser.end()));
-        errors.append(&mut parser.errors);
-    }
-    let line_start = header.unwrap_or(0);
-    errors.extend(long_lines(text, line_start..end));
-    crate::error::sort_errors(&mut errors);
-    (green::node(SOURCE_FILE, children), errors)
-}
-
-/// File-level trivia, words without a block number, then blocks.
-fn parse_body(text: &str, body: Range<usize>, parallel_threshold: usize) -> (Vec<GreenElement>, Vec<SyntaxError>) {
-    let mut parser = Parser::new(text, body.start, body.end);
-    let mut children = Vec::new();
+    // File-level trivia and words without a block number, up to the first block.
+    let mut parser = Parser::new(text, body_start, end);
     while let Some(token) = parser.peek() {
         match token.kind {
-            WHITESPACE | NEWLINE | COMMENT => children.push(parser.bump_trivia(token)),
+            WHITESPACE | NEWLINE | COMMENT => front.push(parser.bump_trivia(token)),
             LETTER if parser.at_block_start() => break,
-            _ => children.push(NodeOrToken::Node(parser.block())),
+            _ => front.push(NodeOrToken::Node(parser.block())),
         }
     }
     let blocks_start = parser.pos;
-    let mut errors = std::mem::take(&mut parser.errors);
+    errors.append(&mut parser.errors);
     drop(parser);
 
-    if body.end - blocks_start < parallel_threshold {
-        let (mut blocks, mut block_errors) = parse_blocks(text, blocks_start..body.end);
-        children.append(&mut blocks);
-        errors.append(&mut block_errors);
+    // The blocks, in parts that start at block boundaries. Each part also
+    // checks the length of the lines that start inside it.
+    let lines_from = header.unwrap_or(0);
+    let bounds = if end - blocks_start < parallel_threshold {
+        vec![blocks_start, end]
     } else {
+        split_at_blocks(text, blocks_start..end, rayon::current_num_threads() * 4)
+    };
+    let line_starts: Vec<usize> = bounds.iter().map(|&at| line_start_at_or_after(text, at, lines_from, end)).collect();
+    errors.extend(long_lines(text, lines_from..line_starts[0]));
+    let parse_part = |i: usize| {
+        let (blocks, mut part_errors) = parse_blocks(text, bounds[i]..bounds[i + 1]);
+        part_errors.extend(long_lines(text, line_starts[i]..line_starts[i + 1]));
+        (blocks, part_errors)
+    };
+    let parts: Vec<_> = if bounds.len() > 2 {
         use rayon::prelude::*;
-        let pieces = rayon::current_num_threads() * 4;
-        let mut bounds = vec![blocks_start];
-        for i in 1..pieces {
-            let target = blocks_start + (body.end - blocks_start) * i / pieces;
-            let at = next_block_start(text, target, body.end);
-            if at > *bounds.last().unwrap() && at < body.end {
-                bounds.push(at);
-            }
-        }
-        bounds.push(body.end);
-        let parts: Vec<_> = bounds.par_windows(2).map(|w| parse_blocks(text, w[0]..w[1])).collect();
-        children.reserve(parts.iter().map(|(blocks, _)| blocks.len()).sum());
-        for (mut blocks, mut block_errors) in parts {
-            children.append(&mut blocks);
-            errors.append(&mut block_errors);
+        (0..bounds.len() - 1).into_par_iter().map(parse_part).collect()
+    } else {
+        vec![parse_part(0)]
+    };
+
+    let mut back = None;
+    if end < text.len() {
+        let mut parser = Parser::new(text, end, text.len());
+        back = Some(NodeOrToken::Node(parser.end()));
+        errors.append(&mut parser.errors);
+    }
+    let mut block_parts = Vec::with_capacity(parts.len());
+    for (blocks, mut part_errors) in parts {
+        block_parts.push(blocks);
+        errors.append(&mut part_errors);
+    }
+    crate::error::sort_errors(&mut errors);
+
+    // The root takes its children straight from the parts: with millions of
+    // blocks, a concatenated copy would cost time and memory.
+    let len = front.len() + block_parts.iter().map(Vec::len).sum::<usize>() + usize::from(back.is_some());
+    let children = front.into_iter().chain(block_parts.into_iter().flatten()).chain(back);
+    (green::node(SOURCE_FILE, green::ExactLen::new(children, len)), errors)
+}
+
+/// Boundaries that split `region` (which starts at a block) into about
+/// `pieces` parts, each starting at a block.
+fn split_at_blocks(text: &str, region: Range<usize>, pieces: usize) -> Vec<usize> {
+    let mut bounds = vec![region.start];
+    for i in 1..pieces {
+        let target = region.start + (region.end - region.start) * i / pieces;
+        let at = next_block_start(text, target, region.end);
+        if at > *bounds.last().unwrap() && at < region.end {
+            bounds.push(at);
         }
     }
-    (children, errors)
+    bounds.push(region.end);
+    bounds
+}
+
+/// The first position at or after `at` where a line starts (`lines_from`
+/// counts as one), or `limit`.
+fn line_start_at_or_after(text: &str, at: usize, lines_from: usize, limit: usize) -> usize {
+    let bytes = text.as_bytes();
+    if at == lines_from || at >= limit || matches!(bytes[at - 1], b'\n' | b'\r') {
+        return at.min(limit);
+    }
+    match memchr::memchr2(b'\n', b'\r', &bytes[at..limit]) {
+        Some(i) if bytes[at + i] == b'\r' && bytes.get(at + i + 1) == Some(&b'\n') => (at + i + 2).min(limit),
+        Some(i) => at + i + 1,
+        None => limit,
+    }
 }
 
 /// Parses the blocks in `region`, which starts at a block's `N` and ends at
