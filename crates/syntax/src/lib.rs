@@ -10,13 +10,11 @@
 //! analysis.
 
 pub mod ast;
+mod cnc8x6;
 mod decimal;
 pub mod encoding;
 mod error;
 mod green;
-mod lexer;
-mod parser;
-mod reparse;
 mod syntax_kind;
 
 use std::sync::Arc;
@@ -25,9 +23,9 @@ use rowan::GreenNode;
 pub use rowan::{TextRange, TextSize};
 
 pub use crate::{
+    cnc8x6::MAX_LINE_CHARS,
     decimal::{Decimal, Sign},
     error::{Severity, SyntaxError, SyntaxErrorKind},
-    parser::MAX_LINE_CHARS,
     syntax_kind::{NcLanguage, SyntaxElement, SyntaxKind, SyntaxNode, SyntaxToken},
 };
 
@@ -76,7 +74,7 @@ impl Parse {
     pub fn new(text: &str, dialect: Dialect) -> Parse {
         match dialect {
             Dialect::Cnc8x6 => {
-                let (green, errors) = parser::parse_source_file(text);
+                let (green, errors) = cnc8x6::parse_source_file(text);
                 Parse { green, errors: errors.into(), dialect }
             }
         }
@@ -88,7 +86,7 @@ impl Parse {
     pub fn reparse(&self, edit: &TextEdit, new_text: &str) -> Parse {
         match self.dialect {
             Dialect::Cnc8x6 => {
-                reparse::reparse_blocks(self, edit, new_text).unwrap_or_else(|| Parse::new(new_text, self.dialect))
+                cnc8x6::reparse_blocks(self, edit, new_text).unwrap_or_else(|| Parse::new(new_text, self.dialect))
             }
         }
     }

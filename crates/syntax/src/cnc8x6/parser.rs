@@ -23,11 +23,11 @@ use std::ops::Range;
 
 use rowan::{GreenNode, NodeOrToken, TextRange, TextSize};
 
+use super::lexer::{self, Token};
 use crate::{
     SyntaxError, SyntaxErrorKind as E,
     SyntaxKind::{self, *},
     green::{self, GreenElement, GreenFactory},
-    lexer::{self, Token},
 };
 
 /// The control's limit on characters per line.

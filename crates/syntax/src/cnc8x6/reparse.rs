@@ -11,12 +11,11 @@
 
 use rowan::{NodeOrToken, TextRange, TextSize};
 
-use crate::{
-    Parse, SyntaxErrorKind, SyntaxKind, SyntaxNode, TextEdit,
-    error::sort_errors,
+use super::{
     lexer::TYPOGRAPHIC_QUOTES,
     parser::{self, is_block_letter},
 };
+use crate::{Parse, SyntaxErrorKind, SyntaxKind, SyntaxNode, TextEdit, error::sort_errors};
 
 pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Option<Parse> {
     let root = old.syntax_node();
