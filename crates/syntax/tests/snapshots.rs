@@ -36,6 +36,17 @@ fn parser_snapshots() {
     }
 }
 
+/// Every syntax diagnostic is shown by at least one fixture.
+#[test]
+fn fixtures_cover_every_syntax_error() {
+    let mut seen = std::collections::BTreeSet::new();
+    for (_, text) in fixtures() {
+        seen.extend(Parse::new(&text, Dialect::Cnc8x6).errors().iter().map(|e| e.kind));
+    }
+    let missing: Vec<_> = ncc_syntax::SyntaxErrorKind::ALL.iter().filter(|k| !seen.contains(k)).collect();
+    assert!(missing.is_empty(), "no fixture shows {missing:?}");
+}
+
 /// Deleting each character, and inserting a few interesting ones at each
 /// position, reparses to the same result as a full parse.
 #[test]

@@ -652,6 +652,13 @@ impl<'a> Parser<'a> {
 
     /// `R` and the parameter number: the `R10` of `FR10`.
     fn parameter_reference(&mut self) -> GreenElement {
+        let children =
+            self.parameter_letter_and_number("`R` must be followed by the parameter number (0 to 95), e.g. `XR1`");
+        NodeOrToken::Node(green::node(PARAM_REF, children))
+    }
+
+    /// `R`, spaces and the parameter number, or `R` and an error.
+    fn parameter_letter_and_number(&mut self, missing: &str) -> Vec<GreenElement> {
         let start = self.pos;
         let mut children = vec![self.address_letter()];
         let number_at = self.skip_whitespace(self.pos);
@@ -661,13 +668,9 @@ impl<'a> Parser<'a> {
             }
             children.push(self.number());
         } else {
-            self.error(
-                E::MissingParameterNumber,
-                start..start + 1,
-                "`R` must be followed by the parameter number (0 to 95), e.g. `XR1`",
-            );
+            self.error(E::MissingParameterNumber, start..start + 1, missing);
         }
-        NodeOrToken::Node(green::node(PARAM_REF, children))
+        children
     }
 
     /// `R`, optional number, optional spaces, `=`.
@@ -685,19 +688,7 @@ impl<'a> Parser<'a> {
     /// `R12=-0.864`, spaces allowed around `=`.
     fn parameter_assignment(&mut self) -> GreenElement {
         let start = self.pos;
-        let mut children = vec![self.address_letter()];
-        while self.kind_at(self.pos) == Some(WHITESPACE) {
-            children.push(self.bump());
-        }
-        if self.kind_at(self.pos) == Some(NUMBER) {
-            children.push(self.number());
-        } else {
-            self.error(
-                E::MissingParameterNumber,
-                start..start + 1,
-                "parameter number missing: assignments read `R12=5.`",
-            );
-        }
+        let mut children = self.parameter_letter_and_number("parameter number missing: assignments read `R12=5.`");
         while self.kind_at(self.pos) == Some(WHITESPACE) {
             children.push(self.bump());
         }
