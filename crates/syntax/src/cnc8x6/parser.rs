@@ -203,27 +203,33 @@ fn is_parameter_letter(byte: u8) -> bool {
 }
 
 /// The first `needle` byte at or after `from` that is not inside a comment.
+///
+/// Each candidate is checked by lexing its line from the start (comments
+/// never span lines) or from the end of the comment that hid the previous
+/// candidate, so no byte is lexed twice however many candidates there are.
 pub(crate) fn find_outside_comments(text: &str, from: usize, needle: u8) -> Option<usize> {
     let bytes = text.as_bytes();
-    for candidate in memchr::memchr_iter(needle, &bytes[from..]).map(|i| from + i) {
-        let line_start = memchr::memrchr2(b'\n', b'\r', &bytes[from..candidate]).map_or(from, |i| from + i + 1);
-        let mut pos = line_start;
+    let mut pos = from;
+    while let Some(i) = memchr::memchr(needle, &bytes[pos..]) {
+        let candidate = pos + i;
+        let mut at = memchr::memrchr2(b'\n', b'\r', &bytes[pos..candidate]).map_or(pos, |i| pos + i + 1);
         loop {
-            let token = lexer::token_at(text, pos);
-            if pos + token.len > candidate {
+            let token = lexer::token_at(text, at);
+            if at + token.len > candidate {
                 if token.kind != COMMENT {
                     return Some(candidate);
                 }
+                pos = at + token.len;
                 break;
             }
-            pos += token.len;
+            at += token.len;
         }
     }
     None
 }
 
-/// `line-too-long` for every line that starts or ends inside `region`,
-/// counting characters of the region only.
+/// `line-too-long` for the lines of `region`, whose start counts as a line
+/// start and whose end as a line end.
 pub(crate) fn long_lines(text: &str, region: Range<usize>) -> Vec<SyntaxError> {
     let bytes = &text.as_bytes()[..region.end];
     let mut errors = Vec::new();
@@ -741,6 +747,14 @@ impl<'a> Parser<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn many_hidden_markers_are_skipped_in_one_pass() {
+        // A quadratic search would not finish on this.
+        let text = format!("\"{}\"%1\nN1 \"{}\n*", "%".repeat(1 << 20), "*".repeat(1 << 20));
+        assert_eq!(find_outside_comments(&text, 0, b'%'), Some((1 << 20) + 2));
+        assert_eq!(find_outside_comments(&text, 0, b'*'), Some(text.len() - 1));
+    }
 
     #[test]
     fn parallel_parse_equals_sequential_parse() {
