@@ -5,7 +5,7 @@ use libfuzzer_sys::fuzz_target;
 use ncc_syntax::{Dialect, Parse, encoding};
 
 fuzz_target!(|data: &[u8]| {
-    let (text, encoding) = encoding::decode(data);
+    let (text, encoding) = encoding::decode(data.to_vec());
     assert_eq!(encoding::encode(&text, encoding), data);
     let parse = Parse::new(&text, Dialect::Cnc8x6);
     assert_eq!(parse.syntax_node().to_string(), text);

@@ -25,7 +25,7 @@ pub(crate) enum Format {
 /// Reads a program file; bytes that are not UTF-8 are read as Kamenický, so
 /// every file can be read (see `ncc_syntax::encoding`).
 pub(crate) fn read_program(path: &Path) -> io::Result<String> {
-    Ok(encoding::decode(&std::fs::read(path)?).0)
+    Ok(encoding::decode(std::fs::read(path)?).0)
 }
 
 struct CheckedFile {

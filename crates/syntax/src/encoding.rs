@@ -14,11 +14,11 @@ pub enum Encoding {
     Kamenicky,
 }
 
-/// Decodes a program file. Never fails.
-pub fn decode(bytes: &[u8]) -> (String, Encoding) {
-    match std::str::from_utf8(bytes) {
-        Ok(text) => (text.to_owned(), Encoding::Utf8),
-        Err(_) => (bytes.iter().map(|&b| kamenicky_char(b)).collect(), Encoding::Kamenicky),
+/// Decodes a program file. Never fails; UTF-8 input is not copied.
+pub fn decode(bytes: Vec<u8>) -> (String, Encoding) {
+    match String::from_utf8(bytes) {
+        Ok(text) => (text, Encoding::Utf8),
+        Err(error) => (error.into_bytes().into_iter().map(kamenicky_char).collect(), Encoding::Kamenicky),
     }
 }
 
@@ -76,7 +76,7 @@ mod tests {
     #[test]
     fn every_byte_sequence_round_trips() {
         let bytes: Vec<u8> = (0..=255u8).chain([0xFF, 0x80, b'N']).collect();
-        let (text, encoding) = decode(&bytes);
+        let (text, encoding) = decode(bytes.clone());
         assert_eq!(encoding, Encoding::Kamenicky);
         assert_eq!(encode(&text, encoding), bytes);
     }
@@ -84,9 +84,9 @@ mod tests {
     #[test]
     fn czech_comment_from_the_control() {
         // "ŘEZÁNÍ" in Kamenický.
-        let (text, encoding) = decode(b"N10 \"\x9EEZ\x8FN\x8B\"");
+        let (text, encoding) = decode(b"N10 \"\x9EEZ\x8FN\x8B\"".to_vec());
         assert_eq!((text.as_str(), encoding), ("N10 \"ŘEZÁNÍ\"", Encoding::Kamenicky));
-        let (text, encoding) = decode("N10 \"ŘEZÁNÍ\"".as_bytes());
+        let (text, encoding) = decode("N10 \"ŘEZÁNÍ\"".into());
         assert_eq!((text.as_str(), encoding), ("N10 \"ŘEZÁNÍ\"", Encoding::Utf8));
     }
 }
