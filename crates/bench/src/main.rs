@@ -71,6 +71,14 @@ enum Command {
         #[arg(long, default_value_t = 3)]
         runs: usize,
     },
+    /// Time incremental reparses after single-character edits at random
+    /// places of a generated program, against a full parse.
+    Reparse {
+        #[arg(long, default_value_t = 100_000)]
+        blocks: usize,
+        #[arg(long, default_value_t = 200)]
+        edits: usize,
+    },
     /// Parse a file once (for profilers such as perf or callgrind).
     ParseFile {
         path: PathBuf,
@@ -101,6 +109,7 @@ enum SyntaxArg {
 fn main() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::Parse { blocks, runs } => parse_benchmark(blocks, runs.max(1)),
+        Command::Reparse { blocks, edits } => reparse_benchmark(blocks, edits),
         Command::ParseFile { path, threads, gcode } => {
             let text = std::fs::read_to_string(&path)?;
             let start = Instant::now();
@@ -197,5 +206,40 @@ fn parse_benchmark(blocks: usize, runs: usize) -> anyhow::Result<()> {
         ncc_one.peak_bytes as f64 / gcode_rs.peak_bytes as f64,
         ncc_all.peak_bytes as f64 / gcode_rs.peak_bytes as f64
     );
+    Ok(())
+}
+
+fn reparse_benchmark(blocks: usize, edits: usize) -> anyhow::Result<()> {
+    use ncc_syntax::{TextEdit, TextRange, TextSize};
+
+    let mut text = progen::write(&progen::surfacing(blocks), Syntax::Cnc8x6);
+    let start = Instant::now();
+    let mut parse = Parse::new(&text, Dialect::Cnc8x6);
+    let full = start.elapsed();
+
+    // A fixed linear congruential sequence: the same edits on every run.
+    let mut seed = 0x2545_F491_4F6C_DD1Du64;
+    let mut next = move |bound: usize| {
+        seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        (seed >> 33) as usize % bound
+    };
+    let mut times = Vec::with_capacity(edits);
+    for _ in 0..edits {
+        let at = (0..=next(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap_or(0);
+        let insert = ["1", " ", "X", "\n", "-", "."][next(6)];
+        let delete = if next(2) == 0 && at < text.len() && text.is_char_boundary(at + 1) { 1 } else { 0 };
+        let edit = TextEdit::replace(TextRange::at(TextSize::from(at as u32), TextSize::from(delete)), insert);
+        edit.apply(&mut text);
+        let start = Instant::now();
+        parse = parse.reparse(&edit, &text);
+        times.push(start.elapsed());
+    }
+    anyhow::ensure!(parse == Parse::new(&text, Dialect::Cnc8x6), "incremental result differs from a full parse");
+    times.sort();
+    let percentile = |p: f64| times[((times.len() - 1) as f64 * p) as usize];
+    println!("reparse benchmark: {blocks} blocks ({:.1} MB), {edits} single-character edits", text.len() as f64 / 1e6);
+    println!("  full parse   {:>9.3} ms", full.as_secs_f64() * 1e3);
+    println!("  reparse p50  {:>9.3} ms", percentile(0.5).as_secs_f64() * 1e3);
+    println!("  reparse p99  {:>9.3} ms", percentile(0.99).as_secs_f64() * 1e3);
     Ok(())
 }

@@ -26,13 +26,13 @@ pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Op
     // `%` decides the preamble and `*` the physical end: both are global, and
     // a quote or a line break can hide or reveal one on its line.
     let global = |c: char| c == '%' || c == '*';
-    let deleted = root.text().slice(edit.delete);
-    if edit.insert.contains(global) || deleted.contains_char('%') || deleted.contains_char('*') {
+    let deleted = deleted_text(&root, edit.delete);
+    if edit.insert.contains(global) || deleted.contains(global) {
         return None;
     }
-    let comment_delimiters = TYPOGRAPHIC_QUOTES.iter().map(|q| q.chars().next().unwrap()).chain(['"', '\n', '\r']);
-    let comments_changed = comment_delimiters.clone().any(|c| edit.insert.contains(c) || deleted.contains_char(c));
-    if comments_changed {
+    let comment_delimiter =
+        |c: char| matches!(c, '"' | '\n' | '\r') || TYPOGRAPHIC_QUOTES.iter().any(|q| q.starts_with(c));
+    if edit.insert.contains(comment_delimiter) || deleted.contains(comment_delimiter) {
         let start = usize::from(edit.delete.start());
         let lines = line_start(new_text, start)..line_end(new_text, start + edit.insert.len(), new_text.len());
         if new_text[lines].contains(global) {
@@ -105,6 +105,21 @@ pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Op
     Some(Parse { green, errors: errors.into(), dialect: old.dialect })
 }
 
+/// The text of `range`, read from the smallest element that covers it
+/// (walking the whole tree's text would make every edit cost a full pass).
+fn deleted_text(root: &SyntaxNode, range: TextRange) -> String {
+    if range.is_empty() {
+        return String::new();
+    }
+    let covering = root.covering_element(range);
+    let start = usize::from(range.start() - covering.text_range().start());
+    let text = match covering {
+        NodeOrToken::Node(node) => node.to_string(),
+        NodeOrToken::Token(token) => token.text().to_owned(),
+    };
+    text[start..start + usize::from(range.len())].to_owned()
+}
+
 /// Where the blocks are among the children of the root.
 struct Layout {
     /// Start of the first block that begins with its `N`.
@@ -121,7 +136,7 @@ impl Layout {
     fn of(root: &SyntaxNode) -> Layout {
         let (body_end, end_index) = match root.last_child() {
             Some(end) if end.kind() == SyntaxKind::END => (end.text_range().start(), end.index()),
-            _ => (root.text_range().end(), root.children_with_tokens().count()),
+            _ => (root.text_range().end(), root.green().children().len()),
         };
         let mut first_block = None;
         let mut lines_from = 0;
