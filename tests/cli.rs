@@ -156,3 +156,37 @@ fn checks_a_35_megabyte_program() {
     assert_eq!(json[0]["line"].as_u64(), Some(last_lines as u64));
     assert_eq!(json[0]["code"], "S003");
 }
+
+#[test]
+fn explain_prints_the_catalogue_text() {
+    let output = ncc(&["explain", "G40"]);
+    assert_eq!(output.status.code(), Some(0));
+    let text = stdout(&output);
+    assert!(text.starts_with("### G40 — "), "{text}");
+    assert!(text.contains("Group: G3"), "{text}");
+
+    let text = stdout(&ncc(&["explain", "R39"]));
+    assert!(text.starts_with("### R39 — machine constant"), "{text}");
+    assert!(text.contains("### R39 — program parameter"), "{text}");
+    assert!(stdout(&ncc(&["explain", "op:48"])).starts_with("### Operation 48 — "));
+    assert!(stdout(&ncc(&["explain", "x"])).starts_with("### X — "));
+}
+
+#[test]
+fn explain_suggests_for_unknown_input() {
+    let output = ncc(&["explain", "G99"]);
+    assert_eq!(output.status.code(), Some(1));
+    let error = String::from_utf8_lossy(&output.stderr);
+    assert!(error.contains("`G99` is not a code"), "{error}");
+    assert!(error.contains("did you mean G09"), "{error}");
+}
+
+#[test]
+fn explain_list_prints_the_counts() {
+    let text = stdout(&ncc(&["explain", "--list"]));
+    for heading in
+        ["groups (26)", "G codes (70)", "M codes (29)", "addresses (29)", "program parameters (96)", "operations (52)"]
+    {
+        assert!(text.contains(heading), "{heading} missing from\n{text}");
+    }
+}

@@ -1,6 +1,7 @@
 //! `ncc`: the command line of the CNC partprogram toolchain.
 
 mod check;
+mod explain;
 
 use std::{path::PathBuf, process::ExitCode};
 
@@ -31,6 +32,19 @@ enum Command {
         #[arg(long, value_enum, default_value_t = check::Format::Human)]
         format: check::Format,
     },
+    /// Explain a code, address, parameter, machine constant or operation.
+    ///
+    /// Examples: `G40`, `M30`, `X`, `&`, `R5` (program parameter), `R39`
+    /// (machine constant 39, then parameter 39), `mc:39`, `param:39`,
+    /// `op:48` (parameter-arithmetic operation), `group:G3`.
+    Explain {
+        /// What to explain.
+        #[arg(required_unless_present = "list")]
+        query: Option<String>,
+        /// List everything the catalogue knows, with counts.
+        #[arg(long, conflicts_with = "query")]
+        list: bool,
+    },
     /// Print the syntax tree of a partprogram (a debugging aid).
     Parse {
         /// The program to parse.
@@ -41,6 +55,7 @@ enum Command {
 fn main() -> ExitCode {
     match Cli::parse().command {
         Command::Check { paths, format } => check::run(&paths, format),
+        Command::Explain { query, list } => explain::run(query.as_deref(), list),
         Command::Parse { file } => match check::read_program(&file) {
             Ok(text) => {
                 let parse = ncc_syntax::Parse::new(&text, ncc_syntax::Dialect::Cnc8x6);

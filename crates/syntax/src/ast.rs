@@ -148,7 +148,7 @@ pub enum BlockItem {
 impl Block {
     /// The block number word, `None` for words written before any `N`.
     pub fn number(&self) -> Option<Word> {
-        self.words().next().filter(|w| w.letter() == 'N')
+        self.words().next().filter(Word::is_block_number)
     }
 
     pub fn items(&self) -> impl Iterator<Item = BlockItem> + use<> {
@@ -183,7 +183,7 @@ impl Block {
     /// Whether the block holds nothing but its number (and trivia).
     pub fn is_empty(&self) -> bool {
         self.items().all(|item| match item {
-            BlockItem::Word(word) => word.letter() == 'N',
+            BlockItem::Word(word) => word.is_block_number(),
             BlockItem::Comment(_) => true,
             _ => false,
         })
@@ -223,6 +223,11 @@ fn value_of(node: &SyntaxNode) -> Option<Value> {
 impl Word {
     pub fn address_token(&self) -> SyntaxToken {
         self.0.first_token().expect("a word starts with its address")
+    }
+
+    /// Whether the address is the block-number letter (`N`).
+    pub fn is_block_number(&self) -> bool {
+        crate::cnc8x6::is_block_letter(self.address_token().text().as_bytes()[0])
     }
 
     /// The address, upper-cased (`&` for length compensation).

@@ -22,23 +22,14 @@ use std::sync::Arc;
 use rowan::GreenNode;
 pub use rowan::{TextRange, TextSize};
 
+pub use ncc_catalog::Dialect;
+
 pub use crate::{
     cnc8x6::MAX_LINE_CHARS,
     decimal::{Decimal, Sign},
     error::{Severity, SyntaxError, SyntaxErrorKind},
     syntax_kind::{NcLanguage, SyntaxElement, SyntaxKind, SyntaxNode, SyntaxToken},
 };
-
-/// The programming language of a control.
-///
-/// Each dialect has its own lexer and parser over the shared [`SyntaxKind`]s.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-#[non_exhaustive]
-pub enum Dialect {
-    /// MEFI CNC836 / CNC846 / CNC856.
-    #[default]
-    Cnc8x6,
-}
 
 /// A replacement of `delete` (a range of the old text) by `insert`.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]

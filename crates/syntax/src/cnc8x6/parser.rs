@@ -23,7 +23,10 @@ use std::ops::Range;
 
 use rowan::{GreenNode, NodeOrToken, TextRange, TextSize};
 
-use super::lexer::{self, Token};
+use super::{
+    is_block_letter, is_parameter_letter,
+    lexer::{self, Token},
+};
 use crate::{
     SyntaxError, SyntaxErrorKind as E,
     SyntaxKind::{self, *},
@@ -192,14 +195,6 @@ fn next_block_start(text: &str, from: usize, limit: usize) -> usize {
         pos += token.len;
     }
     limit
-}
-
-pub(crate) fn is_block_letter(byte: u8) -> bool {
-    byte == b'N' || byte == b'n'
-}
-
-fn is_parameter_letter(byte: u8) -> bool {
-    byte == b'R' || byte == b'r'
 }
 
 /// The first `needle` byte at or after `from` that is not inside a comment.
@@ -485,14 +480,14 @@ impl<'a> Parser<'a> {
         let bytes = &self.text.as_bytes()[..self.end];
         let start = self.pos;
         let digits = bytes[start + 1..].iter().take_while(|b| b.is_ascii_digit()).count();
-        let plain = bytes[start] == b'N' && digits > 0 && bytes.get(start + 1 + digits) != Some(&b'.');
+        let plain = bytes[start].is_ascii_uppercase() && digits > 0 && bytes.get(start + 1 + digits) != Some(&b'.');
         if !plain {
             return self.word();
         }
         self.pos = start + 1 + digits;
         self.last_number = Some(start + 1..self.pos);
         let number = self.green.token(NUMBER, &self.text[start + 1..self.pos]);
-        NodeOrToken::Node(green::node(WORD, [self.green.letter(b'N'), number]))
+        NodeOrToken::Node(green::node(WORD, [self.green.letter(bytes[start]), number]))
     }
 
     /// Length of a run of three or more letters none of which has a value,
@@ -561,7 +556,7 @@ impl<'a> Parser<'a> {
         let bytes = &self.text.as_bytes()[..self.end];
         let start = self.pos;
         let letter = bytes[start];
-        if !letter.is_ascii_uppercase() || letter == b'N' || letter == b'R' {
+        if !letter.is_ascii_uppercase() || is_block_letter(letter) || is_parameter_letter(letter) {
             return None;
         }
         let sign_len = usize::from(matches!(bytes.get(start + 1), Some(b'-' | b'+')));

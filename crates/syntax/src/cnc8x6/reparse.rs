@@ -11,10 +11,7 @@
 
 use rowan::{NodeOrToken, TextRange, TextSize};
 
-use super::{
-    lexer::TYPOGRAPHIC_QUOTES,
-    parser::{self, is_block_letter},
-};
+use super::{is_block_letter, lexer::TYPOGRAPHIC_QUOTES, parser};
 use crate::{Parse, SyntaxErrorKind, SyntaxKind, SyntaxNode, TextEdit, error::sort_errors};
 
 pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Option<Parse> {

@@ -1,0 +1,130 @@
+//! Looking entries up by what a programmer types: `G40`, `M30`, `R39`,
+//! `op:48`, `X`, `group:G3`.
+
+use crate::{Address, Catalogue, Code, Cycle, Group, MachineConstant, Operation, ParameterStatus};
+
+/// One thing the catalogue can describe.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Item<'a> {
+    Group(&'a Group),
+    Code(&'a Code),
+    /// An M code the catalogue does not list, which belongs to an open group
+    /// (the machine builder defines it).
+    UnlistedCode {
+        letter: char,
+        number: u32,
+        group: &'a Group,
+    },
+    Address(&'a Address),
+    /// Program parameter `R<number>`.
+    Parameter(u32),
+    /// Machine constant `number` (the entry may describe a run of constants).
+    MachineConstant {
+        number: u32,
+        constant: &'a MachineConstant,
+    },
+    Operation(&'a Operation),
+    Cycle(&'a Cycle),
+}
+
+/// A query that matches nothing, with the closest entries.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct NotFound {
+    pub query: String,
+    pub suggestions: Vec<String>,
+}
+
+impl Catalogue {
+    /// Everything `query` can name. `R39` names both machine constant 39
+    /// and program parameter 39: the parameter comes first when it has a
+    /// special role (`R5`), else the machine constant. Prefixes pick one
+    /// kind: `mc:39`, `param:39`, `op:48`, `group:G3`.
+    pub fn explain(&self, query: &str) -> Result<Vec<Item<'_>>, NotFound> {
+        let items = self.lookup(query.trim());
+        if items.is_empty() {
+            Err(NotFound { query: query.trim().to_owned(), suggestions: self.suggestions(query.trim()) })
+        } else {
+            Ok(items)
+        }
+    }
+
+    fn lookup(&self, query: &str) -> Vec<Item<'_>> {
+        let upper = query.to_ascii_uppercase();
+        let number_after = |prefix: &str| -> Option<u32> {
+            let rest = upper.strip_prefix(prefix)?.trim_start_matches(':').trim();
+            (!rest.is_empty() && rest.bytes().all(|b| b.is_ascii_digit())).then(|| rest.parse().ok()).flatten()
+        };
+        if let Some(code) = number_after("OP") {
+            return self.operation(code).map(Item::Operation).into_iter().collect();
+        }
+        if let Some(number) = number_after("MC") {
+            return self.machine_constant_item(number).into_iter().collect();
+        }
+        if let Some(number) = number_after("PARAM") {
+            return self.is_parameter(number).then_some(Item::Parameter(number)).into_iter().collect();
+        }
+        if let Some(id) = upper.strip_prefix("GROUP:") {
+            return self.group(id.trim()).map(Item::Group).into_iter().collect();
+        }
+        if let Some(address) = self.address(&upper) {
+            return vec![Item::Address(address)];
+        }
+        let Some((letter, number)) = crate::split_code(&upper) else { return Vec::new() };
+        match letter {
+            'R' => {
+                let constant = self.machine_constant_item(number);
+                let parameter = self.is_parameter(number).then_some(Item::Parameter(number));
+                // A parameter with a role of its own (R5, R95) is what a
+                // programmer most likely means; otherwise the machine
+                // constant (R39) is the one with something to say.
+                let special = self.parameter_ranges_of(number).any(|r| r.status != ParameterStatus::Ordinary);
+                if special {
+                    parameter.into_iter().chain(constant).collect()
+                } else {
+                    constant.into_iter().chain(parameter).collect()
+                }
+            }
+            'G' | 'M' => {
+                let mut items = Vec::new();
+                match self.code(letter, number) {
+                    Some(code) => items.push(Item::Code(code)),
+                    None => {
+                        if let Some(group) = self.group_of(letter, number) {
+                            items.push(Item::UnlistedCode { letter, number, group });
+                        }
+                    }
+                }
+                let name = format!("{letter}{number:02}");
+                items.extend(self.cycles_for(&name).map(Item::Cycle));
+                items
+            }
+            // `X10`, `F200`: the address.
+            _ => self.address(&letter.to_string()).map(Item::Address).into_iter().collect(),
+        }
+    }
+
+    fn machine_constant_item(&self, number: u32) -> Option<Item<'_>> {
+        self.machine_constant(number).map(|constant| Item::MachineConstant { number, constant })
+    }
+
+    /// Up to three names close to `query`, for "did you mean".
+    fn suggestions(&self, query: &str) -> Vec<String> {
+        let query = query.to_ascii_uppercase();
+        let mut names: Vec<String> = Vec::new();
+        names.extend(self.codes.iter().map(|c| c.code.clone()));
+        names.extend(self.groups.iter().map(|g| format!("group:{}", g.id)));
+        names.extend(self.addresses.iter().map(|a| a.letter.clone()));
+        names.extend((0..self.parameters.count).map(|n| format!("R{n}")));
+        names.extend(self.machine_constants.iter().map(|c| format!("R{}", c.number)));
+        names.extend(self.operations.iter().map(|op| format!("op:{}", op.code)));
+        names.sort();
+        names.dedup();
+        let mut scored: Vec<(f64, String)> = names
+            .into_iter()
+            .map(|name| (strsim::normalized_damerau_levenshtein(&query, &name.to_ascii_uppercase()), name))
+            .filter(|(score, _)| *score >= 0.5)
+            .collect();
+        scored.sort_by(|a, b| b.0.total_cmp(&a.0).then_with(|| a.1.cmp(&b.1)));
+        scored.into_iter().take(3).map(|(_, name)| name).collect()
+    }
+}

@@ -1,0 +1,290 @@
+//! The language catalogue: every code, address, parameter, machine constant,
+//! arithmetic operation and fixed cycle of a dialect, described once, as data.
+//!
+//! The parser reads the address table (which letter starts a block, which
+//! one is the parameter letter), and the checker, hover, completion, the
+//! executor and `ncc explain` read the rest. The data lives in TOML files
+//! under `data/<dialect>/`, compiled into the binary and parsed once on first
+//! use; tests validate them against the manual's tables.
+
+mod explain;
+mod render;
+pub mod schema;
+
+use std::{collections::HashMap, sync::OnceLock};
+
+pub use crate::{
+    explain::{Item, NotFound},
+    schema::*,
+};
+
+/// The programming language of a control. Matches on it are exhaustive on
+/// purpose: adding a dialect makes the compiler list every place to extend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Dialect {
+    /// MEFI CNC836 / CNC846 / CNC856.
+    #[default]
+    Cnc8x6,
+}
+
+impl Dialect {
+    /// The catalogue of this dialect.
+    pub fn catalogue(self) -> &'static Catalogue {
+        match self {
+            Dialect::Cnc8x6 => {
+                static CNC8X6: OnceLock<Catalogue> = OnceLock::new();
+                CNC8X6.get_or_init(|| Catalogue::load(&CNC8X6_FILES))
+            }
+        }
+    }
+}
+
+/// The data files of one dialect, by name and content.
+struct DataFiles {
+    codes: (&'static str, &'static str),
+    addresses: (&'static str, &'static str),
+    parameters: (&'static str, &'static str),
+    machine_constants: (&'static str, &'static str),
+    operations: (&'static str, &'static str),
+    cycles: (&'static str, &'static str),
+}
+
+macro_rules! data_file {
+    ($dialect:literal, $name:literal) => {
+        ($name, include_str!(concat!("../data/", $dialect, "/", $name)))
+    };
+}
+
+static CNC8X6_FILES: DataFiles = DataFiles {
+    codes: data_file!("cnc8x6", "codes.toml"),
+    addresses: data_file!("cnc8x6", "addresses.toml"),
+    parameters: data_file!("cnc8x6", "parameters.toml"),
+    machine_constants: data_file!("cnc8x6", "machine_constants.toml"),
+    operations: data_file!("cnc8x6", "operations.toml"),
+    cycles: data_file!("cnc8x6", "cycles.toml"),
+};
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CodesFile {
+    #[serde(rename = "group")]
+    groups: Vec<Group>,
+    #[serde(rename = "code")]
+    codes: Vec<Code>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AddressesFile {
+    #[serde(rename = "address")]
+    addresses: Vec<Address>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ParametersFile {
+    parameters: ParameterOverview,
+    #[serde(rename = "range")]
+    ranges: Vec<ParameterRange>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MachineConstantsFile {
+    #[serde(rename = "constant")]
+    constants: Vec<MachineConstant>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OperationsFile {
+    #[serde(rename = "operation")]
+    operations: Vec<Operation>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CyclesFile {
+    #[serde(rename = "cycle")]
+    cycles: Vec<Cycle>,
+}
+
+fn parse<T: serde::de::DeserializeOwned>((name, text): (&str, &str)) -> T {
+    // The files are part of the program and checked by the tests; a broken
+    // one is a build defect, never a user error.
+    toml::from_str(text).unwrap_or_else(|error| panic!("catalogue file {name}: {error}"))
+}
+
+/// Everything known about a dialect's language.
+#[derive(Debug)]
+pub struct Catalogue {
+    pub groups: Vec<Group>,
+    pub codes: Vec<Code>,
+    pub addresses: Vec<Address>,
+    pub parameters: ParameterOverview,
+    pub parameter_ranges: Vec<ParameterRange>,
+    pub machine_constants: Vec<MachineConstant>,
+    pub operations: Vec<Operation>,
+    pub cycles: Vec<Cycle>,
+    codes_by_number: HashMap<(char, u32), usize>,
+    roles: [Option<AddressRole>; 128],
+}
+
+impl Catalogue {
+    fn load(files: &DataFiles) -> Catalogue {
+        let codes: CodesFile = parse(files.codes);
+        let addresses: AddressesFile = parse(files.addresses);
+        let parameters: ParametersFile = parse(files.parameters);
+        let constants: MachineConstantsFile = parse(files.machine_constants);
+        let operations: OperationsFile = parse(files.operations);
+        let cycles: CyclesFile = parse(files.cycles);
+
+        let codes_by_number =
+            codes.codes.iter().enumerate().filter_map(|(i, code)| Some((split_code(&code.code)?, i))).collect();
+        let mut roles = [None; 128];
+        for address in &addresses.addresses {
+            for byte in address.letter.bytes().filter(u8::is_ascii) {
+                roles[usize::from(byte.to_ascii_uppercase())] = Some(address.role);
+                roles[usize::from(byte.to_ascii_lowercase())] = Some(address.role);
+            }
+        }
+        Catalogue {
+            groups: codes.groups,
+            codes: codes.codes,
+            addresses: addresses.addresses,
+            parameters: parameters.parameters,
+            parameter_ranges: parameters.ranges,
+            machine_constants: constants.constants,
+            operations: operations.operations,
+            cycles: cycles.cycles,
+            codes_by_number,
+            roles,
+        }
+    }
+
+    /// The code `letter` + `number` (`'G', 1` is G01), if the catalogue lists it.
+    pub fn code(&self, letter: char, number: u32) -> Option<&Code> {
+        self.codes_by_number.get(&(letter.to_ascii_uppercase(), number)).map(|&i| &self.codes[i])
+    }
+
+    pub fn group(&self, id: &str) -> Option<&Group> {
+        self.groups.iter().find(|g| g.id.eq_ignore_ascii_case(id))
+    }
+
+    /// The group of a code: its listed group, or the open group (M14) that
+    /// takes every unlisted M code.
+    pub fn group_of(&self, letter: char, number: u32) -> Option<&Group> {
+        match self.code(letter, number) {
+            Some(code) => self.group(code.group.as_deref()?),
+            None if letter.eq_ignore_ascii_case(&'M') && (10..=99).contains(&number) => {
+                self.groups.iter().rev().find(|g| g.open && g.id.starts_with('M'))
+            }
+            None => None,
+        }
+    }
+
+    /// The codes of a group, in catalogue order.
+    pub fn codes_in<'a>(&'a self, group: &'a str) -> impl Iterator<Item = &'a Code> + 'a {
+        self.codes.iter().filter(move |c| c.group.as_deref() == Some(group))
+    }
+
+    pub fn address(&self, letter: &str) -> Option<&Address> {
+        self.addresses.iter().find(|a| a.letter.eq_ignore_ascii_case(letter))
+    }
+
+    /// The role of an address byte, case-insensitively; a table lookup, for
+    /// the parser's hot loop.
+    pub fn role_of(&self, byte: u8) -> Option<AddressRole> {
+        self.roles.get(usize::from(byte)).copied().flatten()
+    }
+
+    /// The (upper-case) letter that has `role`, e.g. `N` for block numbers.
+    pub fn letter_with_role(&self, role: AddressRole) -> Option<u8> {
+        self.addresses.iter().find(|a| a.role == role).map(|a| a.letter.as_bytes()[0])
+    }
+
+    /// The machine constant `number` (an entry may describe a run of them).
+    pub fn machine_constant(&self, number: u32) -> Option<&MachineConstant> {
+        self.machine_constants.iter().find(|c| (c.number..=c.last.unwrap_or(c.number)).contains(&number))
+    }
+
+    /// Whether `number` is a program parameter (`R0`–`R95`).
+    pub fn is_parameter(&self, number: u32) -> bool {
+        number < self.parameters.count
+    }
+
+    /// The ranges with a special role that contain parameter `number`.
+    pub fn parameter_ranges_of(&self, number: u32) -> impl Iterator<Item = &ParameterRange> {
+        self.parameter_ranges.iter().filter(move |r| (r.first..=r.last).contains(&number))
+    }
+
+    pub fn operation(&self, code: u32) -> Option<&Operation> {
+        self.operations.iter().find(|op| op.code == code)
+    }
+
+    /// The fixed cycles with this code (one per flavour).
+    pub fn cycles_for(&self, code: &str) -> impl Iterator<Item = &Cycle> + use<'_> {
+        let code = code.to_ascii_uppercase();
+        self.cycles.iter().filter(move |c| c.code.eq_ignore_ascii_case(&code))
+    }
+}
+
+/// `"G01"` → `('G', 1)`.
+pub fn split_code(code: &str) -> Option<(char, u32)> {
+    let mut chars = code.chars();
+    let letter = chars.next()?.to_ascii_uppercase();
+    let digits = chars.as_str();
+    if !letter.is_ascii_alphabetic() || digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    Some((letter, digits.parse().ok()?))
+}
+
+#[cfg(test)]
+mod data_files {
+    //! One test per data file, so that each file can be checked on its own.
+
+    use super::*;
+
+    fn read(name: &str) -> (&'static str, &'static str) {
+        let path = format!("{}/data/cnc8x6/{name}", env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+        (Box::leak(name.to_owned().into_boxed_str()), Box::leak(text.into_boxed_str()))
+    }
+
+    #[test]
+    fn codes() {
+        let file: CodesFile = parse(read("codes.toml"));
+        assert!(!file.codes.is_empty() && !file.groups.is_empty());
+    }
+
+    #[test]
+    fn addresses() {
+        let file: AddressesFile = parse(read("addresses.toml"));
+        assert!(!file.addresses.is_empty());
+    }
+
+    #[test]
+    fn parameters() {
+        let file: ParametersFile = parse(read("parameters.toml"));
+        assert_eq!(file.parameters.count, 96);
+    }
+
+    #[test]
+    fn machine_constants() {
+        let file: MachineConstantsFile = parse(read("machine_constants.toml"));
+        assert!(!file.constants.is_empty());
+    }
+
+    #[test]
+    fn operations() {
+        let file: OperationsFile = parse(read("operations.toml"));
+        assert_eq!(file.operations.len(), 52);
+    }
+
+    #[test]
+    fn cycles() {
+        let file: CyclesFile = parse(read("cycles.toml"));
+        assert!(!file.cycles.is_empty());
+    }
+}

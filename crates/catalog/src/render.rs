@@ -1,0 +1,275 @@
+//! Hover and `ncc explain` text: Markdown rendered from the entries.
+//!
+//! The same text serves the terminal and the editor, so it is plain
+//! Markdown that reads well unrendered.
+
+use std::fmt::Write;
+
+use crate::{AddressRole, Catalogue, Dimensional, Documented, Flavour, Item, Modality, ParameterStatus, schema::Doc};
+
+impl Item<'_> {
+    /// A one-line heading: `G41 — Radius compensation left`.
+    pub fn heading(&self, catalogue: &Catalogue) -> String {
+        match *self {
+            Item::Group(group) => format!("Group {} — {}", group.id, group.title),
+            Item::Code(code) => format!("{} — {}", code.code, code.title),
+            Item::UnlistedCode { letter, number, group } => {
+                format!("{letter}{number:02} — machine-defined function (group {})", group.id)
+            }
+            Item::Address(address) => format!("{} — {}", address.letter, address.title),
+            Item::Parameter(number) => {
+                let role = catalogue.parameter_ranges_of(number).next().map(|r| r.title.as_str());
+                match role {
+                    Some(role) => format!("R{number} — program parameter ({role})"),
+                    None => format!("R{number} — program parameter"),
+                }
+            }
+            Item::MachineConstant { number, constant } => {
+                format!("R{number} — machine constant: {}", constant.title)
+            }
+            Item::Operation(op) => format!("Operation {} — {}", op.code, op.title),
+            Item::Cycle(cycle) => {
+                let flavour = match cycle.flavour {
+                    Flavour::Milling => "milling",
+                    Flavour::Lathe => "lathe",
+                };
+                format!("{} ({flavour} cycle) — {}", cycle.code, cycle.title)
+            }
+        }
+    }
+
+    /// The full text.
+    pub fn markdown(&self, catalogue: &Catalogue) -> String {
+        let mut out = format!("### {}\n\n", self.heading(catalogue));
+        match *self {
+            Item::Group(group) => {
+                facts(
+                    &mut out,
+                    &[
+                        ("Default", group.default.clone()),
+                        ("Default note", group.default_note.clone()),
+                        ("Defined by", group.configured_by.as_ref().map(|c| format!("machine constant {c}"))),
+                        ("Codes", Some(codes_of(catalogue, &group.id)).filter(|c| !c.is_empty())),
+                    ],
+                );
+                doc(&mut out, group.doc());
+            }
+            Item::Code(code) => {
+                let group = code.group.as_deref().and_then(|id| catalogue.group(id));
+                let group_text = match group {
+                    Some(g) => Some(format!("{} ({})", g.id, g.title)),
+                    None => Some("none (not in the address dictionary's groups)".to_owned()),
+                };
+                let listed = (!code.in_dictionary)
+                    .then(|| "used in the manual's text, absent from the address dictionary".to_owned());
+                facts(
+                    &mut out,
+                    &[
+                        ("Group", group_text),
+                        ("Modality", Some(modality(code.modality).to_owned())),
+                        ("Reset default", code.reset_default.then(|| "yes".to_owned())),
+                        ("Listed", listed),
+                        ("Requires", list(&code.requires)),
+                        ("Reads", list(&code.allows)),
+                        ("Cancels", list(&code.cancels)),
+                        ("Units", code.units.clone()),
+                    ],
+                );
+                doc(&mut out, code.doc());
+            }
+            Item::UnlistedCode { group, .. } => {
+                let _ = writeln!(
+                    out,
+                    "The manual does not define this code; it belongs to group {} ({}), whose functions the machine builder defines in the PLC program.\n",
+                    group.id, group.title
+                );
+                doc(&mut out, group.doc());
+            }
+            Item::Address(address) => {
+                let range = match (&address.min, &address.max) {
+                    (Some(min), Some(max)) => Some(format!("{min} … {max}")),
+                    _ => None,
+                };
+                facts(
+                    &mut out,
+                    &[
+                        ("Role", Some(role(address.role).to_owned())),
+                        ("Dimensional", Some(dimensional(address.dimensional).to_owned())),
+                        ("Format", address.format.clone()),
+                        ("Range", range),
+                        ("Signed", Some(if address.signed { "yes" } else { "no" }.to_owned())),
+                        ("Units", address.units.clone()),
+                        (
+                            "Parameter substitution",
+                            Some(if address.substitutable {
+                                format!("allowed (e.g. `{}R1`)", address.letter)
+                            } else {
+                                "not allowed".to_owned()
+                            }),
+                        ),
+                        ("Modality", address.modality.map(|m| modality(m).to_owned())),
+                        (
+                            "Axis letter",
+                            address
+                                .configurable_axis
+                                .then(|| "assignable to axis 4, 5 or 6 by the machine configuration".to_owned()),
+                        ),
+                        (
+                            "Listed",
+                            (!address.in_dictionary)
+                                .then(|| "used in the manual's text, absent from the address dictionary".to_owned()),
+                        ),
+                    ],
+                );
+                doc(&mut out, address.doc());
+            }
+            Item::Parameter(number) => {
+                let _ = writeln!(out, "Program parameter {number} of R0–R{}.\n", catalogue.parameters.count - 1);
+                for range in catalogue.parameter_ranges_of(number) {
+                    let _ = writeln!(out, "**{}** ({}): {}\n", range.title, status(range.status), range.summary);
+                    if !range.details.is_empty() {
+                        let _ = writeln!(out, "{}\n", range.details.trim());
+                    }
+                }
+                doc(&mut out, catalogue.parameters.doc());
+            }
+            Item::MachineConstant { constant, .. } => {
+                let run = constant
+                    .last
+                    .filter(|&last| last != constant.number)
+                    .map(|last| format!("R{}–R{last}", constant.number));
+                let _ = writeln!(
+                    out,
+                    "A machine constant: configuration of the control (TAB0.REK), not a program parameter.\n"
+                );
+                facts(
+                    &mut out,
+                    &[
+                        ("Described together", run),
+                        ("Unit", constant.unit.clone()),
+                        ("Default", constant.default.clone()),
+                    ],
+                );
+                if !constant.decades.is_empty() {
+                    out.push_str("| Decades | Meaning |\n|---|---|\n");
+                    for field in &constant.decades {
+                        let _ = writeln!(out, "| {} | {} |", field.decades, field.meaning.replace('\n', " "));
+                    }
+                    out.push('\n');
+                }
+                doc(&mut out, constant.doc());
+            }
+            Item::Operation(op) => {
+                facts(
+                    &mut out,
+                    &[
+                        ("Defined", (!op.defined).then(|| "no: the manual leaves this code undefined".to_owned())),
+                        ("Operands", Some(op.operands.clone())),
+                        ("Result", Some(op.result.clone())),
+                        ("Conditional", op.conditional.then(|| "yes".to_owned())),
+                        ("Real and integer", op.modes.clone()),
+                        ("Errors", op.errors.clone()),
+                    ],
+                );
+                doc(&mut out, op.doc());
+            }
+            Item::Cycle(cycle) => {
+                facts(&mut out, &[("Cycle file", cycle.file.clone())]);
+                if !cycle.parameters.is_empty() {
+                    out.push_str("| Parameter | Meaning | Unit |\n|---|---|---|\n");
+                    for p in &cycle.parameters {
+                        let _ = writeln!(
+                            out,
+                            "| R{} | {} | {} |",
+                            p.r,
+                            p.meaning.replace('\n', " "),
+                            p.unit.as_deref().unwrap_or("")
+                        );
+                    }
+                    out.push('\n');
+                }
+                doc(&mut out, cycle.doc());
+            }
+        }
+        out.truncate(out.trim_end().len());
+        out.push('\n');
+        out
+    }
+}
+
+fn doc(out: &mut String, doc: Doc<'_>) {
+    let _ = writeln!(out, "{}\n", doc.summary.trim());
+    if !doc.details.trim().is_empty() {
+        let _ = writeln!(out, "{}\n", doc.details.trim());
+    }
+    if let Some(example) = doc.example {
+        let _ = writeln!(out, "Example:\n\n```\n{}\n```\n", example.trim());
+    }
+    let _ = writeln!(out, "Manual: {}", doc.source.trim());
+}
+
+fn facts(out: &mut String, facts: &[(&str, Option<String>)]) {
+    let present: Vec<_> = facts.iter().filter_map(|(name, value)| Some((name, value.as_ref()?))).collect();
+    if present.is_empty() {
+        return;
+    }
+    for (name, value) in present {
+        let _ = writeln!(out, "- {name}: {value}");
+    }
+    out.push('\n');
+}
+
+fn list(items: &[String]) -> Option<String> {
+    (!items.is_empty()).then(|| items.join(", "))
+}
+
+fn codes_of(catalogue: &Catalogue, group: &str) -> String {
+    catalogue.codes_in(group).map(|c| c.code.as_str()).collect::<Vec<_>>().join(", ")
+}
+
+fn modality(modality: Modality) -> &'static str {
+    match modality {
+        Modality::Modal => "modal (holds until replaced)",
+        Modality::Block => "only in its block",
+    }
+}
+
+fn status(status: ParameterStatus) -> &'static str {
+    match status {
+        ParameterStatus::Ordinary => "ordinary",
+        ParameterStatus::Special => "special role",
+        ParameterStatus::NotRecommended => "not recommended",
+        ParameterStatus::Reserved => "reserved, must not be used",
+    }
+}
+
+fn dimensional(dimensional: Dimensional) -> &'static str {
+    match dimensional {
+        Dimensional::Yes => "yes (carries a unit)",
+        Dimensional::No => "no (a code or count)",
+        Dimensional::Depends => "depends on the function in the block",
+        Dimensional::Unclassified => "not classified by the manual",
+    }
+}
+
+fn role(role: AddressRole) -> &'static str {
+    match role {
+        AddressRole::BlockNumber => "block number",
+        AddressRole::Parameter => "parameter",
+        AddressRole::Function => "function code",
+        AddressRole::Axis => "axis",
+        AddressRole::Interpolation => "interpolation parameter",
+        AddressRole::Feed => "feed",
+        AddressRole::Speed => "spindle speed",
+        AddressRole::Tool => "tool",
+        AddressRole::Offset => "tool-offset entry",
+        AddressRole::LengthCompensation => "length compensation",
+        AddressRole::Count => "count or dwell",
+        AddressRole::Label => "subprogram, macrocycle or jump target",
+        AddressRole::Auxiliary => "auxiliary function",
+        AddressRole::ThreadLeadIn => "thread lead-in",
+        AddressRole::BlockSkip => "block skip",
+        AddressRole::ProgramNumber => "program number",
+        AddressRole::ProgramEnd => "physical end",
+    }
+}

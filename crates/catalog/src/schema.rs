@@ -1,0 +1,330 @@
+//! The entry types of the catalogue, as the data files spell them.
+//!
+//! Every entry carries the same documentation fields (title, summary,
+//! details, example, source); the [`entry!`] macro adds them, so that the
+//! files are checked strictly (`deny_unknown_fields`) and hover text is
+//! rendered the same way for every kind of entry.
+
+use serde::Deserialize;
+
+/// The documentation every entry has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Doc<'a> {
+    /// A short name: "Rapid positioning".
+    pub title: &'a str,
+    /// One sentence: what it is and does.
+    pub summary: &'a str,
+    /// Further paragraphs in Markdown; may be empty.
+    pub details: &'a str,
+    /// A one-line program example.
+    pub example: Option<&'a str>,
+    /// Where the manual describes it, by chapter and section name.
+    pub source: &'a str,
+}
+
+/// Entries that have documentation.
+pub trait Documented {
+    fn doc(&self) -> Doc<'_>;
+}
+
+macro_rules! entry {
+    (
+        $(#[$meta:meta])*
+        pub struct $name:ident {
+            $($(#[$field_meta:meta])* pub $field:ident : $ty:ty,)*
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, PartialEq, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub struct $name {
+            $($(#[$field_meta])* pub $field: $ty,)*
+            pub title: String,
+            pub summary: String,
+            #[serde(default)]
+            pub details: String,
+            #[serde(default)]
+            pub example: Option<String>,
+            pub source: String,
+        }
+
+        impl Documented for $name {
+            fn doc(&self) -> Doc<'_> {
+                Doc {
+                    title: &self.title,
+                    summary: &self.summary,
+                    details: &self.details,
+                    example: self.example.as_deref(),
+                    source: &self.source,
+                }
+            }
+        }
+    };
+}
+
+/// Whether a function or word holds until changed or only in its block.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Modality {
+    /// Holds until another value (or another code of the group) replaces it.
+    Modal,
+    /// Valid only in the block where it is written (`x` in the dictionary).
+    Block,
+}
+
+fn yes() -> bool {
+    true
+}
+
+entry! {
+    /// A group of G or M functions, of which one may be written per block.
+    pub struct Group {
+        /// `G0` … `G11`, `M1` … `M14`.
+        pub id: String,
+        /// The code set at reset and by M02/M30 (the `+` code, or the
+        /// priority block's where the dictionary marks none).
+        #[serde(default)]
+        pub default: Option<String>,
+        /// Where the default comes from, when it is not the dictionary's `+`.
+        #[serde(default)]
+        pub default_note: Option<String>,
+        /// The machine builder defines the codes (M10–M14): any code of the
+        /// open range that no other group lists belongs here.
+        #[serde(default)]
+        pub open: bool,
+        /// The machine constant that defines an open group (`R56` for M10).
+        #[serde(default)]
+        pub configured_by: Option<String>,
+    }
+}
+
+entry! {
+    /// A G or M code.
+    pub struct Code {
+        /// Letter and two digits: `G00`, `M30`.
+        pub code: String,
+        /// The group; `None` for codes the manual uses outside the groups.
+        #[serde(default)]
+        pub group: Option<String>,
+        pub modality: Modality,
+        /// Marked `+` in the dictionary.
+        #[serde(default)]
+        pub reset_default: bool,
+        /// Listed in the address dictionary (false for codes only the text uses).
+        #[serde(default = "yes")]
+        pub in_dictionary: bool,
+        /// Addresses that must be written in the same block (`L` for G71).
+        #[serde(default)]
+        pub requires: Vec<String>,
+        /// Addresses the function reads besides the required ones.
+        #[serde(default)]
+        pub allows: Vec<String>,
+        /// Codes of other groups this one cancels or resets.
+        #[serde(default)]
+        pub cancels: Vec<String>,
+        /// Units of the values it uses, where that matters.
+        #[serde(default)]
+        pub units: Option<String>,
+    }
+}
+
+/// What an address does in the grammar and the program.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AddressRole {
+    /// `N`: starts a block.
+    BlockNumber,
+    /// `R`: parameter assignment `R1=…` and reference `XR1`.
+    Parameter,
+    /// `G`, `M`.
+    Function,
+    /// A coordinate axis: X, Y, Z and the letters of axes 4–6.
+    Axis,
+    /// `I`, `J`, `K`: circle centre and thread data.
+    Interpolation,
+    Feed,
+    Speed,
+    Tool,
+    /// `D`: entry of the tool-offset table.
+    Offset,
+    /// `&`: length-compensation assignment.
+    LengthCompensation,
+    /// `Q`: repetitions or dwell.
+    Count,
+    /// `L`: subprogram, macrocycle or jump target.
+    Label,
+    /// `H`, `P`.
+    Auxiliary,
+    /// `E`: thread lead-in length.
+    ThreadLeadIn,
+    /// `/`.
+    BlockSkip,
+    /// `%`.
+    ProgramNumber,
+    /// `*`.
+    ProgramEnd,
+}
+
+/// Whether a word carries a unit (the manual's "dimensional word").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Dimensional {
+    Yes,
+    No,
+    /// Depends on the function (Q: count or dwell).
+    Depends,
+    /// The manual does not classify it.
+    Unclassified,
+}
+
+entry! {
+    /// An address letter (or `&`, `/`, `%`, `*`).
+    pub struct Address {
+        pub letter: String,
+        pub role: AddressRole,
+        pub dimensional: Dimensional,
+        /// May carry a sign.
+        #[serde(default)]
+        pub signed: bool,
+        /// The maximal block format, as printed: `+5.3`, `8`, `2..3 or 5`.
+        #[serde(default)]
+        pub format: Option<String>,
+        /// Digits before the point the format allows.
+        #[serde(default)]
+        pub int_digits: Option<u8>,
+        /// Digits after the point the format allows (0: no point).
+        #[serde(default)]
+        pub frac_digits: Option<u8>,
+        /// Smallest and largest value, as written (`-69999.999`).
+        #[serde(default)]
+        pub min: Option<String>,
+        #[serde(default)]
+        pub max: Option<String>,
+        /// How the value is read: unit with and without a decimal point.
+        #[serde(default)]
+        pub units: Option<String>,
+        /// May be replaced by a parameter (`XR1`).
+        pub substitutable: bool,
+        /// `None` where the manual does not say.
+        #[serde(default)]
+        pub modality: Option<Modality>,
+        /// A letter the machine configuration may assign to axis 4, 5 or 6.
+        #[serde(default)]
+        pub configurable_axis: bool,
+        /// Listed in the address dictionary (false for `E`, which only the
+        /// text uses).
+        #[serde(default = "yes")]
+        pub in_dictionary: bool,
+    }
+}
+
+/// How a range of program parameters may be used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ParameterStatus {
+    Ordinary,
+    /// Has a special role but may be used (R0–R4 in `G92 D`, R5–R8).
+    Special,
+    /// Reserved for future use: better not used.
+    NotRecommended,
+    /// Must not be written.
+    Reserved,
+}
+
+entry! {
+    /// What holds for all program parameters R0–R95.
+    pub struct ParameterOverview {
+        /// Number of parameters (96).
+        pub count: u32,
+    }
+}
+
+entry! {
+    /// Program parameters with a common role: `R5`–`R8`, `R95`, …
+    pub struct ParameterRange {
+        pub first: u32,
+        pub last: u32,
+        pub status: ParameterStatus,
+    }
+}
+
+/// One field of a machine constant encoded digit by digit.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DecadeField {
+    /// `"1"`, `"1-4"`, `"8"`: decade 1 is the rightmost digit.
+    pub decades: String,
+    pub meaning: String,
+}
+
+entry! {
+    /// A machine constant (`R39`, `R232`, …): configuration of the control,
+    /// not a program parameter.
+    pub struct MachineConstant {
+        pub number: u32,
+        /// For a run of constants described together (`R356`–`R381`).
+        #[serde(default)]
+        pub last: Option<u32>,
+        #[serde(default)]
+        pub unit: Option<String>,
+        #[serde(default)]
+        pub default: Option<String>,
+        #[serde(default)]
+        pub decades: Vec<DecadeField>,
+    }
+}
+
+entry! {
+    /// A parameter-arithmetic operation (control word `CCAABBTT`, CC = code).
+    pub struct Operation {
+        pub code: u32,
+        /// False for the code the manual leaves undefined (43).
+        #[serde(default = "yes")]
+        pub defined: bool,
+        /// The operands, `*` where double precision is possible: `op1*, op2*`.
+        pub operands: String,
+        /// What is stored: `target* := op1 + op2`.
+        pub result: String,
+        /// Stores 73/78 or gates the following operations.
+        #[serde(default)]
+        pub conditional: bool,
+        /// Real (`+` sign) and integer (`-` sign) behaviour, where it differs.
+        #[serde(default)]
+        pub modes: Option<String>,
+        /// Failure cases (division by zero, …) and what the manual says of them.
+        #[serde(default)]
+        pub errors: Option<String>,
+    }
+}
+
+/// Which machine family a fixed cycle belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Flavour {
+    Milling,
+    Lathe,
+}
+
+/// One input of a fixed cycle.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CycleParameter {
+    /// The program parameter number (`0` for R0).
+    pub r: u32,
+    pub meaning: String,
+    #[serde(default)]
+    pub unit: Option<String>,
+}
+
+entry! {
+    /// A fixed cycle (G81–G89) of the milling or lathe cycle files.
+    pub struct Cycle {
+        pub code: String,
+        pub flavour: Flavour,
+        /// The `$PC` file it comes from.
+        #[serde(default)]
+        pub file: Option<String>,
+        #[serde(default, rename = "parameter")]
+        pub parameters: Vec<CycleParameter>,
+    }
+}

@@ -1,0 +1,65 @@
+//! `ncc explain`: the catalogue's text for a code, like `rustc --explain`.
+
+use std::process::ExitCode;
+
+use ncc_catalog::{Catalogue, Dialect};
+
+pub(crate) fn run(query: Option<&str>, list: bool) -> ExitCode {
+    let catalogue = Dialect::Cnc8x6.catalogue();
+    if list {
+        print!("{}", listing(catalogue));
+        return ExitCode::SUCCESS;
+    }
+    let query = query.unwrap_or_default();
+    match catalogue.explain(query) {
+        Ok(items) => {
+            let texts: Vec<String> = items.iter().map(|item| item.markdown(catalogue)).collect();
+            print!("{}", texts.join("\n"));
+            ExitCode::SUCCESS
+        }
+        Err(not_found) => {
+            eprintln!(
+                "error: `{}` is not a code, address, parameter, machine constant or operation of CNC8x6",
+                not_found.query
+            );
+            if !not_found.suggestions.is_empty() {
+                eprintln!("help: did you mean {}?", not_found.suggestions.join(", "));
+            }
+            eprintln!("help: `ncc explain --list` shows everything that can be explained");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// Every entry by kind, with counts.
+fn listing(catalogue: &Catalogue) -> String {
+    let mut out = String::new();
+    let mut section = |title: &str, names: Vec<String>| {
+        out.push_str(&format!("{title} ({}):\n", names.len()));
+        for line in names.chunks(12) {
+            out.push_str(&format!("  {}\n", line.join(" ")));
+        }
+    };
+    section("groups", catalogue.groups.iter().map(|g| format!("group:{}", g.id)).collect());
+    section("G codes", catalogue.codes.iter().filter(|c| c.code.starts_with('G')).map(|c| c.code.clone()).collect());
+    section("M codes", catalogue.codes.iter().filter(|c| c.code.starts_with('M')).map(|c| c.code.clone()).collect());
+    section("addresses", catalogue.addresses.iter().map(|a| a.letter.clone()).collect());
+    section("program parameters", (0..catalogue.parameters.count).map(|n| format!("R{n}")).collect());
+    section(
+        "machine constants",
+        catalogue
+            .machine_constants
+            .iter()
+            .map(|c| match c.last.filter(|&l| l != c.number) {
+                Some(last) => format!("mc:{}-{last}", c.number),
+                None => format!("mc:{}", c.number),
+            })
+            .collect(),
+    );
+    section("operations", catalogue.operations.iter().map(|op| format!("op:{}", op.code)).collect());
+    section(
+        "fixed cycles",
+        catalogue.cycles.iter().map(|c| format!("{}({})", c.code, format!("{:?}", c.flavour).to_lowercase())).collect(),
+    );
+    out
+}
