@@ -9,12 +9,29 @@ use std::sync::OnceLock;
 use ncc_catalog::{AddressRole, Dialect};
 
 /// The letters the grammar gives a role, from the dialect's address table.
-struct GrammarLetters {
+#[derive(Clone, Copy)]
+pub(crate) struct GrammarLetters {
     block: u8,
     parameter: u8,
 }
 
-fn grammar_letters() -> &'static GrammarLetters {
+impl GrammarLetters {
+    /// Whether the letter starts a block (`N`), in either case.
+    pub(crate) fn is_block(self, byte: u8) -> bool {
+        byte.to_ascii_uppercase() == self.block
+    }
+
+    /// Whether the letter is the parameter letter (`R`), in either case.
+    pub(crate) fn is_parameter(self, byte: u8) -> bool {
+        byte.to_ascii_uppercase() == self.parameter
+    }
+}
+
+pub(crate) fn grammar_letters() -> GrammarLetters {
+    *grammar_letters_ref()
+}
+
+fn grammar_letters_ref() -> &'static GrammarLetters {
     static LETTERS: OnceLock<GrammarLetters> = OnceLock::new();
     LETTERS.get_or_init(|| {
         let catalogue = Dialect::Cnc8x6.catalogue();
@@ -25,12 +42,7 @@ fn grammar_letters() -> &'static GrammarLetters {
 
 /// Whether the letter starts a block (`N`), in either case.
 pub(crate) fn is_block_letter(byte: u8) -> bool {
-    byte.to_ascii_uppercase() == grammar_letters().block
-}
-
-/// Whether the letter is the parameter letter (`R`), in either case.
-pub(crate) fn is_parameter_letter(byte: u8) -> bool {
-    byte.to_ascii_uppercase() == grammar_letters().parameter
+    grammar_letters().is_block(byte)
 }
 
 pub use parser::MAX_LINE_CHARS;

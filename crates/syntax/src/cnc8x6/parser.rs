@@ -24,7 +24,7 @@ use std::ops::Range;
 use rowan::{GreenNode, NodeOrToken, TextRange, TextSize};
 
 use super::{
-    is_block_letter, is_parameter_letter,
+    GrammarLetters, grammar_letters, is_block_letter,
     lexer::{self, Token},
 };
 use crate::{
@@ -272,6 +272,8 @@ struct Parser<'a> {
     last_number: Option<Range<usize>>,
     /// Reused for the children of each block.
     block_children: Vec<GreenElement>,
+    /// Copied from the catalogue once, for the hot loop.
+    letters: GrammarLetters,
 }
 
 impl<'a> Parser<'a> {
@@ -284,6 +286,7 @@ impl<'a> Parser<'a> {
             green: GreenFactory::new(),
             last_number: None,
             block_children: Vec::with_capacity(32),
+            letters: grammar_letters(),
         }
     }
 
@@ -314,7 +317,7 @@ impl<'a> Parser<'a> {
     }
 
     fn at_block_start(&self) -> bool {
-        self.kind_at(self.pos) == Some(LETTER) && is_block_letter(self.byte_at(self.pos))
+        self.kind_at(self.pos) == Some(LETTER) && self.letters.is_block(self.byte_at(self.pos))
     }
 
     fn error(&mut self, kind: E, r: Range<usize>, message: impl Into<String>) {
@@ -405,7 +408,7 @@ impl<'a> Parser<'a> {
                     self.bump()
                 }
                 NEWLINE | COMMENT => self.bump_trivia(token),
-                LETTER if is_block_letter(self.byte_at(self.pos)) => break,
+                LETTER if self.letters.is_block(self.byte_at(self.pos)) => break,
                 STAR => break,
                 LETTER if self.at_parameter_assignment(self.pos) => self.parameter_assignment(),
                 LETTER if self.foreign_text_len() > 0 => {
@@ -495,7 +498,7 @@ impl<'a> Parser<'a> {
     /// by letter. The run stops before `N`, which always starts a block.
     fn foreign_text_len(&self) -> usize {
         let bytes = &self.text.as_bytes()[self.pos..self.end];
-        let run = bytes.iter().take_while(|&&b| b.is_ascii_alphabetic() && !is_block_letter(b)).count();
+        let run = bytes.iter().take_while(|&&b| b.is_ascii_alphabetic() && !self.letters.is_block(b)).count();
         let last_has_value = run > 0 && self.at_value(self.skip_whitespace(self.pos + run));
         let text_len = run - usize::from(last_has_value);
         if text_len >= 3 { text_len } else { 0 }
@@ -527,7 +530,7 @@ impl<'a> Parser<'a> {
         let value_at = self.skip_whitespace(self.pos);
         if self.at_value(value_at) {
             self.value(&mut children);
-            if is_parameter_letter(self.byte_at(start)) {
+            if self.letters.is_parameter(self.byte_at(start)) {
                 let written = self.text[start..self.pos].to_owned();
                 self.error(
                     E::ParameterWithoutAssignment,
@@ -537,7 +540,7 @@ impl<'a> Parser<'a> {
             }
         } else {
             let address = &self.text[start..start + 1];
-            let message = if is_block_letter(self.byte_at(start)) {
+            let message = if self.letters.is_block(self.byte_at(start)) {
                 "block number missing: write it after `N`, e.g. `N10`".to_owned()
             } else {
                 format!(
@@ -556,7 +559,7 @@ impl<'a> Parser<'a> {
         let bytes = &self.text.as_bytes()[..self.end];
         let start = self.pos;
         let letter = bytes[start];
-        if !letter.is_ascii_uppercase() || is_block_letter(letter) || is_parameter_letter(letter) {
+        if !letter.is_ascii_uppercase() || self.letters.is_block(letter) || self.letters.is_parameter(letter) {
             return None;
         }
         let sign_len = usize::from(matches!(bytes.get(start + 1), Some(b'-' | b'+')));
@@ -595,7 +598,7 @@ impl<'a> Parser<'a> {
     fn at_value(&self, pos: usize) -> bool {
         match self.kind_at(pos) {
             Some(PLUS | MINUS | NUMBER) => true,
-            Some(LETTER) => is_parameter_letter(self.byte_at(pos)) && !self.at_parameter_assignment(pos),
+            Some(LETTER) => self.letters.is_parameter(self.byte_at(pos)) && !self.at_parameter_assignment(pos),
             _ => false,
         }
     }
@@ -618,7 +621,7 @@ impl<'a> Parser<'a> {
             children.push(self.bump());
             let digits_at = self.skip_whitespace(self.pos);
             let value_follows = self.kind_at(digits_at) == Some(NUMBER)
-                || (self.kind_at(digits_at) == Some(LETTER) && is_parameter_letter(self.byte_at(digits_at)));
+                || (self.kind_at(digits_at) == Some(LETTER) && self.letters.is_parameter(self.byte_at(digits_at)));
             if !value_follows {
                 self.error(E::MissingValue, sign_start..self.pos, "sign without digits after it");
                 return;
@@ -676,7 +679,7 @@ impl<'a> Parser<'a> {
 
     /// `R`, optional number, optional spaces, `=`.
     fn at_parameter_assignment(&self, pos: usize) -> bool {
-        if self.kind_at(pos) != Some(LETTER) || !is_parameter_letter(self.byte_at(pos)) {
+        if self.kind_at(pos) != Some(LETTER) || !self.letters.is_parameter(self.byte_at(pos)) {
             return false;
         }
         let mut at = self.skip_whitespace(pos + 1);
