@@ -1,51 +1,147 @@
 //! Semantic analysis of partprograms.
 //!
-//! This layer turns syntax trees into what editors and the command line
-//! show: diagnostics today; the program model, hover and navigation as they
-//! arrive. Everything here is plain Rust data with text ranges; converting
-//! to line/column, LSP or terminal output is the caller's business.
+//! An [`AnalysisHost`] owns the incremental database: programs go in as
+//! text, edits are applied as text edits (reparsing only the touched
+//! blocks), and an [`Analysis`] snapshot answers questions: diagnostics
+//! today; hover, navigation and the program model as they arrive. Every
+//! answer is plain Rust data with text ranges; line/column conversion, LSP
+//! and terminal output are the caller's business.
+
+mod checks;
+mod config;
+mod db;
+mod diagnostic;
+pub mod lower;
+mod suppress;
+
+use std::sync::Arc;
 
 use ncc_syntax::Parse;
-pub use ncc_syntax::{Dialect, Severity, TextRange, TextSize};
+pub use ncc_syntax::{Dialect, Severity, TextEdit, TextRange, TextSize};
+use salsa::Setter;
 
-/// A finding in one file.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
-pub struct Diagnostic {
-    pub range: TextRange,
-    pub severity: Severity,
-    /// Stable identifier, e.g. `S002`.
-    pub code: &'static str,
-    /// Stable readable name, e.g. `space-in-number`.
-    pub name: &'static str,
-    pub message: String,
+use crate::db::{Db, Settings};
+pub use crate::{
+    config::{CONFIG_FILE, Config, Level, MachineConfig, parse_constant},
+    db::{RootDatabase, SourceFile},
+    diagnostic::{Diagnostic, Fix, Related, Rule},
+};
+
+/// A file of the analysis.
+pub type FileId = SourceFile;
+
+/// Owns the database; the only way to change inputs.
+pub struct AnalysisHost {
+    db: RootDatabase,
 }
 
-/// Every diagnostic of a parsed program, in source order.
-pub fn diagnostics(parse: &Parse) -> Vec<Diagnostic> {
-    parse
-        .errors()
-        .iter()
-        .map(|error| Diagnostic {
-            range: error.range,
-            severity: error.severity(),
-            code: error.kind.code(),
-            name: error.kind.name(),
-            message: error.message.clone(),
-        })
-        .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn syntax_errors_become_diagnostics() {
-        let parse = Parse::new("%1\nN10 X36.  12\n", Dialect::Cnc8x6);
-        let diagnostics = diagnostics(&parse);
-        assert_eq!(diagnostics.len(), 1);
-        let d = &diagnostics[0];
-        assert_eq!((d.code, d.name, d.severity), ("S002", "space-in-number", Severity::Error));
-        assert_eq!(d.range, TextRange::new(8.into(), 15.into()));
+impl Default for AnalysisHost {
+    fn default() -> Self {
+        AnalysisHost::new(Config::default())
     }
+}
+
+impl AnalysisHost {
+    pub fn new(config: Config) -> AnalysisHost {
+        AnalysisHost::with_database(RootDatabase::default(), config)
+    }
+
+    /// A host over `db` (e.g. one that logs executions).
+    pub fn with_database(db: RootDatabase, config: Config) -> AnalysisHost {
+        Settings::new(&db, config, Vec::new());
+        AnalysisHost { db }
+    }
+
+    /// Adds a file of the workspace (a program or a macrocycle file).
+    pub fn add_file(&mut self, path: impl Into<String>, text: impl Into<Arc<str>>) -> FileId {
+        let text: Arc<str> = text.into();
+        let parse = Parse::new(&text, Dialect::Cnc8x6);
+        let file = SourceFile::new(&self.db, path.into(), text, parse);
+        let settings = Settings::get(&self.db);
+        let mut files = settings.files(&self.db).clone();
+        files.push(file);
+        settings.set_files(&mut self.db).to(files);
+        file
+    }
+
+    /// Replaces a file's text.
+    pub fn set_text(&mut self, file: FileId, text: impl Into<Arc<str>>) {
+        let text: Arc<str> = text.into();
+        let parse = Parse::new(&text, Dialect::Cnc8x6);
+        file.set_text(&mut self.db).to(text);
+        file.set_parse(&mut self.db).to(parse);
+    }
+
+    /// Applies an edit, reparsing only the blocks it touches.
+    pub fn apply_edit(&mut self, file: FileId, edit: &TextEdit) {
+        let mut text = file.text(&self.db).to_string();
+        edit.apply(&mut text);
+        let parse = file.parse(&self.db).reparse(edit, &text);
+        file.set_text(&mut self.db).to(text.into());
+        file.set_parse(&mut self.db).to(parse);
+    }
+
+    pub fn set_config(&mut self, config: Config) {
+        Settings::get(&self.db).set_config(&mut self.db).to(config);
+    }
+
+    /// A snapshot for queries, usable from another thread.
+    pub fn analysis(&self) -> Analysis {
+        Analysis { db: self.db.clone() }
+    }
+
+    /// The database, for tests that inspect query executions.
+    pub fn db(&self) -> &RootDatabase {
+        &self.db
+    }
+}
+
+impl std::fmt::Debug for AnalysisHost {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("AnalysisHost").finish_non_exhaustive()
+    }
+}
+
+/// Answers about the current inputs. Clones answer in parallel.
+#[derive(Clone)]
+pub struct Analysis {
+    db: RootDatabase,
+}
+
+impl std::fmt::Debug for Analysis {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Analysis").finish_non_exhaustive()
+    }
+}
+
+impl Analysis {
+    /// Every diagnostic of a file after configuration and suppression
+    /// comments, sorted by position.
+    pub fn diagnostics(&self, file: FileId) -> Vec<Diagnostic> {
+        file_diagnostics(&self.db, file).clone()
+    }
+
+    pub fn path(&self, file: FileId) -> String {
+        file.path(&self.db).clone()
+    }
+
+    pub fn text(&self, file: FileId) -> Arc<str> {
+        file.text(&self.db).clone()
+    }
+}
+
+/// Syntax, block and program diagnostics of a file, configured.
+#[salsa::tracked(returns(ref))]
+fn file_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
+    let config = Settings::get(db).config(db);
+    let parse = file.parse(db);
+    let mut all: Vec<Diagnostic> = parse.errors().iter().map(Diagnostic::from_syntax).collect();
+    for block in db::file_blocks(db, file) {
+        all.extend(db::block_diagnostics(db, block.syntax).iter().map(|d| d.clone().shifted(block.offset)));
+    }
+    let suppressions = suppress::Suppressions::of(file.text(db), parse);
+    let mut diagnostics: Vec<Diagnostic> =
+        all.into_iter().filter(|d| !suppressions.silences(d)).filter_map(|d| config.adjust(d)).collect();
+    diagnostics.sort_by(|a, b| (a.range.start(), a.range.end(), a.code).cmp(&(b.range.start(), b.range.end(), b.code)));
+    diagnostics
 }

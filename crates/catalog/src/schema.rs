@@ -195,6 +195,10 @@ entry! {
         /// Digits after the point the format allows (0: no point).
         #[serde(default)]
         pub frac_digits: Option<u8>,
+        /// Digits allowed when the value is written without a decimal
+        /// point, where the format has a second form (F: 5, R: 8).
+        #[serde(default)]
+        pub int_digits_without_point: Option<u8>,
         /// Smallest and largest value, as written (`-69999.999`).
         #[serde(default)]
         pub min: Option<String>,

@@ -7,10 +7,12 @@ use std::{
     process::ExitCode,
 };
 
-use ariadne::{Color, Config, IndexType, Label, Report, ReportKind, Source};
+use std::{collections::BTreeMap, sync::Arc};
+
+use ariadne::{Color, IndexType, Label, Report, ReportKind, Source};
 use line_index::{LineIndex, WideEncoding};
-use ncc_analysis::{Diagnostic, Dialect, Severity, TextSize};
-use ncc_syntax::{Parse, encoding};
+use ncc_analysis::{AnalysisHost, Config, Diagnostic, Severity, TextSize};
+use ncc_syntax::encoding;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -30,27 +32,51 @@ pub(crate) fn read_program(path: &Path) -> io::Result<String> {
 
 struct CheckedFile {
     path: PathBuf,
-    text: String,
+    text: Arc<str>,
     diagnostics: Vec<Diagnostic>,
 }
 
 pub(crate) fn run(paths: &[PathBuf], format: Format) -> ExitCode {
     let (files, mut failures) = collect_files(paths);
-    let results: Vec<Result<CheckedFile, String>> = files
+    let read: Vec<Result<(PathBuf, String), String>> = files
         .par_iter()
-        .map(|path| {
-            let text = read_program(path).map_err(|e| format!("{}: {e}", path.display()))?;
-            let diagnostics = ncc_analysis::diagnostics(&Parse::new(&text, Dialect::Cnc8x6));
-            Ok(CheckedFile { path: path.clone(), text, diagnostics })
-        })
+        .map(|path| read_program(path).map(|text| (path.clone(), text)).map_err(|e| format!("{}: {e}", path.display())))
         .collect();
-    let mut checked = Vec::with_capacity(results.len());
-    for result in results {
+
+    // Files under the same `ncc.toml` form one workspace.
+    let mut workspaces: BTreeMap<Option<PathBuf>, Vec<(PathBuf, String)>> = BTreeMap::new();
+    for result in read {
         match result {
-            Ok(file) => checked.push(file),
+            Ok((path, text)) => workspaces.entry(Config::find_for(&path)).or_default().push((path, text)),
             Err(message) => failures.push(message),
         }
     }
+    let mut checked = Vec::new();
+    for (config_path, programs) in workspaces {
+        let config = match &config_path {
+            Some(path) => match std::fs::read_to_string(path)
+                .map_err(|e| format!("{}: {e}", path.display()))
+                .and_then(|text| Config::from_toml(&text, &path.display().to_string()))
+            {
+                Ok(config) => config,
+                Err(message) => {
+                    failures.push(message);
+                    continue;
+                }
+            },
+            None => Config::default(),
+        };
+        let mut host = AnalysisHost::new(config);
+        let ids: Vec<_> =
+            programs.into_iter().map(|(path, text)| (host.add_file(path.display().to_string(), text), path)).collect();
+        let analysis = host.analysis();
+        checked.par_extend(ids.into_par_iter().map_with(analysis, |analysis, (file, path)| CheckedFile {
+            path,
+            text: analysis.text(file),
+            diagnostics: analysis.diagnostics(file),
+        }));
+    }
+    checked.sort_by(|a, b| a.path.cmp(&b.path));
 
     let stdout = io::stdout();
     let mut out = io::BufWriter::new(stdout.lock());
@@ -115,14 +141,14 @@ fn is_partprogram(path: &Path) -> bool {
 
 fn write_human(out: &mut impl Write, files: &[CheckedFile]) -> io::Result<()> {
     let color = io::stdout().is_terminal();
-    let config = Config::default().with_index_type(IndexType::Byte).with_color(color);
+    let config = ariadne::Config::default().with_index_type(IndexType::Byte).with_color(color);
     let mut counts = [0usize; 4];
     for file in files {
         if file.diagnostics.is_empty() {
             continue;
         }
         let name = file.path.display().to_string();
-        let source = Source::from(file.text.as_str());
+        let source = Source::from(&*file.text);
         for diagnostic in &file.diagnostics {
             counts[diagnostic.severity as usize] += 1;
             let range: Range<usize> = diagnostic.range.into();
@@ -132,17 +158,31 @@ fn write_human(out: &mut impl Write, files: &[CheckedFile]) -> io::Result<()> {
                 Severity::Info => (ReportKind::Custom("info", Color::Blue), Color::Blue),
                 Severity::Hint => (ReportKind::Custom("hint", Color::Cyan), Color::Cyan),
             };
-            Report::build(kind, (name.clone(), range.clone()))
+            let mut report = Report::build(kind, (name.clone(), range.clone()))
                 .with_config(config)
                 .with_code(format!("{} {}", diagnostic.code, diagnostic.name))
                 .with_message(&diagnostic.message)
                 .with_label(
                     Label::new((name.clone(), range))
                         .with_message(diagnostic.name.replace('-', " "))
-                        .with_color(label_color),
-                )
-                .finish()
-                .write((name.clone(), &source), &mut *out)?;
+                        .with_color(label_color)
+                        .with_order(0),
+                );
+            for related in &diagnostic.related {
+                match &related.file {
+                    None => report.add_label(
+                        Label::new((name.clone(), related.range.into()))
+                            .with_message(&related.message)
+                            .with_color(Color::Cyan)
+                            .with_order(1),
+                    ),
+                    Some(other) => report.add_note(format!("{}: {}", other, related.message)),
+                }
+            }
+            for fix in &diagnostic.fixes {
+                report.add_help(&fix.title);
+            }
+            report.finish().write((name.clone(), &source), &mut *out)?;
         }
     }
     let [hints, infos, warnings, errors] = counts;

@@ -5,5 +5,11 @@
 //! fixed cycles, geometry with nalgebra) and produce a printable trace with
 //! the predicted cycle time. The crate is part of the workspace layout from
 //! the start so that the layering (analysis calls into the executor's
-//! evaluator, never the other way round) is fixed early; it holds no code
-//! until the executor is built.
+//! evaluator, never the other way round) is fixed early.
+//!
+//! What exists so far:
+//! - [`arith`]: the parameter-arithmetic evaluator of G26–G29 (control words
+//!   in R5–R8, operations 0–51). It works on partly unknown parameters, so
+//!   the static analysis uses it as well.
+
+pub mod arith;

@@ -1,0 +1,414 @@
+//! Rules decided by one block, the catalogue and the machine configuration.
+
+use ncc_catalog::{Address, AddressRole, Catalogue, Dialect};
+use ncc_syntax::{Decimal, TextRange};
+use rustc_hash::FxHashMap;
+
+use crate::{
+    Config, Diagnostic, Rule,
+    lower::{BlockData, Value, Word},
+};
+
+/// The codes that read Q (dwell or repetitions) and L (call or jump target).
+const READS_Q: [u32; 4] = [4, 71, 72, 73];
+const READS_L: [u32; 4] = [71, 72, 73, 79];
+
+pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
+    let catalogue = Dialect::Cnc8x6.catalogue();
+    let mut out = Vec::new();
+    let indirect_g = block.words_with(b'G').any(|w| matches!(w.value, Some(Value::Parameter { .. })));
+
+    let mut seen: FxHashMap<u8, &Word> = FxHashMap::default();
+    let mut axes = Vec::new();
+    for word in &block.words {
+        let Some(address) = address_of(catalogue, word.letter) else {
+            out.push(Diagnostic::new(
+                Rule::UnknownAddress,
+                word.address_range,
+                format!("`{}` is no address of the CNC8x6 language", char::from(word.letter)),
+            ));
+            continue;
+        };
+        if address.role == AddressRole::Axis {
+            if !config.machine.is_axis(word.letter) {
+                let configured: Vec<String> = config.machine.axes.iter().map(|&a| char::from(a).to_string()).collect();
+                out.push(Diagnostic::new(
+                    Rule::UnknownAddress,
+                    word.address_range,
+                    format!(
+                        "the machine has no axis `{}`: its axes are {} (set `machine.axes` in ncc.toml for other letters)",
+                        char::from(word.letter),
+                        configured.join(", ")
+                    ),
+                ));
+            }
+            axes.push(word);
+        }
+        if address.role != AddressRole::Function {
+            if let Some(first) = seen.get(&word.letter) {
+                out.push(
+                    Diagnostic::new(
+                        Rule::AddressRepeated,
+                        word.range,
+                        format!(
+                            "address `{}` appears twice in this block; each address may be written once (only G and M codes of different groups and R assignments repeat)",
+                            char::from(word.letter)
+                        ),
+                    )
+                    .with_related(None, first.range, "first written here"),
+                );
+            } else {
+                seen.insert(word.letter, word);
+            }
+        }
+        match &word.value {
+            Some(Value::Literal(literal)) => check_literal(word, address, &literal.decimal(), catalogue, &mut out),
+            Some(Value::Parameter { .. }) if !address.substitutable => out.push(Diagnostic::new(
+                Rule::NotSubstitutable,
+                word.value_range.unwrap_or(word.range),
+                format!("`{}` cannot take a parameter: write the value itself", address.letter),
+            )),
+            _ => {}
+        }
+    }
+    if axes.len() > 6 {
+        out.push(Diagnostic::new(
+            Rule::TooManyAxes,
+            TextRange::new(axes[6].range.start(), axes.last().expect("more than six").range.end()),
+            format!("{} coordinates in one block; the control interpolates at most six", axes.len()),
+        ));
+    }
+
+    check_groups(block, catalogue, &mut out);
+    if !indirect_g {
+        check_required_addresses(block, catalogue, &mut out);
+        check_block_only_addresses(block, &mut out);
+    }
+    check_assignments(block, catalogue, &mut out);
+    check_skip(block, &mut out);
+    check_dwell(block, &mut out);
+    check_offset_table_form(block, &mut out);
+    check_g98_alone(block, &mut out);
+    check_swallowed_words(block, catalogue, &mut out);
+    out
+}
+
+fn address_of(catalogue: &Catalogue, letter: u8) -> Option<&Address> {
+    catalogue.address(std::str::from_utf8(&[letter]).ok()?)
+}
+
+/// Digits, range, sign and decimal point of a literal value.
+fn check_literal(word: &Word, address: &Address, value: &Decimal, catalogue: &Catalogue, out: &mut Vec<Diagnostic>) {
+    let range = word.value_range.unwrap_or(word.range);
+    let letter = &address.letter;
+    if value.sign().is_some() && !address.signed {
+        out.push(Diagnostic::new(
+            Rule::UnexpectedSign,
+            range,
+            format!("`{letter}` takes only unsigned values; remove the sign"),
+        ));
+        return;
+    }
+    if let Some(message) = digit_overflow(address, value) {
+        out.push(Diagnostic::new(Rule::TooManyDigits, range, message));
+        return;
+    }
+    if value.has_point() && address.frac_digits == Some(0) {
+        out.push(Diagnostic::new(
+            Rule::UnexpectedDecimalPoint,
+            range,
+            format!("`{letter}` is a code or count without decimals; write it without a decimal point"),
+        ));
+    }
+    if address.role == AddressRole::Function && !value.has_point() && value.sign().is_none() {
+        check_code(word, value, catalogue, out);
+        return;
+    }
+    if address.role == AddressRole::LengthCompensation {
+        let digits = value.to_string();
+        if digits.bytes().any(|b| !matches!(b, b'0'..=b'2' | b'.' | b'-' | b'+')) {
+            out.push(Diagnostic::new(
+                Rule::LengthCompensationDigits,
+                range,
+                format!("`&{digits}`: each digit assigns one axis's length correction and must be 0 (off), 1 (add) or 2 (subtract)"),
+            ));
+            return;
+        }
+    }
+    if address.role == AddressRole::ThreadLeadIn && !value.has_point() {
+        out.push(Diagnostic::new(
+            Rule::DecimalPointRequired,
+            range,
+            format!("the lead-in length must be written with a decimal point: `E{value}.`"),
+        ));
+    }
+    if let (Some(min), Some(max)) = (bound(&address.min), bound(&address.max)) {
+        let number = value.to_f64();
+        if number < min || number > max {
+            out.push(Diagnostic::new(
+                Rule::ValueOutOfRange,
+                range,
+                format!(
+                    "`{letter}{value}` is outside the range of `{letter}`: {} to {}",
+                    address.min.as_deref().unwrap_or_default(),
+                    address.max.as_deref().unwrap_or_default()
+                ),
+            ));
+        }
+    }
+}
+
+fn bound(text: &Option<String>) -> Option<f64> {
+    text.as_deref()?.parse().ok()
+}
+
+/// The format's digit limits: significant digits before the point (leading
+/// zeros may always be written) and digits after it (trailing zeros may be).
+pub(crate) fn digit_overflow(address: &Address, value: &Decimal) -> Option<String> {
+    let int_limit =
+        if value.has_point() { address.int_digits? } else { address.int_digits_without_point.or(address.int_digits)? };
+    let int = value.significant_int_digits();
+    let frac = significant_frac_digits(value);
+    let letter = &address.letter;
+    if int > u32::from(int_limit) {
+        let form = if address.int_digits_without_point.is_some() {
+            if value.has_point() { " with a decimal point" } else { " without a decimal point" }
+        } else {
+            ""
+        };
+        return Some(format!(
+            "`{letter}{value}` has {int} digits before the point; the format of `{letter}` allows {int_limit}{form}"
+        ));
+    }
+    let frac_limit = address.frac_digits.unwrap_or(0);
+    if value.has_point() && frac > u32::from(frac_limit) && frac_limit > 0 {
+        return Some(format!(
+            "`{letter}{value}` has {frac} decimals; `{letter}` takes at most {frac_limit} (the control's resolution)"
+        ));
+    }
+    None
+}
+
+fn significant_frac_digits(value: &Decimal) -> u32 {
+    let text = value.to_string();
+    match text.split_once('.') {
+        Some((_, frac)) => frac.trim_end_matches('0').len() as u32,
+        None => 0,
+    }
+}
+
+fn check_code(word: &Word, value: &Decimal, catalogue: &Catalogue, out: &mut Vec<Diagnostic>) {
+    let Some(number) = value.scaled(0).and_then(|v| u32::try_from(v).ok()) else { return };
+    let letter = char::from(word.letter);
+    if catalogue.code(letter, number).is_none() && catalogue.group_of(letter, number).is_none() {
+        let range = word.range;
+        out.push(Diagnostic::new(
+            Rule::UnknownCode,
+            range,
+            format!("{letter}{number:02} is not a function of the CNC8x6 control (`ncc explain {letter}{number:02}` suggests similar ones)"),
+        ));
+    }
+}
+
+/// One code per G and M group (the open group M14 takes one value too).
+fn check_groups(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Diagnostic>) {
+    let mut by_group: FxHashMap<&str, (u32, &Word)> = FxHashMap::default();
+    for letter in [b'G', b'M'] {
+        for (number, word) in block.codes(letter) {
+            let Some(group) = catalogue.group_of(char::from(letter), number) else { continue };
+            match by_group.get(group.id.as_str()) {
+                Some(&(first, first_word)) if first != number => {
+                    let l = char::from(letter);
+                    out.push(
+                        Diagnostic::new(
+                            Rule::GroupConflict,
+                            word.range,
+                            format!(
+                                "{l}{number:02} and {l}{first:02} are both in group {} ({}); one code per group may be written in a block",
+                                group.id, group.title
+                            ),
+                        )
+                        .with_related(None, first_word.range, format!("{l}{first:02} is here")),
+                    );
+                }
+                Some(_) => {}
+                None => {
+                    by_group.insert(group.id.as_str(), (number, word));
+                }
+            }
+        }
+    }
+}
+
+/// Addresses a function needs in its own block (`G71 L`, `G04 Q`, `G26 R5`).
+fn check_required_addresses(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Diagnostic>) {
+    for letter in [b'G', b'M'] {
+        for (number, word) in block.codes(letter) {
+            let Some(code) = catalogue.code(char::from(letter), number) else { continue };
+            let missing: Vec<&str> =
+                code.requires.iter().map(String::as_str).filter(|required| !block_has(block, required)).collect();
+            if !missing.is_empty() {
+                let what = missing.iter().map(|m| format!("`{m}`")).collect::<Vec<_>>().join(", ");
+                out.push(Diagnostic::new(
+                    Rule::MissingRequiredAddress,
+                    word.range,
+                    format!("{} ({}) needs {what} in the same block", code.code, code.title),
+                ));
+            }
+        }
+    }
+}
+
+/// Whether the block writes `name`: an address letter, or `R5` for an
+/// assignment of parameter 5.
+fn block_has(block: &BlockData, name: &str) -> bool {
+    match ncc_catalog::split_code(name) {
+        Some(('R', index)) => block.assignments.iter().any(|a| a.index == Some(index)),
+        _ => name.bytes().next().is_some_and(|letter| block.word(letter).is_some()),
+    }
+}
+
+/// L and Q are valid only in their block and only mean something there
+/// with a call, jump or dwell.
+fn check_block_only_addresses(block: &BlockData, out: &mut Vec<Diagnostic>) {
+    let reads = |codes: &[u32]| codes.iter().any(|&c| block.has_code(b'G', c));
+    if let Some(q) = block.word(b'Q').filter(|_| !reads(&READS_Q)) {
+        out.push(Diagnostic::new(
+            Rule::MeaninglessAddress,
+            q.range,
+            "Q has no effect here: it is the dwell of G04 or the repetitions of G71, G72, G73, and holds only in its block",
+        ));
+    }
+    if let Some(l) = block.word(b'L').filter(|_| !reads(&READS_L)) {
+        out.push(Diagnostic::new(
+            Rule::MeaninglessAddress,
+            l.range,
+            "L has no effect here: it names the target of G71, G72, G73 or G79, and holds only in its block",
+        ));
+    }
+}
+
+/// Parameter assignments: numbers, values, and the 95-per-block limit.
+fn check_assignments(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Diagnostic>) {
+    let Some(r) = catalogue.address("R") else { return };
+    for assignment in &block.assignments {
+        match &assignment.value {
+            Some(Value::Literal(literal)) => {
+                let value = literal.decimal();
+                let range = assignment.value_range.unwrap_or(assignment.range);
+                if let Some(message) = digit_overflow(r, &value) {
+                    out.push(Diagnostic::new(Rule::TooManyDigits, range, message));
+                } else if parameter_raw(&value).is_none_or(|raw| raw.abs() > 69_999_999) {
+                    out.push(Diagnostic::new(
+                        Rule::ValueOutOfRange,
+                        range,
+                        format!("`{value}` is outside the parameter range -69999.999 to 69999.999"),
+                    ));
+                }
+            }
+            Some(Value::Parameter { .. }) => out.push(Diagnostic::new(
+                Rule::NotSubstitutable,
+                assignment.value_range.unwrap_or(assignment.range),
+                "a parameter cannot be assigned another parameter (`R1=R2`); use parameter arithmetic: `G26 R5=00020001` copies R2 into R1",
+            )),
+            None => {}
+        }
+    }
+    if block.assignments.len() > 95 {
+        out.push(Diagnostic::new(
+            Rule::TooManyParameterAssignments,
+            block.assignments[95].range,
+            format!("{} parameter assignments in one block; the control takes at most 95", block.assignments.len()),
+        ));
+    }
+}
+
+/// The raw value a parameter stores: thousandths (`R1=864` → 864,
+/// `R1=864.` → 864000).
+pub(crate) fn parameter_raw(value: &Decimal) -> Option<i64> {
+    let raw = if value.has_point() { value.scaled(3)? } else { value.scaled(0)? };
+    i64::try_from(raw).ok()
+}
+
+fn check_skip(block: &BlockData, out: &mut Vec<Diagnostic>) {
+    for digit in &block.skip_digits {
+        out.push(Diagnostic::new(
+            Rule::SkipDigitIgnored,
+            *digit,
+            "the digit after `/` is not evaluated: any `/` is skipped when block skip is on",
+        ));
+    }
+    for skip in block.skip.iter().skip(1) {
+        out.push(Diagnostic::new(Rule::SkipRepeated, *skip, "this block already has `/`; one is enough"));
+    }
+}
+
+fn check_dwell(block: &BlockData, out: &mut Vec<Diagnostic>) {
+    let Some((_, dwell)) = block.codes(b'G').find(|(code, _)| *code == 4) else { return };
+    if let Some((code, call)) = block.codes(b'G').find(|(code, _)| matches!(code, 71..=73)) {
+        out.push(
+            Diagnostic::new(
+                Rule::DwellOverridesRepeat,
+                call.range,
+                format!("with G04 in the block, Q is the dwell time: G{code} runs once, not Q times; put the dwell in a block of its own"),
+            )
+            .with_related(None, dwell.range, "G04 is here"),
+        );
+    }
+}
+
+fn check_offset_table_form(block: &BlockData, out: &mut Vec<Diagnostic>) {
+    for code in [92, 93] {
+        let Some((_, word)) = block.codes(b'G').find(|(c, _)| *c == code) else { continue };
+        let has_offset_code = block.codes(b'G').any(|(c, _)| (53..=59).contains(&c));
+        let writes_tool_table = code == 92 && block.word(b'D').is_some();
+        if !has_offset_code && !writes_tool_table {
+            let message = if code == 92 {
+                "G92 names neither the zero-offset row to write (G53 to G59 in the block) nor a tool-offset entry (D)"
+            } else {
+                "G93 needs the zero-offset row to set (G53 to G59 in the block)"
+            };
+            out.push(Diagnostic::new(Rule::OffsetTableForm, word.range, message));
+        }
+    }
+}
+
+fn check_g98_alone(block: &BlockData, out: &mut Vec<Diagnostic>) {
+    let Some((_, g98)) = block.codes(b'G').find(|(c, _)| *c == 98) else { return };
+    let others = block.body_words().count() + block.assignments.len();
+    if others > 1 {
+        out.push(Diagnostic::new(
+            Rule::G98NotAlone,
+            g98.range,
+            "G98 ends the helix and must be programmed in a block of its own",
+        ));
+    }
+}
+
+/// An unclosed comment ends at the line end, so words typed after its text
+/// become part of it (`"TEXT Y200 Z300`).
+fn check_swallowed_words(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Diagnostic>) {
+    for comment in block.comments.iter().filter(|c| !c.closed && c.after_words) {
+        let tokens: Vec<&str> = comment.body.split_whitespace().collect();
+        let trailing_words = tokens.iter().rev().take_while(|t| looks_like_word(t, catalogue)).count();
+        if trailing_words > 0 && trailing_words < tokens.len() {
+            let words = tokens[tokens.len() - trailing_words..].join(" ");
+            out.push(Diagnostic::new(
+                Rule::SwallowedWords,
+                comment.range,
+                format!("the comment is not closed, so `{words}` belongs to it and is not executed; close the comment with `\"` before them if they are program words"),
+            ));
+        }
+    }
+}
+
+fn looks_like_word(token: &str, catalogue: &Catalogue) -> bool {
+    let bytes = token.as_bytes();
+    let Some((&letter, rest)) = bytes.split_first() else { return false };
+    let rest = rest.strip_prefix(b"-").unwrap_or(rest);
+    letter.is_ascii_uppercase()
+        && catalogue.role_of(letter).is_some()
+        && !rest.is_empty()
+        && rest.iter().all(|b| b.is_ascii_digit() || *b == b'.')
+        && rest.iter().any(u8::is_ascii_digit)
+}

@@ -1,0 +1,3 @@
+//! The rules, by what they need to decide.
+
+pub(crate) mod block;

@@ -1,0 +1,234 @@
+//! The project configuration, `ncc.toml`: rule severities and the machine.
+//!
+//! ```toml
+//! [rules]
+//! missing-feed = "warning"     # by name or by code
+//! S009 = "off"
+//!
+//! [machine]
+//! axes = ["X", "Y", "Z", "U", "V", "C"]   # letters of axes 1-6
+//! feed-limit = 24000                      # mm/min
+//!
+//! [machine.constants]                      # as in TAB0.REK
+//! R339 = "01000000"                        # the eight decades
+//! R39 = "60.000"                           # or with the decimal point
+//! ```
+
+use std::{
+    collections::BTreeMap,
+    path::{Path, PathBuf},
+};
+
+use ncc_catalog::Dialect;
+use ncc_syntax::{Decimal, Severity, Sign};
+use serde::Deserialize;
+
+use crate::Diagnostic;
+
+/// The name of the project file, looked for from a program's directory up.
+pub const CONFIG_FILE: &str = "ncc.toml";
+
+/// What a rule's diagnostics become.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Level {
+    Off,
+    Hint,
+    Info,
+    Warning,
+    Error,
+}
+
+impl Level {
+    fn severity(self) -> Option<Severity> {
+        match self {
+            Level::Off => None,
+            Level::Hint => Some(Severity::Hint),
+            Level::Info => Some(Severity::Info),
+            Level::Warning => Some(Severity::Warning),
+            Level::Error => Some(Severity::Error),
+        }
+    }
+}
+
+/// Everything configurable about an analysis.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Default)]
+pub struct Config {
+    /// Severity overrides by rule code or name.
+    pub rules: BTreeMap<String, Level>,
+    pub machine: MachineConfig,
+}
+
+/// The machine the programs run on.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct MachineConfig {
+    /// Letters of axes 1 to 6.
+    pub axes: Vec<u8>,
+    /// Highest programmable feed in mm/min.
+    pub feed_limit: u32,
+    /// Machine constants set in the configuration, as raw values (the
+    /// decades as digits: `00233.112` → 233112).
+    pub constants: BTreeMap<u32, i64>,
+}
+
+impl Default for MachineConfig {
+    fn default() -> Self {
+        MachineConfig { axes: b"XYZUVC".to_vec(), feed_limit: 24_000, constants: BTreeMap::new() }
+    }
+}
+
+impl MachineConfig {
+    /// A machine constant's raw value: configured, else the catalogue's
+    /// default, else zero.
+    pub fn constant(&self, number: u32) -> i64 {
+        if let Some(&value) = self.constants.get(&number) {
+            return value;
+        }
+        Dialect::Cnc8x6
+            .catalogue()
+            .machine_constant(number)
+            .and_then(|c| c.default.as_deref())
+            .and_then(parse_constant)
+            .unwrap_or(0)
+    }
+
+    /// Decade `decade` (1 = rightmost digit) of a machine constant.
+    pub fn decade(&self, number: u32, decade: u32) -> u8 {
+        let raw = self.constant(number).unsigned_abs();
+        ((raw / 10u64.pow(decade.saturating_sub(1))) % 10) as u8
+    }
+
+    /// Whether `letter` names a configured axis.
+    pub fn is_axis(&self, letter: u8) -> bool {
+        self.axes.contains(&letter.to_ascii_uppercase())
+    }
+}
+
+/// Reads a machine-constant value as written in TAB0.REK: with a decimal
+/// point in thousandths (`60.000`), without one as the raw decades.
+pub fn parse_constant(text: &str) -> Option<i64> {
+    let text = text.trim();
+    let (sign, digits) = match text.strip_prefix('-') {
+        Some(rest) => (Some(Sign::Minus), rest),
+        None => (None, text.strip_prefix('+').unwrap_or(text)),
+    };
+    let value = Decimal::parse(sign, digits)?;
+    let scale = if value.has_point() { 3 } else { 0 };
+    i64::try_from(value.scaled(scale)?).ok()
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "kebab-case")]
+struct ConfigFile {
+    #[serde(default)]
+    rules: BTreeMap<String, Level>,
+    #[serde(default)]
+    machine: Option<MachineFile>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "kebab-case")]
+struct MachineFile {
+    axes: Option<Vec<String>>,
+    feed_limit: Option<u32>,
+    #[serde(default)]
+    constants: BTreeMap<String, String>,
+}
+
+impl Config {
+    /// Reads a configuration file's text; `origin` names it in errors.
+    pub fn from_toml(text: &str, origin: &str) -> Result<Config, String> {
+        let file: ConfigFile = toml::from_str(text).map_err(|e| format!("{origin}: {e}"))?;
+        let mut config = Config { rules: file.rules, machine: MachineConfig::default() };
+        let known = |key: &str| {
+            crate::Rule::ALL.iter().any(|r| r.code() == key || r.name() == key)
+                || ncc_syntax::SyntaxErrorKind::ALL.iter().any(|k| k.code() == key || k.name() == key)
+        };
+        if let Some(unknown) = config.rules.keys().find(|key| !known(key)) {
+            return Err(format!("{origin}: [rules] names no rule `{unknown}` (see `ncc rules`)"));
+        }
+        if let Some(machine) = file.machine {
+            if let Some(axes) = machine.axes {
+                let letters: Vec<u8> =
+                    axes.iter().map(|a| a.as_bytes().first().copied().unwrap_or(b'?').to_ascii_uppercase()).collect();
+                if axes.iter().any(|a| a.len() != 1 || !a.as_bytes()[0].is_ascii_alphabetic())
+                    || axes.is_empty()
+                    || axes.len() > 6
+                {
+                    return Err(format!("{origin}: machine.axes must list one to six axis letters"));
+                }
+                config.machine.axes = letters;
+            }
+            if let Some(limit) = machine.feed_limit {
+                config.machine.feed_limit = limit;
+            }
+            for (name, value) in machine.constants {
+                let number = name
+                    .strip_prefix(['R', 'r'])
+                    .and_then(|n| n.parse().ok())
+                    .ok_or_else(|| format!("{origin}: machine.constants key `{name}` is not like `R339`"))?;
+                let raw = parse_constant(&value)
+                    .ok_or_else(|| format!("{origin}: machine constant {name} = `{value}` is not a number"))?;
+                config.machine.constants.insert(number, raw);
+            }
+        }
+        Ok(config)
+    }
+
+    /// The `ncc.toml` that applies to `path`: the nearest one in its
+    /// directory or above.
+    pub fn find_for(path: &Path) -> Option<PathBuf> {
+        let start = if path.is_dir() { path } else { path.parent()? };
+        let start = if start.as_os_str().is_empty() { Path::new(".") } else { start };
+        let start = start.canonicalize().ok()?;
+        start.ancestors().map(|dir| dir.join(CONFIG_FILE)).find(|candidate| candidate.is_file())
+    }
+
+    /// Applies the severity overrides; `None` when the rule is turned off.
+    pub(crate) fn adjust(&self, mut diagnostic: Diagnostic) -> Option<Diagnostic> {
+        let level = self.rules.get(diagnostic.code).or_else(|| self.rules.get(diagnostic.name));
+        match level {
+            None => Some(diagnostic),
+            Some(level) => {
+                diagnostic.severity = level.severity()?;
+                Some(diagnostic)
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_rules_and_machine() {
+        let config = Config::from_toml(
+            "[rules]\nS009 = \"off\"\nunknown-code = \"warning\"\n[machine]\naxes = [\"X\", \"Z\"]\nfeed-limit = 10000\n[machine.constants]\nR339 = \"01000000\"\nR39 = \"45.5\"\n",
+            "ncc.toml",
+        )
+        .unwrap();
+        assert_eq!(config.rules.get("S009"), Some(&Level::Off));
+        assert_eq!(config.machine.axes, b"XZ");
+        assert_eq!(config.machine.feed_limit, 10_000);
+        assert_eq!(config.machine.decade(339, 7), 1);
+        assert_eq!(config.machine.constant(39), 45_500);
+    }
+
+    #[test]
+    fn rejects_mistakes_with_a_clear_message() {
+        let error = Config::from_toml("[rules]\nno-such-rule = \"off\"\n", "ncc.toml").unwrap_err();
+        assert!(error.contains("no-such-rule"), "{error}");
+        let error = Config::from_toml("[machine]\naxes = [\"XY\"]\n", "ncc.toml").unwrap_err();
+        assert!(error.contains("axis letters"), "{error}");
+        assert!(Config::from_toml("[machine.constants]\nR39 = \"abc\"\n", "x").is_err());
+        assert!(Config::from_toml("[unknown]\n", "x").is_err());
+    }
+
+    #[test]
+    fn defaults_come_from_the_catalogue() {
+        let machine = MachineConfig::default();
+        assert_eq!(machine.constant(39), 60_000, "R39 default 60.000");
+        assert_eq!(machine.constant(339), 0);
+    }
+}

@@ -1,0 +1,67 @@
+//! Suppression comments.
+//!
+//! A comment that contains `ncc:ignore` silences the diagnostics that start
+//! on its line; `ncc:ignore missing-feed, S009` silences only those rules
+//! (by name or code). A comment alone on its line silences the next line
+//! instead, for lines that have no room left:
+//!
+//! ```text
+//! N10 G01 X10 "ncc:ignore missing-feed
+//! "ncc:ignore line-too-long
+//! N20 X1 Y2 …a line longer than 80 characters…
+//! ```
+
+use std::ops::Range;
+
+use ncc_syntax::{Parse, SyntaxKind, ast::Comment};
+
+use crate::Diagnostic;
+
+const MARKER: &str = "ncc:ignore";
+
+pub(crate) struct Suppressions {
+    /// Byte ranges of silenced lines, with the rules silenced (empty = all).
+    lines: Vec<(Range<usize>, Vec<String>)>,
+}
+
+impl Suppressions {
+    pub(crate) fn of(text: &str, parse: &Parse) -> Suppressions {
+        let mut lines = Vec::new();
+        let comments = parse
+            .syntax_node()
+            .descendants_with_tokens()
+            .filter_map(|e| e.into_token())
+            .filter(|t| t.kind() == SyntaxKind::COMMENT)
+            .filter_map(Comment::cast);
+        for comment in comments {
+            let Some(at) = comment.body().find(MARKER) else { continue };
+            let rules: Vec<String> = comment.body()[at + MARKER.len()..]
+                .split([',', ' '])
+                .map(str::trim)
+                .filter(|s| !s.is_empty())
+                .map(str::to_owned)
+                .collect();
+            let start = usize::from(comment.syntax().text_range().start());
+            let line = line_around(text, start);
+            let alone = text[line.start..start].trim().is_empty();
+            let target = if alone { line_around(text, (line.end + 1).min(text.len())) } else { line };
+            lines.push((target, rules));
+        }
+        Suppressions { lines }
+    }
+
+    pub(crate) fn silences(&self, diagnostic: &Diagnostic) -> bool {
+        let at = usize::from(diagnostic.range.start());
+        self.lines.iter().any(|(line, rules)| {
+            line.contains(&at) || (line.is_empty() && line.start == at)
+        } && (rules.is_empty() || rules.iter().any(|r| r == diagnostic.code || r == diagnostic.name)))
+    }
+}
+
+/// The line holding `at`, without its terminator.
+fn line_around(text: &str, at: usize) -> Range<usize> {
+    let bytes = text.as_bytes();
+    let start = bytes[..at].iter().rposition(|&b| b == b'\n' || b == b'\r').map_or(0, |i| i + 1);
+    let end = bytes[at..].iter().position(|&b| b == b'\n' || b == b'\r').map_or(text.len(), |i| at + i);
+    start..end
+}

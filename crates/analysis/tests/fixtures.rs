@@ -1,0 +1,159 @@
+//! Fixture programs with the expected diagnostics written inline.
+//!
+//! Every `*.ncp` in `test_data/rules` is analysed and its diagnostics are
+//! compared with the annotations in it. An annotation is a comment-only line
+//! right after the line it describes:
+//!
+//! ```text
+//! N20 G01 X10 Y10
+//! "   ^^^ missing-feed
+//! ```
+//!
+//! The carets stand under the diagnostic's range (same columns, counted in
+//! characters), followed by the rule's name. `"@ name` instead says that a
+//! diagnostic of that rule starts somewhere on the line above (for ranges
+//! that start in the first column). A `name.toml` beside a fixture is used
+//! as its `ncc.toml`. Files without annotations must have no diagnostics.
+
+use std::{fmt::Write, fs, path::PathBuf};
+
+use ncc_analysis::{AnalysisHost, Config, Diagnostic, Rule};
+
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+struct Expected {
+    line: usize,
+    /// Start and end column; `None` for `@` annotations.
+    columns: Option<(usize, usize)>,
+    name: String,
+}
+
+fn annotations(text: &str) -> Vec<Expected> {
+    let mut expected = Vec::new();
+    let mut target_line = 0;
+    for (number, line) in text.lines().enumerate() {
+        let Some(rest) = line.strip_prefix('"') else {
+            target_line = number;
+            continue;
+        };
+        let body = rest.trim_start();
+        if let Some(name) = body.strip_prefix('@') {
+            expected.push(Expected { line: target_line, columns: None, name: name.trim().to_owned() });
+        } else if body.starts_with('^') {
+            let chars: Vec<char> = line.chars().collect();
+            let start = chars.iter().position(|&c| c == '^').expect("a caret");
+            let end = start + chars[start..].iter().take_while(|&&c| c == '^').count();
+            let name = chars[end..].iter().collect::<String>().trim().to_owned();
+            expected.push(Expected { line: target_line, columns: Some((start, end)), name });
+        } else {
+            // An ordinary comment line belongs to nothing.
+            continue;
+        }
+    }
+    expected
+}
+
+fn actual(text: &str, diagnostic: &Diagnostic) -> Expected {
+    let start = usize::from(diagnostic.range.start());
+    let end = usize::from(diagnostic.range.end());
+    let line = text[..start].matches('\n').count();
+    let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
+    let column = |at: usize| text[line_start..at].chars().count();
+    let end_column = if text[start..end].contains('\n') { column(start) + 1 } else { column(end) };
+    Expected { line, columns: Some((column(start), end_column)), name: diagnostic.name.to_owned() }
+}
+
+fn matches(expected: &Expected, actual: &Expected) -> bool {
+    expected.line == actual.line
+        && expected.name == actual.name
+        && expected.columns.is_none_or(|columns| Some(columns) == actual.columns)
+}
+
+fn fixtures() -> Vec<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("test_data/rules");
+    let mut files: Vec<PathBuf> = fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ncp"))
+        .collect();
+    files.sort();
+    files
+}
+
+fn check(path: &PathBuf) -> Result<Vec<Diagnostic>, String> {
+    let text = fs::read_to_string(path).unwrap();
+    let config_path = path.with_extension("toml");
+    let config = if config_path.exists() {
+        Config::from_toml(&fs::read_to_string(&config_path).unwrap(), &config_path.display().to_string())?
+    } else {
+        Config::default()
+    };
+    let mut host = AnalysisHost::new(config);
+    let file = host.add_file(path.display().to_string(), text.as_str());
+    let diagnostics = host.analysis().diagnostics(file);
+
+    let mut expected = annotations(&text);
+    let mut unexpected = Vec::new();
+    for diagnostic in &diagnostics {
+        let found = actual(&text, diagnostic);
+        match expected.iter().position(|e| matches(e, &found)) {
+            Some(i) => {
+                expected.remove(i);
+            }
+            None => unexpected.push((found, diagnostic)),
+        }
+    }
+    if expected.is_empty() && unexpected.is_empty() {
+        return Ok(diagnostics);
+    }
+    let mut report = format!("{}:\n", path.display());
+    for e in &expected {
+        let at = e.columns.map_or(String::new(), |(s, end)| format!(":{}-{}", s + 1, end + 1));
+        let _ = writeln!(report, "  missing    {}{at} {}", e.line + 1, e.name);
+    }
+    for (found, diagnostic) in &unexpected {
+        let (s, end) = found.columns.unwrap();
+        let _ = writeln!(
+            report,
+            "  unexpected {}:{}-{} {}: {}",
+            found.line + 1,
+            s + 1,
+            end + 1,
+            found.name,
+            diagnostic.message
+        );
+    }
+    Err(report)
+}
+
+#[test]
+fn fixtures_have_exactly_the_annotated_diagnostics() {
+    let mut failures = String::new();
+    let mut covered = std::collections::BTreeSet::new();
+    for path in fixtures() {
+        match check(&path) {
+            Ok(diagnostics) => covered.extend(diagnostics.iter().map(|d| d.name)),
+            Err(report) => failures.push_str(&report),
+        }
+    }
+    assert!(failures.is_empty(), "\n{failures}");
+    let untested: Vec<_> = Rule::ALL.iter().map(|r| r.name()).filter(|name| !covered.contains(name)).collect();
+    assert!(untested.is_empty(), "rules without a fixture that shows them: {untested:?}");
+    println!("{} rules shown by fixtures", Rule::ALL.len());
+}
+
+/// The bundled examples are realistic programs: they must be clean.
+#[test]
+fn examples_have_no_diagnostics() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let mut host = AnalysisHost::default();
+    let mut files = Vec::new();
+    for entry in ["milling/pocket.NCP", "milling/holes.NCP", "lathe/shaft.NCP", "macros/L9001"] {
+        let path = dir.join(entry);
+        files.push(host.add_file(path.display().to_string(), fs::read_to_string(&path).unwrap().as_str()));
+    }
+    let analysis = host.analysis();
+    for file in files {
+        let diagnostics = analysis.diagnostics(file);
+        assert!(diagnostics.is_empty(), "{}: {diagnostics:#?}", analysis.path(file));
+    }
+}
