@@ -141,7 +141,7 @@ impl Config {
         let file: ConfigFile = toml::from_str(text).map_err(|e| format!("{origin}: {e}"))?;
         let mut config = Config { rules: file.rules, machine: MachineConfig::default() };
         let known = |key: &str| {
-            crate::Rule::ALL.iter().any(|r| r.code() == key || r.name() == key)
+            crate::Rule::find(key).is_some()
                 || ncc_syntax::SyntaxErrorKind::ALL.iter().any(|k| k.code() == key || k.name() == key)
         };
         if let Some(unknown) = config.rules.keys().find(|key| !known(key)) {

@@ -37,12 +37,12 @@ pub struct Fix {
 }
 
 impl Diagnostic {
-    pub fn new(rule: Rule, range: TextRange, message: impl Into<String>) -> Diagnostic {
+    pub fn new(rule: &'static Rule, range: TextRange, message: impl Into<String>) -> Diagnostic {
         Diagnostic {
             range,
-            severity: rule.severity(),
-            code: rule.code(),
-            name: rule.name(),
+            severity: rule.severity,
+            code: rule.code,
+            name: rule.name,
             message: message.into(),
             related: Vec::new(),
             fixes: Vec::new(),
@@ -86,68 +86,42 @@ impl Diagnostic {
     }
 }
 
-macro_rules! rules {
-    ($($variant:ident = $code:literal, $name:literal, $severity:ident, $summary:literal;)*) => {
-        /// Every semantic rule. Codes and names are stable: configuration
-        /// and suppression comments refer to them.
-        #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
-        pub enum Rule {
-            $($variant,)*
-        }
+/// A rule: what a diagnostic is about. Codes and names are stable:
+/// configuration and suppression comments refer to them.
+#[derive(Debug, PartialEq, Eq, Hash)]
+pub struct Rule {
+    pub code: &'static str,
+    pub name: &'static str,
+    /// The severity unless the project configuration changes it.
+    pub severity: Severity,
+    /// One line on what the rule checks.
+    pub summary: &'static str,
+}
 
-        impl Rule {
-            pub const ALL: &'static [Rule] = &[$(Rule::$variant,)*];
+impl Rule {
+    /// Every rule of every check module.
+    pub fn all() -> impl Iterator<Item = &'static Rule> {
+        crate::checks::RULES.iter().flat_map(|rules| rules.iter().copied())
+    }
 
-            pub fn code(self) -> &'static str {
-                match self {
-                    $(Rule::$variant => $code,)*
-                }
-            }
+    /// The rule with this code or name.
+    pub fn find(key: &str) -> Option<&'static Rule> {
+        Rule::all().find(|rule| rule.code == key || rule.name == key)
+    }
+}
 
-            pub fn name(self) -> &'static str {
-                match self {
-                    $(Rule::$variant => $name,)*
-                }
-            }
-
-            /// The severity unless the project configuration changes it.
-            pub fn severity(self) -> Severity {
-                match self {
-                    $(Rule::$variant => Severity::$severity,)*
-                }
-            }
-
-            /// One line on what the rule checks.
-            pub fn summary(self) -> &'static str {
-                match self {
-                    $(Rule::$variant => $summary,)*
-                }
-            }
-        }
+/// Declares a check module's rules as statics and lists them in `RULES`.
+macro_rules! declare_rules {
+    ($($ident:ident = $code:literal, $name:literal, $severity:ident, $summary:literal;)*) => {
+        $(
+            pub(crate) static $ident: $crate::Rule = $crate::Rule {
+                code: $code,
+                name: $name,
+                severity: ncc_syntax::Severity::$severity,
+                summary: $summary,
+            };
+        )*
+        pub(crate) static RULES: &[&$crate::Rule] = &[$(&$ident,)*];
     };
 }
-
-rules! {
-    // Block rules: one block and the catalogue.
-    UnknownCode = "B201", "unknown-code", Error, "A G code the control does not know.";
-    UnknownAddress = "B202", "unknown-address", Error, "A letter that is no address of the dialect or the configured axes.";
-    AddressRepeated = "B203", "address-repeated", Error, "An address written twice in one block.";
-    GroupConflict = "B204", "group-conflict", Error, "Two codes of one G or M group in one block.";
-    TooManyDigits = "B205", "too-many-digits", Error, "A value with more digits than its address's format allows.";
-    ValueOutOfRange = "B206", "value-out-of-range", Error, "A value outside its address's range.";
-    UnexpectedSign = "B207", "unexpected-sign", Error, "A sign on an address that takes only unsigned values.";
-    UnexpectedDecimalPoint = "B208", "unexpected-decimal-point", Warning, "A decimal point on a code, count or number.";
-    MissingRequiredAddress = "B209", "missing-required-address", Error, "A function without the address it needs in its block.";
-    NotSubstitutable = "B210", "not-substitutable", Error, "A parameter used where the control does not substitute one.";
-    TooManyAxes = "B211", "too-many-axes", Error, "More than six coordinates in one block.";
-    LengthCompensationDigits = "B212", "length-compensation-digits", Error, "An `&` digit other than 0, 1 or 2.";
-    DecimalPointRequired = "B213", "decimal-point-required", Error, "E written without its mandatory decimal point.";
-    SkipDigitIgnored = "B214", "skip-digit-ignored", Warning, "A digit after `/`, which the control does not evaluate.";
-    SkipRepeated = "B215", "skip-repeated", Warning, "More than one `/` in a block.";
-    MeaninglessAddress = "B216", "meaningless-address", Warning, "L or Q in a block without a function that reads it.";
-    TooManyParameterAssignments = "B217", "too-many-parameter-assignments", Error, "More than 95 parameter assignments in one block.";
-    G98NotAlone = "B218", "g98-not-alone", Error, "G98 (end of helix) shares its block with other words.";
-    DwellOverridesRepeat = "B219", "dwell-overrides-repeat", Warning, "G04 with a call or jump: Q is the dwell and the call runs once.";
-    SwallowedWords = "B221", "swallowed-words", Warning, "An unclosed comment that hides words after it.";
-    OffsetTableForm = "B223", "offset-table-form", Warning, "G92/G93 without the group-5 code that names the table row.";
-}
+pub(crate) use declare_rules;

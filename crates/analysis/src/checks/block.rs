@@ -5,9 +5,34 @@ use ncc_syntax::{Decimal, TextRange};
 use rustc_hash::FxHashMap;
 
 use crate::{
-    Config, Diagnostic, Rule,
+    Config, Diagnostic,
+    diagnostic::declare_rules,
     lower::{BlockData, Value, Word},
 };
+
+declare_rules! {
+    UNKNOWN_CODE = "B201", "unknown-code", Error, "A G code the control does not know.";
+    UNKNOWN_ADDRESS = "B202", "unknown-address", Error, "A letter that is no address of the dialect or the configured axes.";
+    ADDRESS_REPEATED = "B203", "address-repeated", Error, "An address written twice in one block.";
+    GROUP_CONFLICT = "B204", "group-conflict", Error, "Two codes of one G or M group in one block.";
+    TOO_MANY_DIGITS = "B205", "too-many-digits", Error, "A value with more digits than its address's format allows.";
+    VALUE_OUT_OF_RANGE = "B206", "value-out-of-range", Error, "A value outside its address's range.";
+    UNEXPECTED_SIGN = "B207", "unexpected-sign", Error, "A sign on an address that takes only unsigned values.";
+    UNEXPECTED_DECIMAL_POINT = "B208", "unexpected-decimal-point", Warning, "A decimal point on a code, count or number.";
+    MISSING_REQUIRED_ADDRESS = "B209", "missing-required-address", Error, "A function without the address it needs in its block.";
+    NOT_SUBSTITUTABLE = "B210", "not-substitutable", Error, "A parameter used where the control does not substitute one.";
+    TOO_MANY_AXES = "B211", "too-many-axes", Error, "More than six coordinates in one block.";
+    LENGTH_COMPENSATION_DIGITS = "B212", "length-compensation-digits", Error, "An `&` digit other than 0, 1 or 2.";
+    DECIMAL_POINT_REQUIRED = "B213", "decimal-point-required", Error, "E written without its mandatory decimal point.";
+    SKIP_DIGIT_IGNORED = "B214", "skip-digit-ignored", Warning, "A digit after `/`, which the control does not evaluate.";
+    SKIP_REPEATED = "B215", "skip-repeated", Warning, "More than one `/` in a block.";
+    MEANINGLESS_ADDRESS = "B216", "meaningless-address", Warning, "L or Q in a block without a function that reads it.";
+    TOO_MANY_PARAMETER_ASSIGNMENTS = "B217", "too-many-parameter-assignments", Error, "More than 95 parameter assignments in one block.";
+    G98_NOT_ALONE = "B218", "g98-not-alone", Error, "G98 (end of helix) shares its block with other words.";
+    DWELL_OVERRIDES_REPEAT = "B219", "dwell-overrides-repeat", Warning, "G04 with a call or jump: Q is the dwell and the call runs once.";
+    SWALLOWED_WORDS = "B221", "swallowed-words", Warning, "An unclosed comment that hides words after it.";
+    OFFSET_TABLE_FORM = "B223", "offset-table-form", Warning, "G92/G93 without the group-5 code that names the table row.";
+}
 
 /// The codes that read Q (dwell or repetitions) and L (call or jump target).
 const READS_Q: [u32; 4] = [4, 71, 72, 73];
@@ -23,7 +48,7 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
     for word in &block.words {
         let Some(address) = address_of(catalogue, word.letter) else {
             out.push(Diagnostic::new(
-                Rule::UnknownAddress,
+                &UNKNOWN_ADDRESS,
                 word.address_range,
                 format!("`{}` is no address of the CNC8x6 language", char::from(word.letter)),
             ));
@@ -33,7 +58,7 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
             if !config.machine.is_axis(word.letter) {
                 let configured: Vec<String> = config.machine.axes.iter().map(|&a| char::from(a).to_string()).collect();
                 out.push(Diagnostic::new(
-                    Rule::UnknownAddress,
+                    &UNKNOWN_ADDRESS,
                     word.address_range,
                     format!(
                         "the machine has no axis `{}`: its axes are {} (set `machine.axes` in ncc.toml for other letters)",
@@ -48,7 +73,7 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
             if let Some(first) = seen.get(&word.letter) {
                 out.push(
                     Diagnostic::new(
-                        Rule::AddressRepeated,
+                        &ADDRESS_REPEATED,
                         word.range,
                         format!(
                             "address `{}` appears twice in this block; each address may be written once (only G and M codes of different groups and R assignments repeat)",
@@ -64,7 +89,7 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
         match &word.value {
             Some(Value::Literal(literal)) => check_literal(word, address, &literal.decimal(), catalogue, &mut out),
             Some(Value::Parameter { .. }) if !address.substitutable => out.push(Diagnostic::new(
-                Rule::NotSubstitutable,
+                &NOT_SUBSTITUTABLE,
                 word.value_range.unwrap_or(word.range),
                 format!("`{}` cannot take a parameter: write the value itself", address.letter),
             )),
@@ -73,7 +98,7 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
     }
     if axes.len() > 6 {
         out.push(Diagnostic::new(
-            Rule::TooManyAxes,
+            &TOO_MANY_AXES,
             TextRange::new(axes[6].range.start(), axes.last().expect("more than six").range.end()),
             format!("{} coordinates in one block; the control interpolates at most six", axes.len()),
         ));
@@ -103,19 +128,19 @@ fn check_literal(word: &Word, address: &Address, value: &Decimal, catalogue: &Ca
     let letter = &address.letter;
     if value.sign().is_some() && !address.signed {
         out.push(Diagnostic::new(
-            Rule::UnexpectedSign,
+            &UNEXPECTED_SIGN,
             range,
             format!("`{letter}` takes only unsigned values; remove the sign"),
         ));
         return;
     }
     if let Some(message) = digit_overflow(address, value) {
-        out.push(Diagnostic::new(Rule::TooManyDigits, range, message));
+        out.push(Diagnostic::new(&TOO_MANY_DIGITS, range, message));
         return;
     }
     if value.has_point() && address.frac_digits == Some(0) {
         out.push(Diagnostic::new(
-            Rule::UnexpectedDecimalPoint,
+            &UNEXPECTED_DECIMAL_POINT,
             range,
             format!("`{letter}` is a code or count without decimals; write it without a decimal point"),
         ));
@@ -128,7 +153,7 @@ fn check_literal(word: &Word, address: &Address, value: &Decimal, catalogue: &Ca
         let digits = value.to_string();
         if digits.bytes().any(|b| !matches!(b, b'0'..=b'2' | b'.' | b'-' | b'+')) {
             out.push(Diagnostic::new(
-                Rule::LengthCompensationDigits,
+                &LENGTH_COMPENSATION_DIGITS,
                 range,
                 format!("`&{digits}`: each digit assigns one axis's length correction and must be 0 (off), 1 (add) or 2 (subtract)"),
             ));
@@ -137,7 +162,7 @@ fn check_literal(word: &Word, address: &Address, value: &Decimal, catalogue: &Ca
     }
     if address.role == AddressRole::ThreadLeadIn && !value.has_point() {
         out.push(Diagnostic::new(
-            Rule::DecimalPointRequired,
+            &DECIMAL_POINT_REQUIRED,
             range,
             format!("the lead-in length must be written with a decimal point: `E{value}.`"),
         ));
@@ -146,7 +171,7 @@ fn check_literal(word: &Word, address: &Address, value: &Decimal, catalogue: &Ca
         let number = value.to_f64();
         if number < min || number > max {
             out.push(Diagnostic::new(
-                Rule::ValueOutOfRange,
+                &VALUE_OUT_OF_RANGE,
                 range,
                 format!(
                     "`{letter}{value}` is outside the range of `{letter}`: {} to {}",
@@ -203,7 +228,7 @@ fn check_code(word: &Word, value: &Decimal, catalogue: &Catalogue, out: &mut Vec
     if catalogue.code(letter, number).is_none() && catalogue.group_of(letter, number).is_none() {
         let range = word.range;
         out.push(Diagnostic::new(
-            Rule::UnknownCode,
+            &UNKNOWN_CODE,
             range,
             format!("{letter}{number:02} is not a function of the CNC8x6 control (`ncc explain {letter}{number:02}` suggests similar ones)"),
         ));
@@ -221,7 +246,7 @@ fn check_groups(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Diagnost
                     let l = char::from(letter);
                     out.push(
                         Diagnostic::new(
-                            Rule::GroupConflict,
+                            &GROUP_CONFLICT,
                             word.range,
                             format!(
                                 "{l}{number:02} and {l}{first:02} are both in group {} ({}); one code per group may be written in a block",
@@ -250,7 +275,7 @@ fn check_required_addresses(block: &BlockData, catalogue: &Catalogue, out: &mut 
             if !missing.is_empty() {
                 let what = missing.iter().map(|m| format!("`{m}`")).collect::<Vec<_>>().join(", ");
                 out.push(Diagnostic::new(
-                    Rule::MissingRequiredAddress,
+                    &MISSING_REQUIRED_ADDRESS,
                     word.range,
                     format!("{} ({}) needs {what} in the same block", code.code, code.title),
                 ));
@@ -274,14 +299,14 @@ fn check_block_only_addresses(block: &BlockData, out: &mut Vec<Diagnostic>) {
     let reads = |codes: &[u32]| codes.iter().any(|&c| block.has_code(b'G', c));
     if let Some(q) = block.word(b'Q').filter(|_| !reads(&READS_Q)) {
         out.push(Diagnostic::new(
-            Rule::MeaninglessAddress,
+            &MEANINGLESS_ADDRESS,
             q.range,
             "Q has no effect here: it is the dwell of G04 or the repetitions of G71, G72, G73, and holds only in its block",
         ));
     }
     if let Some(l) = block.word(b'L').filter(|_| !reads(&READS_L)) {
         out.push(Diagnostic::new(
-            Rule::MeaninglessAddress,
+            &MEANINGLESS_ADDRESS,
             l.range,
             "L has no effect here: it names the target of G71, G72, G73 or G79, and holds only in its block",
         ));
@@ -297,17 +322,17 @@ fn check_assignments(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Dia
                 let value = literal.decimal();
                 let range = assignment.value_range.unwrap_or(assignment.range);
                 if let Some(message) = digit_overflow(r, &value) {
-                    out.push(Diagnostic::new(Rule::TooManyDigits, range, message));
+                    out.push(Diagnostic::new(&TOO_MANY_DIGITS, range, message));
                 } else if parameter_raw(&value).is_none_or(|raw| raw.abs() > 69_999_999) {
                     out.push(Diagnostic::new(
-                        Rule::ValueOutOfRange,
+                        &VALUE_OUT_OF_RANGE,
                         range,
                         format!("`{value}` is outside the parameter range -69999.999 to 69999.999"),
                     ));
                 }
             }
             Some(Value::Parameter { .. }) => out.push(Diagnostic::new(
-                Rule::NotSubstitutable,
+                &NOT_SUBSTITUTABLE,
                 assignment.value_range.unwrap_or(assignment.range),
                 "a parameter cannot be assigned another parameter (`R1=R2`); use parameter arithmetic: `G26 R5=00020001` copies R2 into R1",
             )),
@@ -316,7 +341,7 @@ fn check_assignments(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Dia
     }
     if block.assignments.len() > 95 {
         out.push(Diagnostic::new(
-            Rule::TooManyParameterAssignments,
+            &TOO_MANY_PARAMETER_ASSIGNMENTS,
             block.assignments[95].range,
             format!("{} parameter assignments in one block; the control takes at most 95", block.assignments.len()),
         ));
@@ -333,13 +358,13 @@ pub(crate) fn parameter_raw(value: &Decimal) -> Option<i64> {
 fn check_skip(block: &BlockData, out: &mut Vec<Diagnostic>) {
     for digit in &block.skip_digits {
         out.push(Diagnostic::new(
-            Rule::SkipDigitIgnored,
+            &SKIP_DIGIT_IGNORED,
             *digit,
             "the digit after `/` is not evaluated: any `/` is skipped when block skip is on",
         ));
     }
     for skip in block.skip.iter().skip(1) {
-        out.push(Diagnostic::new(Rule::SkipRepeated, *skip, "this block already has `/`; one is enough"));
+        out.push(Diagnostic::new(&SKIP_REPEATED, *skip, "this block already has `/`; one is enough"));
     }
 }
 
@@ -348,7 +373,7 @@ fn check_dwell(block: &BlockData, out: &mut Vec<Diagnostic>) {
     if let Some((code, call)) = block.codes(b'G').find(|(code, _)| matches!(code, 71..=73)) {
         out.push(
             Diagnostic::new(
-                Rule::DwellOverridesRepeat,
+                &DWELL_OVERRIDES_REPEAT,
                 call.range,
                 format!("with G04 in the block, Q is the dwell time: G{code} runs once, not Q times; put the dwell in a block of its own"),
             )
@@ -368,7 +393,7 @@ fn check_offset_table_form(block: &BlockData, out: &mut Vec<Diagnostic>) {
             } else {
                 "G93 needs the zero-offset row to set (G53 to G59 in the block)"
             };
-            out.push(Diagnostic::new(Rule::OffsetTableForm, word.range, message));
+            out.push(Diagnostic::new(&OFFSET_TABLE_FORM, word.range, message));
         }
     }
 }
@@ -378,7 +403,7 @@ fn check_g98_alone(block: &BlockData, out: &mut Vec<Diagnostic>) {
     let others = block.body_words().count() + block.assignments.len();
     if others > 1 {
         out.push(Diagnostic::new(
-            Rule::G98NotAlone,
+            &G98_NOT_ALONE,
             g98.range,
             "G98 ends the helix and must be programmed in a block of its own",
         ));
@@ -394,7 +419,7 @@ fn check_swallowed_words(block: &BlockData, catalogue: &Catalogue, out: &mut Vec
         if trailing_words > 0 && trailing_words < tokens.len() {
             let words = tokens[tokens.len() - trailing_words..].join(" ");
             out.push(Diagnostic::new(
-                Rule::SwallowedWords,
+                &SWALLOWED_WORDS,
                 comment.range,
                 format!("the comment is not closed, so `{words}` belongs to it and is not executed; close the comment with `\"` before them if they are program words"),
             ));

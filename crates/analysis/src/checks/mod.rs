@@ -1,3 +1,27 @@
 //! The rules, by what they need to decide.
 
 pub(crate) mod block;
+
+/// The rules of every check module.
+pub(crate) static RULES: &[&[&crate::Rule]] = &[block::RULES];
+
+#[cfg(test)]
+mod tests {
+    use std::collections::HashSet;
+
+    use crate::Rule;
+
+    #[test]
+    fn codes_and_names_are_unique() {
+        let mut codes = HashSet::new();
+        let mut names = HashSet::new();
+        for kind in ncc_syntax::SyntaxErrorKind::ALL {
+            assert!(codes.insert(kind.code()) && names.insert(kind.name()));
+        }
+        for rule in Rule::all() {
+            assert!(codes.insert(rule.code), "code {} twice", rule.code);
+            assert!(names.insert(rule.name), "name {} twice", rule.name);
+            assert!(rule.summary.ends_with('.'), "{}: summary is a sentence", rule.name);
+        }
+    }
+}
