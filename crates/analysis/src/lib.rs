@@ -12,6 +12,7 @@ mod config;
 mod db;
 mod diagnostic;
 pub mod lower;
+pub mod model;
 mod suppress;
 
 use std::sync::Arc;
@@ -139,6 +140,7 @@ fn file_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
     for block in db::file_blocks(db, file) {
         all.extend(db::block_diagnostics(db, block.syntax).iter().map(|d| d.clone().shifted(block.offset)));
     }
+    all.extend(checks::structure::check(db, file));
     let suppressions = suppress::Suppressions::of(file.text(db), parse);
     let mut diagnostics: Vec<Diagnostic> =
         all.into_iter().filter(|d| !suppressions.silences(d)).filter_map(|d| config.adjust(d)).collect();

@@ -68,33 +68,62 @@ fn matches(expected: &Expected, actual: &Expected) -> bool {
         && expected.columns.is_none_or(|columns| Some(columns) == actual.columns)
 }
 
+/// Single-file fixtures (`*.ncp`) and workspace fixtures (directories whose
+/// files are analysed together, e.g. a program and its macrocycle files).
 fn fixtures() -> Vec<PathBuf> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("test_data/rules");
-    let mut files: Vec<PathBuf> = fs::read_dir(&dir)
+    let mut entries: Vec<PathBuf> = fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "ncp"))
+        .filter(|p| p.is_dir() || p.extension().is_some_and(|e| e == "ncp"))
         .collect();
-    files.sort();
-    files
+    entries.sort();
+    entries
 }
 
-fn check(path: &PathBuf) -> Result<Vec<Diagnostic>, String> {
-    let text = fs::read_to_string(path).unwrap();
-    let config_path = path.with_extension("toml");
+fn check(fixture: &PathBuf) -> Result<Vec<Diagnostic>, String> {
+    let (files, config_path) = if fixture.is_dir() {
+        let mut files: Vec<PathBuf> = fs::read_dir(fixture)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.file_name().is_some_and(|n| n != "ncc.toml"))
+            .collect();
+        files.sort();
+        (files, fixture.join("ncc.toml"))
+    } else {
+        (vec![fixture.clone()], fixture.with_extension("toml"))
+    };
     let config = if config_path.exists() {
         Config::from_toml(&fs::read_to_string(&config_path).unwrap(), &config_path.display().to_string())?
     } else {
         Config::default()
     };
     let mut host = AnalysisHost::new(config);
-    let file = host.add_file(path.display().to_string(), text.as_str());
-    let diagnostics = host.analysis().diagnostics(file);
+    let ids: Vec<_> = files
+        .iter()
+        .map(|path| {
+            let text = fs::read_to_string(path).unwrap();
+            (host.add_file(path.display().to_string(), text.as_str()), path, text)
+        })
+        .collect();
+    let analysis = host.analysis();
+    let mut all = Vec::new();
+    let mut report = String::new();
+    for (file, path, text) in ids {
+        let diagnostics = analysis.diagnostics(file);
+        if let Err(mismatch) = compare(path, &text, &diagnostics) {
+            report.push_str(&mismatch);
+        }
+        all.extend(diagnostics);
+    }
+    if report.is_empty() { Ok(all) } else { Err(report) }
+}
 
-    let mut expected = annotations(&text);
+fn compare(path: &std::path::Path, text: &str, diagnostics: &[Diagnostic]) -> Result<(), String> {
+    let mut expected = annotations(text);
     let mut unexpected = Vec::new();
-    for diagnostic in &diagnostics {
-        let found = actual(&text, diagnostic);
+    for diagnostic in diagnostics {
+        let found = actual(text, diagnostic);
         match expected.iter().position(|e| matches(e, &found)) {
             Some(i) => {
                 expected.remove(i);
@@ -103,7 +132,7 @@ fn check(path: &PathBuf) -> Result<Vec<Diagnostic>, String> {
         }
     }
     if expected.is_empty() && unexpected.is_empty() {
-        return Ok(diagnostics);
+        return Ok(());
     }
     let mut report = format!("{}:\n", path.display());
     for e in &expected {

@@ -1,9 +1,10 @@
 //! The rules, by what they need to decide.
 
 pub(crate) mod block;
+pub(crate) mod structure;
 
 /// The rules of every check module.
-pub(crate) static RULES: &[&[&crate::Rule]] = &[block::RULES];
+pub(crate) static RULES: &[&[&crate::Rule]] = &[block::RULES, structure::RULES];
 
 #[cfg(test)]
 mod tests {

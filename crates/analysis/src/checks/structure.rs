@@ -1,0 +1,377 @@
+//! Program structure: header and end, units, block numbers, calls and jumps.
+
+use ncc_syntax::{TextEdit, TextRange, TextSize, ast::AstNode};
+use rustc_hash::FxHashMap;
+
+use crate::{
+    Diagnostic,
+    db::{self, Db, SourceFile},
+    diagnostic::declare_rules,
+    model::{self, FileKind, Program, Transfer, Unit},
+};
+
+declare_rules! {
+    MISSING_PROGRAM_HEADER = "P101", "missing-program-header", Error, "A partprogram without its `%` header.";
+    INVALID_PROGRAM_NUMBER = "P102", "invalid-program-number", Error, "A program number outside 1 to 999999.";
+    MISSING_PHYSICAL_END = "P103", "missing-physical-end", Info, "No `*` at the end, needed only for loading over a serial line.";
+    DUPLICATE_BLOCK_NUMBER = "P104", "duplicate-block-number", Error, "A block number used twice in one file.";
+    MISSING_PROGRAM_END = "P105", "missing-program-end", Error, "A main program without M02 or M30 in its last block.";
+    CODE_AFTER_PROGRAM_END = "P106", "code-after-program-end", Error, "Blocks after M02/M30 that belong to no subprogram.";
+    MISPLACED_SUBPROGRAM = "P107", "misplaced-subprogram", Error, "A subprogram before the main program's end.";
+    SUBPROGRAM_START_EXTRA_WORDS = "P108", "subprogram-start-extra-words", Error, "A `G79` block with words other than N, G79 and L.";
+    MISSING_G70 = "P109", "missing-g70", Error, "A subprogram or macrocycle without its closing G70 block.";
+    G70_OUTSIDE_SUBPROGRAM = "P110", "g70-outside-subprogram", Warning, "G70 in the main program, outside any subprogram.";
+    TOO_MANY_SUBPROGRAMS = "P111", "too-many-subprograms", Error, "More than 99 subprograms in one file.";
+    DUPLICATE_SUBPROGRAM = "P112", "duplicate-subprogram", Error, "Two subprograms with the same number.";
+    UNDEFINED_SUBPROGRAM = "P113", "undefined-subprogram", Error, "G71 calls a subprogram the file does not define.";
+    UNDEFINED_MACROCYCLE = "P114", "undefined-macrocycle", Warning, "G72 calls a macrocycle file the workspace does not have.";
+    MACROCYCLE_NUMBER_MISMATCH = "P115", "macrocycle-number-mismatch", Error, "A macrocycle file whose G79 L differs from its name.";
+    MACROCYCLE_WITHOUT_G79 = "P116", "macrocycle-without-g79", Error, "A macrocycle or cycle file that does not start with `G79 L..`.";
+    DUPLICATE_MACROCYCLE = "P117", "duplicate-macrocycle", Error, "Two macrocycle files with the same number.";
+    JUMP_TARGET_NOT_IN_UNIT = "P118", "jump-target-not-in-unit", Error, "G73 jumps to a block outside its program unit, or to none.";
+    NESTED_SUBPROGRAM_CALL = "P119", "nested-subprogram-call", Info, "G71 inside a subprogram, which the manual does not describe.";
+    CYCLE_NUMBER_UNREACHABLE = "P120", "cycle-number-unreachable", Warning, "A fixed-cycle body with a number outside 81 to 89.";
+}
+
+pub(crate) fn check(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
+    let program = model::program(db, file);
+    let mut out = Vec::new();
+    check_header_and_end(db, file, program, &mut out);
+    check_block_numbers(program, &mut out);
+    check_units(db, file, program, &mut out);
+    check_transfers(db, program, &mut out);
+    out
+}
+
+fn file_start(db: &dyn Db, file: SourceFile) -> TextRange {
+    let text = file.text(db);
+    let first_char = text.chars().next().map_or(0, char::len_utf8);
+    TextRange::at(TextSize::from(0), TextSize::from(first_char as u32))
+}
+
+fn check_header_and_end(db: &dyn Db, file: SourceFile, program: &Program, out: &mut Vec<Diagnostic>) {
+    let tree = file.parse(db).tree();
+    match tree.header() {
+        None if program.kind == FileKind::Program => out.push(Diagnostic::new(
+            &MISSING_PROGRAM_HEADER,
+            file_start(db, file),
+            "a partprogram must start with `%` and its number (1 to 999999), e.g. `%100 \"NAME\"`",
+        )),
+        None => {}
+        Some(header) => {
+            if let Some(number) = header.number() {
+                let value = number.scaled(0).filter(|_| !number.has_point() && number.sign().is_none());
+                if !value.is_some_and(|v| (1..=999_999).contains(&v)) {
+                    let range = header.number_token().map_or(header.text_range(), |t| t.text_range());
+                    out.push(Diagnostic::new(
+                        &INVALID_PROGRAM_NUMBER,
+                        range,
+                        format!("program number `{number}`: it must be a whole number from 1 to 999999, without sign or decimal point"),
+                    ));
+                }
+            }
+        }
+    }
+    if program.kind == FileKind::Program && tree.end().is_none() {
+        let last = program.blocks.len().checked_sub(1);
+        let range = last.map_or_else(|| file_start(db, file), |last| head(db, file, last));
+        out.push(Diagnostic::new(
+            &MISSING_PHYSICAL_END,
+            range,
+            "no physical end `*` after the last block: the control's editor adds it, but loading over a serial line needs it",
+        ));
+    }
+}
+
+/// Block numbers are unique in a file (in a fixed-cycle file, per body).
+fn check_block_numbers(program: &Program, out: &mut Vec<Diagnostic>) {
+    let mut seen: FxHashMap<(Option<usize>, u64), TextRange> = FxHashMap::default();
+    for block in &program.blocks {
+        let (Some(number), Some(range)) = (block.number, block.number_range) else { continue };
+        let scope = if program.kind == FileKind::CycleFile { block.unit } else { None };
+        match seen.get(&(scope, number)) {
+            Some(&first) => out.push(
+                Diagnostic::new(
+                    &DUPLICATE_BLOCK_NUMBER,
+                    range,
+                    format!("block number N{number} is already used: block numbers must be unique from `%` to `*`, subprograms included"),
+                )
+                .with_related(None, first, "first used here"),
+            ),
+            None => {
+                seen.insert((scope, number), range);
+            }
+        }
+    }
+}
+
+/// The range of a block's first word (its number, or whatever comes first).
+fn head(db: &dyn Db, file: SourceFile, index: usize) -> TextRange {
+    let block = &db::file_blocks(db, file)[index];
+    let data = db::lower_block(db, block.syntax);
+    data.words.first().map_or(TextRange::empty(block.offset), |w| w.range + block.offset)
+}
+
+fn check_units(db: &dyn Db, file: SourceFile, program: &Program, out: &mut Vec<Diagnostic>) {
+    let blocks = db::file_blocks(db, file);
+    if program.kind == FileKind::Program && !blocks.is_empty() && program.end_of_main.is_none() {
+        let last_main = program.units[0].blocks.end.saturating_sub(1);
+        out.push(Diagnostic::new(
+            &MISSING_PROGRAM_END,
+            head(db, file, last_main),
+            "the main program has no M02 or M30: its last block must end the program (subprograms follow after it)",
+        ));
+    }
+    for &index in &program.early_unit_starts {
+        let end = program.end_of_main.map(|e| head(db, file, e));
+        let mut diagnostic = Diagnostic::new(
+            &MISPLACED_SUBPROGRAM,
+            head(db, file, index),
+            "this subprogram starts before the main program's end: subprograms go after the block with M02 or M30",
+        );
+        if let Some(end) = end {
+            diagnostic = diagnostic.with_related(None, end, "the main program ends here");
+        }
+        out.push(diagnostic);
+    }
+    // In macrocycle and cycle files, blocks before the first unit are what
+    // `macrocycle-without-g79` reports.
+    let first_unit = program.units.first().map_or(usize::MAX, |u| u.blocks.start);
+    let stray: Vec<usize> = match program.kind {
+        FileKind::Program => program.stray_blocks.clone(),
+        _ => program.stray_blocks.iter().copied().filter(|&b| b > first_unit).collect(),
+    };
+    if let Some(&first) = stray.first() {
+        let last = *stray.last().expect("not empty");
+        let range = head(db, file, first).cover(head(db, file, last));
+        let message = match program.kind {
+            FileKind::Program => {
+                "blocks after M02/M30 must belong to a subprogram (`G79 L..` … `G70`); the control never runs these"
+            }
+            _ => "blocks outside `G79 L..` … `G70` are never run",
+        };
+        let mut diagnostic = Diagnostic::new(&CODE_AFTER_PROGRAM_END, range, message);
+        if let Some(end) = program.end_of_main {
+            diagnostic = diagnostic.with_related(None, head(db, file, end), "the main program ends here");
+        }
+        out.push(diagnostic);
+    }
+    for &index in &program.stray_g70 {
+        out.push(Diagnostic::new(
+            &G70_OUTSIDE_SUBPROGRAM,
+            g_word(db, file, index, 70).unwrap_or_else(|| head(db, file, index)),
+            "G70 ends a subprogram or macrocycle; in the main program it has no subprogram to end",
+        ));
+    }
+
+    let subprograms: Vec<&Unit> = program.units.iter().filter(|u| u.number.is_some()).collect();
+    if program.kind == FileKind::Program && subprograms.len() > 99 {
+        out.push(Diagnostic::new(
+            &TOO_MANY_SUBPROGRAMS,
+            head(db, file, subprograms[99].blocks.start),
+            format!("{} subprograms in one partprogram; the control takes at most 99", subprograms.len()),
+        ));
+    }
+    let mut numbers: FxHashMap<u32, usize> = FxHashMap::default();
+    for unit in &subprograms {
+        let start = unit.blocks.start;
+        check_unit_start(db, file, start, out);
+        let number = unit.number.expect("subprograms have numbers");
+        if let Some(&first) = numbers.get(&number) {
+            out.push(
+                Diagnostic::new(
+                    &DUPLICATE_SUBPROGRAM,
+                    head(db, file, start),
+                    format!("subprogram L{number} is defined twice"),
+                )
+                .with_related(None, head(db, file, first), "first defined here"),
+            );
+        } else {
+            numbers.insert(number, start);
+        }
+        if !unit.closed {
+            out.push(missing_g70(db, file, program, unit));
+        }
+        if program.kind == FileKind::CycleFile && !(81..=89).contains(&number) {
+            out.push(Diagnostic::new(
+                &CYCLE_NUMBER_UNREACHABLE,
+                head(db, file, start),
+                format!("cycle body L{number}: only G81 to G89 call fixed cycles, so this body can never run"),
+            ));
+        }
+    }
+    if let FileKind::Macrocycle(name) = program.kind {
+        check_macrocycle_file(db, file, program, name, out);
+    }
+}
+
+/// A `G79` block holds only N, G79 and L.
+fn check_unit_start(db: &dyn Db, file: SourceFile, index: usize, out: &mut Vec<Diagnostic>) {
+    let block = &db::file_blocks(db, file)[index];
+    let data = db::lower_block(db, block.syntax);
+    let extra: Vec<_> = data
+        .body_words()
+        .filter(|w| !(w.letter == b'L' || (w.letter == b'G' && data.codes(b'G').any(|(c, cw)| c == 79 && cw == *w))))
+        .collect();
+    let extra_assignments = data.assignments.first();
+    if let Some(first) = extra.first().map(|w| w.range).or(extra_assignments.map(|a| a.range)) {
+        out.push(Diagnostic::new(
+            &SUBPROGRAM_START_EXTRA_WORDS,
+            first + block.offset,
+            "the first block of a subprogram or macrocycle may hold only its number, G79 and L; move the other words to the next block",
+        ));
+    }
+}
+
+/// Missing G70, with a quick fix that closes the unit after its last block.
+fn missing_g70(db: &dyn Db, file: SourceFile, program: &Program, unit: &Unit) -> Diagnostic {
+    let number = unit.number.expect("subprograms have numbers");
+    let last = unit.blocks.end - 1;
+    let insert_at = block_end(db, file, last);
+    let used: Vec<u64> = program.blocks.iter().filter_map(|b| b.number).collect();
+    let numbers: Vec<u64> = program.blocks[unit.blocks.clone()].iter().filter_map(|b| b.number).collect();
+    let step = match numbers.as_slice() {
+        [.., a, b] if b > a => b - a,
+        _ => 1,
+    };
+    let mut next = numbers.last().copied().unwrap_or(0) + step;
+    while used.contains(&next) {
+        next += 1;
+    }
+    let text = file.text(db);
+    let at = usize::from(insert_at);
+    let needs_newline = at > 0 && !matches!(text.as_bytes()[at - 1], b'\n' | b'\r');
+    let insert = format!("{}N{next} G70\n", if needs_newline { "\n" } else { "" });
+    let reached = if unit.blocks.end < program.blocks.len() { "the next one starts" } else { "the file ends" };
+    let what = match program.kind {
+        FileKind::Program => "subprogram",
+        FileKind::Macrocycle(_) => "macrocycle",
+        FileKind::CycleFile => "cycle body",
+    };
+    Diagnostic::new(
+        &MISSING_G70,
+        head(db, file, unit.blocks.start),
+        format!("{what} L{number} has no closing G70 block: {reached} before it is closed"),
+    )
+    .with_related(None, head(db, file, last), "its last block")
+    .with_fix(
+        format!("Insert `N{next} G70` after the last block"),
+        vec![TextEdit::replace(TextRange::empty(insert_at), insert)],
+    )
+}
+
+/// Where block `index` ends.
+fn block_end(db: &dyn Db, file: SourceFile, index: usize) -> TextSize {
+    let block = &db::file_blocks(db, file)[index];
+    block.offset + db::lower_block(db, block.syntax).len
+}
+
+/// The range of the `G<code>` word in block `index`.
+fn g_word(db: &dyn Db, file: SourceFile, index: usize, code: u32) -> Option<TextRange> {
+    let block = &db::file_blocks(db, file)[index];
+    let data = db::lower_block(db, block.syntax);
+    data.codes(b'G').find(|(c, _)| *c == code).map(|(_, w)| w.range + block.offset)
+}
+
+fn check_macrocycle_file(db: &dyn Db, file: SourceFile, program: &Program, name: u32, out: &mut Vec<Diagnostic>) {
+    let Some(first) = program.units.first() else {
+        if !program.blocks.is_empty() {
+            out.push(Diagnostic::new(
+                &MACROCYCLE_WITHOUT_G79,
+                head(db, file, 0),
+                format!("a macrocycle file starts with the block `N.. G79 L{name}`"),
+            ));
+        }
+        return;
+    };
+    if first.blocks.start != 0 {
+        out.push(Diagnostic::new(
+            &MACROCYCLE_WITHOUT_G79,
+            head(db, file, 0),
+            format!("a macrocycle file starts with the block `N.. G79 L{name}`"),
+        ));
+    }
+    if let Some(number) = first.number.filter(|&n| n != name) {
+        out.push(Diagnostic::new(
+            &MACROCYCLE_NUMBER_MISMATCH,
+            head(db, file, first.blocks.start),
+            format!("the file is named L{name} but defines macrocycle L{number}: `G72 L{name}` looks the file up by its name"),
+        ));
+    }
+    let siblings = model::macrocycles(db).get(&name).map_or(&[][..], Vec::as_slice);
+    if let Some(other) = siblings.iter().find(|&&other| other != file) {
+        out.push(
+            Diagnostic::new(
+                &DUPLICATE_MACROCYCLE,
+                head(db, file, first.blocks.start),
+                format!(
+                    "macrocycle L{name} is also in {}: the control must not load two files of one macrocycle",
+                    other.path(db)
+                ),
+            )
+            .with_related(
+                Some(other.path(db).clone()),
+                TextRange::empty(TextSize::from(0)),
+                "the other file",
+            ),
+        );
+    }
+}
+
+fn check_transfers(db: &dyn Db, program: &Program, out: &mut Vec<Diagnostic>) {
+    for (index, block) in program.blocks.iter().enumerate() {
+        let Some((transfer, range)) = block.transfer else { continue };
+        let in_subprogram = program.unit_of(index).is_some_and(|u| u.number.is_some());
+        match transfer {
+            Transfer::Subprogram(number) => {
+                if program.subprogram(number).is_none() {
+                    let message = if program.kind == FileKind::Program {
+                        format!(
+                            "no subprogram L{number} in this file: G71 calls a `G79 L{number}` … `G70` subprogram after M02/M30 (G72 calls macrocycle files)"
+                        )
+                    } else {
+                        format!(
+                            "G71 L{number}: subprograms can be called only from their own partprogram; a macrocycle calls other macrocycles with G72"
+                        )
+                    };
+                    out.push(Diagnostic::new(&UNDEFINED_SUBPROGRAM, range, message));
+                } else if in_subprogram && program.kind == FileKind::Program {
+                    out.push(Diagnostic::new(
+                        &NESTED_SUBPROGRAM_CALL,
+                        range,
+                        "a subprogram calling another subprogram is not described in the manual; check that the control supports it",
+                    ));
+                }
+            }
+            Transfer::Macrocycle(number) => {
+                if !model::macrocycles(db).contains_key(&number) {
+                    out.push(Diagnostic::new(
+                        &UNDEFINED_MACROCYCLE,
+                        range,
+                        format!(
+                            "no macrocycle file L{number} in the workspace; the control needs it loaded as `L{number}`"
+                        ),
+                    ));
+                }
+            }
+            Transfer::Jump(target) => {
+                let Some(unit) = program.unit_of(index) else { continue };
+                let numbers = program.numbers_in(unit);
+                if !numbers.contains_key(&u64::from(target)) {
+                    let elsewhere = program.blocks.iter().position(|b| b.number == Some(u64::from(target)));
+                    let message = match elsewhere {
+                        Some(_) => format!(
+                            "N{target} is in another program unit: G73 jumps only within the main program, one subprogram or one macrocycle"
+                        ),
+                        None => format!("no block N{target} to jump to in this program unit"),
+                    };
+                    let mut diagnostic = Diagnostic::new(&JUMP_TARGET_NOT_IN_UNIT, range, message);
+                    if let Some(target_range) = elsewhere.and_then(|i| program.blocks[i].number_range) {
+                        diagnostic = diagnostic.with_related(None, target_range, "the block is here");
+                    }
+                    out.push(diagnostic);
+                }
+            }
+        }
+    }
+}

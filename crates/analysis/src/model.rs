@@ -1,0 +1,220 @@
+//! The program model: what kind of file, its program units, block numbers
+//! and calls.
+//!
+//! A partprogram is its main body up to the block with M02/M30, followed by
+//! subprograms (`G79 L..` … `G70`). A macrocycle file (`L<number>`) is one
+//! such unit; a fixed-cycle file (`$PC`) is a sequence of them.
+
+use std::ops::Range;
+
+use ncc_syntax::{SyntaxKind, TextRange, TextSize};
+use rustc_hash::FxHashMap;
+
+use crate::{
+    db::{self, Db, SourceFile},
+    lower::{BlockData, Value},
+};
+
+/// What a file is, by its name and first lines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FileKind {
+    Program,
+    /// A macrocycle file `L<number>`.
+    Macrocycle(u32),
+    /// A fixed-cycle file, which starts with the keyword `$PC`.
+    CycleFile,
+}
+
+impl FileKind {
+    /// The kind of the file at `path` whose text before the first block is
+    /// `prelude`.
+    pub fn of(path: &str, prelude: &str) -> FileKind {
+        let name = path.rsplit(['/', '\\']).next().unwrap_or(path);
+        let stem = name.split('.').next().unwrap_or(name);
+        let digits = stem.strip_prefix(['L', 'l']).filter(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()));
+        if let Some(number) = digits.and_then(|d| d.parse().ok()) {
+            return FileKind::Macrocycle(number);
+        }
+        if prelude.contains("$PC") { FileKind::CycleFile } else { FileKind::Program }
+    }
+}
+
+/// A program unit: the main body, a subprogram, a macrocycle or a cycle body.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct Unit {
+    /// The `L` of its `G79` block; `None` for the main body.
+    pub number: Option<u32>,
+    /// Indices of its blocks.
+    pub blocks: Range<usize>,
+    /// The block with G70 that closes it (the last block), if any.
+    pub closed: bool,
+}
+
+/// A call or jump written in a block.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Transfer {
+    /// `G71 L`: a subprogram of this file.
+    Subprogram(u32),
+    /// `G72 L`: a macrocycle file.
+    Macrocycle(u32),
+    /// `G73 L`: a block of the same unit.
+    Jump(u32),
+}
+
+/// One block in the model.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct BlockInfo {
+    pub offset: TextSize,
+    pub number: Option<u64>,
+    pub number_range: Option<TextRange>,
+    /// Which unit the block belongs to, if any (blocks after the program's
+    /// end outside a subprogram belong to none).
+    pub unit: Option<usize>,
+    pub transfer: Option<(Transfer, TextRange)>,
+}
+
+/// The structure of one file.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct Program {
+    pub kind: FileKind,
+    pub blocks: Vec<BlockInfo>,
+    pub units: Vec<Unit>,
+    /// The block that ends the main body (M02 or M30).
+    pub end_of_main: Option<usize>,
+    /// `G79` blocks found before the main body's end.
+    pub early_unit_starts: Vec<usize>,
+    /// Blocks after the main body that belong to no subprogram.
+    pub stray_blocks: Vec<usize>,
+    /// G70 blocks in the main body.
+    pub stray_g70: Vec<usize>,
+}
+
+impl Program {
+    /// The unit holding block `index`.
+    pub fn unit_of(&self, index: usize) -> Option<&Unit> {
+        self.blocks[index].unit.map(|u| &self.units[u])
+    }
+
+    /// The subprogram `G79 L<number>` of this file.
+    pub fn subprogram(&self, number: u32) -> Option<&Unit> {
+        self.units.iter().find(|u| u.number == Some(number))
+    }
+
+    /// Block indices of unit `unit` by block number.
+    pub fn numbers_in(&self, unit: &Unit) -> FxHashMap<u64, usize> {
+        let mut numbers = FxHashMap::default();
+        for index in unit.blocks.clone() {
+            if let Some(n) = self.blocks[index].number {
+                numbers.entry(n).or_insert(index);
+            }
+        }
+        numbers
+    }
+}
+
+/// The literal value of the first `letter` word, as an integer.
+fn literal(block: &BlockData, letter: u8) -> Option<(u32, TextRange)> {
+    block.words_with(letter).find_map(|w| match &w.value {
+        Some(Value::Literal(l)) => l.decimal().scaled(0).and_then(|v| u32::try_from(v).ok()).map(|v| (v, w.range)),
+        _ => None,
+    })
+}
+
+fn transfer(block: &BlockData) -> Option<(Transfer, TextRange)> {
+    let (target, _) = literal(block, b'L')?;
+    let (code, range) = block.codes(b'G').find(|(c, _)| matches!(c, 71..=73)).map(|(c, w)| (c, w.range))?;
+    let transfer = match code {
+        71 => Transfer::Subprogram(target),
+        72 => Transfer::Macrocycle(target),
+        _ => Transfer::Jump(target),
+    };
+    Some((transfer, range))
+}
+
+/// The structure of a file.
+#[salsa::tracked(returns(ref))]
+pub fn program(db: &dyn Db, file: SourceFile) -> Program {
+    let kind = file_kind(db, file);
+    let mut program = Program {
+        kind,
+        blocks: Vec::new(),
+        units: Vec::new(),
+        end_of_main: None,
+        early_unit_starts: Vec::new(),
+        stray_blocks: Vec::new(),
+        stray_g70: Vec::new(),
+    };
+    let file_blocks = db::file_blocks(db, file);
+    // Partprograms start in their main body; the other files in units only.
+    let mut in_main = kind == FileKind::Program;
+    if in_main {
+        program.units.push(Unit { number: None, blocks: 0..0, closed: false });
+    }
+    let mut open: Option<usize> = in_main.then_some(0);
+    for (index, file_block) in file_blocks.iter().enumerate() {
+        let block = db::lower_block(db, file_block.syntax);
+        let starts_unit = block.has_code(b'G', 79);
+        if starts_unit {
+            if in_main {
+                program.early_unit_starts.push(index);
+            }
+            let number = literal(block, b'L').map(|(n, _)| n);
+            program.units.push(Unit { number, blocks: index..index, closed: false });
+            open = Some(program.units.len() - 1);
+        }
+        let unit = open;
+        match unit {
+            Some(u) => program.units[u].blocks.end = index + 1,
+            None => program.stray_blocks.push(index),
+        }
+        program.blocks.push(BlockInfo {
+            offset: file_block.offset,
+            number: block.number.and_then(|n| n.value),
+            number_range: block.number.map(|n| n.range + file_block.offset),
+            unit,
+            transfer: transfer(block).map(|(t, range)| (t, range + file_block.offset)),
+        });
+        if block.has_code(b'G', 70) {
+            match open {
+                Some(u) if program.units[u].number.is_some() => {
+                    program.units[u].closed = true;
+                    open = if in_main { Some(0) } else { None };
+                }
+                _ => program.stray_g70.push(index),
+            }
+        }
+        let ends_main = in_main && open == Some(0) && (block.has_code(b'M', 2) || block.has_code(b'M', 30));
+        if ends_main {
+            program.end_of_main = Some(index);
+            in_main = false;
+            open = None;
+        }
+    }
+    program
+}
+
+/// The kind of a file.
+pub fn file_kind(db: &dyn Db, file: SourceFile) -> FileKind {
+    let text = file.text(db);
+    let first_block = db::file_blocks(db, file).first().map_or(text.len(), |b| usize::from(b.offset));
+    FileKind::of(file.path(db), &text[..first_block])
+}
+
+/// Whether the file has the `%` header and the `*` end.
+pub fn header_and_end(db: &dyn Db, file: SourceFile) -> (bool, bool) {
+    let root = file.parse(db).syntax_node();
+    let has = |kind| root.children().any(|n| n.kind() == kind);
+    (has(SyntaxKind::HEADER), has(SyntaxKind::END))
+}
+
+/// The macrocycle files of the workspace by number.
+#[salsa::tracked(returns(ref))]
+pub fn macrocycles(db: &dyn Db) -> FxHashMap<u32, Vec<SourceFile>> {
+    let mut map: FxHashMap<u32, Vec<SourceFile>> = FxHashMap::default();
+    for &file in db::Settings::get(db).files(db) {
+        if let FileKind::Macrocycle(number) = file_kind(db, file) {
+            map.entry(number).or_default().push(file);
+        }
+    }
+    map
+}
