@@ -1,23 +1,20 @@
 //! The salsa database: inputs and the queries computed from them.
 //!
 //! Inputs are the files (text and parse, kept in step by the host) and the
-//! settings (configuration and the workspace's file list). Per-block work is
-//! keyed by the block's green node, interned by identity: after an edit,
-//! the incremental reparse keeps every untouched block's node, so only the
-//! blocks the edit touched are lowered and checked again.
+//! settings (configuration and the workspace's file list). Block work is
+//! keyed by chunks of blocks interned by the blocks' identities: after an
+//! edit, the incremental reparse keeps every untouched block's node, so only
+//! the chunk the edit touched is lowered and checked again.
 
 use std::{
     hash::{Hash, Hasher},
     sync::{Arc, Mutex},
 };
 
-use ncc_syntax::{
-    Parse, SyntaxKind, SyntaxNode, TextSize,
-    ast::{self, AstNode},
-};
+use ncc_syntax::{Parse, SyntaxKind, TextSize};
 use rowan::GreenNode;
 
-use crate::{Config, Diagnostic, lower::BlockData};
+use crate::{Config, Diagnostic, lower::BlockData, model::BlockSummary};
 
 #[salsa::db]
 pub trait Db: salsa::Database {}
@@ -46,7 +43,7 @@ pub struct Settings {
 }
 
 /// A block's green node, compared and hashed by identity: blocks the
-/// reparse kept are the same node, and the interned value keeps the node
+/// reparse kept are the same node, and the interned chunk keeps the node
 /// alive, so an address is never reused while it is a key.
 #[derive(Debug, Clone)]
 pub struct BlockGreen(pub GreenNode);
@@ -65,45 +62,88 @@ impl Hash for BlockGreen {
     }
 }
 
+/// A run of consecutive blocks, the unit of incremental work. Chunks keep
+/// every query small (salsa's bookkeeping gets slow for queries with a
+/// million dependencies) and memory low (per-block results are kept as a
+/// compact summary, full block data is rebuilt when needed). Boundaries
+/// follow the blocks' identities, so an edit moves only the boundaries
+/// near it and leaves the other chunks, and their results, as they were.
 #[salsa::interned(debug)]
-pub struct BlockSyntax<'db> {
+pub struct BlockChunk<'db> {
     #[returns(ref)]
-    pub green: BlockGreen,
+    pub blocks: Vec<BlockGreen>,
 }
 
-/// A block of a file and where it starts.
+/// Chunks end after a block whose identity hashes to zero, or at this size.
+const MAX_CHUNK: usize = 1024;
+const CHUNK_SPREAD: u64 = 256;
+
+/// A chunk of a file and where it starts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, salsa::SalsaValue)]
-pub struct FileBlock<'db> {
-    pub syntax: BlockSyntax<'db>,
+pub struct FileChunk<'db> {
+    pub chunk: BlockChunk<'db>,
     pub offset: TextSize,
 }
 
-/// The blocks of a file, in order.
+/// The file's blocks in chunks, in order.
 #[salsa::tracked(returns(ref))]
-pub fn file_blocks(db: &dyn Db, file: SourceFile) -> Vec<FileBlock<'_>> {
+pub fn file_chunks(db: &dyn Db, file: SourceFile) -> Vec<FileChunk<'_>> {
     let root = file.parse(db).syntax_node();
-    root.children()
-        .filter(|node| node.kind() == SyntaxKind::BLOCK)
-        .map(|node| FileBlock {
-            syntax: BlockSyntax::new(db, BlockGreen(node.green().to_owned())),
-            offset: node.text_range().start(),
+    let mut chunks = Vec::new();
+    let mut current: Vec<BlockGreen> = Vec::new();
+    let mut start = TextSize::from(0);
+    for node in root.children().filter(|node| node.kind() == SyntaxKind::BLOCK) {
+        if current.is_empty() {
+            start = node.text_range().start();
+        }
+        let green = BlockGreen(node.green().to_owned());
+        let boundary = identity_hash(&green) % CHUNK_SPREAD == 0;
+        current.push(green);
+        if boundary || current.len() == MAX_CHUNK {
+            chunks.push(FileChunk { chunk: BlockChunk::new(db, std::mem::take(&mut current)), offset: start });
+        }
+    }
+    if !current.is_empty() {
+        chunks.push(FileChunk { chunk: BlockChunk::new(db, current), offset: start });
+    }
+    chunks
+}
+
+fn identity_hash(green: &BlockGreen) -> u64 {
+    let mut hasher = rustc_hash::FxHasher::default();
+    green.hash(&mut hasher);
+    hasher.finish()
+}
+
+/// The blocks of a chunk lowered, each with its offset from the chunk's
+/// start. Lowering is cheap and its results are large, so they are rebuilt
+/// on demand rather than stored.
+pub fn lower_chunk<'a>(db: &'a dyn Db, chunk: BlockChunk<'a>) -> impl Iterator<Item = (TextSize, BlockData)> + 'a {
+    let mut offset = TextSize::from(0);
+    chunk.blocks(db).iter().map(move |green| {
+        let block = (offset, BlockData::lower(&green.0));
+        offset += green.0.text_len();
+        block
+    })
+}
+
+/// The findings about the blocks of a chunk that need nothing but each
+/// block and the configuration; ranges relative to the chunk's start.
+#[salsa::tracked(returns(ref))]
+pub fn chunk_diagnostics<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<Diagnostic> {
+    let config = Settings::get(db).config(db);
+    lower_chunk(db, chunk)
+        .flat_map(|(offset, data)| {
+            crate::checks::block::check(&data, config).into_iter().map(move |d| d.shifted(offset))
         })
         .collect()
 }
 
-/// One block as plain data, ranges relative to its start.
+/// What the program model needs of each block of a chunk; ranges relative
+/// to the chunk's start.
 #[salsa::tracked(returns(ref))]
-pub fn lower_block<'db>(db: &'db dyn Db, block: BlockSyntax<'db>) -> BlockData {
-    let node = SyntaxNode::new_root(block.green(db).0.clone());
-    BlockData::lower(&ast::Block::cast(node).expect("interned blocks are BLOCK nodes"))
-}
-
-/// The findings about one block that need nothing but the block and the
-/// configuration; ranges relative to the block's start.
-#[salsa::tracked(returns(ref))]
-pub fn block_diagnostics<'db>(db: &'db dyn Db, block: BlockSyntax<'db>) -> Vec<Diagnostic> {
-    let config = Settings::get(db).config(db);
-    crate::checks::block::check(lower_block(db, block), config)
+pub fn chunk_summaries<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<BlockSummary> {
+    lower_chunk(db, chunk).map(|(offset, data)| BlockSummary::of(&data, offset)).collect()
 }
 
 /// The database. Cloning it gives a handle for another thread.

@@ -137,8 +137,8 @@ fn file_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
     let config = Settings::get(db).config(db);
     let parse = file.parse(db);
     let mut all: Vec<Diagnostic> = parse.errors().iter().map(Diagnostic::from_syntax).collect();
-    for block in db::file_blocks(db, file) {
-        all.extend(db::block_diagnostics(db, block.syntax).iter().map(|d| d.clone().shifted(block.offset)));
+    for chunk in db::file_chunks(db, file) {
+        all.extend(db::chunk_diagnostics(db, chunk.chunk).iter().map(|d| d.clone().shifted(chunk.offset)));
     }
     all.extend(checks::structure::check(db, file));
     let suppressions = suppress::Suppressions::of(file.text(db), parse);

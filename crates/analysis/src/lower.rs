@@ -5,10 +5,9 @@
 //! the block's green node: an edit re-lowers the blocks it touched and no
 //! other.
 
-use ncc_syntax::{
-    Decimal, Sign, SyntaxKind, SyntaxNode, TextRange, TextSize,
-    ast::{self, AstNode, BlockItem},
-};
+use ncc_catalog::{AddressRole, Dialect};
+use ncc_syntax::{Decimal, NcLanguage, Sign, SyntaxKind, TextRange, TextSize, ast};
+use rowan::{GreenNodeData, NodeOrToken};
 
 /// One block.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
@@ -49,31 +48,10 @@ pub struct Word {
 /// A word's or an assignment's value.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub enum Value {
-    Literal(Literal),
+    /// A number as written, with its sign.
+    Literal(Decimal),
     /// A parameter reference `R<index>`, with the sign written before it.
-    Parameter {
-        negative: bool,
-        index: Option<u32>,
-        index_range: TextRange,
-    },
-}
-
-/// A number as written; `Decimal` with hashing on its text.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
-pub struct Literal {
-    /// The written form, sign included (`-0.864`).
-    pub text: String,
-}
-
-impl Literal {
-    pub fn decimal(&self) -> Decimal {
-        let (sign, digits) = match self.text.as_bytes().first() {
-            Some(b'-') => (Some(Sign::Minus), &self.text[1..]),
-            Some(b'+') => (Some(Sign::Plus), &self.text[1..]),
-            _ => (None, self.text.as_str()),
-        };
-        Decimal::parse(sign, digits).expect("lowering keeps only numbers with digits")
-    }
+    Parameter { negative: bool, index: Option<u32>, index_range: TextRange },
 }
 
 /// `R<index>=<value>`.
@@ -97,77 +75,64 @@ pub struct Comment {
 }
 
 impl BlockData {
-    pub fn lower(block: &ast::Block) -> BlockData {
-        let start = block.syntax().text_range().start();
-        let relative = |range: TextRange| range - start;
+    /// Lowers a `BLOCK` green node. Works on the green tree directly: no red
+    /// tree is built, which makes lowering a large program several times
+    /// cheaper.
+    pub fn lower(block: &GreenNodeData) -> BlockData {
+        let block_letter = Dialect::Cnc8x6.catalogue().letter_with_role(AddressRole::BlockNumber);
         let mut data = BlockData {
             number: None,
             skip: Vec::new(),
             words: Vec::new(),
             assignments: Vec::new(),
             comments: Vec::new(),
-            len: block.syntax().text_range().len(),
+            len: block.text_len(),
             skip_digits: Vec::new(),
         };
         let mut line_has_words = false;
-        for element in block.syntax().children_with_tokens() {
-            match element.kind() {
-                SyntaxKind::NEWLINE => line_has_words = false,
-                SyntaxKind::WHITESPACE => {}
-                SyntaxKind::COMMENT => {
-                    let token = element.into_token().expect("a comment is a token");
-                    let comment = ast::Comment::cast(token).expect("COMMENT");
-                    data.comments.push(Comment {
-                        range: relative(comment.syntax().text_range()),
-                        closed: comment.is_closed(),
-                        body: comment.body().to_owned(),
-                        after_words: line_has_words,
-                    });
-                }
-                _ => line_has_words = true,
-            }
-        }
-        for item in block.items() {
-            match item {
-                BlockItem::Word(word) => {
-                    let lowered = Word {
-                        letter: word.letter() as u8,
-                        value: word.value().and_then(|v| lower_value(v, &relative)),
-                        range: relative(word.text_range()),
-                        address_range: relative(word.address_token().text_range()),
-                        value_range: word.value_range().map(relative),
-                    };
-                    if data.number.is_none() && data.words.is_empty() && word.is_block_number() {
-                        let value = match &lowered.value {
-                            Some(Value::Literal(literal)) => {
-                                literal.decimal().scaled(0).and_then(|v| u64::try_from(v).ok())
+        for (range, child) in children(block, TextSize::from(0)) {
+            match child {
+                NodeOrToken::Token(token) => match kind(token.kind()) {
+                    SyntaxKind::NEWLINE => line_has_words = false,
+                    SyntaxKind::WHITESPACE => {}
+                    SyntaxKind::COMMENT => {
+                        let (body, closed) = ast::comment_parts(token.text());
+                        data.comments.push(Comment {
+                            range,
+                            closed,
+                            body: body.to_owned(),
+                            after_words: line_has_words,
+                        });
+                    }
+                    _ => line_has_words = true,
+                },
+                NodeOrToken::Node(node) => {
+                    line_has_words = true;
+                    match kind(node.kind()) {
+                        SyntaxKind::WORD => {
+                            let word = lower_word(node, range);
+                            let first = data.words.is_empty() && data.number.is_none();
+                            if first && Some(word.letter) == block_letter {
+                                let value = match &word.value {
+                                    Some(Value::Literal(d)) => d.scaled(0).and_then(|v| u64::try_from(v).ok()),
+                                    _ => None,
+                                };
+                                data.number = Some(Number { value, range: word.range });
                             }
-                            _ => None,
-                        };
-                        data.number = Some(Number { value, range: lowered.range });
-                    }
-                    data.words.push(lowered);
-                }
-                BlockItem::Assign(assign) => {
-                    let index_range = assign
-                        .number_token()
-                        .map(|t| t.text_range())
-                        .unwrap_or_else(|| assign.syntax().first_token().expect("R").text_range());
-                    data.assignments.push(Assignment {
-                        index: assign.index().and_then(|d| d.scaled(0)).and_then(|v| u32::try_from(v).ok()),
-                        value: assign.value().and_then(|v| lower_value(v, &relative)),
-                        range: relative(assign.text_range()),
-                        index_range: relative(index_range),
-                        value_range: value_range_of(assign.syntax()).map(relative),
-                    });
-                }
-                BlockItem::Skip(skip) => {
-                    data.skip.push(relative(skip.text_range()));
-                    if let Some(digit) = skip.digit() {
-                        data.skip_digits.push(relative(digit.text_range()));
+                            data.words.push(word);
+                        }
+                        SyntaxKind::PARAM_ASSIGN => data.assignments.push(lower_assignment(node, range)),
+                        SyntaxKind::BLOCK_SKIP => {
+                            data.skip.push(range);
+                            let digit =
+                                children(node, range.start()).find(|(_, c)| kind(c.kind()) == SyntaxKind::NUMBER);
+                            if let Some((digit, _)) = digit {
+                                data.skip_digits.push(digit);
+                            }
+                        }
+                        _ => {}
                     }
                 }
-                BlockItem::Comment(_) | BlockItem::Error(_) => {}
             }
         }
         data
@@ -186,13 +151,10 @@ impl BlockData {
     /// The G or M codes written as literals, with their words.
     pub fn codes(&self, letter: u8) -> impl Iterator<Item = (u32, &Word)> {
         self.words_with(letter).filter_map(|w| match &w.value {
-            Some(Value::Literal(literal)) => {
-                let decimal = literal.decimal();
-                (!decimal.has_point() && decimal.sign().is_none())
-                    .then(|| decimal.scaled(0).and_then(|v| u32::try_from(v).ok()))
-                    .flatten()
-                    .map(|code| (code, w))
-            }
+            Some(Value::Literal(decimal)) => (!decimal.has_point() && decimal.sign().is_none())
+                .then(|| decimal.scaled(0).and_then(|v| u32::try_from(v).ok()))
+                .flatten()
+                .map(|code| (code, w)),
             _ => None,
         })
     }
@@ -209,23 +171,96 @@ impl BlockData {
     }
 }
 
-fn lower_value(value: ast::Value, relative: &impl Fn(TextRange) -> TextRange) -> Option<Value> {
-    Some(match value {
-        ast::Value::Literal(decimal) => Value::Literal(Literal { text: decimal.to_string() }),
-        ast::Value::Parameter { sign, param } => {
-            let token = param.number_token();
-            Value::Parameter {
-                negative: sign == Some(Sign::Minus),
-                index: param.index().and_then(|d| d.scaled(0)).and_then(|v| u32::try_from(v).ok()),
-                index_range: relative(token.map_or(param.text_range(), |t| t.text_range())),
-            }
-        }
+fn kind(raw: rowan::SyntaxKind) -> SyntaxKind {
+    <NcLanguage as rowan::Language>::kind_from_raw(raw)
+}
+
+type GreenRef<'a> = NodeOrToken<&'a GreenNodeData, &'a rowan::GreenTokenData>;
+
+/// The children of a green node with their ranges, `start` being the node's.
+fn children(node: &GreenNodeData, start: TextSize) -> impl Iterator<Item = (TextRange, GreenRef<'_>)> {
+    let mut offset = start;
+    node.children().map(move |child| {
+        let range = TextRange::at(offset, child.text_len());
+        offset = range.end();
+        (range, child)
     })
 }
 
-/// The range of an assignment's value: from the sign or number after `=`.
-fn value_range_of(node: &SyntaxNode) -> Option<TextRange> {
-    let mut after_eq = node.children_with_tokens().skip_while(|e| e.kind() != SyntaxKind::EQ).skip(1);
-    let first = after_eq.find(|e| e.kind() != SyntaxKind::WHITESPACE)?;
-    Some(TextRange::new(first.text_range().start(), node.text_range().end()))
+/// A word: address, then its value.
+fn lower_word(node: &GreenNodeData, range: TextRange) -> Word {
+    let mut items = children(node, range.start());
+    let (address_range, address) = items.next().expect("a word starts with its address");
+    let letter = match address {
+        NodeOrToken::Token(token) => token.text().as_bytes()[0].to_ascii_uppercase(),
+        NodeOrToken::Node(_) => b'?',
+    };
+    let (value, value_range) = lower_value(items, range.end());
+    Word { letter, value, range, address_range, value_range }
+}
+
+/// `R12=-0.864`.
+fn lower_assignment(node: &GreenNodeData, range: TextRange) -> Assignment {
+    let mut items = children(node, range.start());
+    let (letter_range, _) = items.next().expect("an assignment starts with R");
+    let mut index = None;
+    let mut index_range = letter_range;
+    for (item_range, item) in items.by_ref() {
+        match kind(item.kind()) {
+            SyntaxKind::NUMBER => {
+                index_range = item_range;
+                index = number(item).and_then(|d| d.scaled(0)).and_then(|v| u32::try_from(v).ok());
+            }
+            SyntaxKind::EQ => break,
+            _ => {}
+        }
+    }
+    let (value, value_range) = lower_value(items, range.end());
+    Assignment { index, value, range, index_range, value_range }
+}
+
+/// What follows an address or `=`: spaces, a sign, a number or `R<n>`.
+fn lower_value<'a>(
+    items: impl Iterator<Item = (TextRange, GreenRef<'a>)>,
+    end: TextSize,
+) -> (Option<Value>, Option<TextRange>) {
+    let mut sign = None;
+    let mut start = None;
+    for (range, item) in items {
+        let item_kind = kind(item.kind());
+        if item_kind == SyntaxKind::WHITESPACE && start.is_none() {
+            continue;
+        }
+        start.get_or_insert(range.start());
+        let value_range = start.map(|s| TextRange::new(s, end));
+        match (item_kind, item) {
+            (SyntaxKind::PLUS, _) => sign = Some(Sign::Plus),
+            (SyntaxKind::MINUS, _) => sign = Some(Sign::Minus),
+            (SyntaxKind::NUMBER, NodeOrToken::Token(token)) => {
+                return (Decimal::parse(sign, token.text()).map(Value::Literal), value_range);
+            }
+            (SyntaxKind::PARAM_REF, NodeOrToken::Node(param)) => {
+                let digits = children(param, range.start()).find(|(_, c)| kind(c.kind()) == SyntaxKind::NUMBER);
+                let (index_range, index) = match digits {
+                    Some((index_range, digits)) => {
+                        (index_range, number(digits).and_then(|d| d.scaled(0)).and_then(|v| u32::try_from(v).ok()))
+                    }
+                    None => (range, None),
+                };
+                return (
+                    Some(Value::Parameter { negative: sign == Some(Sign::Minus), index, index_range }),
+                    value_range,
+                );
+            }
+            _ => {}
+        }
+    }
+    (None, start.map(|s| TextRange::new(s, end)))
+}
+
+fn number(item: GreenRef<'_>) -> Option<Decimal> {
+    match item {
+        NodeOrToken::Token(token) => Decimal::parse(None, token.text()),
+        NodeOrToken::Node(_) => None,
+    }
 }

@@ -61,16 +61,73 @@ pub enum Transfer {
     Jump(u32),
 }
 
-/// One block in the model.
+/// What the program model needs of one block (ranges relative to where
+/// the summary's owner puts them: the chunk, or the file in [`BlockInfo`]).
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
-pub struct BlockInfo {
+pub struct BlockSummary {
     pub offset: TextSize,
+    pub len: TextSize,
     pub number: Option<u64>,
     pub number_range: Option<TextRange>,
+    /// The first word, where diagnostics about the whole block point.
+    pub head: TextRange,
+    /// `G79`, with its L if written as a number.
+    pub starts_unit: Option<Option<u32>>,
+    /// The G70 word.
+    pub closes_unit: Option<TextRange>,
+    /// M02 or M30.
+    pub ends_program: bool,
+    pub transfer: Option<(Transfer, TextRange)>,
+}
+
+impl BlockSummary {
+    pub(crate) fn of(block: &BlockData, offset: TextSize) -> BlockSummary {
+        BlockSummary {
+            offset,
+            len: block.len,
+            number: block.number.and_then(|n| n.value),
+            number_range: block.number.map(|n| n.range + offset),
+            head: block.words.first().map_or(TextRange::empty(offset), |w| w.range + offset),
+            starts_unit: block.has_code(b'G', 79).then(|| literal(block, b'L').map(|(n, _)| n)),
+            closes_unit: block.codes(b'G').find(|(c, _)| *c == 70).map(|(_, w)| w.range + offset),
+            ends_program: block.has_code(b'M', 2) || block.has_code(b'M', 30),
+            transfer: transfer(block).map(|(t, range)| (t, range + offset)),
+        }
+    }
+
+    fn shifted(&self, by: TextSize) -> BlockSummary {
+        let shift = |r: TextRange| r + by;
+        BlockSummary {
+            offset: self.offset + by,
+            number_range: self.number_range.map(shift),
+            head: shift(self.head),
+            closes_unit: self.closes_unit.map(shift),
+            transfer: self.transfer.map(|(t, r)| (t, shift(r))),
+            ..self.clone()
+        }
+    }
+
+    /// Where the block ends.
+    pub fn end(&self) -> TextSize {
+        self.offset + self.len
+    }
+}
+
+/// One block in the model, with file offsets.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct BlockInfo {
+    pub summary: BlockSummary,
     /// Which unit the block belongs to, if any (blocks after the program's
     /// end outside a subprogram belong to none).
     pub unit: Option<usize>,
-    pub transfer: Option<(Transfer, TextRange)>,
+}
+
+impl std::ops::Deref for BlockInfo {
+    type Target = BlockSummary;
+
+    fn deref(&self) -> &BlockSummary {
+        &self.summary
+    }
 }
 
 /// The structure of one file.
@@ -115,7 +172,7 @@ impl Program {
 /// The literal value of the first `letter` word, as an integer.
 fn literal(block: &BlockData, letter: u8) -> Option<(u32, TextRange)> {
     block.words_with(letter).find_map(|w| match &w.value {
-        Some(Value::Literal(l)) => l.decimal().scaled(0).and_then(|v| u32::try_from(v).ok()).map(|v| (v, w.range)),
+        Some(Value::Literal(l)) => l.scaled(0).and_then(|v| u32::try_from(v).ok()).map(|v| (v, w.range)),
         _ => None,
     })
 }
@@ -144,21 +201,20 @@ pub fn program(db: &dyn Db, file: SourceFile) -> Program {
         stray_blocks: Vec::new(),
         stray_g70: Vec::new(),
     };
-    let file_blocks = db::file_blocks(db, file);
     // Partprograms start in their main body; the other files in units only.
     let mut in_main = kind == FileKind::Program;
     if in_main {
         program.units.push(Unit { number: None, blocks: 0..0, closed: false });
     }
     let mut open: Option<usize> = in_main.then_some(0);
-    for (index, file_block) in file_blocks.iter().enumerate() {
-        let block = db::lower_block(db, file_block.syntax);
-        let starts_unit = block.has_code(b'G', 79);
-        if starts_unit {
+    let summaries = db::file_chunks(db, file)
+        .iter()
+        .flat_map(|chunk| db::chunk_summaries(db, chunk.chunk).iter().map(move |s| s.shifted(chunk.offset)));
+    for (index, summary) in summaries.enumerate() {
+        if let Some(number) = summary.starts_unit {
             if in_main {
                 program.early_unit_starts.push(index);
             }
-            let number = literal(block, b'L').map(|(n, _)| n);
             program.units.push(Unit { number, blocks: index..index, closed: false });
             open = Some(program.units.len() - 1);
         }
@@ -167,14 +223,10 @@ pub fn program(db: &dyn Db, file: SourceFile) -> Program {
             Some(u) => program.units[u].blocks.end = index + 1,
             None => program.stray_blocks.push(index),
         }
-        program.blocks.push(BlockInfo {
-            offset: file_block.offset,
-            number: block.number.and_then(|n| n.value),
-            number_range: block.number.map(|n| n.range + file_block.offset),
-            unit,
-            transfer: transfer(block).map(|(t, range)| (t, range + file_block.offset)),
-        });
-        if block.has_code(b'G', 70) {
+        let closes = summary.closes_unit.is_some();
+        let ends_main = in_main && open == Some(0) && summary.ends_program;
+        program.blocks.push(BlockInfo { summary, unit });
+        if closes {
             match open {
                 Some(u) if program.units[u].number.is_some() => {
                     program.units[u].closed = true;
@@ -183,7 +235,6 @@ pub fn program(db: &dyn Db, file: SourceFile) -> Program {
                 _ => program.stray_g70.push(index),
             }
         }
-        let ends_main = in_main && open == Some(0) && (block.has_code(b'M', 2) || block.has_code(b'M', 30));
         if ends_main {
             program.end_of_main = Some(index);
             in_main = false;
@@ -196,7 +247,7 @@ pub fn program(db: &dyn Db, file: SourceFile) -> Program {
 /// The kind of a file.
 pub fn file_kind(db: &dyn Db, file: SourceFile) -> FileKind {
     let text = file.text(db);
-    let first_block = db::file_blocks(db, file).first().map_or(text.len(), |b| usize::from(b.offset));
+    let first_block = db::file_chunks(db, file).first().map_or(text.len(), |c| usize::from(c.offset));
     FileKind::of(file.path(db), &text[..first_block])
 }
 

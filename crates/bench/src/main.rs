@@ -79,6 +79,11 @@ enum Command {
         #[arg(long, default_value_t = 200)]
         edits: usize,
     },
+    /// Check a generated program with the full analysis: time and peak heap.
+    Check {
+        #[arg(long, default_value_t = 1_000_000)]
+        blocks: usize,
+    },
     /// Parse a file once (for profilers such as perf or callgrind).
     ParseFile {
         path: PathBuf,
@@ -110,6 +115,7 @@ fn main() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::Parse { blocks, runs } => parse_benchmark(blocks, runs.max(1)),
         Command::Reparse { blocks, edits } => reparse_benchmark(blocks, edits),
+        Command::Check { blocks } => check_benchmark(blocks),
         Command::ParseFile { path, threads, gcode } => {
             let text = std::fs::read_to_string(&path)?;
             let start = Instant::now();
@@ -241,5 +247,38 @@ fn reparse_benchmark(blocks: usize, edits: usize) -> anyhow::Result<()> {
     println!("  full parse   {:>9.3} ms", full.as_secs_f64() * 1e3);
     println!("  reparse p50  {:>9.3} ms", percentile(0.5).as_secs_f64() * 1e3);
     println!("  reparse p99  {:>9.3} ms", percentile(0.99).as_secs_f64() * 1e3);
+    Ok(())
+}
+
+fn check_benchmark(blocks: usize) -> anyhow::Result<()> {
+    let text = progen::write(&progen::surfacing(blocks), Syntax::Cnc8x6);
+    let mb = text.len() as f64 / 1e6;
+    let base = IN_USE.load(Relaxed);
+    PEAK.store(base, Relaxed);
+    let start = Instant::now();
+    let mut host = ncc_analysis::AnalysisHost::default();
+    let file = host.add_file("surface.NCP", text);
+    let parsed = start.elapsed();
+    let after_parse = IN_USE.load(Relaxed) - base;
+    let diagnostics = host.analysis().diagnostics(file);
+    let total = start.elapsed();
+    anyhow::ensure!(diagnostics.is_empty(), "findings in a generated program: {:?}", &diagnostics[..1]);
+    println!("check benchmark: {blocks} blocks ({mb:.1} MB)");
+    println!("  parse            {:>9.1} ms", parsed.as_secs_f64() * 1e3);
+    println!(
+        "  parse + analysis {:>9.1} ms ({:.0} blocks/s)",
+        total.as_secs_f64() * 1e3,
+        blocks as f64 / total.as_secs_f64()
+    );
+    println!(
+        "  heap after parse {:>9.1} MB, held at the end {:.1} MB",
+        after_parse as f64 / 1e6,
+        (IN_USE.load(Relaxed) - base) as f64 / 1e6
+    );
+    println!(
+        "  peak heap        {:>9.1} MB ({:.0} bytes per block)",
+        (PEAK.load(Relaxed) - base) as f64 / 1e6,
+        (PEAK.load(Relaxed) - base) as f64 / blocks as f64
+    );
     Ok(())
 }

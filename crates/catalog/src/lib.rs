@@ -133,7 +133,11 @@ pub struct Catalogue {
 impl Catalogue {
     fn load(files: &DataFiles) -> Catalogue {
         let codes: CodesFile = parse(files.codes);
-        let addresses: AddressesFile = parse(files.addresses);
+        let mut addresses: AddressesFile = parse(files.addresses);
+        for address in &mut addresses.addresses {
+            let number = |text: &Option<String>| text.as_deref().and_then(|t| t.parse::<f64>().ok());
+            address.bounds = number(&address.min).zip(number(&address.max));
+        }
         let parameters: ParametersFile = parse(files.parameters);
         let constants: MachineConstantsFile = parse(files.machine_constants);
         let operations: OperationsFile = parse(files.operations);

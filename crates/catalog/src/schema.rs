@@ -219,6 +219,9 @@ entry! {
         /// text uses).
         #[serde(default = "yes")]
         pub in_dictionary: bool,
+        /// `min` and `max` as numbers, filled in when the catalogue loads.
+        #[serde(skip)]
+        pub bounds: Option<(f64, f64)>,
     }
 }
 

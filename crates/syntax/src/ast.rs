@@ -314,18 +314,21 @@ impl Comment {
 
     /// Whether the comment has its closing quote (else it ends at the line end).
     pub fn is_closed(&self) -> bool {
-        let text = self.0.text();
-        let open = text.chars().next().map_or(0, char::len_utf8);
-        text.len() > open && text[open..].ends_with(['"', '\u{201C}', '\u{201D}', '\u{201E}'])
+        comment_parts(self.0.text()).1
     }
 
     /// The text between the quotes.
     pub fn body(&self) -> &str {
-        let text = self.0.text();
-        let open = text.chars().next().map_or(0, char::len_utf8);
-        let close = if self.is_closed() { text.chars().next_back().map_or(0, char::len_utf8) } else { 0 };
-        &text[open..text.len() - close]
+        comment_parts(self.0.text()).0
     }
+}
+
+/// A comment token's text split into its body and whether it is closed.
+pub fn comment_parts(text: &str) -> (&str, bool) {
+    let open = text.chars().next().map_or(0, char::len_utf8);
+    let closed = text.len() > open && text[open..].ends_with(['"', '\u{201C}', '\u{201D}', '\u{201E}']);
+    let close = if closed { text.chars().next_back().map_or(0, char::len_utf8) } else { 0 };
+    (&text[open..text.len() - close], closed)
 }
 
 #[cfg(test)]

@@ -15,15 +15,16 @@ pub enum Sign {
 }
 
 /// A decimal number in its written form.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Decimal {
     sign: Option<Sign>,
-    int_digits: u32,
-    leading_zeros: u32,
-    frac_digits: u32,
     has_point: bool,
-    /// All digits as one integer (`12.50` → 1250); `None` past 38 digits.
-    mantissa: Option<u128>,
+    int_digits: u16,
+    leading_zeros: u16,
+    frac_digits: u16,
+    /// All digits as one integer (`12.50` → 1250); `None` past 19 digits,
+    /// far beyond any address's format.
+    mantissa: Option<u64>,
 }
 
 impl Decimal {
@@ -43,13 +44,14 @@ impl Decimal {
         let mantissa = int
             .bytes()
             .chain(frac_text.bytes())
-            .try_fold(0u128, |acc, b| acc.checked_mul(10)?.checked_add(u128::from(b - b'0')));
+            .try_fold(0u64, |acc, b| acc.checked_mul(10)?.checked_add(u64::from(b - b'0')));
+        let count = |n: usize| u16::try_from(n).unwrap_or(u16::MAX);
         Some(Decimal {
             sign,
-            int_digits: int.len() as u32,
-            leading_zeros: int.bytes().take_while(|&b| b == b'0').count() as u32,
-            frac_digits: frac_text.len() as u32,
             has_point: frac.is_some(),
+            int_digits: count(int.len()),
+            leading_zeros: count(int.bytes().take_while(|&b| b == b'0').count()),
+            frac_digits: count(frac_text.len()),
             mantissa,
         })
     }
@@ -69,29 +71,41 @@ impl Decimal {
 
     /// Digits written before the point, leading zeros included.
     pub fn int_digits(&self) -> u32 {
-        self.int_digits
+        u32::from(self.int_digits)
     }
 
     /// Digits written before the point without leading zeros (`0.5` → 0,
     /// `002500` → 4).
     pub fn significant_int_digits(&self) -> u32 {
-        self.int_digits - self.leading_zeros
+        u32::from(self.int_digits - self.leading_zeros)
     }
 
     /// Digits written after the point.
     pub fn frac_digits(&self) -> u32 {
-        self.frac_digits
+        u32::from(self.frac_digits)
+    }
+
+    /// Digits after the point without trailing zeros (`1.2500` → 2).
+    pub fn significant_frac_digits(&self) -> u32 {
+        let mut mantissa = self.mantissa.unwrap_or(1);
+        let mut digits = self.frac_digits();
+        while digits > 0 && mantissa % 10 == 0 {
+            mantissa /= 10;
+            digits -= 1;
+        }
+        digits
     }
 
     /// The value scaled by `10^scale` as an exact integer (`1.25` at scale 3
     /// is 1250). `None` if more than `scale` decimals were written with a
     /// non-zero digit among the extra ones, or on overflow.
     pub fn scaled(&self, scale: u32) -> Option<i128> {
-        let mantissa = i128::try_from(self.mantissa?).ok()?;
-        let magnitude = if scale >= self.frac_digits {
-            mantissa.checked_mul(10i128.checked_pow(scale - self.frac_digits)?)?
+        let mantissa = i128::from(self.mantissa?);
+        let frac_digits = self.frac_digits();
+        let magnitude = if scale >= frac_digits {
+            mantissa.checked_mul(10i128.checked_pow(scale - frac_digits)?)?
         } else {
-            let divisor = 10i128.checked_pow(self.frac_digits - scale)?;
+            let divisor = 10i128.checked_pow(frac_digits - scale)?;
             if mantissa % divisor != 0 {
                 return None;
             }
@@ -103,7 +117,7 @@ impl Decimal {
     /// The value as written (decimal point respected, no unit applied).
     pub fn to_f64(&self) -> f64 {
         let magnitude = match self.mantissa {
-            Some(m) => m as f64 / 10f64.powi(self.frac_digits as i32),
+            Some(m) => m as f64 / 10f64.powi(i32::from(self.frac_digits)),
             None => f64::INFINITY,
         };
         if self.sign == Some(Sign::Minus) { -magnitude } else { magnitude }
@@ -118,12 +132,12 @@ impl fmt::Display for Decimal {
             Some(Sign::Minus) => f.write_str("-")?,
             None => {}
         }
-        let width = (self.int_digits + self.frac_digits) as usize;
+        let width = usize::from(self.int_digits) + usize::from(self.frac_digits);
         let digits = match self.mantissa {
             Some(m) => format!("{m:0width$}"),
             None => "9".repeat(width),
         };
-        let (int, frac) = digits.split_at(self.int_digits as usize);
+        let (int, frac) = digits.split_at(usize::from(self.int_digits));
         f.write_str(int)?;
         if self.has_point {
             write!(f, ".{frac}")?;
@@ -171,6 +185,8 @@ mod tests {
         assert_eq!(dec("100.").scaled(3), Some(100_000));
         assert_eq!(dec("1.0005").scaled(3), None);
         assert_eq!(dec("1.2500").scaled(3), Some(1250));
+        assert_eq!(dec("1.2500").significant_frac_digits(), 2);
+        assert_eq!(dec("0.000").significant_frac_digits(), 0);
         assert_eq!(dec("1.5").to_f64(), 1.5);
         assert!(!dec("-0").is_negative());
     }

@@ -32,6 +32,7 @@ declare_rules! {
     DWELL_OVERRIDES_REPEAT = "B219", "dwell-overrides-repeat", Warning, "G04 with a call or jump: Q is the dwell and the call runs once.";
     SWALLOWED_WORDS = "B221", "swallowed-words", Warning, "An unclosed comment that hides words after it.";
     OFFSET_TABLE_FORM = "B223", "offset-table-form", Warning, "G92/G93 without the group-5 code that names the table row.";
+    SUBPROGRAM_START_EXTRA_WORDS = "B224", "subprogram-start-extra-words", Error, "A `G79` block with words other than N, G79 and L.";
 }
 
 /// The codes that read Q (dwell or repetitions) and L (call or jump target).
@@ -43,7 +44,7 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     let indirect_g = block.words_with(b'G').any(|w| matches!(w.value, Some(Value::Parameter { .. })));
 
-    let mut seen: FxHashMap<u8, &Word> = FxHashMap::default();
+    let mut seen: [Option<&Word>; 128] = [None; 128];
     let mut axes = Vec::new();
     for word in &block.words {
         let Some(address) = address_of(catalogue, word.letter) else {
@@ -70,7 +71,8 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
             axes.push(word);
         }
         if address.role != AddressRole::Function {
-            if let Some(first) = seen.get(&word.letter) {
+            let slot = &mut seen[usize::from(word.letter & 0x7F)];
+            if let Some(first) = slot {
                 out.push(
                     Diagnostic::new(
                         &ADDRESS_REPEATED,
@@ -83,11 +85,11 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
                     .with_related(None, first.range, "first written here"),
                 );
             } else {
-                seen.insert(word.letter, word);
+                *slot = Some(word);
             }
         }
         match &word.value {
-            Some(Value::Literal(literal)) => check_literal(word, address, &literal.decimal(), catalogue, &mut out),
+            Some(Value::Literal(literal)) => check_literal(word, address, literal, catalogue, &mut out),
             Some(Value::Parameter { .. }) if !address.substitutable => out.push(Diagnostic::new(
                 &NOT_SUBSTITUTABLE,
                 word.value_range.unwrap_or(word.range),
@@ -114,6 +116,7 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
     check_dwell(block, &mut out);
     check_offset_table_form(block, &mut out);
     check_g98_alone(block, &mut out);
+    check_unit_start(block, &mut out);
     check_swallowed_words(block, catalogue, &mut out);
     out
 }
@@ -167,7 +170,7 @@ fn check_literal(word: &Word, address: &Address, value: &Decimal, catalogue: &Ca
             format!("the lead-in length must be written with a decimal point: `E{value}.`"),
         ));
     }
-    if let (Some(min), Some(max)) = (bound(&address.min), bound(&address.max)) {
+    if let Some((min, max)) = address.bounds {
         let number = value.to_f64();
         if number < min || number > max {
             out.push(Diagnostic::new(
@@ -183,17 +186,13 @@ fn check_literal(word: &Word, address: &Address, value: &Decimal, catalogue: &Ca
     }
 }
 
-fn bound(text: &Option<String>) -> Option<f64> {
-    text.as_deref()?.parse().ok()
-}
-
 /// The format's digit limits: significant digits before the point (leading
 /// zeros may always be written) and digits after it (trailing zeros may be).
 pub(crate) fn digit_overflow(address: &Address, value: &Decimal) -> Option<String> {
     let int_limit =
         if value.has_point() { address.int_digits? } else { address.int_digits_without_point.or(address.int_digits)? };
     let int = value.significant_int_digits();
-    let frac = significant_frac_digits(value);
+    let frac = value.significant_frac_digits();
     let letter = &address.letter;
     if int > u32::from(int_limit) {
         let form = if address.int_digits_without_point.is_some() {
@@ -212,14 +211,6 @@ pub(crate) fn digit_overflow(address: &Address, value: &Decimal) -> Option<Strin
         ));
     }
     None
-}
-
-fn significant_frac_digits(value: &Decimal) -> u32 {
-    let text = value.to_string();
-    match text.split_once('.') {
-        Some((_, frac)) => frac.trim_end_matches('0').len() as u32,
-        None => 0,
-    }
 }
 
 fn check_code(word: &Word, value: &Decimal, catalogue: &Catalogue, out: &mut Vec<Diagnostic>) {
@@ -318,8 +309,7 @@ fn check_assignments(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Dia
     let Some(r) = catalogue.address("R") else { return };
     for assignment in &block.assignments {
         match &assignment.value {
-            Some(Value::Literal(literal)) => {
-                let value = literal.decimal();
+            Some(Value::Literal(value)) => {
                 let range = assignment.value_range.unwrap_or(assignment.range);
                 if let Some(message) = digit_overflow(r, &value) {
                     out.push(Diagnostic::new(&TOO_MANY_DIGITS, range, message));
@@ -406,6 +396,23 @@ fn check_g98_alone(block: &BlockData, out: &mut Vec<Diagnostic>) {
             &G98_NOT_ALONE,
             g98.range,
             "G98 ends the helix and must be programmed in a block of its own",
+        ));
+    }
+}
+
+/// A `G79` block holds only N, G79 and L.
+fn check_unit_start(block: &BlockData, out: &mut Vec<Diagnostic>) {
+    if !block.has_code(b'G', 79) {
+        return;
+    }
+    let extra = block.body_words().find(|w| {
+        !(w.letter == b'L' || (w.letter == b'G' && block.codes(b'G').any(|(c, cw)| c == 79 && std::ptr::eq(cw, *w))))
+    });
+    if let Some(range) = extra.map(|w| w.range).or(block.assignments.first().map(|a| a.range)) {
+        out.push(Diagnostic::new(
+            &SUBPROGRAM_START_EXTRA_WORDS,
+            range,
+            "the first block of a subprogram or macrocycle may hold only its number, G79 and L; move the other words to the next block",
         ));
     }
 }

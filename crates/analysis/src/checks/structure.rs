@@ -5,7 +5,7 @@ use rustc_hash::FxHashMap;
 
 use crate::{
     Diagnostic,
-    db::{self, Db, SourceFile},
+    db::{Db, SourceFile},
     diagnostic::declare_rules,
     model::{self, FileKind, Program, Transfer, Unit},
 };
@@ -18,7 +18,6 @@ declare_rules! {
     MISSING_PROGRAM_END = "P105", "missing-program-end", Error, "A main program without M02 or M30 in its last block.";
     CODE_AFTER_PROGRAM_END = "P106", "code-after-program-end", Error, "Blocks after M02/M30 that belong to no subprogram.";
     MISPLACED_SUBPROGRAM = "P107", "misplaced-subprogram", Error, "A subprogram before the main program's end.";
-    SUBPROGRAM_START_EXTRA_WORDS = "P108", "subprogram-start-extra-words", Error, "A `G79` block with words other than N, G79 and L.";
     MISSING_G70 = "P109", "missing-g70", Error, "A subprogram or macrocycle without its closing G70 block.";
     G70_OUTSIDE_SUBPROGRAM = "P110", "g70-outside-subprogram", Warning, "G70 in the main program, outside any subprogram.";
     TOO_MANY_SUBPROGRAMS = "P111", "too-many-subprograms", Error, "More than 99 subprograms in one file.";
@@ -74,7 +73,7 @@ fn check_header_and_end(db: &dyn Db, file: SourceFile, program: &Program, out: &
     }
     if program.kind == FileKind::Program && tree.end().is_none() {
         let last = program.blocks.len().checked_sub(1);
-        let range = last.map_or_else(|| file_start(db, file), |last| head(db, file, last));
+        let range = last.map_or_else(|| file_start(db, file), |last| head(program, last));
         out.push(Diagnostic::new(
             &MISSING_PHYSICAL_END,
             range,
@@ -105,28 +104,25 @@ fn check_block_numbers(program: &Program, out: &mut Vec<Diagnostic>) {
     }
 }
 
-/// The range of a block's first word (its number, or whatever comes first).
-fn head(db: &dyn Db, file: SourceFile, index: usize) -> TextRange {
-    let block = &db::file_blocks(db, file)[index];
-    let data = db::lower_block(db, block.syntax);
-    data.words.first().map_or(TextRange::empty(block.offset), |w| w.range + block.offset)
+/// The range of a block's first word, where diagnostics about the block point.
+fn head(program: &Program, index: usize) -> TextRange {
+    program.blocks[index].head
 }
 
 fn check_units(db: &dyn Db, file: SourceFile, program: &Program, out: &mut Vec<Diagnostic>) {
-    let blocks = db::file_blocks(db, file);
-    if program.kind == FileKind::Program && !blocks.is_empty() && program.end_of_main.is_none() {
+    if program.kind == FileKind::Program && !program.blocks.is_empty() && program.end_of_main.is_none() {
         let last_main = program.units[0].blocks.end.saturating_sub(1);
         out.push(Diagnostic::new(
             &MISSING_PROGRAM_END,
-            head(db, file, last_main),
+            head(program, last_main),
             "the main program has no M02 or M30: its last block must end the program (subprograms follow after it)",
         ));
     }
     for &index in &program.early_unit_starts {
-        let end = program.end_of_main.map(|e| head(db, file, e));
+        let end = program.end_of_main.map(|e| head(program, e));
         let mut diagnostic = Diagnostic::new(
             &MISPLACED_SUBPROGRAM,
-            head(db, file, index),
+            head(program, index),
             "this subprogram starts before the main program's end: subprograms go after the block with M02 or M30",
         );
         if let Some(end) = end {
@@ -143,7 +139,7 @@ fn check_units(db: &dyn Db, file: SourceFile, program: &Program, out: &mut Vec<D
     };
     if let Some(&first) = stray.first() {
         let last = *stray.last().expect("not empty");
-        let range = head(db, file, first).cover(head(db, file, last));
+        let range = head(program, first).cover(head(program, last));
         let message = match program.kind {
             FileKind::Program => {
                 "blocks after M02/M30 must belong to a subprogram (`G79 L..` … `G70`); the control never runs these"
@@ -152,14 +148,14 @@ fn check_units(db: &dyn Db, file: SourceFile, program: &Program, out: &mut Vec<D
         };
         let mut diagnostic = Diagnostic::new(&CODE_AFTER_PROGRAM_END, range, message);
         if let Some(end) = program.end_of_main {
-            diagnostic = diagnostic.with_related(None, head(db, file, end), "the main program ends here");
+            diagnostic = diagnostic.with_related(None, head(program, end), "the main program ends here");
         }
         out.push(diagnostic);
     }
     for &index in &program.stray_g70 {
         out.push(Diagnostic::new(
             &G70_OUTSIDE_SUBPROGRAM,
-            g_word(db, file, index, 70).unwrap_or_else(|| head(db, file, index)),
+            program.blocks[index].closes_unit.unwrap_or_else(|| head(program, index)),
             "G70 ends a subprogram or macrocycle; in the main program it has no subprogram to end",
         ));
     }
@@ -168,23 +164,22 @@ fn check_units(db: &dyn Db, file: SourceFile, program: &Program, out: &mut Vec<D
     if program.kind == FileKind::Program && subprograms.len() > 99 {
         out.push(Diagnostic::new(
             &TOO_MANY_SUBPROGRAMS,
-            head(db, file, subprograms[99].blocks.start),
+            head(program, subprograms[99].blocks.start),
             format!("{} subprograms in one partprogram; the control takes at most 99", subprograms.len()),
         ));
     }
     let mut numbers: FxHashMap<u32, usize> = FxHashMap::default();
     for unit in &subprograms {
         let start = unit.blocks.start;
-        check_unit_start(db, file, start, out);
         let number = unit.number.expect("subprograms have numbers");
         if let Some(&first) = numbers.get(&number) {
             out.push(
                 Diagnostic::new(
                     &DUPLICATE_SUBPROGRAM,
-                    head(db, file, start),
+                    head(program, start),
                     format!("subprogram L{number} is defined twice"),
                 )
-                .with_related(None, head(db, file, first), "first defined here"),
+                .with_related(None, head(program, first), "first defined here"),
             );
         } else {
             numbers.insert(number, start);
@@ -195,7 +190,7 @@ fn check_units(db: &dyn Db, file: SourceFile, program: &Program, out: &mut Vec<D
         if program.kind == FileKind::CycleFile && !(81..=89).contains(&number) {
             out.push(Diagnostic::new(
                 &CYCLE_NUMBER_UNREACHABLE,
-                head(db, file, start),
+                head(program, start),
                 format!("cycle body L{number}: only G81 to G89 call fixed cycles, so this body can never run"),
             ));
         }
@@ -205,29 +200,11 @@ fn check_units(db: &dyn Db, file: SourceFile, program: &Program, out: &mut Vec<D
     }
 }
 
-/// A `G79` block holds only N, G79 and L.
-fn check_unit_start(db: &dyn Db, file: SourceFile, index: usize, out: &mut Vec<Diagnostic>) {
-    let block = &db::file_blocks(db, file)[index];
-    let data = db::lower_block(db, block.syntax);
-    let extra: Vec<_> = data
-        .body_words()
-        .filter(|w| !(w.letter == b'L' || (w.letter == b'G' && data.codes(b'G').any(|(c, cw)| c == 79 && cw == *w))))
-        .collect();
-    let extra_assignments = data.assignments.first();
-    if let Some(first) = extra.first().map(|w| w.range).or(extra_assignments.map(|a| a.range)) {
-        out.push(Diagnostic::new(
-            &SUBPROGRAM_START_EXTRA_WORDS,
-            first + block.offset,
-            "the first block of a subprogram or macrocycle may hold only its number, G79 and L; move the other words to the next block",
-        ));
-    }
-}
-
 /// Missing G70, with a quick fix that closes the unit after its last block.
 fn missing_g70(db: &dyn Db, file: SourceFile, program: &Program, unit: &Unit) -> Diagnostic {
     let number = unit.number.expect("subprograms have numbers");
     let last = unit.blocks.end - 1;
-    let insert_at = block_end(db, file, last);
+    let insert_at = program.blocks[last].end();
     let used: Vec<u64> = program.blocks.iter().filter_map(|b| b.number).collect();
     let numbers: Vec<u64> = program.blocks[unit.blocks.clone()].iter().filter_map(|b| b.number).collect();
     let step = match numbers.as_slice() {
@@ -250,27 +227,14 @@ fn missing_g70(db: &dyn Db, file: SourceFile, program: &Program, unit: &Unit) ->
     };
     Diagnostic::new(
         &MISSING_G70,
-        head(db, file, unit.blocks.start),
+        head(program, unit.blocks.start),
         format!("{what} L{number} has no closing G70 block: {reached} before it is closed"),
     )
-    .with_related(None, head(db, file, last), "its last block")
+    .with_related(None, head(program, last), "its last block")
     .with_fix(
         format!("Insert `N{next} G70` after the last block"),
         vec![TextEdit::replace(TextRange::empty(insert_at), insert)],
     )
-}
-
-/// Where block `index` ends.
-fn block_end(db: &dyn Db, file: SourceFile, index: usize) -> TextSize {
-    let block = &db::file_blocks(db, file)[index];
-    block.offset + db::lower_block(db, block.syntax).len
-}
-
-/// The range of the `G<code>` word in block `index`.
-fn g_word(db: &dyn Db, file: SourceFile, index: usize, code: u32) -> Option<TextRange> {
-    let block = &db::file_blocks(db, file)[index];
-    let data = db::lower_block(db, block.syntax);
-    data.codes(b'G').find(|(c, _)| *c == code).map(|(_, w)| w.range + block.offset)
 }
 
 fn check_macrocycle_file(db: &dyn Db, file: SourceFile, program: &Program, name: u32, out: &mut Vec<Diagnostic>) {
@@ -278,7 +242,7 @@ fn check_macrocycle_file(db: &dyn Db, file: SourceFile, program: &Program, name:
         if !program.blocks.is_empty() {
             out.push(Diagnostic::new(
                 &MACROCYCLE_WITHOUT_G79,
-                head(db, file, 0),
+                head(program, 0),
                 format!("a macrocycle file starts with the block `N.. G79 L{name}`"),
             ));
         }
@@ -287,14 +251,14 @@ fn check_macrocycle_file(db: &dyn Db, file: SourceFile, program: &Program, name:
     if first.blocks.start != 0 {
         out.push(Diagnostic::new(
             &MACROCYCLE_WITHOUT_G79,
-            head(db, file, 0),
+            head(program, 0),
             format!("a macrocycle file starts with the block `N.. G79 L{name}`"),
         ));
     }
     if let Some(number) = first.number.filter(|&n| n != name) {
         out.push(Diagnostic::new(
             &MACROCYCLE_NUMBER_MISMATCH,
-            head(db, file, first.blocks.start),
+            head(program, first.blocks.start),
             format!("the file is named L{name} but defines macrocycle L{number}: `G72 L{name}` looks the file up by its name"),
         ));
     }
@@ -303,7 +267,7 @@ fn check_macrocycle_file(db: &dyn Db, file: SourceFile, program: &Program, name:
         out.push(
             Diagnostic::new(
                 &DUPLICATE_MACROCYCLE,
-                head(db, file, first.blocks.start),
+                head(program, first.blocks.start),
                 format!(
                     "macrocycle L{name} is also in {}: the control must not load two files of one macrocycle",
                     other.path(db)
