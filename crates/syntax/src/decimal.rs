@@ -89,7 +89,7 @@ impl Decimal {
     pub fn significant_frac_digits(&self) -> u32 {
         let mut mantissa = self.mantissa.unwrap_or(1);
         let mut digits = self.frac_digits();
-        while digits > 0 && mantissa % 10 == 0 {
+        while digits > 0 && mantissa.is_multiple_of(10) {
             mantissa /= 10;
             digits -= 1;
         }
