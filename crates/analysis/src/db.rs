@@ -97,7 +97,7 @@ pub fn file_chunks(db: &dyn Db, file: SourceFile) -> Vec<FileChunk<'_>> {
             start = node.text_range().start();
         }
         let green = BlockGreen(node.green().to_owned());
-        let boundary = identity_hash(&green) % CHUNK_SPREAD == 0;
+        let boundary = identity_hash(&green).is_multiple_of(CHUNK_SPREAD);
         current.push(green);
         if boundary || current.len() == MAX_CHUNK {
             chunks.push(FileChunk { chunk: BlockChunk::new(db, std::mem::take(&mut current)), offset: start });

@@ -311,9 +311,9 @@ fn check_assignments(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Dia
         match &assignment.value {
             Some(Value::Literal(value)) => {
                 let range = assignment.value_range.unwrap_or(assignment.range);
-                if let Some(message) = digit_overflow(r, &value) {
+                if let Some(message) = digit_overflow(r, value) {
                     out.push(Diagnostic::new(&TOO_MANY_DIGITS, range, message));
-                } else if parameter_raw(&value).is_none_or(|raw| raw.abs() > 69_999_999) {
+                } else if parameter_raw(value).is_none_or(|raw| raw.abs() > 69_999_999) {
                     out.push(Diagnostic::new(
                         &VALUE_OUT_OF_RANGE,
                         range,
