@@ -77,8 +77,8 @@ fn files_in_the_controls_code_page_are_read_losslessly() {
     assert_eq!(output.status.code(), Some(1));
     let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
     let first = &json[0];
-    // `N10 X1 "ŘÁ" Y 2 Z`: Z is the 17th character of line 2.
-    assert_eq!((first["line"].as_u64(), first["column"].as_u64()), (Some(2), Some(17)));
+    // `N10 G00 X1 "ŘÁ" Y 2 Z`: Z is the 21st character of line 2.
+    assert_eq!((first["line"].as_u64(), first["column"].as_u64()), (Some(2), Some(21)));
     assert_eq!(first["code"], "S004");
 
     let tree = stdout(&ncc(&["parse", "tests/fixtures/kamenicky.NCP"]));
@@ -89,7 +89,7 @@ fn files_in_the_controls_code_page_are_read_losslessly() {
 fn warnings_alone_do_not_fail() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("typo.NCP");
-    std::fs::write(&path, "%1\nN10 X1 \u{201C}TYPOGRAPHIC QUOTE\nN20 M30\n").unwrap();
+    std::fs::write(&path, "%1\nN10 G00 X1 \u{201C}TYPOGRAPHIC QUOTE\nN20 M30\n*\n").unwrap();
     let output = ncc(&["check", "--format", "json", path.to_str().unwrap()]);
     assert_eq!(output.status.code(), Some(0));
     let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();

@@ -164,6 +164,11 @@ impl BlockData {
         self.codes(letter).any(|(code, _)| code == number)
     }
 
+    /// Whether the block holds nothing but its number (and comments).
+    pub fn is_empty(&self) -> bool {
+        self.body_words().next().is_none() && self.assignments.is_empty() && self.skip.is_empty()
+    }
+
     /// Words other than the block number.
     pub fn body_words(&self) -> impl Iterator<Item = &Word> {
         let skip = usize::from(self.number.is_some());

@@ -20,22 +20,22 @@ fn diagnostics(text: &str) -> Vec<Diagnostic> {
 
 #[test]
 fn missing_g70_fix_closes_the_subprogram() {
-    let text = "%1\nN10 G71 L100\nN20 M30\nN100 G79 L100\nN110 X5. \"keep me\"\nN200 G79 L200\nN210 G70\n*\n";
+    let text = "%1\nN10 G71 L100\nN20 M30\nN100 G79 L100\nN110 G00 X5. \"keep me\"\nN200 G79 L200\nN210 G70\n*\n";
     let found = diagnostics(text);
     let missing = found.iter().find(|d| d.name == "missing-g70").expect("missing-g70");
     let fixed = apply_fix(text, missing);
     assert_eq!(
         fixed,
-        "%1\nN10 G71 L100\nN20 M30\nN100 G79 L100\nN110 X5. \"keep me\"\nN120 G70\nN200 G79 L200\nN210 G70\n*\n"
+        "%1\nN10 G71 L100\nN20 M30\nN100 G79 L100\nN110 G00 X5. \"keep me\"\nN120 G70\nN200 G79 L200\nN210 G70\n*\n"
     );
     assert!(diagnostics(&fixed).is_empty(), "{:#?}", diagnostics(&fixed));
 }
 
 #[test]
 fn missing_g70_fix_at_the_end_of_a_file_without_newline() {
-    let text = "%1\nN10 M30\nN100 G79 L100\nN101 X5.";
+    let text = "%1\nN10 M30\nN100 G79 L100\nN101 G00 X5.";
     let found = diagnostics(text);
     let missing = found.iter().find(|d| d.name == "missing-g70").expect("missing-g70");
     let fixed = apply_fix(text, missing);
-    assert_eq!(fixed, "%1\nN10 M30\nN100 G79 L100\nN101 X5.\nN102 G70\n");
+    assert_eq!(fixed, "%1\nN10 M30\nN100 G79 L100\nN101 G00 X5.\nN102 G70\n");
 }

@@ -174,15 +174,26 @@ fn fixtures_have_exactly_the_annotated_diagnostics() {
 #[test]
 fn examples_have_no_diagnostics() {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples");
-    let mut host = AnalysisHost::default();
-    let mut files = Vec::new();
+    // Each example's workspace is the examples with the same ncc.toml, as
+    // `ncc check examples` groups them.
+    let mut workspaces: std::collections::BTreeMap<Option<PathBuf>, Vec<PathBuf>> = Default::default();
     for entry in ["milling/pocket.NCP", "milling/holes.NCP", "lathe/shaft.NCP", "macros/L9001"] {
         let path = dir.join(entry);
-        files.push(host.add_file(path.display().to_string(), fs::read_to_string(&path).unwrap().as_str()));
+        workspaces.entry(Config::find_for(&path)).or_default().push(path);
     }
-    let analysis = host.analysis();
-    for file in files {
-        let diagnostics = analysis.diagnostics(file);
-        assert!(diagnostics.is_empty(), "{}: {diagnostics:#?}", analysis.path(file));
+    for (config_path, paths) in workspaces {
+        let config = config_path
+            .map(|p| Config::from_toml(&fs::read_to_string(&p).unwrap(), &p.display().to_string()).unwrap())
+            .unwrap_or_default();
+        let mut host = AnalysisHost::new(config);
+        let files: Vec<_> = paths
+            .iter()
+            .map(|path| host.add_file(path.display().to_string(), fs::read_to_string(path).unwrap().as_str()))
+            .collect();
+        let analysis = host.analysis();
+        for file in files {
+            let diagnostics = analysis.diagnostics(file);
+            assert!(diagnostics.is_empty(), "{}: {diagnostics:#?}", analysis.path(file));
+        }
     }
 }

@@ -1,10 +1,21 @@
 //! The rules, by what they need to decide.
 
 pub(crate) mod block;
+pub(crate) mod motion;
+pub(crate) mod params;
 pub(crate) mod structure;
+pub(crate) mod threads;
+
+use crate::flow::FlowCheck;
 
 /// The rules of every check module.
-pub(crate) static RULES: &[&[&crate::Rule]] = &[block::RULES, structure::RULES];
+pub(crate) static RULES: &[&[&crate::Rule]] =
+    &[block::RULES, structure::RULES, params::RULES, motion::RULES, threads::RULES];
+
+/// The checks that follow the program's flow, fresh for one walk.
+pub(crate) fn flow_checks() -> Vec<Box<dyn FlowCheck>> {
+    vec![Box::new(params::Parameters), Box::new(motion::Motion), Box::new(threads::Threads::default())]
+}
 
 #[cfg(test)]
 mod tests {

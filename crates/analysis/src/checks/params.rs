@@ -1,0 +1,185 @@
+//! Parameters: substitution into addresses, and parameter arithmetic.
+
+use ncc_catalog::{AddressRole, Dialect};
+use ncc_syntax::Decimal;
+
+use crate::{
+    Diagnostic,
+    diagnostic::declare_rules,
+    flow::{FlowCheck, Substitution, Visit},
+    lower::Value,
+};
+
+declare_rules! {
+    PARAMETER_DIGIT_OVERFLOW = "R301", "parameter-digit-overflow", Error, "A parameter whose value has more digits than the address it is substituted into.";
+    SUBSTITUTED_VALUE_OUT_OF_RANGE = "R302", "substituted-value-out-of-range", Error, "A parameter whose value is outside the range of the address it is substituted into.";
+    PARAMETER_IN_THOUSANDTHS = "R303", "parameter-in-thousandths", Warning, "A length taken from a parameter written without a decimal point (read in thousandths).";
+    FEED_PARAMETER_IN_METRES = "R304", "feed-parameter-in-metres", Warning, "A feed taken from a parameter written with a decimal point (read in m/min).";
+    RESERVED_PARAMETER = "R305", "reserved-parameter", Error, "R95, the control's own parameter, written by the program.";
+    NOT_RECOMMENDED_PARAMETER = "R306", "not-recommended-parameter", Warning, "R90 to R94, reserved for future control parameters.";
+    PARAMETER_NUMBER_OUT_OF_RANGE = "R307", "parameter-number-out-of-range", Error, "A parameter number above 95.";
+    ARITHMETIC_ERROR = "R308", "arithmetic-error", Error, "Parameter arithmetic that fails with the values known before it runs.";
+    USED_BEFORE_ASSIGNMENT = "R309", "parameter-used-before-assignment", Warning, "A parameter read before the program assigns it.";
+}
+
+/// Substitution checks and arithmetic errors, block by block.
+#[derive(Default)]
+pub(crate) struct Parameters;
+
+impl FlowCheck for Parameters {
+    fn block(&mut self, visit: &Visit<'_>, out: &mut Vec<Diagnostic>) {
+        let block = visit.block;
+        for (word, substitution) in block.words.iter().zip(visit.substitutions) {
+            if let Some(Value::Parameter { index: Some(index), index_range, .. }) = &word.value {
+                check_number(*index, visit.range(*index_range), out);
+                let unassigned =
+                    visit.params.from_start && visit.params.origins.get(*index as usize).is_some_and(Option::is_none);
+                if unassigned {
+                    out.push(Diagnostic::new(
+                        &USED_BEFORE_ASSIGNMENT,
+                        visit.range(*index_range),
+                        format!("R{index} is read before the program assigns it, so it holds whatever an earlier program left; assign it first (R{index}=…)"),
+                    ));
+                }
+            }
+            if let Some(substitution) = substitution {
+                check_substitution(visit, word, *substitution, out);
+            }
+        }
+        for assignment in &block.assignments {
+            if let Some(index) = assignment.index {
+                check_number(index, visit.range(assignment.index_range), out);
+                if index == 95 {
+                    out.push(Diagnostic::new(
+                        &RESERVED_PARAMETER,
+                        visit.range(assignment.range),
+                        "R95 is the control's own parameter and must not be written by a program (its decade 1 is set with `G26 R5=48110095` and cleared with `R5=48210095`)",
+                    ));
+                }
+            }
+        }
+        if let Some((range, error)) = visit.arithmetic_error {
+            out.push(Diagnostic::new(&ARITHMETIC_ERROR, *range, format!("parameter arithmetic fails: {error}")));
+        }
+    }
+}
+
+fn check_number(index: u32, range: ncc_syntax::TextRange, out: &mut Vec<Diagnostic>) {
+    if index > 95 {
+        out.push(Diagnostic::new(
+            &PARAMETER_NUMBER_OUT_OF_RANGE,
+            range,
+            format!("R{index}: the control has parameters R0 to R95"),
+        ));
+    } else if (90..=94).contains(&index) {
+        out.push(Diagnostic::new(
+            &NOT_RECOMMENDED_PARAMETER,
+            range,
+            format!("R{index}: R90 to R94 are reserved for future control parameters; use another parameter"),
+        ));
+    }
+}
+
+/// A substituted value against the address's format and range.
+fn check_substitution(
+    visit: &Visit<'_>,
+    word: &crate::lower::Word,
+    substitution: Substitution,
+    out: &mut Vec<Diagnostic>,
+) {
+    let catalogue = Dialect::Cnc8x6.catalogue();
+    let Some(address) = catalogue.address(std::str::from_utf8(&[word.letter]).unwrap_or("?")) else { return };
+    let range = visit.range(word.value_range.unwrap_or(word.range));
+    let related = |d: Diagnostic| match substitution.origin {
+        Some(origin) if origin.computed => d.with_related(None, origin.range, "the value was computed here"),
+        Some(origin) => d.with_related(None, origin.range, "the value was assigned here"),
+        None => d,
+    };
+    let raw = substitution.raw;
+    let letter = &address.letter;
+    let dimensionless = address.frac_digits == Some(0) || address.role == AddressRole::Feed;
+    if dimensionless {
+        // The address takes the raw digits: `R10=123` → `G123`.
+        let digits = raw.unsigned_abs().to_string();
+        let limit = match address.role {
+            AddressRole::Feed => address.int_digits_without_point,
+            _ => address.int_digits,
+        };
+        if let Some(limit) = limit.filter(|&l| digits.len() > usize::from(l)) {
+            out.push(related(Diagnostic::new(
+                &PARAMETER_DIGIT_OVERFLOW,
+                range,
+                format!(
+                    "the parameter holds {} ({digits} as digits, {} decades) but `{letter}` takes at most {limit}: the control stops with \"an R of more than {limit} decades cannot be substituted\"",
+                    show(raw),
+                    digits.len()
+                ),
+            )));
+            return;
+        }
+        if raw < 0 && !address.signed {
+            out.push(related(Diagnostic::new(
+                &SUBSTITUTED_VALUE_OUT_OF_RANGE,
+                range,
+                format!("the parameter holds {}, but `{letter}` takes only unsigned values", show(raw)),
+            )));
+            return;
+        }
+        if let Some((min, max)) = address.bounds.filter(|_| address.role != AddressRole::Feed) {
+            let value = raw as f64;
+            if value < min || value > max {
+                out.push(related(Diagnostic::new(
+                    &SUBSTITUTED_VALUE_OUT_OF_RANGE,
+                    range,
+                    format!(
+                        "the parameter holds {} (read as `{letter}{}`), outside `{letter}`'s range {} to {}",
+                        show(raw),
+                        raw,
+                        address.min.as_deref().unwrap_or_default(),
+                        address.max.as_deref().unwrap_or_default()
+                    ),
+                )));
+            }
+        }
+        if address.role == AddressRole::LengthCompensation && digits_outside(&raw.unsigned_abs().to_string(), b'2') {
+            out.push(related(Diagnostic::new(
+                &SUBSTITUTED_VALUE_OUT_OF_RANGE,
+                range,
+                format!("the parameter holds {} (read as `&{raw}`): each `&` digit must be 0, 1 or 2", show(raw)),
+            )));
+        }
+        if address.role == AddressRole::Feed && substitution.origin.is_some_and(|o| o.point && !o.computed) {
+            out.push(related(Diagnostic::new(
+                &FEED_PARAMETER_IN_METRES,
+                range,
+                format!(
+                    "the parameter was written with a decimal point, so `{letter}` reads {} m/min ({raw} mm/min); write it without the point for mm/min",
+                    show(raw)
+                ),
+            )));
+        }
+    } else if matches!(address.role, AddressRole::Axis | AddressRole::Interpolation)
+        && substitution.origin.is_some_and(|o| !o.point && !o.computed)
+        && raw != 0
+    {
+        out.push(related(Diagnostic::new(
+            &PARAMETER_IN_THOUSANDTHS,
+            range,
+            format!(
+                "the parameter was written without a decimal point, so it holds {} mm, not {raw} mm; write `{raw}.` for millimetres",
+                show(raw)
+            ),
+        )));
+    }
+}
+
+fn digits_outside(digits: &str, max: u8) -> bool {
+    digits.bytes().any(|b| b > max)
+}
+
+/// A raw value as the real number the parameter holds (`864` → `0.864`).
+fn show(raw: i64) -> String {
+    let value = Decimal::parse(None, &raw.unsigned_abs().to_string()).map_or(0.0, |d| d.to_f64()) / 1000.0;
+    let sign = if raw < 0 { "-" } else { "" };
+    format!("{sign}{value:.3}")
+}

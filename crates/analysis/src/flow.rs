@@ -1,0 +1,568 @@
+//! The flow walk: the modal state and the parameter values, block by block,
+//! in the order the control runs the program.
+//!
+//! The main program starts in the state of the priority block (the
+//! catalogue's group defaults, F0, S0, &0) with unknown parameters. A G71
+//! call walks its subprogram with the caller's state and continues with the
+//! state the subprogram leaves; a G72 call does the same with the workspace's
+//! macrocycle file (or makes everything unknown when the file is missing).
+//! Subprograms nobody calls, macrocycle files and cycle bodies are walked
+//! from an unknown state. Unknown values never produce findings: a rule
+//! reports only what it can prove.
+//!
+//! Checks are [`FlowCheck`]s that see every block with the state before and
+//! after it.
+
+use std::sync::Arc;
+
+use nc_exec::arith::{self, ArithConfig, ArithError, ControlWord, Parameters, Raw, UnknownMachine};
+use ncc_catalog::{AddressRole, Catalogue, Dialect, Modality};
+use ncc_syntax::{Decimal, Sign, TextRange, TextSize};
+use rustc_hash::FxHashMap;
+
+use crate::{
+    Config, Diagnostic,
+    db::{self, Db, Settings, SourceFile},
+    lower::{BlockData, Value, Word},
+    model::{self, FileKind, Program, Transfer},
+};
+
+/// A value that may not be known statically.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Known<T> {
+    Unknown,
+    Is(T),
+}
+
+impl<T> Known<T> {
+    pub fn known(self) -> Option<T> {
+        match self {
+            Known::Is(value) => Some(value),
+            Known::Unknown => None,
+        }
+    }
+}
+
+/// A modal value as programmed: its number and where it was written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Setting {
+    /// The value as written, or for a parameter its raw value as the
+    /// address reads it.
+    pub value: Decimal,
+    pub range: TextRange,
+}
+
+/// What the control keeps from block to block.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct ModalState {
+    /// The active code of each G group `G0`…`G11` (`None`: no code active).
+    pub g: [Known<Option<u32>>; 12],
+    /// The active code of each M group `M1`…`M14` (index 0 unused).
+    pub m: [Known<Option<u32>>; 15],
+    /// F, S, T, D and `&`; `None`: not programmed since the start (the
+    /// priority block's zero).
+    pub feed: Known<Option<Setting>>,
+    pub speed: Known<Option<Setting>>,
+    pub tool: Known<Option<Setting>>,
+    pub offset: Known<Option<Setting>>,
+    pub length: Known<Option<Setting>>,
+}
+
+impl ModalState {
+    /// The state after reset: the priority block.
+    pub fn reset(catalogue: &Catalogue) -> ModalState {
+        let mut state = ModalState::unknown();
+        for group in &catalogue.groups {
+            let Some((letter, index)) = group_index(&group.id) else { continue };
+            let default = group.default.as_deref().and_then(ncc_catalog::split_code).map(|(_, n)| n);
+            let slot = Known::Is(default);
+            match letter {
+                'G' => state.g[index] = slot,
+                _ => state.m[index] = slot,
+            }
+        }
+        // Groups without a reset code whose codes hold until changed (G74
+        // and G75) start unknown: the manual gives no default.
+        for group in catalogue.groups.iter().filter(|g| g.default.is_none()) {
+            let Some(('G', index)) = group_index(&group.id) else { continue };
+            if catalogue.codes_in(&group.id).any(|c| c.modality == Modality::Modal) {
+                state.g[index] = Known::Unknown;
+            }
+        }
+        ModalState {
+            feed: Known::Is(None),
+            speed: Known::Is(None),
+            tool: Known::Unknown,
+            offset: Known::Unknown,
+            length: Known::Is(None),
+            ..state
+        }
+    }
+
+    pub fn unknown() -> ModalState {
+        ModalState {
+            g: [Known::Unknown; 12],
+            m: [Known::Unknown; 15],
+            feed: Known::Unknown,
+            speed: Known::Unknown,
+            tool: Known::Unknown,
+            offset: Known::Unknown,
+            length: Known::Unknown,
+        }
+    }
+
+    /// The active code of G group `group`, if known.
+    pub fn g(&self, group: usize) -> Option<Option<u32>> {
+        self.g[group].known()
+    }
+
+    /// Whether `code` is known to be the active code of its G group.
+    pub fn has_g(&self, group: usize, code: u32) -> bool {
+        self.g[group] == Known::Is(Some(code))
+    }
+}
+
+/// `"G3"` → `('G', 3)`.
+fn group_index(id: &str) -> Option<(char, usize)> {
+    let (letter, number) = ncc_catalog::split_code(id)?;
+    let index = usize::try_from(number).ok()?;
+    let fits = match letter {
+        'G' => index < 12,
+        'M' => (1..15).contains(&index),
+        _ => false,
+    };
+    fits.then_some((letter, index))
+}
+
+/// Where a parameter's value came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Origin {
+    pub range: TextRange,
+    /// The value was written with a decimal point.
+    pub point: bool,
+    /// Set by parameter arithmetic, not by an assignment.
+    pub computed: bool,
+}
+
+/// Parameter values and where they came from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ParamState {
+    pub values: Parameters,
+    pub origins: Vec<Option<Origin>>,
+    /// The walk started at the program's start, so a parameter without an
+    /// origin has not been assigned by the program.
+    pub from_start: bool,
+}
+
+impl ParamState {
+    pub fn unknown() -> ParamState {
+        ParamState { values: Parameters::unknown(), origins: vec![None; arith::PARAMETER_COUNT], from_start: false }
+    }
+
+    /// The parameters at the start of a program: values left from earlier
+    /// programs, none assigned yet.
+    pub fn program_start() -> ParamState {
+        ParamState { from_start: true, ..ParamState::unknown() }
+    }
+
+    pub fn get(&self, index: u32) -> Option<(Raw, Option<Origin>)> {
+        let index = usize::try_from(index).ok().filter(|&i| i < arith::PARAMETER_COUNT)?;
+        Some((self.values.get(index)?, self.origins[index]))
+    }
+}
+
+/// A parameter reference resolved to its value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Substitution {
+    /// The raw value (sign of the reference applied).
+    pub raw: Raw,
+    pub origin: Option<Origin>,
+}
+
+/// One block as a check sees it.
+pub(crate) struct Visit<'a> {
+    pub block: &'a BlockData,
+    /// Where the block starts in the file.
+    pub offset: TextSize,
+    pub before: &'a ModalState,
+    pub after: &'a ModalState,
+    /// Parameter values before the block.
+    pub params: &'a ParamState,
+    /// The substituted value of each word (same order as `block.words`);
+    /// `None` for literals and unknown parameters.
+    pub substitutions: &'a [Option<Substitution>],
+    /// G and M codes of the block, literal or substituted.
+    pub codes: &'a [(u8, u32, TextRange)],
+    /// The failure of the block's parameter arithmetic, if it has one.
+    pub arithmetic_error: Option<&'a (TextRange, ArithError)>,
+    pub config: &'a Config,
+}
+
+impl Visit<'_> {
+    /// A block-relative range as a file range.
+    pub fn range(&self, range: TextRange) -> TextRange {
+        range + self.offset
+    }
+
+    /// Whether the block has code `letter` `number` (literal or substituted).
+    pub fn has_code(&self, letter: u8, number: u32) -> bool {
+        self.codes.iter().any(|&(l, n, _)| l == letter && n == number)
+    }
+
+    /// The file range of code `letter` `number` in the block.
+    pub fn code_range(&self, letter: u8, number: u32) -> Option<TextRange> {
+        self.codes.iter().find(|&&(l, n, _)| l == letter && n == number).map(|&(_, _, r)| r)
+    }
+}
+
+/// A rule that needs the modal state or parameter values.
+pub(crate) trait FlowCheck {
+    /// Called for every block in run order.
+    fn block(&mut self, visit: &Visit<'_>, out: &mut Vec<Diagnostic>);
+
+    /// Called when a program unit ends, with the state at its end.
+    fn end_of_unit(&mut self, _state: &ModalState, _last: Option<(TextSize, &BlockData)>, _out: &mut Vec<Diagnostic>) {}
+}
+
+/// Diagnostics of the rules that follow the program's flow.
+#[salsa::tracked(returns(ref))]
+pub fn flow_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
+    let program = model::program(db, file);
+    let mut walk = Walk::new(db, file, program, crate::checks::flow_checks());
+    walk.run();
+    let mut out = walk.out;
+    out.sort_by(|a, b| (a.range.start(), a.range.end(), a.code).cmp(&(b.range.start(), b.range.end(), b.code)));
+    out.dedup();
+    out
+}
+
+/// The lowered blocks of a file, rebuilt on demand chunk by chunk (the
+/// walk mostly goes forward; calls jump to subprograms).
+struct Blocks<'db> {
+    db: &'db dyn Db,
+    chunks: &'db [db::FileChunk<'db>],
+    /// Block index where each chunk starts.
+    starts: Vec<usize>,
+    cache: FxHashMap<usize, Arc<Vec<(TextSize, BlockData)>>>,
+}
+
+impl<'db> Blocks<'db> {
+    fn new(db: &'db dyn Db, file: SourceFile) -> Self {
+        let chunks = db::file_chunks(db, file).as_slice();
+        let mut starts = Vec::with_capacity(chunks.len());
+        let mut next = 0;
+        for chunk in chunks {
+            starts.push(next);
+            next += chunk.chunk.blocks(db).len();
+        }
+        Blocks { db, chunks, starts, cache: FxHashMap::default() }
+    }
+
+    /// Block `index` with its file offset.
+    fn get(&mut self, index: usize) -> (TextSize, Arc<Vec<(TextSize, BlockData)>>, usize) {
+        let chunk = self.starts.partition_point(|&start| start <= index) - 1;
+        if !self.cache.contains_key(&chunk) {
+            if self.cache.len() >= 16 {
+                self.cache.clear();
+            }
+            let lowered: Vec<_> = db::lower_chunk(self.db, self.chunks[chunk].chunk).collect();
+            self.cache.insert(chunk, Arc::new(lowered));
+        }
+        let lowered = self.cache[&chunk].clone();
+        (self.chunks[chunk].offset, lowered, index - self.starts[chunk])
+    }
+}
+
+/// How deep calls are followed (runaway recursion is the executor's
+/// business, not the checker's).
+const MAX_CALL_DEPTH: usize = 8;
+
+struct Walk<'db> {
+    db: &'db dyn Db,
+    program: &'db Program,
+    catalogue: &'static Catalogue,
+    config: &'db Config,
+    checks: Vec<Box<dyn FlowCheck>>,
+    blocks: Blocks<'db>,
+    out: Vec<Diagnostic>,
+    /// Subprograms on the call stack (by unit index).
+    stack: Vec<usize>,
+    called: Vec<bool>,
+}
+
+impl<'db> Walk<'db> {
+    fn new(db: &'db dyn Db, file: SourceFile, program: &'db Program, checks: Vec<Box<dyn FlowCheck>>) -> Self {
+        Walk {
+            db,
+            program,
+            catalogue: Dialect::Cnc8x6.catalogue(),
+            config: Settings::get(db).config(db),
+            checks,
+            blocks: Blocks::new(db, file),
+            out: Vec::new(),
+            stack: Vec::new(),
+            called: vec![false; program.units.len()],
+        }
+    }
+
+    fn run(&mut self) {
+        let units = self.program.units.len();
+        if self.program.kind == FileKind::Program && units > 0 {
+            let state = ModalState::reset(self.catalogue);
+            self.walk_unit(0, state, ParamState::program_start());
+        }
+        for unit in 0..units {
+            let standalone = self.program.kind != FileKind::Program || (unit > 0 && !self.called[unit]);
+            if standalone {
+                self.walk_unit(unit, ModalState::unknown(), ParamState::unknown());
+            }
+        }
+    }
+
+    /// Walks a unit from `state`; returns the state at its end.
+    fn walk_unit(&mut self, unit: usize, mut state: ModalState, mut params: ParamState) -> (ModalState, ParamState) {
+        self.stack.push(unit);
+        let mut last = None;
+        for index in self.program.units[unit].blocks.clone() {
+            let (chunk_offset, lowered, at) = self.blocks.get(index);
+            let (offset, block) = (&lowered[at].0, &lowered[at].1);
+            let offset = chunk_offset + *offset;
+            let (after, after_params) = self.visit(block, offset, &state, &params);
+            state = after;
+            params = after_params;
+            if let Some((transfer, range)) = self.program.blocks[index].transfer {
+                (state, params) = self.follow(transfer, range, state, params);
+            }
+            last = Some(index);
+        }
+        let last_block = last.map(|index| {
+            let (chunk_offset, lowered, at) = self.blocks.get(index);
+            (chunk_offset + lowered[at].0, lowered, at)
+        });
+        for check in &mut self.checks {
+            check.end_of_unit(&state, last_block.as_ref().map(|(o, l, a)| (*o, &l[*a].1)), &mut self.out);
+        }
+        self.stack.pop();
+        (state, params)
+    }
+
+    /// Follows a call: the callee runs with the caller's state.
+    fn follow(
+        &mut self,
+        transfer: Transfer,
+        call: TextRange,
+        state: ModalState,
+        params: ParamState,
+    ) -> (ModalState, ParamState) {
+        match transfer {
+            Transfer::Jump(_) => (state, params),
+            Transfer::Subprogram(number) => {
+                let unit = self.program.units.iter().position(|u| u.number == Some(number));
+                match unit {
+                    Some(unit) if self.stack.len() < MAX_CALL_DEPTH && !self.stack.contains(&unit) => {
+                        self.called[unit] = true;
+                        self.walk_unit(unit, state, params)
+                    }
+                    _ => (ModalState::unknown(), ParamState::unknown()),
+                }
+            }
+            Transfer::Macrocycle(number) => {
+                let file = model::macrocycles(self.db).get(&number).and_then(|files| files.first().copied());
+                match file {
+                    Some(file) if self.stack.len() < MAX_CALL_DEPTH => {
+                        // The macrocycle's own findings belong to its file;
+                        // here only the state it leaves matters.
+                        let program = model::program(self.db, file);
+                        let mut inner = Walk::new(self.db, file, program, Vec::new());
+                        inner.stack = vec![usize::MAX; self.stack.len()];
+                        if program.units.is_empty() {
+                            return (ModalState::unknown(), ParamState::unknown());
+                        }
+                        let origins_before = params.origins.clone();
+                        let (state, mut params) = inner.walk_unit(0, state, params);
+                        // Ranges in the macrocycle's file mean nothing here:
+                        // what it assigned comes from the call.
+                        for (origin, before) in params.origins.iter_mut().zip(origins_before) {
+                            if *origin != before {
+                                *origin = origin.map(|_| Origin { range: call, point: false, computed: true });
+                            }
+                        }
+                        (state, params)
+                    }
+                    _ => (ModalState::unknown(), ParamState::unknown()),
+                }
+            }
+        }
+    }
+
+    /// Runs the checks on one block and returns the state after it.
+    fn visit(
+        &mut self,
+        block: &BlockData,
+        offset: TextSize,
+        before: &ModalState,
+        params: &ParamState,
+    ) -> (ModalState, ParamState) {
+        let substitutions: Vec<Option<Substitution>> = block.words.iter().map(|w| substitute(w, params)).collect();
+        let codes = codes(block, &substitutions, offset);
+        let after = self.apply(before, block, &substitutions, &codes, offset);
+        let mut after_params = params.clone();
+        let arithmetic_error = self.assign(block, offset, &mut after_params);
+        let visit = Visit {
+            block,
+            offset,
+            before,
+            after: &after,
+            params,
+            substitutions: &substitutions,
+            codes: &codes,
+            arithmetic_error: arithmetic_error.as_ref(),
+            config: self.config,
+        };
+        for check in &mut self.checks {
+            check.block(&visit, &mut self.out);
+        }
+        (after, after_params)
+    }
+
+    /// The modal state after a block.
+    fn apply(
+        &self,
+        before: &ModalState,
+        block: &BlockData,
+        substitutions: &[Option<Substitution>],
+        codes: &[(u8, u32, TextRange)],
+        offset: TextSize,
+    ) -> ModalState {
+        let mut after = before.clone();
+        for &(letter, number, _) in codes {
+            let Some(group) = self.catalogue.group_of(char::from(letter), number) else { continue };
+            let Some((_, index)) = group_index(&group.id) else { continue };
+            let modal = self.catalogue.code(char::from(letter), number).is_none_or(|c| c.modality == Modality::Modal);
+            if modal {
+                let slot = if letter == b'G' { &mut after.g[index] } else { &mut after.m[index] };
+                *slot = Known::Is(Some(number));
+            }
+        }
+        let indirect_code = block.words.iter().zip(substitutions).any(|(w, s)| {
+            matches!(w.letter, b'G' | b'M') && matches!(w.value, Some(Value::Parameter { .. })) && s.is_none()
+        });
+        if indirect_code {
+            // A code from an unknown parameter may be any code.
+            after.g = [Known::Unknown; 12];
+            after.m = [Known::Unknown; 15];
+        }
+        for (word, substitution) in block.words.iter().zip(substitutions) {
+            let slot = match self.catalogue.role_of(word.letter) {
+                Some(AddressRole::Feed) => &mut after.feed,
+                Some(AddressRole::Speed) => &mut after.speed,
+                Some(AddressRole::Tool) => &mut after.tool,
+                Some(AddressRole::Offset) => &mut after.offset,
+                Some(AddressRole::LengthCompensation) => &mut after.length,
+                _ => continue,
+            };
+            *slot = match setting(word, *substitution, offset) {
+                Some(setting) => Known::Is(Some(setting)),
+                None => Known::Unknown,
+            };
+        }
+        after
+    }
+
+    /// Applies the block's assignments and parameter arithmetic to `params`.
+    fn assign(&self, block: &BlockData, offset: TextSize, params: &mut ParamState) -> Option<(TextRange, ArithError)> {
+        for assignment in &block.assignments {
+            let Some(index) = assignment.index.map(|i| i as usize).filter(|&i| i < arith::PARAMETER_COUNT) else {
+                continue;
+            };
+            let value = match &assignment.value {
+                Some(Value::Literal(decimal)) => crate::checks::block::parameter_raw(decimal),
+                _ => None,
+            };
+            params.values.set(index, value.filter(|raw| raw.abs() <= arith::MAX_RAW));
+            params.origins[index] = value.map(|_| Origin {
+                range: assignment.value_range.unwrap_or(assignment.range) + offset,
+                point: matches!(&assignment.value, Some(Value::Literal(d)) if d.has_point()),
+                computed: false,
+            });
+        }
+        let function = block.codes(b'G').find(|(code, _)| (26..=29).contains(code));
+        let (code, word) = function?;
+        let count = (code - 25) as usize;
+        let range = word.range + offset;
+        let mut words = Vec::with_capacity(count);
+        for slot in 5..5 + count {
+            match params.values.get(slot).map(ControlWord::decode) {
+                Some(Ok(word)) => words.push(word),
+                Some(Err(error)) => return Some((range, error)),
+                None => {
+                    // An unknown control word may write any parameter.
+                    *params = ParamState::unknown();
+                    return None;
+                }
+            }
+        }
+        let before = params.values.clone();
+        let config = ArithConfig { double_precision: self.double_precision(params) };
+        let result = arith::execute(&words, &mut params.values, &mut UnknownMachine, config);
+        for index in 0..arith::PARAMETER_COUNT {
+            if params.values.get(index) != before.get(index) {
+                params.origins[index] =
+                    params.values.get(index).map(|_| Origin { range, point: false, computed: true });
+            }
+        }
+        result.err().map(|(_, error)| (range, error))
+    }
+
+    /// Double precision per machine constant 283 decade 4 (and R95).
+    fn double_precision(&self, params: &ParamState) -> bool {
+        match self.config.machine.decade(283, 4) {
+            0 => true,
+            2 => params.values.get(95).is_some_and(|r95| r95.rem_euclid(10) == 0),
+            _ => false,
+        }
+    }
+}
+
+/// The value a parameter reference substitutes, if known.
+fn substitute(word: &Word, params: &ParamState) -> Option<Substitution> {
+    let Some(Value::Parameter { negative, index: Some(index), .. }) = word.value else { return None };
+    let (raw, origin) = params.get(index)?;
+    Some(Substitution { raw: if negative { -raw } else { raw }, origin })
+}
+
+/// The block's G and M codes: literal, or substituted with a known value.
+fn codes(block: &BlockData, substitutions: &[Option<Substitution>], offset: TextSize) -> Vec<(u8, u32, TextRange)> {
+    let mut codes = Vec::new();
+    for (word, substitution) in block.words.iter().zip(substitutions) {
+        if !matches!(word.letter, b'G' | b'M') {
+            continue;
+        }
+        let number = match (&word.value, substitution) {
+            (Some(Value::Literal(d)), _) if !d.has_point() && d.sign().is_none() => {
+                d.scaled(0).and_then(|v| u32::try_from(v).ok())
+            }
+            // A dimensionless address reads the raw digits (`R21=40` → G40).
+            (Some(Value::Parameter { .. }), Some(s)) => u32::try_from(s.raw).ok(),
+            _ => None,
+        };
+        if let Some(number) = number {
+            codes.push((word.letter, number, word.range + offset));
+        }
+    }
+    codes
+}
+
+/// A modal word's setting: its literal, or the substituted raw value read
+/// as the address reads it (dimensionless digits; F in mm/min).
+fn setting(word: &Word, substitution: Option<Substitution>, offset: TextSize) -> Option<Setting> {
+    let range = word.range + offset;
+    match (&word.value, substitution) {
+        (Some(Value::Literal(value)), _) => Some(Setting { value: *value, range }),
+        (Some(Value::Parameter { .. }), Some(s)) => {
+            let sign = (s.raw < 0).then_some(Sign::Minus);
+            Decimal::parse(sign, &s.raw.unsigned_abs().to_string()).map(|value| Setting { value, range })
+        }
+        _ => None,
+    }
+}
