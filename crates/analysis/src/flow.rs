@@ -66,6 +66,10 @@ pub struct ModalState {
     pub tool: Known<Option<Setting>>,
     pub offset: Known<Option<Setting>>,
     pub length: Known<Option<Setting>>,
+    /// The programmed end position per axis letter (index = letter − `A`),
+    /// in program coordinates, in micrometres (thousandths of a degree for
+    /// rotary axes) as written: X stays a diameter under G74.
+    pub position: [Known<i64>; 26],
 }
 
 impl ModalState {
@@ -99,6 +103,11 @@ impl ModalState {
         }
     }
 
+    /// The programmed position of axis `letter`, if known.
+    pub fn position(&self, letter: u8) -> Option<i64> {
+        self.position.get(usize::from(letter.to_ascii_uppercase().wrapping_sub(b'A')))?.known()
+    }
+
     pub fn unknown() -> ModalState {
         ModalState {
             g: [Known::Unknown; 12],
@@ -108,6 +117,7 @@ impl ModalState {
             tool: Known::Unknown,
             offset: Known::Unknown,
             length: Known::Unknown,
+            position: [Known::Unknown; 26],
         }
     }
 
@@ -466,7 +476,55 @@ impl<'db> Walk<'db> {
                 None => Known::Unknown,
             };
         }
+        self.move_axes(&mut after, block, substitutions, codes);
         after
+    }
+
+    /// The programmed end position after a block.
+    fn move_axes(
+        &self,
+        after: &mut ModalState,
+        block: &BlockData,
+        substitutions: &[Option<Substitution>],
+        codes: &[(u8, u32, TextRange)],
+    ) {
+        let has = |code: u32| codes.iter().any(|&(l, n, _)| l == b'G' && n == code);
+        // Offsets and transformations move the program's coordinate system
+        // under the tool; a fixed cycle moves the tool in its body.
+        let frame_changes = [92, 93, 53, 54, 55, 56, 57, 58, 59, 35, 36, 37, 38, 39, 31].iter().any(|&c| has(c));
+        let transformed = !matches!(after.g[11], Known::Is(None) | Known::Is(Some(34)));
+        let cycle = matches!(after.g[8], Known::Is(Some(81..=89)) | Known::Unknown);
+        if frame_changes || transformed {
+            after.position = [Known::Unknown; 26];
+            return;
+        }
+        let data_block = [10, 92, 93].iter().any(|&c| has(c));
+        if !data_block {
+            let incremental = match after.g[9] {
+                Known::Is(Some(91)) => Some(true),
+                Known::Is(_) => Some(false),
+                Known::Unknown => None,
+            };
+            for (word, substitution) in block.words.iter().zip(substitutions) {
+                if self.catalogue.role_of(word.letter) != Some(AddressRole::Axis) {
+                    continue;
+                }
+                let slot = &mut after.position[usize::from(word.letter - b'A')];
+                let value = match (&word.value, substitution) {
+                    (Some(Value::Literal(d)), _) => d.scaled(3).and_then(|v| i64::try_from(v).ok()),
+                    (Some(Value::Parameter { .. }), Some(s)) => Some(s.raw),
+                    _ => None,
+                };
+                *slot = match (value, incremental, *slot) {
+                    (Some(v), Some(false), _) => Known::Is(v),
+                    (Some(v), Some(true), Known::Is(from)) => Known::Is(from + v),
+                    _ => Known::Unknown,
+                };
+            }
+        }
+        if cycle {
+            after.position = [Known::Unknown; 26];
+        }
     }
 
     /// Applies the block's assignments and parameter arithmetic to `params`.
