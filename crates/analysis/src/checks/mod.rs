@@ -1,20 +1,47 @@
 //! The rules, by what they need to decide.
 
+pub(crate) mod arith;
 pub(crate) mod block;
+pub(crate) mod cycles;
+pub(crate) mod dynamics;
+pub(crate) mod feed;
+pub(crate) mod geometry;
 pub(crate) mod motion;
 pub(crate) mod params;
 pub(crate) mod structure;
 pub(crate) mod threads;
+pub(crate) mod transform;
 
 use crate::flow::FlowCheck;
 
 /// The rules of every check module.
-pub(crate) static RULES: &[&[&crate::Rule]] =
-    &[block::RULES, structure::RULES, params::RULES, motion::RULES, threads::RULES];
+pub(crate) static RULES: &[&[&crate::Rule]] = &[
+    block::RULES,
+    structure::RULES,
+    params::RULES,
+    arith::RULES,
+    motion::RULES,
+    geometry::RULES,
+    feed::RULES,
+    threads::RULES,
+    transform::RULES,
+    cycles::RULES,
+    dynamics::RULES,
+];
 
 /// The checks that follow the program's flow, fresh for one walk.
 pub(crate) fn flow_checks() -> Vec<Box<dyn FlowCheck>> {
-    vec![Box::new(params::Parameters), Box::new(motion::Motion), Box::new(threads::Threads::default())]
+    vec![
+        Box::new(params::Parameters),
+        Box::new(arith::Arithmetic),
+        Box::new(motion::Motion),
+        Box::new(geometry::Geometry),
+        Box::new(feed::Feed),
+        Box::new(threads::Threads::default()),
+        Box::new(transform::Transformations),
+        Box::new(cycles::Cycles),
+        Box::new(dynamics::Dynamics),
+    ]
 }
 
 #[cfg(test)]
