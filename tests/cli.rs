@@ -41,7 +41,9 @@ fn json_positions_count_characters_in_czech_comments() {
             "severity": "error",
             "code": "S002",
             "name": "space-in-number",
-            "message": "space inside a number: the control rejects a value interrupted by spaces; join the digits"
+            "message": "space inside a number: the control rejects a value interrupted by spaces; join the digits",
+            "related": [],
+            "fixes": []
           },
           {
             "file": "tests/fixtures/czech_columns.NCP",
@@ -52,7 +54,9 @@ fn json_positions_count_characters_in_czech_comments() {
             "severity": "error",
             "code": "S003",
             "name": "space-after-sign",
-            "message": "space between the sign and the digits: the control rejects it; write the sign next to the number"
+            "message": "space between the sign and the digits: the control rejects it; write the sign next to the number",
+            "related": [],
+            "fixes": []
           }
         ]
     "#]]
@@ -86,15 +90,127 @@ fn files_in_the_controls_code_page_are_read_losslessly() {
 }
 
 #[test]
-fn warnings_alone_do_not_fail() {
+fn warnings_fail_and_infos_do_not() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("typo.NCP");
     std::fs::write(&path, "%1\nN10 G00 X1 \u{201C}TYPOGRAPHIC QUOTE\nN20 M30\n*\n").unwrap();
     let output = ncc(&["check", "--format", "json", path.to_str().unwrap()]);
-    assert_eq!(output.status.code(), Some(0));
+    assert_eq!(output.status.code(), Some(1));
     let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
     assert_eq!(json[0]["severity"], "warning");
     assert_eq!(json[0]["code"], "S010");
+
+    // Without the physical end `*` there is only an info.
+    std::fs::write(&path, "%1\nN10 G00 X1\nN20 M30\n").unwrap();
+    let output = ncc(&["check", "--format", "json", path.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(0));
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(json[0]["severity"], "info", "{json}");
+}
+
+#[test]
+fn short_format_is_one_line_per_finding() {
+    let output = ncc(&["check", "--format", "short", "tests/fixtures/findings.NCP"]);
+    assert_eq!(output.status.code(), Some(1));
+    expect![[r#"
+        tests/fixtures/findings.NCP:4:6: error[R301]: the parameter holds 0.123 (123 as digits, 3 decades) but `G` takes at most 2: the control stops with "an R of more than 2 decades cannot be substituted"
+        tests/fixtures/findings.NCP:7:1: error[P109]: subprogram L100 has no closing G70 block: the file ends before it is closed
+    "#]]
+    .assert_eq(&stdout(&output));
+}
+
+#[test]
+fn json_has_related_locations_and_fixes() {
+    let output = ncc(&["check", "--format", "json", "tests/fixtures/findings.NCP"]);
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let overflow = &json[0];
+    assert_eq!(overflow["code"], "R301");
+    assert_eq!(overflow["related"][0]["line"], 3);
+    assert_eq!(overflow["related"][0]["column"], 9);
+    assert_eq!(overflow["related"][0]["message"], "the value was assigned here");
+    let missing_g70 = &json[1];
+    assert_eq!(missing_g70["fixes"][0]["edits"][0]["new_text"], "N80 G70\n");
+    assert_eq!(missing_g70["fixes"][0]["edits"][0]["line"], 9);
+}
+
+#[test]
+fn sarif_is_valid_against_the_schema() {
+    // The published schema's `language` pattern has a stray `]`, which makes
+    // the schema itself invalid; it is corrected to what it means.
+    let text = include_str!("schemas/sarif-2.1.0.json")
+        .replace(r#""^[a-zA-Z]{2}|^[a-zA-Z]{2}-[a-zA-Z]{2}]?$""#, r#""^[a-zA-Z]{2}(-[a-zA-Z]{2})?$""#);
+    let schema: serde_json::Value = serde_json::from_str(&text).expect("the schema is JSON");
+    let validator = jsonschema::validator_for(&schema).expect("the schema compiles");
+    let output = ncc(&["check", "--format", "sarif", "tests/fixtures/findings.NCP", "tests/fixtures/clean.NCP"]);
+    assert_eq!(output.status.code(), Some(1));
+    let log: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let errors: Vec<String> = validator.iter_errors(&log).map(|e| format!("{e} at {}", e.instance_path())).collect();
+    assert!(errors.is_empty(), "{errors:#?}");
+    // The validator does reject what the schema forbids.
+    let mut broken = log.clone();
+    broken["runs"][0]["results"][0]["level"] = "fatal".into();
+    assert!(!validator.is_valid(&broken));
+
+    let run = &log["runs"][0];
+    assert_eq!(log["version"], "2.1.0");
+    assert_eq!(run["columnKind"], "unicodeCodePoints");
+    let results = run["results"].as_array().unwrap();
+    assert_eq!(results.len(), 2);
+    let rules = run["tool"]["driver"]["rules"].as_array().unwrap();
+    for result in results {
+        let index = result["ruleIndex"].as_u64().unwrap() as usize;
+        assert_eq!(rules[index]["id"], result["ruleId"]);
+    }
+    let overflow = &results[0];
+    assert_eq!(overflow["ruleId"], "R301");
+    assert_eq!(overflow["level"], "error");
+    let location = &overflow["locations"][0]["physicalLocation"];
+    assert_eq!(location["artifactLocation"]["uri"], "tests/fixtures/findings.NCP");
+    assert_eq!(location["artifactLocation"]["uriBaseId"], "SRCROOT");
+    assert_eq!(
+        (location["region"]["startLine"].as_u64(), location["region"]["startColumn"].as_u64()),
+        (Some(4), Some(6))
+    );
+    assert_eq!(overflow["relatedLocations"][0]["physicalLocation"]["region"]["startLine"], 3);
+    let fix = &results[1]["fixes"][0]["artifactChanges"][0]["replacements"][0];
+    assert_eq!(fix["insertedContent"]["text"], "N80 G70\n");
+}
+
+#[test]
+fn macrocycles_beside_a_checked_program_are_resolved_not_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("main.NCP");
+    std::fs::write(&program, "%1\nN10 G72 L9001\nN20 M30\n*\n").unwrap();
+    // The macrocycle has a finding of its own (a repeated address).
+    std::fs::write(dir.path().join("L9001"), "N10 G79 L9001\nN20 X1 X2\nN30 G70\n").unwrap();
+    let output = ncc(&["check", "--format", "json", program.to_str().unwrap()]);
+    assert_eq!(stdout(&output), "[]\n");
+    assert_eq!(output.status.code(), Some(0));
+
+    std::fs::remove_file(dir.path().join("L9001")).unwrap();
+    let output = ncc(&["check", "--format", "json", program.to_str().unwrap()]);
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(json[0]["name"], "undefined-macrocycle", "{json}");
+}
+
+#[test]
+fn rules_lists_every_rule_and_finds_one() {
+    let output = ncc(&["rules"]);
+    assert_eq!(output.status.code(), Some(0));
+    let text = stdout(&output);
+    assert!(text.contains("S002  error    space-in-number"), "{text}");
+    assert!(text.contains("missing-g70"), "{text}");
+
+    let text = stdout(&ncc(&["rules", "missing-g70"]));
+    assert!(text.starts_with("P109  error    missing-g70  "), "{text}");
+    assert!(text.ends_with("1 rules\n"), "{text}");
+    assert_eq!(ncc(&["rules", "no-such-rule"]).status.code(), Some(1));
+}
+
+#[test]
+fn usage_errors_exit_with_2() {
+    assert_eq!(ncc(&["check", "--format", "xml", "examples"]).status.code(), Some(2));
+    assert_eq!(ncc(&["frobnicate"]).status.code(), Some(2));
 }
 
 #[test]

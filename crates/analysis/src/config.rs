@@ -140,11 +140,7 @@ impl Config {
     pub fn from_toml(text: &str, origin: &str) -> Result<Config, String> {
         let file: ConfigFile = toml::from_str(text).map_err(|e| format!("{origin}: {e}"))?;
         let mut config = Config { rules: file.rules, machine: MachineConfig::default() };
-        let known = |key: &str| {
-            crate::Rule::find(key).is_some()
-                || ncc_syntax::SyntaxErrorKind::ALL.iter().any(|k| k.code() == key || k.name() == key)
-        };
-        if let Some(unknown) = config.rules.keys().find(|key| !known(key)) {
+        if let Some(unknown) = config.rules.keys().find(|key| crate::Rule::find(key).is_none()) {
             return Err(format!("{origin}: [rules] names no rule `{unknown}` (see `ncc rules`)"));
         }
         if let Some(machine) = file.machine {

@@ -86,6 +86,15 @@ impl Diagnostic {
     }
 }
 
+/// The parser's diagnostics as rules, so that configuration, suppression
+/// and listings treat them like every other rule.
+static SYNTAX_RULES: std::sync::LazyLock<Vec<Rule>> = std::sync::LazyLock::new(|| {
+    ncc_syntax::SyntaxErrorKind::ALL
+        .iter()
+        .map(|kind| Rule { code: kind.code(), name: kind.name(), severity: kind.severity(), summary: kind.summary() })
+        .collect()
+});
+
 /// A rule: what a diagnostic is about. Codes and names are stable:
 /// configuration and suppression comments refer to them.
 #[derive(Debug, PartialEq, Eq, Hash)]
@@ -99,9 +108,9 @@ pub struct Rule {
 }
 
 impl Rule {
-    /// Every rule of every check module.
+    /// Every rule: the parser's syntax diagnostics, then every check module's.
     pub fn all() -> impl Iterator<Item = &'static Rule> {
-        crate::checks::RULES.iter().flat_map(|rules| rules.iter().copied())
+        SYNTAX_RULES.iter().chain(crate::checks::RULES.iter().flat_map(|rules| rules.iter().copied()))
     }
 
     /// The rule with this code or name.

@@ -165,9 +165,12 @@ fn fixtures_have_exactly_the_annotated_diagnostics() {
         }
     }
     assert!(failures.is_empty(), "\n{failures}");
-    let untested: Vec<_> = Rule::all().map(|r| r.name).filter(|name| !covered.contains(name)).collect();
+    // Syntax diagnostics have their own fixtures in crates/syntax.
+    let syntax: std::collections::BTreeSet<_> = ncc_syntax::SyntaxErrorKind::ALL.iter().map(|k| k.name()).collect();
+    let checks: Vec<_> = Rule::all().map(|r| r.name).filter(|name| !syntax.contains(name)).collect();
+    let untested: Vec<_> = checks.iter().filter(|name| !covered.contains(*name)).collect();
     assert!(untested.is_empty(), "rules without a fixture that shows them: {untested:?}");
-    println!("{} rules shown by fixtures", Rule::all().count());
+    println!("{} rules shown by fixtures", checks.len());
 }
 
 /// The bundled examples are realistic programs: they must be clean.

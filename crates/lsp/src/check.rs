@@ -1,27 +1,30 @@
 //! `ncc check`: find partprograms, check them in parallel, report.
 
 use std::{
+    collections::{BTreeMap, HashMap, HashSet},
     io::{self, IsTerminal, Write},
-    ops::Range,
     path::{Path, PathBuf},
     process::ExitCode,
+    sync::Arc,
 };
 
-use std::{collections::BTreeMap, sync::Arc};
-
-use ariadne::{Color, IndexType, Label, Report, ReportKind, Source};
-use line_index::{LineIndex, WideEncoding};
-use ncc_analysis::{AnalysisHost, Config, Diagnostic, Severity, TextSize};
+use indicatif::{ParallelProgressIterator, ProgressBar, ProgressStyle};
+use ncc_analysis::{AnalysisHost, Config, Diagnostic, Severity};
 use ncc_syntax::encoding;
 use rayon::prelude::*;
-use serde::Serialize;
+
+use crate::{report, sarif};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum Format {
     /// Reports with source snippets, for people.
     Human,
+    /// One line per diagnostic: `file:line:col: severity[code]: message`.
+    Short,
     /// One JSON array of diagnostics, for tools (a stable contract).
     Json,
+    /// SARIF 2.1.0, for code-scanning services.
+    Sarif,
 }
 
 /// Reads a program file; bytes that are not UTF-8 are read as Kamenický, so
@@ -30,14 +33,32 @@ pub(crate) fn read_program(path: &Path) -> io::Result<String> {
     Ok(encoding::decode(std::fs::read(path)?).0)
 }
 
-struct CheckedFile {
-    path: PathBuf,
-    text: Arc<str>,
-    diagnostics: Vec<Diagnostic>,
+pub(crate) struct CheckedFile {
+    pub path: PathBuf,
+    pub text: Arc<str>,
+    pub diagnostics: Vec<Diagnostic>,
 }
+
+/// What a report shows: the checked files, and the text of every file a
+/// diagnostic points into (macrocycle files that were not checked too).
+pub(crate) struct Checked {
+    pub files: Vec<CheckedFile>,
+    pub sources: HashMap<String, Arc<str>>,
+}
+
+impl Checked {
+    /// The text of a file named in a related location.
+    pub fn source(&self, name: &str) -> Option<&str> {
+        self.sources.get(name).map(|text| &**text)
+    }
+}
+
+/// Below this many files a run is quick enough not to need a progress bar.
+const PROGRESS_BAR_MIN_FILES: usize = 200;
 
 pub(crate) fn run(paths: &[PathBuf], format: Format) -> ExitCode {
     let (files, mut failures) = collect_files(paths);
+    let progress = progress_bar(files.len());
     let read: Vec<Result<(PathBuf, String), String>> = files
         .par_iter()
         .map(|path| read_program(path).map(|text| (path.clone(), text)).map_err(|e| format!("{}: {e}", path.display())))
@@ -52,6 +73,7 @@ pub(crate) fn run(paths: &[PathBuf], format: Format) -> ExitCode {
         }
     }
     let mut checked = Vec::new();
+    let mut sources = HashMap::new();
     for (config_path, programs) in workspaces {
         let config = match &config_path {
             Some(path) => match std::fs::read_to_string(path)
@@ -67,22 +89,40 @@ pub(crate) fn run(paths: &[PathBuf], format: Format) -> ExitCode {
             None => Config::default(),
         };
         let mut host = AnalysisHost::new(config);
+        // Macrocycle files beside the checked programs are what their G72
+        // calls run, so they are part of the workspace even when they are
+        // not checked themselves.
+        let context: Vec<_> = macrocycles_beside(&programs)
+            .into_iter()
+            .map(|(path, text)| host.add_file(path.display().to_string(), text))
+            .collect();
         let ids: Vec<_> =
             programs.into_iter().map(|(path, text)| (host.add_file(path.display().to_string(), text), path)).collect();
         let analysis = host.analysis();
-        checked.par_extend(ids.into_par_iter().map_with(analysis, |analysis, (file, path)| CheckedFile {
-            path,
-            text: analysis.text(file),
-            diagnostics: analysis.diagnostics(file),
-        }));
+        for &file in context.iter().chain(ids.iter().map(|(file, _)| file)) {
+            sources.insert(analysis.path(file), analysis.text(file));
+        }
+        checked.par_extend(ids.into_par_iter().progress_with(progress.clone()).map_with(
+            analysis,
+            |analysis, (file, path)| CheckedFile {
+                path,
+                text: analysis.text(file),
+                diagnostics: analysis.diagnostics(file),
+            },
+        ));
     }
+    progress.finish_and_clear();
     checked.sort_by(|a, b| a.path.cmp(&b.path));
+    let checked = Checked { files: checked, sources };
 
     let stdout = io::stdout();
+    let color = stdout.is_terminal();
     let mut out = io::BufWriter::new(stdout.lock());
     let written = match format {
-        Format::Human => write_human(&mut out, &checked),
-        Format::Json => write_json(&mut out, &checked),
+        Format::Human => report::write_human(&mut out, &checked, color),
+        Format::Short => report::write_short(&mut out, &checked),
+        Format::Json => report::write_json(&mut out, &checked),
+        Format::Sarif => sarif::write(&mut out, &checked),
     };
     if let Err(error) = written.and_then(|()| out.flush()) {
         if error.kind() != io::ErrorKind::BrokenPipe {
@@ -93,13 +133,59 @@ pub(crate) fn run(paths: &[PathBuf], format: Format) -> ExitCode {
     for failure in &failures {
         eprintln!("error: {failure}");
     }
+    exit_code(&checked, &failures)
+}
+
+/// 2 when something could not be read, 1 when an error or a warning was
+/// found, 0 otherwise (infos and hints are advice, not findings).
+fn exit_code(checked: &Checked, failures: &[String]) -> ExitCode {
     if !failures.is_empty() {
         ExitCode::from(2)
-    } else if checked.iter().flat_map(|f| &f.diagnostics).any(|d| d.severity == Severity::Error) {
+    } else if checked.files.iter().flat_map(|f| &f.diagnostics).any(|d| d.severity >= Severity::Warning) {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS
     }
+}
+
+/// A progress bar on stderr for runs large enough to take a while, only
+/// when a person is watching.
+fn progress_bar(files: usize) -> ProgressBar {
+    if files < PROGRESS_BAR_MIN_FILES || !io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(files as u64);
+    if let Ok(style) = ProgressStyle::with_template("{spinner} checking {pos}/{len} files {wide_bar} {eta}") {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// Macrocycle files in the directories of `programs` that are not among them.
+fn macrocycles_beside(programs: &[(PathBuf, String)]) -> Vec<(PathBuf, String)> {
+    let given: HashSet<&Path> = programs.iter().map(|(path, _)| path.as_path()).collect();
+    let mut directories: Vec<&Path> = programs.iter().filter_map(|(path, _)| path.parent()).collect();
+    directories.sort();
+    directories.dedup();
+    let mut found = Vec::new();
+    for directory in directories {
+        let Ok(entries) = std::fs::read_dir(if directory.as_os_str().is_empty() { Path::new(".") } else { directory })
+        else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let path = directory.join(entry.file_name());
+            if is_macrocycle(&path)
+                && !given.contains(path.as_path())
+                && path.is_file()
+                && let Ok(text) = read_program(&path)
+            {
+                found.push((path, text));
+            }
+        }
+    }
+    found.sort();
+    found
 }
 
 /// The files to check: explicit files as given, partprograms found in
@@ -132,118 +218,14 @@ fn collect_files(paths: &[PathBuf]) -> (Vec<PathBuf>, Vec<String>) {
 /// Partprograms (`*.NCP`, any case) and macrocycle files (`L<number>`, with
 /// or without an extension).
 fn is_partprogram(path: &Path) -> bool {
-    let extension_is_ncp = path.extension().is_some_and(|ext| ext.eq_ignore_ascii_case("ncp"));
-    let is_macrocycle = path.file_stem().and_then(|stem| stem.to_str()).is_some_and(|stem| {
+    path.extension().is_some_and(|ext| ext.eq_ignore_ascii_case("ncp")) || is_macrocycle(path)
+}
+
+/// Macrocycle files: `L<number>`, with or without an extension.
+fn is_macrocycle(path: &Path) -> bool {
+    path.file_stem().and_then(|stem| stem.to_str()).is_some_and(|stem| {
         stem.len() > 1 && stem.starts_with(['L', 'l']) && stem[1..].bytes().all(|b| b.is_ascii_digit())
-    });
-    extension_is_ncp || is_macrocycle
-}
-
-fn write_human(out: &mut impl Write, files: &[CheckedFile]) -> io::Result<()> {
-    let color = io::stdout().is_terminal();
-    let config = ariadne::Config::default().with_index_type(IndexType::Byte).with_color(color);
-    let mut counts = [0usize; 4];
-    for file in files {
-        if file.diagnostics.is_empty() {
-            continue;
-        }
-        let name = file.path.display().to_string();
-        let source = Source::from(&*file.text);
-        for diagnostic in &file.diagnostics {
-            counts[diagnostic.severity as usize] += 1;
-            let range: Range<usize> = diagnostic.range.into();
-            let (kind, label_color) = match diagnostic.severity {
-                Severity::Error => (ReportKind::Error, Color::Red),
-                Severity::Warning => (ReportKind::Warning, Color::Yellow),
-                Severity::Info => (ReportKind::Custom("info", Color::Blue), Color::Blue),
-                Severity::Hint => (ReportKind::Custom("hint", Color::Cyan), Color::Cyan),
-            };
-            let mut report = Report::build(kind, (name.clone(), range.clone()))
-                .with_config(config)
-                .with_code(format!("{} {}", diagnostic.code, diagnostic.name))
-                .with_message(&diagnostic.message)
-                .with_label(
-                    Label::new((name.clone(), range))
-                        .with_message(diagnostic.name.replace('-', " "))
-                        .with_color(label_color)
-                        .with_order(0),
-                );
-            for related in &diagnostic.related {
-                match &related.file {
-                    None => report.add_label(
-                        Label::new((name.clone(), related.range.into()))
-                            .with_message(&related.message)
-                            .with_color(Color::Cyan)
-                            .with_order(1),
-                    ),
-                    Some(other) => report.add_note(format!("{}: {}", other, related.message)),
-                }
-            }
-            for fix in &diagnostic.fixes {
-                report.add_help(&fix.title);
-            }
-            report.finish().write((name.clone(), &source), &mut *out)?;
-        }
-    }
-    let [hints, infos, warnings, errors] = counts;
-    let plural = |n: usize, word: &str| format!("{n} {word}{}", if n == 1 { "" } else { "s" });
-    let checked = plural(files.len(), "file");
-    if errors + warnings + infos + hints == 0 {
-        writeln!(out, "All checks passed ({checked} checked).")
-    } else {
-        writeln!(
-            out,
-            "Found {}, {}, {} and {} in {checked}.",
-            plural(errors, "error"),
-            plural(warnings, "warning"),
-            plural(infos, "info"),
-            plural(hints, "hint"),
-        )
-    }
-}
-
-/// One diagnostic in `--format json`. Lines and columns are 1-based, columns
-/// count characters (Unicode scalar values), and the end is exclusive.
-#[derive(Serialize)]
-struct JsonDiagnostic<'a> {
-    file: String,
-    line: u32,
-    column: u32,
-    end_line: u32,
-    end_column: u32,
-    severity: &'static str,
-    code: &'static str,
-    name: &'static str,
-    message: &'a str,
-}
-
-fn write_json(out: &mut impl Write, files: &[CheckedFile]) -> io::Result<()> {
-    let mut all = Vec::new();
-    for file in files {
-        let index = LineIndex::new(&file.text);
-        let position = |offset: TextSize| {
-            let line_col = index.line_col(offset);
-            let wide = index.to_wide(WideEncoding::Utf32, line_col).expect("offset inside the text");
-            (wide.line + 1, wide.col + 1)
-        };
-        for diagnostic in &file.diagnostics {
-            let (line, column) = position(diagnostic.range.start());
-            let (end_line, end_column) = position(diagnostic.range.end());
-            all.push(JsonDiagnostic {
-                file: file.path.display().to_string(),
-                line,
-                column,
-                end_line,
-                end_column,
-                severity: diagnostic.severity.as_str(),
-                code: diagnostic.code,
-                name: diagnostic.name,
-                message: &diagnostic.message,
-            });
-        }
-    }
-    serde_json::to_writer_pretty(&mut *out, &all)?;
-    writeln!(out)
+    })
 }
 
 #[cfg(test)]

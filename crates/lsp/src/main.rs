@@ -2,6 +2,9 @@
 
 mod check;
 mod explain;
+mod report;
+mod rules;
+mod sarif;
 
 use std::{path::PathBuf, process::ExitCode};
 
@@ -23,7 +26,8 @@ enum Command {
     ///
     /// Directories are searched for partprograms (`*.NCP` and macrocycle
     /// files `L<number>`), honouring `.gitignore`. Exit status: 0 when no
-    /// errors were found, 1 when some were, 2 when a path could not be read.
+    /// error or warning was found, 1 when one was, 2 when a path or an
+    /// `ncc.toml` could not be read.
     Check {
         /// Files or directories to check.
         #[arg(default_value = ".")]
@@ -45,6 +49,13 @@ enum Command {
         #[arg(long, conflicts_with = "query")]
         list: bool,
     },
+    /// List the rules `ncc check` applies: code, default severity, name.
+    ///
+    /// Names and codes are what `ncc.toml` and `ncc:ignore` comments use.
+    Rules {
+        /// Show only the rule with this code, or rules whose name contains it.
+        query: Option<String>,
+    },
     /// Print the syntax tree of a partprogram (a debugging aid).
     Parse {
         /// The program to parse.
@@ -56,6 +67,7 @@ fn main() -> ExitCode {
     match Cli::parse().command {
         Command::Check { paths, format } => check::run(&paths, format),
         Command::Explain { query, list } => explain::run(query.as_deref(), list),
+        Command::Rules { query } => rules::run(query.as_deref()),
         Command::Parse { file } => match check::read_program(&file) {
             Ok(text) => {
                 let parse = ncc_syntax::Parse::new(&text, ncc_syntax::Dialect::Cnc8x6);

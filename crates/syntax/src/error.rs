@@ -31,7 +31,7 @@ impl fmt::Display for Severity {
 }
 
 macro_rules! syntax_error_kinds {
-    ($($variant:ident = $code:literal, $name:literal, $severity:ident;)*) => {
+    ($($variant:ident = $code:literal, $name:literal, $severity:ident, $summary:literal;)*) => {
         /// Every syntax diagnostic. Codes are stable: tools and suppressions
         /// refer to them, so a code is never reused for something else.
         #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -61,30 +61,37 @@ macro_rules! syntax_error_kinds {
                     $(SyntaxErrorKind::$variant => Severity::$severity,)*
                 }
             }
+
+            /// One sentence on what the diagnostic reports.
+            pub fn summary(self) -> &'static str {
+                match self {
+                    $(SyntaxErrorKind::$variant => $summary,)*
+                }
+            }
         }
     };
 }
 
 syntax_error_kinds! {
-    UnexpectedCharacter = "S001", "unexpected-character", Error;
-    SpaceInNumber = "S002", "space-in-number", Error;
-    SpaceAfterSign = "S003", "space-after-sign", Error;
-    MissingValue = "S004", "missing-value", Error;
-    NumberWithoutDigits = "S005", "number-without-digits", Error;
-    NumberWithoutAddress = "S006", "number-without-address", Error;
-    SignWithoutAddress = "S007", "sign-without-address", Error;
-    MissingBlockNumber = "S008", "missing-block-number", Error;
-    LineTooLong = "S009", "line-too-long", Error;
-    TypographicQuote = "S010", "typographic-quote", Warning;
-    TypographicMinus = "S011", "typographic-minus", Warning;
-    LowercaseAddress = "S012", "lowercase-address", Warning;
-    IgnoredPreamble = "S013", "ignored-preamble", Info;
-    TextAfterEnd = "S014", "text-after-end", Warning;
-    MissingProgramNumber = "S015", "missing-program-number", Error;
-    MisplacedPercent = "S016", "misplaced-percent", Error;
-    ParameterWithoutAssignment = "S017", "parameter-without-assignment", Error;
-    MissingParameterNumber = "S018", "missing-parameter-number", Error;
-    MisplacedEquals = "S019", "misplaced-equals", Error;
+    UnexpectedCharacter = "S001", "unexpected-character", Error, "A character the control does not accept outside comments.";
+    SpaceInNumber = "S002", "space-in-number", Error, "A space inside a number.";
+    SpaceAfterSign = "S003", "space-after-sign", Error, "A space between a sign and its digits.";
+    MissingValue = "S004", "missing-value", Error, "An address letter without a value.";
+    NumberWithoutDigits = "S005", "number-without-digits", Error, "A number made of a sign or a point only.";
+    NumberWithoutAddress = "S006", "number-without-address", Error, "A number that follows no address letter.";
+    SignWithoutAddress = "S007", "sign-without-address", Error, "A sign that follows no address letter.";
+    MissingBlockNumber = "S008", "missing-block-number", Error, "Words that belong to no block because no block number N precedes them.";
+    LineTooLong = "S009", "line-too-long", Error, "A line longer than the control's 80 characters.";
+    TypographicQuote = "S010", "typographic-quote", Warning, "A typographic quote where the control needs a straight double quote.";
+    TypographicMinus = "S011", "typographic-minus", Warning, "A typographic minus where the control needs `-`.";
+    LowercaseAddress = "S012", "lowercase-address", Warning, "A lowercase address letter.";
+    IgnoredPreamble = "S013", "ignored-preamble", Info, "Text before the `%` header, which the control ignores.";
+    TextAfterEnd = "S014", "text-after-end", Warning, "Text other than comments after the physical end `*`.";
+    MissingProgramNumber = "S015", "missing-program-number", Error, "A `%` header without its program number.";
+    MisplacedPercent = "S016", "misplaced-percent", Error, "A `%` anywhere but at the start of the program.";
+    ParameterWithoutAssignment = "S017", "parameter-without-assignment", Error, "A parameter `R12` on its own: neither assigned (`R12=5.`) nor used after an address (`XR12`).";
+    MissingParameterNumber = "S018", "missing-parameter-number", Error, "`R` without the parameter number.";
+    MisplacedEquals = "S019", "misplaced-equals", Error, "An `=` that does not follow a parameter.";
 }
 
 /// One syntax diagnostic.

@@ -1,0 +1,229 @@
+//! The text and JSON reports of `ncc check`.
+
+use std::{
+    io::{self, Write},
+    ops::Range,
+};
+
+use ariadne::{Color, FnCache, IndexType, Label, Report, ReportKind};
+use line_index::{LineIndex, WideEncoding};
+use ncc_analysis::{Diagnostic, Severity, TextRange, TextSize};
+use serde::Serialize;
+
+use crate::check::Checked;
+
+/// Line and column of offsets in one file: 1-based, columns counting
+/// characters (Unicode scalar values), as editors and people count them.
+pub(crate) struct Positions(LineIndex);
+
+impl Positions {
+    pub fn new(text: &str) -> Positions {
+        Positions(LineIndex::new(text))
+    }
+
+    pub fn at(&self, offset: TextSize) -> (u32, u32) {
+        let line_col = self.0.line_col(offset);
+        // Offsets of diagnostics are always inside their file's text.
+        let wide = self
+            .0
+            .to_wide(WideEncoding::Utf32, line_col)
+            .unwrap_or(line_index::WideLineCol { line: line_col.line, col: line_col.col });
+        (wide.line + 1, wide.col + 1)
+    }
+}
+
+pub(crate) fn write_human(out: &mut impl Write, checked: &Checked, color: bool) -> io::Result<()> {
+    let config = ariadne::Config::default().with_index_type(IndexType::Byte).with_color(color);
+    // Each file's text is indexed once, however many reports point into it.
+    let mut cache = FnCache::new(|name: &String| checked.sources.get(name).cloned().ok_or("not read"));
+    let mut counts = [0usize; 4];
+    for file in &checked.files {
+        let name = file.path.display().to_string();
+        for diagnostic in &file.diagnostics {
+            counts[diagnostic.severity as usize] += 1;
+            let range: Range<usize> = diagnostic.range.into();
+            let (kind, label_color) = match diagnostic.severity {
+                Severity::Error => (ReportKind::Error, Color::Red),
+                Severity::Warning => (ReportKind::Warning, Color::Yellow),
+                Severity::Info => (ReportKind::Custom("info", Color::Blue), Color::Blue),
+                Severity::Hint => (ReportKind::Custom("hint", Color::Cyan), Color::Cyan),
+            };
+            let mut report = Report::build(kind, (name.clone(), range.clone()))
+                .with_config(config)
+                .with_code(format!("{} {}", diagnostic.code, diagnostic.name))
+                .with_message(&diagnostic.message)
+                .with_label(
+                    Label::new((name.clone(), range))
+                        .with_message(diagnostic.name.replace('-', " "))
+                        .with_color(label_color)
+                        .with_order(0),
+                );
+            for related in &diagnostic.related {
+                let other = related.file.as_ref().unwrap_or(&name);
+                if checked.source(other).is_some() {
+                    report.add_label(
+                        Label::new((other.clone(), related.range.into()))
+                            .with_message(&related.message)
+                            .with_color(Color::Cyan)
+                            .with_order(1),
+                    );
+                } else {
+                    report.add_note(format!("{other}: {}", related.message));
+                }
+            }
+            for fix in &diagnostic.fixes {
+                report.add_help(&fix.title);
+            }
+            report.finish().write(&mut cache, &mut *out)?;
+        }
+    }
+    let [hints, infos, warnings, errors] = counts;
+    let plural = |n: usize, word: &str| format!("{n} {word}{}", if n == 1 { "" } else { "s" });
+    let files = plural(checked.files.len(), "file");
+    if errors + warnings + infos + hints == 0 {
+        writeln!(out, "All checks passed ({files} checked).")
+    } else {
+        writeln!(
+            out,
+            "Found {}, {}, {} and {} in {files}.",
+            plural(errors, "error"),
+            plural(warnings, "warning"),
+            plural(infos, "info"),
+            plural(hints, "hint"),
+        )
+    }
+}
+
+/// `file:line:col: severity[code]: message`, one line each, like compilers
+/// print for editors and grep.
+pub(crate) fn write_short(out: &mut impl Write, checked: &Checked) -> io::Result<()> {
+    for file in &checked.files {
+        let positions = Positions::new(&file.text);
+        for diagnostic in &file.diagnostics {
+            let (line, column) = positions.at(diagnostic.range.start());
+            // A message is one line; keep the report one line per finding
+            // even if a future message is not.
+            let message = diagnostic.message.replace('\n', " ");
+            writeln!(
+                out,
+                "{}:{line}:{column}: {}[{}]: {message}",
+                file.path.display(),
+                diagnostic.severity,
+                diagnostic.code
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// A range in `--format json`: 1-based, columns count characters, the end
+/// is exclusive.
+#[derive(Serialize)]
+struct JsonRange {
+    line: u32,
+    column: u32,
+    end_line: u32,
+    end_column: u32,
+}
+
+impl JsonRange {
+    fn new(positions: &Positions, range: TextRange) -> JsonRange {
+        let (line, column) = positions.at(range.start());
+        let (end_line, end_column) = positions.at(range.end());
+        JsonRange { line, column, end_line, end_column }
+    }
+}
+
+/// One diagnostic in `--format json`.
+#[derive(Serialize)]
+struct JsonDiagnostic<'a> {
+    file: String,
+    #[serde(flatten)]
+    range: JsonRange,
+    severity: &'static str,
+    code: &'static str,
+    name: &'static str,
+    message: &'a str,
+    related: Vec<JsonRelated<'a>>,
+    fixes: Vec<JsonFix<'a>>,
+}
+
+/// Another place that explains a diagnostic.
+#[derive(Serialize)]
+struct JsonRelated<'a> {
+    file: String,
+    /// Absent when the place is in a file that was not read.
+    #[serde(flatten)]
+    range: Option<JsonRange>,
+    message: &'a str,
+}
+
+#[derive(Serialize)]
+struct JsonFix<'a> {
+    title: &'a str,
+    edits: Vec<JsonEdit<'a>>,
+}
+
+/// Replace the text of `range` (in the diagnostic's file) with `new_text`.
+#[derive(Serialize)]
+struct JsonEdit<'a> {
+    #[serde(flatten)]
+    range: JsonRange,
+    new_text: &'a str,
+}
+
+pub(crate) fn write_json(out: &mut impl Write, checked: &Checked) -> io::Result<()> {
+    let mut all = Vec::new();
+    for file in &checked.files {
+        let positions = Positions::new(&file.text);
+        let name = file.path.display().to_string();
+        all.extend(file.diagnostics.iter().map(|diagnostic| json_diagnostic(checked, &name, &positions, diagnostic)));
+    }
+    serde_json::to_writer_pretty(&mut *out, &all)?;
+    writeln!(out)
+}
+
+fn json_diagnostic<'a>(
+    checked: &Checked,
+    file: &str,
+    positions: &Positions,
+    diagnostic: &'a Diagnostic,
+) -> JsonDiagnostic<'a> {
+    JsonDiagnostic {
+        file: file.to_owned(),
+        range: JsonRange::new(positions, diagnostic.range),
+        severity: diagnostic.severity.as_str(),
+        code: diagnostic.code,
+        name: diagnostic.name,
+        message: &diagnostic.message,
+        related: diagnostic
+            .related
+            .iter()
+            .map(|related| {
+                let range = match &related.file {
+                    None => Some(JsonRange::new(positions, related.range)),
+                    Some(other) => {
+                        checked.source(other).map(|text| JsonRange::new(&Positions::new(text), related.range))
+                    }
+                };
+                JsonRelated {
+                    file: related.file.clone().unwrap_or_else(|| file.to_owned()),
+                    range,
+                    message: &related.message,
+                }
+            })
+            .collect(),
+        fixes: diagnostic
+            .fixes
+            .iter()
+            .map(|fix| JsonFix {
+                title: &fix.title,
+                edits: fix
+                    .edits
+                    .iter()
+                    .map(|edit| JsonEdit { range: JsonRange::new(positions, edit.delete), new_text: &edit.insert })
+                    .collect(),
+            })
+            .collect(),
+    }
+}
