@@ -43,6 +43,8 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
     let catalogue = Dialect::Cnc8x6.catalogue();
     let mut out = Vec::new();
     let indirect_g = block.words_with(b'G').any(|w| matches!(w.value, Some(Value::Parameter { .. })));
+    // In a G31/G38/G39 block E is the angle divisor, an integer (`E100`).
+    let divides_angles = [31, 38, 39].iter().any(|&c| block.has_code(b'G', c));
 
     let mut seen: [Option<&Word>; 128] = [None; 128];
     let mut axes = Vec::new();
@@ -89,7 +91,7 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
             }
         }
         match &word.value {
-            Some(Value::Literal(literal)) => check_literal(word, address, literal, catalogue, &mut out),
+            Some(Value::Literal(literal)) => check_literal(word, address, literal, catalogue, divides_angles, &mut out),
             Some(Value::Parameter { .. }) if !address.substitutable => out.push(Diagnostic::new(
                 &NOT_SUBSTITUTABLE,
                 word.value_range.unwrap_or(word.range),
@@ -126,7 +128,14 @@ fn address_of(catalogue: &Catalogue, letter: u8) -> Option<&Address> {
 }
 
 /// Digits, range, sign and decimal point of a literal value.
-fn check_literal(word: &Word, address: &Address, value: &Decimal, catalogue: &Catalogue, out: &mut Vec<Diagnostic>) {
+fn check_literal(
+    word: &Word,
+    address: &Address,
+    value: &Decimal,
+    catalogue: &Catalogue,
+    divides_angles: bool,
+    out: &mut Vec<Diagnostic>,
+) {
     let range = word.value_range.unwrap_or(word.range);
     let letter = &address.letter;
     if value.sign().is_some() && !address.signed {
@@ -163,7 +172,7 @@ fn check_literal(word: &Word, address: &Address, value: &Decimal, catalogue: &Ca
             return;
         }
     }
-    if address.role == AddressRole::ThreadLeadIn && !value.has_point() {
+    if address.role == AddressRole::ThreadLeadIn && !value.has_point() && !divides_angles {
         out.push(Diagnostic::new(
             &DECIMAL_POINT_REQUIRED,
             range,

@@ -38,7 +38,7 @@ pub(crate) fn flow_checks() -> Vec<Box<dyn FlowCheck>> {
         Box::new(geometry::Geometry),
         Box::new(feed::Feed),
         Box::new(threads::Threads::default()),
-        Box::new(transform::Transformations),
+        Box::new(transform::Transformations::default()),
         Box::new(cycles::Cycles),
         Box::new(dynamics::Dynamics),
     ]
