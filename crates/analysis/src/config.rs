@@ -4,6 +4,7 @@
 //! [rules]
 //! missing-feed = "warning"     # by name or by code
 //! S009 = "off"
+//! non-canonical-word-order = "info"   # opt-in rules are off until named
 //!
 //! [machine]
 //! axes = ["X", "Y", "Z", "U", "V", "C"]   # letters of axes 1-6
@@ -81,15 +82,17 @@ impl MachineConfig {
     /// A machine constant's raw value: configured, else the catalogue's
     /// default, else zero.
     pub fn constant(&self, number: u32) -> i64 {
+        self.known_constant(number).unwrap_or(0)
+    }
+
+    /// A machine constant's raw value when the configuration or the
+    /// catalogue gives one; `None` for a constant without a documented
+    /// default that the configuration does not set.
+    pub fn known_constant(&self, number: u32) -> Option<i64> {
         if let Some(&value) = self.constants.get(&number) {
-            return value;
+            return Some(value);
         }
-        Dialect::Cnc8x6
-            .catalogue()
-            .machine_constant(number)
-            .and_then(|c| c.default.as_deref())
-            .and_then(parse_constant)
-            .unwrap_or(0)
+        Dialect::Cnc8x6.catalogue().machine_constant(number).and_then(|c| c.default.as_deref()).and_then(parse_constant)
     }
 
     /// Decade `decade` (1 = rightmost digit) of a machine constant.
@@ -180,10 +183,12 @@ impl Config {
         start.ancestors().map(|dir| dir.join(CONFIG_FILE)).find(|candidate| candidate.is_file())
     }
 
-    /// Applies the severity overrides; `None` when the rule is turned off.
+    /// Applies the severity overrides; `None` when the rule is turned off,
+    /// or is an opt-in rule the configuration does not name.
     pub(crate) fn adjust(&self, mut diagnostic: Diagnostic) -> Option<Diagnostic> {
         let level = self.rules.get(diagnostic.code).or_else(|| self.rules.get(diagnostic.name));
         match level {
+            None if crate::Rule::find(diagnostic.code).is_some_and(|rule| rule.opt_in) => None,
             None => Some(diagnostic),
             Some(level) => {
                 diagnostic.severity = level.severity()?;

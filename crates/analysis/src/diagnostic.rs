@@ -105,6 +105,9 @@ pub struct Rule {
     pub severity: Severity,
     /// One line on what the rule checks.
     pub summary: &'static str,
+    /// Off unless the project configuration gives it a level (a matter of
+    /// style that not every shop follows).
+    pub opt_in: bool,
 }
 
 impl Rule {
@@ -120,14 +123,18 @@ impl Rule {
 }
 
 /// Declares a check module's rules as statics and lists them in `RULES`.
+/// A trailing `, opt_in` marks a rule that is off unless configured.
 macro_rules! declare_rules {
-    ($($ident:ident = $code:literal, $name:literal, $severity:ident, $summary:literal;)*) => {
+    (@opt_in) => { false };
+    (@opt_in opt_in) => { true };
+    ($($ident:ident = $code:literal, $name:literal, $severity:ident, $summary:literal $(, $opt_in:ident)?;)*) => {
         $(
             pub(crate) static $ident: $crate::Rule = $crate::Rule {
                 code: $code,
                 name: $name,
                 severity: ncc_syntax::Severity::$severity,
                 summary: $summary,
+                opt_in: $crate::diagnostic::declare_rules!(@opt_in $($opt_in)?),
             };
         )*
         pub(crate) static RULES: &[&$crate::Rule] = &[$(&$ident,)*];

@@ -462,10 +462,14 @@ impl<'db> Walk<'db> {
             after.g = [Known::Unknown; 12];
             after.m = [Known::Unknown; 15];
         }
+        // With G76, S is the CSS speed limit, not the spindle speed.
+        let speed_limit = codes.iter().any(|&(letter, number, _)| letter == b'G' && number == 76);
+        let writes_speed =
+            !speed_limit && block.words.iter().any(|w| self.catalogue.role_of(w.letter) == Some(AddressRole::Speed));
         for (word, substitution) in block.words.iter().zip(substitutions) {
             let slot = match self.catalogue.role_of(word.letter) {
                 Some(AddressRole::Feed) => &mut after.feed,
-                Some(AddressRole::Speed) => &mut after.speed,
+                Some(AddressRole::Speed) if !speed_limit => &mut after.speed,
                 Some(AddressRole::Tool) => &mut after.tool,
                 Some(AddressRole::Offset) => &mut after.offset,
                 Some(AddressRole::LengthCompensation) => &mut after.length,
@@ -475,6 +479,12 @@ impl<'db> Walk<'db> {
                 Some(setting) => Known::Is(Some(setting)),
                 None => Known::Unknown,
             };
+        }
+        // When constant cutting speed ends without a new S, the control
+        // keeps the speed it last reached, not the S written (a cutting speed).
+        let maybe_css = |state: &ModalState| !matches!(state.g[6], Known::Is(Some(94 | 95)));
+        if maybe_css(before) && !maybe_css(&after) && !writes_speed {
+            after.speed = Known::Unknown;
         }
         self.move_axes(&mut after, block, substitutions, codes);
         after

@@ -39,3 +39,13 @@ fn missing_g70_fix_at_the_end_of_a_file_without_newline() {
     let fixed = apply_fix(text, missing);
     assert_eq!(fixed, "%1\nN10 M30\nN100 G79 L100\nN101 G00 X5.\nN102 G70\n");
 }
+
+#[test]
+fn empty_block_fix_removes_the_block() {
+    let text = "%1\nN10 G00 X5.\nN20\nN30 M30\n*\n";
+    let found = diagnostics(text);
+    let empty = found.iter().find(|d| d.name == "empty-block").expect("empty-block");
+    let fixed = apply_fix(text, empty);
+    assert_eq!(fixed, "%1\nN10 G00 X5.\nN30 M30\n*\n");
+    assert!(diagnostics(&fixed).is_empty(), "{:#?}", diagnostics(&fixed));
+}

@@ -33,7 +33,14 @@ declare_rules! {
     SWALLOWED_WORDS = "B221", "swallowed-words", Warning, "An unclosed comment that hides words after it.";
     OFFSET_TABLE_FORM = "B223", "offset-table-form", Warning, "G92/G93 without the group-5 code that names the table row.";
     SUBPROGRAM_START_EXTRA_WORDS = "B224", "subprogram-start-extra-words", Error, "A `G79` block with words other than N, G79 and L.";
+    BLOCK_SKIP_BEFORE_BLOCK_NUMBER = "B225", "block-skip-before-block-number", Warning, "`/` as the last item of a block, where it skips this block rather than the next.";
+    NON_CANONICAL_WORD_ORDER = "B226", "non-canonical-word-order", Info, "Words out of the maximal block format's order (opt-in: off unless named in ncc.toml).", opt_in;
 }
+
+/// The order of the maximal block format, the recommended word order:
+/// these addresses, the machine's axes 1–6 in their place, then the rest.
+const FORMAT_BEFORE_AXES: &[u8] = b"NGD";
+const FORMAT_AFTER_AXES: &[u8] = b"IJKR&FSLQHPTM";
 
 /// The codes that read Q (dwell or repetitions) and L (call or jump target).
 const READS_Q: [u32; 4] = [4, 71, 72, 73];
@@ -115,6 +122,8 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
     }
     check_assignments(block, catalogue, &mut out);
     check_skip(block, &mut out);
+    check_skip_position(block, &mut out);
+    check_word_order(block, config, &mut out);
     check_dwell(block, &mut out);
     check_offset_table_form(block, &mut out);
     check_g98_alone(block, &mut out);
@@ -364,6 +373,56 @@ fn check_skip(block: &BlockData, out: &mut Vec<Diagnostic>) {
     }
     for skip in block.skip.iter().skip(1) {
         out.push(Diagnostic::new(&SKIP_REPEATED, *skip, "this block already has `/`; one is enough"));
+    }
+}
+
+/// A block ends just before the next N, so a `/` typed in front of a block
+/// number belongs to the block before it. (A further `/` after one in its
+/// place is only redundant: skip-repeated.)
+fn check_skip_position(block: &BlockData, out: &mut Vec<Diagnostic>) {
+    let Some(&skip) = block.skip.first() else { return };
+    let mut items = block.words.iter().map(|w| w.range).chain(block.assignments.iter().map(|a| a.range));
+    if items.all(|item| item.end() <= skip.start()) {
+        out.push(Diagnostic::new(
+            &BLOCK_SKIP_BEFORE_BLOCK_NUMBER,
+            skip,
+            "nothing follows this `/` in its block, so it skips this block, not the next one (a block ends just before the next N); to skip the next block, write `/` after its number",
+        ));
+    }
+}
+
+/// The first word written after one that the maximal block format puts
+/// later (`N10 F200 X5.`: X belongs before F).
+fn check_word_order(block: &BlockData, config: &Config, out: &mut Vec<Diagnostic>) {
+    let order: Vec<u8> =
+        FORMAT_BEFORE_AXES.iter().chain(&config.machine.axes).chain(FORMAT_AFTER_AXES).copied().collect();
+    let mut items: Vec<(TextRange, u8)> = block.words.iter().map(|w| (w.range, w.letter)).collect();
+    items.extend(block.assignments.iter().map(|a| (a.range, b'R')));
+    items.sort_by_key(|(range, _)| range.start());
+    // The word of the latest place in the order seen so far.
+    let mut latest: Option<(usize, TextRange, u8)> = None;
+    for (range, letter) in items {
+        let Some(place) = order.iter().position(|&l| l == letter) else { continue };
+        match latest {
+            Some((latest_place, latest_range, latest_letter)) if place < latest_place => {
+                let order: Vec<String> = order.iter().map(|&l| char::from(l).to_string()).collect();
+                let (letter, latest_letter) = (char::from(letter), char::from(latest_letter));
+                out.push(
+                    Diagnostic::new(
+                        &NON_CANONICAL_WORD_ORDER,
+                        range,
+                        format!(
+                            "`{letter}` is written after `{latest_letter}`; the recommended word order, that of the maximal block format, is {}",
+                            order.join(" ")
+                        ),
+                    )
+                    .with_related(None, latest_range, format!("`{latest_letter}` is here")),
+                );
+                return;
+            }
+            Some((latest_place, ..)) if place == latest_place => {}
+            _ => latest = Some((place, range, letter)),
+        }
     }
 }
 

@@ -36,7 +36,7 @@ pub(crate) fn flow_checks() -> Vec<Box<dyn FlowCheck>> {
         Box::new(arith::Arithmetic),
         Box::new(motion::Motion),
         Box::new(geometry::Geometry),
-        Box::new(feed::Feed),
+        Box::new(feed::Feed::default()),
         Box::new(threads::Threads::default()),
         Box::new(transform::Transformations::default()),
         Box::new(cycles::Cycles),
