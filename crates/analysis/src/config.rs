@@ -81,21 +81,29 @@ impl MachineConfig {
     /// A machine constant's raw value: configured, else the catalogue's
     /// default, else zero.
     pub fn constant(&self, number: u32) -> i64 {
+        self.known_constant(number).unwrap_or(0)
+    }
+
+    /// A machine constant's raw value if the configuration or the catalogue
+    /// gives one: `None` when neither does, so that rules needing it can
+    /// stay silent.
+    pub fn known_constant(&self, number: u32) -> Option<i64> {
         if let Some(&value) = self.constants.get(&number) {
-            return value;
+            return Some(value);
         }
-        Dialect::Cnc8x6
-            .catalogue()
-            .machine_constant(number)
-            .and_then(|c| c.default.as_deref())
-            .and_then(parse_constant)
-            .unwrap_or(0)
+        Dialect::Cnc8x6.catalogue().machine_constant(number).and_then(|c| c.default.as_deref()).and_then(parse_constant)
     }
 
     /// Decade `decade` (1 = rightmost digit) of a machine constant.
     pub fn decade(&self, number: u32, decade: u32) -> u8 {
-        let raw = self.constant(number).unsigned_abs();
-        ((raw / 10u64.pow(decade.saturating_sub(1))) % 10) as u8
+        self.known_decade(number, decade).unwrap_or(0)
+    }
+
+    /// Decade `decade` of a machine constant the configuration or the
+    /// catalogue gives.
+    pub fn known_decade(&self, number: u32, decade: u32) -> Option<u8> {
+        let raw = self.known_constant(number)?.unsigned_abs();
+        Some(((raw / 10u64.pow(decade.saturating_sub(1))) % 10) as u8)
     }
 
     /// Whether `letter` names a configured axis.
