@@ -97,8 +97,15 @@ impl MachineConfig {
 
     /// Decade `decade` (1 = rightmost digit) of a machine constant.
     pub fn decade(&self, number: u32, decade: u32) -> u8 {
-        let raw = self.constant(number).unsigned_abs();
-        ((raw / 10u64.pow(decade.saturating_sub(1))) % 10) as u8
+        self.known_decade(number, decade).unwrap_or(0)
+    }
+
+    /// Decade `decade` of a machine constant the configuration or the
+    /// catalogue gives.
+    pub fn known_decade(&self, number: u32, decade: u32) -> Option<u8> {
+        let raw = self.known_constant(number)?.unsigned_abs();
+        // Decades beyond the number's digits are zero.
+        Some(10u64.checked_pow(decade.saturating_sub(1)).map_or(0, |divisor| (raw / divisor % 10) as u8))
     }
 
     /// Whether `letter` names a configured axis.

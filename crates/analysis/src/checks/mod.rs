@@ -40,7 +40,7 @@ pub(crate) fn flow_checks() -> Vec<Box<dyn FlowCheck>> {
         Box::new(threads::Threads::default()),
         Box::new(transform::Transformations::default()),
         Box::new(cycles::Cycles),
-        Box::new(dynamics::Dynamics),
+        Box::new(dynamics::Dynamics::default()),
     ]
 }
 
