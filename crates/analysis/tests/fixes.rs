@@ -39,3 +39,14 @@ fn missing_g70_fix_at_the_end_of_a_file_without_newline() {
     let fixed = apply_fix(text, missing);
     assert_eq!(fixed, "%1\nN10 M30\nN100 G79 L100\nN101 G00 X5.\nN102 G70\n");
 }
+
+#[test]
+fn arc_missing_end_coordinate_fix_repeats_the_unchanged_coordinate() {
+    let text = "%1\nN10 G90 G17 G00 X0 Y5. F100\nN20 G02 X10. I5.\nN30 G91 G02 X0 I5.\nN40 M30\n*\n";
+    let found = diagnostics(text);
+    let missing: Vec<_> = found.iter().filter(|d| d.name == "arc-missing-end-coordinate").collect();
+    assert_eq!(missing.len(), 2, "{found:#?}");
+    let fixed = apply_fix(&apply_fix(text, missing[1]), missing[0]);
+    assert_eq!(fixed, "%1\nN10 G90 G17 G00 X0 Y5. F100\nN20 G02 X10. Y5. I5.\nN30 G91 G02 X0 Y0 I5.\nN40 M30\n*\n");
+    assert!(diagnostics(&fixed).is_empty(), "{:#?}", diagnostics(&fixed));
+}
