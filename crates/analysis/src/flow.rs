@@ -70,6 +70,12 @@ pub struct ModalState {
     /// in program coordinates, in micrometres (thousandths of a degree for
     /// rotary axes) as written: X stays a diameter under G74.
     pub position: [Known<i64>; 26],
+    /// The axis the last G10 gave a helix lead (`None`: no lead since the
+    /// start).
+    pub helix_lead_axis: Known<Option<u8>>,
+    /// Whether D has been written since the start. D is not in the priority
+    /// block, so `offset` starts unknown and cannot tell this.
+    pub offset_written: Known<bool>,
 }
 
 impl ModalState {
@@ -99,6 +105,8 @@ impl ModalState {
             tool: Known::Unknown,
             offset: Known::Unknown,
             length: Known::Is(None),
+            helix_lead_axis: Known::Is(None),
+            offset_written: Known::Is(false),
             ..state
         }
     }
@@ -118,6 +126,8 @@ impl ModalState {
             offset: Known::Unknown,
             length: Known::Unknown,
             position: [Known::Unknown; 26],
+            helix_lead_axis: Known::Unknown,
+            offset_written: Known::Unknown,
         }
     }
 
@@ -461,6 +471,14 @@ impl<'db> Walk<'db> {
             // A code from an unknown parameter may be any code.
             after.g = [Known::Unknown; 12];
             after.m = [Known::Unknown; 15];
+            after.helix_lead_axis = Known::Unknown;
+        }
+        if codes.iter().any(|&(l, n, _)| l == b'G' && n == 10) {
+            // `N10 Z1.05 G10`: the axis written is the one the helix drives.
+            let axis = block.words.iter().find(|w| self.catalogue.role_of(w.letter) == Some(AddressRole::Axis));
+            if let Some(axis) = axis {
+                after.helix_lead_axis = Known::Is(Some(axis.letter));
+            }
         }
         // With G76, S is the CSS speed limit, not the spindle speed.
         let speed_limit = codes.iter().any(|&(letter, number, _)| letter == b'G' && number == 76);
@@ -471,7 +489,10 @@ impl<'db> Walk<'db> {
                 Some(AddressRole::Feed) => &mut after.feed,
                 Some(AddressRole::Speed) if !speed_limit => &mut after.speed,
                 Some(AddressRole::Tool) => &mut after.tool,
-                Some(AddressRole::Offset) => &mut after.offset,
+                Some(AddressRole::Offset) => {
+                    after.offset_written = Known::Is(true);
+                    &mut after.offset
+                }
                 Some(AddressRole::LengthCompensation) => &mut after.length,
                 _ => continue,
             };
@@ -520,16 +541,19 @@ impl<'db> Walk<'db> {
                     continue;
                 }
                 let slot = &mut after.position[usize::from(word.letter - b'A')];
-                let value = match (&word.value, substitution) {
-                    (Some(Value::Literal(d)), _) => d.scaled(3).and_then(|v| i64::try_from(v).ok()),
-                    (Some(Value::Parameter { .. }), Some(s)) => Some(s.raw),
-                    _ => None,
-                };
-                *slot = match (value, incremental, *slot) {
+                *slot = match (thousandths(word, *substitution), incremental, *slot) {
                     (Some(v), Some(false), _) => Known::Is(v),
                     (Some(v), Some(true), Known::Is(from)) => Known::Is(from + v),
                     _ => Known::Unknown,
                 };
+            }
+        }
+        // A helix moves its lead axis without a word for it.
+        let helix = after.g[2] == Known::Is(Some(9)) && matches!(after.g[0], Known::Is(Some(2 | 3)));
+        if helix && !data_block {
+            match after.helix_lead_axis {
+                Known::Is(Some(axis)) => after.position[usize::from(axis - b'A')] = Known::Unknown,
+                _ => after.position = [Known::Unknown; 26],
             }
         }
         if cycle {
@@ -597,6 +621,16 @@ fn substitute(word: &Word, params: &ParamState) -> Option<Substitution> {
     let Some(Value::Parameter { negative, index: Some(index), .. }) = word.value else { return None };
     let (raw, origin) = params.get(index)?;
     Some(Substitution { raw: if negative { -raw } else { raw }, origin })
+}
+
+/// A dimensional word's value in thousandths of its unit (µm for lengths):
+/// its literal, or the raw value of a known parameter.
+pub(crate) fn thousandths(word: &Word, substitution: Option<Substitution>) -> Option<i64> {
+    match (&word.value, substitution) {
+        (Some(Value::Literal(d)), _) => d.scaled(3).and_then(|v| i64::try_from(v).ok()),
+        (Some(Value::Parameter { .. }), Some(s)) => Some(s.raw),
+        _ => None,
+    }
 }
 
 /// The block's G and M codes: literal, or substituted with a known value.

@@ -49,3 +49,14 @@ fn empty_block_fix_removes_the_block() {
     assert_eq!(fixed, "%1\nN10 G00 X5.\nN30 M30\n*\n");
     assert!(diagnostics(&fixed).is_empty(), "{:#?}", diagnostics(&fixed));
 }
+
+#[test]
+fn arc_missing_end_coordinate_fix_repeats_the_unchanged_coordinate() {
+    let text = "%1\nN10 G90 G17 G00 X0 Y5. F100\nN20 G02 X10. I5.\nN30 G91 G02 X0 I5.\nN40 M30\n*\n";
+    let found = diagnostics(text);
+    let missing: Vec<_> = found.iter().filter(|d| d.name == "arc-missing-end-coordinate").collect();
+    assert_eq!(missing.len(), 2, "{found:#?}");
+    let fixed = apply_fix(&apply_fix(text, missing[1]), missing[0]);
+    assert_eq!(fixed, "%1\nN10 G90 G17 G00 X0 Y5. F100\nN20 G02 X10. Y5. I5.\nN30 G91 G02 X0 Y0 I5.\nN40 M30\n*\n");
+    assert!(diagnostics(&fixed).is_empty(), "{:#?}", diagnostics(&fixed));
+}

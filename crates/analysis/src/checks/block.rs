@@ -445,7 +445,9 @@ fn check_offset_table_form(block: &BlockData, out: &mut Vec<Diagnostic>) {
         let Some((_, word)) = block.codes(b'G').find(|(c, _)| *c == code) else { continue };
         let has_offset_code = block.codes(b'G').any(|(c, _)| (53..=59).contains(&c));
         let writes_tool_table = code == 92 && block.word(b'D').is_some();
-        if !has_offset_code && !writes_tool_table {
+        // A tool-table write that lacks its D: `g92-correction-without-d`.
+        let writes_corrections = code == 92 && assigns_corrections(block);
+        if !has_offset_code && !writes_tool_table && !writes_corrections {
             let message = if code == 92 {
                 "G92 names neither the zero-offset row to write (G53 to G59 in the block) nor a tool-offset entry (D)"
             } else {
@@ -454,6 +456,15 @@ fn check_offset_table_form(block: &BlockData, out: &mut Vec<Diagnostic>) {
             out.push(Diagnostic::new(&OFFSET_TABLE_FORM, word.range, message));
         }
     }
+}
+
+/// Whether a G92 block assigns correction values (R0 radius, R1–R4 lengths)
+/// for the tool-offset table; with axis words it writes a zero-offset row
+/// and R0–R4 are plain parameters.
+pub(crate) fn assigns_corrections(block: &BlockData) -> bool {
+    let catalogue = Dialect::Cnc8x6.catalogue();
+    block.assignments.iter().any(|a| matches!(a.index, Some(0..=4)))
+        && !block.words.iter().any(|w| catalogue.role_of(w.letter) == Some(AddressRole::Axis))
 }
 
 fn check_g98_alone(block: &BlockData, out: &mut Vec<Diagnostic>) {

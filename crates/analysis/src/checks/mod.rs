@@ -34,7 +34,7 @@ pub(crate) fn flow_checks() -> Vec<Box<dyn FlowCheck>> {
     vec![
         Box::new(params::Parameters),
         Box::new(arith::Arithmetic),
-        Box::new(motion::Motion),
+        Box::new(motion::Motion::default()),
         Box::new(geometry::Geometry),
         Box::new(feed::Feed::default()),
         Box::new(threads::Threads::default()),
