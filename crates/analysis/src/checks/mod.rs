@@ -39,7 +39,7 @@ pub(crate) fn flow_checks() -> Vec<Box<dyn FlowCheck>> {
         Box::new(feed::Feed),
         Box::new(threads::Threads::default()),
         Box::new(transform::Transformations),
-        Box::new(cycles::Cycles),
+        Box::new(cycles::Cycles::default()),
         Box::new(dynamics::Dynamics),
     ]
 }
