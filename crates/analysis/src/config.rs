@@ -9,6 +9,7 @@
 //! [machine]
 //! axes = ["X", "Y", "Z", "U", "V", "C"]   # letters of axes 1-6
 //! feed-limit = 24000                      # mm/min
+//! cycle-file = "PCYKLYDG.NCP"             # CNC836.KNF $17: what G81-G89 do
 //!
 //! [machine.constants]                      # as in TAB0.REK
 //! R339 = "01000000"                        # the eight decades
@@ -70,11 +71,15 @@ pub struct MachineConfig {
     /// Machine constants set in the configuration, as raw values (the
     /// decades as digits: `00233.112` → 233112).
     pub constants: BTreeMap<u32, i64>,
+    /// The fixed-cycle file the control loads (parameter `$17` of
+    /// CNC836.KNF), e.g. `PCYKLYDG.NCP` (milling) or `PEVNECY5.NCP`
+    /// (lathe): it decides what G81–G89 do.
+    pub cycle_file: Option<String>,
 }
 
 impl Default for MachineConfig {
     fn default() -> Self {
-        MachineConfig { axes: b"XYZUVC".to_vec(), feed_limit: 24_000, constants: BTreeMap::new() }
+        MachineConfig { axes: b"XYZUVC".to_vec(), feed_limit: 24_000, constants: BTreeMap::new(), cycle_file: None }
     }
 }
 
@@ -141,6 +146,7 @@ struct ConfigFile {
 struct MachineFile {
     axes: Option<Vec<String>>,
     feed_limit: Option<u32>,
+    cycle_file: Option<String>,
     #[serde(default)]
     constants: BTreeMap<String, String>,
 }
@@ -167,6 +173,12 @@ impl Config {
             }
             if let Some(limit) = machine.feed_limit {
                 config.machine.feed_limit = limit;
+            }
+            if let Some(name) = machine.cycle_file {
+                if name.trim().is_empty() {
+                    return Err(format!("{origin}: machine.cycle-file must name a file, e.g. \"PCYKLYDG.NCP\""));
+                }
+                config.machine.cycle_file = Some(name);
             }
             for (name, value) in machine.constants {
                 let number = name

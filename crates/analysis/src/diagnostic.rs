@@ -91,7 +91,13 @@ impl Diagnostic {
 static SYNTAX_RULES: std::sync::LazyLock<Vec<Rule>> = std::sync::LazyLock::new(|| {
     ncc_syntax::SyntaxErrorKind::ALL
         .iter()
-        .map(|kind| Rule { code: kind.code(), name: kind.name(), severity: kind.severity(), summary: kind.summary() })
+        .map(|kind| Rule {
+            code: kind.code(),
+            name: kind.name(),
+            severity: kind.severity(),
+            summary: kind.summary(),
+            opt_in: false,
+        })
         .collect()
 });
 

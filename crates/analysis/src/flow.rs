@@ -208,6 +208,8 @@ pub(crate) struct Visit<'a> {
     pub after: &'a ModalState,
     /// Parameter values before the block.
     pub params: &'a ParamState,
+    /// Parameter values after the block's assignments and arithmetic.
+    pub params_after: &'a ParamState,
     /// The substituted value of each word (same order as `block.words`);
     /// `None` for literals and unknown parameters.
     pub substitutions: &'a [Option<Substitution>],
@@ -216,6 +218,10 @@ pub(crate) struct Visit<'a> {
     /// The failure of the block's parameter arithmetic, if it has one.
     pub arithmetic_error: Option<&'a (TextRange, ArithError)>,
     pub config: &'a Config,
+    /// The programmed end position of the block's own motion (as in
+    /// [`ModalState::position`]), where a fixed cycle running in the block
+    /// starts; `after.position` is unknown then, as the cycle moves the tool.
+    pub reached: &'a [Known<i64>; 26],
 }
 
 impl Visit<'_> {
@@ -425,7 +431,12 @@ impl<'db> Walk<'db> {
     ) -> (ModalState, ParamState) {
         let substitutions: Vec<Option<Substitution>> = block.words.iter().map(|w| substitute(w, params)).collect();
         let codes = codes(block, &substitutions, offset);
-        let after = self.apply(before, block, &substitutions, &codes, offset);
+        let mut after = self.apply(before, block, &substitutions, &codes, offset);
+        let reached = after.position;
+        // A fixed cycle moves the tool in its body.
+        if matches!(after.g[8], Known::Is(Some(81..=89)) | Known::Unknown) {
+            after.position = [Known::Unknown; 26];
+        }
         let mut after_params = params.clone();
         let arithmetic_error = self.assign(block, offset, &mut after_params);
         let visit = Visit {
@@ -434,10 +445,12 @@ impl<'db> Walk<'db> {
             before,
             after: &after,
             params,
+            params_after: &after_params,
             substitutions: &substitutions,
             codes: &codes,
             arithmetic_error: arithmetic_error.as_ref(),
             config: self.config,
+            reached: &reached,
         };
         for check in &mut self.checks {
             check.block(&visit, &mut self.out);
@@ -521,10 +534,9 @@ impl<'db> Walk<'db> {
     ) {
         let has = |code: u32| codes.iter().any(|&(l, n, _)| l == b'G' && n == code);
         // Offsets and transformations move the program's coordinate system
-        // under the tool; a fixed cycle moves the tool in its body.
+        // under the tool.
         let frame_changes = [92, 93, 53, 54, 55, 56, 57, 58, 59, 35, 36, 37, 38, 39, 31].iter().any(|&c| has(c));
         let transformed = !matches!(after.g[11], Known::Is(None) | Known::Is(Some(34)));
-        let cycle = matches!(after.g[8], Known::Is(Some(81..=89)) | Known::Unknown);
         if frame_changes || transformed {
             after.position = [Known::Unknown; 26];
             return;
@@ -555,9 +567,6 @@ impl<'db> Walk<'db> {
                 Known::Is(Some(axis)) => after.position[usize::from(axis - b'A')] = Known::Unknown,
                 _ => after.position = [Known::Unknown; 26],
             }
-        }
-        if cycle {
-            after.position = [Known::Unknown; 26];
         }
     }
 

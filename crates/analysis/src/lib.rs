@@ -142,6 +142,7 @@ fn file_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
         all.extend(db::chunk_diagnostics(db, chunk.chunk).iter().map(|d| d.clone().shifted(chunk.offset)));
     }
     all.extend(checks::structure::check(db, file));
+    all.extend(checks::cycles::check_file(db, file));
     all.extend(flow::flow_diagnostics(db, file).iter().cloned());
     let suppressions = suppress::Suppressions::of(file.text(db), parse);
     let mut diagnostics: Vec<Diagnostic> =

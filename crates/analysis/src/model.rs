@@ -29,14 +29,19 @@ impl FileKind {
     /// The kind of the file at `path` whose text before the first block is
     /// `prelude`.
     pub fn of(path: &str, prelude: &str) -> FileKind {
-        let name = path.rsplit(['/', '\\']).next().unwrap_or(path);
-        let stem = name.split('.').next().unwrap_or(name);
-        let digits = stem.strip_prefix(['L', 'l']).filter(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()));
+        let digits =
+            file_stem(path).strip_prefix(['L', 'l']).filter(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()));
         if let Some(number) = digits.and_then(|d| d.parse().ok()) {
             return FileKind::Macrocycle(number);
         }
         if prelude.contains("$PC") { FileKind::CycleFile } else { FileKind::Program }
     }
+}
+
+/// A file's name without its directory and extension.
+pub(crate) fn file_stem(path: &str) -> &str {
+    let name = path.rsplit(['/', '\\']).next().unwrap_or(path);
+    name.split('.').next().unwrap_or(name)
 }
 
 /// A program unit: the main body, a subprogram, a macrocycle or a cycle body.
@@ -246,9 +251,20 @@ pub fn program(db: &dyn Db, file: SourceFile) -> Program {
 
 /// The kind of a file.
 pub fn file_kind(db: &dyn Db, file: SourceFile) -> FileKind {
+    let path = file.path(db);
+    let kind = FileKind::of(path, prelude(db, file));
+    // The file the machine loads as its cycle file is one, even when its
+    // `$PC` is missing.
+    let configured = db::Settings::get(db).config(db).machine.cycle_file.as_deref();
+    let named = configured.is_some_and(|name| file_stem(name).eq_ignore_ascii_case(file_stem(path)));
+    if kind == FileKind::Program && named { FileKind::CycleFile } else { kind }
+}
+
+/// The text before the first block: comments, and a cycle file's `$PC`.
+pub fn prelude(db: &dyn Db, file: SourceFile) -> &str {
     let text = file.text(db);
     let first_block = db::file_chunks(db, file).first().map_or(text.len(), |c| usize::from(c.offset));
-    FileKind::of(file.path(db), &text[..first_block])
+    &text[..first_block]
 }
 
 /// Whether the file has the `%` header and the `*` end.

@@ -39,7 +39,7 @@ pub(crate) fn flow_checks() -> Vec<Box<dyn FlowCheck>> {
         Box::new(feed::Feed::default()),
         Box::new(threads::Threads::default()),
         Box::new(transform::Transformations::default()),
-        Box::new(cycles::Cycles),
+        Box::new(cycles::Cycles::default()),
         Box::new(dynamics::Dynamics::default()),
     ]
 }

@@ -178,7 +178,7 @@ fn digits_outside(digits: &str, max: u8) -> bool {
 }
 
 /// A raw value as the real number the parameter holds (`864` → `0.864`).
-fn show(raw: i64) -> String {
+pub(crate) fn show(raw: i64) -> String {
     let value = Decimal::parse(None, &raw.unsigned_abs().to_string()).map_or(0.0, |d| d.to_f64()) / 1000.0;
     let sign = if raw < 0 { "-" } else { "" };
     format!("{sign}{value:.3}")

@@ -42,7 +42,7 @@ pub(crate) fn check(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
     out
 }
 
-fn file_start(db: &dyn Db, file: SourceFile) -> TextRange {
+pub(crate) fn file_start(db: &dyn Db, file: SourceFile) -> TextRange {
     let text = file.text(db);
     let first_char = text.chars().next().map_or(0, char::len_utf8);
     TextRange::at(TextSize::from(0), TextSize::from(first_char as u32))
