@@ -604,7 +604,8 @@ impl<'db> Walk<'db> {
             }
         }
         let before = params.values.clone();
-        let config = ArithConfig { double_precision: self.double_precision(params) };
+        let r95 = params.values.get(95);
+        let config = ArithConfig { double_precision: double_precision(self.config, r95).unwrap_or(false) };
         let result = arith::execute(&words, &mut params.values, &mut UnknownMachine, config);
         for index in 0..arith::PARAMETER_COUNT {
             if params.values.get(index) != before.get(index) {
@@ -614,14 +615,17 @@ impl<'db> Walk<'db> {
         }
         result.err().map(|(_, error)| (range, error))
     }
+}
 
-    /// Double precision per machine constant 283 decade 4 (and R95).
-    fn double_precision(&self, params: &ParamState) -> bool {
-        match self.config.machine.decade(283, 4) {
-            0 => true,
-            2 => params.values.get(95).is_some_and(|r95| r95.rem_euclid(10) == 0),
-            _ => false,
-        }
+/// Whether arithmetic reads fields 50–99 as double-precision pairs, per
+/// machine constant 283 decade 4 and, when that is 2, decade 1 of R95
+/// (`None`: not known).
+pub(crate) fn double_precision(config: &Config, r95: Option<Raw>) -> Option<bool> {
+    match config.machine.decade(283, 4) {
+        0 => Some(true),
+        1 => Some(false),
+        2 => r95.map(|r95| r95.rem_euclid(10) == 0),
+        _ => None,
     }
 }
 

@@ -33,7 +33,7 @@ pub(crate) static RULES: &[&[&crate::Rule]] = &[
 pub(crate) fn flow_checks() -> Vec<Box<dyn FlowCheck>> {
     vec![
         Box::new(params::Parameters),
-        Box::new(arith::Arithmetic),
+        Box::new(arith::Arithmetic::default()),
         Box::new(motion::Motion::default()),
         Box::new(geometry::Geometry),
         Box::new(feed::Feed::default()),

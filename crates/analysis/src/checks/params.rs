@@ -58,7 +58,8 @@ impl FlowCheck for Parameters {
                 }
             }
         }
-        if let Some((range, error)) = visit.arithmetic_error {
+        // Errors of the control words themselves have rules of their own.
+        if let Some((range, error)) = visit.arithmetic_error.filter(|(_, error)| !super::arith::has_own_rule(error)) {
             out.push(Diagnostic::new(&ARITHMETIC_ERROR, *range, format!("parameter arithmetic fails: {error}")));
         }
     }
@@ -81,7 +82,7 @@ fn check_number(index: u32, range: ncc_syntax::TextRange, out: &mut Vec<Diagnost
 }
 
 /// A substituted value against the address's format and range.
-fn check_substitution(
+pub(crate) fn check_substitution(
     visit: &Visit<'_>,
     word: &crate::lower::Word,
     substitution: Substitution,
