@@ -14,7 +14,7 @@ use ncc_syntax::TextRange;
 
 use crate::{
     Diagnostic,
-    checks::motion,
+    checks::{block, motion},
     diagnostic::declare_rules,
     flow::{FlowCheck, Visit},
     lower::{Value, Word},
@@ -346,14 +346,15 @@ impl Transformations {
 }
 
 /// G92/G93 write the axes written in the block; without any they do
-/// nothing (`G92 D..` writes the tool-offset table instead).
+/// nothing (`G92 D..` and G92 with corrections R0–R4 write the tool-offset
+/// table instead, which `g92-correction-without-d` checks).
 fn check_offset_write(visit: &Visit<'_>, out: &mut Vec<Diagnostic>) {
     if axis_words(visit).next().is_some() {
         return;
     }
     for code in [92, 93] {
         let Some(range) = visit.code_range(b'G', code) else { continue };
-        if code == 92 && visit.block.word(b'D').is_some() {
+        if code == 92 && (visit.block.word(b'D').is_some() || block::assigns_corrections(visit.block)) {
             continue;
         }
         let message = if code == 92 {
