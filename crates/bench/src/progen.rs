@@ -129,7 +129,10 @@ pub fn write(moves: &[Move], syntax: Syntax) -> String {
         match *m {
             Move::Start { x, y, z, spindle_rpm } => {
                 let code = if syntax == Syntax::Cnc8x6 { "G00" } else { "G0" };
-                let _ = write!(out, "G54 G90 G17 {code} X{x:.3} Y{y:.3} Z{z:.3} M03 S{spindle_rpm}");
+                // CAM output for this control joins its short segments
+                // with continuity G23.
+                let continuity = if syntax == Syntax::Cnc8x6 { " G23" } else { "" };
+                let _ = write!(out, "G54 G90 G17 {code}{continuity} X{x:.3} Y{y:.3} Z{z:.3} M03 S{spindle_rpm}");
             }
             Move::Rapid { x, y, z } => {
                 out.push_str("G0");
@@ -215,7 +218,7 @@ mod tests {
         let moves = surfacing(500);
         let cnc = write(&moves, Syntax::Cnc8x6);
         let ngc = write(&moves, Syntax::Ngc);
-        assert!(cnc.starts_with("%1 \"SURFACING\"\nN1 G54 G90 G17 G00 X0.000 Y0.000 Z5.000 M03 S8000\n"));
+        assert!(cnc.starts_with("%1 \"SURFACING\"\nN1 G54 G90 G17 G00 G23 X0.000 Y0.000 Z5.000 M03 S8000\n"));
         assert!(cnc.ends_with("N500 M30\n*\n"));
         assert!(ngc.ends_with("M2\n"));
         assert_eq!(cnc.lines().count(), ngc.lines().count() + 2);

@@ -355,6 +355,8 @@ pub(crate) struct Dynamics {
     /// Short feed blocks in a row without continuity, from the first one.
     short_run: usize,
     short_run_start: Option<TextRange>,
+    /// The advice to program G23 is given once per program.
+    continuity_advised: bool,
     g23_seen: bool,
     disabled_reported: bool,
 }
@@ -482,6 +484,7 @@ impl Dynamics {
         let minimum = for_control(visit.config, CONTINUITY_MIN_MS);
         let short = feed_move
             && !self.g23_seen
+            && !self.continuity_advised
             && visit.after.g(2) == Some(Some(98))
             && matches!((path, feed), (Some(path), Some(feed)) if duration_ms(path.length, feed) < minimum);
         if !short {
@@ -495,6 +498,7 @@ impl Dynamics {
         if self.short_run == MANY_SHORT_BLOCKS
             && let Some(range) = self.short_run_start
         {
+            self.continuity_advised = true;
             out.push(Diagnostic::new(
                 &MISSING_CONTINUITY_MODE,
                 range,
