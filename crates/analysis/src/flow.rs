@@ -79,6 +79,26 @@ pub struct ModalState {
 }
 
 impl ModalState {
+    fn settings(&self) -> [&Known<Option<Setting>>; 5] {
+        [&self.feed, &self.speed, &self.tool, &self.offset, &self.length]
+    }
+
+    fn settings_mut(&mut self) -> [&mut Known<Option<Setting>>; 5] {
+        [&mut self.feed, &mut self.speed, &mut self.tool, &mut self.offset, &mut self.length]
+    }
+
+    /// Makes the settings changed since `before` point at `call`: they were
+    /// written in a macrocycle file, whose ranges mean nothing here.
+    fn point_settings_at(&mut self, before: &ModalState, call: TextRange) {
+        for (setting, old) in self.settings_mut().into_iter().zip(before.settings()) {
+            if *setting != *old
+                && let Known::Is(Some(changed)) = setting
+            {
+                changed.range = call;
+            }
+        }
+    }
+
     /// The state after reset: the priority block.
     pub fn reset(catalogue: &Catalogue) -> ModalState {
         let mut state = ModalState::unknown();
@@ -257,8 +277,12 @@ pub fn flow_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
     let mut walk = Walk::new(db, file, program, crate::checks::flow_checks());
     walk.run();
     let mut out = walk.out;
-    out.sort_by(|a, b| (a.range.start(), a.range.end(), a.code).cmp(&(b.range.start(), b.range.end(), b.code)));
-    out.dedup();
+    // A subprogram called from several places repeats its findings, with
+    // the first call's related locations kept.
+    out.sort_by(|a, b| {
+        (a.range.start(), a.range.end(), a.code, &a.message).cmp(&(b.range.start(), b.range.end(), b.code, &b.message))
+    });
+    out.dedup_by(|later, first| (later.range, later.code, &later.message) == (first.range, first.code, &first.message));
     out
 }
 
@@ -332,13 +356,14 @@ impl<'db> Walk<'db> {
     }
 
     fn run(&mut self) {
-        let units = self.program.units.len();
-        if self.program.kind == FileKind::Program && units > 0 {
+        let has_main = self.program.has_main();
+        if has_main {
             let state = ModalState::reset(self.catalogue);
             self.walk_unit(0, state, ParamState::program_start());
         }
-        for unit in 0..units {
-            let standalone = self.program.kind != FileKind::Program || (unit > 0 && !self.called[unit]);
+        for unit in 0..self.program.units.len() {
+            let called = self.program.kind == FileKind::Program && self.called[unit];
+            let standalone = !(has_main && unit == 0) && !called;
             if standalone {
                 self.walk_unit(unit, ModalState::unknown(), ParamState::unknown());
             }
@@ -405,7 +430,9 @@ impl<'db> Walk<'db> {
                             return (ModalState::unknown(), ParamState::unknown());
                         }
                         let origins_before = params.origins.clone();
-                        let (state, mut params) = inner.walk_unit(0, state, params);
+                        let settings_before = state.clone();
+                        let (mut state, mut params) = inner.walk_unit(0, state, params);
+                        state.point_settings_at(&settings_before, call);
                         // Ranges in the macrocycle's file mean nothing here:
                         // what it assigned comes from the call.
                         for (origin, before) in params.origins.iter_mut().zip(origins_before) {

@@ -2,7 +2,7 @@
 //! and calls.
 //!
 //! A partprogram is its main body up to the block with M02/M30, followed by
-//! subprograms (`G79 L..` … `G70`). A macrocycle file (`L<number>`) is one
+//! subprograms (`G79 L..` up to their last `G70`). A macrocycle file (`L<number>`) is one
 //! such unit; a fixed-cycle file (`$PC`) is a sequence of them.
 
 use std::ops::Range;
@@ -51,7 +51,8 @@ pub struct Unit {
     pub number: Option<u32>,
     /// Indices of its blocks.
     pub blocks: Range<usize>,
-    /// The block with G70 that closes it (the last block), if any.
+    /// Whether it has a G70; a body may return from several places and
+    /// ends at its last G70.
     pub closed: bool,
 }
 
@@ -152,6 +153,11 @@ pub struct Program {
 }
 
 impl Program {
+    /// Whether the file has a main body (the first unit, without a number).
+    pub fn has_main(&self) -> bool {
+        self.units.first().is_some_and(|u| u.number.is_none())
+    }
+
     /// The unit holding block `index`.
     pub fn unit_of(&self, index: usize) -> Option<&Unit> {
         self.blocks[index].unit.map(|u| &self.units[u])
@@ -206,20 +212,27 @@ pub fn program(db: &dyn Db, file: SourceFile) -> Program {
         stray_blocks: Vec::new(),
         stray_g70: Vec::new(),
     };
-    // Partprograms start in their main body; the other files in units only.
-    let mut in_main = kind == FileKind::Program;
+    let mut summaries = db::file_chunks(db, file)
+        .iter()
+        .flat_map(|chunk| db::chunk_summaries(db, chunk.chunk).iter().map(move |s| s.shifted(chunk.offset)))
+        .peekable();
+    // Partprograms start in their main body; the other files, and a
+    // program file that starts with `G79`, in units only.
+    let starts_with_unit = summaries.peek().is_some_and(|s| s.starts_unit.is_some());
+    let mut in_main = kind == FileKind::Program && !starts_with_unit;
     if in_main {
         program.units.push(Unit { number: None, blocks: 0..0, closed: false });
     }
     let mut open: Option<usize> = in_main.then_some(0);
-    let summaries = db::file_chunks(db, file)
-        .iter()
-        .flat_map(|chunk| db::chunk_summaries(db, chunk.chunk).iter().map(move |s| s.shifted(chunk.offset)));
+    // The last G70 of the open subprogram after the main body: a body may
+    // return from several places, and it ends at its last G70.
+    let mut last_g70: Option<usize> = None;
     for (index, summary) in summaries.enumerate() {
         if let Some(number) = summary.starts_unit {
             if in_main {
                 program.early_unit_starts.push(index);
             }
+            end_unit(&mut program, open, last_g70.take());
             program.units.push(Unit { number, blocks: index..index, closed: false });
             open = Some(program.units.len() - 1);
         }
@@ -233,9 +246,15 @@ pub fn program(db: &dyn Db, file: SourceFile) -> Program {
         program.blocks.push(BlockInfo { summary, unit });
         if closes {
             match open {
+                // A subprogram inside the main body returns to it at its
+                // first G70 (it is misplaced anyway).
+                Some(u) if in_main && program.units[u].number.is_some() => {
+                    program.units[u].closed = true;
+                    open = Some(0);
+                }
                 Some(u) if program.units[u].number.is_some() => {
                     program.units[u].closed = true;
-                    open = if in_main { Some(0) } else { None };
+                    last_g70 = Some(index);
                 }
                 _ => program.stray_g70.push(index),
             }
@@ -246,7 +265,20 @@ pub fn program(db: &dyn Db, file: SourceFile) -> Program {
             open = None;
         }
     }
+    end_unit(&mut program, open, last_g70);
     program
+}
+
+/// Ends unit `open` at its last G70, if it has one: the blocks after it
+/// belong to no unit, since the body returns before them.
+fn end_unit(program: &mut Program, open: Option<usize>, last_g70: Option<usize>) {
+    let (Some(unit), Some(last)) = (open, last_g70) else { return };
+    let after = last + 1..program.units[unit].blocks.end;
+    for index in after.clone() {
+        program.blocks[index].unit = None;
+    }
+    program.stray_blocks.extend(after);
+    program.units[unit].blocks.end = last + 1;
 }
 
 /// The kind of a file.

@@ -110,7 +110,14 @@ fn head(program: &Program, index: usize) -> TextRange {
 }
 
 fn check_units(db: &dyn Db, file: SourceFile, program: &Program, out: &mut Vec<Diagnostic>) {
-    if program.kind == FileKind::Program && !program.blocks.is_empty() && program.end_of_main.is_none() {
+    if program.kind == FileKind::Program && !program.blocks.is_empty() && !program.has_main() {
+        out.push(Diagnostic::new(
+            &MISSING_PROGRAM_END,
+            head(program, 0),
+            "this file starts with `G79`, so it has no main program ending with M02/M30: \
+             a partprogram starts with its main program, and a macrocycle file is named `L<number>`",
+        ));
+    } else if program.kind == FileKind::Program && !program.blocks.is_empty() && program.end_of_main.is_none() {
         let last_main = program.units[0].blocks.end.saturating_sub(1);
         out.push(Diagnostic::new(
             &MISSING_PROGRAM_END,
@@ -140,11 +147,10 @@ fn check_units(db: &dyn Db, file: SourceFile, program: &Program, out: &mut Vec<D
     if let Some(&first) = stray.first() {
         let last = *stray.last().expect("not empty");
         let range = head(program, first).cover(head(program, last));
-        let message = match program.kind {
-            FileKind::Program => {
-                "blocks after M02/M30 must belong to a subprogram (`G79 L..` … `G70`); the control never runs these"
-            }
-            _ => "blocks outside `G79 L..` … `G70` are never run",
+        let message = if program.has_main() {
+            "blocks after M02/M30 must belong to a subprogram (`G79 L..` … `G70`); the control never runs these"
+        } else {
+            "blocks outside `G79 L..` … `G70` are never run"
         };
         let mut diagnostic = Diagnostic::new(&CODE_AFTER_PROGRAM_END, range, message);
         if let Some(end) = program.end_of_main {
