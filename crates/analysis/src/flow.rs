@@ -362,9 +362,9 @@ impl<'db> Walk<'db> {
             self.walk_unit(0, state, ParamState::program_start());
         }
         for unit in 0..self.program.units.len() {
+            let is_main = has_main && unit == 0;
             let called = self.program.kind == FileKind::Program && self.called[unit];
-            let standalone = !(has_main && unit == 0) && !called;
-            if standalone {
+            if !is_main && !called {
                 self.walk_unit(unit, ModalState::unknown(), ParamState::unknown());
             }
         }
