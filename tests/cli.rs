@@ -208,6 +208,16 @@ fn rules_lists_every_rule_and_finds_one() {
 }
 
 #[test]
+fn the_rules_reference_is_current() {
+    let output = ncc(&["rules", "--markdown"]);
+    assert_eq!(output.status.code(), Some(0));
+    let text = stdout(&output);
+    let listed = text.lines().filter(|line| line.starts_with("| ") && !line.starts_with("| code")).count();
+    assert_eq!(listed, ncc_analysis::Rule::all().count(), "every rule has a section");
+    expect_test::expect_file!["../docs/rules.md"].assert_eq(&text);
+}
+
+#[test]
 fn usage_errors_exit_with_2() {
     assert_eq!(ncc(&["check", "--format", "xml", "examples"]).status.code(), Some(2));
     assert_eq!(ncc(&["frobnicate"]).status.code(), Some(2));

@@ -55,6 +55,9 @@ enum Command {
     Rules {
         /// Show only the rule with this code, or rules whose name contains it.
         query: Option<String>,
+        /// Print a Markdown reference, grouped by kind (what docs/rules.md holds).
+        #[arg(long, conflicts_with = "query")]
+        markdown: bool,
     },
     /// Print the syntax tree of a partprogram (a debugging aid).
     Parse {
@@ -67,7 +70,7 @@ fn main() -> ExitCode {
     match Cli::parse().command {
         Command::Check { paths, format } => check::run(&paths, format),
         Command::Explain { query, list } => explain::run(query.as_deref(), list),
-        Command::Rules { query } => rules::run(query.as_deref()),
+        Command::Rules { query, markdown } => rules::run(query.as_deref(), markdown),
         Command::Parse { file } => match check::read_program(&file) {
             Ok(text) => {
                 let parse = ncc_syntax::Parse::new(&text, ncc_syntax::Dialect::Cnc8x6);
