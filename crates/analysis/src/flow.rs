@@ -270,6 +270,32 @@ pub(crate) trait FlowCheck {
     fn end_of_unit(&mut self, _state: &ModalState, _last: Option<(TextSize, &BlockData)>, _out: &mut Vec<Diagnostic>) {}
 }
 
+/// The state before block `index` of `file` each time the walk reaches it (a subprogram called twice is reached twice).
+pub fn states_before(db: &dyn Db, file: SourceFile, index: usize) -> Vec<(ModalState, ParamState)> {
+    let program = model::program(db, file);
+    let Some(block) = program.blocks.get(index) else { return Vec::new() };
+    let seen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+    let probe = Probe { offset: block.offset, seen: seen.clone() };
+    let mut walk = Walk::new(db, file, program, vec![Box::new(probe)]);
+    walk.run();
+    drop(walk);
+    std::rc::Rc::try_unwrap(seen).map(|cell| cell.into_inner()).unwrap_or_default()
+}
+
+/// Records the state at one block.
+struct Probe {
+    offset: TextSize,
+    seen: std::rc::Rc<std::cell::RefCell<Vec<(ModalState, ParamState)>>>,
+}
+
+impl FlowCheck for Probe {
+    fn block(&mut self, visit: &Visit<'_>, _out: &mut Vec<Diagnostic>) {
+        if visit.offset == self.offset {
+            self.seen.borrow_mut().push((visit.before.clone(), visit.params.clone()));
+        }
+    }
+}
+
 /// Diagnostics of the rules that follow the program's flow.
 #[salsa::tracked(returns(ref))]
 pub fn flow_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
@@ -321,6 +347,15 @@ impl<'db> Blocks<'db> {
         let lowered = self.cache[&chunk].clone();
         (self.chunks[chunk].offset, lowered, index - self.starts[chunk])
     }
+}
+
+/// Block `index` of `file`, lowered, with its file offset.
+pub fn lowered_block(db: &dyn Db, file: SourceFile, index: usize) -> Option<(TextSize, BlockData)> {
+    let blocks_in_file = model::program(db, file).blocks.len();
+    (index < blocks_in_file).then(|| {
+        let (chunk_offset, lowered, at) = Blocks::new(db, file).get(index);
+        (chunk_offset + lowered[at].0, lowered[at].1.clone())
+    })
 }
 
 /// How deep calls are followed (runaway recursion is the executor's
@@ -661,6 +696,12 @@ fn substitute(word: &Word, params: &ParamState) -> Option<Substitution> {
     let Some(Value::Parameter { negative, index: Some(index), .. }) = word.value else { return None };
     let (raw, origin) = params.get(index)?;
     Some(Substitution { raw: if negative { -raw } else { raw }, origin })
+}
+
+/// Thousandths as a plain number: 1500 → `1.5`.
+pub(crate) fn show_thousandths(value: i64) -> String {
+    let text = format!("{:.3}", value as f64 / 1000.0);
+    text.trim_end_matches('0').trim_end_matches('.').to_owned()
 }
 
 /// A dimensional word's value in thousandths of its unit (µm for lengths):

@@ -2,8 +2,8 @@
 //!
 //! An [`AnalysisHost`] owns the incremental database: programs go in as
 //! text, edits are applied as text edits (reparsing only the touched
-//! blocks), and an [`Analysis`] snapshot answers questions: diagnostics
-//! today; hover, navigation and the program model as they arrive. Every
+//! blocks), and an [`Analysis`] snapshot answers questions: diagnostics,
+//! hover, go to definition and the state at a block. Every
 //! answer is plain Rust data with text ranges; line/column conversion, LSP
 //! and terminal output are the caller's business.
 
@@ -12,6 +12,7 @@ mod config;
 mod db;
 mod diagnostic;
 pub mod flow;
+mod ide;
 pub mod lower;
 pub mod model;
 mod suppress;
@@ -27,6 +28,7 @@ pub use crate::{
     config::{CONFIG_FILE, Config, Level, MachineConfig, parse_constant},
     db::{RootDatabase, SourceFile},
     diagnostic::{Diagnostic, Fix, Related, Rule},
+    ide::{HoverResult, NavigationTarget},
 };
 
 /// A file of the analysis.
@@ -121,6 +123,25 @@ impl Analysis {
     /// comments, sorted by position.
     pub fn diagnostics(&self, file: FileId) -> Vec<Diagnostic> {
         file_diagnostics(&self.db, file).clone()
+    }
+
+    /// What the thing at `offset` is: a code's or an address's
+    /// documentation, a parameter's with its known values there.
+    pub fn hover(&self, file: FileId, offset: TextSize) -> Option<HoverResult> {
+        ide::hover(&self.db, file, offset)
+    }
+
+    /// Where the thing at `offset` is defined: a call's subprogram or
+    /// macrocycle file, a jump's block, the assignments a parameter's value
+    /// comes from.
+    pub fn goto_definition(&self, file: FileId, offset: TextSize) -> Vec<NavigationTarget> {
+        ide::goto_definition(&self.db, file, offset)
+    }
+
+    /// The modal state and parameters before the block at `offset`, each
+    /// time the program reaches it.
+    pub fn states_at(&self, file: FileId, offset: TextSize) -> Vec<(flow::ModalState, flow::ParamState)> {
+        ide::states_at(&self.db, file, offset)
     }
 
     pub fn path(&self, file: FileId) -> String {

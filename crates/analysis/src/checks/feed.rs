@@ -11,7 +11,7 @@ use crate::{
         motion,
     },
     diagnostic::declare_rules,
-    flow::{FlowCheck, Known, ModalState, Setting, Substitution, Visit},
+    flow::{FlowCheck, Known, ModalState, Setting, Substitution, Visit, show_thousandths},
     lower::{BlockData, Value, Word},
 };
 
@@ -65,12 +65,6 @@ fn feed_value(feed: &Setting) -> Option<i64> {
 /// The block's word with `letter`, with its substituted value.
 fn written<'a>(visit: &Visit<'a>, letter: u8) -> Option<(&'a Word, Option<Substitution>)> {
     visit.block.words.iter().zip(visit.substitutions).find(|(w, _)| w.letter == letter).map(|(w, s)| (w, *s))
-}
-
-/// Thousandths as a plain number: 1500 → `1.5`.
-fn thousandths(value: i64) -> String {
-    let text = format!("{:.3}", value as f64 / 1000.0);
-    text.trim_end_matches('0').trim_end_matches('.').to_owned()
 }
 
 #[derive(Default)]
@@ -209,7 +203,7 @@ fn check_velocity(visit: &Visit<'_>, out: &mut Vec<Diagnostic>) {
             "under G{} the axes move at S × F = {} rpm × {} mm/rev = {velocity:.0} mm/min, above this machine's maximum feed of {limit} mm/min (`feed-limit` in ncc.toml); at S{} the feed may be at most {:.3} mm/rev",
             mode.code,
             speed.value,
-            thousandths(micrometres_per_rev),
+            show_thousandths(micrometres_per_rev),
             speed.value,
             limit / rpm
         ),

@@ -1,0 +1,222 @@
+//! Answers for editors: hover and go to definition, as plain data.
+//!
+//! Both start from the block under the cursor, lowered, and the word in it;
+//! what the program knows there (parameter values, where they were set)
+//! comes from the flow walk, stopped at nothing: every time the walk reaches
+//! the block counts, so a subprogram called with different values shows
+//! them all.
+
+use ncc_catalog::{Dialect, Item};
+use ncc_syntax::{TextRange, TextSize};
+
+use crate::{
+    db::{Db, SourceFile},
+    flow::{self, ModalState, ParamState, show_thousandths},
+    lower::{BlockData, Value, Word},
+    model::{self, Transfer},
+};
+
+/// Text to show for the thing under the cursor.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct HoverResult {
+    /// What the text describes.
+    pub range: TextRange,
+    pub markdown: String,
+}
+
+/// A place to go to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NavigationTarget {
+    pub file: SourceFile,
+    /// The whole target, e.g. a subprogram's `G79` block.
+    pub range: TextRange,
+    /// The part to select: the block number, or the assignment.
+    pub focus: TextRange,
+}
+
+/// The index of the block of `file` at `offset` (a position at a block's
+/// end belongs to it, so the cursor after the last character still finds
+/// the word).
+fn block_index_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<usize> {
+    let blocks = &model::program(db, file).blocks;
+    let index = blocks.partition_point(|b| b.end() < offset);
+    blocks.get(index).is_some_and(|b| b.offset <= offset).then_some(index)
+}
+
+/// The block at `offset`, lowered, with its index and file offset.
+fn block_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<(usize, TextSize, BlockData)> {
+    let index = block_index_at(db, file, offset)?;
+    let (start, block) = flow::lowered_block(db, file, index)?;
+    Some((index, start, block))
+}
+
+/// The modal state and parameters before the block at `offset`.
+pub(crate) fn states_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Vec<(ModalState, ParamState)> {
+    block_index_at(db, file, offset).map(|index| flow::states_before(db, file, index)).unwrap_or_default()
+}
+
+/// What the cursor is on inside a block.
+enum Target<'a> {
+    Word(&'a Word),
+    /// A parameter: referenced in a word, or assigned (`index_range`).
+    Parameter {
+        index: u32,
+        range: TextRange,
+    },
+}
+
+fn target_at(block: &BlockData, at: TextSize) -> Option<Target<'_>> {
+    let contains = |range: TextRange| range.contains_inclusive(at);
+    // `R12` in `XR12` or `R1=R12`, sign included.
+    let reference = |value: &Option<Value>, range: Option<TextRange>| match (value, range) {
+        (Some(Value::Parameter { index: Some(index), .. }), Some(range)) if contains(range) => {
+            Some(Target::Parameter { index: *index, range })
+        }
+        _ => None,
+    };
+    for word in &block.words {
+        if let Some(target) = reference(&word.value, word.value_range) {
+            return Some(target);
+        }
+        if contains(word.range) {
+            return Some(Target::Word(word));
+        }
+    }
+    for assignment in &block.assignments {
+        if let Some(target) = reference(&assignment.value, assignment.value_range) {
+            return Some(target);
+        }
+        let assigned = TextRange::new(assignment.range.start(), assignment.index_range.end());
+        if let Some(index) = assignment.index
+            && contains(assigned)
+        {
+            return Some(Target::Parameter { index, range: assigned });
+        }
+    }
+    None
+}
+
+pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<HoverResult> {
+    let (index, start, block) = block_at(db, file, offset)?;
+    let catalogue = Dialect::Cnc8x6.catalogue();
+    match target_at(&block, offset - start)? {
+        Target::Word(word) => {
+            let literal = match &word.value {
+                Some(Value::Literal(value)) => value.scaled(0).and_then(|v| u32::try_from(v).ok()),
+                _ => None,
+            };
+            let letter = char::from(word.letter);
+            let query = match literal {
+                Some(number) if matches!(letter, 'G' | 'M') => format!("{letter}{number}"),
+                _ => letter.to_string(),
+            };
+            let items = catalogue.explain(&query).ok()?;
+            let item = items.iter().find(|item| !matches!(item, Item::Group(_)))?;
+            let mut markdown = item.markdown(catalogue);
+            if letter == 'L'
+                && let Some(call) = call_text(db, file, index)
+            {
+                markdown = format!("{call}\n\n{markdown}");
+            }
+            Some(HoverResult { range: word.range + start, markdown })
+        }
+        Target::Parameter { index: number, range } => {
+            let items = catalogue.explain(&format!("param:{number}")).ok()?;
+            let mut markdown = items.first()?.markdown(catalogue);
+            let states = flow::states_before(db, file, index);
+            markdown.push_str(&values_text(number, states.iter().map(|(_, params)| params)));
+            Some(HoverResult { range: range + start, markdown })
+        }
+    }
+}
+
+/// What a `G71`/`G72`/`G73` block's L calls, in words.
+fn call_text(db: &dyn Db, file: SourceFile, index: usize) -> Option<String> {
+    let (transfer, _) = model::program(db, file).blocks[index].transfer?;
+    let what = match transfer {
+        Transfer::Subprogram(n) => format!("Calls subprogram L{n}"),
+        Transfer::Macrocycle(n) => format!("Calls macrocycle file L{n}"),
+        Transfer::Jump(n) => format!("Jumps to block N{n}"),
+    };
+    let missing = if transfer_targets(db, file, index, transfer).is_empty() { ", which does not exist" } else { "" };
+    Some(format!("{what}{missing}."))
+}
+
+/// The parameter's values before the block, as the walk found them.
+fn values_text<'a>(number: u32, states: impl Iterator<Item = &'a ParamState>) -> String {
+    let mut values: Vec<String> = Vec::new();
+    for params in states {
+        let value = match params.get(number) {
+            Some((raw, _)) => format!("`{}` ({raw} thousandths)", show_thousandths(raw)),
+            None => "unknown here".to_owned(),
+        };
+        if !values.contains(&value) {
+            values.push(value);
+        }
+    }
+    match values.as_slice() {
+        [] => "\n\n**Value before this block:** never reached from the program's start".to_owned(),
+        [one] => format!("\n\n**Value before this block:** {one}"),
+        many => format!("\n\n**Values before this block** (one per call): {}", many.join(", ")),
+    }
+}
+
+pub(crate) fn goto_definition(db: &dyn Db, file: SourceFile, offset: TextSize) -> Vec<NavigationTarget> {
+    let Some((index, start, block)) = block_at(db, file, offset) else { return Vec::new() };
+    match target_at(&block, offset - start) {
+        Some(Target::Parameter { index: number, .. }) => {
+            let mut targets: Vec<NavigationTarget> = flow::states_before(db, file, index)
+                .iter()
+                .filter_map(|(_, params)| params.get(number)?.1)
+                .map(|origin| NavigationTarget { file, range: origin.range, focus: origin.range })
+                .collect();
+            targets.sort_by_key(|t| t.range.start());
+            targets.dedup();
+            targets
+        }
+        // The call's L, or its G71/G72/G73.
+        Some(Target::Word(word)) if matches!(word.letter, b'L' | b'G') => {
+            let program = model::program(db, file);
+            match program.blocks[index].transfer {
+                Some((transfer, code)) if word.letter == b'L' || code == word.range + start => {
+                    transfer_targets(db, file, index, transfer)
+                }
+                _ => Vec::new(),
+            }
+        }
+        _ => Vec::new(),
+    }
+}
+
+/// Where a call or jump in block `index` goes.
+fn transfer_targets(db: &dyn Db, file: SourceFile, index: usize, transfer: Transfer) -> Vec<NavigationTarget> {
+    let program = model::program(db, file);
+    let block_target = |file: SourceFile, program: &model::Program, block: usize| {
+        let info = &program.blocks[block];
+        NavigationTarget {
+            file,
+            range: TextRange::new(info.offset, info.end()),
+            focus: info.number_range.unwrap_or(info.head),
+        }
+    };
+    match transfer {
+        Transfer::Subprogram(number) => {
+            program.subprogram(number).map(|unit| block_target(file, program, unit.blocks.start)).into_iter().collect()
+        }
+        Transfer::Macrocycle(number) => model::macrocycles(db)
+            .get(&number)
+            .into_iter()
+            .flatten()
+            .filter_map(|&macro_file| {
+                let macro_program = model::program(db, macro_file);
+                let unit = macro_program.units.first()?;
+                Some(block_target(macro_file, macro_program, unit.blocks.start))
+            })
+            .collect(),
+        Transfer::Jump(number) => {
+            let Some(unit) = program.unit_of(index) else { return Vec::new() };
+            let target = program.numbers_in(unit).get(&u64::from(number)).copied();
+            target.map(|block| block_target(file, program, block)).into_iter().collect()
+        }
+    }
+}
