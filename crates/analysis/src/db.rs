@@ -11,7 +11,7 @@ use std::{
     sync::{Arc, Mutex},
 };
 
-use ncc_syntax::{Parse, SyntaxKind, TextSize};
+use ncc_syntax::{Dialect, Parse, SyntaxKind, TextSize};
 use rowan::GreenNode;
 
 use crate::{Config, Diagnostic, lower::BlockData, model::BlockSummary};
@@ -35,6 +35,8 @@ pub struct SourceFile {
 /// What holds for the whole workspace.
 #[salsa::input(singleton, debug)]
 pub struct Settings {
+    /// The language of every file; the parser and the catalogue follow it.
+    pub dialect: Dialect,
     #[returns(ref)]
     pub config: Config,
     /// Every file of the workspace (main programs and macrocycle files).

@@ -16,7 +16,7 @@
 use std::sync::Arc;
 
 use nc_exec::arith::{self, ArithConfig, ArithError, ControlWord, Parameters, Raw, UnknownMachine};
-use ncc_catalog::{AddressRole, Catalogue, Dialect, Modality};
+use ncc_catalog::{AddressRole, Catalogue, Modality};
 use ncc_syntax::{Decimal, Sign, TextRange, TextSize};
 use rustc_hash::FxHashMap;
 
@@ -380,7 +380,7 @@ impl<'db> Walk<'db> {
         Walk {
             db,
             program,
-            catalogue: Dialect::Cnc8x6.catalogue(),
+            catalogue: Settings::get(db).dialect(db).catalogue(),
             config: Settings::get(db).config(db),
             checks,
             blocks: Blocks::new(db, file),

@@ -6,11 +6,11 @@
 //! the block counts, so a subprogram called with different values shows
 //! them all.
 
-use ncc_catalog::{Dialect, Item};
+use ncc_catalog::Item;
 use ncc_syntax::{TextRange, TextSize};
 
 use crate::{
-    db::{Db, SourceFile},
+    db::{Db, Settings, SourceFile},
     flow::{self, ModalState, ParamState, show_thousandths},
     lower::{BlockData, Value, Word},
     model::{self, Transfer},
@@ -98,7 +98,7 @@ fn target_at(block: &BlockData, at: TextSize) -> Option<Target<'_>> {
 
 pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<HoverResult> {
     let (index, start, block) = block_at(db, file, offset)?;
-    let catalogue = Dialect::Cnc8x6.catalogue();
+    let catalogue = Settings::get(db).dialect(db).catalogue();
     match target_at(&block, offset - start)? {
         Target::Word(word) => {
             let literal = match &word.value {

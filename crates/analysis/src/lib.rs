@@ -52,14 +52,14 @@ impl AnalysisHost {
 
     /// A host over `db` (e.g. one that logs executions).
     pub fn with_database(db: RootDatabase, config: Config) -> AnalysisHost {
-        Settings::new(&db, config, Vec::new());
+        Settings::new(&db, Dialect::default(), config, Vec::new());
         AnalysisHost { db }
     }
 
     /// Adds a file of the workspace (a program or a macrocycle file).
     pub fn add_file(&mut self, path: impl Into<String>, text: impl Into<Arc<str>>) -> FileId {
         let text: Arc<str> = text.into();
-        let parse = Parse::new(&text, Dialect::Cnc8x6);
+        let parse = Parse::new(&text, self.dialect());
         let file = SourceFile::new(&self.db, path.into(), text, parse);
         let settings = Settings::get(&self.db);
         let mut files = settings.files(&self.db).clone();
@@ -71,7 +71,7 @@ impl AnalysisHost {
     /// Replaces a file's text.
     pub fn set_text(&mut self, file: FileId, text: impl Into<Arc<str>>) {
         let text: Arc<str> = text.into();
-        let parse = Parse::new(&text, Dialect::Cnc8x6);
+        let parse = Parse::new(&text, self.dialect());
         file.set_text(&mut self.db).to(text);
         file.set_parse(&mut self.db).to(parse);
     }
@@ -83,6 +83,10 @@ impl AnalysisHost {
         let parse = file.parse(&self.db).reparse(edit, &text);
         file.set_text(&mut self.db).to(text.into());
         file.set_parse(&mut self.db).to(parse);
+    }
+
+    fn dialect(&self) -> Dialect {
+        *Settings::get(&self.db).dialect(&self.db)
     }
 
     pub fn set_config(&mut self, config: Config) {
