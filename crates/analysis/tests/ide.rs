@@ -53,23 +53,25 @@ fn at(text: &str, needle: &str) -> String {
     format!("{}$0{}", &text[..at], &text[at..])
 }
 
-#[test]
-fn hover_on_a_g_code_shows_its_documentation() {
-    let text = at(PROGRAM, "01 XR12");
-    let (host, file, offset, _) = setup(&[("main.NCP", &text)]);
-    let hover = host.analysis().hover(file, offset).unwrap();
-    assert_eq!(&host.analysis().text(file)[hover.range], "G01");
-    assert!(hover.markdown.starts_with("### G01"), "{}", hover.markdown);
-    assert!(hover.markdown.contains("G1"), "{}", hover.markdown);
+/// The hovered text and the hover's first line, with the cursor on `needle`.
+fn hover_heading(needle: &str) -> (String, String) {
+    let (host, file, offset, _) = setup(&[("main.NCP", &at(PROGRAM, needle))]);
+    let hover = host.analysis().hover(file, offset).expect("a hover");
+    let heading = hover.markdown.lines().next().unwrap_or_default().to_owned();
+    (host.analysis().text(file)[hover.range].to_owned(), heading)
 }
 
 #[test]
-fn hover_on_an_address_shows_its_documentation() {
-    let text = at(PROGRAM, "F100");
-    let (host, file, offset, _) = setup(&[("main.NCP", &text)]);
-    let hover = host.analysis().hover(file, offset).unwrap();
-    assert_eq!(&host.analysis().text(file)[hover.range], "F100");
-    assert!(hover.markdown.starts_with("### F"), "{}", hover.markdown);
+fn hover_on_a_code_or_an_address_shows_its_documentation() {
+    let (hovered, heading) = hover_heading("01 XR12");
+    assert_eq!(hovered, "G01");
+    assert!(heading.starts_with("### G01"), "{heading}");
+    let (hovered, heading) = hover_heading("F100");
+    assert_eq!(hovered, "F100");
+    assert!(heading.starts_with("### F"), "{heading}");
+    let (hovered, heading) = hover_heading("M30");
+    assert_eq!(hovered, "M30");
+    assert!(heading.starts_with("### M30"), "{heading}");
 }
 
 #[test]
