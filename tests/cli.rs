@@ -241,6 +241,53 @@ fn directories_are_searched_for_partprograms() {
     assert!(human.ends_with("in 2 files.\n"), "{human}");
 }
 
+/// The pre-commit hook's `files` pattern picks the files `ncc check` finds
+/// in a directory.
+#[test]
+fn the_pre_commit_hook_matches_the_partprograms() {
+    let hooks = std::fs::read_to_string(workspace().join(".pre-commit-hooks.yaml")).unwrap();
+    let pattern = hooks
+        .lines()
+        .find_map(|line| line.trim().strip_prefix("files: '")?.strip_suffix('\''))
+        .expect("a single-quoted `files:` pattern");
+    let pattern = regex::Regex::new(pattern).unwrap();
+    let names = [
+        "a.NCP",
+        "b.ncp",
+        "L9001",
+        "l12",
+        "macros/L9001",
+        "macros/L12.NCP",
+        "notes.txt",
+        "L12a",
+        "LX.NCP",
+        "NCP",
+        "L",
+        "sub/L7.txt",
+        "PL12",
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("macros")).unwrap();
+    std::fs::create_dir(dir.path().join("sub")).unwrap();
+    for name in names {
+        std::fs::write(dir.path().join(name), "%1\nN10 X\n").unwrap();
+    }
+    let output = ncc(&["check", "--format", "json", dir.path().to_str().unwrap()]);
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let prefix = format!("{}/", dir.path().display());
+    let mut found: Vec<String> = json
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d["file"].as_str().unwrap().strip_prefix(&prefix).unwrap().to_owned())
+        .collect();
+    found.sort();
+    found.dedup();
+    let mut matched: Vec<String> = names.iter().filter(|name| pattern.is_match(name)).map(|n| n.to_string()).collect();
+    matched.sort();
+    assert_eq!(found, matched);
+}
+
 #[test]
 fn clean_file_gives_an_empty_json_array() {
     let output = ncc(&["check", "--format", "json", "tests/fixtures/clean.NCP"]);
