@@ -28,7 +28,6 @@ declare_rules! {
     SKIP_REPEATED = "B215", "skip-repeated", Warning, "More than one `/` in a block.";
     MEANINGLESS_ADDRESS = "B216", "meaningless-address", Warning, "L or Q in a block without a function that reads it.";
     TOO_MANY_PARAMETER_ASSIGNMENTS = "B217", "too-many-parameter-assignments", Error, "More than 95 parameter assignments in one block.";
-    G98_NOT_ALONE = "B218", "g98-not-alone", Error, "G98 (end of helix) shares its block with other words.";
     DWELL_OVERRIDES_REPEAT = "B219", "dwell-overrides-repeat", Warning, "G04 with a call or jump: Q is the dwell and the call runs once.";
     SWALLOWED_WORDS = "B221", "swallowed-words", Warning, "An unclosed comment that hides words after it.";
     OFFSET_TABLE_FORM = "B223", "offset-table-form", Warning, "G92/G93 without the group-5 code that names the table row.";
@@ -126,7 +125,6 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
     check_word_order(block, config, &mut out);
     check_dwell(block, &mut out);
     check_offset_table_form(block, &mut out);
-    check_g98_alone(block, &mut out);
     check_unit_start(block, &mut out);
     check_swallowed_words(block, catalogue, &mut out);
     out
@@ -465,18 +463,6 @@ pub(crate) fn assigns_corrections(block: &BlockData) -> bool {
     let catalogue = Dialect::Cnc8x6.catalogue();
     block.assignments.iter().any(|a| matches!(a.index, Some(0..=4)))
         && !block.words.iter().any(|w| catalogue.role_of(w.letter) == Some(AddressRole::Axis))
-}
-
-fn check_g98_alone(block: &BlockData, out: &mut Vec<Diagnostic>) {
-    let Some((_, g98)) = block.codes(b'G').find(|(c, _)| *c == 98) else { return };
-    let others = block.body_words().count() + block.assignments.len();
-    if others > 1 {
-        out.push(Diagnostic::new(
-            &G98_NOT_ALONE,
-            g98.range,
-            "G98 ends the helix and must be programmed in a block of its own",
-        ));
-    }
 }
 
 /// A `G79` block holds only N, G79 and L.
