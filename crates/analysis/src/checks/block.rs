@@ -6,6 +6,7 @@ use rustc_hash::FxHashMap;
 
 use crate::{
     Config, Diagnostic,
+    checks::motion,
     diagnostic::declare_rules,
     lower::{BlockData, Value, Word},
 };
@@ -97,7 +98,9 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
             }
         }
         match &word.value {
-            Some(Value::Literal(literal)) => check_literal(word, address, literal, catalogue, divides_angles, &mut out),
+            Some(Value::Literal(literal)) => {
+                check_literal(word, address, literal, catalogue, config, divides_angles, &mut out)
+            }
             Some(Value::Parameter { .. }) if !address.substitutable => out.push(Diagnostic::new(
                 &NOT_SUBSTITUTABLE,
                 word.value_range.unwrap_or(word.range),
@@ -140,6 +143,7 @@ fn check_literal(
     address: &Address,
     value: &Decimal,
     catalogue: &Catalogue,
+    config: &Config,
     divides_angles: bool,
     out: &mut Vec<Diagnostic>,
 ) {
@@ -188,7 +192,7 @@ fn check_literal(
     }
     if let Some((min, max)) = address.bounds {
         let number = value.to_f64();
-        if number < min || number > max {
+        if (number < min || number > max) && !motion::cancels_length_compensation(word.letter, number, config) {
             out.push(Diagnostic::new(
                 &VALUE_OUT_OF_RANGE,
                 range,

@@ -5,7 +5,7 @@ use ncc_syntax::Decimal;
 
 use crate::{
     Diagnostic,
-    checks::feed,
+    checks::{feed, motion},
     diagnostic::declare_rules,
     flow::{FlowCheck, Substitution, Visit},
     lower::Value,
@@ -133,7 +133,7 @@ pub(crate) fn check_substitution(
         }
         if let Some((min, max)) = address.bounds.filter(|_| address.role != AddressRole::Feed) {
             let value = raw as f64;
-            if value < min || value > max {
+            if (value < min || value > max) && !motion::cancels_length_compensation(word.letter, value, visit.config) {
                 out.push(related(Diagnostic::new(
                     &SUBSTITUTED_VALUE_OUT_OF_RANGE,
                     range,
