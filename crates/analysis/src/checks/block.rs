@@ -24,7 +24,6 @@ declare_rules! {
     NOT_SUBSTITUTABLE = "B210", "not-substitutable", Error, "A parameter used where the control does not substitute one.";
     TOO_MANY_AXES = "B211", "too-many-axes", Error, "More than six coordinates in one block.";
     LENGTH_COMPENSATION_DIGITS = "B212", "length-compensation-digits", Error, "An `&` digit other than 0, 1 or 2.";
-    DECIMAL_POINT_REQUIRED = "B213", "decimal-point-required", Error, "E written without its mandatory decimal point.";
     SKIP_DIGIT_IGNORED = "B214", "skip-digit-ignored", Warning, "A digit after `/`, which the control does not evaluate.";
     SKIP_REPEATED = "B215", "skip-repeated", Warning, "More than one `/` in a block.";
     MEANINGLESS_ADDRESS = "B216", "meaningless-address", Warning, "L or Q in a block without a function that reads it.";
@@ -50,8 +49,6 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
     let catalogue = Dialect::Cnc8x6.catalogue();
     let mut out = Vec::new();
     let indirect_g = block.words_with(b'G').any(|w| matches!(w.value, Some(Value::Parameter { .. })));
-    // In a G31/G38/G39 block E is the angle divisor, an integer (`E100`).
-    let divides_angles = [31, 38, 39].iter().any(|&c| block.has_code(b'G', c));
 
     let mut seen: [Option<&Word>; 128] = [None; 128];
     let mut axes = Vec::new();
@@ -98,9 +95,7 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
             }
         }
         match &word.value {
-            Some(Value::Literal(literal)) => {
-                check_literal(word, address, literal, catalogue, config, divides_angles, &mut out)
-            }
+            Some(Value::Literal(literal)) => check_literal(word, address, literal, catalogue, config, &mut out),
             Some(Value::Parameter { .. }) if !address.substitutable => out.push(Diagnostic::new(
                 &NOT_SUBSTITUTABLE,
                 word.value_range.unwrap_or(word.range),
@@ -144,7 +139,6 @@ fn check_literal(
     value: &Decimal,
     catalogue: &Catalogue,
     config: &Config,
-    divides_angles: bool,
     out: &mut Vec<Diagnostic>,
 ) {
     let range = word.value_range.unwrap_or(word.range);
@@ -182,13 +176,6 @@ fn check_literal(
             ));
             return;
         }
-    }
-    if address.role == AddressRole::ThreadLeadIn && !value.has_point() && !divides_angles {
-        out.push(Diagnostic::new(
-            &DECIMAL_POINT_REQUIRED,
-            range,
-            format!("the lead-in length must be written with a decimal point: `E{value}.`"),
-        ));
     }
     if let Some((min, max)) = address.bounds {
         let number = value.to_f64();
