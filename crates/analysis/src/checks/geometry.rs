@@ -10,7 +10,7 @@ use ncc_syntax::{TextEdit, TextRange};
 
 use crate::{
     Diagnostic,
-    checks::motion::{self, PLANE_CODES, plane_axes},
+    checks::motion::{self, plane_axes},
     diagnostic::declare_rules,
     flow::{FlowCheck, Known, Visit, thousandths},
     lower::Word,
@@ -250,9 +250,7 @@ fn end_off_circle(visit: &Visit<'_>, arc: &Arc<'_>, refinement: Refinement) -> O
     }
     let [a, b] = arc.axes.as_slice() else { return None };
     let written = [a.letter, b.letter];
-    let [first, second] = PLANE_CODES
-        .into_iter()
-        .filter_map(|code| plane_axes(code, visit.config))
+    let [first, second] = motion::interpolation_planes(visit.config)
         .find(|plane| written.contains(&plane[0]) && written.contains(&plane[1]) && plane[0] != plane[1])?;
     let start = [visit.before.position(first)?, visit.before.position(second)?];
     let end = [visit.after.position(first)?, visit.after.position(second)?];
