@@ -479,7 +479,9 @@ fn check_swallowed_words(block: &BlockData, catalogue: &Catalogue, out: &mut Vec
     for comment in block.comments.iter().filter(|c| !c.closed && c.after_words) {
         let tokens: Vec<&str> = comment.body.split_whitespace().collect();
         let trailing_words = tokens.iter().rev().take_while(|t| looks_like_word(t, catalogue)).count();
-        if trailing_words > 0 && trailing_words < tokens.len() {
+        // Comments often end by naming a parameter, block or code ("copy
+        // R11 into R37", "jump to N50"); only a run of words is program text.
+        if trailing_words >= 2 && trailing_words < tokens.len() {
             let words = tokens[tokens.len() - trailing_words..].join(" ");
             out.push(Diagnostic::new(
                 &SWALLOWED_WORDS,
