@@ -263,13 +263,19 @@ fn check_groups(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Diagnost
     }
 }
 
-/// Addresses a function needs in its own block (`G71 L`, `G04 Q`, `G26 R5`).
+/// Addresses a function needs in its own block (`G71 L`, `G04 Q`). The
+/// control words R5–R8 of G26–G29 may also be left from an earlier block,
+/// which only the flow can tell (arithmetic's `check_control_words_set`).
 fn check_required_addresses(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Diagnostic>) {
     for letter in [b'G', b'M'] {
         for (number, word) in block.codes(letter) {
             let Some(code) = catalogue.code(char::from(letter), number) else { continue };
-            let missing: Vec<&str> =
-                code.requires.iter().map(String::as_str).filter(|required| !block_has(block, required)).collect();
+            let missing: Vec<&str> = code
+                .requires
+                .iter()
+                .map(String::as_str)
+                .filter(|required| !required.starts_with('R') && !block_has(block, required))
+                .collect();
             if !missing.is_empty() {
                 let what = missing.iter().map(|m| format!("`{m}`")).collect::<Vec<_>>().join(", ");
                 out.push(Diagnostic::new(
@@ -282,13 +288,9 @@ fn check_required_addresses(block: &BlockData, catalogue: &Catalogue, out: &mut 
     }
 }
 
-/// Whether the block writes `name`: an address letter, or `R5` for an
-/// assignment of parameter 5.
+/// Whether the block writes address `name`.
 fn block_has(block: &BlockData, name: &str) -> bool {
-    match ncc_catalog::split_code(name) {
-        Some(('R', index)) => block.assignments.iter().any(|a| a.index == Some(index)),
-        _ => name.bytes().next().is_some_and(|letter| block.word(letter).is_some()),
-    }
+    name.bytes().next().is_some_and(|letter| block.word(letter).is_some())
 }
 
 /// L and Q are valid only in their block and only mean something there
