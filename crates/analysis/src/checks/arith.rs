@@ -16,7 +16,10 @@ use rustc_hash::FxHashSet;
 
 use crate::{
     Diagnostic, Rule,
-    checks::{block::parameter_raw, params},
+    checks::{
+        block::{self, parameter_raw},
+        params,
+    },
     diagnostic::declare_rules,
     flow::{self, FlowCheck, Origin, Visit},
     lower::{Value, Word},
@@ -66,6 +69,7 @@ pub(crate) struct Arithmetic {
 impl FlowCheck for Arithmetic {
     fn block(&mut self, visit: &Visit<'_>, out: &mut Vec<Diagnostic>) {
         if let Some((code, word)) = visit.block.codes(b'G').find(|(code, _)| (26..=29).contains(code)) {
+            check_control_words_set(visit, code, word, out);
             let run = Run::new(visit, code, word);
             run.check_format(out);
             run.check_words(out);
@@ -401,6 +405,33 @@ impl<'v, 'a> Run<'v, 'a> {
 
 /// R`n` when the block's arithmetic starts: after the block's own
 /// assignments, which the arithmetic sees.
+/// G26–G29 run the control words R5, R6, … hold: written in the block, or
+/// left there by an earlier block (the manual's cycles compute a "modified
+/// instruction" into R7 and leave it out of the G29 block). Only a control
+/// word the program never assigned is missing.
+fn check_control_words_set(visit: &Visit<'_>, code: u32, word: &Word, out: &mut Vec<Diagnostic>) {
+    if !visit.params.from_start {
+        return;
+    }
+    let last = 4 + code - 25;
+    let missing: Vec<String> = (5..=last)
+        .filter(|&n| visit.block.assignments.iter().all(|a| a.index != Some(n)))
+        .filter(|&n| visit.params.origins.get(n as usize).is_some_and(Option::is_none))
+        .map(|n| format!("R{n}"))
+        .collect();
+    if !missing.is_empty() {
+        out.push(Diagnostic::new(
+            &block::MISSING_REQUIRED_ADDRESS,
+            visit.range(word.range),
+            format!(
+                "G{code} runs the control words in R5 to R{last}, but the program has not assigned {}, so the control runs whatever an earlier program left there; write `{}=…` with its control word in this block",
+                missing.join(", "),
+                missing[0]
+            ),
+        ));
+    }
+}
+
 fn value_at_start(visit: &Visit<'_>, n: usize) -> Option<(Raw, Option<Origin>)> {
     let assignment = visit.block.assignments.iter().rev().find(|a| a.index == Some(n as u32));
     let Some(assignment) = assignment else { return visit.params.get(n as u32) };

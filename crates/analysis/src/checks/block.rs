@@ -6,6 +6,7 @@ use rustc_hash::FxHashMap;
 
 use crate::{
     Config, Diagnostic,
+    checks::motion,
     diagnostic::declare_rules,
     lower::{BlockData, Value, Word},
 };
@@ -23,12 +24,10 @@ declare_rules! {
     NOT_SUBSTITUTABLE = "B210", "not-substitutable", Error, "A parameter used where the control does not substitute one.";
     TOO_MANY_AXES = "B211", "too-many-axes", Error, "More than six coordinates in one block.";
     LENGTH_COMPENSATION_DIGITS = "B212", "length-compensation-digits", Error, "An `&` digit other than 0, 1 or 2.";
-    DECIMAL_POINT_REQUIRED = "B213", "decimal-point-required", Error, "E written without its mandatory decimal point.";
     SKIP_DIGIT_IGNORED = "B214", "skip-digit-ignored", Warning, "A digit after `/`, which the control does not evaluate.";
     SKIP_REPEATED = "B215", "skip-repeated", Warning, "More than one `/` in a block.";
     MEANINGLESS_ADDRESS = "B216", "meaningless-address", Warning, "L or Q in a block without a function that reads it.";
     TOO_MANY_PARAMETER_ASSIGNMENTS = "B217", "too-many-parameter-assignments", Error, "More than 95 parameter assignments in one block.";
-    G98_NOT_ALONE = "B218", "g98-not-alone", Error, "G98 (end of helix) shares its block with other words.";
     DWELL_OVERRIDES_REPEAT = "B219", "dwell-overrides-repeat", Warning, "G04 with a call or jump: Q is the dwell and the call runs once.";
     SWALLOWED_WORDS = "B221", "swallowed-words", Warning, "An unclosed comment that hides words after it.";
     OFFSET_TABLE_FORM = "B223", "offset-table-form", Warning, "G92/G93 without the group-5 code that names the table row.";
@@ -50,8 +49,6 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
     let catalogue = Dialect::Cnc8x6.catalogue();
     let mut out = Vec::new();
     let indirect_g = block.words_with(b'G').any(|w| matches!(w.value, Some(Value::Parameter { .. })));
-    // In a G31/G38/G39 block E is the angle divisor, an integer (`E100`).
-    let divides_angles = [31, 38, 39].iter().any(|&c| block.has_code(b'G', c));
 
     let mut seen: [Option<&Word>; 128] = [None; 128];
     let mut axes = Vec::new();
@@ -98,7 +95,7 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
             }
         }
         match &word.value {
-            Some(Value::Literal(literal)) => check_literal(word, address, literal, catalogue, divides_angles, &mut out),
+            Some(Value::Literal(literal)) => check_literal(word, address, literal, catalogue, config, &mut out),
             Some(Value::Parameter { .. }) if !address.substitutable => out.push(Diagnostic::new(
                 &NOT_SUBSTITUTABLE,
                 word.value_range.unwrap_or(word.range),
@@ -126,7 +123,6 @@ pub(crate) fn check(block: &BlockData, config: &Config) -> Vec<Diagnostic> {
     check_word_order(block, config, &mut out);
     check_dwell(block, &mut out);
     check_offset_table_form(block, &mut out);
-    check_g98_alone(block, &mut out);
     check_unit_start(block, &mut out);
     check_swallowed_words(block, catalogue, &mut out);
     out
@@ -142,7 +138,7 @@ fn check_literal(
     address: &Address,
     value: &Decimal,
     catalogue: &Catalogue,
-    divides_angles: bool,
+    config: &Config,
     out: &mut Vec<Diagnostic>,
 ) {
     let range = word.value_range.unwrap_or(word.range);
@@ -181,16 +177,9 @@ fn check_literal(
             return;
         }
     }
-    if address.role == AddressRole::ThreadLeadIn && !value.has_point() && !divides_angles {
-        out.push(Diagnostic::new(
-            &DECIMAL_POINT_REQUIRED,
-            range,
-            format!("the lead-in length must be written with a decimal point: `E{value}.`"),
-        ));
-    }
     if let Some((min, max)) = address.bounds {
         let number = value.to_f64();
-        if number < min || number > max {
+        if (number < min || number > max) && !motion::cancels_length_compensation(word.letter, number, config) {
             out.push(Diagnostic::new(
                 &VALUE_OUT_OF_RANGE,
                 range,
@@ -274,13 +263,19 @@ fn check_groups(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Diagnost
     }
 }
 
-/// Addresses a function needs in its own block (`G71 L`, `G04 Q`, `G26 R5`).
+/// Addresses a function needs in its own block (`G71 L`, `G04 Q`). The
+/// control words R5–R8 of G26–G29 may also be left from an earlier block,
+/// which only the flow can tell (arithmetic's `check_control_words_set`).
 fn check_required_addresses(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Diagnostic>) {
     for letter in [b'G', b'M'] {
         for (number, word) in block.codes(letter) {
             let Some(code) = catalogue.code(char::from(letter), number) else { continue };
-            let missing: Vec<&str> =
-                code.requires.iter().map(String::as_str).filter(|required| !block_has(block, required)).collect();
+            let missing: Vec<&str> = code
+                .requires
+                .iter()
+                .map(String::as_str)
+                .filter(|required| !required.starts_with('R') && !block_has(block, required))
+                .collect();
             if !missing.is_empty() {
                 let what = missing.iter().map(|m| format!("`{m}`")).collect::<Vec<_>>().join(", ");
                 out.push(Diagnostic::new(
@@ -293,13 +288,9 @@ fn check_required_addresses(block: &BlockData, catalogue: &Catalogue, out: &mut 
     }
 }
 
-/// Whether the block writes `name`: an address letter, or `R5` for an
-/// assignment of parameter 5.
+/// Whether the block writes address `name`.
 fn block_has(block: &BlockData, name: &str) -> bool {
-    match ncc_catalog::split_code(name) {
-        Some(('R', index)) => block.assignments.iter().any(|a| a.index == Some(index)),
-        _ => name.bytes().next().is_some_and(|letter| block.word(letter).is_some()),
-    }
+    name.bytes().next().is_some_and(|letter| block.word(letter).is_some())
 }
 
 /// L and Q are valid only in their block and only mean something there
@@ -467,18 +458,6 @@ pub(crate) fn assigns_corrections(block: &BlockData) -> bool {
         && !block.words.iter().any(|w| catalogue.role_of(w.letter) == Some(AddressRole::Axis))
 }
 
-fn check_g98_alone(block: &BlockData, out: &mut Vec<Diagnostic>) {
-    let Some((_, g98)) = block.codes(b'G').find(|(c, _)| *c == 98) else { return };
-    let others = block.body_words().count() + block.assignments.len();
-    if others > 1 {
-        out.push(Diagnostic::new(
-            &G98_NOT_ALONE,
-            g98.range,
-            "G98 ends the helix and must be programmed in a block of its own",
-        ));
-    }
-}
-
 /// A `G79` block holds only N, G79 and L.
 fn check_unit_start(block: &BlockData, out: &mut Vec<Diagnostic>) {
     if !block.has_code(b'G', 79) {
@@ -502,7 +481,9 @@ fn check_swallowed_words(block: &BlockData, catalogue: &Catalogue, out: &mut Vec
     for comment in block.comments.iter().filter(|c| !c.closed && c.after_words) {
         let tokens: Vec<&str> = comment.body.split_whitespace().collect();
         let trailing_words = tokens.iter().rev().take_while(|t| looks_like_word(t, catalogue)).count();
-        if trailing_words > 0 && trailing_words < tokens.len() {
+        // Comments often end by naming a parameter, block or code ("copy
+        // R11 into R37", "jump to N50"); only a run of words is program text.
+        if trailing_words >= 2 && trailing_words < tokens.len() {
             let words = tokens[tokens.len() - trailing_words..].join(" ");
             out.push(Diagnostic::new(
                 &SWALLOWED_WORDS,

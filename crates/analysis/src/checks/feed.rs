@@ -29,14 +29,14 @@ const MAX_FEED_PER_MINUTE: i64 = 90_000;
 
 /// How the active group-G6 code makes F read.
 #[derive(Clone, Copy)]
-struct FeedMode {
-    code: u32,
-    per_revolution: bool,
+pub(crate) struct FeedMode {
+    pub code: u32,
+    pub per_revolution: bool,
     /// Constant cutting speed: S is a cutting speed, not a spindle speed.
     css: bool,
 }
 
-fn feed_mode(state: &ModalState, config: &Config) -> Option<FeedMode> {
+pub(crate) fn feed_mode(state: &ModalState, config: &Config) -> Option<FeedMode> {
     let code = state.g(6)??;
     // Machine constant 329 decade 3 = 1 or 3 swaps G96 and G97.
     let swapped = matches!(config.machine.decade(329, 3), 1 | 3);

@@ -1,6 +1,6 @@
 //! Geometry of circular and helical blocks: both end coordinates of the
 //! arc's plane and no third axis, the end point on the circle, the centre
-//! refinement E, and the helix lead G10 before G09.
+//! refinement E, the helix lead G10 before G09, and G98 ending a helix.
 //!
 //! The arc's plane is given by the two axes written in the block (G17–G19
 //! choose only the radius-compensation plane); I is the centre offset along
@@ -10,7 +10,7 @@ use ncc_syntax::{TextEdit, TextRange};
 
 use crate::{
     Diagnostic,
-    checks::motion::{self, PLANE_CODES, plane_axes},
+    checks::motion::{self, plane_axes},
     diagnostic::declare_rules,
     flow::{FlowCheck, Known, Visit, thousandths},
     lower::Word,
@@ -22,6 +22,7 @@ declare_rules! {
     ARC_END_NOT_ON_CIRCLE = "M415", "arc-end-not-on-circle", Error, "An arc whose end point is not on the circle through its start point around the centre I, J (beyond 1 µm or machine constant 55).";
     INVALID_ARC_REFINEMENT = "M416", "invalid-arc-refinement", Error, "A centre refinement E whose eighth digit is neither 0 (refine I) nor 1 (refine J).";
     HELIX_WITHOUT_PITCH = "M417", "helix-without-pitch", Warning, "G09 with no helix lead programmed by G10 since the program start.";
+    G98_NOT_ALONE = "B218", "g98-not-alone", Error, "G98 ending a helix shares its block with other words.";
 }
 
 /// Decade 8 of a refinement E (in thousandths of a µm) picks I or J.
@@ -36,6 +37,7 @@ pub(crate) struct Geometry;
 impl FlowCheck for Geometry {
     fn block(&mut self, visit: &Visit<'_>, out: &mut Vec<Diagnostic>) {
         check_helix_lead(visit, out);
+        check_helix_end(visit, out);
         let Some(arc) = Arc::of(visit) else { return };
         let refinement = check_refinement(visit, out);
         match arc.axes.len() {
@@ -97,6 +99,20 @@ fn check_helix_lead(visit: &Visit<'_>, out: &mut Vec<Diagnostic>) {
             &HELIX_WITHOUT_PITCH,
             range,
             "G09 moves the helix's axis by the lead programmed with G10, but no lead has been programmed since the program start; program it in an earlier block, e.g. `N10 Z1.05 G10` for 1.05 mm per turn on Z",
+        ));
+    }
+}
+
+/// The manual wants the G98 that ends a helix in a block of its own; as
+/// the standard block joining after other modes G98 may share its block.
+fn check_helix_end(visit: &Visit<'_>, out: &mut Vec<Diagnostic>) {
+    let Some(range) = visit.code_range(b'G', 98) else { return };
+    let block = visit.block;
+    if visit.before.has_g(2, 9) && block.body_words().count() + block.assignments.len() > 1 {
+        out.push(Diagnostic::new(
+            &G98_NOT_ALONE,
+            range,
+            "G98 ends the helix here and must be programmed in a block of its own; move the other words to the next block",
         ));
     }
 }
@@ -234,9 +250,7 @@ fn end_off_circle(visit: &Visit<'_>, arc: &Arc<'_>, refinement: Refinement) -> O
     }
     let [a, b] = arc.axes.as_slice() else { return None };
     let written = [a.letter, b.letter];
-    let [first, second] = PLANE_CODES
-        .into_iter()
-        .filter_map(|code| plane_axes(code, visit.config))
+    let [first, second] = motion::interpolation_planes(visit.config)
         .find(|plane| written.contains(&plane[0]) && written.contains(&plane[1]) && plane[0] != plane[1])?;
     let start = [visit.before.position(first)?, visit.before.position(second)?];
     let end = [visit.after.position(first)?, visit.after.position(second)?];

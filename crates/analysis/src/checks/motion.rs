@@ -10,6 +10,7 @@ use ncc_syntax::{Severity, TextEdit, TextRange};
 use crate::{
     Config, Diagnostic,
     checks::block::{assigns_corrections, parameter_raw},
+    config::parse_constant,
     diagnostic::declare_rules,
     flow::{FlowCheck, Known, ModalState, Visit},
     lower::{BlockData, Value, Word},
@@ -59,19 +60,38 @@ pub(crate) fn axis_words(block: &BlockData) -> impl Iterator<Item = &Word> {
     block.words.iter().filter(move |w| catalogue.role_of(w.letter) == Some(AddressRole::Axis))
 }
 
-/// The two axes of the plane of G17/G18/G19 (G14–G16 use the configured
-/// fourth axis), first axis first: the one I refers to in an arc.
+/// The two axes of the compensation plane of G17/G18/G19 (machine
+/// constant 340) or G14/G15/G16 (constant 341), first axis first: the one
+/// I refers to in an arc.
 pub(crate) fn plane_axes(code: u32, config: &Config) -> Option<[u8; 2]> {
-    let fourth = config.machine.axes.get(3).copied().unwrap_or(b'U');
-    Some(match code {
-        17 => [b'X', b'Y'],
-        18 => [b'Z', b'X'],
-        19 => [b'Y', b'Z'],
-        14 => [b'Z', fourth],
-        15 => [b'Y', fourth],
-        16 => [fourth, b'X'],
-        _ => return None,
-    })
+    match code {
+        17..=19 => machine_plane(340, code - 17, config),
+        14..=16 => machine_plane(341, code - 14, config),
+        _ => None,
+    }
+}
+
+/// The machine's interpolation planes: the four pairs of each of machine
+/// constants 340 and 341, the first three of which are also the
+/// compensation planes.
+pub(crate) fn interpolation_planes(config: &Config) -> impl Iterator<Item = [u8; 2]> {
+    [340, 341]
+        .into_iter()
+        .flat_map(move |constant| (0..4).filter_map(move |pair| machine_plane(constant, pair, config)))
+}
+
+/// Pair `pair` (0 = decades 2–1) of a plane constant: the ordinals of the
+/// plane's first and second axis, as letters of the configured axes (so
+/// the default 12 of G17 is X–Y on a mill and X–Z on a lathe with axes X,
+/// Z). A constant of zeros reads as its default (`00233.112`, `00412.434`).
+fn machine_plane(constant: u32, pair: u32, config: &Config) -> Option<[u8; 2]> {
+    let planes = match config.machine.constant(constant) {
+        0 => Dialect::Cnc8x6.catalogue().machine_constant(constant)?.default.as_deref().and_then(parse_constant)?,
+        planes => planes,
+    };
+    let ordinals = planes.unsigned_abs() / 100u64.pow(pair) % 100;
+    let axis = |ordinal: u64| config.machine.axes.get(usize::try_from(ordinal).ok()?.checked_sub(1)?).copied();
+    Some([axis(ordinals / 10)?, axis(ordinals % 10)?])
 }
 
 fn moves_in_plane(visit: &Visit<'_>, axes: [u8; 2]) -> bool {
@@ -266,6 +286,11 @@ enum LengthMode {
     B,
     /// `&1`/`&0` switch the corrections of D.
     C,
+}
+
+/// `D0` cancels the length corrections in mode B, beside the entries 1–99.
+pub(crate) fn cancels_length_compensation(letter: u8, value: f64, config: &Config) -> bool {
+    letter == b'D' && value == 0.0 && length_mode(config) == Some(LengthMode::B)
 }
 
 fn length_mode(config: &Config) -> Option<LengthMode> {

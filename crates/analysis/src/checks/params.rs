@@ -5,6 +5,7 @@ use ncc_syntax::Decimal;
 
 use crate::{
     Diagnostic,
+    checks::{feed, motion},
     diagnostic::declare_rules,
     flow::{FlowCheck, Substitution, Visit},
     lower::Value,
@@ -14,7 +15,7 @@ declare_rules! {
     PARAMETER_DIGIT_OVERFLOW = "R301", "parameter-digit-overflow", Error, "A parameter whose value has more digits than the address it is substituted into.";
     SUBSTITUTED_VALUE_OUT_OF_RANGE = "R302", "substituted-value-out-of-range", Error, "A parameter whose value is outside the range of the address it is substituted into.";
     PARAMETER_IN_THOUSANDTHS = "R303", "parameter-in-thousandths", Warning, "A length taken from a parameter written without a decimal point (read in thousandths).";
-    FEED_PARAMETER_IN_METRES = "R304", "feed-parameter-in-metres", Warning, "A feed taken from a parameter written with a decimal point (read in m/min).";
+    FEED_PARAMETER_IN_METRES = "R304", "feed-parameter-in-metres", Warning, "A feed per minute taken from a parameter written with a decimal point (read in m/min).";
     RESERVED_PARAMETER = "R305", "reserved-parameter", Error, "R95, the control's own parameter, written by the program.";
     NOT_RECOMMENDED_PARAMETER = "R306", "not-recommended-parameter", Warning, "R90 to R94, reserved for future control parameters.";
     PARAMETER_NUMBER_OUT_OF_RANGE = "R307", "parameter-number-out-of-range", Error, "A parameter number above 95.";
@@ -99,10 +100,14 @@ pub(crate) fn check_substitution(
     let raw = substitution.raw;
     let letter = &address.letter;
     let dimensionless = address.frac_digits == Some(0) || address.role == AddressRole::Feed;
+    // In a thread block F is the lead, read in µm/rev like a feed per revolution.
+    let thread = visit.after.g(0) == Some(Some(33));
     if dimensionless {
         // The address takes the raw digits: `R10=123` → `G123`.
         let digits = raw.unsigned_abs().to_string();
         let limit = match address.role {
+            // Leads above 99.99 mm are what a parameter is for: `R10=250.0` then `FR10` cuts a 250 mm lead.
+            AddressRole::Feed if thread => None,
             AddressRole::Feed => address.int_digits_without_point,
             _ => address.int_digits,
         };
@@ -128,7 +133,7 @@ pub(crate) fn check_substitution(
         }
         if let Some((min, max)) = address.bounds.filter(|_| address.role != AddressRole::Feed) {
             let value = raw as f64;
-            if value < min || value > max {
+            if (value < min || value > max) && !motion::cancels_length_compensation(word.letter, value, visit.config) {
                 out.push(related(Diagnostic::new(
                     &SUBSTITUTED_VALUE_OUT_OF_RANGE,
                     range,
@@ -149,12 +154,19 @@ pub(crate) fn check_substitution(
                 format!("the parameter holds {} (read as `&{raw}`): each `&` digit must be 0, 1 or 2", show(raw)),
             )));
         }
-        if address.role == AddressRole::Feed && substitution.origin.is_some_and(|o| o.point && !o.computed) {
+        // Only per minute does the point mean metres; per revolution (and for
+        // a thread lead) it means mm/rev, the natural unit.
+        if address.role == AddressRole::Feed
+            && !thread
+            && substitution.origin.is_some_and(|o| o.point && !o.computed)
+            && let Some(mode) = feed::feed_mode(visit.after, visit.config).filter(|mode| !mode.per_revolution)
+        {
             out.push(related(Diagnostic::new(
                 &FEED_PARAMETER_IN_METRES,
                 range,
                 format!(
-                    "the parameter was written with a decimal point, so `{letter}` reads {} m/min ({raw} mm/min); write it without the point for mm/min",
+                    "under G{} the parameter was written with a decimal point, so `{letter}` reads {} m/min ({raw} mm/min); write it without the point for mm/min",
+                    mode.code,
                     show(raw)
                 ),
             )));

@@ -18,6 +18,7 @@ declare_rules! {
     THREAD_EXIT_MISSING_AXES = "T605", "thread-exit-missing-axes", Error, "The block after a thread's empty block does not program every axis.";
     NEGATIVE_RUNOUT = "T606", "negative-runout", Error, "A negative run-out length J.";
     SPINDLE_NOT_RUNNING = "T607", "spindle-not-running", Warning, "G33 while the spindle is stopped.";
+    DECIMAL_POINT_REQUIRED = "B213", "decimal-point-required", Error, "A thread lead-in E written without its mandatory decimal point.";
 }
 
 /// What the blocks after a thread with run-out or lead-in must be.
@@ -103,6 +104,15 @@ impl Threads {
                 &NEGATIVE_RUNOUT,
                 visit.range(word.range),
                 "the run-out length J is always positive, whatever the direction of the thread",
+            ));
+        }
+        // Only the lead-in needs the point: elsewhere E is a centre
+        // refinement or an angle divisor.
+        if let Some((word, lead_in)) = literal(b'E').filter(|(_, lead_in)| !lead_in.has_point()) {
+            out.push(Diagnostic::new(
+                &DECIMAL_POINT_REQUIRED,
+                visit.range(word.value_range.unwrap_or(word.range)),
+                format!("in a thread block E is the lead-in length, which the control takes only with a decimal point: write `E{lead_in}.`"),
             ));
         }
         if spindle_stopped(visit.after) {
