@@ -638,16 +638,18 @@ impl<'db> Walk<'db> {
             let Some(index) = assignment.index.map(|i| i as usize).filter(|&i| i < arith::PARAMETER_COUNT) else {
                 continue;
             };
-            let value = match &assignment.value {
-                Some(Value::Literal(decimal)) => crate::checks::block::parameter_raw(decimal),
-                _ => None,
+            let range = assignment.value_range.unwrap_or(assignment.range) + offset;
+            // Assigned even when the value is not known: it is no longer
+            // what an earlier program left.
+            let (value, origin) = match &assignment.value {
+                Some(Value::Literal(decimal)) => (
+                    crate::checks::block::parameter_raw(decimal),
+                    Origin { range, point: decimal.has_point(), computed: false },
+                ),
+                _ => (None, Origin { range, point: false, computed: false }),
             };
             params.values.set(index, value.filter(|raw| raw.abs() <= arith::MAX_RAW));
-            params.origins[index] = value.map(|_| Origin {
-                range: assignment.value_range.unwrap_or(assignment.range) + offset,
-                point: matches!(&assignment.value, Some(Value::Literal(d)) if d.has_point()),
-                computed: false,
-            });
+            params.origins[index] = Some(origin);
         }
         let function = block.codes(b'G').find(|(code, _)| (26..=29).contains(code));
         let (code, word) = function?;
@@ -669,10 +671,10 @@ impl<'db> Walk<'db> {
         let r95 = params.values.get(95);
         let config = ArithConfig { double_precision: double_precision(self.config, r95).unwrap_or(false) };
         let result = arith::execute(&words, &mut params.values, &mut UnknownMachine, config);
+        let targets: Vec<usize> = words.iter().map(|word| usize::from(word.target)).collect();
         for index in 0..arith::PARAMETER_COUNT {
-            if params.values.get(index) != before.get(index) {
-                params.origins[index] =
-                    params.values.get(index).map(|_| Origin { range, point: false, computed: true });
+            if params.values.get(index) != before.get(index) || targets.contains(&index) {
+                params.origins[index] = Some(Origin { range, point: false, computed: true });
             }
         }
         result.err().map(|(_, error)| (range, error))
