@@ -180,11 +180,16 @@ fn check_literal(
     if let Some((min, max)) = address.bounds {
         let number = value.to_f64();
         if (number < min || number > max) && !motion::cancels_length_compensation(word.letter, number, config) {
+            let d0 = if word.letter == b'D' && number == 0.0 {
+                "; `D0` cancels the length corrections only in length-compensation mode B (machine constant 329 decade 7 = 1 in ncc.toml)"
+            } else {
+                ""
+            };
             out.push(Diagnostic::new(
                 &VALUE_OUT_OF_RANGE,
                 range,
                 format!(
-                    "`{letter}{value}` is outside the range of `{letter}`: {} to {}",
+                    "`{letter}{value}` is outside the range of `{letter}`: {} to {}{d0}",
                     address.min.as_deref().unwrap_or_default(),
                     address.max.as_deref().unwrap_or_default()
                 ),
