@@ -214,9 +214,7 @@ fn transfer_targets(db: &dyn Db, file: SourceFile, index: usize, transfer: Trans
             })
             .collect(),
         Transfer::Jump(number) => {
-            let Some(unit) = program.unit_of(index) else { return Vec::new() };
-            let target = program.numbers_in(unit).get(&u64::from(number)).copied();
-            target.map(|block| block_target(file, program, block)).into_iter().collect()
+            program.jump_target(index, number).map(|block| block_target(file, program, block)).into_iter().collect()
         }
     }
 }

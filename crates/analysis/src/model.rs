@@ -168,15 +168,12 @@ impl Program {
         self.units.iter().find(|u| u.number == Some(number))
     }
 
-    /// Block indices of unit `unit` by block number.
-    pub fn numbers_in(&self, unit: &Unit) -> FxHashMap<u64, usize> {
-        let mut numbers = FxHashMap::default();
-        for index in unit.blocks.clone() {
-            if let Some(n) = self.blocks[index].number {
-                numbers.entry(n).or_insert(index);
-            }
-        }
-        numbers
+    /// The block a `G73 L<number>` in block `from` jumps to: the first block
+    /// with that number in the same unit.
+    pub fn jump_target(&self, from: usize, number: u32) -> Option<usize> {
+        let unit = self.unit_of(from)?;
+        let position = self.blocks[unit.blocks.clone()].iter().position(|b| b.number == Some(u64::from(number)))?;
+        Some(unit.blocks.start + position)
     }
 }
 

@@ -208,3 +208,25 @@ fn goto_the_assignments_a_parameter_comes_from() {
 fn goto_on_an_unknown_parameter_finds_nothing() {
     check_goto(&[("main.NCP", "%1\nN10 G01 XR$07 F100\nN20 M30\n")], expect![""]);
 }
+
+#[test]
+fn the_state_at_a_block_follows_each_call() {
+    let text = "%1\nN10 G90 G00 X0 R2=5.\nN20 G01 X5. F100\nN30 G71 L100\nN40 F250 R2=7.\nN50 G71 L100\nN60 M30\nN100 G79 L100\nN110 G91 YR2\nN120 G70\n*\n";
+    let (host, file, offset, _) = setup(&[("main.NCP", &text.replace("N110", "$0N110"))]);
+    let states = host.analysis().states_at(file, offset);
+    let seen: Vec<(String, Option<i64>, Option<i64>)> = states
+        .iter()
+        .map(|(modal, params)| {
+            let feed = match &modal.feed {
+                ncc_analysis::flow::Known::Is(Some(setting)) => setting.value.to_string(),
+                other => format!("{other:?}"),
+            };
+            (feed, params.get(2).map(|(raw, _)| raw), modal.position(b'X'))
+        })
+        .collect();
+    assert_eq!(
+        seen,
+        [("100".to_owned(), Some(5000), Some(5000)), ("250".to_owned(), Some(7000), Some(5000))],
+        "one state per call, each with the caller's feed, parameters and position"
+    );
+}

@@ -325,9 +325,7 @@ fn check_transfers(db: &dyn Db, program: &Program, out: &mut Vec<Diagnostic>) {
                 }
             }
             Transfer::Jump(target) => {
-                let Some(unit) = program.unit_of(index) else { continue };
-                let numbers = program.numbers_in(unit);
-                if !numbers.contains_key(&u64::from(target)) {
+                if program.unit_of(index).is_some() && program.jump_target(index, target).is_none() {
                     let elsewhere = program.blocks.iter().position(|b| b.number == Some(u64::from(target)));
                     let message = match elsewhere {
                         Some(_) => format!(
