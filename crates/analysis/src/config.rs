@@ -94,9 +94,11 @@ impl MachineConfig {
     /// catalogue gives one; `None` for a constant without a documented
     /// default that the configuration does not set.
     pub fn known_constant(&self, number: u32) -> Option<i64> {
-        if let Some(&value) = self.constants.get(&number) {
-            return Some(value);
-        }
+        self.constants.get(&number).copied().or_else(|| Self::default_constant(number))
+    }
+
+    /// A machine constant's documented default, from the catalogue.
+    pub fn default_constant(number: u32) -> Option<i64> {
         Dialect::Cnc8x6.catalogue().machine_constant(number).and_then(|c| c.default.as_deref()).and_then(parse_constant)
     }
 
