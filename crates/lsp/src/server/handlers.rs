@@ -2,7 +2,7 @@
 
 use std::collections::HashMap;
 
-use ncc_analysis::NavigationTarget;
+use ncc_analysis::{CompletionKind, NavigationTarget};
 use tower_lsp_server::ls_types as lsp;
 
 use super::{Snapshot, convert};
@@ -21,6 +21,13 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
             code_action_kinds: Some(vec![lsp::CodeActionKind::QUICKFIX]),
             ..Default::default()
         })),
+        completion_provider: Some(lsp::CompletionOptions {
+            // Codes and addresses are letters; call targets follow `L`.
+            trigger_characters: Some(["G", "M", "L", "R"].map(String::from).to_vec()),
+            ..Default::default()
+        }),
+        inlay_hint_provider: Some(lsp::OneOf::Left(true)),
+        document_formatting_provider: Some(lsp::OneOf::Left(true)),
         ..Default::default()
     }
 }
@@ -62,4 +69,54 @@ pub(crate) fn code_actions(s: &Snapshot, range: lsp::Range) -> lsp::CodeActionRe
         }
     }
     actions
+}
+
+pub(crate) fn completion(s: &Snapshot, position: lsp::Position) -> Vec<lsp::CompletionItem> {
+    let items = s.analysis.completions(s.file, s.map.offset(position));
+    // The analysis lists the most relevant first; the sort text keeps that.
+    let width = items.len().to_string().len();
+    items
+        .into_iter()
+        .enumerate()
+        .map(|(rank, item)| lsp::CompletionItem {
+            kind: Some(match item.kind {
+                CompletionKind::Code => lsp::CompletionItemKind::KEYWORD,
+                CompletionKind::Address => lsp::CompletionItemKind::FIELD,
+                CompletionKind::Subprogram | CompletionKind::Macrocycle => lsp::CompletionItemKind::FUNCTION,
+                CompletionKind::Block => lsp::CompletionItemKind::REFERENCE,
+                CompletionKind::Parameter => lsp::CompletionItemKind::VARIABLE,
+            }),
+            detail: Some(item.detail),
+            documentation: item.documentation.map(|text| lsp::Documentation::MarkupContent(convert::markdown(text))),
+            sort_text: Some(format!("{rank:0width$}")),
+            filter_text: Some(item.label.clone()),
+            text_edit: Some(lsp::CompletionTextEdit::Edit(lsp::TextEdit {
+                range: s.map.range(item.replace),
+                new_text: item.insert_text,
+            })),
+            label: item.label,
+            ..Default::default()
+        })
+        .collect()
+}
+
+pub(crate) fn formatting(s: &Snapshot) -> Vec<lsp::TextEdit> {
+    s.analysis.format(s.file).iter().map(|edit| s.map.text_edit(edit)).collect()
+}
+
+pub(crate) fn inlay_hints(s: &Snapshot, range: lsp::Range) -> Vec<lsp::InlayHint> {
+    s.analysis
+        .inlay_hints(s.file, Some(s.map.range_offsets(range)))
+        .into_iter()
+        .map(|hint| lsp::InlayHint {
+            position: s.map.position(hint.offset),
+            label: lsp::InlayHintLabel::String(hint.label),
+            kind: None,
+            text_edits: None,
+            tooltip: hint.tooltip.map(|text| lsp::InlayHintTooltip::MarkupContent(convert::markdown(text))),
+            padding_left: Some(true),
+            padding_right: None,
+            data: None,
+        })
+        .collect()
 }

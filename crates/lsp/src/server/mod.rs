@@ -334,6 +334,21 @@ impl LanguageServer for Server {
         Ok((!links.is_empty()).then_some(lsp::GotoDefinitionResponse::Link(links)))
     }
 
+    async fn completion(&self, params: lsp::CompletionParams) -> jsonrpc::Result<Option<lsp::CompletionResponse>> {
+        let position = params.text_document_position;
+        let items =
+            self.query(&position.text_document.uri, move |s| handlers::completion(s, position.position)).await?;
+        Ok(Some(lsp::CompletionResponse::Array(items)))
+    }
+
+    async fn formatting(&self, params: lsp::DocumentFormattingParams) -> jsonrpc::Result<Option<Vec<lsp::TextEdit>>> {
+        self.query(&params.text_document.uri, handlers::formatting).await.map(Some)
+    }
+
+    async fn inlay_hint(&self, params: lsp::InlayHintParams) -> jsonrpc::Result<Option<Vec<lsp::InlayHint>>> {
+        self.query(&params.text_document.uri, move |s| handlers::inlay_hints(s, params.range)).await.map(Some)
+    }
+
     async fn code_action(&self, params: lsp::CodeActionParams) -> jsonrpc::Result<Option<lsp::CodeActionResponse>> {
         let uri = params.text_document.uri.clone();
         self.query(&uri, move |s| handlers::code_actions(s, params.range)).await.map(Some)
