@@ -14,10 +14,14 @@ use std::{
 use ncc_syntax::{Dialect, Parse, SyntaxKind, TextSize};
 use rowan::GreenNode;
 
-use crate::{Config, Diagnostic, lower::BlockData, model::BlockSummary};
+use crate::{Config, Diagnostic, lower::BlockData, model::BlockSummary, states::StateCache};
 
 #[salsa::db]
-pub trait Db: salsa::Database {}
+pub trait Db: salsa::Database {
+    /// Modal-state checkpoints, kept outside salsa because they stay valid
+    /// across edits (see `states`).
+    fn state_cache(&self) -> &StateCache;
+}
 
 /// A program file of the workspace.
 #[salsa::input(debug)]
@@ -163,6 +167,7 @@ pub fn chunk_summaries<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<Bloc
 pub struct RootDatabase {
     storage: salsa::Storage<Self>,
     log: Option<Arc<Mutex<Vec<String>>>>,
+    states: Arc<StateCache>,
 }
 
 impl RootDatabase {
@@ -177,6 +182,7 @@ impl RootDatabase {
                 }
             }))),
             log: Some(log),
+            states: Arc::default(),
         }
     }
 
@@ -196,4 +202,8 @@ impl std::fmt::Debug for RootDatabase {
 impl salsa::Database for RootDatabase {}
 
 #[salsa::db]
-impl Db for RootDatabase {}
+impl Db for RootDatabase {
+    fn state_cache(&self) -> &StateCache {
+        &self.states
+    }
+}

@@ -15,6 +15,7 @@ pub mod flow;
 mod ide;
 pub mod lower;
 pub mod model;
+mod states;
 mod suppress;
 
 use std::sync::Arc;
@@ -78,6 +79,7 @@ impl AnalysisHost {
         let settings = Settings::get(&self.db);
         let files: Vec<SourceFile> = settings.files(&self.db).iter().copied().filter(|&f| f != file).collect();
         settings.set_files(&mut self.db).to(files);
+        self.db.state_cache().forget(file);
     }
 
     /// Replaces a file's text.
