@@ -28,7 +28,10 @@ pub use crate::{
     config::{CONFIG_FILE, Config, Level, MachineConfig, parse_constant},
     db::{RootDatabase, SourceFile},
     diagnostic::{Diagnostic, Fix, Related, Rule},
-    ide::{HoverResult, NavigationTarget},
+    ide::{
+        DocumentSymbol, Fold, FoldKind, HighlightKind, HighlightRange, HoverResult, NavigationTarget, Reference,
+        ReferenceKind, SymbolKind,
+    },
 };
 
 /// A file of the analysis.
@@ -146,6 +149,32 @@ impl Analysis {
     /// time the program reaches it.
     pub fn states_at(&self, file: FileId, offset: TextSize) -> Vec<(flow::ModalState, flow::ParamState)> {
         ide::states_at(&self.db, file, offset)
+    }
+
+    /// The outline: program units, and the blocks jumps go to in each.
+    pub fn document_symbols(&self, file: FileId) -> Vec<DocumentSymbol> {
+        ide::document_symbols(&self.db, file)
+    }
+
+    /// Program units and runs of comment lines, sorted by start.
+    pub fn folding_ranges(&self, file: FileId) -> Vec<Fold> {
+        ide::folding_ranges(&self.db, file)
+    }
+
+    /// Every token classified, for semantic highlighting.
+    pub fn highlight(&self, file: FileId) -> Vec<HighlightRange> {
+        ide::highlight(&self.db, file, None)
+    }
+
+    /// The highlighting of the blocks (and header, end) that overlap `range`.
+    pub fn highlight_range(&self, file: FileId, range: TextRange) -> Vec<HighlightRange> {
+        ide::highlight(&self.db, file, Some(range))
+    }
+
+    /// The definition (with `include_declaration`) and the uses of the
+    /// subprogram, macrocycle, jump target or parameter at `offset`.
+    pub fn references(&self, file: FileId, offset: TextSize, include_declaration: bool) -> Vec<Reference> {
+        ide::references(&self.db, file, offset, include_declaration)
     }
 
     pub fn path(&self, file: FileId) -> String {
