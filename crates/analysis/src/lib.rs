@@ -21,17 +21,23 @@ use std::sync::Arc;
 
 use ncc_syntax::Parse;
 pub use ncc_syntax::{Dialect, Severity, TextEdit, TextRange, TextSize};
+pub use salsa::Cancelled;
 use salsa::Setter;
 
 use crate::db::{Db, Settings};
+pub use crate::ide::{
+    completion::{CompletionItem, CompletionKind},
+    folding::{Fold, FoldKind},
+    highlight::{HighlightKind, HighlightRange},
+    inlay::{InlayHint, InlayHintKind},
+    references::{Reference, ReferenceKind},
+    symbols::{DocumentSymbol, SymbolKind},
+};
 pub use crate::{
     config::{CONFIG_FILE, Config, Level, MachineConfig, parse_constant},
     db::{RootDatabase, SourceFile},
     diagnostic::{Diagnostic, Fix, Related, Rule},
-    ide::{
-        DocumentSymbol, Fold, FoldKind, HighlightKind, HighlightRange, HoverResult, NavigationTarget, Reference,
-        ReferenceKind, SymbolKind,
-    },
+    ide::{HoverResult, NavigationTarget},
 };
 
 /// A file of the analysis.
@@ -69,6 +75,13 @@ impl AnalysisHost {
         files.push(file);
         settings.set_files(&mut self.db).to(files);
         file
+    }
+
+    /// Removes a file from the workspace (its handle must not be used again).
+    pub fn remove_file(&mut self, file: FileId) {
+        let settings = Settings::get(&self.db);
+        let files: Vec<SourceFile> = settings.files(&self.db).iter().copied().filter(|&f| f != file).collect();
+        settings.set_files(&mut self.db).to(files);
     }
 
     /// Replaces a file's text.
@@ -129,7 +142,23 @@ impl Analysis {
     /// Every diagnostic of a file after configuration and suppression
     /// comments, sorted by position.
     pub fn diagnostics(&self, file: FileId) -> Vec<Diagnostic> {
-        file_diagnostics(&self.db, file).clone()
+        let mut all = local_diagnostics(&self.db, file).clone();
+        all.extend(self.flow_diagnostics(file));
+        sort_diagnostics(&mut all);
+        all
+    }
+
+    /// The diagnostics that need no flow walk (syntax, blocks, program
+    /// structure): after an edit these cost only the edited chunk, so an
+    /// editor can show them at once and the flow findings when they come.
+    pub fn local_diagnostics(&self, file: FileId) -> Vec<Diagnostic> {
+        local_diagnostics(&self.db, file).clone()
+    }
+
+    /// The diagnostics of the rules that follow the program's flow,
+    /// configured and sorted.
+    pub fn flow_diagnostics(&self, file: FileId) -> Vec<Diagnostic> {
+        configured_flow_diagnostics(&self.db, file).clone()
     }
 
     /// What the thing at `offset` is: a code's or an address's
@@ -153,28 +182,45 @@ impl Analysis {
 
     /// The outline: program units, and the blocks jumps go to in each.
     pub fn document_symbols(&self, file: FileId) -> Vec<DocumentSymbol> {
-        ide::document_symbols(&self.db, file)
+        ide::symbols::document_symbols(&self.db, file)
     }
 
     /// Program units and runs of comment lines, sorted by start.
     pub fn folding_ranges(&self, file: FileId) -> Vec<Fold> {
-        ide::folding_ranges(&self.db, file)
+        ide::folding::folding_ranges(&self.db, file)
     }
 
     /// Every token classified, for semantic highlighting.
     pub fn highlight(&self, file: FileId) -> Vec<HighlightRange> {
-        ide::highlight(&self.db, file, None)
+        ide::highlight::highlight(&self.db, file, None)
     }
 
     /// The highlighting of the blocks (and header, end) that overlap `range`.
     pub fn highlight_range(&self, file: FileId, range: TextRange) -> Vec<HighlightRange> {
-        ide::highlight(&self.db, file, Some(range))
+        ide::highlight::highlight(&self.db, file, Some(range))
     }
 
     /// The definition (with `include_declaration`) and the uses of the
     /// subprogram, macrocycle, jump target or parameter at `offset`.
     pub fn references(&self, file: FileId, offset: TextSize, include_declaration: bool) -> Vec<Reference> {
-        ide::references(&self.db, file, offset, include_declaration)
+        ide::references::references(&self.db, file, offset, include_declaration)
+    }
+
+    /// The edits that format the file: spacing only (the style is in
+    /// `ide/format.rs`), sorted and not overlapping.
+    pub fn format(&self, file: FileId) -> Vec<TextEdit> {
+        ide::format::format(file.text(&self.db), file.parse(&self.db))
+    }
+
+    /// What may be written at `offset`, most relevant first.
+    pub fn completions(&self, file: FileId, offset: TextSize) -> Vec<CompletionItem> {
+        ide::completion::completions(&self.db, file, offset)
+    }
+
+    /// The inlay hints of the blocks `range` touches (of every block
+    /// without one).
+    pub fn inlay_hints(&self, file: FileId, range: Option<TextRange>) -> Vec<InlayHint> {
+        ide::inlay::inlay_hints(&self.db, file, range)
     }
 
     pub fn path(&self, file: FileId) -> String {
@@ -186,10 +232,9 @@ impl Analysis {
     }
 }
 
-/// Syntax, block and program diagnostics of a file, configured.
+/// Syntax, block and program-structure diagnostics of a file, configured.
 #[salsa::tracked(returns(ref))]
-fn file_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
-    let config = Settings::get(db).config(db);
+fn local_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
     let parse = file.parse(db);
     let mut all: Vec<Diagnostic> = parse.errors().iter().map(Diagnostic::from_syntax).collect();
     for chunk in db::file_chunks(db, file) {
@@ -197,10 +242,25 @@ fn file_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
     }
     all.extend(checks::structure::check(db, file));
     all.extend(checks::cycles::check_file(db, file));
-    all.extend(flow::flow_diagnostics(db, file).iter().cloned());
-    let suppressions = suppress::Suppressions::of(file.text(db), parse);
+    configure(db, file, all)
+}
+
+/// The flow walk's diagnostics of a file, configured.
+#[salsa::tracked(returns(ref))]
+fn configured_flow_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
+    configure(db, file, flow::flow_diagnostics(db, file).clone())
+}
+
+/// Applies suppression comments and the configured levels, and sorts.
+fn configure(db: &dyn Db, file: SourceFile, all: Vec<Diagnostic>) -> Vec<Diagnostic> {
+    let config = Settings::get(db).config(db);
+    let suppressions = suppress::Suppressions::of(file.text(db), file.parse(db));
     let mut diagnostics: Vec<Diagnostic> =
         all.into_iter().filter(|d| !suppressions.silences(d)).filter_map(|d| config.adjust(d)).collect();
-    diagnostics.sort_by(|a, b| (a.range.start(), a.range.end(), a.code).cmp(&(b.range.start(), b.range.end(), b.code)));
+    sort_diagnostics(&mut diagnostics);
     diagnostics
+}
+
+fn sort_diagnostics(diagnostics: &mut [Diagnostic]) {
+    diagnostics.sort_by(|a, b| (a.range.start(), a.range.end(), a.code).cmp(&(b.range.start(), b.range.end(), b.code)));
 }

@@ -1,12 +1,16 @@
 //! Document symbols, folding, semantic highlighting and find references.
 //! `$0` in a program marks the cursor.
 
+#[path = "../../syntax/tests/strategies/mod.rs"]
+mod strategies;
+
 use expect_test::{Expect, expect};
 use ncc_analysis::{
     Analysis, AnalysisHost, Config, Dialect, DocumentSymbol, FileId, HighlightKind, RootDatabase, TextEdit, TextRange,
     TextSize,
 };
 use proptest::prelude::*;
+use strategies::{block_program, program_text};
 
 /// A partprogram with subprograms, jumps, parameters and Czech comments.
 const PROGRAM: &str = "%100 \"DÍL – ČEP Ø20\"
@@ -444,29 +448,48 @@ fn highlighting_computes_nothing_and_references_relower_one_chunk_after_an_edit(
     assert_eq!(chunks, 1, "only the edited chunk is lowered again: {executions:#?}");
 }
 
-/// Text made mostly of the language's own characters, with some foreign
-/// and multi-byte ones.
-fn program_text() -> impl Strategy<Value = String> {
-    let piece = prop_oneof![
-        8 => Just("N".to_owned()),
-        8 => "[0-9]{1,4}",
-        6 => "[XYZGMFRSTLOIJ]",
-        4 => Just(" ".to_owned()),
-        4 => Just("\n".to_owned()),
-        2 => Just(".".to_owned()),
-        2 => Just("-".to_owned()),
-        2 => Just("=".to_owned()),
-        2 => Just("\"".to_owned()),
-        1 => Just("$PC".to_owned()),
-        1 => Just("\r\n".to_owned()),
-        1 => Just("%".to_owned()),
-        1 => Just("*".to_owned()),
-        1 => Just("/".to_owned()),
-        1 => Just("&".to_owned()),
-        1 => "[\u{201E}\u{2212}ČŘáx#,;\t]",
-        1 => any::<char>().prop_map(String::from),
-    ];
-    prop::collection::vec(piece, 0..120).prop_map(|pieces| pieces.concat())
+/// Checks that the highlighting of `text` is well formed, and that of the
+/// blocks around `start..end` is part of it.
+fn check_highlight_ranges(path: &str, text: &str, start: usize, end: usize) {
+    let mut host = AnalysisHost::default();
+    let file = host.add_file(path, text);
+    let analysis = host.analysis();
+    let ranges = analysis.highlight(file);
+    let kinds = HighlightKind::all(Dialect::Cnc8x6);
+    let mut previous_end = 0;
+    for highlight in &ranges {
+        let range = std::ops::Range::<usize>::from(highlight.range);
+        assert!(range.start >= previous_end && range.start < range.end && range.end <= text.len(), "{highlight:?}");
+        assert!(text.is_char_boundary(range.start) && text.is_char_boundary(range.end), "{highlight:?}");
+        let piece = &text[range.clone()];
+        assert!(!piece.contains(['\n', '\r']), "{piece:?}");
+        assert!(!piece.starts_with([' ', '\t']) && !piece.ends_with([' ', '\t']), "{piece:?}");
+        assert!(kinds.contains(&highlight.kind), "{:?} is not listed", highlight.kind);
+        previous_end = range.end;
+    }
+    let boundary = |at: usize| (0..=at.min(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap_or(0);
+    let (start, end) = (boundary(start), boundary(end));
+    let within = TextRange::new(TextSize::try_from(start).unwrap(), TextSize::try_from(end.max(start)).unwrap());
+    for highlight in analysis.highlight_range(file, within) {
+        assert!(ranges.contains(&highlight), "{highlight:?}");
+    }
+}
+
+#[test]
+fn odd_input_gives_well_formed_answers() {
+    for text in ["", "%", "\u{b}", "\"NN\r\n\"$PC N", "$PC\"\"\"  ", "\u{201E}  ", "\"  $PC\nN1 X1\n\"  \n"] {
+        check_highlight_ranges("P.NCP", text, 0, 0);
+        let (host, ids, _) = setup(&[("P.NCP", text)]);
+        let analysis = host.analysis();
+        assert!(analysis.document_symbols(ids[0]).iter().all(|s| s.range.contains_range(s.selection_range)));
+        assert!(analysis.folding_ranges(ids[0]).iter().all(|f| usize::from(f.range.end()) <= text.len()));
+    }
+}
+
+/// Program text, sometimes a fixed-cycle file's (`$PC` before the blocks).
+fn any_program() -> impl Strategy<Value = String> {
+    let text = prop_oneof![program_text(), block_program()];
+    (text, prop::bool::ANY).prop_map(|(text, cycles)| if cycles { format!("\"  $PC \"\n{text}") } else { text })
 }
 
 proptest! {
@@ -474,37 +497,16 @@ proptest! {
 
     #[test]
     fn highlight_ranges_are_sorted_disjoint_and_on_char_boundaries(
-        text in program_text(),
+        text in any_program(),
         path in prop_oneof![Just("P.NCP"), Just("L9001")],
         start in 0usize..400,
         len in 0usize..100,
     ) {
-        let mut host = AnalysisHost::default();
-        let file = host.add_file(path, text.as_str());
-        let analysis = host.analysis();
-        let ranges = analysis.highlight(file);
-        let kinds = HighlightKind::all(Dialect::Cnc8x6);
-        let mut end = 0;
-        for highlight in &ranges {
-            let range = std::ops::Range::<usize>::from(highlight.range);
-            prop_assert!(range.start >= end && range.start < range.end && range.end <= text.len(), "{highlight:?}");
-            prop_assert!(text.is_char_boundary(range.start) && text.is_char_boundary(range.end));
-            let piece = &text[range.clone()];
-            prop_assert!(!piece.contains(['\n', '\r']), "{piece:?}");
-            prop_assert!(!piece.starts_with([' ', '\t']) && !piece.ends_with([' ', '\t']), "{piece:?}");
-            prop_assert!(kinds.contains(&highlight.kind), "{:?} is not listed", highlight.kind);
-            end = range.end;
-        }
-        let start = (0..=start.min(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap();
-        let end = (start..=(start + len).min(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap();
-        let within = TextRange::new(TextSize::try_from(start).unwrap(), TextSize::try_from(end).unwrap());
-        for highlight in analysis.highlight_range(file, within) {
-            prop_assert!(ranges.contains(&highlight));
-        }
+        check_highlight_ranges(path, &text, start, start + len);
     }
 
     #[test]
-    fn other_answers_never_panic(text in program_text(), at in 0usize..400) {
+    fn other_answers_never_panic(text in any_program(), at in 0usize..400) {
         let mut host = AnalysisHost::default();
         let file = host.add_file("P.NCP", text.as_str());
         let analysis = host.analysis();

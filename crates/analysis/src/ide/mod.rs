@@ -6,23 +6,17 @@
 //! the block counts, so a subprogram called with different values shows
 //! them all.
 
-mod folding;
-mod highlight;
-mod references;
-mod symbols;
+pub(crate) mod completion;
+pub(crate) mod folding;
+pub(crate) mod format;
+pub(crate) mod highlight;
+pub(crate) mod inlay;
+pub(crate) mod references;
+pub(crate) mod symbols;
 
 use ncc_catalog::Item;
 use ncc_syntax::{TextRange, TextSize};
 
-pub(crate) use self::{
-    folding::folding_ranges, highlight::highlight, references::references, symbols::document_symbols,
-};
-pub use self::{
-    folding::{Fold, FoldKind},
-    highlight::{HighlightKind, HighlightRange},
-    references::{Reference, ReferenceKind},
-    symbols::{DocumentSymbol, SymbolKind},
-};
 use crate::{
     db::{Db, Settings, SourceFile},
     flow::{self, ModalState, ParamState, show_thousandths},

@@ -208,15 +208,13 @@ pub(super) struct Outline<'db> {
 
 impl<'db> Outline<'db> {
     pub fn new(db: &'db dyn Db, file: SourceFile) -> Outline<'db> {
-        let root = file.parse(db).syntax_node();
+        let tree = file.parse(db).tree();
         Outline {
             program: model::program(db, file),
             text: file.text(db),
             path: file.path(db),
-            // The header is the first node, if any: looking further would
-            // visit every block.
-            header: root.first_child().and_then(ast::Header::cast),
-            root,
+            header: tree.header(),
+            root: tree.syntax().clone(),
         }
     }
 
