@@ -7,8 +7,12 @@
 //! them all.
 
 pub(crate) mod completion;
+pub(crate) mod folding;
 pub(crate) mod format;
+pub(crate) mod highlight;
 pub(crate) mod inlay;
+pub(crate) mod references;
+pub(crate) mod symbols;
 
 use ncc_catalog::Item;
 use ncc_syntax::{TextRange, TextSize};
