@@ -2,10 +2,10 @@
 
 use std::collections::HashMap;
 
-use ncc_analysis::{CompletionKind, NavigationTarget};
+use ncc_analysis::{CompletionKind, Dialect, DocumentSymbol, FoldKind, NavigationTarget, ReferenceKind, SymbolKind};
 use tower_lsp_server::ls_types as lsp;
 
-use super::{Snapshot, convert};
+use super::{Snapshot, convert, semantic};
 
 pub(crate) fn capabilities() -> lsp::ServerCapabilities {
     lsp::ServerCapabilities {
@@ -27,6 +27,18 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
             ..Default::default()
         }),
         inlay_hint_provider: Some(lsp::OneOf::Left(true)),
+        references_provider: Some(lsp::OneOf::Left(true)),
+        document_highlight_provider: Some(lsp::OneOf::Left(true)),
+        document_symbol_provider: Some(lsp::OneOf::Left(true)),
+        folding_range_provider: Some(lsp::FoldingRangeProviderCapability::Simple(true)),
+        semantic_tokens_provider: Some(lsp::SemanticTokensServerCapabilities::SemanticTokensOptions(
+            lsp::SemanticTokensOptions {
+                legend: semantic::legend(Dialect::Cnc8x6),
+                full: Some(lsp::SemanticTokensFullOptions::Bool(true)),
+                range: Some(true),
+                ..Default::default()
+            },
+        )),
         document_formatting_provider: Some(lsp::OneOf::Left(true)),
         ..Default::default()
     }
@@ -119,4 +131,62 @@ pub(crate) fn inlay_hints(s: &Snapshot, range: lsp::Range) -> Vec<lsp::InlayHint
             data: None,
         })
         .collect()
+}
+
+pub(crate) fn references(s: &Snapshot, position: lsp::Position, include_declaration: bool) -> Vec<ncc_analysis::Reference> {
+    s.analysis.references(s.file, s.map.offset(position), include_declaration)
+}
+
+/// Whether a reference is written (for document highlights and clients
+/// that show it).
+pub(crate) fn is_write(kind: ReferenceKind) -> bool {
+    matches!(kind, ReferenceKind::Definition | ReferenceKind::Write)
+}
+
+pub(crate) fn document_symbols(s: &Snapshot) -> Vec<lsp::DocumentSymbol> {
+    fn convert_symbol(s: &Snapshot, symbol: DocumentSymbol) -> lsp::DocumentSymbol {
+        #[allow(deprecated)] // `deprecated` is a required field of the type.
+        lsp::DocumentSymbol {
+            name: symbol.name,
+            detail: symbol.detail,
+            kind: match symbol.kind {
+                SymbolKind::Program => lsp::SymbolKind::MODULE,
+                SymbolKind::Subprogram | SymbolKind::Macrocycle | SymbolKind::CycleBody => lsp::SymbolKind::FUNCTION,
+                SymbolKind::JumpTarget => lsp::SymbolKind::KEY,
+            },
+            tags: None,
+            deprecated: None,
+            range: s.map.range(symbol.range),
+            selection_range: s.map.range(symbol.selection_range),
+            children: Some(symbol.children.into_iter().map(|child| convert_symbol(s, child)).collect()),
+        }
+    }
+    s.analysis.document_symbols(s.file).into_iter().map(|symbol| convert_symbol(s, symbol)).collect()
+}
+
+pub(crate) fn folding_ranges(s: &Snapshot) -> Vec<lsp::FoldingRange> {
+    s.analysis
+        .folding_ranges(s.file)
+        .into_iter()
+        .filter_map(|fold| {
+            let (start, end) = (s.map.position(fold.range.start()), s.map.position(fold.range.end()));
+            (end.line > start.line).then(|| lsp::FoldingRange {
+                start_line: start.line,
+                end_line: end.line,
+                kind: Some(match fold.kind {
+                    FoldKind::Region => lsp::FoldingRangeKind::Region,
+                    FoldKind::Comment => lsp::FoldingRangeKind::Comment,
+                }),
+                ..Default::default()
+            })
+        })
+        .collect()
+}
+
+pub(crate) fn semantic_tokens(s: &Snapshot, range: Option<lsp::Range>) -> lsp::SemanticTokens {
+    let ranges = match range {
+        Some(range) => s.analysis.highlight_range(s.file, s.map.range_offsets(range)),
+        None => s.analysis.highlight(s.file),
+    };
+    lsp::SemanticTokens { result_id: None, data: semantic::encode(&s.map, &ranges) }
 }

@@ -14,6 +14,7 @@
 
 mod convert;
 mod handlers;
+mod semantic;
 mod workspace;
 
 use std::{
@@ -347,6 +348,73 @@ impl LanguageServer for Server {
 
     async fn inlay_hint(&self, params: lsp::InlayHintParams) -> jsonrpc::Result<Option<Vec<lsp::InlayHint>>> {
         self.query(&params.text_document.uri, move |s| handlers::inlay_hints(s, params.range)).await.map(Some)
+    }
+
+    async fn references(&self, params: lsp::ReferenceParams) -> jsonrpc::Result<Option<Vec<lsp::Location>>> {
+        let position = params.text_document_position;
+        let uri = position.text_document.uri.clone();
+        let include = params.context.include_declaration;
+        let references = self.query(&uri, move |s| handlers::references(s, position.position, include)).await?;
+        let state = self.state();
+        let Some(workspace) = state.documents.get(&uri).map(|d| d.workspace) else { return Ok(None) };
+        let locations = references
+            .into_iter()
+            .filter_map(|reference| state.workspaces.location(workspace, reference.file, reference.range))
+            .collect();
+        Ok(Some(locations))
+    }
+
+    async fn document_highlight(
+        &self,
+        params: lsp::DocumentHighlightParams,
+    ) -> jsonrpc::Result<Option<Vec<lsp::DocumentHighlight>>> {
+        let position = params.text_document_position_params;
+        let highlights = self
+            .query(&position.text_document.uri, move |s| {
+                handlers::references(s, position.position, true)
+                    .into_iter()
+                    .filter(|reference| reference.file == s.file)
+                    .map(|reference| lsp::DocumentHighlight {
+                        range: s.map.range(reference.range),
+                        kind: Some(if handlers::is_write(reference.kind) {
+                            lsp::DocumentHighlightKind::WRITE
+                        } else {
+                            lsp::DocumentHighlightKind::READ
+                        }),
+                    })
+                    .collect()
+            })
+            .await?;
+        Ok(Some(highlights))
+    }
+
+    async fn document_symbol(
+        &self,
+        params: lsp::DocumentSymbolParams,
+    ) -> jsonrpc::Result<Option<lsp::DocumentSymbolResponse>> {
+        let symbols = self.query(&params.text_document.uri, handlers::document_symbols).await?;
+        Ok(Some(lsp::DocumentSymbolResponse::Nested(symbols)))
+    }
+
+    async fn folding_range(&self, params: lsp::FoldingRangeParams) -> jsonrpc::Result<Option<Vec<lsp::FoldingRange>>> {
+        self.query(&params.text_document.uri, handlers::folding_ranges).await.map(Some)
+    }
+
+    async fn semantic_tokens_full(
+        &self,
+        params: lsp::SemanticTokensParams,
+    ) -> jsonrpc::Result<Option<lsp::SemanticTokensResult>> {
+        let tokens = self.query(&params.text_document.uri, |s| handlers::semantic_tokens(s, None)).await?;
+        Ok(Some(lsp::SemanticTokensResult::Tokens(tokens)))
+    }
+
+    async fn semantic_tokens_range(
+        &self,
+        params: lsp::SemanticTokensRangeParams,
+    ) -> jsonrpc::Result<Option<lsp::SemanticTokensRangeResult>> {
+        let range = params.range;
+        let tokens = self.query(&params.text_document.uri, move |s| handlers::semantic_tokens(s, Some(range))).await?;
+        Ok(Some(lsp::SemanticTokensRangeResult::Tokens(tokens)))
     }
 
     async fn code_action(&self, params: lsp::CodeActionParams) -> jsonrpc::Result<Option<lsp::CodeActionResponse>> {
