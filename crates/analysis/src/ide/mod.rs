@@ -48,11 +48,14 @@ pub struct NavigationTarget {
 fn block_index_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<usize> {
     let blocks = &model::program(db, file).blocks;
     let index = blocks.partition_point(|b| b.end() < offset);
+    // Where one block ends and the next starts, the cursor is on the
+    // next one's block number.
+    let index = if blocks.get(index + 1).is_some_and(|b| b.offset == offset) { index + 1 } else { index };
     blocks.get(index).is_some_and(|b| b.offset <= offset).then_some(index)
 }
 
 /// The block at `offset`, lowered, with its index and file offset.
-fn block_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<(usize, TextSize, BlockData)> {
+pub(crate) fn block_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<(usize, TextSize, BlockData)> {
     let index = block_index_at(db, file, offset)?;
     let (start, block) = flow::lowered_block(db, file, index)?;
     Some((index, start, block))

@@ -9,10 +9,9 @@
 use ncc_catalog::{AddressRole, split_code};
 use ncc_syntax::{TextRange, TextSize};
 
-use super::{Target, block_index_at, symbols::Outline, target_at};
+use super::{Target, block_at, symbols::Outline, target_at};
 use crate::{
     db::{self, BlockChunk, Db, Settings, SourceFile},
-    flow,
     lower::{BlockData, Value},
     model::{self, FileKind, Program, Transfer},
 };
@@ -52,7 +51,7 @@ pub enum ReferenceKind {
 /// on double precision (machine constant 283 and R95) and, for operation
 /// 33, on other parameters' values, none of which the text fixes.
 pub(crate) fn references(db: &dyn Db, file: SourceFile, offset: TextSize, include_declaration: bool) -> Vec<Reference> {
-    let Some((index, start, block)) = cursor_block(db, file, offset) else { return Vec::new() };
+    let Some((index, start, block)) = block_at(db, file, offset) else { return Vec::new() };
     let program = model::program(db, file);
     let info = &program.blocks[index];
     let mut references = match target_at(&block, offset - start) {
@@ -83,16 +82,6 @@ pub(crate) fn references(db: &dyn Db, file: SourceFile, offset: TextSize, includ
         references.retain(|r| r.kind != ReferenceKind::Definition);
     }
     references
-}
-
-/// The block at `offset`; between two blocks, the second, whose block
-/// number starts there.
-fn cursor_block(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<(usize, TextSize, BlockData)> {
-    let index = block_index_at(db, file, offset)?;
-    let next_starts_here = model::program(db, file).blocks.get(index + 1).is_some_and(|b| b.offset == offset);
-    let index = if next_starts_here { index + 1 } else { index };
-    let (start, block) = flow::lowered_block(db, file, index)?;
-    Some((index, start, block))
 }
 
 fn transfer_references(

@@ -133,7 +133,11 @@ pub(crate) fn inlay_hints(s: &Snapshot, range: lsp::Range) -> Vec<lsp::InlayHint
         .collect()
 }
 
-pub(crate) fn references(s: &Snapshot, position: lsp::Position, include_declaration: bool) -> Vec<ncc_analysis::Reference> {
+pub(crate) fn references(
+    s: &Snapshot,
+    position: lsp::Position,
+    include_declaration: bool,
+) -> Vec<ncc_analysis::Reference> {
     s.analysis.references(s.file, s.map.offset(position), include_declaration)
 }
 
