@@ -33,7 +33,7 @@ export function deactivate(): Promise<void> | undefined {
 
 type Status =
   | { state: 'starting' }
-  | { state: 'running'; launch: Launch; version: string | undefined }
+  | { state: 'running'; launch: Launch }
   | { state: 'stopped' }
   | { state: 'error'; message: string };
 
@@ -69,7 +69,7 @@ class Server implements vscode.Disposable {
       return;
     }
     const { command, args, initializationOptions } = launch.value;
-    this.output.info(`Starting ${command} ${args.join(' ')}`);
+    this.output.info(`Starting ${launch.value.version}: ${command} ${args.join(' ')}`);
     const client = new LanguageClient(
       'ncc',
       'ncc',
@@ -89,7 +89,7 @@ class Server implements vscode.Disposable {
           this.show({ state: 'starting' });
           break;
         case State.Running:
-          this.show({ state: 'running', launch: launch.value, version: client.initializeResult?.serverInfo?.version });
+          this.show({ state: 'running', launch: launch.value });
           break;
         case State.Stopped:
           if (!this.stopping) {
@@ -168,8 +168,7 @@ class Server implements vscode.Disposable {
         break;
       case 'running': {
         this.item.text = '$(check) ncc';
-        const version = status.version === undefined ? '' : ` ${status.version}`;
-        tooltip.appendText(`ncc${version} is running: `).appendCodeblock(
+        tooltip.appendText(`${status.launch.version} is running:`).appendCodeblock(
           [status.launch.command, ...status.launch.args].join(' '),
           'text',
         );

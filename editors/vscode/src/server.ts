@@ -2,6 +2,7 @@
 // binary and building its command line and initialization options. This
 // module does not import `vscode`, so the tests run it in plain node.
 
+import { execFile } from 'node:child_process';
 import { constants, promises as fs } from 'node:fs';
 import * as path from 'node:path';
 
@@ -31,6 +32,8 @@ export interface Launch {
   command: string;
   args: string[];
   initializationOptions: InitializationOptions;
+  /** What `ncc lsp --version` printed, e.g. `ncc 0.1.0`. */
+  version: string;
 }
 
 /** Where relative paths and `ncc` on PATH are looked up. */
@@ -170,6 +173,34 @@ export function initializationOptions(settings: Settings, environment: Environme
   return { ok: true, value: { configFile } };
 }
 
+/** How long `ncc lsp --version` may take: a cold start from a slow disk. */
+const VERSION_TIMEOUT_MS = 10_000;
+
+/**
+ * What `ncc lsp --version` prints. It fails for a binary that is not ncc or
+ * that was built before ncc had a language server, which the user can fix
+ * in `ncc.server.path`.
+ */
+export function serverVersion(command: string): Promise<Result<string>> {
+  return new Promise((resolve) => {
+    execFile(command, ['lsp', '--version'], { timeout: VERSION_TIMEOUT_MS }, (error, stdout, stderr) => {
+      const version = stdout.trim();
+      if (error === null && version.startsWith('ncc ')) {
+        resolve({ ok: true, value: version });
+        return;
+      }
+      const said = (stderr.trim() || version || (error?.message ?? '')).split('\n')[0];
+      resolve({
+        ok: false,
+        setting: 'ncc.server.path',
+        message:
+          `${command} is not an ncc with a language server: "ncc lsp --version" answered "${said}". ` +
+          'Install a current ncc with "cargo install --path crates/lsp", or set ncc.server.path to one.',
+      });
+    });
+  });
+}
+
 /** Everything needed to start the server, or why it cannot start. */
 export async function serverLaunch(settings: Settings, environment: Environment): Promise<Result<Launch>> {
   const options = initializationOptions(settings, environment);
@@ -180,12 +211,17 @@ export async function serverLaunch(settings: Settings, environment: Environment)
   if (!command.ok) {
     return command;
   }
+  const version = await serverVersion(command.value);
+  if (!version.ok) {
+    return version;
+  }
   return {
     ok: true,
     value: {
       command: command.value,
       args: ['lsp', '--log-level', settings.logLevel],
       initializationOptions: options.value,
+      version: version.value,
     },
   };
 }

@@ -90,7 +90,7 @@ describe('example programs', () => {
       ['"', 'punctuation.definition.comment.begin.cnc8x6'],
     ]);
     assert.deepEqual(scopesFrom(tokens, 'N20', 8), [
-      ['N20', 'entity.name.tag.block-number.cnc8x6'],
+      ['N20', 'entity.name.label.block-number.cnc8x6'],
       [' ', 'source.cnc8x6'],
       ['R10', 'variable.parameter.cnc8x6'],
       ['=', 'keyword.operator.assignment.cnc8x6'],
@@ -101,7 +101,7 @@ describe('example programs', () => {
     ]);
     assert.deepEqual(scopesFrom(tokens, 'R11', 3).at(-1), ['2.', 'constant.numeric.decimal.cnc8x6']);
     assert.deepEqual(scopesFrom(tokens, 'N90', 13), [
-      ['N90', 'entity.name.tag.block-number.cnc8x6'],
+      ['N90', 'entity.name.label.block-number.cnc8x6'],
       [' ', 'source.cnc8x6'],
       ['G', 'keyword.other.g-code.cnc8x6'],
       ['91', 'keyword.other.g-code.cnc8x6'],
@@ -116,7 +116,7 @@ describe('example programs', () => {
       ['R12', 'variable.parameter.cnc8x6'],
     ]);
     assert.deepEqual(scopesFrom(tokens, 'N110', 7), [
-      ['N110', 'entity.name.tag.block-number.cnc8x6'],
+      ['N110', 'entity.name.label.block-number.cnc8x6'],
       [' ', 'source.cnc8x6'],
       ['G71', 'keyword.control.flow.cnc8x6'],
       [' ', 'source.cnc8x6'],
@@ -226,7 +226,7 @@ describe('mistakes and rarer forms', () => {
       ['$PC', 'keyword.other.cycle-file.cnc8x6'],
     ]);
     assert.deepEqual(scopes(1), [
-      ['N1', 'entity.name.tag.block-number.cnc8x6'],
+      ['N1', 'entity.name.label.block-number.cnc8x6'],
       [' ', 'source.cnc8x6'],
       ['/1', 'keyword.operator.block-skip.cnc8x6'],
       [' ', 'source.cnc8x6'],
@@ -241,7 +241,7 @@ describe('mistakes and rarer forms', () => {
       [' missing-feed', 'comment.line.double-quote.cnc8x6'],
     ]);
     assert.deepEqual(scopes(2), [
-      ['N2', 'entity.name.tag.block-number.cnc8x6'],
+      ['N2', 'entity.name.label.block-number.cnc8x6'],
       [' ', 'source.cnc8x6'],
       ['\u201e', 'invalid.deprecated.typographic-quote.cnc8x6'],
       ['QUOTED', 'comment.line.typographic-quote.cnc8x6'],
@@ -254,7 +254,7 @@ describe('mistakes and rarer forms', () => {
       ['OPEN N3 G0', 'comment.line.double-quote.cnc8x6'],
     ]);
     // The comment left open on the line before ended with that line.
-    assert.deepEqual(scopes(3)[0], ['N4', 'entity.name.tag.block-number.cnc8x6']);
+    assert.deepEqual(scopes(3)[0], ['N4', 'entity.name.label.block-number.cnc8x6']);
     assert.deepEqual(invalidTokens(tokens).length, 1, 'only the typographic quote');
   });
 });

@@ -12,6 +12,7 @@ import {
   readSettings,
   resolveSettingPath,
   serverLaunch,
+  serverVersion,
   type Settings,
 } from '../src/server';
 
@@ -20,6 +21,7 @@ const posix = process.platform !== 'win32';
 let scratch: string;
 let bin: string;
 let other: string;
+let old: string;
 
 before(async () => {
   scratch = await fs.mkdtemp(path.join(os.tmpdir(), 'ncc-vscode-'));
@@ -28,8 +30,15 @@ before(async () => {
   await fs.mkdir(bin);
   await fs.mkdir(other);
   await fs.mkdir(path.join(scratch, 'bin', 'dir'));
-  await fs.writeFile(path.join(bin, 'ncc'), '#!/bin/sh\n', { mode: 0o755 });
+  await fs.writeFile(
+    path.join(bin, 'ncc'),
+    '#!/bin/sh\n[ "$*" = "lsp --version" ] && echo "ncc 9.8.7" && exit 0\nexit 2\n',
+    { mode: 0o755 },
+  );
   await fs.writeFile(path.join(other, 'ncc'), 'not executable\n', { mode: 0o644 });
+  // An ncc from before the language server.
+  old = path.join(scratch, 'old-ncc');
+  await fs.writeFile(old, "#!/bin/sh\necho \"error: unrecognized subcommand '$1'\" >&2\nexit 2\n", { mode: 0o755 });
 });
 
 after(async () => {
@@ -141,7 +150,24 @@ describe('initializationOptions', () => {
   });
 });
 
-describe('serverLaunch', () => {
+describe('serverVersion', { skip: !posix }, () => {
+  test('is what `ncc lsp --version` prints', async () => {
+    assert.deepEqual(await serverVersion(path.join(bin, 'ncc')), { ok: true, value: 'ncc 9.8.7' });
+  });
+
+  test('says what a binary without a language server answered', async () => {
+    assert.deepEqual(await serverVersion(old), {
+      ok: false,
+      setting: 'ncc.server.path',
+      message:
+        `${old} is not an ncc with a language server: ` +
+        `"ncc lsp --version" answered "error: unrecognized subcommand 'lsp'". ` +
+        'Install a current ncc with "cargo install --path crates/lsp", or set ncc.server.path to one.',
+    });
+  });
+});
+
+describe('serverLaunch', { skip: !posix }, () => {
   test('runs `ncc lsp` with the log level', async () => {
     const launch = await serverLaunch(
       settings({ serverPath: path.join(bin, 'ncc'), logLevel: 'trace', configFile: '~/ncc.toml' }),
@@ -153,12 +179,17 @@ describe('serverLaunch', () => {
         command: path.join(bin, 'ncc'),
         args: ['lsp', '--log-level', 'trace'],
         initializationOptions: { configFile: path.join(scratch, 'ncc.toml') },
+        version: 'ncc 9.8.7',
       },
     });
   });
 
   test('reports the first setting that keeps the server from starting', async () => {
-    const launch = await serverLaunch(settings({ serverPath: 'nothing' }), environment());
-    assert.equal(!launch.ok && launch.setting, 'ncc.server.path');
+    const noFolder = await serverLaunch(settings({ serverPath: 'nothing', configFile: 'ncc.toml' }), environment({ base: undefined }));
+    assert.equal(!noFolder.ok && noFolder.setting, 'ncc.machine.configFile');
+    const missing = await serverLaunch(settings({ serverPath: 'nothing' }), environment());
+    assert.equal(!missing.ok && missing.setting, 'ncc.server.path');
+    const outdated = await serverLaunch(settings({ serverPath: old }), environment());
+    assert.match(!outdated.ok ? outdated.message : '', /is not an ncc with a language server/);
   });
 });

@@ -70,6 +70,7 @@ before(async () => {
   }
   launch = found.value;
   assert.deepEqual(launch.args, ['lsp', '--log-level', 'warn']);
+  assert.match(launch.version, /^ncc \d+\.\d+\.\d+/);
 
   server = spawn(launch.command, launch.args, { stdio: ['pipe', 'pipe', 'pipe'] });
   // 'close' comes after stderr has been read to its end.
