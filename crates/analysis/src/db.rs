@@ -90,20 +90,29 @@ pub struct FileChunk<'db> {
 /// The file's blocks in chunks, in order.
 #[salsa::tracked(returns(ref))]
 pub fn file_chunks(db: &dyn Db, file: SourceFile) -> Vec<FileChunk<'_>> {
-    let root = file.parse(db).syntax_node();
+    // The green tree is walked directly: red nodes would allocate one node
+    // per block on every edit.
+    let root = file.parse(db).green();
     let mut chunks = Vec::new();
     let mut current: Vec<BlockGreen> = Vec::new();
     let mut start = TextSize::from(0);
-    for node in root.children().filter(|node| node.kind() == SyntaxKind::BLOCK) {
-        if current.is_empty() {
-            start = node.text_range().start();
+    let mut offset = TextSize::from(0);
+    for child in root.children() {
+        let len = child.text_len();
+        if let rowan::NodeOrToken::Node(node) = child
+            && node.kind() == SyntaxKind::BLOCK.into()
+        {
+            if current.is_empty() {
+                start = offset;
+            }
+            let green = BlockGreen(node.to_owned());
+            let boundary = identity_hash(&green).is_multiple_of(CHUNK_SPREAD);
+            current.push(green);
+            if boundary || current.len() == MAX_CHUNK {
+                chunks.push(FileChunk { chunk: BlockChunk::new(db, std::mem::take(&mut current)), offset: start });
+            }
         }
-        let green = BlockGreen(node.green().to_owned());
-        let boundary = identity_hash(&green).is_multiple_of(CHUNK_SPREAD);
-        current.push(green);
-        if boundary || current.len() == MAX_CHUNK {
-            chunks.push(FileChunk { chunk: BlockChunk::new(db, std::mem::take(&mut current)), offset: start });
-        }
+        offset += len;
     }
     if !current.is_empty() {
         chunks.push(FileChunk { chunk: BlockChunk::new(db, current), offset: start });

@@ -338,6 +338,9 @@ impl<'db> Blocks<'db> {
     fn get(&mut self, index: usize) -> (TextSize, Arc<Vec<(TextSize, BlockData)>>, usize) {
         let chunk = self.starts.partition_point(|&start| start <= index) - 1;
         if !self.cache.contains_key(&chunk) {
+            // A walk over a large file is one long query: give an edit
+            // waiting to change the inputs its chance, once per chunk.
+            self.db.unwind_if_revision_cancelled();
             if self.cache.len() >= 16 {
                 self.cache.clear();
             }

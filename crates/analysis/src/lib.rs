@@ -25,6 +25,10 @@ pub use salsa::Cancelled;
 use salsa::Setter;
 
 use crate::db::{Db, Settings};
+pub use crate::ide::{
+    completion::{CompletionItem, CompletionKind},
+    inlay::{InlayHint, InlayHintKind},
+};
 pub use crate::{
     config::{CONFIG_FILE, Config, Level, MachineConfig, parse_constant},
     db::{RootDatabase, SourceFile},
@@ -170,6 +174,23 @@ impl Analysis {
     /// time the program reaches it.
     pub fn states_at(&self, file: FileId, offset: TextSize) -> Vec<(flow::ModalState, flow::ParamState)> {
         ide::states_at(&self.db, file, offset)
+    }
+
+    /// The edits that format the file: spacing only (the style is in
+    /// `ide/format.rs`), sorted and not overlapping.
+    pub fn format(&self, file: FileId) -> Vec<TextEdit> {
+        ide::format::format(file.text(&self.db), file.parse(&self.db))
+    }
+
+    /// What may be written at `offset`, most relevant first.
+    pub fn completions(&self, file: FileId, offset: TextSize) -> Vec<CompletionItem> {
+        ide::completion::completions(&self.db, file, offset)
+    }
+
+    /// The inlay hints of the blocks `range` touches (of every block
+    /// without one).
+    pub fn inlay_hints(&self, file: FileId, range: Option<TextRange>) -> Vec<InlayHint> {
+        ide::inlay::inlay_hints(&self.db, file, range)
     }
 
     pub fn path(&self, file: FileId) -> String {

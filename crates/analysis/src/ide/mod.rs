@@ -6,6 +6,10 @@
 //! the block counts, so a subprogram called with different values shows
 //! them all.
 
+pub(crate) mod completion;
+pub(crate) mod format;
+pub(crate) mod inlay;
+
 use ncc_catalog::Item;
 use ncc_syntax::{TextRange, TextSize};
 
