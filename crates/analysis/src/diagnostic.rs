@@ -1,7 +1,7 @@
 //! What the analysis reports: diagnostics with ranges, related locations and
 //! quick fixes, and the registry of rules with their stable codes.
 
-use ncc_syntax::{Severity, SyntaxError, TextEdit, TextRange};
+use ncc_syntax::{Severity, SyntaxError, SyntaxErrorKind, TextEdit, TextRange};
 
 /// A finding in one file.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
@@ -18,6 +18,8 @@ pub struct Diagnostic {
     pub related: Vec<Related>,
     /// Edits that would resolve it.
     pub fixes: Vec<Fix>,
+    /// The text it points at has no effect (editors fade it).
+    pub unnecessary: bool,
 }
 
 /// A place related to a diagnostic.
@@ -46,6 +48,7 @@ impl Diagnostic {
             message: message.into(),
             related: Vec::new(),
             fixes: Vec::new(),
+            unnecessary: rule.unnecessary,
         }
     }
 
@@ -68,7 +71,35 @@ impl Diagnostic {
             message: error.message.clone(),
             related: Vec::new(),
             fixes: Vec::new(),
+            unnecessary: syntax_unnecessary(error.kind),
         }
+    }
+
+    /// The diagnostic where it stands after `edit` (made after it was
+    /// computed), or `None` when the edit touches what it points at. Lets
+    /// an editor keep slow findings in place until they are recomputed.
+    pub fn moved_through(mut self, edit: &TextEdit) -> Option<Diagnostic> {
+        let map = |range: TextRange| -> Option<TextRange> {
+            let deleted = edit.delete;
+            if range.end() <= deleted.start() {
+                Some(range)
+            } else if range.start() >= deleted.end() {
+                let inserted = ncc_syntax::TextSize::of(edit.insert.as_str());
+                Some(TextRange::new(range.start() - deleted.len() + inserted, range.end() - deleted.len() + inserted))
+            } else {
+                None
+            }
+        };
+        self.range = map(self.range)?;
+        for related in self.related.iter_mut().filter(|r| r.file.is_none()) {
+            related.range = map(related.range)?;
+        }
+        for fix in &mut self.fixes {
+            for fix_edit in &mut fix.edits {
+                fix_edit.delete = map(fix_edit.delete)?;
+            }
+        }
+        Some(self)
     }
 
     /// The diagnostic moved by `offset` (block-relative ranges become file ranges).
@@ -86,10 +117,15 @@ impl Diagnostic {
     }
 }
 
+/// Text the control ignores.
+fn syntax_unnecessary(kind: SyntaxErrorKind) -> bool {
+    matches!(kind, SyntaxErrorKind::IgnoredPreamble | SyntaxErrorKind::TextAfterEnd)
+}
+
 /// The parser's diagnostics as rules, so that configuration, suppression
 /// and listings treat them like every other rule.
 static SYNTAX_RULES: std::sync::LazyLock<Vec<Rule>> = std::sync::LazyLock::new(|| {
-    ncc_syntax::SyntaxErrorKind::ALL
+    SyntaxErrorKind::ALL
         .iter()
         .map(|kind| Rule {
             code: kind.code(),
@@ -97,6 +133,7 @@ static SYNTAX_RULES: std::sync::LazyLock<Vec<Rule>> = std::sync::LazyLock::new(|
             severity: kind.severity(),
             summary: kind.summary(),
             opt_in: false,
+            unnecessary: syntax_unnecessary(*kind),
         })
         .collect()
 });
@@ -114,6 +151,8 @@ pub struct Rule {
     /// Off unless the project configuration gives it a level (a matter of
     /// style that not every shop follows).
     pub opt_in: bool,
+    /// Its findings point at text that has no effect.
+    pub unnecessary: bool,
 }
 
 impl Rule {
@@ -129,18 +168,22 @@ impl Rule {
 }
 
 /// Declares a check module's rules as statics and lists them in `RULES`.
-/// A trailing `, opt_in` marks a rule that is off unless configured.
+/// A trailing `, opt_in` marks a rule that is off unless configured, a
+/// trailing `, unnecessary` one whose findings point at text without effect.
 macro_rules! declare_rules {
-    (@opt_in) => { false };
     (@opt_in opt_in) => { true };
-    ($($ident:ident = $code:literal, $name:literal, $severity:ident, $summary:literal $(, $opt_in:ident)?;)*) => {
+    (@opt_in $($other:ident)?) => { false };
+    (@unnecessary unnecessary) => { true };
+    (@unnecessary $($other:ident)?) => { false };
+    ($($ident:ident = $code:literal, $name:literal, $severity:ident, $summary:literal $(, $marker:ident)?;)*) => {
         $(
             pub(crate) static $ident: $crate::Rule = $crate::Rule {
                 code: $code,
                 name: $name,
                 severity: ncc_syntax::Severity::$severity,
                 summary: $summary,
-                opt_in: $crate::diagnostic::declare_rules!(@opt_in $($opt_in)?),
+                opt_in: $crate::diagnostic::declare_rules!(@opt_in $($marker)?),
+                unnecessary: $crate::diagnostic::declare_rules!(@unnecessary $($marker)?),
             };
         )*
         pub(crate) static RULES: &[&$crate::Rule] = &[$(&$ident,)*];

@@ -21,6 +21,7 @@ use std::sync::Arc;
 
 use ncc_syntax::Parse;
 pub use ncc_syntax::{Dialect, Severity, TextEdit, TextRange, TextSize};
+pub use salsa::Cancelled;
 use salsa::Setter;
 
 use crate::db::{Db, Settings};
@@ -66,6 +67,13 @@ impl AnalysisHost {
         files.push(file);
         settings.set_files(&mut self.db).to(files);
         file
+    }
+
+    /// Removes a file from the workspace (its handle must not be used again).
+    pub fn remove_file(&mut self, file: FileId) {
+        let settings = Settings::get(&self.db);
+        let files: Vec<SourceFile> = settings.files(&self.db).iter().copied().filter(|&f| f != file).collect();
+        settings.set_files(&mut self.db).to(files);
     }
 
     /// Replaces a file's text.
@@ -126,7 +134,23 @@ impl Analysis {
     /// Every diagnostic of a file after configuration and suppression
     /// comments, sorted by position.
     pub fn diagnostics(&self, file: FileId) -> Vec<Diagnostic> {
-        file_diagnostics(&self.db, file).clone()
+        let mut all = local_diagnostics(&self.db, file).clone();
+        all.extend(self.flow_diagnostics(file));
+        sort_diagnostics(&mut all);
+        all
+    }
+
+    /// The diagnostics that need no flow walk (syntax, blocks, program
+    /// structure): after an edit these cost only the edited chunk, so an
+    /// editor can show them at once and the flow findings when they come.
+    pub fn local_diagnostics(&self, file: FileId) -> Vec<Diagnostic> {
+        local_diagnostics(&self.db, file).clone()
+    }
+
+    /// The diagnostics of the rules that follow the program's flow,
+    /// configured and sorted.
+    pub fn flow_diagnostics(&self, file: FileId) -> Vec<Diagnostic> {
+        configured_flow_diagnostics(&self.db, file).clone()
     }
 
     /// What the thing at `offset` is: a code's or an address's
@@ -157,10 +181,9 @@ impl Analysis {
     }
 }
 
-/// Syntax, block and program diagnostics of a file, configured.
+/// Syntax, block and program-structure diagnostics of a file, configured.
 #[salsa::tracked(returns(ref))]
-fn file_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
-    let config = Settings::get(db).config(db);
+fn local_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
     let parse = file.parse(db);
     let mut all: Vec<Diagnostic> = parse.errors().iter().map(Diagnostic::from_syntax).collect();
     for chunk in db::file_chunks(db, file) {
@@ -168,10 +191,25 @@ fn file_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
     }
     all.extend(checks::structure::check(db, file));
     all.extend(checks::cycles::check_file(db, file));
-    all.extend(flow::flow_diagnostics(db, file).iter().cloned());
-    let suppressions = suppress::Suppressions::of(file.text(db), parse);
+    configure(db, file, all)
+}
+
+/// The flow walk's diagnostics of a file, configured.
+#[salsa::tracked(returns(ref))]
+fn configured_flow_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
+    configure(db, file, flow::flow_diagnostics(db, file).clone())
+}
+
+/// Applies suppression comments and the configured levels, and sorts.
+fn configure(db: &dyn Db, file: SourceFile, all: Vec<Diagnostic>) -> Vec<Diagnostic> {
+    let config = Settings::get(db).config(db);
+    let suppressions = suppress::Suppressions::of(file.text(db), file.parse(db));
     let mut diagnostics: Vec<Diagnostic> =
         all.into_iter().filter(|d| !suppressions.silences(d)).filter_map(|d| config.adjust(d)).collect();
-    diagnostics.sort_by(|a, b| (a.range.start(), a.range.end(), a.code).cmp(&(b.range.start(), b.range.end(), b.code)));
+    sort_diagnostics(&mut diagnostics);
     diagnostics
+}
+
+fn sort_diagnostics(diagnostics: &mut [Diagnostic]) {
+    diagnostics.sort_by(|a, b| (a.range.start(), a.range.end(), a.code).cmp(&(b.range.start(), b.range.end(), b.code)));
 }

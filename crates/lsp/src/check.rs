@@ -56,6 +56,13 @@ impl Checked {
 /// Below this many files a run is quick enough not to need a progress bar.
 const PROGRESS_BAR_MIN_FILES: usize = 200;
 
+/// Reads an `ncc.toml`; the error names the file.
+pub(crate) fn load_config(path: &Path) -> Result<Config, String> {
+    std::fs::read_to_string(path)
+        .map_err(|e| format!("{}: {e}", path.display()))
+        .and_then(|text| Config::from_toml(&text, &path.display().to_string()))
+}
+
 pub(crate) fn run(paths: &[PathBuf], format: Format) -> ExitCode {
     let (files, mut failures) = collect_files(paths);
     let progress = progress_bar(files.len());
@@ -76,10 +83,7 @@ pub(crate) fn run(paths: &[PathBuf], format: Format) -> ExitCode {
     let mut sources = HashMap::new();
     for (config_path, programs) in workspaces {
         let config = match &config_path {
-            Some(path) => match std::fs::read_to_string(path)
-                .map_err(|e| format!("{}: {e}", path.display()))
-                .and_then(|text| Config::from_toml(&text, &path.display().to_string()))
-            {
+            Some(path) => match load_config(path) {
                 Ok(config) => config,
                 Err(message) => {
                     failures.push(message);
@@ -162,7 +166,7 @@ fn progress_bar(files: usize) -> ProgressBar {
 }
 
 /// Macrocycle files in the directories of `programs` that are not among them.
-fn macrocycles_beside(programs: &[(PathBuf, String)]) -> Vec<(PathBuf, String)> {
+pub(crate) fn macrocycles_beside(programs: &[(PathBuf, String)]) -> Vec<(PathBuf, String)> {
     let given: HashSet<&Path> = programs.iter().map(|(path, _)| path.as_path()).collect();
     let mut directories: Vec<&Path> = programs.iter().filter_map(|(path, _)| path.parent()).collect();
     directories.sort();
@@ -190,7 +194,7 @@ fn macrocycles_beside(programs: &[(PathBuf, String)]) -> Vec<(PathBuf, String)> 
 
 /// The files to check: explicit files as given, partprograms found in
 /// directories. Returns them sorted, and the paths that do not exist.
-fn collect_files(paths: &[PathBuf]) -> (Vec<PathBuf>, Vec<String>) {
+pub(crate) fn collect_files(paths: &[PathBuf]) -> (Vec<PathBuf>, Vec<String>) {
     let mut files = Vec::new();
     let mut failures = Vec::new();
     for path in paths {

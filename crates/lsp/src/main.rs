@@ -5,6 +5,7 @@ mod explain;
 mod report;
 mod rules;
 mod sarif;
+mod server;
 
 use std::{path::PathBuf, process::ExitCode};
 
@@ -59,6 +60,18 @@ enum Command {
         #[arg(long, conflicts_with = "query")]
         markdown: bool,
     },
+    /// Serve the Language Server Protocol over stdin and stdout.
+    ///
+    /// For editors: diagnostics, hover, go to definition and the rest of
+    /// what `ncc check` and `ncc explain` know, while typing.
+    Lsp {
+        /// How much to log to stderr.
+        #[arg(long, value_enum, default_value_t = server::LogLevel::Warn)]
+        log_level: server::LogLevel,
+        /// Print the version and exit.
+        #[arg(long)]
+        version: bool,
+    },
     /// Print the syntax tree of a partprogram (a debugging aid).
     Parse {
         /// The program to parse.
@@ -71,6 +84,11 @@ fn main() -> ExitCode {
         Command::Check { paths, format } => check::run(&paths, format),
         Command::Explain { query, list } => explain::run(query.as_deref(), list),
         Command::Rules { query, markdown } => rules::run(query.as_deref(), markdown),
+        Command::Lsp { version: true, .. } => {
+            println!("ncc {}", env!("CARGO_PKG_VERSION"));
+            ExitCode::SUCCESS
+        }
+        Command::Lsp { log_level, .. } => server::run(log_level),
         Command::Parse { file } => match check::read_program(&file) {
             Ok(text) => {
                 let parse = ncc_syntax::Parse::new(&text, ncc_syntax::Dialect::Cnc8x6);

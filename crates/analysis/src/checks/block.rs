@@ -24,7 +24,7 @@ declare_rules! {
     NOT_SUBSTITUTABLE = "B210", "not-substitutable", Error, "A parameter used where the control does not substitute one.";
     TOO_MANY_AXES = "B211", "too-many-axes", Error, "More than six coordinates in one block.";
     LENGTH_COMPENSATION_DIGITS = "B212", "length-compensation-digits", Error, "An `&` digit other than 0, 1 or 2.";
-    SKIP_DIGIT_IGNORED = "B214", "skip-digit-ignored", Warning, "A digit after `/`, which the control does not evaluate.";
+    SKIP_DIGIT_IGNORED = "B214", "skip-digit-ignored", Warning, "A digit after `/`, which the control does not evaluate.", unnecessary;
     SKIP_REPEATED = "B215", "skip-repeated", Warning, "More than one `/` in a block.";
     MEANINGLESS_ADDRESS = "B216", "meaningless-address", Warning, "L or Q in a block without a function that reads it.";
     TOO_MANY_PARAMETER_ASSIGNMENTS = "B217", "too-many-parameter-assignments", Error, "More than 95 parameter assignments in one block.";

@@ -16,7 +16,7 @@ declare_rules! {
     MISSING_PHYSICAL_END = "P103", "missing-physical-end", Info, "No `*` at the end, needed only for loading over a serial line.";
     DUPLICATE_BLOCK_NUMBER = "P104", "duplicate-block-number", Error, "A block number used twice in one file.";
     MISSING_PROGRAM_END = "P105", "missing-program-end", Error, "A main program without M02 or M30 in its last block.";
-    CODE_AFTER_PROGRAM_END = "P106", "code-after-program-end", Error, "Blocks after M02/M30 that belong to no subprogram.";
+    CODE_AFTER_PROGRAM_END = "P106", "code-after-program-end", Error, "Blocks after M02/M30 that belong to no subprogram.", unnecessary;
     MISPLACED_SUBPROGRAM = "P107", "misplaced-subprogram", Error, "A subprogram before the main program's end.";
     MISSING_G70 = "P109", "missing-g70", Error, "A subprogram or macrocycle without its closing G70 block.";
     G70_OUTSIDE_SUBPROGRAM = "P110", "g70-outside-subprogram", Warning, "G70 in the main program, outside any subprogram.";
@@ -29,7 +29,7 @@ declare_rules! {
     DUPLICATE_MACROCYCLE = "P117", "duplicate-macrocycle", Error, "Two macrocycle files with the same number.";
     JUMP_TARGET_NOT_IN_UNIT = "P118", "jump-target-not-in-unit", Error, "G73 jumps to a block outside its program unit, or to none.";
     NESTED_SUBPROGRAM_CALL = "P119", "nested-subprogram-call", Info, "G71 inside a subprogram, which the manual does not describe.";
-    CYCLE_NUMBER_UNREACHABLE = "P120", "cycle-number-unreachable", Warning, "A fixed-cycle body with a number outside 81 to 89.";
+    CYCLE_NUMBER_UNREACHABLE = "P120", "cycle-number-unreachable", Warning, "A fixed-cycle body with a number outside 81 to 89.", unnecessary;
 }
 
 pub(crate) fn check(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {

@@ -1,0 +1,345 @@
+//! `ncc lsp`: the language server.
+//!
+//! Edits are applied to the analysis host synchronously, in the order they
+//! arrive, before the handler first awaits (so tower-lsp-server's
+//! concurrent dispatch cannot reorder them). Every question runs on a
+//! snapshot on tokio's blocking pool; an edit cancels the snapshots still
+//! computing (salsa unwinds them), and their requests answer
+//! `ContentModified`. No handler waits for a reply from the client.
+//!
+//! Diagnostics are pushed in two steps per version: the findings that need
+//! no flow walk as soon as the edited chunk is checked (with the previous
+//! flow findings moved along with the edit), then the complete set when
+//! the flow walk is done — unless a newer edit came first.
+
+mod convert;
+mod handlers;
+mod workspace;
+
+use std::{
+    collections::HashMap,
+    path::PathBuf,
+    process::ExitCode,
+    sync::{
+        Arc, Mutex, MutexGuard,
+        atomic::{AtomicBool, Ordering},
+    },
+};
+
+use ncc_analysis::{Analysis, Cancelled, Diagnostic, FileId};
+use tower_lsp_server::{
+    Client, LanguageServer, LspService,
+    jsonrpc::{self, ErrorCode},
+    ls_types::{self as lsp, Uri},
+};
+
+use tracing_subscriber::{filter::Targets, layer::SubscriberExt, util::SubscriberInitExt};
+
+use self::{convert::LineMap, workspace::Workspaces};
+
+/// How much the server logs to stderr.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub(crate) enum LogLevel {
+    Error,
+    Warn,
+    Info,
+    Debug,
+    Trace,
+}
+
+pub(crate) fn run(log_level: LogLevel) -> ExitCode {
+    let level = match log_level {
+        LogLevel::Error => tracing::Level::ERROR,
+        LogLevel::Warn => tracing::Level::WARN,
+        LogLevel::Info => tracing::Level::INFO,
+        LogLevel::Debug => tracing::Level::DEBUG,
+        LogLevel::Trace => tracing::Level::TRACE,
+    };
+    // The server's own events and the protocol layer's at the chosen level;
+    // the database's bookkeeping only when something goes wrong.
+    let filter = Targets::new()
+        .with_target(env!("CARGO_CRATE_NAME"), level)
+        .with_target("tower_lsp_server", level)
+        .with_default(tracing::Level::WARN);
+    tracing_subscriber::registry()
+        .with(tracing_subscriber::fmt::layer().with_writer(std::io::stderr).with_ansi(false))
+        .with(filter)
+        .init();
+    let runtime = match tokio::runtime::Builder::new_multi_thread().enable_all().build() {
+        Ok(runtime) => runtime,
+        Err(error) => {
+            eprintln!("ncc lsp: cannot start the runtime: {error}");
+            return ExitCode::from(2);
+        }
+    };
+    let shut_down = Arc::new(AtomicBool::new(false));
+    let flag = shut_down.clone();
+    runtime.block_on(async move {
+        let (service, socket) = LspService::new(move |client| Server::new(client, flag));
+        tower_lsp_server::Server::new(tokio::io::stdin(), tokio::io::stdout(), socket).serve(service).await;
+    });
+    // Blocking tasks still computing are abandoned: their snapshots answer
+    // nobody now.
+    runtime.shutdown_background();
+    // The protocol's rule: exit after shutdown is success, otherwise not.
+    if shut_down.load(Ordering::SeqCst) { ExitCode::SUCCESS } else { ExitCode::FAILURE }
+}
+
+/// An open document.
+#[derive(Debug)]
+struct Document {
+    workspace: usize,
+    file: FileId,
+    version: i32,
+    map: LineMap,
+    /// The flow findings last computed, moved along with later edits until
+    /// they are computed again.
+    flow: Vec<Diagnostic>,
+}
+
+#[derive(Debug, Default)]
+struct State {
+    workspaces: Workspaces,
+    documents: HashMap<Uri, Document>,
+}
+
+#[derive(Debug)]
+pub(crate) struct Server {
+    client: Client,
+    state: Arc<Mutex<State>>,
+    shut_down: Arc<AtomicBool>,
+}
+
+/// A request's view of a document: a snapshot and what converts positions.
+struct Snapshot {
+    analysis: Analysis,
+    file: FileId,
+    map: LineMap,
+    uri: Uri,
+}
+
+impl Server {
+    fn new(client: Client, shut_down: Arc<AtomicBool>) -> Server {
+        Server { client, state: Arc::default(), shut_down }
+    }
+
+    fn state(&self) -> MutexGuard<'_, State> {
+        // A panic while holding the lock leaves consistent data (edits are
+        // applied whole), so a poisoned lock is still usable.
+        self.state.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    fn snapshot(&self, uri: &Uri) -> jsonrpc::Result<Snapshot> {
+        let state = self.state();
+        let document =
+            state.documents.get(uri).ok_or_else(|| invalid_params(format!("{} is not open", uri.as_str())))?;
+        Ok(Snapshot {
+            analysis: state.workspaces.get(document.workspace).analysis(),
+            file: document.file,
+            map: document.map.clone(),
+            uri: uri.clone(),
+        })
+    }
+
+    /// Runs `query` on a snapshot of `uri`'s document on the blocking pool.
+    async fn query<T: Send + 'static>(
+        &self,
+        uri: &Uri,
+        query: impl FnOnce(&Snapshot) -> T + Send + 'static,
+    ) -> jsonrpc::Result<T> {
+        let snapshot = self.snapshot(uri)?;
+        let task =
+            tokio::task::spawn_blocking(move || Cancelled::catch(std::panic::AssertUnwindSafe(|| query(&snapshot))));
+        match task.await {
+            Ok(Ok(answer)) => Ok(answer),
+            Ok(Err(_cancelled)) => Err(jsonrpc::Error {
+                code: ErrorCode::ContentModified,
+                message: "the document changed while answering".into(),
+                data: None,
+            }),
+            Err(join_error) => {
+                tracing::error!("request failed: {join_error}");
+                Err(jsonrpc::Error::internal_error())
+            }
+        }
+    }
+
+    /// Pushes the document's diagnostics for its current version: local
+    /// findings first, then the complete set.
+    fn publish_diagnostics(&self, uri: Uri) {
+        let (analysis, file, version, map, carried) = {
+            let state = self.state();
+            let Some(document) = state.documents.get(&uri) else { return };
+            let analysis = state.workspaces.get(document.workspace).analysis();
+            (analysis, document.file, document.version, document.map.clone(), document.flow.clone())
+        };
+        let client = self.client.clone();
+        let state = self.state.clone();
+        let runtime = tokio::runtime::Handle::current();
+        // The snapshot lives only on the blocking thread, so an edit waiting
+        // to cancel it never waits for the async runtime.
+        tokio::task::spawn_blocking(move || {
+            let send = |diagnostics: Vec<Diagnostic>| {
+                let diagnostics = diagnostics.iter().map(|d| convert::diagnostic(&map, &uri, d)).collect();
+                runtime.block_on(client.publish_diagnostics(uri.clone(), diagnostics, Some(version)));
+            };
+            let started = std::time::Instant::now();
+            let Ok(local) = Cancelled::catch(|| analysis.local_diagnostics(file)) else { return };
+            tracing::debug!("{} v{version}: local diagnostics in {:?}", uri.as_str(), started.elapsed());
+            let mut first = local.clone();
+            first.extend(carried);
+            send(first);
+            let Ok(flow) = Cancelled::catch(|| analysis.flow_diagnostics(file)) else {
+                tracing::debug!("{} v{version}: flow walk cancelled by an edit", uri.as_str());
+                return;
+            };
+            tracing::debug!("{} v{version}: all diagnostics in {:?}", uri.as_str(), started.elapsed());
+            drop(analysis);
+            {
+                let mut state = state.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+                match state.documents.get_mut(&uri) {
+                    Some(document) if document.version == version => document.flow = flow.clone(),
+                    _ => return,
+                }
+            }
+            let mut all = local;
+            all.extend(flow);
+            send(all);
+        });
+    }
+}
+
+fn invalid_params(message: String) -> jsonrpc::Error {
+    jsonrpc::Error { code: ErrorCode::InvalidParams, message: message.into(), data: None }
+}
+
+/// The server's configuration from the client.
+#[derive(Debug, Default, serde::Deserialize)]
+#[serde(rename_all = "camelCase")]
+struct InitializationOptions {
+    /// The `ncc.toml` to use for every document, instead of finding one
+    /// upwards from each document.
+    config_file: Option<PathBuf>,
+}
+
+impl LanguageServer for Server {
+    async fn initialize(&self, params: lsp::InitializeParams) -> jsonrpc::Result<lsp::InitializeResult> {
+        let options: InitializationOptions = match params.initialization_options {
+            Some(value) => serde_json::from_value(value)
+                .map_err(|error| invalid_params(format!("initializationOptions: {error}")))?,
+            None => InitializationOptions::default(),
+        };
+        let roots: Vec<PathBuf> = params
+            .workspace_folders
+            .iter()
+            .flatten()
+            .filter_map(|folder| folder.uri.to_file_path().map(|p| p.into_owned()))
+            .collect();
+        #[allow(deprecated)] // Older clients send only `rootUri`.
+        let roots = if roots.is_empty() {
+            params.root_uri.iter().filter_map(|uri| uri.to_file_path().map(|p| p.into_owned())).collect()
+        } else {
+            roots
+        };
+        let errors = {
+            let mut state = self.state();
+            state.workspaces.configure(options.config_file);
+            state.workspaces.load_roots(&roots)
+        };
+        for error in errors {
+            self.client.show_message(lsp::MessageType::ERROR, error).await;
+        }
+        Ok(lsp::InitializeResult {
+            capabilities: handlers::capabilities(),
+            server_info: Some(server_info()),
+            offset_encoding: None,
+        })
+    }
+
+    async fn shutdown(&self) -> jsonrpc::Result<()> {
+        self.shut_down.store(true, Ordering::SeqCst);
+        Ok(())
+    }
+
+    async fn did_open(&self, params: lsp::DidOpenTextDocumentParams) {
+        let document = params.text_document;
+        let errors = {
+            let mut state = self.state();
+            let text: Arc<str> = document.text.into();
+            let (workspace, file, errors) = state.workspaces.open(&document.uri, text.clone());
+            let map = LineMap::new(text);
+            let flow = Vec::new();
+            state
+                .documents
+                .insert(document.uri.clone(), Document { workspace, file, version: document.version, map, flow });
+            errors
+        };
+        self.publish_diagnostics(document.uri);
+        for error in errors {
+            self.client.show_message(lsp::MessageType::ERROR, error).await;
+        }
+    }
+
+    async fn did_change(&self, params: lsp::DidChangeTextDocumentParams) {
+        let uri = params.text_document.uri;
+        {
+            let mut guard = self.state();
+            let state = &mut *guard;
+            let Some(document) = state.documents.get_mut(&uri) else {
+                tracing::warn!("change of {} which is not open", uri.as_str());
+                return;
+            };
+            let host = state.workspaces.host_mut(document.workspace);
+            for change in &params.content_changes {
+                let edit = document.map.edit(change);
+                host.apply_edit(document.file, &edit);
+                document.map = LineMap::new(host.analysis().text(document.file));
+                document.flow = std::mem::take(&mut document.flow)
+                    .into_iter()
+                    .filter_map(|diagnostic| diagnostic.moved_through(&edit))
+                    .collect();
+            }
+            document.version = params.text_document.version;
+        }
+        self.publish_diagnostics(uri);
+    }
+
+    async fn did_close(&self, params: lsp::DidCloseTextDocumentParams) {
+        let uri = params.text_document.uri;
+        {
+            let mut state = self.state();
+            if let Some(document) = state.documents.remove(&uri) {
+                state.workspaces.close(document.workspace, &uri, document.file);
+            }
+        }
+        self.client.publish_diagnostics(uri, Vec::new(), None).await;
+    }
+
+    async fn hover(&self, params: lsp::HoverParams) -> jsonrpc::Result<Option<lsp::Hover>> {
+        let position = params.text_document_position_params;
+        self.query(&position.text_document.uri, move |s| handlers::hover(s, position.position)).await
+    }
+
+    async fn goto_definition(
+        &self,
+        params: lsp::GotoDefinitionParams,
+    ) -> jsonrpc::Result<Option<lsp::GotoDefinitionResponse>> {
+        let position = params.text_document_position_params;
+        let uri = position.text_document.uri.clone();
+        let targets = self.query(&uri, move |s| handlers::definition(s, position.position)).await?;
+        let state = self.state();
+        let Some(workspace) = state.documents.get(&uri).map(|d| d.workspace) else { return Ok(None) };
+        let links: Vec<_> =
+            targets.into_iter().filter_map(|target| state.workspaces.location_link(workspace, target)).collect();
+        Ok((!links.is_empty()).then_some(lsp::GotoDefinitionResponse::Link(links)))
+    }
+
+    async fn code_action(&self, params: lsp::CodeActionParams) -> jsonrpc::Result<Option<lsp::CodeActionResponse>> {
+        let uri = params.text_document.uri.clone();
+        self.query(&uri, move |s| handlers::code_actions(s, params.range)).await.map(Some)
+    }
+}
+
+fn server_info() -> lsp::ServerInfo {
+    lsp::ServerInfo { name: "ncc".into(), version: Some(env!("CARGO_PKG_VERSION").into()) }
+}

@@ -1,0 +1,164 @@
+//! The files the server knows: one analysis host per `ncc.toml` (as
+//! `ncc check` groups them), holding the programs and macrocycle files of
+//! the workspace folders and every open document.
+
+use std::{
+    collections::HashMap,
+    path::{Path, PathBuf},
+    sync::Arc,
+};
+
+use ncc_analysis::{AnalysisHost, Config, FileId, NavigationTarget};
+use tower_lsp_server::ls_types::{self as lsp, Uri};
+
+use super::convert::LineMap;
+use crate::check;
+
+#[derive(Debug, Default)]
+pub(crate) struct Workspaces {
+    /// The configuration file the client named for every document.
+    forced_config: Option<PathBuf>,
+    list: Vec<Workspace>,
+}
+
+#[derive(Debug)]
+struct Workspace {
+    config_path: Option<PathBuf>,
+    host: AnalysisHost,
+    /// Files by the path the analysis knows them by.
+    files: HashMap<String, FileId>,
+    /// The address of each file, for answers that point into it.
+    uris: HashMap<FileId, Uri>,
+}
+
+/// The path the analysis knows a document by: its file path, or the URI
+/// itself for documents that are not files (`untitled:`).
+fn document_path(uri: &Uri) -> (String, Option<PathBuf>) {
+    match uri.to_file_path() {
+        Some(path) => (path.display().to_string(), Some(path.into_owned())),
+        None => (uri.as_str().to_owned(), None),
+    }
+}
+
+impl Workspaces {
+    pub fn configure(&mut self, config_file: Option<PathBuf>) {
+        self.forced_config = config_file;
+    }
+
+    pub fn get(&self, index: usize) -> &AnalysisHost {
+        &self.list[index].host
+    }
+
+    pub fn host_mut(&mut self, index: usize) -> &mut AnalysisHost {
+        &mut self.list[index].host
+    }
+
+    /// The workspace whose configuration applies to `path`; errors reading
+    /// a configuration file are returned, and its defaults used.
+    fn workspace_for(&mut self, path: Option<&Path>, errors: &mut Vec<String>) -> usize {
+        let config_path = self.forced_config.clone().or_else(|| path.and_then(Config::find_for));
+        if let Some(index) = self.list.iter().position(|w| w.config_path == config_path) {
+            return index;
+        }
+        let config = match &config_path {
+            Some(path) => check::load_config(path).unwrap_or_else(|error| {
+                errors.push(error);
+                Config::default()
+            }),
+            None => Config::default(),
+        };
+        self.list.push(Workspace {
+            config_path,
+            host: AnalysisHost::new(config),
+            files: HashMap::new(),
+            uris: HashMap::new(),
+        });
+        self.list.len() - 1
+    }
+
+    /// Adds a file read from disk unless the workspace has it.
+    fn add_from_disk(&mut self, path: &Path, errors: &mut Vec<String>) {
+        let index = self.workspace_for(Some(path), errors);
+        let workspace = &mut self.list[index];
+        let name = path.display().to_string();
+        if workspace.files.contains_key(&name) {
+            return;
+        }
+        match check::read_program(path) {
+            Ok(text) => {
+                let file = workspace.host.add_file(name.clone(), text);
+                workspace.files.insert(name, file);
+                if let Some(uri) = Uri::from_file_path(path) {
+                    workspace.uris.insert(file, uri);
+                }
+            }
+            Err(error) => errors.push(format!("{}: {error}", path.display())),
+        }
+    }
+
+    /// Indexes the partprograms and macrocycle files under the workspace
+    /// folders, so that calls resolve across files.
+    pub fn load_roots(&mut self, roots: &[PathBuf]) -> Vec<String> {
+        let (files, mut errors) = check::collect_files(roots);
+        for path in files {
+            self.add_from_disk(&path, &mut errors);
+        }
+        errors
+    }
+
+    /// Opens a document: its text replaces what was read from disk.
+    /// Macrocycle files beside it join the workspace.
+    pub fn open(&mut self, uri: &Uri, text: Arc<str>) -> (usize, FileId, Vec<String>) {
+        let (name, path) = document_path(uri);
+        let mut errors = Vec::new();
+        if let Some(path) = &path {
+            let beside = check::macrocycles_beside(&[(path.clone(), String::new())]);
+            for (macrocycle, _) in beside {
+                self.add_from_disk(&macrocycle, &mut errors);
+            }
+        }
+        let index = self.workspace_for(path.as_deref(), &mut errors);
+        let workspace = &mut self.list[index];
+        let file = match workspace.files.get(&name) {
+            Some(&file) => {
+                workspace.host.set_text(file, text);
+                file
+            }
+            None => {
+                let file = workspace.host.add_file(name.clone(), text);
+                workspace.files.insert(name, file);
+                file
+            }
+        };
+        workspace.uris.insert(file, uri.clone());
+        (index, file, errors)
+    }
+
+    /// Closes a document: the file on disk takes its place again, or the
+    /// file leaves the workspace when there is none.
+    pub fn close(&mut self, index: usize, uri: &Uri, file: FileId) {
+        let (name, path) = document_path(uri);
+        let workspace = &mut self.list[index];
+        match path.as_deref().map(check::read_program) {
+            Some(Ok(text)) => workspace.host.set_text(file, text),
+            _ => {
+                workspace.host.remove_file(file);
+                workspace.files.remove(&name);
+                workspace.uris.remove(&file);
+            }
+        }
+    }
+
+    /// A navigation target as a link, if its file has an address.
+    pub fn location_link(&self, index: usize, target: NavigationTarget) -> Option<lsp::LocationLink> {
+        let workspace = &self.list[index];
+        let uri = workspace.uris.get(&target.file)?.clone();
+        let map = LineMap::new(workspace.host.analysis().text(target.file));
+        Some(lsp::LocationLink {
+            origin_selection_range: None,
+            target_uri: uri,
+            target_range: map.range(target.range),
+            target_selection_range: map.range(target.focus),
+        })
+    }
+}
