@@ -3,6 +3,7 @@
 //! ```text
 //! cargo run --release -p ncc-bench -- parse [--blocks 1000000] [--runs 3]
 //! cargo run --release -p ncc-bench -- generate --blocks 1000000 --syntax cnc8x6 -o big.NCP
+//! cargo build --release -p ncc -p ncc-bench && target/release/ncc-bench lsp [--json]
 //! ```
 #![allow(unsafe_code)] // The counting allocator below; nothing else.
 
@@ -10,14 +11,20 @@ use std::{
     alloc::{GlobalAlloc, Layout},
     hint::black_box,
     path::PathBuf,
+    process::Command as Process,
     sync::atomic::{AtomicUsize, Ordering::Relaxed},
     time::{Duration, Instant},
 };
 
 use anyhow::Context;
 use clap::{Parser, Subcommand, ValueEnum};
-use ncc_bench::progen::{self, Syntax};
+use ncc_bench::{
+    edits::{self, Lcg},
+    lsp_client::{self, Client, Document},
+    progen::{self, Syntax},
+};
 use ncc_syntax::{Dialect, Parse};
+use serde_json::{Value, json};
 
 /// mimalloc, counting the bytes in use and their peak.
 struct CountingAlloc;
@@ -84,6 +91,21 @@ enum Command {
         #[arg(long, default_value_t = 1_000_000)]
         blocks: usize,
     },
+    /// Drive the language server (`ncc lsp`) through an editing session on a
+    /// generated program: time from each single-character edit to its
+    /// diagnostics, and of a hover after each edit.
+    Lsp {
+        /// The `ncc` binary [default: the one beside ncc-bench].
+        #[arg(long)]
+        server: Option<PathBuf>,
+        #[arg(long, default_value_t = 100_000)]
+        blocks: usize,
+        #[arg(long, default_value_t = 200)]
+        edits: usize,
+        /// Print the results as one JSON object.
+        #[arg(long)]
+        json: bool,
+    },
     /// Parse a file once (for profilers such as perf or callgrind).
     ParseFile {
         path: PathBuf,
@@ -116,6 +138,13 @@ fn main() -> anyhow::Result<()> {
         Command::Parse { blocks, runs } => parse_benchmark(blocks, runs.max(1)),
         Command::Reparse { blocks, edits } => reparse_benchmark(blocks, edits),
         Command::Check { blocks } => check_benchmark(blocks),
+        Command::Lsp { server, blocks, edits, json } => {
+            let server = match server {
+                Some(server) => server,
+                None => std::env::current_exe()?.with_file_name(format!("ncc{}", std::env::consts::EXE_SUFFIX)),
+            };
+            lsp_benchmark(&server, blocks, edits, json)
+        }
         Command::ParseFile { path, threads, gcode } => {
             let text = std::fs::read_to_string(&path)?;
             let start = Instant::now();
@@ -215,6 +244,14 @@ fn parse_benchmark(blocks: usize, runs: usize) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The seed of the random edits: the same edits on every run.
+const SEED: u64 = 0x2545_F491_4F6C_DD1D;
+
+/// The `p` quantile of sorted, non-empty samples.
+fn percentile(sorted: &[Duration], p: f64) -> Duration {
+    sorted[((sorted.len() - 1) as f64 * p) as usize]
+}
+
 fn reparse_benchmark(blocks: usize, edits: usize) -> anyhow::Result<()> {
     use ncc_syntax::{TextEdit, TextRange, TextSize};
 
@@ -223,17 +260,12 @@ fn reparse_benchmark(blocks: usize, edits: usize) -> anyhow::Result<()> {
     let mut parse = Parse::new(&text, Dialect::Cnc8x6);
     let full = start.elapsed();
 
-    // A fixed linear congruential sequence: the same edits on every run.
-    let mut seed = 0x2545_F491_4F6C_DD1Du64;
-    let mut next = move |bound: usize| {
-        seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-        (seed >> 33) as usize % bound
-    };
+    let mut rng = Lcg::new(SEED);
     let mut times = Vec::with_capacity(edits);
     for _ in 0..edits {
-        let at = (0..=next(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap_or(0);
-        let insert = ["1", " ", "X", "\n", "-", "."][next(6)];
-        let delete = if next(2) == 0 && at < text.len() && text.is_char_boundary(at + 1) { 1 } else { 0 };
+        let at = (0..=rng.below(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap_or(0);
+        let insert = ["1", " ", "X", "\n", "-", "."][rng.below(6)];
+        let delete = if rng.below(2) == 0 && at < text.len() && text.is_char_boundary(at + 1) { 1 } else { 0 };
         let edit = TextEdit::replace(TextRange::at(TextSize::from(at as u32), TextSize::from(delete)), insert);
         edit.apply(&mut text);
         let start = Instant::now();
@@ -242,11 +274,10 @@ fn reparse_benchmark(blocks: usize, edits: usize) -> anyhow::Result<()> {
     }
     anyhow::ensure!(parse == Parse::new(&text, Dialect::Cnc8x6), "incremental result differs from a full parse");
     times.sort();
-    let percentile = |p: f64| times[((times.len() - 1) as f64 * p) as usize];
     println!("reparse benchmark: {blocks} blocks ({:.1} MB), {edits} single-character edits", text.len() as f64 / 1e6);
     println!("  full parse   {:>9.3} ms", full.as_secs_f64() * 1e3);
-    println!("  reparse p50  {:>9.3} ms", percentile(0.5).as_secs_f64() * 1e3);
-    println!("  reparse p99  {:>9.3} ms", percentile(0.99).as_secs_f64() * 1e3);
+    println!("  reparse p50  {:>9.3} ms", percentile(&times, 0.5).as_secs_f64() * 1e3);
+    println!("  reparse p99  {:>9.3} ms", percentile(&times, 0.99).as_secs_f64() * 1e3);
     Ok(())
 }
 
@@ -281,4 +312,152 @@ fn check_benchmark(blocks: usize) -> anyhow::Result<()> {
         (PEAK.load(Relaxed) - base) as f64 / blocks as f64
     );
     Ok(())
+}
+
+/// The latency goals of the language server.
+const EDIT_GOAL: Duration = Duration::from_millis(16);
+const HOVER_GOAL: Duration = Duration::from_millis(2);
+
+/// Latencies of one kind, and the goal for their 99th percentile.
+struct Latencies {
+    name: &'static str,
+    goal: Duration,
+    samples: Vec<Duration>,
+}
+
+impl Latencies {
+    fn new(name: &'static str, goal: Duration, capacity: usize) -> Latencies {
+        Latencies { name, goal, samples: Vec::with_capacity(capacity) }
+    }
+
+    /// p50, p90, p99 and max.
+    fn quantiles(&self) -> [Duration; 4] {
+        let mut sorted = self.samples.clone();
+        sorted.sort();
+        [percentile(&sorted, 0.5), percentile(&sorted, 0.9), percentile(&sorted, 0.99), percentile(&sorted, 1.0)]
+    }
+
+    fn met(&self) -> bool {
+        self.quantiles()[2] < self.goal
+    }
+
+    fn json(&self) -> Value {
+        let [p50, p90, p99, max] = self.quantiles().map(|d| d.as_secs_f64() * 1e3);
+        json!({ "p50_ms": p50, "p90_ms": p90, "p99_ms": p99, "max_ms": max, "goal_p99_ms": self.goal.as_secs_f64() * 1e3, "met": self.met() })
+    }
+
+    fn print(&self) {
+        let [p50, p90, p99, max] = self.quantiles().map(|d| d.as_secs_f64() * 1e3);
+        println!(
+            "  {:<22} p50 {p50:>7.2} ms  p90 {p90:>7.2} ms  p99 {p99:>7.2} ms  max {max:>7.2} ms   goal p99 < {} ms: {}",
+            self.name,
+            self.goal.as_millis(),
+            if self.met() { "met" } else { "NOT met" }
+        );
+    }
+}
+
+fn lsp_benchmark(server: &std::path::Path, blocks: usize, edits: usize, as_json: bool) -> anyhow::Result<()> {
+    anyhow::ensure!(edits > 0, "--edits must be at least 1");
+    let text = progen::write(&progen::surfacing(blocks), Syntax::Cnc8x6);
+    let bytes = text.len();
+    // Editors open files that exist; the server may look beside them.
+    let dir = tempfile::tempdir()?;
+    let path = dir.path().join("surface.NCP");
+    std::fs::write(&path, &text)?;
+
+    let mut process = Process::new(server);
+    process.arg("lsp");
+    let mut client = Client::spawn(process)?;
+    // A slow answer is measured, only a missing one fails the run.
+    client.timeout = Duration::from_secs(120);
+    client.initialize(dir.path(), None)?;
+    let mut doc = Document::new(lsp_client::file_uri(&path), text);
+    let opened = client.notify("textDocument/didOpen", doc.did_open())?;
+    let open = client.diagnostics(&doc.uri, doc.version)?.received - opened;
+
+    let mut rng = Lcg::new(SEED);
+    let mut diagnostics = Latencies::new("edit → diagnostics", EDIT_GOAL, edits);
+    let mut hovers = Latencies::new("hover", HOVER_GOAL, edits);
+    let mut empty_hovers = 0;
+    for _ in 0..edits {
+        let edit = edits::typing_edit(doc.text(), &mut rng).context("the program has no block to edit")?;
+        let change = doc.change(edit.range.clone(), &edit.insert);
+        let sent = client.notify("textDocument/didChange", change)?;
+        diagnostics.samples.push(client.diagnostics(&doc.uri, doc.version)?.received - sent);
+
+        let target = g_code_near(doc.text(), edit.range.start, &mut rng).context("no G code near the edit")?;
+        let request = client.request("textDocument/hover", doc.at(doc.position(target)))?;
+        let response = client.response(&request)?;
+        anyhow::ensure!(response.error_code().is_none(), "hover failed: {}", response.json);
+        hovers.samples.push(response.received - request.sent);
+        if response.result().is_none_or(Value::is_null) {
+            empty_hovers += 1;
+        }
+        // Anything else the server sent about this version (a later, more
+        // complete diagnostics set, say) is not measured.
+        client.take_received();
+    }
+    let memory = client.memory();
+    let exit = client.shutdown()?;
+
+    let mb = bytes as f64 / 1e6;
+    if as_json {
+        let output = json!({
+            "blocks": blocks,
+            "bytes": bytes,
+            "edits": edits,
+            "open_to_diagnostics_ms": open.as_secs_f64() * 1e3,
+            "edit_to_diagnostics": diagnostics.json(),
+            "hover": hovers.json(),
+            "empty_hovers": empty_hovers,
+            "peak_rss_bytes": memory.map(|m| m.peak_rss),
+            "exit_code": exit.code(),
+        });
+        println!("{output:#}");
+    } else {
+        println!("lsp benchmark: {blocks} blocks ({mb:.1} MB), {edits} single-character edits, {}", server.display());
+        println!("  didOpen → diagnostics  {:>9.1} ms", open.as_secs_f64() * 1e3);
+        diagnostics.print();
+        hovers.print();
+        if empty_hovers > 0 {
+            println!("  {empty_hovers} of {edits} hovers on a G code answered nothing");
+        }
+        match memory {
+            Some(memory) => println!("  server peak RSS        {:>9.1} MB", memory.peak_rss as f64 / 1e6),
+            None => println!("  server peak RSS        unknown (no /proc)"),
+        }
+    }
+    anyhow::ensure!(exit.success(), "the server ended with {exit} after shutdown and exit");
+    Ok(())
+}
+
+/// The offset of a random character of the first G word at or after a
+/// random line within ten lines of `offset`.
+fn g_code_near(text: &str, offset: usize, rng: &mut Lcg) -> Option<usize> {
+    let mut start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
+    let (up, down) = match rng.below(21) {
+        lines @ 0..10 => (lines + 1, 0),
+        lines => (0, lines - 10),
+    };
+    for _ in 0..up {
+        start = text[..start.saturating_sub(1)].rfind('\n').map_or(0, |i| i + 1);
+    }
+    for _ in 0..down {
+        start = text[start..].find('\n').map_or(start, |i| start + i + 1);
+    }
+    let mut line_start = start;
+    for line in text[start..].split_inclusive('\n') {
+        if line.starts_with('N') {
+            let mut word_start = line_start;
+            for word in line.trim_end().split(' ') {
+                if word.len() > 1 && word.starts_with('G') && word.as_bytes()[1].is_ascii_digit() {
+                    return Some(word_start + rng.below(word.len()));
+                }
+                word_start += word.len() + 1;
+            }
+        }
+        line_start += line.len();
+    }
+    None
 }

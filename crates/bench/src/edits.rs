@@ -1,0 +1,126 @@
+//! Seeded random edits of generated programs, the way a programmer types.
+
+use std::ops::Range;
+
+/// A fixed linear congruential sequence: the same numbers on every run and
+/// every platform, so benchmarks and tests repeat exactly.
+#[derive(Debug, Clone)]
+pub struct Lcg(u64);
+
+impl Lcg {
+    pub fn new(seed: u64) -> Lcg {
+        Lcg(seed)
+    }
+
+    /// A number in `0..bound`; `bound` must not be 0.
+    pub fn below(&mut self, bound: usize) -> usize {
+        self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 33) as usize % bound
+    }
+}
+
+/// Replace the bytes of `range` with `insert`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Edit {
+    pub range: Range<usize>,
+    pub insert: String,
+}
+
+/// Coordinate words, whose digits are typed and deleted. Other words (G, M,
+/// N, F, S) keep theirs, so that the program keeps its meaning and stays
+/// roughly valid: a digit more or less in a coordinate moves one point.
+const COORDINATES: &[u8] = b"XYZIJ";
+
+/// A single-character edit in a random block of a CNC8x6 program: a digit
+/// typed into a coordinate (40%), a digit deleted from a coordinate that
+/// has more than one (30%), or a space typed between two words (30%).
+/// `None` if no block of `text` offers such a place.
+pub fn typing_edit(text: &str, rng: &mut Lcg) -> Option<Edit> {
+    // Nearly every line of a generated program qualifies; a text with no
+    // block line gives up after a bounded number of tries.
+    for _ in 0..1000 {
+        let mut at = rng.below(text.len().max(1));
+        while !text.is_char_boundary(at) {
+            at -= 1;
+        }
+        let start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+        let end = text[start..].find('\n').map_or(text.len(), |i| start + i);
+        let line = &text[start..end];
+        // A block line: `N<number> ` and its words.
+        if !line.starts_with('N') {
+            continue;
+        }
+        let Some(words_start) = line.find(' ') else { continue };
+        let kind = rng.below(10);
+        let mut places = Vec::new();
+        let mut word_start = words_start;
+        for word in line[words_start..].split(' ') {
+            let coordinate = word.as_bytes().first().is_some_and(|b| COORDINATES.contains(b));
+            let digits = word.bytes().filter(u8::is_ascii_digit).count();
+            if kind >= 7 {
+                if !word.is_empty() && word_start > words_start {
+                    places.push(word_start);
+                }
+            } else if coordinate && (kind < 4 || digits > 1) {
+                places.extend(word.char_indices().filter(|(_, c)| c.is_ascii_digit()).map(|(i, _)| word_start + i));
+            }
+            word_start += word.len() + 1;
+        }
+        if places.is_empty() {
+            continue;
+        }
+        let place = start + places[rng.below(places.len())];
+        return Some(match kind {
+            0..4 => Edit { range: place..place, insert: char::from(b'0' + rng.below(10) as u8).to_string() },
+            4..7 => Edit { range: place..place + 1, insert: String::new() },
+            _ => Edit { range: place..place, insert: " ".into() },
+        });
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progen::{self, Syntax};
+
+    #[test]
+    fn edits_touch_only_coordinates_and_spaces_between_words() {
+        let mut text = progen::write(&progen::surfacing(2000), Syntax::Cnc8x6);
+        let mut rng = Lcg::new(7);
+        let (mut typed, mut deleted, mut spaces) = (0, 0, 0);
+        for _ in 0..300 {
+            let edit = typing_edit(&text, &mut rng).unwrap();
+            let line_start = text[..edit.range.start].rfind('\n').unwrap() + 1;
+            let before = &text[line_start..edit.range.start];
+            assert!(before.starts_with('N') && before.contains(' '), "{before:?}");
+            match (edit.range.len(), edit.insert.as_str()) {
+                (0, " ") => {
+                    spaces += 1;
+                    assert!(before.ends_with(' '), "{before:?}");
+                }
+                (0, digit) => {
+                    typed += 1;
+                    assert!(digit.len() == 1 && digit.as_bytes()[0].is_ascii_digit());
+                    assert!(text.as_bytes()[edit.range.start].is_ascii_digit());
+                }
+                (1, "") => {
+                    deleted += 1;
+                    assert!(text.as_bytes()[edit.range.start].is_ascii_digit());
+                }
+                other => panic!("unexpected edit {other:?}"),
+            }
+            let word_start = before.rfind(' ').unwrap() + 1;
+            let letter = text.as_bytes()[line_start + word_start];
+            assert!(edit.insert == " " || COORDINATES.contains(&letter), "{}", letter as char);
+            text.replace_range(edit.range, &edit.insert);
+        }
+        assert!(typed > 60 && deleted > 45 && spaces > 45, "{typed} {deleted} {spaces}");
+    }
+
+    #[test]
+    fn text_without_blocks_gives_no_edit() {
+        assert_eq!(typing_edit("%1\n\"COMMENT\"\n*\n", &mut Lcg::new(1)), None);
+        assert_eq!(typing_edit("", &mut Lcg::new(1)), None);
+    }
+}

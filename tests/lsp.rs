@@ -1,0 +1,315 @@
+//! End-to-end tests of the language server, `ncc lsp`: answers to broken
+//! and unexpected messages, positions outside the document, a very large
+//! document, rapid edits, and the lifecycle. Each test runs its own server
+//! through the client in `ncc-bench`, whose every wait has a timeout.
+
+use std::{process::Command, time::Duration};
+
+use ncc_bench::{
+    edits::{Lcg, typing_edit},
+    lsp_client::{Client, Document, Message, file_uri, initialize_params},
+    progen::{self, Syntax},
+};
+use serde_json::{Value, json};
+use tempfile::TempDir;
+
+/// JSON-RPC and LSP error codes.
+const PARSE_ERROR: i64 = -32700;
+const INVALID_REQUEST: i64 = -32600;
+const METHOD_NOT_FOUND: i64 = -32601;
+const INVALID_PARAMS: i64 = -32602;
+const SERVER_NOT_INITIALIZED: i64 = -32002;
+
+/// A program whose comments hold two-byte Czech letters and a four-byte
+/// emoji (two UTF-16 units), with two syntax errors after them.
+const CZECH: &str = "%7 \"ZKUŠEBNÍ PROGRAM – ŘEZÁNÍ\"
+N10 G00 X0 Y0 \"ŽLUŤOUČKÝ KŮŇ 🙂\" Z2 U36.  12
+N20 G01 X10 F100 \"ČÁRKA, TEČKA ŘEŽ\"
+N30 Z-  5.
+N40 M30
+*
+";
+
+fn server() -> Client {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_ncc"));
+    command.arg("lsp");
+    Client::spawn(command).unwrap()
+}
+
+/// An initialized server with an empty workspace folder.
+fn session() -> (Client, TempDir) {
+    let dir = tempfile::tempdir().unwrap();
+    let mut client = server();
+    client.initialize(dir.path(), None).unwrap();
+    (client, dir)
+}
+
+fn document(dir: &TempDir, name: &str, text: &str) -> Document {
+    Document::new(file_uri(&dir.path().join(name)), text.to_owned())
+}
+
+/// Opens `doc` and waits for its first diagnostics.
+fn open(client: &mut Client, doc: &Document) -> Message {
+    client.notify("textDocument/didOpen", doc.did_open()).unwrap();
+    client.diagnostics(&doc.uri, doc.version).unwrap()
+}
+
+/// The diagnostics of `doc`'s current version once the server is done with
+/// it. The server may push a quick partial set before the complete one and
+/// does not say which is last, so the last one within a quiet second counts.
+fn settled_diagnostics(client: &mut Client, doc: &Document) -> Message {
+    let mut last = client.diagnostics(&doc.uri, doc.version).unwrap();
+    while let Ok(later) = client.diagnostics_within(&doc.uri, doc.version, Duration::from_secs(1)) {
+        last = later;
+    }
+    last
+}
+
+/// What must agree between two copies of one text: diagnostics (with the
+/// document's URI taken out) and semantic tokens.
+fn analysis_of(client: &mut Client, doc: &Document) -> (String, Value) {
+    let diagnostics = settled_diagnostics(client, doc).params()["diagnostics"].to_string().replace(&doc.uri, "URI");
+    let tokens = client.call("textDocument/semanticTokens/full", json!({ "textDocument": doc.id() })).unwrap();
+    let tokens = tokens.result().unwrap_or_else(|| panic!("semantic tokens: {}", tokens.json))["data"].clone();
+    (diagnostics, tokens)
+}
+
+/// Asserts that the server answers an ordinary request on an open document.
+fn assert_serving(client: &mut Client, dir: &TempDir) {
+    let doc = document(dir, "alive.NCP", "%1\nN10 G01 X1 F100\nN20 M30\n");
+    open(client, &doc);
+    let hover = client.call("textDocument/hover", doc.at(doc.position(doc.text().find("G01").unwrap()))).unwrap();
+    assert!(hover.result().is_some_and(|r| r["contents"]["value"].as_str().is_some()), "{}", hover.json);
+}
+
+fn framed(body: &str) -> Vec<u8> {
+    format!("Content-Length: {}\r\n\r\n{body}", body.len()).into_bytes()
+}
+
+#[test]
+fn a_body_that_is_not_json_is_a_parse_error() {
+    let (mut client, dir) = session();
+    client.send_raw(&framed("not json!")).unwrap();
+    let error = client.response_to(&Value::Null).unwrap();
+    assert_eq!(error.error_code(), Some(PARSE_ERROR), "{}", error.json);
+    assert_serving(&mut client, &dir);
+}
+
+#[test]
+fn json_that_is_not_a_request_is_an_invalid_request() {
+    let (mut client, dir) = session();
+    for body in [r#"{"jsonrpc":"2.0","params":{}}"#, "42"] {
+        client.send_raw(&framed(body)).unwrap();
+        let error = client.response_to(&Value::Null).unwrap();
+        assert_eq!(error.error_code(), Some(INVALID_REQUEST), "{body}: {}", error.json);
+    }
+    assert_serving(&mut client, &dir);
+}
+
+#[test]
+fn a_bad_content_length_is_skipped() {
+    let (mut client, dir) = session();
+    // A length that is not a number can be skipped up to the next header.
+    // (A wrong number cannot be detected: it shifts every later message.)
+    client.send_raw(b"Content-Length: twelve\r\n\r\n{}").unwrap();
+    assert_serving(&mut client, &dir);
+}
+
+#[test]
+fn unknown_methods_are_method_not_found_and_unknown_notifications_are_ignored() {
+    let (mut client, dir) = session();
+    let unknown = client.call("foo/bar", json!({})).unwrap();
+    assert_eq!(unknown.error_code(), Some(METHOD_NOT_FOUND), "{}", unknown.json);
+    client.notify("foo/baz", json!({})).unwrap();
+    client.notify("$/ncc/unknown", json!({})).unwrap();
+    // LSP: a `$/` request the server does not know is MethodNotFound too.
+    let dollar = client.call("$/ncc/unknown", json!({})).unwrap();
+    assert_eq!(dollar.error_code(), Some(METHOD_NOT_FOUND), "{}", dollar.json);
+    assert_serving(&mut client, &dir);
+    let answers: Vec<Value> = client.take_received().into_iter().filter(Message::is_response).map(|m| m.json).collect();
+    assert!(answers.is_empty(), "notifications were answered: {answers:?}");
+}
+
+#[test]
+fn requests_before_initialize_fail_and_initialize_comes_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut client = server();
+    let doc = document(&dir, "early.NCP", "%1\nN10 G01 X1 F100\nN20 M30\n");
+    let g01 = doc.position(doc.text().find("G01").unwrap());
+    let early = client.call("textDocument/hover", doc.at(g01.clone())).unwrap();
+    assert_eq!(early.error_code(), Some(SERVER_NOT_INITIALIZED), "{}", early.json);
+    // LSP: notifications before initialize are dropped.
+    client.notify("textDocument/didOpen", doc.did_open()).unwrap();
+
+    let initialized = client.initialize(dir.path(), None).unwrap();
+    let capabilities = &initialized.result().unwrap()["capabilities"];
+    let sync = &capabilities["textDocumentSync"];
+    assert!(sync == 2 || sync["change"] == 2, "incremental sync: {capabilities}");
+    assert!(matches!(capabilities["positionEncoding"].as_str(), None | Some("utf-16")), "{capabilities}");
+
+    let dropped = client.call("textDocument/hover", doc.at(g01)).unwrap();
+    assert!(dropped.result().is_none_or(Value::is_null), "the early didOpen was kept: {}", dropped.json);
+    let again = client.call("initialize", initialize_params(dir.path(), None)).unwrap();
+    assert!(again.error_code().is_some(), "a second initialize succeeded: {}", again.json);
+    assert_serving(&mut client, &dir);
+}
+
+#[test]
+fn positions_past_the_end_are_clamped_and_the_document_stays_in_sync() {
+    let (mut client, dir) = session();
+    let mut doc = document(&dir, "czech.NCP", CZECH);
+    open(&mut client, &doc);
+
+    // Line 2 ends in a comment with Czech letters: its length in UTF-16
+    // units points into a letter when read as bytes.
+    let line = CZECH.lines().nth(2).unwrap();
+    let units = line.encode_utf16().count();
+    let into_a_letter = (units + 1..line.len()).find(|&i| !line.is_char_boundary(i)).unwrap();
+    let emoji_units = CZECH.lines().nth(1).unwrap().split('🙂').next().unwrap().encode_utf16().count();
+    let past_line_ends = [json!({ "line": 2, "character": into_a_letter }), json!({ "line": 3, "character": 10_000 })];
+    let elsewhere = [
+        // Past the last line, at the protocol's largest position, and
+        // between the two UTF-16 units of the emoji.
+        json!({ "line": 99, "character": 0 }),
+        json!({ "line": i32::MAX, "character": i32::MAX }),
+        json!({ "line": 1, "character": emoji_units + 1 }),
+    ];
+    for position in past_line_ends.iter().chain(&elsewhere) {
+        let requests = [
+            ("textDocument/hover", doc.at(position.clone())),
+            ("textDocument/definition", doc.at(position.clone())),
+            ("textDocument/completion", doc.at(position.clone())),
+            ("textDocument/references", {
+                let mut params = doc.at(position.clone());
+                params["context"] = json!({ "includeDeclaration": true });
+                params
+            }),
+        ];
+        for (method, params) in requests {
+            let answer = client.call(method, params).unwrap();
+            // LSP 3.17 clamps a character past the line's end; outside the
+            // lines it says nothing, so "invalid params" is an answer too.
+            let clamped = past_line_ends.contains(position);
+            assert!(
+                answer.result().is_some() || (!clamped && answer.error_code() == Some(INVALID_PARAMS)),
+                "{method} at {position}: {}",
+                answer.json
+            );
+        }
+    }
+
+    // Changes whose ranges end past the line, and past the document, apply
+    // where clamping puts them: a number with a space at the end of line 1,
+    // a comment after the end.
+    let changes = [
+        (json!({ "start": { "line": 1, "character": 500 }, "end": { "line": 1, "character": 600 } }), " Y1 5"),
+        (json!({ "start": { "line": 40, "character": 0 }, "end": { "line": 50, "character": 3 } }), "\"KONEC\"\n"),
+    ];
+    for (range, text) in changes {
+        client.notify("textDocument/didChange", doc.change_lsp(range, text)).unwrap();
+    }
+    // An ordinary edit after them lands where the client means it only if
+    // both sides still hold the same text.
+    let x10 = doc.text().find("X10").unwrap();
+    client.notify("textDocument/didChange", doc.change(x10 + 1..x10 + 1, " ")).unwrap();
+    let formatting = json!({ "textDocument": doc.id(), "options": { "tabSize": 4, "insertSpaces": true } });
+    let formatted = client.call("textDocument/formatting", formatting).unwrap();
+    for edit in formatted.result().unwrap_or_else(|| panic!("{}", formatted.json)).as_array().into_iter().flatten() {
+        assert!(doc.byte_range(&edit["range"]).is_some(), "formatting edit outside the document: {edit}");
+    }
+    let edited = analysis_of(&mut client, &doc);
+    assert_ne!(edited.0, "[]", "the edits leave errors to compare");
+    let copy = document(&dir, "copy.NCP", doc.text());
+    client.notify("textDocument/didOpen", copy.did_open()).unwrap();
+    assert_eq!(edited, analysis_of(&mut client, &copy), "the edited document differs from a fresh copy");
+}
+
+#[test]
+fn a_very_large_document_does_not_stop_the_server() {
+    // 1.5 million blocks make about 50 MB. Debug builds leave the workspace
+    // crates unoptimised and CI has two cores, so there a tenth of it shows
+    // the same behaviour in reasonable time; release runs the full size.
+    let blocks = if cfg!(debug_assertions) { 150_000 } else { 1_500_000 };
+    let (mut client, dir) = session();
+    let small = document(&dir, "small.NCP", "%1\nN10 G01 X1 F100\nN20 M30\n");
+    open(&mut client, &small);
+    let big = document(&dir, "big.NCP", &progen::write(&progen::surfacing(blocks), Syntax::Cnc8x6));
+    client.notify("textDocument/didOpen", big.did_open()).unwrap();
+
+    // The small document is answered while the big one is analysed.
+    let hover =
+        client.request("textDocument/hover", small.at(small.position(small.text().find("G01").unwrap()))).unwrap();
+    let answer = client.response(&hover).unwrap();
+    let waited = answer.received - hover.sent;
+    assert!(answer.result().is_some_and(|r| !r.is_null()), "{}", answer.json);
+    assert!(waited < Duration::from_secs(5), "a hover on a small document waited {waited:?} for the big one");
+
+    let published = client.diagnostics_within(&big.uri, big.version, Duration::from_secs(300)).unwrap();
+    assert_eq!(published.params()["diagnostics"], json!([]), "a generated program is clean");
+}
+
+#[test]
+fn rapid_edits_end_in_the_diagnostics_of_the_final_text_without_growing() {
+    let (mut client, dir) = session();
+    // 170 kB: keeping every version's text alone would add 170 MB.
+    let mut doc = document(&dir, "edited.NCP", &progen::write(&progen::surfacing(5_000), Syntax::Cnc8x6));
+    open(&mut client, &doc);
+    settled_diagnostics(&mut client, &doc);
+    let before = client.memory();
+
+    let mut rng = Lcg::new(1);
+    for _ in 0..1000 {
+        let edit = typing_edit(doc.text(), &mut rng).unwrap();
+        client.notify("textDocument/didChange", doc.change(edit.range, &edit.insert)).unwrap();
+    }
+    let last = settled_diagnostics(&mut client, &doc);
+    // Nothing older may follow the final version's diagnostics: an editor
+    // would show findings of a text that no longer exists.
+    let stale: Vec<Value> = client
+        .take_received()
+        .into_iter()
+        .filter(|m| m.method() == Some("textDocument/publishDiagnostics") && m.received > last.received)
+        .map(|m| m.params()["version"].clone())
+        .collect();
+    assert!(stale.is_empty(), "diagnostics of versions {stale:?} came after version {}", doc.version);
+
+    if let (Some(before), Some(after)) = (before, client.memory()) {
+        // The text, its tree and the analysis of one version are a few MB;
+        // what a retained history would cost is a hundred times more.
+        let grown = after.rss.saturating_sub(before.rss);
+        assert!(grown < 64 << 20, "RSS grew by {} MB over 1000 edits", grown >> 20);
+    }
+
+    let edited = analysis_of(&mut client, &doc);
+    let copy = document(&dir, "copy.NCP", doc.text());
+    client.notify("textDocument/didOpen", copy.did_open()).unwrap();
+    assert_eq!(edited, analysis_of(&mut client, &copy), "the edited document differs from a fresh copy");
+}
+
+#[test]
+fn shutdown_then_exit_ends_with_success() {
+    let (mut client, dir) = session();
+    let doc = document(&dir, "a.NCP", "%1\nN10 G01 X1 F100\nN20 M30\n");
+    open(&mut client, &doc);
+    let shutdown = client.call("shutdown", Value::Null).unwrap();
+    assert_eq!(shutdown.result(), Some(&Value::Null), "{}", shutdown.json);
+    // LSP: requests after shutdown are invalid.
+    let late = client.call("textDocument/hover", doc.at(doc.position(0))).unwrap();
+    assert_eq!(late.error_code(), Some(INVALID_REQUEST), "{}", late.json);
+    client.notify("exit", Value::Null).unwrap();
+    assert_eq!(client.wait_exit(Duration::from_secs(10)).unwrap().code(), Some(0));
+}
+
+#[test]
+fn exit_without_shutdown_ends_with_failure() {
+    let (mut client, _dir) = session();
+    client.notify("exit", Value::Null).unwrap();
+    assert_eq!(client.wait_exit(Duration::from_secs(10)).unwrap().code(), Some(1));
+}
+
+#[test]
+fn closing_stdin_ends_the_server() {
+    let (mut client, _dir) = session();
+    client.close_stdin();
+    client.wait_exit(Duration::from_secs(10)).unwrap();
+}
