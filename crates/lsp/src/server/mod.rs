@@ -13,6 +13,7 @@
 //! the flow walk is done — unless a newer edit came first.
 
 mod convert;
+mod frames;
 mod handlers;
 mod semantic;
 mod workspace;
@@ -28,6 +29,7 @@ use std::{
 };
 
 use ncc_analysis::{Analysis, Cancelled, Diagnostic, FileId};
+use tokio::sync::mpsc;
 use tower_lsp_server::{
     Client, LanguageServer, LspService,
     jsonrpc::{self, ErrorCode},
@@ -77,7 +79,20 @@ pub(crate) fn run(log_level: LogLevel) -> ExitCode {
     let flag = shut_down.clone();
     runtime.block_on(async move {
         let (service, socket) = LspService::new(move |client| Server::new(client, flag));
-        tower_lsp_server::Server::new(tokio::io::stdin(), tokio::io::stdout(), socket).serve(service).await;
+        // The protocol layer talks to in-memory pipes; the frames guard sits
+        // between them and stdio.
+        let (server_input, guarded_input) = tokio::io::duplex(1 << 16);
+        let (server_output, server_frames) = tokio::io::duplex(1 << 16);
+        let (frames_tx, frames_rx) = mpsc::unbounded_channel();
+        let guard = tokio::spawn(frames::guard_input(tokio::io::stdin(), guarded_input, frames_tx.clone()));
+        let forward = tokio::spawn(frames::forward_output(server_frames, frames_tx));
+        let writer = tokio::spawn(frames::write_output(tokio::io::stdout(), frames_rx));
+        tower_lsp_server::Server::new(server_input, server_output, socket).serve(service).await;
+        // Stdin may never close (a client that sent `exit`): stop reading,
+        // and let everything the server wrote reach stdout.
+        guard.abort();
+        let _ = forward.await;
+        let _ = writer.await;
     });
     // Blocking tasks still computing are abandoned: their snapshots answer
     // nobody now.
@@ -109,6 +124,25 @@ pub(crate) struct Server {
     client: Client,
     state: Arc<Mutex<State>>,
     shut_down: Arc<AtomicBool>,
+    publisher: mpsc::UnboundedSender<Publication>,
+}
+
+/// Diagnostics of one version of a document, to send.
+type Publication = (Uri, Vec<lsp::Diagnostic>, i32);
+
+/// Sends diagnostics in the order they were computed, never an older
+/// version's after a newer one's. Blocking threads hand their results over
+/// without waiting, so a snapshot is never held while the output is busy
+/// (an edit waiting for that snapshot would block the runtime).
+async fn publish(client: Client, mut publications: mpsc::UnboundedReceiver<Publication>) {
+    let mut sent: HashMap<Uri, i32> = HashMap::new();
+    while let Some((uri, diagnostics, version)) = publications.recv().await {
+        if sent.get(&uri).is_some_and(|&newest| newest > version) {
+            continue;
+        }
+        sent.insert(uri.clone(), version);
+        client.publish_diagnostics(uri, diagnostics, Some(version)).await;
+    }
 }
 
 /// A request's view of a document: a snapshot and what converts positions.
@@ -121,7 +155,9 @@ struct Snapshot {
 
 impl Server {
     fn new(client: Client, shut_down: Arc<AtomicBool>) -> Server {
-        Server { client, state: Arc::default(), shut_down }
+        let (publisher, publications) = mpsc::unbounded_channel();
+        tokio::spawn(publish(client.clone(), publications));
+        Server { client, state: Arc::default(), shut_down, publisher }
     }
 
     fn state(&self) -> MutexGuard<'_, State> {
@@ -174,15 +210,14 @@ impl Server {
             let analysis = state.workspaces.get(document.workspace).analysis();
             (analysis, document.file, document.version, document.map.clone(), document.flow.clone())
         };
-        let client = self.client.clone();
+        let publisher = self.publisher.clone();
         let state = self.state.clone();
-        let runtime = tokio::runtime::Handle::current();
         // The snapshot lives only on the blocking thread, so an edit waiting
         // to cancel it never waits for the async runtime.
         tokio::task::spawn_blocking(move || {
             let send = |diagnostics: Vec<Diagnostic>| {
                 let diagnostics = diagnostics.iter().map(|d| convert::diagnostic(&map, &uri, d)).collect();
-                runtime.block_on(client.publish_diagnostics(uri.clone(), diagnostics, Some(version)));
+                let _ = publisher.send((uri.clone(), diagnostics, version));
             };
             let started = std::time::Instant::now();
             let Ok(local) = Cancelled::catch(|| analysis.local_diagnostics(file)) else { return };
