@@ -129,7 +129,8 @@ pub(crate) fn main_state_before(db: &dyn Db, file: SourceFile, index: usize) -> 
     });
     if !checkpoints.context.same_as(&context) {
         checkpoints.points.clear();
-    } else if checkpoints.root != root {
+    } else if !std::ptr::eq::<rowan::GreenNodeData>(&*checkpoints.root, &*root) {
+        // Identity, not `!=`: rowan compares green trees deeply.
         let changed = first_changed_block(&checkpoints.root, &root);
         checkpoints.points.retain(|point| point.index <= changed && point.called_end <= changed);
     }
