@@ -14,10 +14,14 @@ use std::{
 use ncc_syntax::{Dialect, Parse, SyntaxKind, TextSize};
 use rowan::GreenNode;
 
-use crate::{Config, Diagnostic, lower::BlockData, model::BlockSummary};
+use crate::{Config, Diagnostic, lower::BlockData, model::BlockSummary, states::StateCache};
 
 #[salsa::db]
-pub trait Db: salsa::Database {}
+pub trait Db: salsa::Database {
+    /// Modal-state checkpoints, kept outside salsa because they stay valid
+    /// across edits (see `states`).
+    fn state_cache(&self) -> &StateCache;
+}
 
 /// A program file of the workspace.
 #[salsa::input(debug)]
@@ -90,20 +94,29 @@ pub struct FileChunk<'db> {
 /// The file's blocks in chunks, in order.
 #[salsa::tracked(returns(ref))]
 pub fn file_chunks(db: &dyn Db, file: SourceFile) -> Vec<FileChunk<'_>> {
-    let root = file.parse(db).syntax_node();
+    // The green tree is walked directly: red nodes would allocate one node
+    // per block on every edit.
+    let root = file.parse(db).green();
     let mut chunks = Vec::new();
     let mut current: Vec<BlockGreen> = Vec::new();
     let mut start = TextSize::from(0);
-    for node in root.children().filter(|node| node.kind() == SyntaxKind::BLOCK) {
-        if current.is_empty() {
-            start = node.text_range().start();
+    let mut offset = TextSize::from(0);
+    for child in root.children() {
+        let len = child.text_len();
+        if let rowan::NodeOrToken::Node(node) = child
+            && node.kind() == SyntaxKind::BLOCK.into()
+        {
+            if current.is_empty() {
+                start = offset;
+            }
+            let green = BlockGreen(node.to_owned());
+            let boundary = identity_hash(&green).is_multiple_of(CHUNK_SPREAD);
+            current.push(green);
+            if boundary || current.len() == MAX_CHUNK {
+                chunks.push(FileChunk { chunk: BlockChunk::new(db, std::mem::take(&mut current)), offset: start });
+            }
         }
-        let green = BlockGreen(node.green().to_owned());
-        let boundary = identity_hash(&green).is_multiple_of(CHUNK_SPREAD);
-        current.push(green);
-        if boundary || current.len() == MAX_CHUNK {
-            chunks.push(FileChunk { chunk: BlockChunk::new(db, std::mem::take(&mut current)), offset: start });
-        }
+        offset += len;
     }
     if !current.is_empty() {
         chunks.push(FileChunk { chunk: BlockChunk::new(db, current), offset: start });
@@ -154,6 +167,7 @@ pub fn chunk_summaries<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<Bloc
 pub struct RootDatabase {
     storage: salsa::Storage<Self>,
     log: Option<Arc<Mutex<Vec<String>>>>,
+    states: Arc<StateCache>,
 }
 
 impl RootDatabase {
@@ -168,6 +182,7 @@ impl RootDatabase {
                 }
             }))),
             log: Some(log),
+            states: Arc::default(),
         }
     }
 
@@ -187,4 +202,8 @@ impl std::fmt::Debug for RootDatabase {
 impl salsa::Database for RootDatabase {}
 
 #[salsa::db]
-impl Db for RootDatabase {}
+impl Db for RootDatabase {
+    fn state_cache(&self) -> &StateCache {
+        &self.states
+    }
+}

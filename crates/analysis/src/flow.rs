@@ -272,6 +272,9 @@ pub(crate) trait FlowCheck {
 
 /// The state before block `index` of `file` each time the walk reaches it (a subprogram called twice is reached twice).
 pub fn states_before(db: &dyn Db, file: SourceFile, index: usize) -> Vec<(ModalState, ParamState)> {
+    if let Some(state) = crate::states::main_state_before(db, file, index) {
+        return vec![state];
+    }
     let program = model::program(db, file);
     let Some(block) = program.blocks.get(index) else { return Vec::new() };
     let seen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
@@ -338,6 +341,9 @@ impl<'db> Blocks<'db> {
     fn get(&mut self, index: usize) -> (TextSize, Arc<Vec<(TextSize, BlockData)>>, usize) {
         let chunk = self.starts.partition_point(|&start| start <= index) - 1;
         if !self.cache.contains_key(&chunk) {
+            // A walk over a large file is one long query: give an edit
+            // waiting to change the inputs its chance, once per chunk.
+            self.db.unwind_if_revision_cancelled();
             if self.cache.len() >= 16 {
                 self.cache.clear();
             }
@@ -362,7 +368,7 @@ pub fn lowered_block(db: &dyn Db, file: SourceFile, index: usize) -> Option<(Tex
 /// business, not the checker's).
 const MAX_CALL_DEPTH: usize = 8;
 
-struct Walk<'db> {
+pub(crate) struct Walk<'db> {
     db: &'db dyn Db,
     program: &'db Program,
     catalogue: &'static Catalogue,
@@ -371,12 +377,17 @@ struct Walk<'db> {
     blocks: Blocks<'db>,
     out: Vec<Diagnostic>,
     /// Subprograms on the call stack (by unit index).
-    stack: Vec<usize>,
+    pub(crate) stack: Vec<usize>,
     called: Vec<bool>,
 }
 
 impl<'db> Walk<'db> {
-    fn new(db: &'db dyn Db, file: SourceFile, program: &'db Program, checks: Vec<Box<dyn FlowCheck>>) -> Self {
+    pub(crate) fn new(
+        db: &'db dyn Db,
+        file: SourceFile,
+        program: &'db Program,
+        checks: Vec<Box<dyn FlowCheck>>,
+    ) -> Self {
         Walk {
             db,
             program,
@@ -410,15 +421,7 @@ impl<'db> Walk<'db> {
         self.stack.push(unit);
         let mut last = None;
         for index in self.program.units[unit].blocks.clone() {
-            let (chunk_offset, lowered, at) = self.blocks.get(index);
-            let (offset, block) = (&lowered[at].0, &lowered[at].1);
-            let offset = chunk_offset + *offset;
-            let (after, after_params) = self.visit(block, offset, &state, &params);
-            state = after;
-            params = after_params;
-            if let Some((transfer, range)) = self.program.blocks[index].transfer {
-                (state, params) = self.follow(transfer, range, state, params);
-            }
+            (state, params) = self.step(index, &state, &params);
             last = Some(index);
         }
         let last_block = last.map(|index| {
@@ -430,6 +433,30 @@ impl<'db> Walk<'db> {
         }
         self.stack.pop();
         (state, params)
+    }
+
+    /// Runs block `index` (and what it calls) from `state`.
+    pub(crate) fn step(&mut self, index: usize, state: &ModalState, params: &ParamState) -> (ModalState, ParamState) {
+        let (chunk_offset, lowered, at) = self.blocks.get(index);
+        let (offset, block) = (&lowered[at].0, &lowered[at].1);
+        let (state, params) = self.visit(block, chunk_offset + *offset, state, params);
+        match self.program.blocks[index].transfer {
+            Some((transfer, range)) => self.follow(transfer, range, state, params),
+            None => (state, params),
+        }
+    }
+
+    /// The end of the last block of the subprograms entered so far (0:
+    /// none).
+    pub(crate) fn called_end(&self) -> usize {
+        self.program
+            .units
+            .iter()
+            .zip(&self.called)
+            .filter(|(_, called)| **called)
+            .map(|(u, _)| u.blocks.end)
+            .max()
+            .unwrap_or(0)
     }
 
     /// Follows a call: the callee runs with the caller's state.

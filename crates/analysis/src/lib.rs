@@ -15,6 +15,7 @@ pub mod flow;
 mod ide;
 pub mod lower;
 pub mod model;
+mod states;
 mod suppress;
 
 use std::sync::Arc;
@@ -25,6 +26,14 @@ pub use salsa::Cancelled;
 use salsa::Setter;
 
 use crate::db::{Db, Settings};
+pub use crate::ide::{
+    completion::{CompletionItem, CompletionKind},
+    folding::{Fold, FoldKind},
+    highlight::{HighlightKind, HighlightRange},
+    inlay::{InlayHint, InlayHintKind},
+    references::{Reference, ReferenceKind},
+    symbols::{DocumentSymbol, SymbolKind},
+};
 pub use crate::{
     config::{CONFIG_FILE, Config, Level, MachineConfig, parse_constant},
     db::{RootDatabase, SourceFile},
@@ -74,6 +83,7 @@ impl AnalysisHost {
         let settings = Settings::get(&self.db);
         let files: Vec<SourceFile> = settings.files(&self.db).iter().copied().filter(|&f| f != file).collect();
         settings.set_files(&mut self.db).to(files);
+        self.db.state_cache().forget(file);
     }
 
     /// Replaces a file's text.
@@ -170,6 +180,49 @@ impl Analysis {
     /// time the program reaches it.
     pub fn states_at(&self, file: FileId, offset: TextSize) -> Vec<(flow::ModalState, flow::ParamState)> {
         ide::states_at(&self.db, file, offset)
+    }
+
+    /// The outline: program units, and the blocks jumps go to in each.
+    pub fn document_symbols(&self, file: FileId) -> Vec<DocumentSymbol> {
+        ide::symbols::document_symbols(&self.db, file)
+    }
+
+    /// Program units and runs of comment lines, sorted by start.
+    pub fn folding_ranges(&self, file: FileId) -> Vec<Fold> {
+        ide::folding::folding_ranges(&self.db, file)
+    }
+
+    /// Every token classified, for semantic highlighting.
+    pub fn highlight(&self, file: FileId) -> Vec<HighlightRange> {
+        ide::highlight::highlight(&self.db, file, None)
+    }
+
+    /// The highlighting of the blocks (and header, end) that overlap `range`.
+    pub fn highlight_range(&self, file: FileId, range: TextRange) -> Vec<HighlightRange> {
+        ide::highlight::highlight(&self.db, file, Some(range))
+    }
+
+    /// The definition (with `include_declaration`) and the uses of the
+    /// subprogram, macrocycle, jump target or parameter at `offset`.
+    pub fn references(&self, file: FileId, offset: TextSize, include_declaration: bool) -> Vec<Reference> {
+        ide::references::references(&self.db, file, offset, include_declaration)
+    }
+
+    /// The edits that format the file: spacing only (the style is in
+    /// `ide/format.rs`), sorted and not overlapping.
+    pub fn format(&self, file: FileId) -> Vec<TextEdit> {
+        ide::format::format(file.text(&self.db), file.parse(&self.db))
+    }
+
+    /// What may be written at `offset`, most relevant first.
+    pub fn completions(&self, file: FileId, offset: TextSize) -> Vec<CompletionItem> {
+        ide::completion::completions(&self.db, file, offset)
+    }
+
+    /// The inlay hints of the blocks `range` touches (of every block
+    /// without one).
+    pub fn inlay_hints(&self, file: FileId, range: Option<TextRange>) -> Vec<InlayHint> {
+        ide::inlay::inlay_hints(&self.db, file, range)
     }
 
     pub fn path(&self, file: FileId) -> String {

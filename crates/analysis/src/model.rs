@@ -7,7 +7,7 @@
 
 use std::ops::Range;
 
-use ncc_syntax::{SyntaxKind, TextRange, TextSize};
+use ncc_syntax::{TextRange, TextSize};
 use rustc_hash::FxHashMap;
 
 use crate::{
@@ -200,16 +200,17 @@ fn transfer(block: &BlockData) -> Option<(Transfer, TextRange)> {
 #[salsa::tracked(returns(ref))]
 pub fn program(db: &dyn Db, file: SourceFile) -> Program {
     let kind = file_kind(db, file);
+    let chunks = db::file_chunks(db, file);
     let mut program = Program {
         kind,
-        blocks: Vec::new(),
+        blocks: Vec::with_capacity(chunks.iter().map(|c| c.chunk.blocks(db).len()).sum()),
         units: Vec::new(),
         end_of_main: None,
         early_unit_starts: Vec::new(),
         stray_blocks: Vec::new(),
         stray_g70: Vec::new(),
     };
-    let mut summaries = db::file_chunks(db, file)
+    let mut summaries = chunks
         .iter()
         .flat_map(|chunk| db::chunk_summaries(db, chunk.chunk).iter().map(move |s| s.shifted(chunk.offset)))
         .peekable();
@@ -298,9 +299,8 @@ pub fn prelude(db: &dyn Db, file: SourceFile) -> &str {
 
 /// Whether the file has the `%` header and the `*` end.
 pub fn header_and_end(db: &dyn Db, file: SourceFile) -> (bool, bool) {
-    let root = file.parse(db).syntax_node();
-    let has = |kind| root.children().any(|n| n.kind() == kind);
-    (has(SyntaxKind::HEADER), has(SyntaxKind::END))
+    let tree = file.parse(db).tree();
+    (tree.header().is_some(), tree.end().is_some())
 }
 
 /// The macrocycle files of the workspace by number.

@@ -132,7 +132,11 @@ fn hover_on_a_parameter_shows_its_value_there() {
             Manual: Chapter 9, Parametric programming - function R (Declaration of parameters; Invocation of parameters; Decimal point in parameter declarations); Chapter 11, Common rules; Double-precision control; Chapter 2, Address dictionary
 
 
-            **Value before this block:** `0.864` (864 thousandths)"#]],
+            **Value before this block:** `0.864` (864 thousandths)
+
+            ---
+
+            **Modal state before this block:** `G01 G17 G98 G40 G53 G94 G70 G80 G90 G34` · F`0` · S`0` · T unknown · D unknown"#]],
     );
 }
 
@@ -143,9 +147,9 @@ fn hover_in_a_subprogram_shows_the_value_of_each_call() {
     let (host, file, offset, _) = setup(&[("main.NCP", text)]);
     let hover = host.analysis().hover(file, offset).unwrap();
     assert!(
-        hover
-            .markdown
-            .ends_with("**Values before this block** (one per call): `5` (5000 thousandths), `7` (7000 thousandths)"),
+        hover.markdown.contains(
+            "**Values before this block** (one per call): `5` (5000 thousandths), `7` (7000 thousandths)\n\n---"
+        ),
         "{}",
         hover.markdown
     );

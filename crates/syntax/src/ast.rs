@@ -88,11 +88,18 @@ fn sign_of(parent: &SyntaxNode) -> Option<Sign> {
 impl SourceFile {
     /// Text before `%`, skipped by the control.
     pub fn preamble(&self) -> Option<SyntaxToken> {
-        token(&self.0, SyntaxKind::PREAMBLE)
+        // Only text before the first node can be the preamble; stopping
+        // there keeps this cheap on files of a million blocks.
+        self.0
+            .children_with_tokens()
+            .take_while(|element| element.as_node().is_none())
+            .filter_map(NodeOrToken::into_token)
+            .find(|t| t.kind() == SyntaxKind::PREAMBLE)
     }
 
     pub fn header(&self) -> Option<Header> {
-        child(&self.0)
+        // The header is the first node when there is one.
+        self.0.first_child().and_then(Header::cast)
     }
 
     /// All blocks in order, including words that lack their `N` (see
@@ -107,7 +114,10 @@ impl SourceFile {
     }
 
     pub fn end(&self) -> Option<End> {
-        child(&self.0)
+        // The end follows every block: look from the back.
+        std::iter::successors(self.0.last_child(), SyntaxNode::prev_sibling)
+            .take_while(|node| node.kind() != SyntaxKind::BLOCK)
+            .find_map(End::cast)
     }
 }
 

@@ -84,7 +84,8 @@ fn check_header_and_end(db: &dyn Db, file: SourceFile, program: &Program, out: &
 
 /// Block numbers are unique in a file (in a fixed-cycle file, per body).
 fn check_block_numbers(program: &Program, out: &mut Vec<Diagnostic>) {
-    let mut seen: FxHashMap<(Option<usize>, u64), TextRange> = FxHashMap::default();
+    let mut seen: FxHashMap<(Option<usize>, u64), TextRange> =
+        FxHashMap::with_capacity_and_hasher(program.blocks.len(), Default::default());
     for block in &program.blocks {
         let (Some(number), Some(range)) = (block.number, block.number_range) else { continue };
         let scope = if program.kind == FileKind::CycleFile { block.unit } else { None };

@@ -6,12 +6,20 @@
 //! the block counts, so a subprogram called with different values shows
 //! them all.
 
+pub(crate) mod completion;
+pub(crate) mod folding;
+pub(crate) mod format;
+pub(crate) mod highlight;
+pub(crate) mod inlay;
+pub(crate) mod references;
+pub(crate) mod symbols;
+
 use ncc_catalog::Item;
 use ncc_syntax::{TextRange, TextSize};
 
 use crate::{
     db::{Db, Settings, SourceFile},
-    flow::{self, ModalState, ParamState, show_thousandths},
+    flow::{self, Known, ModalState, ParamState, show_thousandths},
     lower::{BlockData, Value, Word},
     model::{self, Transfer},
 };
@@ -40,11 +48,14 @@ pub struct NavigationTarget {
 fn block_index_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<usize> {
     let blocks = &model::program(db, file).blocks;
     let index = blocks.partition_point(|b| b.end() < offset);
+    // Where one block ends and the next starts, the cursor is on the
+    // next one's block number.
+    let index = if blocks.get(index + 1).is_some_and(|b| b.offset == offset) { index + 1 } else { index };
     blocks.get(index).is_some_and(|b| b.offset <= offset).then_some(index)
 }
 
 /// The block at `offset`, lowered, with its index and file offset.
-fn block_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<(usize, TextSize, BlockData)> {
+pub(crate) fn block_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<(usize, TextSize, BlockData)> {
     let index = block_index_at(db, file, offset)?;
     let (start, block) = flow::lowered_block(db, file, index)?;
     Some((index, start, block))
@@ -118,6 +129,7 @@ pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<H
             {
                 markdown = format!("{call}\n\n{markdown}");
             }
+            markdown.push_str(&modal_text(&flow::states_before(db, file, index)));
             Some(HoverResult { range: word.range + start, markdown })
         }
         Target::Parameter { index: number, range } => {
@@ -125,6 +137,7 @@ pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<H
             let mut markdown = items.first()?.markdown(catalogue);
             let states = flow::states_before(db, file, index);
             markdown.push_str(&values_text(number, states.iter().map(|(_, params)| params)));
+            markdown.push_str(&modal_text(&states));
             Some(HoverResult { range: range + start, markdown })
         }
     }
@@ -140,6 +153,35 @@ fn call_text(db: &dyn Db, file: SourceFile, index: usize) -> Option<String> {
     };
     let missing = if transfer_targets(db, file, index, transfer).is_empty() { ", which does not exist" } else { "" };
     Some(format!("{what}{missing}."))
+}
+
+/// The modal state before the block: active G codes, F, S, T and D, once
+/// per distinct state the walk reached the block in.
+fn modal_text(states: &[(ModalState, ParamState)]) -> String {
+    let mut lines: Vec<String> = Vec::new();
+    for (state, _) in states {
+        let mut parts: Vec<String> = Vec::new();
+        let codes: Vec<String> =
+            state.g.iter().filter_map(|slot| slot.known().flatten()).map(|code| format!("G{code:02}")).collect();
+        parts.push(format!("`{}`", codes.join(" ")));
+        let settings = [('F', &state.feed), ('S', &state.speed), ('T', &state.tool), ('D', &state.offset)];
+        for (letter, setting) in settings {
+            parts.push(match setting {
+                Known::Is(Some(setting)) => format!("{letter}`{}`", setting.value),
+                Known::Is(None) => format!("{letter}`0`"),
+                Known::Unknown => format!("{letter} unknown"),
+            });
+        }
+        let line = parts.join(" · ");
+        if !lines.contains(&line) {
+            lines.push(line);
+        }
+    }
+    match lines.as_slice() {
+        [] => String::new(),
+        [one] => format!("\n\n---\n\n**Modal state before this block:** {one}"),
+        many => format!("\n\n---\n\n**Modal states before this block** (one per call):\n\n- {}", many.join("\n- ")),
+    }
 }
 
 /// The parameter's values before the block, as the walk found them.

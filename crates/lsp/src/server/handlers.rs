@@ -2,10 +2,10 @@
 
 use std::collections::HashMap;
 
-use ncc_analysis::NavigationTarget;
+use ncc_analysis::{CompletionKind, Dialect, DocumentSymbol, FoldKind, NavigationTarget, ReferenceKind, SymbolKind};
 use tower_lsp_server::ls_types as lsp;
 
-use super::{Snapshot, convert};
+use super::{Snapshot, convert, semantic};
 
 pub(crate) fn capabilities() -> lsp::ServerCapabilities {
     lsp::ServerCapabilities {
@@ -21,6 +21,25 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
             code_action_kinds: Some(vec![lsp::CodeActionKind::QUICKFIX]),
             ..Default::default()
         })),
+        completion_provider: Some(lsp::CompletionOptions {
+            // Codes and addresses are letters; call targets follow `L`.
+            trigger_characters: Some(["G", "M", "L", "R"].map(String::from).to_vec()),
+            ..Default::default()
+        }),
+        inlay_hint_provider: Some(lsp::OneOf::Left(true)),
+        references_provider: Some(lsp::OneOf::Left(true)),
+        document_highlight_provider: Some(lsp::OneOf::Left(true)),
+        document_symbol_provider: Some(lsp::OneOf::Left(true)),
+        folding_range_provider: Some(lsp::FoldingRangeProviderCapability::Simple(true)),
+        semantic_tokens_provider: Some(lsp::SemanticTokensServerCapabilities::SemanticTokensOptions(
+            lsp::SemanticTokensOptions {
+                legend: semantic::legend(Dialect::Cnc8x6),
+                full: Some(lsp::SemanticTokensFullOptions::Bool(true)),
+                range: Some(true),
+                ..Default::default()
+            },
+        )),
+        document_formatting_provider: Some(lsp::OneOf::Left(true)),
         ..Default::default()
     }
 }
@@ -62,4 +81,116 @@ pub(crate) fn code_actions(s: &Snapshot, range: lsp::Range) -> lsp::CodeActionRe
         }
     }
     actions
+}
+
+pub(crate) fn completion(s: &Snapshot, position: lsp::Position) -> Vec<lsp::CompletionItem> {
+    let items = s.analysis.completions(s.file, s.map.offset(position));
+    // The analysis lists the most relevant first; the sort text keeps that.
+    let width = items.len().to_string().len();
+    items
+        .into_iter()
+        .enumerate()
+        .map(|(rank, item)| lsp::CompletionItem {
+            kind: Some(match item.kind {
+                CompletionKind::Code => lsp::CompletionItemKind::KEYWORD,
+                CompletionKind::Address => lsp::CompletionItemKind::FIELD,
+                CompletionKind::Subprogram | CompletionKind::Macrocycle => lsp::CompletionItemKind::FUNCTION,
+                CompletionKind::Block => lsp::CompletionItemKind::REFERENCE,
+                CompletionKind::Parameter => lsp::CompletionItemKind::VARIABLE,
+            }),
+            detail: Some(item.detail),
+            documentation: item.documentation.map(|text| lsp::Documentation::MarkupContent(convert::markdown(text))),
+            sort_text: Some(format!("{rank:0width$}")),
+            filter_text: Some(item.label.clone()),
+            text_edit: Some(lsp::CompletionTextEdit::Edit(lsp::TextEdit {
+                range: s.map.range(item.replace),
+                new_text: item.insert_text,
+            })),
+            label: item.label,
+            ..Default::default()
+        })
+        .collect()
+}
+
+pub(crate) fn formatting(s: &Snapshot) -> Vec<lsp::TextEdit> {
+    s.analysis.format(s.file).iter().map(|edit| s.map.text_edit(edit)).collect()
+}
+
+pub(crate) fn inlay_hints(s: &Snapshot, range: lsp::Range) -> Vec<lsp::InlayHint> {
+    s.analysis
+        .inlay_hints(s.file, Some(s.map.range_offsets(range)))
+        .into_iter()
+        .map(|hint| lsp::InlayHint {
+            position: s.map.position(hint.offset),
+            label: lsp::InlayHintLabel::String(hint.label),
+            kind: None,
+            text_edits: None,
+            tooltip: hint.tooltip.map(|text| lsp::InlayHintTooltip::MarkupContent(convert::markdown(text))),
+            padding_left: Some(true),
+            padding_right: None,
+            data: None,
+        })
+        .collect()
+}
+
+pub(crate) fn references(
+    s: &Snapshot,
+    position: lsp::Position,
+    include_declaration: bool,
+) -> Vec<ncc_analysis::Reference> {
+    s.analysis.references(s.file, s.map.offset(position), include_declaration)
+}
+
+/// Whether a reference is written (for document highlights and clients
+/// that show it).
+pub(crate) fn is_write(kind: ReferenceKind) -> bool {
+    matches!(kind, ReferenceKind::Definition | ReferenceKind::Write)
+}
+
+pub(crate) fn document_symbols(s: &Snapshot) -> Vec<lsp::DocumentSymbol> {
+    fn convert_symbol(s: &Snapshot, symbol: DocumentSymbol) -> lsp::DocumentSymbol {
+        #[allow(deprecated)] // `deprecated` is a required field of the type.
+        lsp::DocumentSymbol {
+            name: symbol.name,
+            detail: symbol.detail,
+            kind: match symbol.kind {
+                SymbolKind::Program => lsp::SymbolKind::MODULE,
+                SymbolKind::Subprogram | SymbolKind::Macrocycle | SymbolKind::CycleBody => lsp::SymbolKind::FUNCTION,
+                SymbolKind::JumpTarget => lsp::SymbolKind::KEY,
+            },
+            tags: None,
+            deprecated: None,
+            range: s.map.range(symbol.range),
+            selection_range: s.map.range(symbol.selection_range),
+            children: Some(symbol.children.into_iter().map(|child| convert_symbol(s, child)).collect()),
+        }
+    }
+    s.analysis.document_symbols(s.file).into_iter().map(|symbol| convert_symbol(s, symbol)).collect()
+}
+
+pub(crate) fn folding_ranges(s: &Snapshot) -> Vec<lsp::FoldingRange> {
+    s.analysis
+        .folding_ranges(s.file)
+        .into_iter()
+        .filter_map(|fold| {
+            let (start, end) = (s.map.position(fold.range.start()), s.map.position(fold.range.end()));
+            (end.line > start.line).then(|| lsp::FoldingRange {
+                start_line: start.line,
+                end_line: end.line,
+                kind: Some(match fold.kind {
+                    FoldKind::Region => lsp::FoldingRangeKind::Region,
+                    FoldKind::Comment => lsp::FoldingRangeKind::Comment,
+                }),
+                ..Default::default()
+            })
+        })
+        .collect()
+}
+
+pub(crate) fn semantic_tokens(s: &Snapshot, range: Option<lsp::Range>) -> lsp::SemanticTokens {
+    let ranges = match range {
+        Some(range) => s.analysis.highlight_range(s.file, s.map.range_offsets(range)),
+        None => s.analysis.highlight(s.file),
+    };
+    lsp::SemanticTokens { result_id: None, data: semantic::encode(&s.map, &ranges) }
 }

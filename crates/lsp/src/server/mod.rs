@@ -13,7 +13,9 @@
 //! the flow walk is done — unless a newer edit came first.
 
 mod convert;
+mod frames;
 mod handlers;
+mod semantic;
 mod workspace;
 
 use std::{
@@ -27,6 +29,7 @@ use std::{
 };
 
 use ncc_analysis::{Analysis, Cancelled, Diagnostic, FileId};
+use tokio::sync::mpsc;
 use tower_lsp_server::{
     Client, LanguageServer, LspService,
     jsonrpc::{self, ErrorCode},
@@ -76,7 +79,20 @@ pub(crate) fn run(log_level: LogLevel) -> ExitCode {
     let flag = shut_down.clone();
     runtime.block_on(async move {
         let (service, socket) = LspService::new(move |client| Server::new(client, flag));
-        tower_lsp_server::Server::new(tokio::io::stdin(), tokio::io::stdout(), socket).serve(service).await;
+        // The protocol layer talks to in-memory pipes; the frames guard sits
+        // between them and stdio.
+        let (server_input, guarded_input) = tokio::io::duplex(1 << 16);
+        let (server_output, server_frames) = tokio::io::duplex(1 << 16);
+        let (frames_tx, frames_rx) = mpsc::unbounded_channel();
+        let guard = tokio::spawn(frames::guard_input(tokio::io::stdin(), guarded_input, frames_tx.clone()));
+        let forward = tokio::spawn(frames::forward_output(server_frames, frames_tx));
+        let writer = tokio::spawn(frames::write_output(tokio::io::stdout(), frames_rx));
+        tower_lsp_server::Server::new(server_input, server_output, socket).serve(service).await;
+        // Stdin may never close (a client that sent `exit`): stop reading,
+        // and let everything the server wrote reach stdout.
+        guard.abort();
+        let _ = forward.await;
+        let _ = writer.await;
     });
     // Blocking tasks still computing are abandoned: their snapshots answer
     // nobody now.
@@ -108,6 +124,25 @@ pub(crate) struct Server {
     client: Client,
     state: Arc<Mutex<State>>,
     shut_down: Arc<AtomicBool>,
+    publisher: mpsc::UnboundedSender<Publication>,
+}
+
+/// Diagnostics of one version of a document, to send.
+type Publication = (Uri, Vec<lsp::Diagnostic>, i32);
+
+/// Sends diagnostics in the order they were computed, never an older
+/// version's after a newer one's. Blocking threads hand their results over
+/// without waiting, so a snapshot is never held while the output is busy
+/// (an edit waiting for that snapshot would block the runtime).
+async fn publish(client: Client, mut publications: mpsc::UnboundedReceiver<Publication>) {
+    let mut sent: HashMap<Uri, i32> = HashMap::new();
+    while let Some((uri, diagnostics, version)) = publications.recv().await {
+        if sent.get(&uri).is_some_and(|&newest| newest > version) {
+            continue;
+        }
+        sent.insert(uri.clone(), version);
+        client.publish_diagnostics(uri, diagnostics, Some(version)).await;
+    }
 }
 
 /// A request's view of a document: a snapshot and what converts positions.
@@ -120,7 +155,9 @@ struct Snapshot {
 
 impl Server {
     fn new(client: Client, shut_down: Arc<AtomicBool>) -> Server {
-        Server { client, state: Arc::default(), shut_down }
+        let (publisher, publications) = mpsc::unbounded_channel();
+        tokio::spawn(publish(client.clone(), publications));
+        Server { client, state: Arc::default(), shut_down, publisher }
     }
 
     fn state(&self) -> MutexGuard<'_, State> {
@@ -173,15 +210,14 @@ impl Server {
             let analysis = state.workspaces.get(document.workspace).analysis();
             (analysis, document.file, document.version, document.map.clone(), document.flow.clone())
         };
-        let client = self.client.clone();
+        let publisher = self.publisher.clone();
         let state = self.state.clone();
-        let runtime = tokio::runtime::Handle::current();
         // The snapshot lives only on the blocking thread, so an edit waiting
         // to cancel it never waits for the async runtime.
         tokio::task::spawn_blocking(move || {
             let send = |diagnostics: Vec<Diagnostic>| {
                 let diagnostics = diagnostics.iter().map(|d| convert::diagnostic(&map, &uri, d)).collect();
-                runtime.block_on(client.publish_diagnostics(uri.clone(), diagnostics, Some(version)));
+                let _ = publisher.send((uri.clone(), diagnostics, version));
             };
             let started = std::time::Instant::now();
             let Ok(local) = Cancelled::catch(|| analysis.local_diagnostics(file)) else { return };
@@ -332,6 +368,88 @@ impl LanguageServer for Server {
         let links: Vec<_> =
             targets.into_iter().filter_map(|target| state.workspaces.location_link(workspace, target)).collect();
         Ok((!links.is_empty()).then_some(lsp::GotoDefinitionResponse::Link(links)))
+    }
+
+    async fn completion(&self, params: lsp::CompletionParams) -> jsonrpc::Result<Option<lsp::CompletionResponse>> {
+        let position = params.text_document_position;
+        let items =
+            self.query(&position.text_document.uri, move |s| handlers::completion(s, position.position)).await?;
+        Ok(Some(lsp::CompletionResponse::Array(items)))
+    }
+
+    async fn formatting(&self, params: lsp::DocumentFormattingParams) -> jsonrpc::Result<Option<Vec<lsp::TextEdit>>> {
+        self.query(&params.text_document.uri, handlers::formatting).await.map(Some)
+    }
+
+    async fn inlay_hint(&self, params: lsp::InlayHintParams) -> jsonrpc::Result<Option<Vec<lsp::InlayHint>>> {
+        self.query(&params.text_document.uri, move |s| handlers::inlay_hints(s, params.range)).await.map(Some)
+    }
+
+    async fn references(&self, params: lsp::ReferenceParams) -> jsonrpc::Result<Option<Vec<lsp::Location>>> {
+        let position = params.text_document_position;
+        let uri = position.text_document.uri.clone();
+        let include = params.context.include_declaration;
+        let references = self.query(&uri, move |s| handlers::references(s, position.position, include)).await?;
+        let state = self.state();
+        let Some(workspace) = state.documents.get(&uri).map(|d| d.workspace) else { return Ok(None) };
+        let locations = references
+            .into_iter()
+            .filter_map(|reference| state.workspaces.location(workspace, reference.file, reference.range))
+            .collect();
+        Ok(Some(locations))
+    }
+
+    async fn document_highlight(
+        &self,
+        params: lsp::DocumentHighlightParams,
+    ) -> jsonrpc::Result<Option<Vec<lsp::DocumentHighlight>>> {
+        let position = params.text_document_position_params;
+        let highlights = self
+            .query(&position.text_document.uri, move |s| {
+                handlers::references(s, position.position, true)
+                    .into_iter()
+                    .filter(|reference| reference.file == s.file)
+                    .map(|reference| lsp::DocumentHighlight {
+                        range: s.map.range(reference.range),
+                        kind: Some(if handlers::is_write(reference.kind) {
+                            lsp::DocumentHighlightKind::WRITE
+                        } else {
+                            lsp::DocumentHighlightKind::READ
+                        }),
+                    })
+                    .collect()
+            })
+            .await?;
+        Ok(Some(highlights))
+    }
+
+    async fn document_symbol(
+        &self,
+        params: lsp::DocumentSymbolParams,
+    ) -> jsonrpc::Result<Option<lsp::DocumentSymbolResponse>> {
+        let symbols = self.query(&params.text_document.uri, handlers::document_symbols).await?;
+        Ok(Some(lsp::DocumentSymbolResponse::Nested(symbols)))
+    }
+
+    async fn folding_range(&self, params: lsp::FoldingRangeParams) -> jsonrpc::Result<Option<Vec<lsp::FoldingRange>>> {
+        self.query(&params.text_document.uri, handlers::folding_ranges).await.map(Some)
+    }
+
+    async fn semantic_tokens_full(
+        &self,
+        params: lsp::SemanticTokensParams,
+    ) -> jsonrpc::Result<Option<lsp::SemanticTokensResult>> {
+        let tokens = self.query(&params.text_document.uri, |s| handlers::semantic_tokens(s, None)).await?;
+        Ok(Some(lsp::SemanticTokensResult::Tokens(tokens)))
+    }
+
+    async fn semantic_tokens_range(
+        &self,
+        params: lsp::SemanticTokensRangeParams,
+    ) -> jsonrpc::Result<Option<lsp::SemanticTokensRangeResult>> {
+        let range = params.range;
+        let tokens = self.query(&params.text_document.uri, move |s| handlers::semantic_tokens(s, Some(range))).await?;
+        Ok(Some(lsp::SemanticTokensRangeResult::Tokens(tokens)))
     }
 
     async fn code_action(&self, params: lsp::CodeActionParams) -> jsonrpc::Result<Option<lsp::CodeActionResponse>> {

@@ -149,6 +149,14 @@ impl Workspaces {
         }
     }
 
+    /// A range of a file as a location, if the file has an address.
+    pub fn location(&self, index: usize, file: FileId, range: ncc_analysis::TextRange) -> Option<lsp::Location> {
+        let workspace = &self.list[index];
+        let uri = workspace.uris.get(&file)?.clone();
+        let map = LineMap::new(workspace.host.analysis().text(file));
+        Some(lsp::Location::new(uri, map.range(range)))
+    }
+
     /// A navigation target as a link, if its file has an address.
     pub fn location_link(&self, index: usize, target: NavigationTarget) -> Option<lsp::LocationLink> {
         let workspace = &self.list[index];

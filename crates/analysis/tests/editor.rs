@@ -1,0 +1,522 @@
+//! Document symbols, folding, semantic highlighting and find references.
+//! `$0` in a program marks the cursor.
+
+#[path = "../../syntax/tests/strategies/mod.rs"]
+mod strategies;
+
+use expect_test::{Expect, expect};
+use ncc_analysis::{
+    Analysis, AnalysisHost, Config, Dialect, DocumentSymbol, FileId, HighlightKind, RootDatabase, TextEdit, TextRange,
+    TextSize,
+};
+use proptest::prelude::*;
+use strategies::{block_program, program_text};
+
+/// A partprogram with subprograms, jumps, parameters and Czech comments.
+const PROGRAM: &str = "%100 \"DÍL – ČEP Ø20\"
+\" NULOVÝ BOD: STŘED ČELA
+\" NÁSTROJ T1 VRTÁK Ø8
+N10 G90 G17 G54 R12=5. R13=-2.5 \"začátek\"
+N20 G00 X0 Y0 ZR12 S1200 M03
+N30 G01 X-R13 F100
+N40 G71 L100 Q2
+N50 G91 X1.
+N60 G73 L50 Q3
+N70 G71 L100
+N80 M30
+\" podprogram drážky
+N100 G79 L100 \"DRÁŽKA\"
+N110 G01 ZR13 R12=R13
+N120 G73 L110 Q1
+N130 G70
+\" NÁVRAT DO VÝCHOZÍ POLOHY
+N200 G79 L200
+N210 G70
+*
+";
+
+const MACROCYCLE: &str = "N1 G79 L9001 \"VRTÁNÍ ŘADY\"
+\" R20 = ROZTEČ
+\" R21 = POČET
+N2 G01 ZR20
+N3 G73 L2 Q3
+N4 G70
+*
+";
+
+const CYCLE_FILE: &str = "\"  $PC - PEVNÉ CYKLY
+N1 G79 L81 \"VRTÁNÍ\"
+N2 G01 ZR31 FR26
+N3 G00 ZR32 G70
+N1 G79 L82
+N2 G04 QR28
+N3 G70
+*
+";
+
+/// The host with `files` added, the ids, and the cursor (file, offset) if
+/// one of them has `$0`.
+fn setup(files: &[(&str, &str)]) -> (AnalysisHost, Vec<FileId>, Option<(FileId, TextSize)>) {
+    let mut host = AnalysisHost::default();
+    let mut cursor = None;
+    let mut ids = Vec::new();
+    for (path, text) in files {
+        let offset = text.find("$0");
+        let id = host.add_file(*path, text.replace("$0", ""));
+        if let Some(offset) = offset {
+            cursor = Some((id, TextSize::try_from(offset).unwrap()));
+        }
+        ids.push(id);
+    }
+    (host, ids, cursor)
+}
+
+/// A range's text; its first and last line if it spans several.
+fn show(text: &str, range: TextRange) -> String {
+    let shown = &text[range];
+    match (shown.lines().next(), shown.lines().last()) {
+        (Some(first), Some(last)) if shown.contains('\n') => format!("`{first}` … `{last}`"),
+        _ => format!("`{shown}`"),
+    }
+}
+
+fn check_symbols(path: &str, text: &str, expect: Expect) {
+    fn render(analysis: &Analysis, file: FileId, symbols: &[DocumentSymbol], depth: usize, out: &mut String) {
+        let text = analysis.text(file);
+        for symbol in symbols {
+            assert!(symbol.range.contains_range(symbol.selection_range), "{symbol:?}");
+            let detail = symbol.detail.as_deref().map(|d| format!(" ({d})")).unwrap_or_default();
+            out.push_str(&format!(
+                "{}{:?} {}{detail}: {} select {}\n",
+                "  ".repeat(depth),
+                symbol.kind,
+                symbol.name,
+                show(&text, symbol.range),
+                show(&text, symbol.selection_range),
+            ));
+            for child in &symbol.children {
+                assert!(symbol.range.contains_range(child.range), "{child:?} outside {symbol:?}");
+            }
+            render(analysis, file, &symbol.children, depth + 1, out);
+        }
+    }
+    let (host, ids, _) = setup(&[(path, text)]);
+    let analysis = host.analysis();
+    let mut out = String::new();
+    render(&analysis, ids[0], &analysis.document_symbols(ids[0]), 0, &mut out);
+    expect.assert_eq(&out);
+}
+
+fn check_folds(path: &str, text: &str, expect: Expect) {
+    let (host, ids, _) = setup(&[(path, text)]);
+    let analysis = host.analysis();
+    let folds: Vec<String> = analysis
+        .folding_ranges(ids[0])
+        .iter()
+        .map(|fold| format!("{:?} {}", fold.kind, show(text, fold.range)))
+        .collect();
+    expect.assert_eq(&folds.join("\n"));
+}
+
+/// Each line with its highlighted pieces, `text:kind`.
+fn check_highlight(path: &str, text: &str, expect: Expect) {
+    let (host, ids, _) = setup(&[(path, text)]);
+    let ranges = host.analysis().highlight(ids[0]);
+    let mut out = String::new();
+    let mut line_start = 0;
+    for line in text.split_inclusive('\n') {
+        let line_end = line_start + line.len();
+        let pieces: Vec<String> = ranges
+            .iter()
+            .filter(|h| (line_start..line_end).contains(&usize::from(h.range.start())))
+            .map(|h| format!("{}:{}", &text[h.range], short(h.kind)))
+            .collect();
+        out.push_str(&format!("{}\n", pieces.join(" ")));
+        line_start = line_end;
+    }
+    expect.assert_eq(&out);
+}
+
+fn short(kind: HighlightKind) -> String {
+    match kind {
+        HighlightKind::Code { letter, group } => {
+            let groups = &Dialect::Cnc8x6.catalogue().groups;
+            format!("{}{}", char::from(letter), group.map_or("?", |g| groups[usize::from(g)].id.as_str()))
+        }
+        HighlightKind::Address(role) => format!("{role:?}"),
+        HighlightKind::Parameter { write: true } => "write".to_owned(),
+        HighlightKind::Parameter { write: false } => "read".to_owned(),
+        other => format!("{other:?}"),
+    }
+}
+
+fn check_references(files: &[(&str, &str)], include_declaration: bool, expect: Expect) {
+    expect.assert_eq(&references(files, include_declaration));
+}
+
+/// References as `path:line:column: text kind`, one per line.
+fn references(files: &[(&str, &str)], include_declaration: bool) -> String {
+    let (host, _, cursor) = setup(files);
+    let (file, offset) = cursor.expect("a `$0` cursor");
+    let analysis = host.analysis();
+    let found: Vec<String> = analysis
+        .references(file, offset, include_declaration)
+        .iter()
+        .map(|r| {
+            let text = analysis.text(r.file);
+            let before = &text[..usize::from(r.range.start())];
+            let line = before.matches('\n').count() + 1;
+            let column = before.rsplit('\n').next().unwrap_or_default().chars().count() + 1;
+            format!("{}:{line}:{column}: {} {:?}", analysis.path(r.file), &text[r.range], r.kind)
+        })
+        .collect();
+    found.join("\n")
+}
+
+fn at(text: &str, needle: &str) -> String {
+    let at = text.find(needle).unwrap_or_else(|| panic!("`{needle}` in the program"));
+    format!("{}$0{}", &text[..at], &text[at..])
+}
+
+#[test]
+fn symbols_of_a_program_with_subprograms_and_jumps() {
+    check_symbols(
+        "PART.NCP",
+        PROGRAM,
+        expect![[r#"
+            Program %100 (DÍL – ČEP Ø20): `%100 "DÍL – ČEP Ø20"` … `N80 M30` select `%100`
+              JumpTarget N50 (jumped to from N60): `N50 G91 X1.` select `N50`
+            Subprogram L100 (DRÁŽKA · called 2×): `N100 G79 L100 "DRÁŽKA"` … `N130 G70` select `L100`
+              JumpTarget N110 (jumped to from N120): `N110 G01 ZR13 R12=R13` select `N110`
+            Subprogram L200 (NÁVRAT DO VÝCHOZÍ POLOHY · not called): `N200 G79 L200` … `N210 G70` select `L200`
+        "#]],
+    );
+}
+
+#[test]
+fn symbols_of_a_program_without_header() {
+    check_symbols(
+        "dir/PART.NCP",
+        "N10 G00 X0\nN20 M30\n",
+        expect![[r#"
+        Program PART: `N10 G00 X0` … `N20 M30` select `N10`
+    "#]],
+    );
+}
+
+#[test]
+fn symbols_of_a_macrocycle_file() {
+    check_symbols(
+        "macros/L9001",
+        MACROCYCLE,
+        expect![[r#"
+        Macrocycle L9001 (VRTÁNÍ ŘADY): `N1 G79 L9001 "VRTÁNÍ ŘADY"` … `N4 G70` select `L9001`
+          JumpTarget N2 (jumped to from N3): `N2 G01 ZR20` select `N2`
+    "#]],
+    );
+}
+
+#[test]
+fn symbols_of_a_cycle_file() {
+    check_symbols(
+        "PCYKLY.NCP",
+        CYCLE_FILE,
+        expect![[r#"
+        CycleBody L81 (VRTÁNÍ): `N1 G79 L81 "VRTÁNÍ"` … `N3 G00 ZR32 G70` select `L81`
+        CycleBody L82: `N1 G79 L82` … `N3 G70` select `L82`
+    "#]],
+    );
+}
+
+#[test]
+fn folds_units_and_comment_runs() {
+    check_folds(
+        "PART.NCP",
+        PROGRAM,
+        expect![[r#"
+        Region `%100 "DÍL – ČEP Ø20"` … `N80 M30`
+        Comment `" NULOVÝ BOD: STŘED ČELA` … `" NÁSTROJ T1 VRTÁK Ø8`
+        Region `N100 G79 L100 "DRÁŽKA"` … `N130 G70`
+        Region `N200 G79 L200` … `N210 G70`"#]],
+    );
+    check_folds(
+        "macros/L9001",
+        MACROCYCLE,
+        expect![[r#"
+        Region `N1 G79 L9001 "VRTÁNÍ ŘADY"` … `N4 G70`
+        Comment `" R20 = ROZTEČ` … `" R21 = POČET`"#]],
+    );
+}
+
+#[test]
+fn a_single_comment_line_or_a_one_line_unit_does_not_fold() {
+    check_folds(
+        "PART.NCP",
+        "%1 \"A\"\n\" one\nN10 M30 \"x\"\n\" two\n\n\" three\n",
+        expect![[r#"Region `%1 "A"` … `N10 M30 "x"`"#]],
+    );
+}
+
+#[test]
+fn highlight_a_program() {
+    check_highlight(
+        "PART.NCP",
+        PROGRAM,
+        expect![[r#"
+            %:Keyword 100:Number "DÍL – ČEP Ø20":Comment
+            " NULOVÝ BOD: STŘED ČELA:Comment
+            " NÁSTROJ T1 VRTÁK Ø8:Comment
+            N10:BlockNumber G90:GG9 G17:GG1 G54:GG5 R12:write =:Operator 5.:Number R13:write =:Operator -2.5:Number "začátek":Comment
+            N20:BlockNumber G00:GG0 X:Axis 0:Number Y:Axis 0:Number Z:Axis R12:read S:Speed 1200:Number M03:MM2
+            N30:BlockNumber G01:GG0 X:Axis -:Operator R13:read F:Feed 100:Number
+            N40:BlockNumber G71:GG7 L:Label 100:Number Q:Count 2:Number
+            N50:BlockNumber G91:GG9 X:Axis 1.:Number
+            N60:BlockNumber G73:GG7 L:Label 50:Number Q:Count 3:Number
+            N70:BlockNumber G71:GG7 L:Label 100:Number
+            N80:BlockNumber M30:MM1
+            " podprogram drážky:Comment
+            N100:BlockNumber G79:GG7 L:Label 100:Number "DRÁŽKA":Comment
+            N110:BlockNumber G01:GG0 Z:Axis R13:read R12:write =:Operator R13:read
+            N120:BlockNumber G73:GG7 L:Label 110:Number Q:Count 1:Number
+            N130:BlockNumber G70:GG7
+            " NÁVRAT DO VÝCHOZÍ POLOHY:Comment
+            N200:BlockNumber G79:GG7 L:Label 200:Number
+            N210:BlockNumber G70:GG7
+            *:Keyword
+        "#]],
+    );
+}
+
+#[test]
+fn highlight_a_cycle_file() {
+    check_highlight(
+        "PCYKLY.NCP",
+        CYCLE_FILE,
+        expect![[r#"
+        ":Comment $PC:Keyword - PEVNÉ CYKLY:Comment
+        N1:BlockNumber G79:GG7 L:Label 81:Number "VRTÁNÍ":Comment
+        N2:BlockNumber G01:GG0 Z:Axis R31:read F:Feed R26:read
+        N3:BlockNumber G00:GG0 Z:Axis R32:read G70:GG7
+        N1:BlockNumber G79:GG7 L:Label 82:Number
+        N2:BlockNumber G04:GG10 Q:Count R28:read
+        N3:BlockNumber G70:GG7
+        *:Keyword
+    "#]],
+    );
+}
+
+#[test]
+fn highlight_errors_and_unusual_words() {
+    let text = "leader\n%1\nN10 G01 X10 # Y5 g1.5 M99 O5 G 01\n/1 N20 R1 = 5 MSG R2=R3 GR4 =\nN30 X - 5 ,5\n* \"end\" never read\n";
+    check_highlight(
+        "ODD.NCP",
+        text,
+        expect![[r#"
+        leader:Comment
+        %:Keyword 1:Number
+        N10:BlockNumber G01:GG0 X:Axis 10:Number #:Error Y:Axis 5:Number g1.5:G? M99:MM14 O:UnknownAddress 5:Number G:GG0 01:GG0
+        /:Keyword 1:Number N20:BlockNumber R1:write =:Operator 5:Number MSG:Error R2:write =:Operator R3:read G:G? R4:write =:Operator
+        N30:BlockNumber X:Axis -:Number 5:Number ,:Error 5:Error
+        *:Keyword "end":Comment never read:Comment
+    "#]],
+    );
+}
+
+#[test]
+fn highlight_range_takes_the_blocks_that_touch_it() {
+    let (host, ids, _) = setup(&[("PART.NCP", PROGRAM)]);
+    let analysis = host.analysis();
+    let all = analysis.highlight(ids[0]);
+    let start = PROGRAM.find("N30").unwrap();
+    let end = PROGRAM.find("N50").unwrap() - 3;
+    let range = TextRange::new(TextSize::try_from(start).unwrap(), TextSize::try_from(end).unwrap());
+    let visible = analysis.highlight_range(ids[0], range);
+    let shown: Vec<&str> = visible.iter().map(|h| &PROGRAM[h.range]).collect();
+    assert_eq!(shown, ["N30", "G01", "X", "-", "R13", "F", "100", "N40", "G71", "L", "100", "Q", "2"]);
+    assert!(visible.iter().all(|h| all.contains(h)));
+}
+
+#[test]
+fn references_of_a_subprogram() {
+    let from_call = references(&[("PART.NCP", &at(PROGRAM, "L100 Q2"))], true);
+    expect![[r#"
+        PART.NCP:13:10: L100 Definition
+        PART.NCP:7:9: L100 Call
+        PART.NCP:10:9: L100 Call"#]]
+    .assert_eq(&from_call);
+    assert_eq!(references(&[("PART.NCP", &at(PROGRAM, "G79 L100"))], true), from_call);
+    assert_eq!(references(&[("PART.NCP", &at(PROGRAM, "71 L100 Q2"))], true), from_call);
+    check_references(
+        &[("PART.NCP", &at(PROGRAM, "L100 Q2"))],
+        false,
+        expect![[r#"
+        PART.NCP:7:9: L100 Call
+        PART.NCP:10:9: L100 Call"#]],
+    );
+}
+
+#[test]
+fn references_of_a_macrocycle_across_files() {
+    let caller = "%2\nN10 G72 L9001\nN20 G72 L9001 Q2\nN30 M30\n*\n";
+    let other = "%3\nN10 G72 L9001\nN20 M30\n*\n";
+    let from_call =
+        references(&[("A.NCP", &at(caller, "L9001 Q2")), ("B.NCP", other), ("macros/L9001", MACROCYCLE)], true);
+    expect![[r#"
+        macros/L9001:1:8: L9001 Definition
+        A.NCP:2:9: L9001 Call
+        A.NCP:3:9: L9001 Call
+        B.NCP:2:9: L9001 Call"#]]
+    .assert_eq(&from_call);
+    let from_definition =
+        references(&[("A.NCP", caller), ("B.NCP", other), ("macros/L9001", &at(MACROCYCLE, "L9001"))], true);
+    assert_eq!(from_definition, from_call);
+}
+
+#[test]
+fn references_of_a_jump_target() {
+    let from_target = references(&[("PART.NCP", &at(PROGRAM, "N110"))], true);
+    expect![[r#"
+        PART.NCP:14:1: N110 Definition
+        PART.NCP:15:10: L110 Jump"#]]
+    .assert_eq(&from_target);
+    assert_eq!(references(&[("PART.NCP", &at(PROGRAM, "L110"))], true), from_target);
+    // The subprogram's `G73 L50` cannot reach N50 of the main body.
+    let text = PROGRAM.replace("L110 Q1", "L50 Q1");
+    check_references(
+        &[("PART.NCP", &at(&text, "N50"))],
+        true,
+        expect![[r#"
+        PART.NCP:8:1: N50 Definition
+        PART.NCP:9:9: L50 Jump"#]],
+    );
+}
+
+#[test]
+fn references_of_a_parameter() {
+    let from_read = references(&[("PART.NCP", &at(PROGRAM, "R13 F100"))], true);
+    expect![[r#"
+        PART.NCP:4:24: R13 Write
+        PART.NCP:6:11: R13 Read
+        PART.NCP:14:11: R13 Read
+        PART.NCP:14:19: R13 Read"#]]
+    .assert_eq(&from_read);
+    assert_eq!(references(&[("PART.NCP", &at(PROGRAM, "R13=-2.5"))], true), from_read);
+}
+
+#[test]
+fn references_of_a_control_word_include_the_arithmetic_that_runs_it() {
+    let text = "%1\nN10 R20=5. R21=5\nN20 G29 R5=-42210226 R6=-42210127\n R7=-03272027 R8=08270027\nN30 G26 $0R5=48110095\nN40 M30\n*\n";
+    check_references(
+        &[("PART.NCP", text)],
+        true,
+        expect![[r#"
+        PART.NCP:3:5: G29 Read
+        PART.NCP:3:9: R5 Write
+        PART.NCP:5:5: G26 Read
+        PART.NCP:5:9: R5 Write"#]],
+    );
+}
+
+#[test]
+fn no_references_on_other_words() {
+    check_references(&[("PART.NCP", &at(PROGRAM, "G90"))], true, expect![""]);
+    check_references(&[("PART.NCP", &at(PROGRAM, "DÍL"))], true, expect![""]);
+}
+
+#[test]
+fn highlighting_computes_nothing_and_references_relower_one_chunk_after_an_edit() {
+    let mut text = String::from("%1\nN1 R12=5.\n");
+    for n in 2..5000 {
+        text.push_str(&format!("N{n} G01 X{n}. ZR12\n"));
+    }
+    text.push_str("N5000 M30\n*\n");
+    let mut host = AnalysisHost::with_database(RootDatabase::with_execution_log(), Config::default());
+    let file = host.add_file("main.NCP", text.as_str());
+    host.analysis().highlight(file);
+    assert_eq!(host.db().take_executions(), Vec::<String>::new(), "highlighting reads the tree only");
+
+    let cursor = TextSize::try_from(text.find("R12=").unwrap()).unwrap();
+    assert_eq!(host.analysis().references(file, cursor, true).len(), 4999);
+    let chunks = host.db().take_executions().iter().filter(|e| e.starts_with("chunk_parameter_uses")).count();
+    assert!(chunks > 5, "a program of 5000 blocks has several chunks: {chunks}");
+
+    let at = TextSize::try_from(text.find("N2500 G01 X2500.").unwrap() + "N2500 G01 X2".len()).unwrap();
+    host.apply_edit(file, &TextEdit::replace(TextRange::at(at, TextSize::from(1)), "6"));
+    assert_eq!(host.analysis().references(file, cursor, true).len(), 4999);
+    let executions = host.db().take_executions();
+    let chunks = executions.iter().filter(|e| e.starts_with("chunk_parameter_uses")).count();
+    assert_eq!(chunks, 1, "only the edited chunk is lowered again: {executions:#?}");
+}
+
+/// Checks that the highlighting of `text` is well formed, and that of the
+/// blocks around `start..end` is part of it.
+fn check_highlight_ranges(path: &str, text: &str, start: usize, end: usize) {
+    let mut host = AnalysisHost::default();
+    let file = host.add_file(path, text);
+    let analysis = host.analysis();
+    let ranges = analysis.highlight(file);
+    let kinds = HighlightKind::all(Dialect::Cnc8x6);
+    let mut previous_end = 0;
+    for highlight in &ranges {
+        let range = std::ops::Range::<usize>::from(highlight.range);
+        assert!(range.start >= previous_end && range.start < range.end && range.end <= text.len(), "{highlight:?}");
+        assert!(text.is_char_boundary(range.start) && text.is_char_boundary(range.end), "{highlight:?}");
+        let piece = &text[range.clone()];
+        assert!(!piece.contains(['\n', '\r']), "{piece:?}");
+        assert!(!piece.starts_with([' ', '\t']) && !piece.ends_with([' ', '\t']), "{piece:?}");
+        assert!(kinds.contains(&highlight.kind), "{:?} is not listed", highlight.kind);
+        previous_end = range.end;
+    }
+    let boundary = |at: usize| (0..=at.min(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap_or(0);
+    let (start, end) = (boundary(start), boundary(end));
+    let within = TextRange::new(TextSize::try_from(start).unwrap(), TextSize::try_from(end.max(start)).unwrap());
+    for highlight in analysis.highlight_range(file, within) {
+        assert!(ranges.contains(&highlight), "{highlight:?}");
+    }
+}
+
+#[test]
+fn odd_input_gives_well_formed_answers() {
+    for text in ["", "%", "\u{b}", "\"NN\r\n\"$PC N", "$PC\"\"\"  ", "\u{201E}  ", "\"  $PC\nN1 X1\n\"  \n"] {
+        check_highlight_ranges("P.NCP", text, 0, 0);
+        let (host, ids, _) = setup(&[("P.NCP", text)]);
+        let analysis = host.analysis();
+        assert!(analysis.document_symbols(ids[0]).iter().all(|s| s.range.contains_range(s.selection_range)));
+        assert!(analysis.folding_ranges(ids[0]).iter().all(|f| usize::from(f.range.end()) <= text.len()));
+    }
+}
+
+/// Program text, sometimes a fixed-cycle file's (`$PC` before the blocks).
+fn any_program() -> impl Strategy<Value = String> {
+    let text = prop_oneof![program_text(), block_program()];
+    (text, prop::bool::ANY).prop_map(|(text, cycles)| if cycles { format!("\"  $PC \"\n{text}") } else { text })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(500))]
+
+    #[test]
+    fn highlight_ranges_are_sorted_disjoint_and_on_char_boundaries(
+        text in any_program(),
+        path in prop_oneof![Just("P.NCP"), Just("L9001")],
+        start in 0usize..400,
+        len in 0usize..100,
+    ) {
+        check_highlight_ranges(path, &text, start, start + len);
+    }
+
+    #[test]
+    fn other_answers_never_panic(text in any_program(), at in 0usize..400) {
+        let mut host = AnalysisHost::default();
+        let file = host.add_file("P.NCP", text.as_str());
+        let analysis = host.analysis();
+        let at = (0..=at.min(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap();
+        analysis.document_symbols(file);
+        for fold in analysis.folding_ranges(file) {
+            prop_assert!(usize::from(fold.range.end()) <= text.len());
+        }
+        for reference in analysis.references(file, TextSize::try_from(at).unwrap(), true) {
+            prop_assert!(text.is_char_boundary(usize::from(reference.range.start())));
+        }
+    }
+}

@@ -1,0 +1,185 @@
+//! A guard between stdio and the protocol layer. tower-lsp-server's reader
+//! stops for good at the first frame it cannot decode, so one malformed
+//! message would end the server. Frames are checked here first and only
+//! well-formed messages pass; the rest are answered as JSON-RPC and the
+//! protocol say (Parse error, Invalid request, MethodNotFound for unknown
+//! `$/` requests) and reading goes on.
+
+use std::io;
+
+use serde_json::{Value, json};
+use tokio::{
+    io::{AsyncBufRead, AsyncBufReadExt, AsyncRead, AsyncReadExt, AsyncWrite, AsyncWriteExt, BufReader},
+    sync::mpsc,
+};
+
+const CONTENT_LENGTH: &[u8] = b"content-length:";
+
+/// One message read from a stream.
+enum Frame {
+    Body(Vec<u8>),
+    /// Headers without a usable length; the reader skipped to the next.
+    BadHeader,
+}
+
+/// Reads the next frame; `None` at the end of the stream.
+async fn read_frame<R: AsyncBufRead + Unpin>(reader: &mut R) -> io::Result<Option<Frame>> {
+    let mut length: Option<usize> = None;
+    let mut bad = false;
+    let mut line = Vec::new();
+    loop {
+        line.clear();
+        if reader.read_until(b'\n', &mut line).await? == 0 {
+            return Ok(None);
+        }
+        let lower = line.to_ascii_lowercase();
+        // After a bad header the next message may start mid-line, right
+        // after the previous body.
+        let start = lower.windows(CONTENT_LENGTH.len()).position(|w| w == CONTENT_LENGTH);
+        if let Some(start) = start.filter(|&start| start > 0 || bad) {
+            bad = false;
+            line.drain(..start);
+        }
+        let text = String::from_utf8_lossy(&line);
+        let text = text.trim_end_matches(['\r', '\n']);
+        if text.is_empty() {
+            match length {
+                Some(length) if !bad => {
+                    let mut body = vec![0; length];
+                    reader.read_exact(&mut body).await?;
+                    return Ok(Some(Frame::Body(body)));
+                }
+                _ => return Ok(Some(Frame::BadHeader)),
+            }
+        }
+        if let Some((name, value)) = text.split_once(':')
+            && name.trim().eq_ignore_ascii_case("content-length")
+        {
+            length = value.trim().parse().ok();
+            bad |= length.is_none();
+        }
+    }
+}
+
+fn framed(body: &[u8]) -> Vec<u8> {
+    let mut frame = format!("Content-Length: {}\r\n\r\n", body.len()).into_bytes();
+    frame.extend_from_slice(body);
+    frame
+}
+
+fn error_response(id: Value, code: i64, message: &str) -> Vec<u8> {
+    let response = json!({ "jsonrpc": "2.0", "id": id, "error": { "code": code, "message": message } });
+    framed(response.to_string().as_bytes())
+}
+
+/// What to do with a message body: pass it on, or answer it here.
+fn check(body: &[u8]) -> Result<(), Vec<u8>> {
+    let value: Value =
+        serde_json::from_slice(body).map_err(|error| error_response(Value::Null, -32700, &error.to_string()))?;
+    let Some(message) = value.as_object() else {
+        return Err(error_response(Value::Null, -32600, "a message must be a JSON object"));
+    };
+    let id = message.get("id").cloned();
+    match (message.get("method").and_then(Value::as_str), id) {
+        // The protocol: a `$/` request the server does not know is
+        // MethodNotFound (tower-lsp-server drops it unanswered).
+        (Some(method), Some(id)) if method.starts_with("$/") => {
+            Err(error_response(id, -32601, &format!("unknown method {method}")))
+        }
+        (Some(_), _) => Ok(()),
+        (None, Some(_)) if message.contains_key("result") || message.contains_key("error") => Ok(()),
+        (None, id) => Err(error_response(id.unwrap_or(Value::Null), -32600, "neither a request nor a response")),
+    }
+}
+
+/// Copies well-formed messages from `input` to `server`, and sends the
+/// answers to the rest to `output`.
+pub(crate) async fn guard_input(
+    input: impl AsyncRead + Unpin,
+    mut server: impl AsyncWrite + Unpin,
+    output: mpsc::UnboundedSender<Vec<u8>>,
+) -> io::Result<()> {
+    let mut reader = BufReader::new(input);
+    while let Some(frame) = read_frame(&mut reader).await? {
+        match frame {
+            Frame::Body(body) => match check(&body) {
+                Ok(()) => {
+                    server.write_all(&framed(&body)).await?;
+                    server.flush().await?;
+                }
+                Err(answer) => {
+                    tracing::warn!("rejected a message: {}", String::from_utf8_lossy(&body));
+                    let _ = output.send(answer);
+                }
+            },
+            Frame::BadHeader => tracing::warn!("skipped a message without a valid Content-Length"),
+        }
+    }
+    Ok(())
+}
+
+/// Passes the server's messages, whole, to `output`.
+pub(crate) async fn forward_output(
+    server: impl AsyncRead + Unpin,
+    output: mpsc::UnboundedSender<Vec<u8>>,
+) -> io::Result<()> {
+    let mut reader = BufReader::new(server);
+    while let Some(frame) = read_frame(&mut reader).await? {
+        if let Frame::Body(body) = frame {
+            let _ = output.send(framed(&body));
+        }
+    }
+    Ok(())
+}
+
+/// Writes whole frames to `out` until every sender is gone.
+pub(crate) async fn write_output(mut out: impl AsyncWrite + Unpin, mut frames: mpsc::UnboundedReceiver<Vec<u8>>) {
+    while let Some(frame) = frames.recv().await {
+        if out.write_all(&frame).await.is_err() || out.flush().await.is_err() {
+            return;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    async fn frames(input: &[u8]) -> Vec<Option<Vec<u8>>> {
+        let mut reader = BufReader::new(input);
+        let mut out = Vec::new();
+        while let Some(frame) = read_frame(&mut reader).await.unwrap() {
+            out.push(match frame {
+                Frame::Body(body) => Some(body),
+                Frame::BadHeader => None,
+            });
+        }
+        out
+    }
+
+    #[tokio::test]
+    async fn frames_are_read_and_bad_headers_skipped() {
+        let input = b"Content-Length: 2\r\nContent-Type: x\r\n\r\n{}Content-Length: twelve\r\n\r\n{}Content-Length: 4\r\n\r\nnullcontent-length: 1\r\n\r\n1";
+        let read = frames(input).await;
+        assert_eq!(read, vec![Some(b"{}".to_vec()), None, Some(b"null".to_vec()), Some(b"1".to_vec())]);
+    }
+
+    #[test]
+    fn messages_are_checked_as_json_rpc_says() {
+        let code = |body: &str| {
+            check(body.as_bytes()).err().map(|answer| {
+                let text = String::from_utf8(answer).unwrap();
+                let json: Value = serde_json::from_str(text.split("\r\n\r\n").nth(1).unwrap()).unwrap();
+                (json["error"]["code"].as_i64().unwrap(), json["id"].clone())
+            })
+        };
+        assert_eq!(code("not json"), Some((-32700, Value::Null)));
+        assert_eq!(code("42"), Some((-32600, Value::Null)));
+        assert_eq!(code("[]"), Some((-32600, Value::Null)));
+        assert_eq!(code(r#"{"jsonrpc":"2.0","params":{}}"#), Some((-32600, Value::Null)));
+        assert_eq!(code(r#"{"jsonrpc":"2.0","id":7,"method":"$/x"}"#), Some((-32601, json!(7))));
+        assert_eq!(code(r#"{"jsonrpc":"2.0","method":"$/cancelRequest","params":{"id":1}}"#), None);
+        assert_eq!(code(r#"{"jsonrpc":"2.0","id":1,"method":"initialize","params":{}}"#), None);
+        assert_eq!(code(r#"{"jsonrpc":"2.0","id":1,"result":null}"#), None);
+    }
+}

@@ -1,0 +1,107 @@
+-- Starts the ncc language server for MEFI CNC8x6 partprograms (filetype
+-- `cnc8x6`). Works on Neovim 0.7 (Debian 12) and later, without
+-- nvim-lspconfig.
+
+local M = {}
+
+local uv = vim.uv or vim.loop
+
+local option_names = { "cmd", "config_file", "log_level", "capabilities", "on_attach" }
+
+-- The project root: the nearest directory that holds either marker.
+local root_markers = { "ncc.toml", ".git" }
+
+-- Written out because vim.fs.root needs Neovim 0.10. Without a marker the
+-- file's own directory is the root.
+local function root_dir(bufnr)
+  local name = vim.api.nvim_buf_get_name(bufnr)
+  local start = name == "" and vim.fn.getcwd() or vim.fn.fnamemodify(name, ":p:h")
+  local dir = start
+  while true do
+    for _, marker in ipairs(root_markers) do
+      if uv.fs_stat(dir .. "/" .. marker) then
+        return dir
+      end
+    end
+    local parent = vim.fn.fnamemodify(dir, ":h")
+    if parent == dir then
+      return start
+    end
+    dir = parent
+  end
+end
+
+local function client_config(opts, bufnr)
+  local cmd = vim.deepcopy(opts.cmd)
+  if opts.log_level then
+    vim.list_extend(cmd, { "--log-level", opts.log_level })
+  end
+  local init_options
+  if opts.config_file then
+    init_options = { configFile = vim.fn.fnamemodify(vim.fn.expand(opts.config_file), ":p") }
+  end
+  return {
+    name = "ncc",
+    cmd = cmd,
+    root_dir = root_dir(bufnr),
+    init_options = init_options,
+    capabilities = opts.capabilities,
+    on_attach = opts.on_attach,
+  }
+end
+
+-- Client ids by root directory, for Neovim 0.7, which has no vim.lsp.start
+-- to reuse a running server.
+local clients = {}
+
+local function start(config, bufnr)
+  if vim.lsp.start then
+    vim.lsp.start(config, { bufnr = bufnr })
+    return
+  end
+  local id = clients[config.root_dir]
+  local client = id and vim.lsp.get_client_by_id(id)
+  if not client or client.is_stopped() then
+    id = vim.lsp.start_client(config)
+    clients[config.root_dir] = id
+  end
+  if id then
+    vim.lsp.buf_attach_client(bufnr, id)
+  end
+end
+
+--- Starts (or reuses) the server for every buffer of filetype `cnc8x6`.
+---
+--- Options, all optional:
+--- - cmd: the server command, default `{ "ncc", "lsp" }`.
+--- - config_file: the machine configuration for every program, instead of
+---   the `ncc.toml` found above each one.
+--- - log_level: the server's log level ("error", "warn", "info", "debug" or
+---   "trace"). The server logs to stderr, which Neovim copies into its LSP
+---   log, `vim.lsp.get_log_path()`.
+--- - capabilities, on_attach: passed to the client as they are.
+function M.setup(opts)
+  opts = opts or {}
+  for key in pairs(opts) do
+    if not vim.tbl_contains(option_names, key) then
+      error(
+        ("ncc.setup: unknown option %q (known: %s)"):format(key, table.concat(option_names, ", ")),
+        2
+      )
+    end
+  end
+  opts = vim.tbl_extend("keep", opts, { cmd = { "ncc", "lsp" } })
+
+  vim.api.nvim_create_autocmd("FileType", {
+    group = vim.api.nvim_create_augroup("ncc", { clear = true }),
+    pattern = "cnc8x6",
+    callback = function(args)
+      -- Help, terminal and scratch buffers are not files the server can read.
+      if vim.bo[args.buf].buftype == "" then
+        start(client_config(opts, args.buf), args.buf)
+      end
+    end,
+  })
+end
+
+return M

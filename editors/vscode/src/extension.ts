@@ -1,0 +1,199 @@
+// The extension: starts `ncc lsp` for CNC8x6 documents and shows its state.
+
+import * as os from 'node:os';
+import * as vscode from 'vscode';
+import { LanguageClient, State } from 'vscode-languageclient/node';
+import { type Environment, type Launch, readSettings, serverLaunch } from './server';
+
+const LANGUAGE_ID = 'cnc8x6';
+
+let server: Server | undefined;
+
+export function activate(context: vscode.ExtensionContext): Promise<void> {
+  const output = vscode.window.createOutputChannel('ncc', { log: true });
+  server = new Server(output);
+  context.subscriptions.push(
+    output,
+    server,
+    vscode.commands.registerCommand('ncc.restartServer', () => server?.restart()),
+    vscode.commands.registerCommand('ncc.showOutput', () => output.show(true)),
+    vscode.workspace.onDidChangeConfiguration((event) => {
+      // The trace setting is read by the language client itself.
+      if (event.affectsConfiguration('ncc.server') || event.affectsConfiguration('ncc.machine')) {
+        void server?.restart();
+      }
+    }),
+  );
+  return server.restart();
+}
+
+export function deactivate(): Promise<void> | undefined {
+  return server?.stop();
+}
+
+type Status =
+  | { state: 'starting' }
+  | { state: 'running'; launch: Launch }
+  | { state: 'stopped' }
+  | { state: 'error'; message: string };
+
+/** One language client at a time, and the status bar item that shows it. */
+class Server implements vscode.Disposable {
+  private client: LanguageClient | undefined;
+  private readonly item: vscode.StatusBarItem;
+  /** Set while the extension itself stops the client, so that the stop is not shown as a failure. */
+  private stopping = false;
+  private restarting: Promise<void> = Promise.resolve();
+
+  constructor(private readonly output: vscode.LogOutputChannel) {
+    this.item = vscode.window.createStatusBarItem('ncc.status', vscode.StatusBarAlignment.Left);
+    this.item.name = 'ncc';
+    this.item.command = 'ncc.showOutput';
+    this.show({ state: 'stopped' });
+    this.item.show();
+  }
+
+  private async start(): Promise<void> {
+    this.show({ state: 'starting' });
+    const settings = readSettings((key) => vscode.workspace.getConfiguration('ncc').get(key));
+    const launch = await serverLaunch(settings, environment());
+    if (!launch.ok) {
+      this.fail(launch.message);
+      const open = 'Open Setting';
+      // Not awaited: a notification can stay open for as long as the user likes.
+      void vscode.window.showErrorMessage(launch.message, open).then((choice) => {
+        if (choice === open) {
+          void vscode.commands.executeCommand('workbench.action.openSettings', launch.setting);
+        }
+      });
+      return;
+    }
+    const { command, args, initializationOptions } = launch.value;
+    this.output.info(`Starting ${launch.value.version}: ${command} ${args.join(' ')}`);
+    const client = new LanguageClient(
+      'ncc',
+      'ncc',
+      { command, args },
+      {
+        documentSelector: [
+          { scheme: 'file', language: LANGUAGE_ID },
+          { scheme: 'untitled', language: LANGUAGE_ID },
+        ],
+        initializationOptions,
+        outputChannel: this.output,
+      },
+    );
+    client.onDidChangeState(({ newState }) => {
+      switch (newState) {
+        case State.Starting:
+          this.show({ state: 'starting' });
+          break;
+        case State.Running:
+          this.show({ state: 'running', launch: launch.value });
+          break;
+        case State.Stopped:
+          if (!this.stopping) {
+            // The client gave up restarting a server that kept exiting.
+            this.fail(`${command} stopped unexpectedly.`);
+          }
+          break;
+        case State.StartFailed:
+          // Reported where `start` fails.
+          break;
+      }
+    });
+    this.client = client;
+    try {
+      await client.start();
+    } catch (error) {
+      this.fail(`${command} did not start: ${error instanceof Error ? error.message : String(error)}`);
+      const log = 'Show Log';
+      void vscode.window.showErrorMessage('The ncc language server did not start.', log).then((choice) => {
+        if (choice === log) {
+          this.output.show(true);
+        }
+      });
+    }
+  }
+
+  async stop(): Promise<void> {
+    const client = this.client;
+    this.client = undefined;
+    // A client whose start failed has no server left to stop.
+    if (client === undefined || !client.isRunning()) {
+      this.show({ state: 'stopped' });
+      return;
+    }
+    this.stopping = true;
+    try {
+      await client.dispose();
+    } catch (error) {
+      this.output.warn(`Stopping the server: ${error instanceof Error ? error.message : String(error)}`);
+    } finally {
+      this.stopping = false;
+      this.show({ state: 'stopped' });
+    }
+  }
+
+  /** Stops the server if it runs, and starts it. */
+  restart(): Promise<void> {
+    // Restarts run one after another, however fast settings change, and a
+    // failed one does not hold up the next.
+    const next = this.restarting.then(async () => {
+      await this.stop();
+      await this.start();
+    });
+    this.restarting = next.catch(() => undefined);
+    return next;
+  }
+
+  dispose(): void {
+    void this.stop();
+    this.item.dispose();
+  }
+
+  private fail(message: string): void {
+    this.output.error(message);
+    this.show({ state: 'error', message });
+  }
+
+  private show(status: Status): void {
+    const tooltip = new vscode.MarkdownString('', true);
+    tooltip.isTrusted = { enabledCommands: ['ncc.restartServer', 'ncc.showOutput'] };
+    this.item.backgroundColor = undefined;
+    switch (status.state) {
+      case 'starting':
+        this.item.text = '$(sync~spin) ncc';
+        tooltip.appendText('The ncc language server is starting.');
+        break;
+      case 'running': {
+        this.item.text = '$(check) ncc';
+        tooltip.appendText(`${status.launch.version} is running:`).appendCodeblock(
+          [status.launch.command, ...status.launch.args].join(' '),
+          'text',
+        );
+        break;
+      }
+      case 'stopped':
+        this.item.text = '$(circle-slash) ncc';
+        tooltip.appendText('The ncc language server is stopped.');
+        break;
+      case 'error':
+        this.item.text = '$(error) ncc';
+        this.item.backgroundColor = new vscode.ThemeColor('statusBarItem.errorBackground');
+        tooltip.appendText(status.message);
+        break;
+    }
+    tooltip.appendMarkdown('\n\n[Restart](command:ncc.restartServer) · [Show log](command:ncc.showOutput)');
+    this.item.tooltip = tooltip;
+  }
+}
+
+function environment(): Environment {
+  return {
+    base: vscode.workspace.workspaceFolders?.[0]?.uri.fsPath,
+    home: os.homedir(),
+    env: process.env,
+    platform: process.platform,
+  };
+}

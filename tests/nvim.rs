@@ -1,0 +1,159 @@
+//! End-to-end test of the Neovim client in `editors/nvim`: a headless Neovim
+//! with the plugin on its runtimepath talks to the real `ncc lsp`.
+//!
+//! Without `nvim` on the PATH the test passes with a note, unless
+//! `NCC_REQUIRE_NVIM=1` (as in CI).
+
+use std::{
+    fs,
+    path::{Path, PathBuf},
+    process::{Command, Stdio},
+    thread,
+    time::{Duration, Instant},
+};
+
+use serde_json::{Value, json};
+
+/// Neovim is killed after this long; its own waits are shorter.
+const DEADLINE: Duration = Duration::from_secs(10);
+const LUA_TIMEOUT_MS: u64 = 3000;
+
+/// One error: the space after the sign of `X-`.
+const PROGRAM: &str = "%1\nN10 G01 X- 5 F100\nN20 M30\n*\n";
+const MACRO: &str = "N10 G79 L9001\nN20 G90 G00 Z2.\nN30 G70\n*\n";
+
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().unwrap()
+}
+
+/// The first line of `nvim --version`, or `None` when there is no `nvim`.
+fn nvim_version() -> Option<String> {
+    let output = Command::new("nvim").arg("--version").output().ok()?;
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    output.status.success().then(|| stdout.lines().next().unwrap_or_default().to_owned())
+}
+
+/// `nvim --headless` with the driver script; killed at the deadline.
+fn run_nvim(input: &Path, state: &Path) {
+    let log = |name: &str| fs::File::create(state.join(name)).unwrap();
+    let mut child = Command::new("nvim")
+        .args(["--headless", "--clean", "-u"])
+        .arg(workspace().join("tests/fixtures/nvim/init.lua"))
+        .env("NCC_NVIM_TEST", input)
+        // Neovim's logs (and the LSP log) go to the temporary directory.
+        .env("XDG_STATE_HOME", state)
+        .env("XDG_CACHE_HOME", state)
+        .stdin(Stdio::null())
+        .stdout(log("stdout"))
+        .stderr(log("stderr"))
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if start.elapsed() > DEADLINE {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            panic!("Neovim did not finish within {DEADLINE:?}\n{}", nvim_logs(state));
+        }
+        thread::sleep(Duration::from_millis(20));
+    };
+    assert!(status.success(), "Neovim exited with {status}\n{}", nvim_logs(state));
+}
+
+/// What Neovim and the server said, for failure messages.
+fn nvim_logs(state: &Path) -> String {
+    ["stdout", "stderr", "nvim/lsp.log"]
+        .iter()
+        .map(|name| format!("--- {name}:\n{}", fs::read_to_string(state.join(name)).unwrap_or_default()))
+        .collect()
+}
+
+#[test]
+fn neovim_detects_programs_and_shows_diagnostics_and_hover() {
+    let Some(version) = nvim_version() else {
+        if std::env::var("NCC_REQUIRE_NVIM").as_deref() == Ok("1") {
+            panic!("nvim is not on the PATH, and NCC_REQUIRE_NVIM=1 requires it");
+        }
+        eprintln!("nvim is not on the PATH: the Neovim test did not run (NCC_REQUIRE_NVIM=1 makes this a failure)");
+        return;
+    };
+    eprintln!("testing with {version}");
+
+    let temp = tempfile::tempdir().unwrap();
+    let dir = temp.path().canonicalize().unwrap();
+    let project = dir.join("project");
+    let programs = project.join("programs");
+    fs::create_dir_all(&programs).unwrap();
+    fs::write(project.join("ncc.toml"), "# The project root.\n").unwrap();
+    fs::write(programs.join("drill.NCP"), PROGRAM).unwrap();
+    fs::write(programs.join("L9001"), MACRO).unwrap();
+    // Passed as `configFile`: the server reports S003 as a warning only if it
+    // got the file.
+    let config = dir.join("machine.toml");
+    fs::write(&config, "[rules]\nS003 = \"warning\"\n").unwrap();
+
+    // The second line holds both the error and the G code to hover.
+    let line = PROGRAM.lines().nth(1).unwrap();
+    let state = dir.join("state");
+    fs::create_dir(&state).unwrap();
+    let output_path = dir.join("output.json");
+    let probes = ["part.Ncp", "L12.txt", "Lathe"].map(|name| programs.join(name));
+    let input = json!({
+        "runtime": workspace().join("editors/nvim"),
+        "server": env!("CARGO_BIN_EXE_ncc"),
+        "config_file": config,
+        "macro": programs.join("L9001"),
+        "program": programs.join("drill.NCP"),
+        "hover": { "line": 1, "character": line.find("G01").unwrap() },
+        "timeout_ms": LUA_TIMEOUT_MS,
+        "filetype_probes": probes,
+        "output": output_path,
+    });
+    let input_path = dir.join("input.json");
+    fs::write(&input_path, input.to_string()).unwrap();
+
+    run_nvim(&input_path, &state);
+    let output = fs::read_to_string(&output_path)
+        .unwrap_or_else(|error| panic!("the driver wrote no output: {error}\n{}", nvim_logs(&state)));
+    let output: Value = serde_json::from_str(&output).unwrap();
+    let context = format!("{output:#}\n{}", nvim_logs(&state));
+    assert_eq!(output.get("error"), None, "{context}");
+
+    let filetypes = &output["filetypes"];
+    for name in ["drill.NCP", "L9001", "part.Ncp"] {
+        assert_eq!(filetypes[name], "cnc8x6", "{name}: {context}");
+    }
+    for name in ["L12.txt", "Lathe"] {
+        assert_ne!(filetypes[name], "cnc8x6", "{name}: {context}");
+    }
+    assert_eq!(output["highlight"], "cnc8x6GCode", "{context}");
+
+    // One server for the project, found by its `ncc.toml`, serves both files.
+    let clients = output["clients"].as_array().unwrap();
+    assert_eq!(clients.len(), 1, "{context}");
+    assert_eq!(clients[0]["name"], "ncc", "{context}");
+    assert_eq!(clients[0]["root_dir"], json!(project), "{context}");
+    assert_eq!(clients[0]["init_options"], json!({ "configFile": config }), "{context}");
+    assert_eq!(clients[0]["buffers"], json!({ "program": true, "macro": true }), "{context}");
+
+    let space_after_sign = json!({
+        "code": "S003",
+        "source": "ncc",
+        "severity": "WARN",
+        "line": 1,
+        "character": line.find("- ").unwrap(),
+    });
+    assert_eq!(output["diagnostics"], json!([space_after_sign]), "{context}");
+
+    let explain = Command::new(env!("CARGO_BIN_EXE_ncc")).args(["explain", "G01"]).output().unwrap();
+    let explain = String::from_utf8(explain.stdout).unwrap();
+    let [hover] = output["hover"].as_array().unwrap().as_slice() else { panic!("one hover answer: {context}") };
+    assert_eq!(hover["kind"], "markdown", "{context}");
+    // The catalogue's text, then the modal state before the block.
+    let value = hover["value"].as_str().unwrap_or_default();
+    assert!(value.starts_with(explain.trim()), "{context}");
+    assert!(value.contains("**Modal state before this block:**"), "{context}");
+}
