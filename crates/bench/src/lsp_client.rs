@@ -4,16 +4,16 @@
 //! `Content-Length` framing. A reader thread timestamps every incoming
 //! message when its body has been read and forwards it over a channel, so
 //! latencies are measured from the moment a request is written to the
-//! moment its answer arrives, whatever the caller does in between. Every
-//! wait has a timeout: a server that stops answering fails a test instead
-//! of hanging it.
+//! moment its answer arrives, whatever the caller does in between. A writer
+//! thread does the writing, so that a write, too, has a timeout: a server
+//! that stops reading or answering fails a test instead of hanging it.
 
 use std::{
     collections::VecDeque,
     io::{self, BufRead, BufReader, Read, Write},
     ops::Range,
     path::Path,
-    process::{Child, ChildStdin, Command, ExitStatus, Stdio},
+    process::{Child, Command, ExitStatus, Stdio},
     sync::mpsc::{self, Receiver, RecvTimeoutError, Sender},
     thread,
     time::{Duration, Instant},
@@ -90,12 +90,16 @@ type Incoming = Result<Message, String>;
 #[derive(Debug)]
 pub struct Client {
     child: Child,
-    stdin: Option<ChildStdin>,
+    /// Frames to write; `None` once stdin is closed or the server stopped
+    /// reading it.
+    frames: Option<Sender<Vec<u8>>>,
+    /// When the write of each frame started, or why it failed.
+    written: Receiver<io::Result<Instant>>,
     incoming: Receiver<Incoming>,
     /// Messages received while waiting for another one, oldest first.
     backlog: VecDeque<Message>,
     next_id: i64,
-    /// How long `response` and `notification` wait.
+    /// How long a write, `response` and `notification` wait.
     pub timeout: Duration,
 }
 
@@ -109,10 +113,23 @@ impl Client {
             .spawn()
             .with_context(|| format!("starting {:?}", command.get_program()))?;
         let stdout = child.stdout.take().context("no stdout pipe")?;
+        let mut stdin = child.stdin.take().context("no stdin pipe")?;
         let (sender, incoming) = mpsc::channel();
         thread::Builder::new().name("lsp-reader".into()).spawn(move || read_messages(stdout, &sender))?;
+        let (frames, to_write) = mpsc::channel::<Vec<u8>>();
+        let (report, written) = mpsc::channel();
+        thread::Builder::new().name("lsp-writer".into()).spawn(move || {
+            for frame in to_write {
+                let start = Instant::now();
+                let result = stdin.write_all(&frame).and_then(|()| stdin.flush()).map(|()| start);
+                if report.send(result).is_err() {
+                    return;
+                }
+            }
+        })?;
         Ok(Client {
-            stdin: child.stdin.take(),
+            frames: Some(frames),
+            written,
             child,
             incoming,
             backlog: VecDeque::new(),
@@ -128,10 +145,7 @@ impl Client {
     /// Writes bytes as they are, for tests of broken framing. Returns the
     /// time the write started.
     pub fn send_raw(&mut self, bytes: &[u8]) -> anyhow::Result<Instant> {
-        let stdin = self.stdin.as_mut().context("stdin is closed")?;
-        let start = Instant::now();
-        stdin.write_all(bytes).and_then(|()| stdin.flush()).context("writing to the server")?;
-        Ok(start)
+        self.write(bytes.to_vec())
     }
 
     /// Writes one framed message.
@@ -139,7 +153,21 @@ impl Client {
         let body = serde_json::to_vec(message)?;
         let mut frame = format!("Content-Length: {}\r\n\r\n", body.len()).into_bytes();
         frame.extend_from_slice(&body);
-        self.send_raw(&frame)
+        self.write(frame)
+    }
+
+    fn write(&mut self, frame: Vec<u8>) -> anyhow::Result<Instant> {
+        let frames = self.frames.as_ref().context("stdin is closed")?;
+        frames.send(frame).context("the writer thread has stopped")?;
+        match self.written.recv_timeout(self.timeout) {
+            Ok(result) => result.context("writing to the server"),
+            Err(_) => {
+                // The write may still finish later; later frames must not
+                // be taken for it.
+                self.frames = None;
+                bail!("the server has not read its input for {:?}", self.timeout)
+            }
+        }
     }
 
     /// Sends a notification; `params` of `null` are left out, as for `exit`.
@@ -276,7 +304,8 @@ impl Client {
 
     /// Closes the server's stdin, as an editor that goes away does.
     pub fn close_stdin(&mut self) {
-        self.stdin = None;
+        // The writer thread ends and drops the pipe.
+        self.frames = None;
     }
 
     /// Waits for the process to end.
@@ -606,6 +635,40 @@ mod tests {
         {
             assert!(read_message(&mut &broken[..]).is_err(), "{}", String::from_utf8_lossy(broken));
         }
+    }
+
+    /// `cat` sends every message back: a notification returns as itself, a
+    /// request as a request from the "server", which the client answers
+    /// with MethodNotFound, and that answer comes back as the response.
+    #[cfg(unix)]
+    #[test]
+    fn a_client_talks_to_an_echo() {
+        let mut client = Client::spawn(Command::new("cat")).unwrap();
+        client.notify("ncc/echo", json!({ "text": "ŘEŽ" })).unwrap();
+        let echoed = client.notification("ncc/echo", |m| m.params()["text"] == "ŘEŽ").unwrap();
+        let request = client.request("ncc/ping", Value::Null).unwrap();
+        let answer = client.response(&request).unwrap();
+        assert_eq!(answer.error_code(), Some(-32601), "{}", answer.json);
+        assert!(request.sent >= echoed.received && answer.received > request.sent);
+        let unclaimed: Vec<Value> = client.take_received().into_iter().map(|m| m.json).collect();
+        assert_eq!(unclaimed, [json!({ "jsonrpc": "2.0", "id": 1, "method": "ncc/ping" })]);
+        client.close_stdin();
+        assert!(client.wait_exit(Duration::from_secs(5)).unwrap().success());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_server_that_reads_nothing_fails_writes_and_waits_instead_of_hanging() {
+        let mut sleep = Command::new("sleep");
+        sleep.arg("60");
+        let mut client = Client::spawn(sleep).unwrap();
+        client.timeout = Duration::from_millis(200);
+        // More than a pipe holds.
+        let error = client.send_raw(&vec![b' '; 1 << 20]).unwrap_err();
+        assert!(error.to_string().contains("has not read its input"), "{error}");
+        assert!(client.notify("exit", Value::Null).is_err());
+        let error = client.response_to(&json!(1)).unwrap_err();
+        assert!(error.to_string().contains("nothing within"), "{error}");
     }
 
     #[test]
