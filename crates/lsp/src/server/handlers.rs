@@ -59,8 +59,7 @@ pub(crate) fn definition(s: &Snapshot, position: lsp::Position) -> Vec<Navigatio
 /// The quick fixes of the diagnostics that touch `range`.
 pub(crate) fn code_actions(s: &Snapshot, range: lsp::Range) -> lsp::CodeActionResponse {
     let range = s.map.range_offsets(range);
-    let mut diagnostics = s.analysis.local_diagnostics(s.file);
-    diagnostics.extend(s.analysis.flow_diagnostics(s.file));
+    let diagnostics = s.analysis.diagnostics(s.file);
     let mut actions = Vec::new();
     for diagnostic in diagnostics.iter().filter(|d| d.range.intersect(range).is_some() && !d.fixes.is_empty()) {
         let converted = convert::diagnostic(&s.map, &s.uri, diagnostic);

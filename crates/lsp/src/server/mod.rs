@@ -161,9 +161,7 @@ impl Server {
     }
 
     fn state(&self) -> MutexGuard<'_, State> {
-        // A panic while holding the lock leaves consistent data (edits are
-        // applied whole), so a poisoned lock is still usable.
-        self.state.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+        lock(&self.state)
     }
 
     fn snapshot(&self, uri: &Uri) -> jsonrpc::Result<Snapshot> {
@@ -232,7 +230,7 @@ impl Server {
             tracing::debug!("{} v{version}: all diagnostics in {:?}", uri.as_str(), started.elapsed());
             drop(analysis);
             {
-                let mut state = state.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+                let mut state = lock(&state);
                 match state.documents.get_mut(&uri) {
                     Some(document) if document.version == version => document.flow = flow.clone(),
                     _ => return,
@@ -243,6 +241,12 @@ impl Server {
             send(all);
         });
     }
+}
+
+/// A panic while holding the lock leaves consistent data (edits are
+/// applied whole), so a poisoned lock is still usable.
+fn lock(state: &Mutex<State>) -> MutexGuard<'_, State> {
+    state.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
 fn invalid_params(message: String) -> jsonrpc::Error {
@@ -365,8 +369,8 @@ impl LanguageServer for Server {
         let targets = self.query(&uri, move |s| handlers::definition(s, position.position)).await?;
         let state = self.state();
         let Some(workspace) = state.documents.get(&uri).map(|d| d.workspace) else { return Ok(None) };
-        let links: Vec<_> =
-            targets.into_iter().filter_map(|target| state.workspaces.location_link(workspace, target)).collect();
+        let mut addresses = state.workspaces.addresses(workspace);
+        let links: Vec<_> = targets.into_iter().filter_map(|target| addresses.location_link(target)).collect();
         Ok((!links.is_empty()).then_some(lsp::GotoDefinitionResponse::Link(links)))
     }
 
@@ -392,9 +396,10 @@ impl LanguageServer for Server {
         let references = self.query(&uri, move |s| handlers::references(s, position.position, include)).await?;
         let state = self.state();
         let Some(workspace) = state.documents.get(&uri).map(|d| d.workspace) else { return Ok(None) };
+        let mut addresses = state.workspaces.addresses(workspace);
         let locations = references
             .into_iter()
-            .filter_map(|reference| state.workspaces.location(workspace, reference.file, reference.range))
+            .filter_map(|reference| addresses.location(reference.file, reference.range))
             .collect();
         Ok(Some(locations))
     }

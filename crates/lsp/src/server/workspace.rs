@@ -149,19 +149,36 @@ impl Workspaces {
         }
     }
 
-    /// A range of a file as a location, if the file has an address.
-    pub fn location(&self, index: usize, file: FileId, range: ncc_analysis::TextRange) -> Option<lsp::Location> {
+    /// Converts ranges of the workspace's files to locations.
+    pub fn addresses(&self, index: usize) -> Addresses<'_> {
         let workspace = &self.list[index];
-        let uri = workspace.uris.get(&file)?.clone();
-        let map = LineMap::new(workspace.host.analysis().text(file));
+        Addresses { uris: &workspace.uris, analysis: workspace.host.analysis(), maps: HashMap::new() }
+    }
+}
+
+/// Locations in a workspace's files; each file's line map is built once,
+/// however many ranges point into it.
+pub(crate) struct Addresses<'a> {
+    uris: &'a HashMap<FileId, Uri>,
+    analysis: ncc_analysis::Analysis,
+    maps: HashMap<FileId, LineMap>,
+}
+
+impl Addresses<'_> {
+    /// The file's address and line map, if it has an address.
+    fn of(&mut self, file: FileId) -> Option<(Uri, &LineMap)> {
+        let uri = self.uris.get(&file)?.clone();
+        let map = self.maps.entry(file).or_insert_with(|| LineMap::new(self.analysis.text(file)));
+        Some((uri, map))
+    }
+
+    pub fn location(&mut self, file: FileId, range: ncc_analysis::TextRange) -> Option<lsp::Location> {
+        let (uri, map) = self.of(file)?;
         Some(lsp::Location::new(uri, map.range(range)))
     }
 
-    /// A navigation target as a link, if its file has an address.
-    pub fn location_link(&self, index: usize, target: NavigationTarget) -> Option<lsp::LocationLink> {
-        let workspace = &self.list[index];
-        let uri = workspace.uris.get(&target.file)?.clone();
-        let map = LineMap::new(workspace.host.analysis().text(target.file));
+    pub fn location_link(&mut self, target: NavigationTarget) -> Option<lsp::LocationLink> {
+        let (uri, map) = self.of(target.file)?;
         Some(lsp::LocationLink {
             origin_selection_range: None,
             target_uri: uri,
