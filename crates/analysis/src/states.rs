@@ -10,7 +10,10 @@
 //! move with the edit). The checkpoints hold the tree they were taken on,
 //! so comparing blocks by identity is exact.
 
-use std::sync::{Arc, Mutex};
+use std::{
+    collections::hash_map::Entry,
+    sync::{Arc, Mutex},
+};
 
 use ncc_syntax::{Dialect, SyntaxKind};
 use rowan::GreenNode;
@@ -100,15 +103,16 @@ struct Checkpoint {
 
 /// The index of the first block that differs between two trees.
 fn first_changed_block(old: &GreenNode, new: &GreenNode) -> usize {
-    let blocks = |root: &GreenNode| -> Vec<*const rowan::GreenNodeData> {
+    fn blocks(root: &GreenNode) -> impl Iterator<Item = *const rowan::GreenNodeData> + '_ {
         root.children()
             .filter_map(|child| child.into_node())
             .filter(|node| node.kind() == SyntaxKind::BLOCK.into())
             .map(|node| node as *const rowan::GreenNodeData)
-            .collect()
-    };
-    let (old, new) = (blocks(old), blocks(new));
-    old.iter().zip(&new).position(|(a, b)| a != b).unwrap_or(old.len().min(new.len()))
+    }
+    blocks(old)
+        .zip(blocks(new))
+        .position(|(a, b)| a != b)
+        .unwrap_or_else(|| blocks(old).count().min(blocks(new).count()))
 }
 
 /// The state before block `index` when it belongs to the main body
@@ -122,21 +126,22 @@ pub(crate) fn main_state_before(db: &dyn Db, file: SourceFile, index: usize) -> 
     let context = Context::of(db, program);
     let cache = db.state_cache();
     let mut files = cache.files.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-    let checkpoints = files.entry(file).or_insert_with(|| Checkpoints {
-        root: root.clone(),
-        context: Context::of(db, program),
-        points: Vec::new(),
-    });
-    if !checkpoints.context.same_as(&context) {
-        checkpoints.points.clear();
-    } else if !std::ptr::eq::<rowan::GreenNodeData>(&*checkpoints.root, &*root) {
-        // Identity, not `!=`: rowan compares green trees deeply.
-        let changed = first_changed_block(&checkpoints.root, &root);
-        checkpoints.points.retain(|point| point.index <= changed && point.called_end <= changed);
-    }
-    checkpoints.root = root;
-    checkpoints.context = context;
-
+    let checkpoints = match files.entry(file) {
+        Entry::Vacant(entry) => entry.insert(Checkpoints { root, context, points: Vec::new() }),
+        Entry::Occupied(entry) => {
+            let checkpoints = entry.into_mut();
+            if !checkpoints.context.same_as(&context) {
+                checkpoints.points.clear();
+            } else if !std::ptr::eq::<rowan::GreenNodeData>(&*checkpoints.root, &*root) {
+                // Identity, not `!=`: rowan compares green trees deeply.
+                let changed = first_changed_block(&checkpoints.root, &root);
+                checkpoints.points.retain(|point| point.index <= changed && point.called_end <= changed);
+            }
+            checkpoints.root = root;
+            checkpoints.context = context;
+            checkpoints
+        }
+    };
     let points = &mut checkpoints.points;
     let (from, mut state, mut params, called_before) = match points.partition_point(|p| p.index <= index) {
         0 => (0, ModalState::reset(Settings::get(db).dialect(db).catalogue()), ParamState::program_start(), 0),
