@@ -105,7 +105,14 @@ impl SourceFile {
     /// All blocks in order, including words that lack their `N` (see
     /// [`Block::number`]).
     pub fn blocks(&self) -> impl Iterator<Item = Block> + use<> {
-        self.0.children().filter_map(Block::cast)
+        self.0
+            .children()
+            .flat_map(|child| {
+                let run = child.kind() == SyntaxKind::BLOCK_RUN;
+                let in_run = run.then(|| child.children()).into_iter().flatten();
+                (!run).then_some(child).into_iter().chain(in_run)
+            })
+            .filter_map(Block::cast)
     }
 
     /// Comments outside any block: between the header and the first block.
@@ -116,7 +123,7 @@ impl SourceFile {
     pub fn end(&self) -> Option<End> {
         // The end follows every block: look from the back.
         std::iter::successors(self.0.last_child(), SyntaxNode::prev_sibling)
-            .take_while(|node| node.kind() != SyntaxKind::BLOCK)
+            .take_while(|node| !matches!(node.kind(), SyntaxKind::BLOCK | SyntaxKind::BLOCK_RUN))
             .find_map(End::cast)
     }
 }

@@ -22,36 +22,6 @@ pub(crate) fn node(
     GreenNode::new(kind.into(), children)
 }
 
-/// An iterator of known length, for building nodes from chained parts.
-pub(crate) struct ExactLen<I> {
-    inner: I,
-    remaining: usize,
-}
-
-impl<I: Iterator> ExactLen<I> {
-    pub(crate) fn new(inner: I, len: usize) -> Self {
-        ExactLen { inner, remaining: len }
-    }
-}
-
-impl<I: Iterator> Iterator for ExactLen<I> {
-    type Item = I::Item;
-
-    fn next(&mut self) -> Option<I::Item> {
-        let item = self.inner.next();
-        if item.is_some() {
-            self.remaining -= 1;
-        }
-        item
-    }
-
-    fn size_hint(&self) -> (usize, Option<usize>) {
-        (self.remaining, Some(self.remaining))
-    }
-}
-
-impl<I: Iterator> ExactSizeIterator for ExactLen<I> {}
-
 pub(crate) struct GreenFactory<'a> {
     /// `A`–`Z` then `a`–`z`.
     letters: Vec<GreenToken>,

@@ -15,6 +15,7 @@ mod decimal;
 pub mod encoding;
 mod error;
 mod green;
+mod runs;
 mod syntax_kind;
 
 use std::sync::Arc;

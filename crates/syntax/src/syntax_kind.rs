@@ -44,6 +44,12 @@ pub enum SyntaxKind {
     SOURCE_FILE,
     /// `%` with the program number and its comment.
     HEADER,
+    /// A run of consecutive blocks. Runs mean nothing: they bound how much
+    /// of the tree an edit rebuilds (a flat root with a million children is
+    /// copied whole on every change). Where a run ends depends only on the
+    /// blocks' text, so an incremental reparse gives the same runs as a
+    /// full parse.
+    BLOCK_RUN,
     /// One block: from its `N` word up to the next `N` or the end.
     BLOCK,
     /// An address with its value: `X-12.5`, `G01`, `FR10`, `&1201`.
@@ -106,6 +112,7 @@ const ALL_KINDS: [SyntaxKind; SyntaxKind::LAST as usize + 1] = {
         __LAST_TOKEN,
         SOURCE_FILE,
         HEADER,
+        BLOCK_RUN,
         BLOCK,
         WORD,
         PARAM_REF,

@@ -53,3 +53,46 @@ proptest! {
         prop_assert_eq!(incremental, Parse::new(&new_text, Dialect::Cnc8x6));
     }
 }
+
+/// A program of `blocks` numbered blocks with varied words, and every
+/// seventh line an unnumbered continuation, long enough for many runs.
+fn long_program(blocks: usize) -> String {
+    let mut text = String::from("%1\n");
+    for i in 0..blocks {
+        text.push_str(&format!("N{i} G1 X{}.{} Y{}\n", i * 7 % 1000, i % 10, i * 13 % 997));
+        if i % 7 == 0 {
+            text.push_str("Z-1.5\n");
+        }
+    }
+    text.push_str("M30\n*\n");
+    text
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// Edits in programs of many runs: regrouping after each edit must give
+    /// the runs of a full parse, however far the change moves run ends.
+    #[test]
+    fn reparse_of_long_programs_equals_full_parse(
+        blocks in 100usize..4000,
+        edits in prop::collection::vec(
+            (any::<bool>(), any::<prop::sample::Index>(), 0usize..40, "[0-9 NXG\n]{0,4}"),
+            1..10,
+        ),
+    ) {
+        let mut text = long_program(blocks);
+        let mut parse = Parse::new(&text, Dialect::Cnc8x6);
+        for (near_run_end, at, len, insert) in edits {
+            // Editing the last block of a run moves where the run ends.
+            let run_ends: Vec<usize> = parse.syntax_node().children().map(|run| usize::from(run.text_range().end())).collect();
+            let at = if near_run_end { run_ends[at.index(run_ends.len())].saturating_sub(len + 3) } else { at.index(text.len() + 1) };
+            let start = char_boundary(&text, at);
+            let end = char_boundary(&text, start + len);
+            let edit = TextEdit::replace(TextRange::new(TextSize::from(start as u32), TextSize::from(end as u32)), insert);
+            edit.apply(&mut text);
+            parse = parse.reparse(&edit, &text);
+            prop_assert_eq!(&parse, &Parse::new(&text, Dialect::Cnc8x6));
+        }
+    }
+}

@@ -31,6 +31,7 @@ use crate::{
     SyntaxError, SyntaxErrorKind as E,
     SyntaxKind::{self, *},
     green::{self, GreenElement, GreenFactory},
+    runs::RunBuilder,
 };
 
 /// The control's limit on characters per line.
@@ -111,18 +112,19 @@ fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, 
         back = Some(NodeOrToken::Node(parser.end()));
         errors.append(&mut parser.errors);
     }
-    let mut block_parts = Vec::with_capacity(parts.len());
+    // Runs are formed in one pass over all parts: where a run ends must not
+    // depend on how the text was split for parallel parsing.
+    let mut runs = RunBuilder::new(text, blocks_start);
     for (blocks, mut part_errors) in parts {
-        block_parts.push(blocks);
+        for block in blocks {
+            runs.push(block);
+        }
         errors.append(&mut part_errors);
     }
     crate::error::sort_errors(&mut errors);
 
-    // The root takes its children straight from the parts: with millions of
-    // blocks, a concatenated copy would cost time and memory.
-    let len = front.len() + block_parts.iter().map(Vec::len).sum::<usize>() + usize::from(back.is_some());
-    let children = front.into_iter().chain(block_parts.into_iter().flatten()).chain(back);
-    (green::node(SOURCE_FILE, green::ExactLen::new(children, len)), errors)
+    let children: Vec<GreenElement> = front.into_iter().chain(runs.finish()).chain(back).collect();
+    (green::node(SOURCE_FILE, children), errors)
 }
 
 /// Boundaries that split `region` (which starts at a block) into about

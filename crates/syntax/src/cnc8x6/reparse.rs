@@ -3,7 +3,8 @@
 //! Like rust-analyzer's block reparsing, but at CNC granularity: the blocks
 //! around the edit are reparsed from the new text until parsing reaches a
 //! block start that also started a block before the edit; the new blocks
-//! replace the old ones in the root node. Everything the edit could change
+//! replace the old ones, and the runs around them are regrouped (see
+//! `runs`), so only the touched runs and the root are rebuilt. Everything the edit could change
 //! beyond blocks (the header, the preamble, the physical end `*`, words
 //! before the first block) makes us return `None` and the caller parses the
 //! whole text again. A property test checks that the result always equals a
@@ -12,7 +13,9 @@
 use rowan::{NodeOrToken, TextRange, TextSize};
 
 use super::{is_block_letter, lexer::TYPOGRAPHIC_QUOTES, parser};
-use crate::{Parse, SyntaxErrorKind, SyntaxKind, SyntaxNode, TextEdit, error::sort_errors};
+use crate::{
+    Parse, SyntaxErrorKind, SyntaxKind, SyntaxNode, TextEdit, error::sort_errors, green::GreenElement, runs::RunBuilder,
+};
 
 pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Option<Parse> {
     let root = old.syntax_node();
@@ -68,9 +71,8 @@ pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Op
         at >= min_end && old_block_starts_at(&root, unshift(at), body_end)
     });
 
-    let first_index = first.index();
-    let end_index = if stop >= limit { layout.end_index } else { block_at(&root, unshift(stop))?.index() };
-    let green = old.green.splice_children(first_index..end_index, blocks);
+    let stop_block = if stop >= limit { None } else { Some(block_at(&root, unshift(stop))?) };
+    let green = regroup(&root, &first, blocks, stop_block.as_ref(), new_text, layout.end_index);
 
     // Errors: block errors of the replaced region and line-length errors of
     // every line touching it are recomputed; later errors move by `delta`.
@@ -100,6 +102,49 @@ pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Op
     errors.extend(parser::long_lines(new_text, line_lo..line_hi));
     sort_errors(&mut errors);
     Some(Parse { green, errors: errors.into(), dialect: old.dialect })
+}
+
+/// The root with the blocks from `first` up to `stop` (or to the end of the
+/// body) replaced by `blocks`, regrouped into runs from the start of
+/// `first`'s run until a new run ends where an old one did.
+fn regroup(
+    root: &SyntaxNode,
+    first: &SyntaxNode,
+    blocks: Vec<GreenElement>,
+    stop: Option<&SyntaxNode>,
+    new_text: &str,
+    end_index: usize,
+) -> rowan::GreenNode {
+    let first_run = first.parent().expect("blocks after the first numbered one are in runs");
+    let mut runs = RunBuilder::new(new_text, usize::from(first_run.text_range().start()));
+    let kept_before = first_run.green().children().take(first.index()).map(|c| c.to_owned()).collect::<Vec<_>>();
+    for block in kept_before.into_iter().chain(blocks) {
+        runs.push(block);
+    }
+    let root_green = root.green();
+    let replaced_end = match stop {
+        None => end_index,
+        Some(stop) => {
+            let stop_run = stop.parent().expect("blocks after the first numbered one are in runs");
+            let mut tail = stop_run.green().children().skip(stop.index()).map(|c| c.to_owned()).collect::<Vec<_>>();
+            let mut replaced_end = stop_run.index() + 1;
+            loop {
+                let mut synced = false;
+                for block in tail {
+                    synced = runs.push(block);
+                }
+                // A new run ends where an old one did: every later run is as before.
+                if synced || replaced_end == end_index {
+                    break replaced_end;
+                }
+                let next = root_green.children().nth(replaced_end).and_then(NodeOrToken::into_node);
+                let Some(next) = next.filter(|n| n.kind() == SyntaxKind::BLOCK_RUN.into()) else { break replaced_end };
+                tail = next.children().map(|c| c.to_owned()).collect();
+                replaced_end += 1;
+            }
+        }
+    };
+    root_green.splice_children(first_run.index()..replaced_end, runs.finish())
 }
 
 /// The text of `range`, read from the smallest element that covers it
@@ -140,7 +185,9 @@ impl Layout {
         for child in root.children() {
             match child.kind() {
                 SyntaxKind::HEADER => lines_from = usize::from(child.text_range().start()),
-                SyntaxKind::BLOCK if starts_with_block_number(&child) => {
+                // Numbered blocks are in runs; the unnumbered ones before
+                // them are not.
+                SyntaxKind::BLOCK_RUN => {
                     first_block = Some(child.text_range().start());
                     break;
                 }
@@ -155,9 +202,11 @@ fn starts_with_block_number(block: &SyntaxNode) -> bool {
     block.first_token().is_some_and(|t| t.kind() == SyntaxKind::LETTER && is_block_letter(t.text().as_bytes()[0]))
 }
 
-/// The block child of the root that contains the character at `offset`.
+/// The numbered block (in its run) that contains the character at `offset`.
 fn block_at(root: &SyntaxNode, offset: TextSize) -> Option<SyntaxNode> {
-    match root.child_or_token_at_range(TextRange::at(offset, TextSize::from(1)))? {
+    let at = TextRange::at(offset, TextSize::from(1));
+    let run = root.child_or_token_at_range(at)?.into_node().filter(|n| n.kind() == SyntaxKind::BLOCK_RUN)?;
+    match run.child_or_token_at_range(at)? {
         NodeOrToken::Node(node) if node.kind() == SyntaxKind::BLOCK && starts_with_block_number(&node) => Some(node),
         _ => None,
     }
@@ -177,7 +226,7 @@ fn line_end(text: &str, at: usize, limit: usize) -> usize {
 
 #[cfg(test)]
 mod tests {
-    use crate::{Dialect, Parse, TextEdit, TextRange, TextSize};
+    use crate::{Dialect, Parse, TextEdit, TextRange, TextSize, ast::AstNode};
 
     #[test]
     fn untouched_blocks_are_shared_with_the_old_tree() {
@@ -191,14 +240,21 @@ mod tests {
         assert_eq!(new, Parse::new(&new_text, Dialect::Cnc8x6));
 
         let blocks = |parse: &Parse| -> Vec<*const rowan::GreenNodeData> {
-            parse.green().children().filter_map(|c| c.into_node()).map(|n| n as *const _).collect()
+            parse
+                .tree()
+                .blocks()
+                .map(|block| {
+                    let green = block.syntax().green();
+                    &*green as *const rowan::GreenNodeData
+                })
+                .collect()
         };
         let (old_blocks, new_blocks) = (blocks(&old), blocks(&new));
-        // Header, five blocks, end: only N30 is reparsed.
+        // Five blocks: only N30 is reparsed.
         assert_eq!(old_blocks.len(), new_blocks.len());
-        for i in [0, 1, 2, 4, 5, 6] {
+        for i in [0, 1, 3, 4] {
             assert_eq!(old_blocks[i], new_blocks[i], "node {i} was rebuilt");
         }
-        assert_ne!(old_blocks[3], new_blocks[3]);
+        assert_ne!(old_blocks[2], new_blocks[2]);
     }
 }
