@@ -308,7 +308,7 @@ fn parse_prints_the_lossless_tree() {
     assert_eq!(output.status.code(), Some(0));
     let tree = stdout(&output);
     assert!(tree.starts_with("SOURCE_FILE@0..89\n  HEADER@0..10\n    PERCENT@0..1 \"%\"\n"), "{tree}");
-    assert!(tree.contains("    WORD@51..54\n      LETTER@51..52 \"G\"\n      NUMBER@52..54 \"01\"\n"), "{tree}");
+    assert!(tree.contains("      WORD@51..54\n        LETTER@51..52 \"G\"\n        NUMBER@52..54 \"01\"\n"), "{tree}");
 }
 
 /// A CAM program of a million blocks (about 35 MB) is checked completely.

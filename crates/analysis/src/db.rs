@@ -14,7 +14,12 @@ use std::{
 use ncc_syntax::{Dialect, Parse, SyntaxKind, TextSize};
 use rowan::GreenNode;
 
-use crate::{Config, Diagnostic, lower::BlockData, model::BlockSummary, states::StateCache};
+use crate::{
+    Config, Diagnostic,
+    lower::BlockData,
+    model::{BlockSummary, ChunkSummary},
+    states::StateCache,
+};
 
 #[salsa::db]
 pub trait Db: salsa::Database {
@@ -48,9 +53,9 @@ pub struct Settings {
     pub files: Vec<SourceFile>,
 }
 
-/// A block's green node, compared and hashed by identity: blocks the
-/// reparse kept are the same node, and the interned chunk keeps the node
-/// alive, so an address is never reused while it is a key.
+/// A green node compared and hashed by identity: nodes the reparse kept are
+/// the same node, and the interned chunk keeps the node alive, so an
+/// address is never reused while it is a key.
 #[derive(Debug, Clone)]
 pub struct BlockGreen(pub GreenNode);
 
@@ -68,66 +73,62 @@ impl Hash for BlockGreen {
     }
 }
 
-/// A run of consecutive blocks, the unit of incremental work. Chunks keep
-/// every query small (salsa's bookkeeping gets slow for queries with a
-/// million dependencies) and memory low (per-block results are kept as a
-/// compact summary, full block data is rebuilt when needed). Boundaries
-/// follow the blocks' identities, so an edit moves only the boundaries
-/// near it and leaves the other chunks, and their results, as they were.
+/// The unit of incremental work: a run of blocks (`BLOCK_RUN`), or one
+/// block outside any run (words before the first numbered block). Chunks
+/// keep every query small (salsa's bookkeeping gets slow for queries with
+/// a million dependencies) and memory low (per-block results are kept as a
+/// compact summary, full block data is rebuilt when needed). The reparse
+/// rebuilds only the runs an edit touches, so the other chunks, and their
+/// results, stay as they were.
 #[salsa::interned(debug)]
 pub struct BlockChunk<'db> {
     #[returns(ref)]
-    pub blocks: Vec<BlockGreen>,
+    pub green: BlockGreen,
 }
 
-/// Chunks end after a block whose identity hashes to zero, or at this size.
-const MAX_CHUNK: usize = 1024;
-const CHUNK_SPREAD: u64 = 256;
+impl<'db> BlockChunk<'db> {
+    /// The chunk's blocks, in order.
+    pub fn blocks(self, db: &'db dyn Db) -> impl Iterator<Item = &'db rowan::GreenNodeData> + 'db {
+        let node: &'db rowan::GreenNodeData = &self.green(db).0;
+        let run = node.kind() == SyntaxKind::BLOCK_RUN.into();
+        let in_run = run.then(|| node.children().filter_map(rowan::NodeOrToken::into_node)).into_iter().flatten();
+        (!run).then_some(node).into_iter().chain(in_run)
+    }
 
-/// A chunk of a file and where it starts.
+    pub fn len(self, db: &'db dyn Db) -> usize {
+        let node = &self.green(db).0;
+        if node.kind() == SyntaxKind::BLOCK_RUN.into() { node.children().len() } else { 1 }
+    }
+}
+
+/// A chunk of a file, where it starts, and the index of its first block.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, salsa::SalsaValue)]
 pub struct FileChunk<'db> {
     pub chunk: BlockChunk<'db>,
     pub offset: TextSize,
+    pub first: usize,
 }
 
 /// The file's blocks in chunks, in order.
 #[salsa::tracked(returns(ref))]
 pub fn file_chunks(db: &dyn Db, file: SourceFile) -> Vec<FileChunk<'_>> {
-    // The green tree is walked directly: red nodes would allocate one node
-    // per block on every edit.
+    // The green tree is walked directly: red nodes would allocate.
     let root = file.parse(db).green();
     let mut chunks = Vec::new();
-    let mut current: Vec<BlockGreen> = Vec::new();
-    let mut start = TextSize::from(0);
     let mut offset = TextSize::from(0);
+    let mut first = 0;
     for child in root.children() {
         let len = child.text_len();
         if let rowan::NodeOrToken::Node(node) = child
-            && node.kind() == SyntaxKind::BLOCK.into()
+            && (node.kind() == SyntaxKind::BLOCK.into() || node.kind() == SyntaxKind::BLOCK_RUN.into())
         {
-            if current.is_empty() {
-                start = offset;
-            }
-            let green = BlockGreen(node.to_owned());
-            let boundary = identity_hash(&green).is_multiple_of(CHUNK_SPREAD);
-            current.push(green);
-            if boundary || current.len() == MAX_CHUNK {
-                chunks.push(FileChunk { chunk: BlockChunk::new(db, std::mem::take(&mut current)), offset: start });
-            }
+            let chunk = BlockChunk::new(db, BlockGreen(node.to_owned()));
+            chunks.push(FileChunk { chunk, offset, first });
+            first += chunk.len(db);
         }
         offset += len;
     }
-    if !current.is_empty() {
-        chunks.push(FileChunk { chunk: BlockChunk::new(db, current), offset: start });
-    }
     chunks
-}
-
-fn identity_hash(green: &BlockGreen) -> u64 {
-    let mut hasher = rustc_hash::FxHasher::default();
-    green.hash(&mut hasher);
-    hasher.finish()
 }
 
 /// The blocks of a chunk lowered, each with its offset from the chunk's
@@ -135,9 +136,9 @@ fn identity_hash(green: &BlockGreen) -> u64 {
 /// on demand rather than stored.
 pub fn lower_chunk<'a>(db: &'a dyn Db, chunk: BlockChunk<'a>) -> impl Iterator<Item = (TextSize, BlockData)> + 'a {
     let mut offset = TextSize::from(0);
-    chunk.blocks(db).iter().map(move |green| {
-        let block = (offset, BlockData::lower(&green.0));
-        offset += green.0.text_len();
+    chunk.blocks(db).map(move |green| {
+        let block = (offset, BlockData::lower(green));
+        offset += green.text_len();
         block
     })
 }
@@ -157,8 +158,8 @@ pub fn chunk_diagnostics<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<Di
 /// What the program model needs of each block of a chunk; ranges relative
 /// to the chunk's start.
 #[salsa::tracked(returns(ref))]
-pub fn chunk_summaries<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<BlockSummary> {
-    lower_chunk(db, chunk).map(|(offset, data)| BlockSummary::of(&data, offset)).collect()
+pub fn chunk_summaries<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Arc<ChunkSummary> {
+    Arc::new(ChunkSummary::new(lower_chunk(db, chunk).map(|(offset, data)| BlockSummary::of(&data, offset)).collect()))
 }
 
 /// The database. Cloning it gives a handle for another thread.

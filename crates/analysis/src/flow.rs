@@ -276,7 +276,7 @@ pub fn states_before(db: &dyn Db, file: SourceFile, index: usize) -> Vec<(ModalS
         return vec![state];
     }
     let program = model::program(db, file);
-    let Some(block) = program.blocks.get(index) else { return Vec::new() };
+    let Some(block) = program.get_block(index) else { return Vec::new() };
     let seen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
     let probe = Probe { offset: block.offset, seen: seen.clone() };
     let mut walk = Walk::new(db, file, program, vec![Box::new(probe)]);
@@ -320,26 +320,18 @@ pub fn flow_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
 struct Blocks<'db> {
     db: &'db dyn Db,
     chunks: &'db [db::FileChunk<'db>],
-    /// Block index where each chunk starts.
-    starts: Vec<usize>,
     cache: FxHashMap<usize, Arc<Vec<(TextSize, BlockData)>>>,
 }
 
 impl<'db> Blocks<'db> {
     fn new(db: &'db dyn Db, file: SourceFile) -> Self {
         let chunks = db::file_chunks(db, file).as_slice();
-        let mut starts = Vec::with_capacity(chunks.len());
-        let mut next = 0;
-        for chunk in chunks {
-            starts.push(next);
-            next += chunk.chunk.blocks(db).len();
-        }
-        Blocks { db, chunks, starts, cache: FxHashMap::default() }
+        Blocks { db, chunks, cache: FxHashMap::default() }
     }
 
     /// Block `index` with its file offset.
     fn get(&mut self, index: usize) -> (TextSize, Arc<Vec<(TextSize, BlockData)>>, usize) {
-        let chunk = self.starts.partition_point(|&start| start <= index) - 1;
+        let chunk = self.chunks.partition_point(|chunk| chunk.first <= index) - 1;
         if !self.cache.contains_key(&chunk) {
             // A walk over a large file is one long query: give an edit
             // waiting to change the inputs its chance, once per chunk.
@@ -351,13 +343,13 @@ impl<'db> Blocks<'db> {
             self.cache.insert(chunk, Arc::new(lowered));
         }
         let lowered = self.cache[&chunk].clone();
-        (self.chunks[chunk].offset, lowered, index - self.starts[chunk])
+        (self.chunks[chunk].offset, lowered, index - self.chunks[chunk].first)
     }
 }
 
 /// Block `index` of `file`, lowered, with its file offset.
 pub fn lowered_block(db: &dyn Db, file: SourceFile, index: usize) -> Option<(TextSize, BlockData)> {
-    let blocks_in_file = model::program(db, file).blocks.len();
+    let blocks_in_file = model::program(db, file).block_count();
     (index < blocks_in_file).then(|| {
         let (chunk_offset, lowered, at) = Blocks::new(db, file).get(index);
         (chunk_offset + lowered[at].0, lowered[at].1.clone())
@@ -440,7 +432,7 @@ impl<'db> Walk<'db> {
         let (chunk_offset, lowered, at) = self.blocks.get(index);
         let (offset, block) = (&lowered[at].0, &lowered[at].1);
         let (state, params) = self.visit(block, chunk_offset + *offset, state, params);
-        match self.program.blocks[index].transfer {
+        match self.program.block(index).transfer {
             Some((transfer, range)) => self.follow(transfer, range, state, params),
             None => (state, params),
         }

@@ -5,7 +5,7 @@
 //! subprograms (`G79 L..` up to their last `G70`). A macrocycle file (`L<number>`) is one
 //! such unit; a fixed-cycle file (`$PC`) is a sequence of them.
 
-use std::ops::Range;
+use std::{ops::Range, sync::Arc};
 
 use ncc_syntax::{TextRange, TextSize};
 use rustc_hash::FxHashMap;
@@ -68,8 +68,9 @@ pub enum Transfer {
 }
 
 /// What the program model needs of one block (ranges relative to where
-/// the summary's owner puts them: the chunk, or the file in [`BlockInfo`]).
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+/// the summary's owner puts them: the chunk in [`ChunkSummary`], the file
+/// in [`Program::block`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct BlockSummary {
     pub offset: TextSize,
     pub len: TextSize,
@@ -109,7 +110,7 @@ impl BlockSummary {
             head: shift(self.head),
             closes_unit: self.closes_unit.map(shift),
             transfer: self.transfer.map(|(t, r)| (t, shift(r))),
-            ..self.clone()
+            ..*self
         }
     }
 
@@ -119,28 +120,56 @@ impl BlockSummary {
     }
 }
 
-/// One block in the model, with file offsets.
+/// What the program model keeps of a chunk: its blocks' summaries
+/// (relative to the chunk), and indexes that let the model and its checks
+/// skip the blocks that matter to nothing but themselves.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
-pub struct BlockInfo {
-    pub summary: BlockSummary,
-    /// Which unit the block belongs to, if any (blocks after the program's
-    /// end outside a subprogram belong to none).
-    pub unit: Option<usize>,
+pub struct ChunkSummary {
+    pub blocks: Vec<BlockSummary>,
+    /// Blocks that start or close a unit, or end the program.
+    marks: Vec<u32>,
+    /// Blocks with a call or a jump.
+    transfers: Vec<u32>,
+    /// Block numbers with their blocks, sorted.
+    numbers: Vec<(u64, u32)>,
 }
 
-impl std::ops::Deref for BlockInfo {
-    type Target = BlockSummary;
-
-    fn deref(&self) -> &BlockSummary {
-        &self.summary
+impl ChunkSummary {
+    pub(crate) fn new(blocks: Vec<BlockSummary>) -> ChunkSummary {
+        let indices = |keep: fn(&BlockSummary) -> bool| {
+            blocks.iter().enumerate().filter(|(_, b)| keep(b)).map(|(i, _)| i as u32).collect::<Vec<u32>>()
+        };
+        let marks = indices(|b| b.starts_unit.is_some() || b.closes_unit.is_some() || b.ends_program);
+        let transfers = indices(|b| b.transfer.is_some());
+        let mut numbers: Vec<(u64, u32)> =
+            blocks.iter().enumerate().filter_map(|(i, b)| Some((b.number?, i as u32))).collect();
+        numbers.sort_unstable();
+        ChunkSummary { blocks, marks, transfers, numbers }
     }
 }
 
-/// The structure of one file.
+/// A chunk in the model: where it starts, and its first block's index.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct ChunkBlocks {
+    pub offset: TextSize,
+    pub first: usize,
+    pub summary: Arc<ChunkSummary>,
+}
+
+impl ChunkBlocks {
+    fn indices<'a>(&'a self, local: &'a [u32]) -> impl Iterator<Item = usize> + 'a {
+        local.iter().map(|&i| self.first + i as usize)
+    }
+}
+
+/// The structure of one file. Blocks are kept per chunk, relative to it,
+/// so that an edit rebuilds the model from shared chunk summaries without
+/// touching every block.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct Program {
     pub kind: FileKind,
-    pub blocks: Vec<BlockInfo>,
+    chunks: Vec<ChunkBlocks>,
+    block_count: usize,
     pub units: Vec<Unit>,
     /// The block that ends the main body (M02 or M30).
     pub end_of_main: Option<usize>,
@@ -153,14 +182,87 @@ pub struct Program {
 }
 
 impl Program {
+    pub fn block_count(&self) -> usize {
+        self.block_count
+    }
+
+    /// Block `index`, with file offsets.
+    pub fn block(&self, index: usize) -> BlockSummary {
+        self.get_block(index).unwrap_or_else(|| panic!("block {index} of {}", self.block_count))
+    }
+
+    pub fn get_block(&self, index: usize) -> Option<BlockSummary> {
+        let chunk = &self.chunks[self.chunks.partition_point(|c| c.first <= index).checked_sub(1)?];
+        chunk.summary.blocks.get(index - chunk.first).map(|b| b.shifted(chunk.offset))
+    }
+
+    /// Every block in order, with file offsets.
+    pub fn blocks(&self) -> impl Iterator<Item = BlockSummary> + '_ {
+        self.chunks.iter().flat_map(|c| c.summary.blocks.iter().map(|b| b.shifted(c.offset)))
+    }
+
+    /// The blocks of `range`, with file offsets.
+    pub fn blocks_in(&self, range: Range<usize>) -> impl Iterator<Item = BlockSummary> + '_ {
+        range.map(|index| self.block(index))
+    }
+
+    /// The index of the block that holds `offset` (a block's end belongs to
+    /// it, but where the next block starts the cursor is on that one).
+    pub fn block_index_at(&self, offset: TextSize) -> Option<usize> {
+        let chunk = self.chunks.partition_point(|c| c.offset <= offset).checked_sub(1)?;
+        let chunk = &self.chunks[chunk];
+        let local = offset - chunk.offset;
+        let blocks = &chunk.summary.blocks;
+        let index = blocks.partition_point(|b| b.end() < local);
+        let block = blocks.get(index).filter(|b| b.offset <= local)?;
+        let next = if block.end() == local { self.get_block(chunk.first + index + 1) } else { None };
+        match next {
+            Some(next) if next.offset == offset => Some(chunk.first + index + 1),
+            _ => Some(chunk.first + index),
+        }
+    }
+
+    /// The blocks with a call or a jump.
+    pub fn transfers(&self) -> impl Iterator<Item = usize> + '_ {
+        self.chunks.iter().flat_map(|c| c.indices(&c.summary.transfers))
+    }
+
+    /// The blocks numbered `number`, in order.
+    pub fn numbered(&self, number: u64) -> impl Iterator<Item = usize> + '_ {
+        self.chunks.iter().flat_map(move |c| {
+            let numbers = &c.summary.numbers;
+            let from = numbers.partition_point(|&(n, _)| n < number);
+            numbers[from..].iter().take_while(move |&&(n, _)| n == number).map(|&(_, i)| c.first + i as usize)
+        })
+    }
+
+    /// Every block number with its block, sorted by number per chunk; the
+    /// chunks' number ranges, for finding duplicates without hashing every
+    /// block.
+    pub(crate) fn chunk_numbers(&self) -> impl Iterator<Item = (usize, &[(u64, u32)])> + '_ {
+        self.chunks.iter().map(|c| (c.first, c.summary.numbers.as_slice()))
+    }
+
     /// Whether the file has a main body (the first unit, without a number).
     pub fn has_main(&self) -> bool {
         self.units.first().is_some_and(|u| u.number.is_none())
     }
 
+    /// The index of the unit holding block `index`, if any.
+    pub fn unit_index(&self, index: usize) -> Option<usize> {
+        // Subprograms do not overlap one another; a misplaced one lies
+        // inside the main body's range and owns its blocks.
+        let subprograms = usize::from(self.has_main())..self.units.len();
+        let found = self.units[subprograms.clone()].partition_point(|u| u.blocks.start <= index);
+        let candidate = (found > 0).then(|| subprograms.start + found - 1);
+        candidate
+            .filter(|&u| self.units[u].blocks.contains(&index))
+            .or_else(|| (self.has_main() && self.units[0].blocks.contains(&index)).then_some(0))
+    }
+
     /// The unit holding block `index`.
     pub fn unit_of(&self, index: usize) -> Option<&Unit> {
-        self.blocks[index].unit.map(|u| &self.units[u])
+        self.unit_index(index).map(|u| &self.units[u])
     }
 
     /// The subprogram `G79 L<number>` of this file.
@@ -172,8 +274,7 @@ impl Program {
     /// with that number in the same unit.
     pub fn jump_target(&self, from: usize, number: u32) -> Option<usize> {
         let unit = self.unit_of(from)?;
-        let position = self.blocks[unit.blocks.clone()].iter().position(|b| b.number == Some(u64::from(number)))?;
-        Some(unit.blocks.start + position)
+        self.numbered(u64::from(number)).find(|index| unit.blocks.contains(index))
     }
 }
 
@@ -200,23 +301,24 @@ fn transfer(block: &BlockData) -> Option<(Transfer, TextRange)> {
 #[salsa::tracked(returns(ref))]
 pub fn program(db: &dyn Db, file: SourceFile) -> Program {
     let kind = file_kind(db, file);
-    let chunks = db::file_chunks(db, file);
+    let chunks: Vec<ChunkBlocks> = db::file_chunks(db, file)
+        .iter()
+        .map(|c| ChunkBlocks { offset: c.offset, first: c.first, summary: db::chunk_summaries(db, c.chunk).clone() })
+        .collect();
+    let block_count = chunks.last().map_or(0, |c| c.first + c.summary.blocks.len());
     let mut program = Program {
         kind,
-        blocks: Vec::with_capacity(chunks.iter().map(|c| c.chunk.blocks(db).len()).sum()),
+        chunks,
+        block_count,
         units: Vec::new(),
         end_of_main: None,
         early_unit_starts: Vec::new(),
         stray_blocks: Vec::new(),
         stray_g70: Vec::new(),
     };
-    let mut summaries = chunks
-        .iter()
-        .flat_map(|chunk| db::chunk_summaries(db, chunk.chunk).iter().map(move |s| s.shifted(chunk.offset)))
-        .peekable();
     // Partprograms start in their main body; the other files, and a
     // program file that starts with `G79`, in units only.
-    let starts_with_unit = summaries.peek().is_some_and(|s| s.starts_unit.is_some());
+    let starts_with_unit = program.get_block(0).is_some_and(|b| b.starts_unit.is_some());
     let mut in_main = kind == FileKind::Program && !starts_with_unit;
     if in_main {
         program.units.push(Unit { number: None, blocks: 0..0, closed: false });
@@ -225,7 +327,14 @@ pub fn program(db: &dyn Db, file: SourceFile) -> Program {
     // The last G70 of the open subprogram after the main body: a body may
     // return from several places, and it ends at its last G70.
     let mut last_g70: Option<usize> = None;
-    for (index, summary) in summaries.enumerate() {
+    // Only marked blocks change the state; the blocks between them join
+    // the open unit, or none.
+    let marks: Vec<usize> = program.chunks.iter().flat_map(|c| c.indices(&c.summary.marks)).collect();
+    let mut next = 0;
+    for index in marks {
+        assign(&mut program, open, next..index);
+        next = index + 1;
+        let summary = program.block(index);
         if let Some(number) = summary.starts_unit {
             if in_main {
                 program.early_unit_starts.push(index);
@@ -234,15 +343,9 @@ pub fn program(db: &dyn Db, file: SourceFile) -> Program {
             program.units.push(Unit { number, blocks: index..index, closed: false });
             open = Some(program.units.len() - 1);
         }
-        let unit = open;
-        match unit {
-            Some(u) => program.units[u].blocks.end = index + 1,
-            None => program.stray_blocks.push(index),
-        }
-        let closes = summary.closes_unit.is_some();
+        assign(&mut program, open, index..index + 1);
         let ends_main = in_main && open == Some(0) && summary.ends_program;
-        program.blocks.push(BlockInfo { summary, unit });
-        if closes {
+        if summary.closes_unit.is_some() {
             match open {
                 // A subprogram inside the main body returns to it at its
                 // first G70 (it is misplaced anyway).
@@ -263,8 +366,20 @@ pub fn program(db: &dyn Db, file: SourceFile) -> Program {
             open = None;
         }
     }
+    assign(&mut program, open, next..block_count);
     end_unit(&mut program, open, last_g70);
     program
+}
+
+/// Puts `blocks` into unit `open`, or among the stray blocks.
+fn assign(program: &mut Program, open: Option<usize>, blocks: Range<usize>) {
+    if blocks.is_empty() {
+        return;
+    }
+    match open {
+        Some(u) => program.units[u].blocks.end = blocks.end,
+        None => program.stray_blocks.extend(blocks),
+    }
 }
 
 /// Ends unit `open` at its last G70, if it has one: the blocks after it
@@ -272,9 +387,6 @@ pub fn program(db: &dyn Db, file: SourceFile) -> Program {
 fn end_unit(program: &mut Program, open: Option<usize>, last_g70: Option<usize>) {
     let (Some(unit), Some(last)) = (open, last_g70) else { return };
     let after = last + 1..program.units[unit].blocks.end;
-    for index in after.clone() {
-        program.blocks[index].unit = None;
-    }
     program.stray_blocks.extend(after);
     program.units[unit].blocks.end = last + 1;
 }

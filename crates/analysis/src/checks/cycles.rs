@@ -545,7 +545,9 @@ pub(crate) fn check_file(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
     if !has_end {
         let text = file.text(db);
         let end = TextSize::from(text.len() as u32);
-        let range = program.blocks.last().map_or_else(|| structure::file_start(db, file), |b| b.head);
+        let range = program
+            .get_block(program.block_count().wrapping_sub(1))
+            .map_or_else(|| structure::file_start(db, file), |b| b.head);
         let insert = if text.is_empty() || text.ends_with('\n') { "*\n" } else { "\n*\n" };
         out.push(
             Diagnostic::new(

@@ -72,7 +72,7 @@ fn check_header_and_end(db: &dyn Db, file: SourceFile, program: &Program, out: &
         }
     }
     if program.kind == FileKind::Program && tree.end().is_none() {
-        let last = program.blocks.len().checked_sub(1);
+        let last = program.block_count().checked_sub(1);
         let range = last.map_or_else(|| file_start(db, file), |last| head(program, last));
         out.push(Diagnostic::new(
             &MISSING_PHYSICAL_END,
@@ -83,23 +83,56 @@ fn check_header_and_end(db: &dyn Db, file: SourceFile, program: &Program, out: &
 }
 
 /// Block numbers are unique in a file (in a fixed-cycle file, per body).
+///
+/// Programs number their blocks mostly in order, so the chunks' number
+/// ranges rarely overlap: only chunks whose ranges overlap are compared,
+/// and each chunk's numbers come sorted.
 fn check_block_numbers(program: &Program, out: &mut Vec<Diagnostic>) {
-    let mut seen: FxHashMap<(Option<usize>, u64), TextRange> =
-        FxHashMap::with_capacity_and_hasher(program.blocks.len(), Default::default());
-    for block in &program.blocks {
-        let (Some(number), Some(range)) = (block.number, block.number_range) else { continue };
-        let scope = if program.kind == FileKind::CycleFile { block.unit } else { None };
-        match seen.get(&(scope, number)) {
-            Some(&first) => out.push(
-                Diagnostic::new(
-                    &DUPLICATE_BLOCK_NUMBER,
-                    range,
-                    format!("block number N{number} is already used: block numbers must be unique from `%` to `*`, subprograms included"),
-                )
-                .with_related(None, first, "first used here"),
-            ),
-            None => {
-                seen.insert((scope, number), range);
+    let mut chunks: Vec<(usize, &[(u64, u32)])> = program.chunk_numbers().filter(|(_, n)| !n.is_empty()).collect();
+    chunks.sort_by_key(|(_, numbers)| numbers[0].0);
+    let highest = |numbers: &[(u64, u32)]| numbers[numbers.len() - 1].0;
+    let mut start = 0;
+    while start < chunks.len() {
+        // The chunks whose number ranges overlap this one's, transitively.
+        let mut end = start + 1;
+        let mut max = highest(chunks[start].1);
+        while end < chunks.len() && chunks[end].1[0].0 <= max {
+            max = max.max(highest(chunks[end].1));
+            end += 1;
+        }
+        let cluster = &chunks[start..end];
+        // Alone, a chunk's sorted numbers show its duplicates side by side.
+        if cluster.len() > 1 || cluster[0].1.windows(2).any(|pair| pair[0].0 == pair[1].0) {
+            let blocks = cluster
+                .iter()
+                .flat_map(|&(first, numbers)| numbers.iter().map(move |&(number, i)| (number, first + i as usize)))
+                .collect();
+            report_duplicates(program, blocks, out);
+        }
+        start = end;
+    }
+}
+
+/// Reports the later uses of each number among `blocks` (number, block
+/// index).
+fn report_duplicates(program: &Program, mut blocks: Vec<(u64, usize)>, out: &mut Vec<Diagnostic>) {
+    blocks.sort_unstable();
+    for same in blocks.chunk_by(|a, b| a.0 == b.0).filter(|same| same.len() > 1) {
+        // The first use in each scope: the file, or a fixed-cycle body.
+        let mut firsts: Vec<(Option<usize>, TextRange)> = Vec::new();
+        for &(number, index) in same {
+            let scope = if program.kind == FileKind::CycleFile { program.unit_index(index) } else { None };
+            let Some(range) = program.block(index).number_range else { continue };
+            match firsts.iter().find(|(s, _)| *s == scope) {
+                Some(&(_, first)) => out.push(
+                    Diagnostic::new(
+                        &DUPLICATE_BLOCK_NUMBER,
+                        range,
+                        format!("block number N{number} is already used: block numbers must be unique from `%` to `*`, subprograms included"),
+                    )
+                    .with_related(None, first, "first used here"),
+                ),
+                None => firsts.push((scope, range)),
             }
         }
     }
@@ -107,18 +140,18 @@ fn check_block_numbers(program: &Program, out: &mut Vec<Diagnostic>) {
 
 /// The range of a block's first word, where diagnostics about the block point.
 fn head(program: &Program, index: usize) -> TextRange {
-    program.blocks[index].head
+    program.block(index).head
 }
 
 fn check_units(db: &dyn Db, file: SourceFile, program: &Program, out: &mut Vec<Diagnostic>) {
-    if program.kind == FileKind::Program && !program.blocks.is_empty() && !program.has_main() {
+    if program.kind == FileKind::Program && program.block_count() > 0 && !program.has_main() {
         out.push(Diagnostic::new(
             &MISSING_PROGRAM_END,
             head(program, 0),
             "this file starts with `G79`, so it has no main program ending with M02/M30: \
              a partprogram starts with its main program, and a macrocycle file is named `L<number>`",
         ));
-    } else if program.kind == FileKind::Program && !program.blocks.is_empty() && program.end_of_main.is_none() {
+    } else if program.kind == FileKind::Program && program.block_count() > 0 && program.end_of_main.is_none() {
         let last_main = program.units[0].blocks.end.saturating_sub(1);
         out.push(Diagnostic::new(
             &MISSING_PROGRAM_END,
@@ -162,7 +195,7 @@ fn check_units(db: &dyn Db, file: SourceFile, program: &Program, out: &mut Vec<D
     for &index in &program.stray_g70 {
         out.push(Diagnostic::new(
             &G70_OUTSIDE_SUBPROGRAM,
-            program.blocks[index].closes_unit.unwrap_or_else(|| head(program, index)),
+            program.block(index).closes_unit.unwrap_or_else(|| head(program, index)),
             "G70 ends a subprogram or macrocycle; in the main program it has no subprogram to end",
         ));
     }
@@ -211,22 +244,21 @@ fn check_units(db: &dyn Db, file: SourceFile, program: &Program, out: &mut Vec<D
 fn missing_g70(db: &dyn Db, file: SourceFile, program: &Program, unit: &Unit) -> Diagnostic {
     let number = unit.number.expect("subprograms have numbers");
     let last = unit.blocks.end - 1;
-    let insert_at = program.blocks[last].end();
-    let used: Vec<u64> = program.blocks.iter().filter_map(|b| b.number).collect();
-    let numbers: Vec<u64> = program.blocks[unit.blocks.clone()].iter().filter_map(|b| b.number).collect();
+    let insert_at = program.block(last).end();
+    let numbers: Vec<u64> = program.blocks_in(unit.blocks.clone()).filter_map(|b| b.number).collect();
     let step = match numbers.as_slice() {
         [.., a, b] if b > a => b - a,
         _ => 1,
     };
     let mut next = numbers.last().copied().unwrap_or(0) + step;
-    while used.contains(&next) {
+    while program.numbered(next).next().is_some() {
         next += 1;
     }
     let text = file.text(db);
     let at = usize::from(insert_at);
     let needs_newline = at > 0 && !matches!(text.as_bytes()[at - 1], b'\n' | b'\r');
     let insert = format!("{}N{next} G70\n", if needs_newline { "\n" } else { "" });
-    let reached = if unit.blocks.end < program.blocks.len() { "the next one starts" } else { "the file ends" };
+    let reached = if unit.blocks.end < program.block_count() { "the next one starts" } else { "the file ends" };
     let what = match program.kind {
         FileKind::Program => "subprogram",
         FileKind::Macrocycle(_) => "macrocycle",
@@ -246,7 +278,7 @@ fn missing_g70(db: &dyn Db, file: SourceFile, program: &Program, unit: &Unit) ->
 
 fn check_macrocycle_file(db: &dyn Db, file: SourceFile, program: &Program, name: u32, out: &mut Vec<Diagnostic>) {
     let Some(first) = program.units.first() else {
-        if !program.blocks.is_empty() {
+        if program.block_count() > 0 {
             out.push(Diagnostic::new(
                 &MACROCYCLE_WITHOUT_G79,
                 head(program, 0),
@@ -290,8 +322,8 @@ fn check_macrocycle_file(db: &dyn Db, file: SourceFile, program: &Program, name:
 }
 
 fn check_transfers(db: &dyn Db, program: &Program, out: &mut Vec<Diagnostic>) {
-    for (index, block) in program.blocks.iter().enumerate() {
-        let Some((transfer, range)) = block.transfer else { continue };
+    for index in program.transfers() {
+        let Some((transfer, range)) = program.block(index).transfer else { continue };
         let in_subprogram = program.unit_of(index).is_some_and(|u| u.number.is_some());
         match transfer {
             Transfer::Subprogram(number) => {
@@ -327,7 +359,7 @@ fn check_transfers(db: &dyn Db, program: &Program, out: &mut Vec<Diagnostic>) {
             }
             Transfer::Jump(target) => {
                 if program.unit_of(index).is_some() && program.jump_target(index, target).is_none() {
-                    let elsewhere = program.blocks.iter().position(|b| b.number == Some(u64::from(target)));
+                    let elsewhere = program.numbered(u64::from(target)).next();
                     let message = match elsewhere {
                         Some(_) => format!(
                             "N{target} is in another program unit: G73 jumps only within the main program, one subprogram or one macrocycle"
@@ -335,7 +367,7 @@ fn check_transfers(db: &dyn Db, program: &Program, out: &mut Vec<Diagnostic>) {
                         None => format!("no block N{target} to jump to in this program unit"),
                     };
                     let mut diagnostic = Diagnostic::new(&JUMP_TARGET_NOT_IN_UNIT, range, message);
-                    if let Some(target_range) = elsewhere.and_then(|i| program.blocks[i].number_range) {
+                    if let Some(target_range) = elsewhere.and_then(|i| program.block(i).number_range) {
                         diagnostic = diagnostic.with_related(None, target_range, "the block is here");
                     }
                     out.push(diagnostic);

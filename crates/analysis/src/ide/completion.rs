@@ -310,8 +310,8 @@ impl Request<'_> {
                 let label = self.catalogue.addresses.iter().find(|a| a.role == AddressRole::Label);
                 let max = label.and_then(|l| l.bounds).map_or(f64::MAX, |(_, max)| max);
                 let text = self.file.text(db);
-                program.blocks[unit.blocks.clone()]
-                    .iter()
+                program
+                    .blocks_in(unit.blocks.clone())
                     .filter_map(|info| {
                         let number = u32::try_from(info.number?).ok().filter(|&n| f64::from(n) <= max)?;
                         let block = &text[usize::from(info.offset)..usize::from(info.end())];
@@ -367,7 +367,7 @@ impl Request<'_> {
 /// A unit's one-line description (the first comment of its start block,
 /// else its first line) and its start block's text.
 fn unit_text(db: &dyn Db, file: SourceFile, program: &model::Program, start: usize) -> (String, Option<String>) {
-    let Some(info) = program.blocks.get(start) else { return (String::new(), None) };
+    let Some(info) = program.get_block(start) else { return (String::new(), None) };
     let text = &file.text(db)[usize::from(info.offset)..usize::from(info.end())];
     let comment = flow::lowered_block(db, file, start)
         .and_then(|(_, block)| block.comments.first().map(|c| c.body.trim().to_owned()))

@@ -60,7 +60,9 @@ impl CommentLines {
         for (range, child) in children(node, start) {
             match child {
                 NodeOrToken::Node(node) => match kind(node.kind()) {
-                    SyntaxKind::BLOCK | SyntaxKind::HEADER | SyntaxKind::END => self.node(node, range.start()),
+                    SyntaxKind::BLOCK_RUN | SyntaxKind::BLOCK | SyntaxKind::HEADER | SyntaxKind::END => {
+                        self.node(node, range.start())
+                    }
                     // Words, assignments and the like never hold a line
                     // break or a comment.
                     _ => self.text = true,

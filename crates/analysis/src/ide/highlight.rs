@@ -126,7 +126,8 @@ pub(crate) fn highlight(db: &dyn Db, file: SourceFile, within: Option<TextRange>
     let text = file.text(db);
     // Read from the text rather than the program model, which an edit
     // invalidates: a fixed-cycle file has `$PC` before its first block.
-    let prelude = children(root, TextSize::from(0)).find(|(_, child)| kind(child.kind()) == SyntaxKind::BLOCK);
+    let prelude = children(root, TextSize::from(0))
+        .find(|(_, child)| matches!(kind(child.kind()), SyntaxKind::BLOCK | SyntaxKind::BLOCK_RUN));
     let prelude = &text[..prelude.map_or(text.len(), |(range, _)| usize::from(range.start()))];
     let mut walk = Walk {
         catalogue: Settings::get(db).dialect(db).catalogue(),
@@ -136,19 +137,28 @@ pub(crate) fn highlight(db: &dyn Db, file: SourceFile, within: Option<TextRange>
         // CAM output has about one piece per four bytes.
         out: Vec::with_capacity(if within.is_some() { 0 } else { text.len() / 4 }),
     };
-    let mut offset = TextSize::from(0);
-    for child in root.children() {
-        let range = TextRange::at(offset, child.text_len());
-        offset = range.end();
-        if kind(child.kind()) == SyntaxKind::BLOCK {
+    // An empty range still shows the item it is in.
+    let skip = |range: TextRange| {
+        within
+            .is_some_and(|within| range.intersect(within).is_none_or(|common| common.is_empty() && !within.is_empty()))
+    };
+    for (range, child) in children(root, TextSize::from(0)) {
+        if within.is_some_and(|within| range.start() > within.end()) {
+            break;
+        }
+        let is_run = kind(child.kind()) == SyntaxKind::BLOCK_RUN;
+        if is_run || kind(child.kind()) == SyntaxKind::BLOCK {
             walk.in_prelude = false;
         }
-        match within {
-            Some(within) if range.start() > within.end() => break,
-            // An empty range still shows the item it is in.
-            Some(within) if range.intersect(within).is_none_or(|common| common.is_empty() && !within.is_empty()) => {
-                continue;
+        match child {
+            // Each block of a run is an item; a run away from the range is
+            // skipped whole.
+            NodeOrToken::Node(run) if is_run && !skip(range) => {
+                for (range, block) in children(run, range.start()).filter(|(range, _)| !skip(*range)) {
+                    walk.element(block, range, None, false);
+                }
             }
+            _ if is_run || skip(range) => {}
             _ => walk.element(child, range, None, false),
         }
     }

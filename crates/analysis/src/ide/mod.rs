@@ -46,12 +46,7 @@ pub struct NavigationTarget {
 /// end belongs to it, so the cursor after the last character still finds
 /// the word).
 fn block_index_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<usize> {
-    let blocks = &model::program(db, file).blocks;
-    let index = blocks.partition_point(|b| b.end() < offset);
-    // Where one block ends and the next starts, the cursor is on the
-    // next one's block number.
-    let index = if blocks.get(index + 1).is_some_and(|b| b.offset == offset) { index + 1 } else { index };
-    blocks.get(index).is_some_and(|b| b.offset <= offset).then_some(index)
+    model::program(db, file).block_index_at(offset)
 }
 
 /// The block at `offset`, lowered, with its index and file offset.
@@ -145,7 +140,7 @@ pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<H
 
 /// What a `G71`/`G72`/`G73` block's L calls, in words.
 fn call_text(db: &dyn Db, file: SourceFile, index: usize) -> Option<String> {
-    let (transfer, _) = model::program(db, file).blocks[index].transfer?;
+    let (transfer, _) = model::program(db, file).block(index).transfer?;
     let what = match transfer {
         Transfer::Subprogram(n) => format!("Calls subprogram L{n}"),
         Transfer::Macrocycle(n) => format!("Calls macrocycle file L{n}"),
@@ -219,7 +214,7 @@ pub(crate) fn goto_definition(db: &dyn Db, file: SourceFile, offset: TextSize) -
         // The call's L, or its G71/G72/G73.
         Some(Target::Word(word)) if matches!(word.letter, b'L' | b'G') => {
             let program = model::program(db, file);
-            match program.blocks[index].transfer {
+            match program.block(index).transfer {
                 Some((transfer, code)) if word.letter == b'L' || code == word.range + start => {
                     transfer_targets(db, file, index, transfer)
                 }
@@ -234,7 +229,7 @@ pub(crate) fn goto_definition(db: &dyn Db, file: SourceFile, offset: TextSize) -
 fn transfer_targets(db: &dyn Db, file: SourceFile, index: usize, transfer: Transfer) -> Vec<NavigationTarget> {
     let program = model::program(db, file);
     let block_target = |file: SourceFile, program: &model::Program, block: usize| {
-        let info = &program.blocks[block];
+        let info = program.block(block);
         NavigationTarget {
             file,
             range: TextRange::new(info.offset, info.end()),

@@ -53,7 +53,7 @@ pub enum ReferenceKind {
 pub(crate) fn references(db: &dyn Db, file: SourceFile, offset: TextSize, include_declaration: bool) -> Vec<Reference> {
     let Some((index, start, block)) = block_at(db, file, offset) else { return Vec::new() };
     let program = model::program(db, file);
-    let info = &program.blocks[index];
+    let info = program.block(index);
     let mut references = match target_at(&block, offset - start) {
         Some(Target::Parameter { index: number, .. }) => parameter_references(db, file, number),
         Some(Target::Word(word)) => {
@@ -131,7 +131,7 @@ fn macrocycle_references(db: &dyn Db, number: u32) -> Vec<Reference> {
 fn jump_target_references(db: &dyn Db, file: SourceFile, program: &Program, index: usize) -> Vec<Reference> {
     let mut references: Vec<Reference> = block_number(file, program, index).into_iter().collect();
     // Only the first block with a number in its unit is reached by jumps.
-    let number = program.blocks[index].number.and_then(|n| u32::try_from(n).ok());
+    let number = program.block(index).number.and_then(|n| u32::try_from(n).ok());
     if let Some(number) = number
         && program.jump_target(index, number) == Some(index)
     {
@@ -141,7 +141,7 @@ fn jump_target_references(db: &dyn Db, file: SourceFile, program: &Program, inde
 }
 
 fn block_number(file: SourceFile, program: &Program, index: usize) -> Option<Reference> {
-    let range = program.blocks[index].number_range?;
+    let range = program.block(index).number_range?;
     Some(Reference { file, range, kind: ReferenceKind::Definition })
 }
 
@@ -149,7 +149,7 @@ fn block_number(file: SourceFile, program: &Program, index: usize) -> Option<Ref
 fn jumps(db: &dyn Db, file: SourceFile, program: &Program, index: usize, number: u32) -> Vec<Reference> {
     let Some(unit) = program.unit_of(index) else { return Vec::new() };
     let blocks =
-        unit.blocks.clone().filter(|&b| program.blocks[b].transfer.is_some_and(|(t, _)| t == Transfer::Jump(number)));
+        unit.blocks.clone().filter(|&b| program.block(b).transfer.is_some_and(|(t, _)| t == Transfer::Jump(number)));
     labels_at(db, file, blocks, ReferenceKind::Jump)
 }
 
@@ -161,7 +161,7 @@ fn labels(
     matches: impl Fn(Transfer) -> bool,
     kind: ReferenceKind,
 ) -> Vec<Reference> {
-    let blocks = (0..program.blocks.len()).filter(|&b| program.blocks[b].transfer.is_some_and(|(t, _)| matches(t)));
+    let blocks = (0..program.block_count()).filter(|&b| program.block(b).transfer.is_some_and(|(t, _)| matches(t)));
     labels_at(db, file, blocks, kind)
 }
 

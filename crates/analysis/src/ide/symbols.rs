@@ -50,8 +50,8 @@ pub(crate) fn document_symbols(db: &dyn Db, file: SourceFile) -> Vec<DocumentSym
     let outline = Outline::new(db, file);
     let program = outline.program;
     let mut calls: FxHashMap<u32, usize> = FxHashMap::default();
-    for block in &program.blocks {
-        if let Some((Transfer::Subprogram(number), _)) = block.transfer {
+    for index in program.transfers() {
+        if let Some((Transfer::Subprogram(number), _)) = program.block(index).transfer {
             *calls.entry(number).or_default() += 1;
         }
     }
@@ -62,7 +62,7 @@ pub(crate) fn document_symbols(db: &dyn Db, file: SourceFile) -> Vec<DocumentSym
         let lowered = first.as_ref().map(|node| (node.text_range().start(), BlockData::lower(node.green())));
         let label = lowered.as_ref().and_then(|(offset, block)| Some(block.word(b'L')?.range + *offset));
         let comment = first.as_ref().and_then(first_comment).or_else(|| leading_comment(&outline, unit));
-        let first_focus = program.blocks.get(unit.blocks.start).map_or(range, block_focus);
+        let first_focus = program.get_block(unit.blocks.start).map_or(range, block_focus);
         let symbol = |kind, name: String, detail| DocumentSymbol {
             name,
             kind,
@@ -121,7 +121,7 @@ fn main_name(path: &str) -> String {
 }
 
 /// What to select of a block: its number, or its first word.
-fn block_focus(block: &model::BlockInfo) -> TextRange {
+fn block_focus(block: model::BlockSummary) -> TextRange {
     block.number_range.unwrap_or(block.head)
 }
 
@@ -132,7 +132,7 @@ fn jump_targets(outline: &Outline<'_>, unit: &Unit) -> Vec<DocumentSymbol> {
     let mut targets: FxHashMap<u32, Option<usize>> = FxHashMap::default();
     let mut sources: Vec<(usize, usize)> = Vec::new();
     for from in unit.blocks.clone() {
-        if let Some((Transfer::Jump(number), _)) = program.blocks[from].transfer
+        if let Some((Transfer::Jump(number), _)) = program.block(from).transfer
             && let Some(target) = *targets.entry(number).or_insert_with(|| program.jump_target(from, number))
         {
             sources.push((target, from));
@@ -142,9 +142,9 @@ fn jump_targets(outline: &Outline<'_>, unit: &Unit) -> Vec<DocumentSymbol> {
     sources
         .chunk_by(|a, b| a.0 == b.0)
         .map(|group| {
-            let target = &program.blocks[group[0].0];
+            let target = program.block(group[0].0);
             let from: Vec<String> =
-                group.iter().filter_map(|&(_, from)| Some(format!("N{}", program.blocks[from].number?))).collect();
+                group.iter().filter_map(|&(_, from)| Some(format!("N{}", program.block(from).number?))).collect();
             let end = outline.block(group[0].0).map_or(target.end(), |node| content_end(&node));
             DocumentSymbol {
                 name: target.number.map_or_else(String::new, |n| format!("N{n}")),
@@ -221,8 +221,13 @@ impl<'db> Outline<'db> {
     /// The tree node of block `index`, found by its range without walking
     /// the blocks before it.
     pub fn block(&self, index: usize) -> Option<SyntaxNode> {
-        let info = self.program.blocks.get(index)?;
-        self.root.child_or_token_at_range(TextRange::at(info.offset, info.len))?.into_node()
+        let info = self.program.get_block(index)?;
+        let range = TextRange::at(info.offset, info.len);
+        let node = self.root.child_or_token_at_range(range)?.into_node()?;
+        match node.kind() {
+            SyntaxKind::BLOCK_RUN => node.child_or_token_at_range(range)?.into_node(),
+            _ => Some(node),
+        }
     }
 
     /// Whether unit `index` is the main body of a partprogram (a file that
@@ -231,7 +236,7 @@ impl<'db> Outline<'db> {
         index == 0
             && self.program.kind == FileKind::Program
             && self.program.units[0].number.is_none()
-            && self.program.blocks.get(self.program.units[0].blocks.start).is_none_or(|b| b.starts_unit.is_none())
+            && self.program.get_block(self.program.units[0].blocks.start).is_none_or(|b| b.starts_unit.is_none())
     }
 
     /// The range of unit `index`: the main body from its header, any unit to
@@ -242,7 +247,7 @@ impl<'db> Outline<'db> {
         let header = self.header.as_ref().filter(|_| self.is_main(index));
         let start = match header {
             Some(header) => header.text_range().start(),
-            None => self.program.blocks.get(unit.blocks.start)?.offset,
+            None => self.program.get_block(unit.blocks.start)?.offset,
         };
         let last = match unit.blocks.end.checked_sub(1).filter(|&last| last >= unit.blocks.start) {
             Some(last) => self.block(last)?,

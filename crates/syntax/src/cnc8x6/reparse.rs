@@ -240,14 +240,7 @@ mod tests {
         assert_eq!(new, Parse::new(&new_text, Dialect::Cnc8x6));
 
         let blocks = |parse: &Parse| -> Vec<*const rowan::GreenNodeData> {
-            parse
-                .tree()
-                .blocks()
-                .map(|block| {
-                    let green = block.syntax().green();
-                    &*green as *const rowan::GreenNodeData
-                })
-                .collect()
+            parse.tree().blocks().map(|block| block.syntax().green() as *const rowan::GreenNodeData).collect()
         };
         let (old_blocks, new_blocks) = (blocks(&old), blocks(&new));
         // Five blocks: only N30 is reparsed.
