@@ -113,3 +113,34 @@ fn states_after_edits_equal_a_fresh_walk_in(mut text: String) {
         }
     }
 }
+
+/// Block numbers are compared across chunks only where their ranges
+/// overlap; a duplicate far apart, in a program numbered in order or not,
+/// is found either way, and each later use points at the first.
+#[test]
+fn duplicate_block_numbers_are_found_across_chunks() {
+    let block = |n: usize| format!("N{n} G01 X{n}. Y-{n}.5 F200\n");
+    let check = |numbers: Vec<usize>, duplicate: usize| {
+        let mut text = String::from("%1\n");
+        for &n in &numbers {
+            text.push_str(&block(n));
+        }
+        text.push_str("N99999 M30\n*\n");
+        let mut host = AnalysisHost::default();
+        let file = host.add_file("main.NCP", text.as_str());
+        let found: Vec<_> = host.analysis().diagnostics(file).into_iter().filter(|d| d.code == "P104").collect();
+        let later = text.rfind(&format!("N{duplicate} ")).unwrap();
+        let first = text.find(&format!("N{duplicate} ")).unwrap();
+        assert_eq!(found.len(), 1, "{found:#?}");
+        assert_eq!(usize::from(found[0].range.start()), later);
+        assert_eq!(usize::from(found[0].related[0].range.start()), first);
+    };
+    // In order, with N10 used again near the end.
+    let mut ascending: Vec<usize> = (1..=4000).map(|n| n * 10).collect();
+    ascending[3900] = 10;
+    check(ascending, 10);
+    // Descending, then a run in order: every chunk's range overlaps others.
+    let mut mixed: Vec<usize> = (1..=2000).rev().chain(3000..5000).collect();
+    mixed.push(1500);
+    check(mixed, 1500);
+}
