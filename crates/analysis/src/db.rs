@@ -34,7 +34,7 @@ pub struct SourceFile {
     #[returns(ref)]
     pub path: String,
     #[returns(ref)]
-    pub text: Arc<str>,
+    pub text: Arc<String>,
     /// The parse of `text`; the host updates both together, reparsing
     /// incrementally after an edit.
     #[returns(ref)]

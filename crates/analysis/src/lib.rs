@@ -67,8 +67,8 @@ impl AnalysisHost {
     }
 
     /// Adds a file of the workspace (a program or a macrocycle file).
-    pub fn add_file(&mut self, path: impl Into<String>, text: impl Into<Arc<str>>) -> FileId {
-        let text: Arc<str> = text.into();
+    pub fn add_file(&mut self, path: impl Into<String>, text: impl Into<String>) -> FileId {
+        let text = Arc::new(text.into());
         let parse = Parse::new(&text, self.dialect());
         let file = SourceFile::new(&self.db, path.into(), text, parse);
         let settings = Settings::get(&self.db);
@@ -87,8 +87,8 @@ impl AnalysisHost {
     }
 
     /// Replaces a file's text.
-    pub fn set_text(&mut self, file: FileId, text: impl Into<Arc<str>>) {
-        let text: Arc<str> = text.into();
+    pub fn set_text(&mut self, file: FileId, text: impl Into<String>) {
+        let text = Arc::new(text.into());
         let parse = Parse::new(&text, self.dialect());
         file.set_text(&mut self.db).to(text);
         file.set_parse(&mut self.db).to(parse);
@@ -96,10 +96,22 @@ impl AnalysisHost {
 
     /// Applies an edit, reparsing only the blocks it touches.
     pub fn apply_edit(&mut self, file: FileId, edit: &TextEdit) {
-        let mut text = file.text(&self.db).to_string();
-        edit.apply(&mut text);
+        // Taking the text out of the database (which cancels the snapshots)
+        // lets a text nobody else holds be edited in place: copying a large
+        // file on every keystroke costs more than everything else an edit
+        // does.
+        let mut text = file.set_text(&mut self.db).to(Arc::default());
+        match Arc::get_mut(&mut text) {
+            Some(owned) => edit.apply(owned),
+            None => {
+                let mut copy = String::with_capacity(text.len() + edit.insert.len());
+                copy.push_str(&text);
+                edit.apply(&mut copy);
+                text = Arc::new(copy);
+            }
+        }
         let parse = file.parse(&self.db).reparse(edit, &text);
-        file.set_text(&mut self.db).to(text.into());
+        file.set_text(&mut self.db).to(text);
         file.set_parse(&mut self.db).to(parse);
     }
 
@@ -229,7 +241,9 @@ impl Analysis {
         file.path(&self.db).clone()
     }
 
-    pub fn text(&self, file: FileId) -> Arc<str> {
+    /// The file's text. Holding it past the next edit makes that edit copy
+    /// the text instead of changing it in place.
+    pub fn text(&self, file: FileId) -> Arc<String> {
         file.text(&self.db).clone()
     }
 }

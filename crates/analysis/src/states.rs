@@ -63,13 +63,13 @@ struct Context {
     /// Number and closedness of every unit: calls resolve by number.
     units: Vec<(Option<u32>, bool)>,
     /// The macrocycle files' texts, kept alive so identity is exact.
-    macrocycles: Vec<Arc<str>>,
+    macrocycles: Vec<Arc<String>>,
 }
 
 impl Context {
     fn of(db: &dyn Db, program: &Program) -> Context {
         let settings = Settings::get(db);
-        let mut macrocycles: Vec<(u32, Arc<str>)> = model::macrocycles(db)
+        let mut macrocycles: Vec<(u32, Arc<String>)> = model::macrocycles(db)
             .iter()
             .flat_map(|(&number, files)| files.iter().map(move |&file| (number, file.text(db).clone())))
             .collect();

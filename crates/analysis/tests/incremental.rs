@@ -144,3 +144,22 @@ fn duplicate_block_numbers_are_found_across_chunks() {
     mixed.push(1500);
     check(mixed, 1500);
 }
+
+/// An edit changes a text nobody else holds in place, and copies one that
+/// someone still reads.
+#[test]
+fn edits_change_an_unshared_text_in_place() {
+    let mut host = AnalysisHost::default();
+    let file = host.add_file("main.NCP", program(100));
+    let at = TextSize::from(program(100).find("X50.").unwrap() as u32 + 1);
+    let buffer = host.analysis().text(file).as_ptr();
+    host.apply_edit(file, &TextEdit::replace(TextRange::at(at, TextSize::from(1)), "6"));
+    assert_eq!(host.analysis().text(file).as_ptr(), buffer, "the text was copied");
+    assert!(host.analysis().text(file).contains("X60."));
+
+    let held = host.analysis().text(file);
+    host.apply_edit(file, &TextEdit::replace(TextRange::at(at, TextSize::from(1)), "7"));
+    assert!(held.contains("X60.") && !held.contains("X70."), "a text someone holds never changes");
+    assert!(host.analysis().text(file).contains("X70."));
+    assert!(host.analysis().diagnostics(file).is_empty());
+}

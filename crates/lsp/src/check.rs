@@ -35,7 +35,7 @@ pub(crate) fn read_program(path: &Path) -> io::Result<String> {
 
 pub(crate) struct CheckedFile {
     pub path: PathBuf,
-    pub text: Arc<str>,
+    pub text: Arc<String>,
     pub diagnostics: Vec<Diagnostic>,
 }
 
@@ -43,13 +43,13 @@ pub(crate) struct CheckedFile {
 /// diagnostic points into (macrocycle files that were not checked too).
 pub(crate) struct Checked {
     pub files: Vec<CheckedFile>,
-    pub sources: HashMap<String, Arc<str>>,
+    pub sources: HashMap<String, Arc<String>>,
 }
 
 impl Checked {
     /// The text of a file named in a related location.
     pub fn source(&self, name: &str) -> Option<&str> {
-        self.sources.get(name).map(|text| &**text)
+        self.sources.get(name).map(|text| text.as_str())
     }
 }
 

@@ -35,7 +35,7 @@ impl Positions {
 pub(crate) fn write_human(out: &mut impl Write, checked: &Checked, color: bool) -> io::Result<()> {
     let config = ariadne::Config::default().with_index_type(IndexType::Byte).with_color(color);
     // Each file's text is indexed once, however many reports point into it.
-    let mut cache = FnCache::new(|name: &String| checked.sources.get(name).cloned().ok_or("not read"));
+    let mut cache = FnCache::new(|name: &String| checked.sources.get(name).map(|text| text.as_str()).ok_or("not read"));
     let mut counts = [0usize; 4];
     for file in &checked.files {
         let name = file.path.display().to_string();

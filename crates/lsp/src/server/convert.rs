@@ -10,12 +10,12 @@ use tower_lsp_server::ls_types::{self as lsp, Uri};
 /// A document's text with its line index.
 #[derive(Debug, Clone)]
 pub(crate) struct LineMap {
-    pub text: Arc<str>,
+    pub text: Arc<String>,
     index: Arc<LineIndex>,
 }
 
 impl LineMap {
-    pub fn new(text: Arc<str>) -> LineMap {
+    pub fn new(text: Arc<String>) -> LineMap {
         let index = Arc::new(LineIndex::new(&text));
         LineMap { text, index }
     }
@@ -120,7 +120,7 @@ mod tests {
     #[test]
     fn positions_count_utf16_units_and_clamp() {
         // `č` is two bytes and one UTF-16 unit; `𝄞` four bytes, two units.
-        let map = LineMap::new("N1 (č𝄞)\r\nN2 X1\n".into());
+        let map = LineMap::new(Arc::new("N1 (č𝄞)\r\nN2 X1\n".to_owned()));
         let at = |line, character| u32::from(map.offset(lsp::Position::new(line, character)));
         assert_eq!(at(0, 5), 6, "after `č`");
         assert_eq!(at(0, 7), 10, "after the surrogate pair");
@@ -134,7 +134,7 @@ mod tests {
 
     #[test]
     fn changes_become_byte_edits() {
-        let map = LineMap::new("N1 (ř)\nN2\n".into());
+        let map = LineMap::new(Arc::new("N1 (ř)\nN2\n".to_owned()));
         let change = lsp::TextDocumentContentChangeEvent {
             range: Some(lsp::Range::new(lsp::Position::new(0, 5), lsp::Position::new(1, 1))),
             range_length: None,

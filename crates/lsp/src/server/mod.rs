@@ -305,9 +305,8 @@ impl LanguageServer for Server {
         let document = params.text_document;
         let errors = {
             let mut state = self.state();
-            let text: Arc<str> = document.text.into();
-            let (workspace, file, errors) = state.workspaces.open(&document.uri, text.clone());
-            let map = LineMap::new(text);
+            let (workspace, file, errors) = state.workspaces.open(&document.uri, document.text);
+            let map = LineMap::new(state.workspaces.get(workspace).analysis().text(file));
             let flow = Vec::new();
             state
                 .documents
@@ -323,6 +322,7 @@ impl LanguageServer for Server {
     async fn did_change(&self, params: lsp::DidChangeTextDocumentParams) {
         let uri = params.text_document.uri;
         {
+            let started = std::time::Instant::now();
             let mut guard = self.state();
             let state = &mut *guard;
             let Some(document) = state.documents.get_mut(&uri) else {
@@ -332,6 +332,9 @@ impl LanguageServer for Server {
             let host = state.workspaces.host_mut(document.workspace);
             for change in &params.content_changes {
                 let edit = document.map.edit(change);
+                // The map lets go of the text, so that the edit can change it
+                // in place.
+                document.map = LineMap::new(Arc::default());
                 host.apply_edit(document.file, &edit);
                 document.map = LineMap::new(host.analysis().text(document.file));
                 document.flow = std::mem::take(&mut document.flow)
@@ -340,6 +343,7 @@ impl LanguageServer for Server {
                     .collect();
             }
             document.version = params.text_document.version;
+            tracing::debug!("{} v{}: edits applied in {:?}", uri.as_str(), document.version, started.elapsed());
         }
         self.publish_diagnostics(uri);
     }

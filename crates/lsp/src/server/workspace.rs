@@ -5,7 +5,6 @@
 use std::{
     collections::HashMap,
     path::{Path, PathBuf},
-    sync::Arc,
 };
 
 use ncc_analysis::{AnalysisHost, Config, FileId, NavigationTarget};
@@ -108,7 +107,7 @@ impl Workspaces {
 
     /// Opens a document: its text replaces what was read from disk.
     /// Macrocycle files beside it join the workspace.
-    pub fn open(&mut self, uri: &Uri, text: Arc<str>) -> (usize, FileId, Vec<String>) {
+    pub fn open(&mut self, uri: &Uri, text: String) -> (usize, FileId, Vec<String>) {
         let (name, path) = document_path(uri);
         let mut errors = Vec::new();
         if let Some(path) = &path {
