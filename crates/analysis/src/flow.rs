@@ -13,7 +13,7 @@
 //! Checks are [`FlowCheck`]s that see every block with the state before and
 //! after it.
 
-use std::sync::Arc;
+use std::{ops::Range, sync::Arc};
 
 use nc_exec::arith::{self, ArithConfig, ArithError, ControlWord, Parameters, Raw, UnknownMachine};
 use ncc_catalog::{AddressRole, Catalogue, Modality};
@@ -83,7 +83,7 @@ impl ModalState {
         [&self.feed, &self.speed, &self.tool, &self.offset, &self.length]
     }
 
-    fn settings_mut(&mut self) -> [&mut Known<Option<Setting>>; 5] {
+    pub(crate) fn settings_mut(&mut self) -> [&mut Known<Option<Setting>>; 5] {
         [&mut self.feed, &mut self.speed, &mut self.tool, &mut self.offset, &mut self.length]
     }
 
@@ -371,6 +371,9 @@ pub(crate) struct Walk<'db> {
     /// Subprograms on the call stack (by unit index).
     pub(crate) stack: Vec<usize>,
     called: Vec<bool>,
+    /// The hull of the blocks of the subprograms entered since the last
+    /// [`Walk::take_entered`].
+    entered: Option<Range<usize>>,
 }
 
 impl<'db> Walk<'db> {
@@ -390,6 +393,7 @@ impl<'db> Walk<'db> {
             out: Vec::new(),
             stack: Vec::new(),
             called: vec![false; program.units.len()],
+            entered: None,
         }
     }
 
@@ -438,17 +442,10 @@ impl<'db> Walk<'db> {
         }
     }
 
-    /// The end of the last block of the subprograms entered so far (0:
-    /// none).
-    pub(crate) fn called_end(&self) -> usize {
-        self.program
-            .units
-            .iter()
-            .zip(&self.called)
-            .filter(|(_, called)| **called)
-            .map(|(u, _)| u.blocks.end)
-            .max()
-            .unwrap_or(0)
+    /// The hull of the blocks of the subprograms entered since the last
+    /// call (`None`: none).
+    pub(crate) fn take_entered(&mut self) -> Option<Range<usize>> {
+        self.entered.take()
     }
 
     /// Follows a call: the callee runs with the caller's state.
@@ -466,6 +463,11 @@ impl<'db> Walk<'db> {
                 match unit {
                     Some(unit) if self.stack.len() < MAX_CALL_DEPTH && !self.stack.contains(&unit) => {
                         self.called[unit] = true;
+                        let blocks = &self.program.units[unit].blocks;
+                        self.entered = Some(match self.entered.take() {
+                            Some(hull) => hull.start.min(blocks.start)..hull.end.max(blocks.end),
+                            None => blocks.clone(),
+                        });
                         self.walk_unit(unit, state, params)
                     }
                     _ => (ModalState::unknown(), ParamState::unknown()),

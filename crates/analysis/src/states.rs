@@ -3,26 +3,33 @@
 //!
 //! Walking a 100,000-block program up to the cursor takes a good part of a
 //! second; hover has a millisecond. So the walk leaves a checkpoint (modal
-//! state and parameters) every [`STRIDE`] blocks of the main body, and a
-//! question walks from the nearest one. An edit keeps the checkpoints that
-//! depend only on blocks before the first changed one: those before it
-//! whose walk entered no subprogram at or after it (a subprogram's ranges
-//! move with the edit). The checkpoints hold the tree they were taken on,
-//! so comparing blocks by identity is exact.
+//! state and parameters) about every [`STRIDE`] blocks of the main body,
+//! and a question walks from the nearest one.
+//!
+//! An edit replaces a run of blocks ([`changed_blocks`]): the checkpoints
+//! before it stay, those inside it go, those after it move with the blocks,
+//! and the text ranges in their states move with the text. A checkpoint is
+//! *linked* when its state is the one the walk from the previous checkpoint
+//! reaches; an edit between the two (in the main body, or in a subprogram
+//! the walk between them entered) unlinks it. A question that needs an
+//! unlinked checkpoint walks to it and compares: the same state links it
+//! again, and so vouches for the linked ones after it. A one-character edit
+//! thus costs a walk across it, not a walk to the end of the file.
 
 use std::{
     collections::hash_map::Entry,
+    ops::Range,
     sync::{Arc, Mutex},
 };
 
-use ncc_syntax::{Dialect, SyntaxKind};
-use rowan::GreenNode;
+use ncc_syntax::{Dialect, SyntaxKind, TextRange, TextSize};
+use rowan::{GreenNode, NodeOrToken};
 use rustc_hash::FxHashMap;
 
 use crate::{
     Config,
     db::{Db, Settings, SourceFile},
-    flow::{ModalState, ParamState, Walk},
+    flow::{Known, ModalState, ParamState, Walk},
     model::{self, Program},
 };
 
@@ -62,6 +69,8 @@ struct Context {
     config: Config,
     /// Number and closedness of every unit: calls resolve by number.
     units: Vec<(Option<u32>, bool)>,
+    /// The blocks of every unit, which move with edits.
+    blocks: Vec<Range<usize>>,
     /// The macrocycle files' texts, kept alive so identity is exact.
     macrocycles: Vec<Arc<String>>,
 }
@@ -78,6 +87,7 @@ impl Context {
             dialect: *settings.dialect(db),
             config: settings.config(db).clone(),
             units: program.units.iter().map(|unit| (unit.number, unit.closed)).collect(),
+            blocks: program.units.iter().map(|unit| unit.blocks.clone()).collect(),
             macrocycles: macrocycles.into_iter().map(|(_, text)| text).collect(),
         }
     }
@@ -89,35 +99,315 @@ impl Context {
             && self.macrocycles.len() == other.macrocycles.len()
             && self.macrocycles.iter().zip(&other.macrocycles).all(|(a, b)| Arc::ptr_eq(a, b))
     }
+
+    /// Whether every unit the change does not meet has the same blocks in
+    /// `new`: a unit can also grow or shrink by an edit beside it (a `G70`
+    /// after its last one), and a walk that entered it is then unchecked.
+    fn units_follow(&self, new: &Context, changed: &Changed) -> bool {
+        self.blocks.iter().zip(&new.blocks).all(|(old, new)| changed.blocks(old).is_none_or(|moved| moved == *new))
+    }
 }
 
 struct Checkpoint {
     /// The state is the one before this block.
     index: usize,
-    state: ModalState,
-    params: ParamState,
-    /// The end of the last block of any subprogram the walk entered before
-    /// this point (0: none).
-    called_end: usize,
+    /// Boxed, so that inserting a checkpoint moves little.
+    state: Box<(ModalState, ParamState)>,
+    /// Where the last text range in `state` ends: an edit after it moves
+    /// none of them.
+    reach: TextSize,
+    /// The hull of the blocks of the subprograms the walk from the previous
+    /// checkpoint entered.
+    entered: Option<Range<usize>>,
+    /// Whether `state` is the one the walk from the previous checkpoint (or
+    /// from the program start) reaches in the current tree.
+    linked: bool,
 }
 
-/// The index of the first block that differs between two trees.
-fn first_changed_block(old: &GreenNode, new: &GreenNode) -> usize {
-    fn blocks(root: &GreenNode) -> impl Iterator<Item = *const rowan::GreenNodeData> + '_ {
-        root.children()
-            .filter_map(|child| child.into_node())
-            .filter(|node| node.kind() == SyntaxKind::BLOCK.into())
-            .map(|node| node as *const rowan::GreenNodeData)
+impl Checkpoint {
+    fn new(index: usize, state: (ModalState, ParamState), entered: Option<Range<usize>>) -> Checkpoint {
+        let mut point = Checkpoint { index, state: Box::new(state), reach: TextSize::from(0), entered, linked: true };
+        point.reach = point.ranges().map(|range| range.end()).max().unwrap_or_default();
+        point
     }
-    blocks(old)
-        .zip(blocks(new))
-        .position(|(a, b)| a != b)
-        .unwrap_or_else(|| blocks(old).count().min(blocks(new).count()))
+
+    /// The text ranges in the state.
+    fn ranges(&mut self) -> impl Iterator<Item = &mut TextRange> {
+        let (state, params) = &mut *self.state;
+        let settings = state.settings_mut().into_iter().filter_map(|setting| match setting {
+            Known::Is(Some(setting)) => Some(&mut setting.range),
+            _ => None,
+        });
+        settings.chain(params.origins.iter_mut().flatten().map(|origin| &mut origin.range))
+    }
+
+    /// Moves the state's text ranges with the text; `false` if one lies in
+    /// the changed text.
+    fn move_ranges(&mut self, changed: &Changed) -> bool {
+        if self.reach <= changed.old_text.start() {
+            return true;
+        }
+        let mut reach = TextSize::from(0);
+        let moved = self.ranges().all(|range| match changed.range(*range) {
+            Some(moved) => {
+                *range = moved;
+                reach = reach.max(moved.end());
+                true
+            }
+            None => false,
+        });
+        self.reach = reach;
+        moved
+    }
+}
+
+/// What an edit replaced: the root's children between the prefix and the
+/// suffix the old and the new tree share.
+#[derive(Debug)]
+struct Changed {
+    /// The old tree's blocks `old` are the new tree's `new` (same start).
+    old: Range<usize>,
+    new: Range<usize>,
+    /// The text of the replaced children, old and new (same start).
+    old_text: TextRange,
+    new_text: TextRange,
+}
+
+impl Changed {
+    /// Where the position before old block `index` is now (`None`: inside
+    /// the change).
+    fn position(&self, index: usize) -> Option<usize> {
+        if index <= self.old.start {
+            Some(index)
+        } else if index >= self.old.end {
+            Some(index - self.old.end + self.new.end)
+        } else {
+            None
+        }
+    }
+
+    /// Where old blocks `range` are now (`None`: the change meets them).
+    fn blocks(&self, range: &Range<usize>) -> Option<Range<usize>> {
+        if range.start >= self.old.end {
+            Some(range.start - self.old.end + self.new.end..range.end - self.old.end + self.new.end)
+        } else if range.end <= self.old.start {
+            Some(range.clone())
+        } else {
+            None
+        }
+    }
+
+    /// Where old text `range` is now (`None`: the change meets it).
+    fn range(&self, range: TextRange) -> Option<TextRange> {
+        if range.start() >= self.old_text.end() {
+            Some(TextRange::at(range.start() - self.old_text.end() + self.new_text.end(), range.len()))
+        } else if range.end() <= self.old_text.start() {
+            Some(range)
+        } else {
+            None
+        }
+    }
+}
+
+/// The change from `old` to `new`, two trees of one file: the longest
+/// common prefix and suffix of their blocks (and the root's other
+/// children), compared by identity (a reparse keeps the blocks and runs it
+/// did not touch), leave the replaced blocks. Runs are compared whole
+/// first, so only the runs the edit rebuilt are looked into. Identical
+/// trees give an empty change at their end.
+fn changed_blocks(old: &GreenNode, new: &GreenNode) -> Changed {
+    let blocks_in = |child: &Child<'_>| match child {
+        NodeOrToken::Node(node) if node.kind() == SyntaxKind::BLOCK_RUN.into() => node.children().len(),
+        NodeOrToken::Node(node) => usize::from(node.kind() == SyntaxKind::BLOCK.into()),
+        NodeOrToken::Token(_) => 0,
+    };
+    let (mut start, mut text_start) = (0, TextSize::from(0));
+    let (old_root, new_root) = (old.children().collect::<Vec<_>>(), new.children().collect::<Vec<_>>());
+    let (prefix, suffix) = common_ends(&old_root, &new_root, |child| {
+        start += blocks_in(child);
+        text_start += child.text_len();
+    });
+    // The blocks (and tokens) of the replaced root children, runs opened.
+    fn opened<'a>(children: &[Child<'a>]) -> Vec<Child<'a>> {
+        children
+            .iter()
+            .flat_map(|child| match child {
+                NodeOrToken::Node(node) if node.kind() == SyntaxKind::BLOCK_RUN.into() => node.children().collect(),
+                _ => vec![*child],
+            })
+            .collect()
+    }
+    let old_items = opened(&old_root[prefix..old_root.len() - suffix]);
+    let new_items = opened(&new_root[prefix..new_root.len() - suffix]);
+    let (prefix, suffix) = common_ends(&old_items, &new_items, |child| {
+        start += blocks_in(child);
+        text_start += child.text_len();
+    });
+    let replaced = |items: &[Child<'_>]| {
+        let items = &items[prefix..items.len() - suffix];
+        let blocks = start..start + items.iter().map(blocks_in).sum::<usize>();
+        (blocks, TextRange::at(text_start, items.iter().map(|child| child.text_len()).sum()))
+    };
+    let ((old, old_text), (new, new_text)) = (replaced(&old_items), replaced(&new_items));
+    Changed { old, new, old_text, new_text }
+}
+
+type Child<'a> = NodeOrToken<&'a rowan::GreenNodeData, &'a rowan::GreenTokenData>;
+
+/// The lengths of the longest common prefix and suffix (not overlapping)
+/// of two lists of children, by identity; `in_prefix` sees the prefix.
+fn common_ends(old: &[Child<'_>], new: &[Child<'_>], mut in_prefix: impl FnMut(&Child<'_>)) -> (usize, usize) {
+    let same = |(a, b): &(&Child<'_>, &Child<'_>)| match (a, b) {
+        (NodeOrToken::Node(a), NodeOrToken::Node(b)) => std::ptr::eq(*a, *b),
+        (NodeOrToken::Token(a), NodeOrToken::Token(b)) => std::ptr::eq(*a, *b),
+        _ => false,
+    };
+    let mut prefix = 0;
+    for (child, _) in old.iter().zip(new).take_while(same) {
+        in_prefix(child);
+        prefix += 1;
+    }
+    let suffix =
+        old.iter().rev().zip(new.iter().rev()).take(old.len().min(new.len()) - prefix).take_while(same).count();
+    (prefix, suffix)
+}
+
+impl Checkpoints {
+    /// Carries the checkpoints over to the file's current tree and context.
+    fn update(&mut self, root: GreenNode, context: Context) {
+        if !self.context.same_as(&context) {
+            self.points.clear();
+        } else if !std::ptr::eq::<rowan::GreenNodeData>(&*self.root, &*root) {
+            // Identity, not `!=`: rowan compares green trees deeply.
+            let changed = changed_blocks(&self.root, &root);
+            if self.context.units_follow(&context, &changed) {
+                self.carry_over(&changed);
+            } else {
+                self.points.clear();
+            }
+        }
+        self.root = root;
+        self.context = context;
+    }
+
+    /// Keeps the checkpoints outside the change, moved with it, and unlinks
+    /// those whose walk from the previous one crosses it.
+    fn carry_over(&mut self, changed: &Changed) {
+        // The old index of the previous checkpoint, whether it went, and the
+        // new index of the last one kept.
+        let (mut previous, mut dropped, mut kept) = (0, false, None);
+        self.points.retain_mut(|point| {
+            let across = previous <= changed.old.start && changed.old.start < point.index;
+            let entered = point.entered.as_ref().map(|hull| changed.blocks(hull));
+            let unlinked = std::mem::take(&mut dropped) || across || entered.as_ref().is_some_and(Option::is_none);
+            previous = point.index;
+            match changed.position(point.index) {
+                // Deleted blocks can bring two checkpoints together: the
+                // later one goes.
+                Some(index) if kept != Some(index) && point.move_ranges(changed) => {
+                    kept = Some(index);
+                    point.index = index;
+                    point.entered = entered.flatten();
+                    point.linked &= !unlinked;
+                    true
+                }
+                _ => {
+                    dropped = true;
+                    false
+                }
+            }
+        });
+    }
+
+    /// The state before block `index` of the main body, and how many blocks
+    /// the walk to it took.
+    fn state_before(
+        &mut self,
+        db: &dyn Db,
+        file: SourceFile,
+        program: &Program,
+        index: usize,
+    ) -> ((ModalState, ParamState), usize) {
+        let points = &mut self.points;
+        // Start at the last checkpoint before the question that only linked
+        // ones precede.
+        let trusted = points.iter().position(|p| !p.linked).unwrap_or(points.len());
+        // `at`: the first checkpoint after `block`.
+        let mut at = points[..trusted].partition_point(|p| p.index <= index);
+        let (mut block, mut state) = match at.checked_sub(1) {
+            Some(start) => (points[start].index, (*points[start].state).clone()),
+            None => (0, (ModalState::reset(Settings::get(db).dialect(db).catalogue()), ParamState::program_start())),
+        };
+        // An unlinked checkpoint just after the question is checked as well:
+        // the edit the question follows left it there, and unchecked ones
+        // would pile up for a later question further down.
+        let end = points[at..]
+            .iter()
+            .find(|p| p.index > index)
+            .filter(|p| !p.linked && p.index - index <= 2 * STRIDE)
+            .map_or(index, |p| p.index);
+        let mut walk = Walk::new(db, file, program, Vec::new());
+        walk.stack.push(0);
+        let (mut last, mut walked, mut answer) = (block, 0, None);
+        loop {
+            if points.get(at).is_some_and(|p| p.index == block) {
+                let entered = walk.take_entered();
+                let point = &mut points[at];
+                if !point.linked {
+                    if *point.state == state {
+                        point.linked = true;
+                        point.entered = entered;
+                    } else {
+                        *point = Checkpoint::new(block, state.clone(), entered);
+                        // The ones linked to it followed the old state.
+                        if let Some(next) = points.get_mut(at + 1) {
+                            next.linked = false;
+                        }
+                    }
+                }
+                // The checkpoints linked to this one hold the states the walk
+                // would reach: go on from the last one up to the question.
+                let run = points[at + 1..].iter().position(|p| !p.linked).map_or(points.len(), |n| at + 1 + n);
+                let jump = at + points[at..run].partition_point(|p| p.index <= index).saturating_sub(1);
+                if jump > at {
+                    block = points[jump].index;
+                    state = (*points[jump].state).clone();
+                }
+                at = jump + 1;
+                last = block;
+            }
+            if block == index && end > index {
+                answer = Some(state.clone());
+            }
+            if block == end {
+                return (answer.unwrap_or(state), walked);
+            }
+            state = walk.step(block, &state.0, &state.1);
+            block += 1;
+            walked += 1;
+            // A new checkpoint every STRIDE blocks, but not right before one.
+            let following = points.get(at).map_or(usize::MAX, |p| p.index);
+            if block - last >= STRIDE && following - block >= STRIDE / 2 {
+                points.insert(at, Checkpoint::new(block, state.clone(), walk.take_entered()));
+                at += 1;
+                last = block;
+            }
+        }
+    }
 }
 
 /// The state before block `index` when it belongs to the main body
 /// (`None` otherwise: other blocks are reached from several places).
 pub(crate) fn main_state_before(db: &dyn Db, file: SourceFile, index: usize) -> Option<(ModalState, ParamState)> {
+    main_state_and_walk(db, file, index).map(|(state, _)| state)
+}
+
+/// [`main_state_before`], and how many blocks it walked.
+pub(crate) fn main_state_and_walk(
+    db: &dyn Db,
+    file: SourceFile,
+    index: usize,
+) -> Option<((ModalState, ParamState), usize)> {
     let program = model::program(db, file);
     if !program.has_main() || !program.units[0].blocks.contains(&index) {
         return None;
@@ -130,39 +420,111 @@ pub(crate) fn main_state_before(db: &dyn Db, file: SourceFile, index: usize) -> 
         Entry::Vacant(entry) => entry.insert(Checkpoints { root, context, points: Vec::new() }),
         Entry::Occupied(entry) => {
             let checkpoints = entry.into_mut();
-            if !checkpoints.context.same_as(&context) {
-                checkpoints.points.clear();
-            } else if !std::ptr::eq::<rowan::GreenNodeData>(&*checkpoints.root, &*root) {
-                // Identity, not `!=`: rowan compares green trees deeply.
-                let changed = first_changed_block(&checkpoints.root, &root);
-                checkpoints.points.retain(|point| point.index <= changed && point.called_end <= changed);
-            }
-            checkpoints.root = root;
-            checkpoints.context = context;
+            checkpoints.update(root, context);
             checkpoints
         }
     };
-    let points = &mut checkpoints.points;
-    let (from, mut state, mut params, called_before) = match points.partition_point(|p| p.index <= index) {
-        0 => (0, ModalState::reset(Settings::get(db).dialect(db).catalogue()), ParamState::program_start(), 0),
-        after => {
-            let point = &points[after - 1];
-            (point.index, point.state.clone(), point.params.clone(), point.called_end)
+    Some(checkpoints.state_before(db, file, program, index))
+}
+
+#[cfg(test)]
+mod tests {
+    use ncc_syntax::{Dialect, Parse, ast::AstNode};
+
+    use super::{STRIDE, changed_blocks, main_state_and_walk, main_state_before};
+    use crate::{AnalysisHost, Config, TextEdit, TextRange, TextSize};
+
+    /// What [`changed_blocks`] promises, whatever the tree's shape: the
+    /// blocks before and after the change are the same nodes, the text
+    /// ranges are those of the blocks between, and a small edit makes a
+    /// small change.
+    #[test]
+    fn changed_blocks_bound_what_an_edit_replaced() {
+        let short = "%1 \"C\"\nN1 G90\nN2 X1.\nN3 X2.\nN4 X3.\nN5 M30\n*\n".to_owned();
+        let edits = [("X2.", "X22."), ("N3 X2.\n", ""), ("N3 ", "N3 G91\nN33 "), ("\nN5", "\n\nN5"), ("M30", "M3")];
+        check_changed_blocks(&short, &edits);
+        // Many runs: edits in the middle, next to where runs end, and at the
+        // ends of the program.
+        let long: String = std::iter::once("%1\n".to_owned())
+            .chain((1..=3000).map(|n| format!("N{n} X{}.\n", n % 97)))
+            .chain(["N9999 M30\n*\n".to_owned()])
+            .collect();
+        let parse = Parse::new(&long, Dialect::Cnc8x6);
+        let run_ends: Vec<String> =
+            parse.syntax_node().children().filter_map(|run| run.last_child()).map(|block| block.to_string()).collect();
+        assert!(run_ends.len() > 3, "{} runs", run_ends.len());
+        let mut edits: Vec<(&str, &str)> =
+            vec![("N1 X1.", "N1 X11."), ("N1500 ", "N1500 G91\nN1501 "), ("N9999 ", "N9999 G4\n")];
+        for end in &run_ends[1..3] {
+            edits.push((end.as_str(), ""));
+            edits.push((end.as_str(), "N7777 Y1.\n"));
         }
-    };
-    let mut walk = Walk::new(db, file, program, Vec::new());
-    walk.stack.push(0);
-    for block in from..index {
-        (state, params) = walk.step(block, &state, &params);
-        let next = block + 1;
-        if next.is_multiple_of(STRIDE) {
-            let called_end = walk.called_end().max(called_before);
-            let at = points.partition_point(|p| p.index < next);
-            if points.get(at).is_none_or(|p| p.index != next) {
-                let point = Checkpoint { index: next, state: state.clone(), params: params.clone(), called_end };
-                points.insert(at, point);
+        check_changed_blocks(&long, &edits);
+    }
+
+    fn check_changed_blocks(text: &str, edits: &[(&str, &str)]) {
+        let old = Parse::new(text, Dialect::Cnc8x6);
+        let blocks = |parse: &Parse| -> Vec<(rowan::GreenNode, TextRange)> {
+            let blocks = parse.tree().blocks().map(|block| block.syntax().clone());
+            blocks.map(|node| (node.green().to_owned(), node.text_range())).collect()
+        };
+        let span =
+            |blocks: &[(rowan::GreenNode, TextRange)]| blocks.iter().map(|(_, range)| *range).reduce(|a, b| a.cover(b));
+        let same = |a: &[(rowan::GreenNode, TextRange)], b: &[(rowan::GreenNode, TextRange)]| {
+            a.len() == b.len()
+                && a.iter().zip(b).all(|((a, _), (b, _))| std::ptr::eq::<rowan::GreenNodeData>(&**a, &**b))
+        };
+        let unchanged = changed_blocks(old.green(), old.green());
+        let count = blocks(&old).len();
+        assert_eq!((unchanged.old, unchanged.new), (count..count, count..count));
+
+        for &(find, replace) in edits {
+            let at = TextSize::from(text.find(find).unwrap() as u32);
+            let edit = TextEdit::replace(TextRange::at(at, TextSize::of(find)), replace);
+            let mut new_text = text.to_owned();
+            edit.apply(&mut new_text);
+            let new = old.reparse(&edit, &new_text);
+            let changed = changed_blocks(old.green(), new.green());
+            let (a, b) = (blocks(&old), blocks(&new));
+            assert_eq!(changed.old.start, changed.new.start, "`{find}`");
+            assert!(changed.old.len() <= 3 && changed.new.len() <= 3, "`{find}`: {changed:?}");
+            assert!(same(&a[..changed.old.start], &b[..changed.new.start]), "`{find}`: {changed:?}");
+            assert!(same(&a[changed.old.end..], &b[changed.new.end..]), "`{find}`: {changed:?}");
+            if let Some(span) = span(&a[changed.old.clone()]) {
+                assert_eq!(changed.old_text, span, "`{find}`");
             }
+            if let Some(span) = span(&b[changed.new.clone()]) {
+                assert_eq!(changed.new_text, span, "`{find}`");
+            }
+            assert_eq!(changed.old_text.start(), changed.new_text.start(), "`{find}`");
         }
     }
-    Some((state, params))
+
+    /// A typed digit far before the question costs the walk across the
+    /// edit and from the checkpoint before the question, not the walk from
+    /// the start. (That the answers equal a fresh walk is tested at length
+    /// in `tests/incremental.rs`.)
+    #[test]
+    fn a_question_after_an_edit_walks_across_the_edit_only() {
+        let mut text = String::from("%1 \"WALK\"\nN1 G90 F100\n");
+        for n in 2..=5000 {
+            text.push_str(&format!("N{n} G01 X{n}. Y-{n}.\n"));
+        }
+        text.push_str("N9999 M30\n*\n");
+        let mut host = AnalysisHost::new(Config::default());
+        let file = host.add_file("main.NCP", text.as_str());
+        let far = 4900;
+        assert_eq!(main_state_and_walk(host.db(), file, far).map(|(_, walked)| walked), Some(far));
+
+        let at = text.find("N101 G01 X1").unwrap() + "N101 G01 X1".len();
+        let edit = TextEdit::replace(TextRange::empty(TextSize::from(at as u32)), "7");
+        host.apply_edit(file, &edit);
+        edit.apply(&mut text);
+        let (state, walked) = main_state_and_walk(host.db(), file, far).unwrap();
+        assert!(walked <= 3 * STRIDE, "walked {walked} blocks");
+
+        let mut fresh = AnalysisHost::new(Config::default());
+        let fresh_file = fresh.add_file("main.NCP", text.as_str());
+        assert_eq!(Some(state), main_state_before(fresh.db(), fresh_file, far));
+    }
 }

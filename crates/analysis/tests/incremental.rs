@@ -1,7 +1,10 @@
 //! Changing one block recomputes only what depends on it: the block's chunk
 //! (a run of blocks) is lowered and checked again, no other.
 
-use ncc_analysis::{AnalysisHost, Config, RootDatabase, TextEdit, TextRange, TextSize};
+use ncc_analysis::{
+    AnalysisHost, Config, FileId, RootDatabase, TextEdit, TextRange, TextSize,
+    flow::{Known, ModalState, ParamState},
+};
 
 fn program(blocks: usize) -> String {
     let mut text = String::from("%1 \"INCREMENTAL\"\n");
@@ -164,4 +167,218 @@ fn edits_change_an_unshared_text_in_place() {
     assert_eq!(digit(&held), "6", "a text someone holds never changes");
     assert_eq!(digit(&host.analysis().text(file)), "7");
     assert!(host.analysis().diagnostics(file).is_empty());
+}
+
+/// The states a fresh analysis of `text` finds at `offset`.
+fn fresh_states(text: &str, offset: TextSize) -> Vec<(ModalState, ParamState)> {
+    let mut host = AnalysisHost::new(Config::default());
+    let file = host.add_file("main.NCP", text);
+    host.analysis().states_at(file, offset)
+}
+
+/// Replaces the first `find` in `text` with `replace`, in the host too.
+fn replace(host: &mut AnalysisHost, file: FileId, text: &mut String, find: &str, replace: &str) {
+    let at = text.find(find).unwrap_or_else(|| panic!("`{find}` is not in the program"));
+    let edit = TextEdit::replace(TextRange::at(TextSize::from(at as u32), TextSize::of(find)), replace);
+    host.apply_edit(file, &edit);
+    edit.apply(text);
+}
+
+/// Where block `number` starts.
+fn block(text: &str, number: usize) -> TextSize {
+    let at = text.find(&format!("\nN{number} ")).unwrap_or_else(|| panic!("no block N{number}"));
+    TextSize::from(at as u32 + 1)
+}
+
+/// The one state the checkpoints give at block `number`, checked against a
+/// fresh walk.
+fn state_at(host: &AnalysisHost, file: FileId, text: &str, number: usize) -> (ModalState, ParamState) {
+    let offset = block(text, number);
+    let kept = host.analysis().states_at(file, offset);
+    assert_eq!(kept, fresh_states(text, offset), "at N{number}");
+    assert_eq!(kept.len(), 1, "N{number} is in the main body");
+    kept.into_iter().next().unwrap()
+}
+
+/// A host whose checkpoints cover `text` up to block `last`.
+fn filled(text: String, last: usize) -> (AnalysisHost, FileId, String) {
+    let mut host = AnalysisHost::new(Config::default());
+    let file = host.add_file("main.NCP", text.as_str());
+    host.analysis().states_at(file, block(&text, last));
+    (host, file, text)
+}
+
+/// Edits early in a long program whose effect on the state ends within a
+/// block or two leave the checkpoints far after them good.
+#[test]
+fn a_question_far_after_an_early_edit_equals_a_fresh_walk() {
+    let (mut host, file, mut text) = filled(stateful_program(4000, false), 4000);
+    for (find, with) in
+        [("N100 G01 X100.", "N100 G01 X1000."), ("N101 G01 X101.", "N101 G01  X101."), ("N5 G01 X5", "N5 G01 X")]
+    {
+        replace(&mut host, file, &mut text, find, with);
+        for number in [3990, 2500, 120, 3000] {
+            state_at(&host, file, &text, number);
+        }
+    }
+}
+
+/// An edit that changes the state before the checkpoints shows in every
+/// later answer: the checkpoints after it are checked against the walk.
+#[test]
+fn an_edit_that_changes_the_state_reaches_the_checkpoints_after_it() {
+    let (mut host, file, mut text) = filled(stateful_program(4000, false), 4000);
+    // N110 sets the feed (110 % 97 == 13), which holds until N207.
+    replace(&mut host, file, &mut text, "N110 G01 X110. YR1 F210", "N110 G01 X110. YR1 F999");
+    let (state, _) = state_at(&host, file, &text, 200);
+    assert_eq!(state.feed.known().flatten().map(|f| f.value.to_string()), Some("999".to_owned()));
+    state_at(&host, file, &text, 3500);
+
+    // N126 assigns R1 (126 % 97 == 29), which every block's Y reads.
+    replace(&mut host, file, &mut text, "N126 G01 X126. YR1 R1=126.", "N126 G01 X126. YR1 R1=5.");
+    let (state, params) = state_at(&host, file, &text, 200);
+    assert_eq!(params.values.get(1), Some(5000));
+    assert_eq!(state.position(b'Y'), Some(5000));
+    state_at(&host, file, &text, 3600);
+
+    // G91 holds to the end; the blocks around it hold no text range a
+    // later state keeps, so only the walk tells the checkpoints after it.
+    replace(&mut host, file, &mut text, "N140 G01", "N140 G91");
+    let (state, _) = state_at(&host, file, &text, 3900);
+    assert_eq!(state.g(9), Some(Some(91)));
+    state_at(&host, file, &text, 2000);
+    replace(&mut host, file, &mut text, "N140 G91", "N140 G01");
+    let (state, _) = state_at(&host, file, &text, 3900);
+    assert_eq!(state.g(9), Some(Some(90)));
+}
+
+/// Inserted and deleted blocks move the checkpoints after them.
+#[test]
+fn inserted_and_deleted_blocks_move_the_checkpoints() {
+    let (mut host, file, mut text) = filled(stateful_program(4000, false), 4000);
+    let numbers = [3950, 1000, 300, 2222];
+    let edits: [(&str, &str); 6] = [
+        // A block of its own, setting the feed until N304.
+        ("\nN300 ", "\nN7000 G01 F5\nN300 "),
+        // A line break inside a block.
+        ("N400 G01 X400.", "N400 G01\nX400."),
+        // A block deleted.
+        ("N500 G01 X500. YR1\n", ""),
+        // Two blocks joined.
+        ("YR1\nN601 ", "YR1 N601 "),
+        // A block split in two.
+        ("N700 G01 X700. YR1", "N700 G01\nN7001 X700. YR1"),
+        // A blank line.
+        ("\nN800 ", "\n\nN800 "),
+    ];
+    for (find, with) in edits {
+        replace(&mut host, file, &mut text, find, with);
+        for number in numbers {
+            state_at(&host, file, &text, number);
+        }
+    }
+    // Several lines deleted at once, across checkpoints.
+    let lines = text.find("N900 ").unwrap()..text.find("N1300 ").unwrap();
+    let edit =
+        TextEdit::replace(TextRange::new(TextSize::from(lines.start as u32), TextSize::from(lines.end as u32)), "");
+    host.apply_edit(file, &edit);
+    edit.apply(&mut text);
+    for number in [3950, 1400, 300, 850] {
+        state_at(&host, file, &text, number);
+    }
+}
+
+/// Editing a subprogram changes the state after every call of it.
+#[test]
+fn an_edited_subprogram_reaches_the_checkpoints_after_its_calls() {
+    // L5 ends at its G70; the blocks after it belong to no unit.
+    let subprogram = "N9993 X1.\nN9994 G17\nN9995 G70\nN9996 G19\nN9997 X5.\n";
+    let text = stateful_program(4000, true).replace("N9993 G70\n", subprogram);
+    let (mut host, file, mut text) = filled(text, 4000);
+    let plane = |state: &ModalState, code| state.g.contains(&Known::Is(Some(code)));
+    let feed = |state: &ModalState| state.feed.known().flatten().map(|f| f.value.to_string());
+    // The checkpoint before N2817 follows the call in N2813 (a multiple of
+    // 97), whose feed holds until N2826; the one before N897 follows the
+    // call in N873, whose plane holds until N914.
+    let (state, _) = state_at(&host, file, &text, 2820);
+    assert_eq!(feed(&state).as_deref(), Some("33"));
+    let (state, _) = state_at(&host, file, &text, 900);
+    assert!(plane(&state, 17), "{state:?}");
+    // No text range in the states points into the edited blocks: only the
+    // subprogram's blocks the walk entered tell.
+    replace(&mut host, file, &mut text, "N9994 G17", "N9994 G18");
+    let (state, _) = state_at(&host, file, &text, 900);
+    assert!(plane(&state, 18), "{state:?}");
+    replace(&mut host, file, &mut text, "N9992 G91 F33", "N9992 G91 F44");
+    let (state, _) = state_at(&host, file, &text, 2820);
+    assert_eq!(feed(&state).as_deref(), Some("44"));
+    // An edit in the subprogram that changes no state moves its ranges.
+    replace(&mut host, file, &mut text, "N9992 G91", "N9992  G91");
+    state_at(&host, file, &text, 2820);
+    // An edit in the main body moves the subprogram after it.
+    replace(&mut host, file, &mut text, "N50 G01", "N50  G01");
+    for number in [2820, 900, 60] {
+        state_at(&host, file, &text, number);
+    }
+    // A G70 after its last one makes L5 end there, with the G19 before it:
+    // the edit is not in L5's blocks, but L5 changed.
+    replace(&mut host, file, &mut text, "N9997 X5.", "N9997 G70");
+    let (state, _) = state_at(&host, file, &text, 900);
+    assert!(plane(&state, 19), "{state:?}");
+}
+
+/// A fixed sequence of random edits, each followed by questions here and
+/// there (or by none, so that several edits meet the checkpoints at once):
+/// every answer equals a fresh walk.
+#[test]
+fn random_edits_keep_the_states_equal_to_a_fresh_walk() {
+    let mut text = stateful_program(1500, true);
+    let mut host = AnalysisHost::new(Config::default());
+    let file = host.add_file("main.NCP", text.as_str());
+    let mut seed = 0x9E37_79B9_7F4A_7C15_u64;
+    let mut below = |bound: usize| {
+        seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        (seed >> 33) as usize % bound
+    };
+    for round in 0..120 {
+        let lines: Vec<usize> = std::iter::once(0).chain(text.match_indices('\n').map(|(at, _)| at + 1)).collect();
+        // Any line but the header and the end.
+        let line = 1 + below(lines.len() - 3);
+        let (start, end) = (lines[line], lines[line + 1]);
+        let at = start + below(end - start);
+        let (range, insert) = match below(6) {
+            0 => (at..at, char::from(b'0' + below(10) as u8).to_string()),
+            1 => (at..at + 1, String::new()),
+            2 => (at..at, "\n".to_owned()),
+            3 => (start..end, String::new()),
+            4 => (start..start, ["N1 G91\n", "N2 F7\n", "N3 R1=2.\n", "N4 G18\n", "N5 G71 L5\n"][below(5)].to_owned()),
+            _ => {
+                let flips = [("G90", "G91"), ("G91", "G90"), ("G17", "G18"), ("F1", "F2"), ("R1=", "R1=9")];
+                let (from, to) = flips[below(flips.len())];
+                match text[start..].find(from).map(|i| start + i) {
+                    Some(i) => (i..i + from.len(), to.to_owned()),
+                    None => (at..at, " ".to_owned()),
+                }
+            }
+        };
+        if text[range.clone()].contains(['%', '*']) {
+            continue;
+        }
+        let edit = TextEdit::replace(
+            TextRange::new(TextSize::from(range.start as u32), TextSize::from(range.end as u32)),
+            insert,
+        );
+        host.apply_edit(file, &edit);
+        edit.apply(&mut text);
+        if below(3) == 0 {
+            continue;
+        }
+        let mut fresh = AnalysisHost::new(Config::default());
+        let fresh_file = fresh.add_file("main.NCP", text.as_str());
+        for _ in 0..3 {
+            let offset = TextSize::from(below(text.len()) as u32);
+            let kept = host.analysis().states_at(file, offset);
+            assert_eq!(kept, fresh.analysis().states_at(fresh_file, offset), "round {round}, at {offset:?}");
+        }
+    }
 }
