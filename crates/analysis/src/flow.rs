@@ -331,11 +331,11 @@ impl<'db> Blocks<'db> {
 
     /// Block `index` with its file offset.
     fn get(&mut self, index: usize) -> (TextSize, Arc<Vec<(TextSize, BlockData)>>, usize) {
+        // A walk over a large file is one long query: an edit waiting to
+        // change the inputs waits for this check (an atomic load).
+        self.db.unwind_if_revision_cancelled();
         let chunk = self.chunks.partition_point(|chunk| chunk.first <= index) - 1;
         if !self.cache.contains_key(&chunk) {
-            // A walk over a large file is one long query: give an edit
-            // waiting to change the inputs its chance, once per chunk.
-            self.db.unwind_if_revision_cancelled();
             if self.cache.len() >= 16 {
                 self.cache.clear();
             }

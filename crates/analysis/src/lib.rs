@@ -194,6 +194,14 @@ impl Analysis {
         ide::states_at(&self.db, file, offset)
     }
 
+    /// Prepares answers about the modal state (hover) anywhere in the main
+    /// body: walks it once, or after an edit across the edit, leaving
+    /// checkpoints. Long, but a question meanwhile waits a millisecond at
+    /// most; meant for idle time.
+    pub fn prepare_states(&self, file: FileId) {
+        states::prepare(&self.db, file);
+    }
+
     /// The outline: program units, and the blocks jumps go to in each.
     pub fn document_symbols(&self, file: FileId) -> Vec<DocumentSymbol> {
         ide::symbols::document_symbols(&self.db, file)

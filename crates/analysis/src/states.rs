@@ -19,7 +19,10 @@
 use std::{
     collections::hash_map::Entry,
     ops::Range,
-    sync::{Arc, Mutex},
+    sync::{
+        Arc, Mutex,
+        atomic::{AtomicUsize, Ordering},
+    },
 };
 
 use ncc_syntax::{Dialect, SyntaxKind, TextRange, TextSize};
@@ -41,6 +44,8 @@ const STRIDE: usize = 128;
 #[derive(Default)]
 pub struct StateCache {
     files: Mutex<FxHashMap<SourceFile, Checkpoints>>,
+    /// Questions waiting for `files`: [`prepare`] lets go for them.
+    waiting: AtomicUsize,
 }
 
 impl std::fmt::Debug for StateCache {
@@ -327,6 +332,7 @@ impl Checkpoints {
         file: SourceFile,
         program: &Program,
         index: usize,
+        waiting: Option<&AtomicUsize>,
     ) -> ((ModalState, ParamState), usize) {
         let points = &mut self.points;
         // Start at the last checkpoint before the question that only linked
@@ -392,7 +398,49 @@ impl Checkpoints {
                 at += 1;
                 last = block;
             }
+            // Preparing for questions must not keep one waiting: leave a
+            // checkpoint here and let go.
+            if waiting.is_some_and(|waiting| waiting.load(Ordering::Relaxed) > 0) && block < end {
+                if following != block && last != block {
+                    points.insert(at, Checkpoint::new(block, state.clone(), walk.take_entered()));
+                }
+                return (state, walked);
+            }
         }
+    }
+}
+
+/// The most blocks one step of [`prepare`] walks: a question waiting for
+/// the checkpoints waits about a millisecond.
+const SLICE: usize = 4 * STRIDE;
+
+/// Walks the main body to its end, a slice at a time: checks the
+/// checkpoints an edit unlinked and leaves new ones, so that a later
+/// question anywhere walks little. After an edit that left the state after
+/// it unchanged, this walks only across the edit.
+pub(crate) fn prepare(db: &dyn Db, file: SourceFile) {
+    let program = model::program(db, file);
+    let Some(last) = program.has_main().then(|| program.units[0].blocks.end.checked_sub(1)).flatten() else {
+        return;
+    };
+    // The first step carries the checkpoints over to the current tree.
+    walk_to(db, file, 0, Asker::Preparation);
+    loop {
+        let target = {
+            let files = db.state_cache().files.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+            let points = files.get(&file).map_or(&[][..], |checkpoints| checkpoints.points.as_slice());
+            match points.iter().find(|point| !point.linked) {
+                Some(unlinked) => unlinked.index,
+                None => {
+                    let from = points.last().map_or(0, |point| point.index);
+                    if from + STRIDE > last {
+                        return;
+                    }
+                    (from + SLICE).min(last)
+                }
+            }
+        };
+        walk_to(db, file, target, Asker::Preparation);
     }
 }
 
@@ -408,6 +456,26 @@ pub(crate) fn main_state_and_walk(
     file: SourceFile,
     index: usize,
 ) -> Option<((ModalState, ParamState), usize)> {
+    walk_to(db, file, index, Asker::Question)
+}
+
+/// Who walks: a question, or [`prepare`], which gives way to questions.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Asker {
+    Question,
+    Preparation,
+}
+
+/// Counts a question as waiting while it lives.
+struct Waiting<'a>(&'a AtomicUsize);
+
+impl Drop for Waiting<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::Relaxed);
+    }
+}
+
+fn walk_to(db: &dyn Db, file: SourceFile, index: usize, asker: Asker) -> Option<((ModalState, ParamState), usize)> {
     let program = model::program(db, file);
     if !program.has_main() || !program.units[0].blocks.contains(&index) {
         return None;
@@ -415,6 +483,10 @@ pub(crate) fn main_state_and_walk(
     let root = file.parse(db).green().clone();
     let context = Context::of(db, program);
     let cache = db.state_cache();
+    let _waiting = (asker == Asker::Question).then(|| {
+        cache.waiting.fetch_add(1, Ordering::Relaxed);
+        Waiting(&cache.waiting)
+    });
     let mut files = cache.files.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     let checkpoints = match files.entry(file) {
         Entry::Vacant(entry) => entry.insert(Checkpoints { root, context, points: Vec::new() }),
@@ -424,7 +496,8 @@ pub(crate) fn main_state_and_walk(
             checkpoints
         }
     };
-    Some(checkpoints.state_before(db, file, program, index))
+    let waiting = (asker == Asker::Preparation).then_some(&cache.waiting);
+    Some(checkpoints.state_before(db, file, program, index, waiting))
 }
 
 #[cfg(test)]

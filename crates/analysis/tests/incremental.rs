@@ -370,6 +370,9 @@ fn random_edits_keep_the_states_equal_to_a_fresh_walk() {
         );
         host.apply_edit(file, &edit);
         edit.apply(&mut text);
+        if below(2) == 0 {
+            host.analysis().prepare_states(file);
+        }
         if below(3) == 0 {
             continue;
         }
@@ -381,4 +384,25 @@ fn random_edits_keep_the_states_equal_to_a_fresh_walk() {
             assert_eq!(kept, fresh.analysis().states_at(fresh_file, offset), "round {round}, at {offset:?}");
         }
     }
+}
+
+/// Preparing the states on another thread while questions come: every
+/// answer equals a fresh walk's, and the preparation gives way to them.
+#[test]
+fn questions_during_preparation_equal_a_fresh_walk() {
+    let text = stateful_program(3000, true);
+    let mut host = AnalysisHost::new(Config::default());
+    let file = host.add_file("main.NCP", text.as_str());
+    let mut fresh = AnalysisHost::new(Config::default());
+    let fresh_file = fresh.add_file("main.NCP", text.as_str());
+    let preparing = host.analysis();
+    let preparation = std::thread::spawn(move || preparing.prepare_states(file));
+    let analysis = host.analysis();
+    for step in 1..60 {
+        let offset = TextSize::from((text.len() * step / 60) as u32);
+        assert_eq!(analysis.states_at(file, offset), fresh.analysis().states_at(fresh_file, offset), "at {offset:?}");
+    }
+    preparation.join().unwrap();
+    let offset = TextSize::from(text.len() as u32 - 20);
+    assert_eq!(analysis.states_at(file, offset), fresh.analysis().states_at(fresh_file, offset));
 }

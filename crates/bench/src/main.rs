@@ -93,7 +93,8 @@ enum Command {
     },
     /// Drive the language server (`ncc lsp`) through an editing session on a
     /// generated program: time from each single-character edit to its
-    /// diagnostics, and of a hover after each edit.
+    /// diagnostics, of a hover after each edit, and of hovers anywhere
+    /// after a pause.
     Lsp {
         /// The `ncc` binary [default: the one beside ncc-bench].
         #[arg(long)]
@@ -317,6 +318,9 @@ fn check_benchmark(blocks: usize) -> anyhow::Result<()> {
 /// The latency goals of the language server.
 const EDIT_GOAL: Duration = Duration::from_millis(16);
 const HOVER_GOAL: Duration = Duration::from_millis(2);
+/// The pause after the edits, and the hovers at random places after it.
+const IDLE: Duration = Duration::from_secs(3);
+const IDLE_HOVERS: usize = 100;
 
 /// Latencies of one kind, and the goal for their 99th percentile.
 struct Latencies {
@@ -398,6 +402,19 @@ fn lsp_benchmark(server: &std::path::Path, blocks: usize, edits: usize, as_json:
         // complete diagnostics set, say) is not measured.
         client.take_received();
     }
+
+    // After a pause in typing the server has prepared the whole program:
+    // hovers anywhere.
+    std::thread::sleep(IDLE);
+    let mut idle_hovers = Latencies::new("hover after a pause", HOVER_GOAL, IDLE_HOVERS);
+    for _ in 0..IDLE_HOVERS {
+        let anywhere = rng.below(doc.text().len());
+        let target = g_code_near(doc.text(), anywhere, &mut rng).context("no G code in the program")?;
+        let request = client.request("textDocument/hover", doc.at(doc.position(target)))?;
+        let response = client.response(&request)?;
+        anyhow::ensure!(response.error_code().is_none(), "hover failed: {}", response.json);
+        idle_hovers.samples.push(response.received - request.sent);
+    }
     let memory = client.memory();
     let exit = client.shutdown()?;
 
@@ -410,6 +427,7 @@ fn lsp_benchmark(server: &std::path::Path, blocks: usize, edits: usize, as_json:
             "open_to_diagnostics_ms": open.as_secs_f64() * 1e3,
             "edit_to_diagnostics": diagnostics.json(),
             "hover": hovers.json(),
+            "hover_after_pause": idle_hovers.json(),
             "empty_hovers": empty_hovers,
             "peak_rss_bytes": memory.map(|m| m.peak_rss),
             "exit_code": exit.code(),
@@ -420,6 +438,7 @@ fn lsp_benchmark(server: &std::path::Path, blocks: usize, edits: usize, as_json:
         println!("  didOpen → diagnostics  {:>9.1} ms", open.as_secs_f64() * 1e3);
         diagnostics.print();
         hovers.print();
+        idle_hovers.print();
         if empty_hovers > 0 {
             println!("  {empty_hovers} of {edits} hovers on a G code answered nothing");
         }

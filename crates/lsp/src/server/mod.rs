@@ -239,6 +239,20 @@ impl Server {
             let mut all = local;
             all.extend(flow);
             send(all);
+            // Idle time: prepare the modal states, so that a hover anywhere
+            // finds a checkpoint near it. (The snapshot above was let go
+            // before taking the lock: an edit holds the lock while it waits
+            // for snapshots to go.)
+            let analysis = {
+                let state = lock(&state);
+                match state.documents.get(&uri) {
+                    Some(document) if document.version == version => {
+                        state.workspaces.get(document.workspace).analysis()
+                    }
+                    _ => return,
+                }
+            };
+            let _ = Cancelled::catch(|| analysis.prepare_states(file));
         });
     }
 }
