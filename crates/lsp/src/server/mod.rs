@@ -210,9 +210,10 @@ impl Server {
         };
         let publisher = self.publisher.clone();
         let state = self.state.clone();
-        // The snapshot lives only on the blocking thread, so an edit waiting
-        // to cancel it never waits for the async runtime.
-        tokio::task::spawn_blocking(move || {
+        // The snapshot lives only on this thread, so an edit waiting to
+        // cancel it never waits for the async runtime. A thread of its own,
+        // since it lowers its priority for the flow walk.
+        let spawned = std::thread::Builder::new().name("ncc-diagnostics".into()).spawn(move || {
             let send = |diagnostics: Vec<Diagnostic>| {
                 let diagnostics = diagnostics.iter().map(|d| convert::diagnostic(&map, &uri, d)).collect();
                 let _ = publisher.send((uri.clone(), diagnostics, version));
@@ -223,6 +224,7 @@ impl Server {
             let mut first = local.clone();
             first.extend(carried);
             send(first);
+            background_priority();
             let Ok(flow) = Cancelled::catch(|| analysis.flow_diagnostics(file)) else {
                 tracing::debug!("{} v{version}: flow walk cancelled by an edit", uri.as_str());
                 return;
@@ -252,9 +254,26 @@ impl Server {
                     _ => return,
                 }
             };
-            let _ = Cancelled::catch(|| analysis.prepare_states(file));
+            let started = std::time::Instant::now();
+            match Cancelled::catch(|| analysis.prepare_states(file)) {
+                Ok(()) => tracing::debug!("{} v{version}: states prepared in {:?}", uri.as_str(), started.elapsed()),
+                Err(_) => tracing::debug!("{} v{version}: preparing states cancelled by an edit", uri.as_str()),
+            }
         });
+        if let Err(error) = spawned {
+            tracing::error!("cannot start a diagnostics thread: {error}");
+        }
     }
+}
+
+/// Lowers the calling thread's priority: the flow walk and the state
+/// preparation take hundreds of milliseconds on a large program, and edits
+/// and hovers must not wait for a core behind them.
+fn background_priority() {
+    // On Linux the "process" priority is the calling thread's. Failing
+    // leaves the thread as it was.
+    #[cfg(target_os = "linux")]
+    let _ = rustix::process::setpriority_process(None, 10);
 }
 
 /// A panic while holding the lock leaves consistent data (edits are
