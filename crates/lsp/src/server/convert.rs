@@ -14,10 +14,36 @@ pub(crate) struct LineMap {
     index: Arc<LineIndex>,
 }
 
+/// Byte offsets to protocol positions: the line index without the text, for
+/// work that may outlive the next edit (a holder of the text makes the edit
+/// copy it instead of changing it in place).
+#[derive(Debug, Clone)]
+pub(crate) struct Positions(Arc<LineIndex>);
+
+impl Positions {
+    pub fn position(&self, offset: TextSize) -> lsp::Position {
+        let offset = offset.min(self.0.len());
+        let line_col = self.0.line_col(offset);
+        let wide = self
+            .0
+            .to_wide(WideEncoding::Utf16, line_col)
+            .unwrap_or(WideLineCol { line: line_col.line, col: line_col.col });
+        lsp::Position::new(wide.line, wide.col)
+    }
+
+    pub fn range(&self, range: TextRange) -> lsp::Range {
+        lsp::Range::new(self.position(range.start()), self.position(range.end()))
+    }
+}
+
 impl LineMap {
     pub fn new(text: Arc<String>) -> LineMap {
         let index = Arc::new(LineIndex::new(&text));
         LineMap { text, index }
+    }
+
+    pub fn positions(&self) -> Positions {
+        Positions(self.index.clone())
     }
 
     /// The byte offset of a position; positions past a line's end or past
@@ -48,17 +74,11 @@ impl LineMap {
     }
 
     pub fn position(&self, offset: TextSize) -> lsp::Position {
-        let offset = offset.min(self.index.len());
-        let line_col = self.index.line_col(offset);
-        let wide = self
-            .index
-            .to_wide(WideEncoding::Utf16, line_col)
-            .unwrap_or(WideLineCol { line: line_col.line, col: line_col.col });
-        lsp::Position::new(wide.line, wide.col)
+        self.positions().position(offset)
     }
 
     pub fn range(&self, range: TextRange) -> lsp::Range {
-        lsp::Range::new(self.position(range.start()), self.position(range.end()))
+        self.positions().range(range)
     }
 
     /// Applies a protocol change; returns the edit in byte offsets.
@@ -75,7 +95,7 @@ impl LineMap {
     }
 }
 
-pub(crate) fn diagnostic(map: &LineMap, uri: &Uri, diagnostic: &Diagnostic) -> lsp::Diagnostic {
+pub(crate) fn diagnostic(map: &Positions, uri: &Uri, diagnostic: &Diagnostic) -> lsp::Diagnostic {
     let severity = match diagnostic.severity {
         Severity::Error => lsp::DiagnosticSeverity::ERROR,
         Severity::Warning => lsp::DiagnosticSeverity::WARNING,

@@ -60,9 +60,10 @@ pub(crate) fn definition(s: &Snapshot, position: lsp::Position) -> Vec<Navigatio
 pub(crate) fn code_actions(s: &Snapshot, range: lsp::Range) -> lsp::CodeActionResponse {
     let range = s.map.range_offsets(range);
     let diagnostics = s.analysis.diagnostics(s.file);
+    let positions = s.map.positions();
     let mut actions = Vec::new();
     for diagnostic in diagnostics.iter().filter(|d| d.range.intersect(range).is_some() && !d.fixes.is_empty()) {
-        let converted = convert::diagnostic(&s.map, &s.uri, diagnostic);
+        let converted = convert::diagnostic(&positions, &s.uri, diagnostic);
         let only_fix = diagnostic.fixes.len() == 1;
         for fix in &diagnostic.fixes {
             let edits = fix.edits.iter().map(|edit| s.map.text_edit(edit)).collect();

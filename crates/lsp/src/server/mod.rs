@@ -202,11 +202,12 @@ impl Server {
     /// Pushes the document's diagnostics for its current version: local
     /// findings first, then the complete set.
     fn publish_diagnostics(&self, uri: Uri) {
-        let (analysis, file, version, map, carried) = {
+        // Positions, not the text: this thread outlives the next edit.
+        let (analysis, file, version, positions, carried) = {
             let state = self.state();
             let Some(document) = state.documents.get(&uri) else { return };
             let analysis = state.workspaces.get(document.workspace).analysis();
-            (analysis, document.file, document.version, document.map.clone(), document.flow.clone())
+            (analysis, document.file, document.version, document.map.positions(), document.flow.clone())
         };
         let publisher = self.publisher.clone();
         let state = self.state.clone();
@@ -215,7 +216,7 @@ impl Server {
         // since it lowers its priority for the flow walk.
         let spawned = std::thread::Builder::new().name("ncc-diagnostics".into()).spawn(move || {
             let send = |diagnostics: Vec<Diagnostic>| {
-                let diagnostics = diagnostics.iter().map(|d| convert::diagnostic(&map, &uri, d)).collect();
+                let diagnostics = diagnostics.iter().map(|d| convert::diagnostic(&positions, &uri, d)).collect();
                 let _ = publisher.send((uri.clone(), diagnostics, version));
             };
             let started = std::time::Instant::now();
