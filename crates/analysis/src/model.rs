@@ -196,11 +196,6 @@ impl Program {
         chunk.summary.blocks.get(index - chunk.first).map(|b| b.shifted(chunk.offset))
     }
 
-    /// Every block in order, with file offsets.
-    pub fn blocks(&self) -> impl Iterator<Item = BlockSummary> + '_ {
-        self.chunks.iter().flat_map(|c| c.summary.blocks.iter().map(|b| b.shifted(c.offset)))
-    }
-
     /// The blocks of `range`, with file offsets.
     pub fn blocks_in(&self, range: Range<usize>) -> impl Iterator<Item = BlockSummary> + '_ {
         range.map(|index| self.block(index))

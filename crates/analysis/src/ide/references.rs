@@ -148,8 +148,9 @@ fn block_number(file: SourceFile, program: &Program, index: usize) -> Option<Ref
 /// The `G73 L<number>` blocks in the unit of block `index`.
 fn jumps(db: &dyn Db, file: SourceFile, program: &Program, index: usize, number: u32) -> Vec<Reference> {
     let Some(unit) = program.unit_of(index) else { return Vec::new() };
-    let blocks =
-        unit.blocks.clone().filter(|&b| program.block(b).transfer.is_some_and(|(t, _)| t == Transfer::Jump(number)));
+    let blocks = program.transfers().filter(|b| {
+        unit.blocks.contains(b) && program.block(*b).transfer.is_some_and(|(t, _)| t == Transfer::Jump(number))
+    });
     labels_at(db, file, blocks, ReferenceKind::Jump)
 }
 
@@ -161,7 +162,7 @@ fn labels(
     matches: impl Fn(Transfer) -> bool,
     kind: ReferenceKind,
 ) -> Vec<Reference> {
-    let blocks = (0..program.block_count()).filter(|&b| program.block(b).transfer.is_some_and(|(t, _)| matches(t)));
+    let blocks = program.transfers().filter(|&b| program.block(b).transfer.is_some_and(|(t, _)| matches(t)));
     labels_at(db, file, blocks, kind)
 }
 
