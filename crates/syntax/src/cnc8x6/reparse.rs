@@ -4,10 +4,10 @@
 //! around the edit are reparsed from the new text until parsing reaches a
 //! block start that also started a block before the edit; the new blocks
 //! replace the old ones, and the runs around them are regrouped (see
-//! `runs`), so only the touched runs and the root are rebuilt. Everything the edit could change
-//! beyond blocks (the header, the preamble, the physical end `*`, words
-//! before the first block) makes us return `None` and the caller parses the
-//! whole text again. A property test checks that the result always equals a
+//! `runs`), so only the touched runs and the root are rebuilt. Everything
+//! the edit could change beyond blocks (the header, the preamble, the
+//! physical end `*`, words before the first block) makes us return `None`
+//! and the caller parses the whole text again. A property test checks that the result always equals a
 //! full parse.
 
 use rowan::{NodeOrToken, TextRange, TextSize};
