@@ -95,6 +95,16 @@ impl<'db> BlockChunk<'db> {
         (!run).then_some(node).into_iter().chain(in_run)
     }
 
+    /// Block `at` of the chunk.
+    pub fn block(self, db: &'db dyn Db, at: usize) -> Option<&'db rowan::GreenNodeData> {
+        let node: &'db rowan::GreenNodeData = &self.green(db).0;
+        if node.kind() == SyntaxKind::BLOCK_RUN.into() {
+            node.children().nth(at)?.into_node()
+        } else {
+            (at == 0).then_some(node)
+        }
+    }
+
     pub fn len(self, db: &'db dyn Db) -> usize {
         let node = &self.green(db).0;
         if node.kind() == SyntaxKind::BLOCK_RUN.into() { node.children().len() } else { 1 }

@@ -315,35 +315,42 @@ pub fn flow_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
     out
 }
 
-/// The lowered blocks of a file, rebuilt on demand chunk by chunk (the
-/// walk mostly goes forward; calls jump to subprograms).
+/// The lowered blocks of a file, each lowered when a walk first reaches it
+/// (a question walks a few dozen blocks of a chunk of hundreds).
 struct Blocks<'db> {
     db: &'db dyn Db,
+    program: &'db Program,
     chunks: &'db [db::FileChunk<'db>],
-    cache: FxHashMap<usize, Arc<Vec<(TextSize, BlockData)>>>,
+    /// Kept for blocks walked again: subprograms called more than once.
+    cache: FxHashMap<usize, Arc<BlockData>>,
 }
 
 impl<'db> Blocks<'db> {
+    /// Blocks kept at most; a walk mostly goes forward.
+    const KEPT: usize = 4096;
+
     fn new(db: &'db dyn Db, file: SourceFile) -> Self {
         let chunks = db::file_chunks(db, file).as_slice();
-        Blocks { db, chunks, cache: FxHashMap::default() }
+        Blocks { db, program: model::program(db, file), chunks, cache: FxHashMap::default() }
     }
 
     /// Block `index` with its file offset.
-    fn get(&mut self, index: usize) -> (TextSize, Arc<Vec<(TextSize, BlockData)>>, usize) {
+    fn get(&mut self, index: usize) -> (TextSize, Arc<BlockData>) {
         // A walk over a large file is one long query: an edit waiting to
         // change the inputs waits for this check (an atomic load).
         self.db.unwind_if_revision_cancelled();
-        let chunk = self.chunks.partition_point(|chunk| chunk.first <= index) - 1;
-        if !self.cache.contains_key(&chunk) {
-            if self.cache.len() >= 16 {
-                self.cache.clear();
-            }
-            let lowered: Vec<_> = db::lower_chunk(self.db, self.chunks[chunk].chunk).collect();
-            self.cache.insert(chunk, Arc::new(lowered));
+        let offset = self.program.block(index).offset;
+        if let Some(block) = self.cache.get(&index) {
+            return (offset, block.clone());
         }
-        let lowered = self.cache[&chunk].clone();
-        (self.chunks[chunk].offset, lowered, index - self.chunks[chunk].first)
+        if self.cache.len() >= Self::KEPT {
+            self.cache.clear();
+        }
+        let chunk = &self.chunks[self.chunks.partition_point(|chunk| chunk.first <= index) - 1];
+        let green = chunk.chunk.block(self.db, index - chunk.first).expect("the model's blocks are the chunks' blocks");
+        let block = Arc::new(BlockData::lower(green));
+        self.cache.insert(index, block.clone());
+        (offset, block)
     }
 }
 
@@ -351,8 +358,8 @@ impl<'db> Blocks<'db> {
 pub fn lowered_block(db: &dyn Db, file: SourceFile, index: usize) -> Option<(TextSize, BlockData)> {
     let blocks_in_file = model::program(db, file).block_count();
     (index < blocks_in_file).then(|| {
-        let (chunk_offset, lowered, at) = Blocks::new(db, file).get(index);
-        (chunk_offset + lowered[at].0, lowered[at].1.clone())
+        let (offset, block) = Blocks::new(db, file).get(index);
+        (offset, Arc::unwrap_or_clone(block))
     })
 }
 
@@ -400,45 +407,41 @@ impl<'db> Walk<'db> {
     fn run(&mut self) {
         let has_main = self.program.has_main();
         if has_main {
-            let state = ModalState::reset(self.catalogue);
-            self.walk_unit(0, state, ParamState::program_start());
+            let (mut state, mut params) = (ModalState::reset(self.catalogue), ParamState::program_start());
+            self.walk_unit(0, &mut state, &mut params);
         }
         for unit in 0..self.program.units.len() {
             let is_main = has_main && unit == 0;
             let called = self.program.kind == FileKind::Program && self.called[unit];
             if !is_main && !called {
-                self.walk_unit(unit, ModalState::unknown(), ParamState::unknown());
+                self.walk_unit(unit, &mut ModalState::unknown(), &mut ParamState::unknown());
             }
         }
     }
 
-    /// Walks a unit from `state`; returns the state at its end.
-    fn walk_unit(&mut self, unit: usize, mut state: ModalState, mut params: ParamState) -> (ModalState, ParamState) {
+    /// Walks a unit from `state`, which it leaves as at the unit's end.
+    fn walk_unit(&mut self, unit: usize, state: &mut ModalState, params: &mut ParamState) {
         self.stack.push(unit);
         let mut last = None;
         for index in self.program.units[unit].blocks.clone() {
-            (state, params) = self.step(index, &state, &params);
+            self.step(index, state, params);
             last = Some(index);
         }
-        let last_block = last.map(|index| {
-            let (chunk_offset, lowered, at) = self.blocks.get(index);
-            (chunk_offset + lowered[at].0, lowered, at)
-        });
+        let last_block = last.map(|index| self.blocks.get(index));
         for check in &mut self.checks {
-            check.end_of_unit(&state, last_block.as_ref().map(|(o, l, a)| (*o, &l[*a].1)), &mut self.out);
+            check.end_of_unit(state, last_block.as_ref().map(|(offset, block)| (*offset, &**block)), &mut self.out);
         }
         self.stack.pop();
-        (state, params)
     }
 
-    /// Runs block `index` (and what it calls) from `state`.
-    pub(crate) fn step(&mut self, index: usize, state: &ModalState, params: &ParamState) -> (ModalState, ParamState) {
-        let (chunk_offset, lowered, at) = self.blocks.get(index);
-        let (offset, block) = (&lowered[at].0, &lowered[at].1);
-        let (state, params) = self.visit(block, chunk_offset + *offset, state, params);
-        match self.program.block(index).transfer {
-            Some((transfer, range)) => self.follow(transfer, range, state, params),
-            None => (state, params),
+    /// Runs block `index` (and what it calls) from `state`, which it
+    /// leaves as after the block. In place: a walk without checks then
+    /// copies no state.
+    pub(crate) fn step(&mut self, index: usize, state: &mut ModalState, params: &mut ParamState) {
+        let (offset, block) = self.blocks.get(index);
+        self.visit(&block, offset, state, params);
+        if let Some((transfer, range)) = self.program.block(index).transfer {
+            self.follow(transfer, range, state, params);
         }
     }
 
@@ -449,15 +452,13 @@ impl<'db> Walk<'db> {
     }
 
     /// Follows a call: the callee runs with the caller's state.
-    fn follow(
-        &mut self,
-        transfer: Transfer,
-        call: TextRange,
-        state: ModalState,
-        params: ParamState,
-    ) -> (ModalState, ParamState) {
+    fn follow(&mut self, transfer: Transfer, call: TextRange, state: &mut ModalState, params: &mut ParamState) {
+        let unknown = |state: &mut ModalState, params: &mut ParamState| {
+            *state = ModalState::unknown();
+            *params = ParamState::unknown();
+        };
         match transfer {
-            Transfer::Jump(_) => (state, params),
+            Transfer::Jump(_) => {}
             Transfer::Subprogram(number) => {
                 let unit = self.program.units.iter().position(|u| u.number == Some(number));
                 match unit {
@@ -468,9 +469,9 @@ impl<'db> Walk<'db> {
                             Some(hull) => hull.start.min(blocks.start)..hull.end.max(blocks.end),
                             None => blocks.clone(),
                         });
-                        self.walk_unit(unit, state, params)
+                        self.walk_unit(unit, state, params);
                     }
-                    _ => (ModalState::unknown(), ParamState::unknown()),
+                    _ => unknown(state, params),
                 }
             }
             Transfer::Macrocycle(number) => {
@@ -483,11 +484,11 @@ impl<'db> Walk<'db> {
                         let mut inner = Walk::new(self.db, file, program, Vec::new());
                         inner.stack = vec![usize::MAX; self.stack.len()];
                         if program.units.is_empty() {
-                            return (ModalState::unknown(), ParamState::unknown());
+                            return unknown(state, params);
                         }
                         let origins_before = params.origins.clone();
                         let settings_before = state.clone();
-                        let (mut state, mut params) = inner.walk_unit(0, state, params);
+                        inner.walk_unit(0, state, params);
                         state.point_settings_at(&settings_before, call);
                         // Ranges in the macrocycle's file mean nothing here:
                         // what it assigned comes from the call.
@@ -496,39 +497,33 @@ impl<'db> Walk<'db> {
                                 *origin = origin.map(|_| Origin { range: call, point: false, computed: true });
                             }
                         }
-                        (state, params)
                     }
-                    _ => (ModalState::unknown(), ParamState::unknown()),
+                    _ => unknown(state, params),
                 }
             }
         }
     }
 
-    /// Runs the checks on one block and returns the state after it.
-    fn visit(
-        &mut self,
-        block: &BlockData,
-        offset: TextSize,
-        before: &ModalState,
-        params: &ParamState,
-    ) -> (ModalState, ParamState) {
+    /// Takes the state over one block, and runs the checks on it.
+    fn visit(&mut self, block: &BlockData, offset: TextSize, state: &mut ModalState, params: &mut ParamState) {
         let substitutions: Vec<Option<Substitution>> = block.words.iter().map(|w| substitute(w, params)).collect();
         let codes = codes(block, &substitutions, offset);
-        let mut after = self.apply(before, block, &substitutions, &codes, offset);
-        let reached = after.position;
+        let before = (!self.checks.is_empty()).then(|| (state.clone(), params.clone()));
+        self.apply(state, block, &substitutions, &codes, offset);
+        let reached = state.position;
         // A fixed cycle moves the tool in its body.
-        if matches!(after.g[8], Known::Is(Some(81..=89)) | Known::Unknown) {
-            after.position = [Known::Unknown; 26];
+        if matches!(state.g[8], Known::Is(Some(81..=89)) | Known::Unknown) {
+            state.position = [Known::Unknown; 26];
         }
-        let mut after_params = params.clone();
-        let arithmetic_error = self.assign(block, offset, &mut after_params);
+        let arithmetic_error = self.assign(block, offset, params);
+        let Some((before, params_before)) = before else { return };
         let visit = Visit {
             block,
             offset,
-            before,
-            after: &after,
-            params,
-            params_after: &after_params,
+            before: &before,
+            after: state,
+            params: &params_before,
+            params_after: params,
             substitutions: &substitutions,
             codes: &codes,
             arithmetic_error: arithmetic_error.as_ref(),
@@ -538,19 +533,21 @@ impl<'db> Walk<'db> {
         for check in &mut self.checks {
             check.block(&visit, &mut self.out);
         }
-        (after, after_params)
     }
 
-    /// The modal state after a block.
+    /// Takes the modal state over a block.
     fn apply(
         &self,
-        before: &ModalState,
+        after: &mut ModalState,
         block: &BlockData,
         substitutions: &[Option<Substitution>],
         codes: &[(u8, u32, TextRange)],
         offset: TextSize,
-    ) -> ModalState {
-        let mut after = before.clone();
+    ) {
+        // When constant cutting speed ends without a new S, the control
+        // keeps the speed it last reached, not the S written (a cutting speed).
+        let maybe_css = |state: &ModalState| !matches!(state.g[6], Known::Is(Some(94 | 95)));
+        let css_before = maybe_css(after);
         for &(letter, number, _) in codes {
             let Some(group) = self.catalogue.group_of(char::from(letter), number) else { continue };
             let Some((_, index)) = group_index(&group.id) else { continue };
@@ -597,14 +594,10 @@ impl<'db> Walk<'db> {
                 None => Known::Unknown,
             };
         }
-        // When constant cutting speed ends without a new S, the control
-        // keeps the speed it last reached, not the S written (a cutting speed).
-        let maybe_css = |state: &ModalState| !matches!(state.g[6], Known::Is(Some(94 | 95)));
-        if maybe_css(before) && !maybe_css(&after) && !writes_speed {
+        if css_before && !maybe_css(after) && !writes_speed {
             after.speed = Known::Unknown;
         }
-        self.move_axes(&mut after, block, substitutions, codes);
-        after
+        self.move_axes(after, block, substitutions, codes);
     }
 
     /// The programmed end position after a block.
