@@ -199,9 +199,17 @@ impl Server {
         }
     }
 
-    /// Pushes the document's diagnostics for its current version: local
-    /// findings first, then the complete set.
-    fn publish_diagnostics(&self, uri: Uri) {
+    /// Pushes the document's diagnostics for its current version (local
+    /// findings first, then the complete set) and prepares its modal
+    /// states, so that a hover anywhere finds a checkpoint near it.
+    ///
+    /// After an edit, preparing mostly walks across the edit; it comes
+    /// before the flow walk, which takes far longer. When the document was
+    /// just `opened`, the states of the whole program are prepared on
+    /// another thread while the local findings are computed (about as long,
+    /// on the other core), and those wait for it: the document is ready,
+    /// hover included, when its first diagnostics arrive.
+    fn analyze(&self, uri: Uri, opened: bool) {
         // Positions, not the text: this thread outlives the next edit.
         let (analysis, file, version, positions, carried) = {
             let state = self.state();
@@ -211,21 +219,45 @@ impl Server {
         };
         let publisher = self.publisher.clone();
         let state = self.state.clone();
-        // The snapshot lives only on this thread, so an edit waiting to
-        // cancel it never waits for the async runtime. A thread of its own,
-        // since it lowers its priority for the flow walk.
+        // The snapshots live only on these threads, so an edit waiting to
+        // cancel them never waits for the async runtime. Threads of their
+        // own, since they lower their priority for the long walks.
         let spawned = std::thread::Builder::new().name("ncc-diagnostics".into()).spawn(move || {
             let send = |diagnostics: Vec<Diagnostic>| {
                 let diagnostics = diagnostics.iter().map(|d| convert::diagnostic(&positions, &uri, d)).collect();
                 let _ = publisher.send((uri.clone(), diagnostics, version));
             };
             let started = std::time::Instant::now();
-            let Ok(local) = Cancelled::catch(|| analysis.local_diagnostics(file)) else { return };
+            let prepare = |analysis: &Analysis| {
+                let started = std::time::Instant::now();
+                match Cancelled::catch(|| analysis.prepare_states(file)) {
+                    Ok(()) => {
+                        tracing::debug!("{} v{version}: states prepared in {:?}", uri.as_str(), started.elapsed())
+                    }
+                    Err(_) => tracing::debug!("{} v{version}: preparing states cancelled by an edit", uri.as_str()),
+                }
+            };
+            let local = std::thread::scope(|scope| {
+                if opened {
+                    let analysis = analysis.clone();
+                    let spawned = std::thread::Builder::new()
+                        .name("ncc-states".into())
+                        .spawn_scoped(scope, move || prepare(&analysis));
+                    if let Err(error) = spawned {
+                        tracing::error!("cannot start a thread preparing states: {error}");
+                    }
+                }
+                Cancelled::catch(|| analysis.local_diagnostics(file))
+            });
+            let Ok(local) = local else { return };
             tracing::debug!("{} v{version}: local diagnostics in {:?}", uri.as_str(), started.elapsed());
             let mut first = local.clone();
             first.extend(carried);
             send(first);
             background_priority();
+            if !opened {
+                prepare(&analysis);
+            }
             let Ok(flow) = Cancelled::catch(|| analysis.flow_diagnostics(file)) else {
                 tracing::debug!("{} v{version}: flow walk cancelled by an edit", uri.as_str());
                 return;
@@ -242,24 +274,6 @@ impl Server {
             let mut all = local;
             all.extend(flow);
             send(all);
-            // Idle time: prepare the modal states, so that a hover anywhere
-            // finds a checkpoint near it. (The snapshot above was let go
-            // before taking the lock: an edit holds the lock while it waits
-            // for snapshots to go.)
-            let analysis = {
-                let state = lock(&state);
-                match state.documents.get(&uri) {
-                    Some(document) if document.version == version => {
-                        state.workspaces.get(document.workspace).analysis()
-                    }
-                    _ => return,
-                }
-            };
-            let started = std::time::Instant::now();
-            match Cancelled::catch(|| analysis.prepare_states(file)) {
-                Ok(()) => tracing::debug!("{} v{version}: states prepared in {:?}", uri.as_str(), started.elapsed()),
-                Err(_) => tracing::debug!("{} v{version}: preparing states cancelled by an edit", uri.as_str()),
-            }
         });
         if let Err(error) = spawned {
             tracing::error!("cannot start a diagnostics thread: {error}");
@@ -267,14 +281,23 @@ impl Server {
     }
 }
 
-/// Lowers the calling thread's priority: the flow walk and the state
-/// preparation take hundreds of milliseconds on a large program, and edits
-/// and hovers must not wait for a core behind them.
+/// Puts the calling thread in the idle scheduling class: the flow walk and
+/// the state preparation take hundreds of milliseconds on a large program,
+/// and edits and hovers must not wait for a core behind them. (A thread
+/// waking in the normal class takes the core from an idle-class one at
+/// once; a merely niced one keeps it until the scheduler's next tick.)
 fn background_priority() {
-    // On Linux the "process" priority is the calling thread's. Failing
-    // leaves the thread as it was.
+    // Failing leaves the thread as it was.
     #[cfg(target_os = "linux")]
-    let _ = rustix::process::setpriority_process(None, 10);
+    {
+        use thread_priority::{NormalThreadSchedulePolicy, ThreadPriority, ThreadSchedulePolicy};
+        let idle = ThreadSchedulePolicy::Normal(NormalThreadSchedulePolicy::Idle);
+        let _ = thread_priority::set_thread_priority_and_policy(
+            thread_priority::thread_native_id(),
+            ThreadPriority::Min,
+            idle,
+        );
+    }
 }
 
 /// A panic while holding the lock leaves consistent data (edits are
@@ -347,7 +370,7 @@ impl LanguageServer for Server {
                 .insert(document.uri.clone(), Document { workspace, file, version: document.version, map, flow });
             errors
         };
-        self.publish_diagnostics(document.uri);
+        self.analyze(document.uri, true);
         for error in errors {
             self.client.show_message(lsp::MessageType::ERROR, error).await;
         }
@@ -379,7 +402,7 @@ impl LanguageServer for Server {
             document.version = params.text_document.version;
             tracing::debug!("{} v{}: edits applied in {:?}", uri.as_str(), document.version, started.elapsed());
         }
-        self.publish_diagnostics(uri);
+        self.analyze(uri, false);
     }
 
     async fn did_close(&self, params: lsp::DidCloseTextDocumentParams) {
