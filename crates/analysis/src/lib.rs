@@ -13,13 +13,14 @@ mod db;
 mod diagnostic;
 pub mod flow;
 mod ide;
-pub mod lower;
 pub mod model;
 mod states;
 mod suppress;
 
 use std::sync::Arc;
 
+/// Blocks as plain data, lowered the same way for the executor.
+pub use nc_exec::lower;
 use ncc_syntax::Parse;
 pub use ncc_syntax::{Dialect, Severity, TextEdit, TextRange, TextSize};
 pub use salsa::Cancelled;

@@ -11,5 +11,8 @@
 //! - [`arith`]: the parameter-arithmetic evaluator of G26–G29 (control words
 //!   in R5–R8, operations 0–51). It works on partly unknown parameters, so
 //!   the static analysis uses it as well.
+//! - [`lower`]: blocks as plain data (words, parameter assignments,
+//!   comments), read from the syntax tree; the analysis uses it too.
 
 pub mod arith;
+pub mod lower;

@@ -1,9 +1,9 @@
 //! Blocks lowered to plain data: the words, codes and parameter assignments
 //! of one block, with ranges relative to the block's start.
 //!
-//! Lowering depends only on the block's own text, so the database keys it by
-//! the block's green node: an edit re-lowers the blocks it touched and no
-//! other.
+//! Lowering depends only on the block's own text (its green node), so the
+//! analysis re-lowers only the blocks an edit touched. The executor and the
+//! analysis read programs through this one lowering.
 
 use ncc_catalog::{AddressRole, Dialect};
 use ncc_syntax::{Decimal, NcLanguage, Sign, SyntaxKind, TextRange, TextSize, ast};
