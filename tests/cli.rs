@@ -363,3 +363,45 @@ fn explain_list_prints_the_counts() {
         assert!(text.contains(heading), "{heading} missing from\n{text}");
     }
 }
+
+/// `ncc run` prints the time split and the end; JSON has the total and a
+/// record per block with its source line.
+#[test]
+fn run_prints_the_time_and_a_record_per_block() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("DEMO.NCP");
+    let text = "%1 \"DEMO\"\nN1 G00 X100 Y0 T1\nN2 G01 X100 Y100 F600\nN3 G02 X0 Y100 I-50\nN4 G04 Q150\nN5 G01 G41 X0\nN6 M30\n";
+    std::fs::write(&program, text).unwrap();
+    let program = program.to_str().unwrap();
+
+    let output = ncc(&["run", program]);
+    assert_eq!(output.status.code(), Some(0));
+    let summary = stdout(&output).replace(program, "DEMO.NCP");
+    expect![[r#"
+        DEMO.NCP
+          total time   0:00:27.808
+            cutting    0:00:25.708       257.080 mm
+            rapid      0:00:00.600       100.000 mm
+            dwell      0:00:01.500
+          tools        T1
+          end position X0.000 Y100.000 Z0.000 U0.000 V0.000 C0.000
+    "#]]
+    .assert_eq(&summary);
+    let warnings = String::from_utf8(output.stderr).unwrap().replace(program, "DEMO.NCP");
+    assert_eq!(
+        warnings,
+        "DEMO.NCP:6: the executor does not run radius compensation (G41/G42) yet: the time leaves them out\n"
+    );
+
+    let output = ncc(&["run", program, "--format", "json"]);
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let total = json["total_time_s"].as_f64().unwrap();
+    assert!((total - (0.6 + 10.0 + 50.0 * std::f64::consts::PI / 600.0 * 60.0 + 1.5)).abs() < 1e-9, "{total}");
+    let blocks = json["blocks"].as_array().unwrap();
+    let lines: Vec<u64> = blocks.iter().map(|b| b["line"].as_u64().unwrap()).collect();
+    assert_eq!(lines, [2, 3, 4, 5, 6, 7]);
+    assert_eq!(blocks[1]["feed_mm_min"], 600.0);
+    assert_eq!(blocks[1]["start_time_s"], 0.6);
+    assert_eq!(blocks[1]["end"]["program"]["Y"], 100.0);
+    assert_eq!(blocks[1]["end"]["machine"]["Y"], 100.0);
+}

@@ -9,6 +9,7 @@
 //! [machine]
 //! axes = ["X", "Y", "Z", "U", "V", "C"]   # letters of axes 1-6
 //! feed-limit = 24000                      # mm/min
+//! rapid-rate = 10000                      # mm/min, every axis (G00)
 //! cycle-file = "PCYKLYDG.NCP"             # CNC836.KNF $17: what G81-G89 do
 //!
 //! [machine.constants]                      # as in TAB0.REK
@@ -21,8 +22,8 @@ use std::{
     path::{Path, PathBuf},
 };
 
-use ncc_catalog::Dialect;
-use ncc_syntax::{Decimal, Severity, Sign};
+pub use nc_exec::machine::{MachineConfig, parse_constant};
+use ncc_syntax::Severity;
 use serde::Deserialize;
 
 use crate::Diagnostic;
@@ -61,79 +62,6 @@ pub struct Config {
     pub machine: MachineConfig,
 }
 
-/// The machine the programs run on.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
-pub struct MachineConfig {
-    /// Letters of axes 1 to 6.
-    pub axes: Vec<u8>,
-    /// Highest programmable feed in mm/min.
-    pub feed_limit: u32,
-    /// Machine constants set in the configuration, as raw values (the
-    /// decades as digits: `00233.112` → 233112).
-    pub constants: BTreeMap<u32, i64>,
-    /// The fixed-cycle file the control loads (parameter `$17` of
-    /// CNC836.KNF), e.g. `PCYKLYDG.NCP` (milling) or `PEVNECY5.NCP`
-    /// (lathe): it decides what G81–G89 do.
-    pub cycle_file: Option<String>,
-}
-
-impl Default for MachineConfig {
-    fn default() -> Self {
-        MachineConfig { axes: b"XYZUVC".to_vec(), feed_limit: 24_000, constants: BTreeMap::new(), cycle_file: None }
-    }
-}
-
-impl MachineConfig {
-    /// A machine constant's raw value: configured, else the catalogue's
-    /// default, else zero.
-    pub fn constant(&self, number: u32) -> i64 {
-        self.known_constant(number).unwrap_or(0)
-    }
-
-    /// A machine constant's raw value when the configuration or the
-    /// catalogue gives one; `None` for a constant without a documented
-    /// default that the configuration does not set.
-    pub fn known_constant(&self, number: u32) -> Option<i64> {
-        self.constants.get(&number).copied().or_else(|| Self::default_constant(number))
-    }
-
-    /// A machine constant's documented default, from the catalogue.
-    pub fn default_constant(number: u32) -> Option<i64> {
-        Dialect::Cnc8x6.catalogue().machine_constant(number).and_then(|c| c.default.as_deref()).and_then(parse_constant)
-    }
-
-    /// Decade `decade` (1 = rightmost digit) of a machine constant.
-    pub fn decade(&self, number: u32, decade: u32) -> u8 {
-        self.known_decade(number, decade).unwrap_or(0)
-    }
-
-    /// Decade `decade` of a machine constant the configuration or the
-    /// catalogue gives.
-    pub fn known_decade(&self, number: u32, decade: u32) -> Option<u8> {
-        let raw = self.known_constant(number)?.unsigned_abs();
-        // Decades beyond the number's digits are zero.
-        Some(10u64.checked_pow(decade.saturating_sub(1)).map_or(0, |divisor| (raw / divisor % 10) as u8))
-    }
-
-    /// Whether `letter` names a configured axis.
-    pub fn is_axis(&self, letter: u8) -> bool {
-        self.axes.contains(&letter.to_ascii_uppercase())
-    }
-}
-
-/// Reads a machine-constant value as written in TAB0.REK: with a decimal
-/// point in thousandths (`60.000`), without one as the raw decades.
-pub fn parse_constant(text: &str) -> Option<i64> {
-    let text = text.trim();
-    let (sign, digits) = match text.strip_prefix('-') {
-        Some(rest) => (Some(Sign::Minus), rest),
-        None => (None, text.strip_prefix('+').unwrap_or(text)),
-    };
-    let value = Decimal::parse(sign, digits)?;
-    let scale = if value.has_point() { 3 } else { 0 };
-    i64::try_from(value.scaled(scale)?).ok()
-}
-
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields, rename_all = "kebab-case")]
 struct ConfigFile {
@@ -148,6 +76,7 @@ struct ConfigFile {
 struct MachineFile {
     axes: Option<Vec<String>>,
     feed_limit: Option<u32>,
+    rapid_rate: Option<u32>,
     cycle_file: Option<String>,
     #[serde(default)]
     constants: BTreeMap<String, String>,
@@ -175,6 +104,12 @@ impl Config {
             }
             if let Some(limit) = machine.feed_limit {
                 config.machine.feed_limit = limit;
+            }
+            if let Some(rate) = machine.rapid_rate {
+                if rate == 0 {
+                    return Err(format!("{origin}: machine.rapid-rate must be above 0 mm/min"));
+                }
+                config.machine.rapid_rate = rate;
             }
             if let Some(name) = machine.cycle_file {
                 if name.trim().is_empty() {
@@ -226,13 +161,14 @@ mod tests {
     #[test]
     fn reads_rules_and_machine() {
         let config = Config::from_toml(
-            "[rules]\nS009 = \"off\"\nunknown-code = \"warning\"\n[machine]\naxes = [\"X\", \"Z\"]\nfeed-limit = 10000\n[machine.constants]\nR339 = \"01000000\"\nR39 = \"45.5\"\n",
+            "[rules]\nS009 = \"off\"\nunknown-code = \"warning\"\n[machine]\naxes = [\"X\", \"Z\"]\nfeed-limit = 10000\nrapid-rate = 15000\n[machine.constants]\nR339 = \"01000000\"\nR39 = \"45.5\"\n",
             "ncc.toml",
         )
         .unwrap();
         assert_eq!(config.rules.get("S009"), Some(&Level::Off));
         assert_eq!(config.machine.axes, b"XZ");
         assert_eq!(config.machine.feed_limit, 10_000);
+        assert_eq!(config.machine.rapid_rate, 15_000);
         assert_eq!(config.machine.decade(339, 7), 1);
         assert_eq!(config.machine.constant(39), 45_500);
     }
@@ -245,6 +181,8 @@ mod tests {
         assert!(error.contains("axis letters"), "{error}");
         assert!(Config::from_toml("[machine.constants]\nR39 = \"abc\"\n", "x").is_err());
         assert!(Config::from_toml("[unknown]\n", "x").is_err());
+        let error = Config::from_toml("[machine]\nrapid-rate = 0\n", "x").unwrap_err();
+        assert!(error.contains("rapid-rate"), "{error}");
     }
 
     #[test]

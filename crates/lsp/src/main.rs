@@ -4,6 +4,7 @@ mod check;
 mod explain;
 mod report;
 mod rules;
+mod run;
 mod sarif;
 mod server;
 
@@ -72,6 +73,20 @@ enum Command {
         #[arg(long)]
         version: bool,
     },
+    /// Run a program on the executor and print what the machine would do.
+    ///
+    /// The summary splits the time into cutting, rapid and dwell, with the
+    /// path lengths, the tools used and the end position. So far the
+    /// executor runs motion (G00–G03, helices), G90/G91, feed units, S,
+    /// dwell, parameter assignments and the program end; anything else it
+    /// names as not run yet.
+    Run {
+        /// The program to run.
+        file: PathBuf,
+        /// Output format: `json` adds a record per block.
+        #[arg(long, value_enum, default_value_t = run::Format::Human)]
+        format: run::Format,
+    },
     /// Print the syntax tree of a partprogram (a debugging aid).
     Parse {
         /// The program to parse.
@@ -89,6 +104,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Command::Lsp { log_level, .. } => server::run(log_level),
+        Command::Run { file, format } => run::run(&file, format),
         Command::Parse { file } => match check::read_program(&file) {
             Ok(text) => {
                 let parse = ncc_syntax::Parse::new(&text, ncc_syntax::Dialect::Cnc8x6);

@@ -67,6 +67,14 @@ use std::fmt;
 /// `R1=864` stores 864 (0.864 as a real value), `R1=864.` stores 864000.
 pub type Raw = i64;
 
+/// The raw value of a literal as a parameter stores it: without a decimal
+/// point the digits are thousandths (`R1=864` is 0.864), with one the
+/// value is in units (`R1=864.` is 864.000).
+pub fn literal_raw(value: &ncc_syntax::Decimal) -> Option<Raw> {
+    let raw = if value.has_point() { value.scaled(3)? } else { value.scaled(0)? };
+    Raw::try_from(raw).ok()
+}
+
 /// The number of program parameters, R0–R95.
 pub const PARAMETER_COUNT: usize = 96;
 

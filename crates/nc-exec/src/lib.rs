@@ -16,3 +16,5 @@
 
 pub mod arith;
 pub mod lower;
+pub mod machine;
+pub mod run;

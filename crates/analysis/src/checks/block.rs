@@ -354,10 +354,7 @@ fn check_assignments(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Dia
 
 /// The raw value a parameter stores: thousandths (`R1=864` → 864,
 /// `R1=864.` → 864000).
-pub(crate) fn parameter_raw(value: &Decimal) -> Option<i64> {
-    let raw = if value.has_point() { value.scaled(3)? } else { value.scaled(0)? };
-    i64::try_from(raw).ok()
-}
+pub(crate) use nc_exec::arith::literal_raw as parameter_raw;
 
 fn check_skip(block: &BlockData, out: &mut Vec<Diagnostic>) {
     for digit in &block.skip_digits {

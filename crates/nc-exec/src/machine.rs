@@ -1,0 +1,91 @@
+//! The machine a program runs on: its axes, rates, the fixed-cycle file
+//! and the machine constants (TAB0.REK). The analysis reads it from
+//! `ncc.toml`; the executor runs on it.
+
+use std::collections::BTreeMap;
+
+use ncc_catalog::Dialect;
+use ncc_syntax::{Decimal, Sign};
+
+/// The machine the programs run on.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct MachineConfig {
+    /// Letters of axes 1 to 6.
+    pub axes: Vec<u8>,
+    /// Highest programmable feed in mm/min.
+    pub feed_limit: u32,
+    /// The rapid traverse (G00) of every axis, in mm/min. The manual makes
+    /// it a machine constant without naming one or a value; the default is
+    /// an assumption.
+    pub rapid_rate: u32,
+    /// Machine constants set in the configuration, as raw values (the
+    /// decades as digits: `00233.112` → 233112).
+    pub constants: BTreeMap<u32, i64>,
+    /// The fixed-cycle file the control loads (parameter `$17` of
+    /// CNC836.KNF), e.g. `PCYKLYDG.NCP` (milling) or `PEVNECY5.NCP`
+    /// (lathe): it decides what G81–G89 do.
+    pub cycle_file: Option<String>,
+}
+
+impl Default for MachineConfig {
+    fn default() -> Self {
+        MachineConfig {
+            axes: b"XYZUVC".to_vec(),
+            feed_limit: 24_000,
+            rapid_rate: 10_000,
+            constants: BTreeMap::new(),
+            cycle_file: None,
+        }
+    }
+}
+
+impl MachineConfig {
+    /// A machine constant's raw value: configured, else the catalogue's
+    /// default, else zero.
+    pub fn constant(&self, number: u32) -> i64 {
+        self.known_constant(number).unwrap_or(0)
+    }
+
+    /// A machine constant's raw value when the configuration or the
+    /// catalogue gives one; `None` for a constant without a documented
+    /// default that the configuration does not set.
+    pub fn known_constant(&self, number: u32) -> Option<i64> {
+        self.constants.get(&number).copied().or_else(|| Self::default_constant(number))
+    }
+
+    /// A machine constant's documented default, from the catalogue.
+    pub fn default_constant(number: u32) -> Option<i64> {
+        Dialect::Cnc8x6.catalogue().machine_constant(number).and_then(|c| c.default.as_deref()).and_then(parse_constant)
+    }
+
+    /// Decade `decade` (1 = rightmost digit) of a machine constant.
+    pub fn decade(&self, number: u32, decade: u32) -> u8 {
+        self.known_decade(number, decade).unwrap_or(0)
+    }
+
+    /// Decade `decade` of a machine constant the configuration or the
+    /// catalogue gives.
+    pub fn known_decade(&self, number: u32, decade: u32) -> Option<u8> {
+        let raw = self.known_constant(number)?.unsigned_abs();
+        // Decades beyond the number's digits are zero.
+        Some(10u64.checked_pow(decade.saturating_sub(1)).map_or(0, |divisor| (raw / divisor % 10) as u8))
+    }
+
+    /// Whether `letter` names a configured axis.
+    pub fn is_axis(&self, letter: u8) -> bool {
+        self.axes.contains(&letter.to_ascii_uppercase())
+    }
+}
+
+/// Reads a machine-constant value as written in TAB0.REK: with a decimal
+/// point in thousandths (`60.000`), without one as the raw decades.
+pub fn parse_constant(text: &str) -> Option<i64> {
+    let text = text.trim();
+    let (sign, digits) = match text.strip_prefix('-') {
+        Some(rest) => (Some(Sign::Minus), rest),
+        None => (None, text.strip_prefix('+').unwrap_or(text)),
+    };
+    let value = Decimal::parse(sign, digits)?;
+    let scale = if value.has_point() { 3 } else { 0 };
+    i64::try_from(value.scaled(scale)?).ok()
+}

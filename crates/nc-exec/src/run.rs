@@ -1,0 +1,546 @@
+//! Running the main body of a CNC8x6 program: the modal state, motion and
+//! time, block by block.
+//!
+//! What runs so far: rapid and linear motion (G00, G01), arcs and helices
+//! (G02, G03) with the centre from I/J/K and the plane from the two axes
+//! written (01 §6.4), absolute and incremental dimensions (G90, G91), feed
+//! per minute and per revolution with the decimal-point rules of F (G94,
+//! G95), the spindle speed S, dwell (G04 Q, in 10 ms), parameter
+//! assignments and references (a block's motion uses the values from before
+//! its own assignments), and the ends M02/M30. A block's time is its path
+//! length over its feed (G00: the longest axis travel over the machine's
+//! rapid rate), plus dwells; ramps and block joining are the velocity
+//! model's business.
+//!
+//! Everything else the control does is reported once per kind as not run
+//! yet (calls, jumps, parameter arithmetic, offsets, compensation, fixed
+//! cycles, transformations, threads), so that a total never silently leaves
+//! something out.
+
+use nalgebra::Vector2;
+use ncc_catalog::{AddressRole, Catalogue, Dialect};
+use ncc_syntax::{Parse, TextRange, ast::AstNode};
+
+use crate::{
+    arith::{self, Parameters, Raw},
+    lower::{BlockData, Value, Word},
+    machine::MachineConfig,
+};
+
+/// Axes by letter (index = letter − `A`); positions in mm (degrees for
+/// rotary axes).
+pub type Position = [f64; 26];
+
+/// What a block did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Motion {
+    /// No motion, no time.
+    None,
+    Rapid,
+    Feed,
+    Dwell,
+}
+
+/// One block as it ran.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Step {
+    /// The block's text range.
+    pub range: TextRange,
+    pub motion: Motion,
+    /// Seconds since the program started, when the block starts.
+    pub start_time: f64,
+    pub duration: f64,
+    /// Path length in mm.
+    pub length: f64,
+    /// The path feed in mm/min (`None` for rapid and non-motion blocks).
+    pub feed: Option<f64>,
+    /// Programmed positions at the block's start and end (program and
+    /// machine coordinates coincide until zero offsets run).
+    pub start: Position,
+    pub end: Position,
+}
+
+/// A problem found while running, at a text range.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Finding {
+    pub range: TextRange,
+    pub message: String,
+    /// The run stopped here (an error the control stops on).
+    pub fatal: bool,
+}
+
+/// A whole run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trace {
+    pub steps: Vec<Step>,
+    pub findings: Vec<Finding>,
+    /// Tools called with T, in order of first use.
+    pub tools: Vec<u32>,
+}
+
+impl Trace {
+    /// Total seconds.
+    pub fn total_time(&self) -> f64 {
+        self.steps.last().map_or(0.0, |step| step.start_time + step.duration)
+    }
+
+    /// Seconds spent in blocks of one kind.
+    pub fn time_in(&self, motion: Motion) -> f64 {
+        self.steps.iter().filter(|step| step.motion == motion).map(|step| step.duration).sum()
+    }
+
+    /// Path length in mm of blocks of one kind.
+    pub fn length_in(&self, motion: Motion) -> f64 {
+        self.steps.iter().filter(|step| step.motion == motion).map(|step| step.length).sum()
+    }
+
+    /// The programmed position at the end.
+    pub fn end_position(&self) -> Position {
+        self.steps.last().map_or([0.0; 26], |step| step.end)
+    }
+}
+
+/// Runs the main body of a CNC8x6 program (blocks up to M02/M30) on
+/// `machine`. Parameters start at zero.
+pub fn run(parse: &Parse, machine: &MachineConfig) -> Trace {
+    let mut runner = Runner::new(machine);
+    for block in parse.tree().blocks() {
+        let node = block.syntax();
+        let data = BlockData::lower(node.green());
+        if runner.block(&data, node.text_range()) == Flow::End {
+            break;
+        }
+    }
+    Trace { steps: runner.steps, findings: runner.findings, tools: runner.tools }
+}
+
+/// Whether a later block still runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Flow {
+    Continue,
+    End,
+}
+
+/// The control's state while a program runs.
+struct Runner<'a> {
+    catalogue: &'static Catalogue,
+    machine: &'a MachineConfig,
+    /// G00–G03.
+    motion: u32,
+    incremental: bool,
+    per_revolution: bool,
+    /// F as programmed: mm/min (per minute) or mm/rev (per revolution).
+    feed: Option<f64>,
+    /// S in rpm.
+    speed: f64,
+    position: Position,
+    params: Parameters,
+    time: f64,
+    steps: Vec<Step>,
+    findings: Vec<Finding>,
+    tools: Vec<u32>,
+    /// Kinds of work already reported as not run.
+    reported: Vec<String>,
+}
+
+/// Tolerance of the arc end point's distance from the centre (1 µm, 01 §6.4).
+const ARC_TOLERANCE: f64 = 0.001;
+
+impl<'a> Runner<'a> {
+    fn new(machine: &'a MachineConfig) -> Self {
+        Runner {
+            catalogue: Dialect::Cnc8x6.catalogue(),
+            machine,
+            // The priority block: G01 G90 G94 F0 S0.
+            motion: 1,
+            incremental: false,
+            per_revolution: false,
+            feed: None,
+            speed: 0.0,
+            position: [0.0; 26],
+            params: Parameters::zeroed(),
+            time: 0.0,
+            steps: Vec::new(),
+            findings: Vec::new(),
+            tools: Vec::new(),
+            reported: Vec::new(),
+        }
+    }
+
+    fn block(&mut self, block: &BlockData, range: TextRange) -> Flow {
+        let at = |local: TextRange| local + range.start();
+        let codes: Vec<(u8, u32, TextRange)> = block
+            .words
+            .iter()
+            .filter(|word| matches!(word.letter, b'G' | b'M'))
+            .filter_map(|word| Some((word.letter, self.integer(word)?, at(word.range))))
+            .collect();
+        let has = |letter: u8, number: u32| codes.iter().any(|&(l, n, _)| l == letter && n == number);
+        for &(letter, number, code_range) in &codes {
+            match (letter, number) {
+                (b'G', 0..=3) => self.motion = number,
+                (b'G', 90) => self.incremental = false,
+                (b'G', 91) => self.incremental = true,
+                (b'G', 94) => self.per_revolution = false,
+                (b'G', 95) => self.per_revolution = true,
+                // Planes, block joining, cancelling and the priority
+                // codes change nothing the executor models yet.
+                (b'G', 4 | 17..=19 | 23 | 24 | 40 | 53 | 78 | 80 | 98) | (b'M', _) => {}
+                (b'G', 26..=29) => self.not_run("parameter arithmetic (G26–G29)", code_range),
+                (b'G', 71..=73) => self.not_run("subprogram calls, macrocycles and jumps (G71–G73)", code_range),
+                (b'G', 41 | 42) => self.not_run("radius compensation (G41/G42)", code_range),
+                (b'G', 33) => self.not_run("thread cutting (G33)", code_range),
+                (b'G', 81..=89) => self.not_run("fixed cycles (G81–G89)", code_range),
+                (b'G', 54..=59 | 92 | 93) => self.not_run("zero offsets (G54–G59, G92, G93)", code_range),
+                (b'G', 31 | 34..=39) => self.not_run("transformations (G31, G34–G39)", code_range),
+                (b'G', 96 | 97) => self.not_run("constant cutting speed (G96/G97)", code_range),
+                _ => self.not_run(&format!("G{number:02}"), code_range),
+            }
+        }
+        for word in &block.words {
+            match self.catalogue.role_of(word.letter) {
+                Some(AddressRole::Feed) => self.feed = self.feed_value(word),
+                Some(AddressRole::Speed) => {
+                    if let Some(speed) = self.number(word) {
+                        self.speed = speed;
+                    }
+                }
+                Some(AddressRole::Tool) => {
+                    if let Some(tool) = self.integer(word)
+                        && !self.tools.contains(&tool)
+                    {
+                        self.tools.push(tool);
+                    }
+                }
+                _ => {}
+            }
+        }
+        let start = self.position;
+        let axes: Vec<&Word> =
+            block.words.iter().filter(|w| self.catalogue.role_of(w.letter) == Some(AddressRole::Axis)).collect();
+        let (motion, length, duration, feed) = if has(b'G', 4) {
+            let dwell = block.word(b'Q').and_then(|q| self.number(q)).unwrap_or(0.0) * 0.01;
+            (Motion::Dwell, 0.0, dwell, None)
+        } else if axes.is_empty() {
+            (Motion::None, 0.0, 0.0, None)
+        } else {
+            let mut end = self.position;
+            for word in &axes {
+                if let Some(value) = self.number(word) {
+                    let slot = &mut end[usize::from(word.letter - b'A')];
+                    *slot = if self.incremental { *slot + value } else { value };
+                }
+            }
+            self.position = end;
+            self.moved(&Move { block, range, axes: &axes, start, end })
+        };
+        self.steps.push(Step {
+            range,
+            motion,
+            start_time: self.time,
+            duration,
+            length,
+            feed,
+            start,
+            end: self.position,
+        });
+        self.time += duration;
+        // Assignments take effect after the block's motion.
+        for assignment in &block.assignments {
+            let (Some(index), Some(value)) = (assignment.index, &assignment.value) else { continue };
+            let raw = match value {
+                Value::Literal(decimal) => arith::literal_raw(decimal),
+                Value::Parameter { .. } => self.raw(value),
+            };
+            self.params.set(index as usize, raw);
+        }
+        if has(b'M', 2) || has(b'M', 30) { Flow::End } else { Flow::Continue }
+    }
+
+    /// Length, duration and feed of a block's move.
+    fn moved(&mut self, step: &Move<'_>) -> (Motion, f64, f64, Option<f64>) {
+        let (range, start, end) = (step.range, step.start, step.end);
+        let travel = |i: usize| end[i] - start[i];
+        let straight = (0..26).map(|i| travel(i).powi(2)).sum::<f64>().sqrt();
+        if self.motion == 0 {
+            let longest = (0..26).map(|i| travel(i).abs()).fold(0.0, f64::max);
+            return (Motion::Rapid, straight, longest / f64::from(self.machine.rapid_rate) * 60.0, None);
+        }
+        let length = match self.motion {
+            2 | 3 => match self.arc_length(step) {
+                Some(length) => length,
+                None => return (Motion::Feed, straight, 0.0, None),
+            },
+            _ => straight,
+        };
+        let feed = match (self.feed, self.per_revolution) {
+            (Some(feed), true) => Some(feed * self.speed),
+            (feed, false) => feed,
+            (None, true) => None,
+        };
+        match feed.filter(|&feed| feed > 0.0) {
+            Some(feed) => (Motion::Feed, length, length / feed * 60.0, Some(feed)),
+            None => {
+                let why = if self.per_revolution && self.feed.is_some() {
+                    "feed per revolution (G95) with spindle speed S0: the axes cannot move"
+                } else {
+                    "no feed F programmed before this motion: G01–G03 need one"
+                };
+                self.findings.push(Finding { range, message: why.to_owned(), fatal: false });
+                (Motion::Feed, length, 0.0, None)
+            }
+        }
+    }
+
+    /// The length of an arc (with a helix's lead along a third axis), or
+    /// `None` after reporting why the block is not an arc.
+    fn arc_length(&mut self, step: &Move<'_>) -> Option<f64> {
+        let Move { block, range, axes, start, end } = *step;
+        let mut letters: Vec<u8> = axes.iter().map(|word| word.letter).collect();
+        letters.dedup();
+        if letters.len() < 2 {
+            let message = "an arc needs both coordinates of its plane, even when the end point equals the start";
+            self.findings.push(Finding { range, message: message.to_owned(), fatal: false });
+            return None;
+        }
+        // The plane's first axis is the one I measures along: X of XY, Y of
+        // YZ, Z of ZX (01 §6.4).
+        let (first, second) = plane(letters[0], letters[1]);
+        let (a, b) = (usize::from(first - b'A'), usize::from(second - b'A'));
+        let centre_offset = |letter: u8| block.word(letter).and_then(|word| self.number(word)).unwrap_or(0.0);
+        let from = Vector2::new(start[a], start[b]);
+        let to = Vector2::new(end[a], end[b]);
+        let centre = from + Vector2::new(centre_offset(b'I'), centre_offset(b'J'));
+        let (radius, end_radius) = ((from - centre).norm(), (to - centre).norm());
+        if (radius - end_radius).abs() > ARC_TOLERANCE {
+            let message = format!(
+                "the end point does not lie on the circle: {} mm from the centre, the start {} mm (error 7.56)",
+                round3(end_radius),
+                round3(radius)
+            );
+            self.findings.push(Finding { range, message, fatal: false });
+            return None;
+        }
+        let angle_of = |point: Vector2<f64>| (point.y - centre.y).atan2(point.x - centre.x);
+        let counter_clockwise = self.motion == 3;
+        let mut sweep = angle_of(to) - angle_of(from);
+        if counter_clockwise && sweep <= 0.0 {
+            sweep += std::f64::consts::TAU;
+        } else if !counter_clockwise && sweep >= 0.0 {
+            sweep -= std::f64::consts::TAU;
+        }
+        let arc = radius * sweep.abs();
+        // A third axis written in the block moves along with the arc.
+        let lead: f64 =
+            letters[2..].iter().map(|&l| (end[usize::from(l - b'A')] - start[usize::from(l - b'A')]).powi(2)).sum();
+        Some((arc * arc + lead).sqrt())
+    }
+
+    /// F in mm/min (per minute) or mm/rev (per revolution): without a
+    /// decimal point mm/min or µm/rev, with one m/min or mm/rev (01 §6.6);
+    /// from a parameter, its raw value as the digits written.
+    fn feed_value(&self, word: &Word) -> Option<f64> {
+        match &word.value {
+            Some(Value::Literal(decimal)) => {
+                let value = decimal.to_f64();
+                Some(match (decimal.has_point(), self.per_revolution) {
+                    (false, false) | (true, true) => value,
+                    (true, false) => value * 1000.0,
+                    (false, true) => value / 1000.0,
+                })
+            }
+            value => self.raw(value.as_ref()?).map(|raw| raw as f64 / if self.per_revolution { 1000.0 } else { 1.0 }),
+        }
+    }
+
+    /// A dimensional word's value: the literal as written (mm), or a
+    /// parameter's raw thousandths.
+    fn number(&self, word: &Word) -> Option<f64> {
+        match word.value.as_ref()? {
+            Value::Literal(decimal) => Some(decimal.to_f64()),
+            value => self.raw(value).map(|raw| raw as f64 / 1000.0),
+        }
+    }
+
+    /// A dimensionless word's whole number (codes, T): the literal, or a
+    /// parameter's raw digits.
+    fn integer(&self, word: &Word) -> Option<u32> {
+        match word.value.as_ref()? {
+            Value::Literal(decimal) if !decimal.has_point() => u32::try_from(decimal.scaled(0)?).ok(),
+            Value::Literal(_) => None,
+            value => u32::try_from(self.raw(value)?).ok(),
+        }
+    }
+
+    /// The raw value a parameter reference reads, sign applied.
+    fn raw(&self, value: &Value) -> Option<Raw> {
+        match value {
+            Value::Parameter { negative, index: Some(index), .. } => {
+                let raw = self.params.get(*index as usize)?;
+                Some(if *negative { -raw } else { raw })
+            }
+            _ => None,
+        }
+    }
+
+    fn not_run(&mut self, what: &str, range: TextRange) {
+        if !self.reported.iter().any(|done| done == what) {
+            self.reported.push(what.to_owned());
+            let message = format!("the executor does not run {what} yet: the time leaves them out");
+            self.findings.push(Finding { range, message, fatal: false });
+        }
+    }
+}
+
+/// A block's move from `start` to `end`, by the axis words `axes`.
+#[derive(Clone, Copy)]
+struct Move<'b> {
+    block: &'b BlockData,
+    range: TextRange,
+    axes: &'b [&'b Word],
+    start: Position,
+    end: Position,
+}
+
+/// The plane of two axes in the order I/J measure along them.
+fn plane(one: u8, other: u8) -> (u8, u8) {
+    match (one, other) {
+        (b'X', b'Z') | (b'Z', b'X') => (b'Z', b'X'),
+        (b'Z', b'Y') => (b'Y', b'Z'),
+        (b'Y', b'X') => (b'X', b'Y'),
+        pair => pair,
+    }
+}
+
+fn round3(value: f64) -> f64 {
+    (value * 1000.0).round() / 1000.0
+}
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::PI;
+
+    use ncc_syntax::{Dialect, Parse};
+
+    use super::{Motion, Trace, run};
+    use crate::machine::MachineConfig;
+
+    fn run_text(text: &str) -> Trace {
+        run(&Parse::new(text, Dialect::Cnc8x6), &MachineConfig::default())
+    }
+
+    /// Durations (s) and lengths (mm) of the blocks, rounded to a
+    /// microsecond and a micrometre.
+    fn timing(trace: &Trace) -> Vec<(f64, f64)> {
+        let round = |v: f64| (v * 1e6).round() / 1e6;
+        trace.steps.iter().map(|step| (round(step.duration), round(step.length))).collect()
+    }
+
+    fn close(actual: f64, expected: f64) {
+        assert!((actual - expected).abs() < 1e-9, "{actual} != {expected}");
+    }
+
+    #[test]
+    fn rapid_and_linear_moves_take_length_over_rate() {
+        let trace = run_text("%1\nN1 G00 X100 Y0\nN2 G01 X100 Y100 F600\nN3 X0 Y100 F1.2\nN4 M30\n");
+        // Rapid: the longest axis travel over 10,000 mm/min; F600 is mm/min;
+        // F1.2 (with a point) is m/min.
+        assert_eq!(timing(&trace), [(0.6, 100.0), (10.0, 100.0), (5.0, 100.0), (0.0, 0.0)]);
+        assert_eq!(trace.steps[1].feed, Some(600.0));
+        assert_eq!(trace.steps[2].feed, Some(1200.0));
+        close(trace.total_time(), 15.6);
+        close(trace.time_in(Motion::Rapid), 0.6);
+        close(trace.length_in(Motion::Feed), 200.0);
+        let end = trace.end_position();
+        assert_eq!([b'X', b'Y', b'Z'].map(|axis| end[usize::from(axis - b'A')]), [0.0, 100.0, 0.0]);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    }
+
+    #[test]
+    fn feed_per_revolution_follows_the_spindle() {
+        // F200 under G95 is 200 µm/rev, F0.5 is 0.5 mm/rev; at S500 that is
+        // 100 and 250 mm/min.
+        let trace = run_text("%1\nN1 G95 S500 G01 X10 F200\nN2 X20 F0.5\nN3 M30\n");
+        assert_eq!(timing(&trace)[..2], [(6.0, 10.0), (2.4, 10.0)]);
+        assert_eq!(trace.steps[1].feed, Some(250.0));
+    }
+
+    #[test]
+    fn incremental_moves_add_to_the_position() {
+        let trace = run_text("%1\nN1 G91 G01 X10 Y10 F600\nN2 X10\nN3 G90 X0\nN4 M30\n");
+        let x: Vec<f64> = trace.steps.iter().map(|step| step.end[usize::from(b'X' - b'A')]).collect();
+        assert_eq!(x, [10.0, 20.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn arcs_run_the_way_their_code_turns() {
+        let r = 10.0;
+        // From (10,0) about the origin to (0,10): a quarter counter-clockwise,
+        // three quarters clockwise; back to the start is a full circle.
+        let trace = run_text(
+            "%1\nN1 G00 X10 Y0\nN2 G03 X0 Y10 I-10 F600\nN3 G00 X10 Y0\nN4 G02 X0 Y10 I-10\nN5 G00 X10 Y0\nN6 G02 X10 Y0 I-10\nN7 M30\n",
+        );
+        let lengths: Vec<f64> = trace.steps.iter().map(|step| step.length).collect();
+        close(lengths[1], PI * r / 2.0);
+        close(lengths[3], 3.0 * PI * r / 2.0);
+        close(lengths[5], 2.0 * PI * r);
+        close(trace.steps[5].duration, 2.0 * PI * r / 600.0 * 60.0);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    }
+
+    #[test]
+    fn in_the_zx_plane_i_measures_along_z() {
+        // The manual's example 7b: from Z500 to Z100 about Z300, radius 200.
+        let trace = run_text("%1\nN1 G00 X100 Z500\nN2 G03 G90 X100.0 Z100.0 I-200.0 F1000\nN3 M30\n");
+        close(trace.steps[1].length, PI * 200.0);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    }
+
+    #[test]
+    fn a_helix_adds_its_lead() {
+        let trace = run_text("%1\nN1 G00 X10 Y0 Z0\nN2 G03 X10 Y0 Z5 I-10 F600\nN3 M30\n");
+        close(trace.steps[1].length, ((2.0 * PI * 10.0f64).powi(2) + 25.0).sqrt());
+    }
+
+    #[test]
+    fn bad_arcs_and_missing_feed_are_reported_where_they_are() {
+        let text = "%1\nN1 G01 X10\nN2 G02 X20 Y0 I3 F100\nN3 G02 X5\nN4 M30\n";
+        let trace = run_text(text);
+        let found: Vec<(&str, &str)> =
+            trace.findings.iter().map(|f| (&text[f.range], f.message.split(':').next().unwrap_or(""))).collect();
+        assert_eq!(
+            found,
+            [
+                ("N1 G01 X10\n", "no feed F programmed before this motion"),
+                ("N2 G02 X20 Y0 I3 F100\n", "the end point does not lie on the circle"),
+                ("N3 G02 X5\n", "an arc needs both coordinates of its plane, even when the end point equals the start"),
+            ]
+        );
+        assert!(trace.steps[..3].iter().all(|step| step.duration == 0.0));
+    }
+
+    #[test]
+    fn dwell_is_q_times_ten_milliseconds() {
+        let trace = run_text("%1\nN1 G04 Q150\nN2 M30\n");
+        assert_eq!(trace.steps[0].motion, Motion::Dwell);
+        close(trace.time_in(Motion::Dwell), 1.5);
+    }
+
+    #[test]
+    fn a_block_moves_with_the_parameters_from_before_its_assignments() {
+        // R1=20000 is 20 mm (thousandths); the block that assigns 50 mm
+        // still moves with 20.
+        let trace = run_text("%1\nN1 R1=20000\nN2 G01 XR1 F1200\nN3 R1=50000 G01 X-R1\nN4 XR1\nN5 M30\n");
+        let x: Vec<f64> = trace.steps.iter().map(|step| step.end[usize::from(b'X' - b'A')]).collect();
+        assert_eq!(x, [0.0, 20.0, -20.0, 50.0, 50.0]);
+        close(trace.steps[1].duration, 1.0);
+    }
+
+    #[test]
+    fn the_program_ends_at_m30_and_unmodelled_work_is_named_once() {
+        let trace = run_text("%1\nN1 G41 X1 F100\nN2 G42 X2\nN3 M30\nN4 G00 X500\n");
+        assert_eq!(trace.steps.len(), 3);
+        let messages: Vec<&str> = trace.findings.iter().map(|f| f.message.as_str()).collect();
+        assert_eq!(messages, ["the executor does not run radius compensation (G41/G42) yet: the time leaves them out"]);
+    }
+}
