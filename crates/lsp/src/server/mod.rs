@@ -281,23 +281,17 @@ impl Server {
     }
 }
 
-/// Puts the calling thread in the idle scheduling class: the flow walk and
-/// the state preparation take hundreds of milliseconds on a large program,
-/// and edits and hovers must not wait for a core behind them. (A thread
-/// waking in the normal class takes the core from an idle-class one at
-/// once; a merely niced one keeps it until the scheduler's next tick.)
+/// Lowers the calling thread's priority (nice 10): the flow walk and the
+/// state preparation take hundreds of milliseconds on a large program, and
+/// edits and hovers must not wait for a core behind them. Not the idle
+/// scheduling class: on a busy machine (a build running) that starves the
+/// walk, and the complete diagnostics would not come until the machine is
+/// idle.
 fn background_priority() {
-    // Failing leaves the thread as it was.
+    // On Linux the "process" priority is the calling thread's. Failing
+    // leaves the thread as it was.
     #[cfg(target_os = "linux")]
-    {
-        use thread_priority::{NormalThreadSchedulePolicy, ThreadPriority, ThreadSchedulePolicy};
-        let idle = ThreadSchedulePolicy::Normal(NormalThreadSchedulePolicy::Idle);
-        let _ = thread_priority::set_thread_priority_and_policy(
-            thread_priority::thread_native_id(),
-            ThreadPriority::Min,
-            idle,
-        );
-    }
+    let _ = rustix::process::setpriority_process(None, 10);
 }
 
 /// A panic while holding the lock leaves consistent data (edits are
