@@ -405,3 +405,15 @@ fn run_prints_the_time_and_a_record_per_block() {
     assert_eq!(blocks[1]["end"]["program"]["Y"], 100.0);
     assert_eq!(blocks[1]["end"]["machine"]["Y"], 100.0);
 }
+
+/// A run that stops on an error says where, and exits with 1.
+#[test]
+fn run_stops_on_a_call_to_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("CALL.NCP");
+    std::fs::write(&program, "%1\nN1 G00 X10\nN2 G71 L9\nN3 M30\n").unwrap();
+    let output = ncc(&["run", program.to_str().unwrap(), "--step-budget", "100"]);
+    assert_eq!(output.status.code(), Some(1));
+    let stderr = String::from_utf8(output.stderr).unwrap();
+    assert!(stderr.ends_with("CALL.NCP:3: there is no subprogram L9 (G79 L9) in this file\n"), "{stderr}");
+}

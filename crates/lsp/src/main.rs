@@ -78,14 +78,19 @@ enum Command {
     /// The summary splits the time into cutting, rapid and dwell, with the
     /// path lengths, the tools used and the end position. So far the
     /// executor runs motion (G00–G03, helices), G90/G91, feed units, S,
-    /// dwell, parameter assignments and the program end; anything else it
-    /// names as not run yet.
+    /// dwell, parameter assignments, subprogram calls, jumps and the
+    /// program end; anything else it names as not run yet. Exit status 1
+    /// when the run stopped on an error.
     Run {
         /// The program to run.
         file: PathBuf,
         /// Output format: `json` adds a record per block.
         #[arg(long, value_enum, default_value_t = run::Format::Human)]
         format: run::Format,
+        /// Stop after running this many blocks (a jump loop that never
+        /// ends, runaway calls).
+        #[arg(long, default_value_t = nc_exec::run::DEFAULT_STEP_BUDGET)]
+        step_budget: usize,
     },
     /// Print the syntax tree of a partprogram (a debugging aid).
     Parse {
@@ -104,7 +109,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Command::Lsp { log_level, .. } => server::run(log_level),
-        Command::Run { file, format } => run::run(&file, format),
+        Command::Run { file, format, step_budget } => run::run(&file, format, step_budget),
         Command::Parse { file } => match check::read_program(&file) {
             Ok(text) => {
                 let parse = ncc_syntax::Parse::new(&text, ncc_syntax::Dialect::Cnc8x6);

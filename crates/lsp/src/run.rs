@@ -18,7 +18,7 @@ pub(crate) enum Format {
     Json,
 }
 
-pub(crate) fn run(path: &Path, format: Format) -> ExitCode {
+pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
     let text = match check::read_program(path) {
         Ok(text) => text,
         Err(error) => {
@@ -34,7 +34,7 @@ pub(crate) fn run(path: &Path, format: Format) -> ExitCode {
         }
     };
     let parse = ncc_syntax::Parse::new(&text, ncc_syntax::Dialect::Cnc8x6);
-    let trace = nc_exec::run::run(&parse, &config.machine);
+    let trace = nc_exec::run::run(&parse, &config.machine, step_budget);
     let lines = LineIndex::new(&text);
     let line = |offset| lines.line_col(offset).line + 1;
     let axes = &config.machine.axes;
@@ -71,6 +71,7 @@ pub(crate) fn run(path: &Path, format: Format) -> ExitCode {
                 "findings": trace.findings.iter().map(|finding| json!({
                     "line": line(finding.range.start()),
                     "message": finding.message,
+                    "stopped": finding.fatal,
                 })).collect::<Vec<Value>>(),
             });
             println!("{output:#}");

@@ -1,19 +1,22 @@
-//! Running the main body of a CNC8x6 program: the modal state, motion and
-//! time, block by block.
+//! Running a CNC8x6 program: the modal state, motion and time, block by
+//! block, in the order the control runs them.
 //!
-//! What runs so far: rapid and linear motion (G00, G01), arcs and helices
+//! What runs so far: the program's flow (subprogram calls G71 L Q with
+//! their repetitions, jumps G73 L Q that run a section Q+1 times, G04 taking
+//! Q from a call in its block, M02/M30, a step budget against endless
+//! loops), rapid and linear motion (G00, G01), arcs and helices
 //! (G02, G03) with the centre from I/J/K and the plane from the two axes
 //! written (01 §6.4), absolute and incremental dimensions (G90, G91), feed
 //! per minute and per revolution with the decimal-point rules of F (G94,
 //! G95), the spindle speed S, dwell (G04 Q, in 10 ms), parameter
 //! assignments and references (a block's motion uses the values from before
-//! its own assignments), and the ends M02/M30. A block's time is its path
+//! its own assignments). A block's time is its path
 //! length over its feed (G00: the longest axis travel over the machine's
 //! rapid rate), plus dwells; ramps and block joining are the velocity
 //! model's business.
 //!
 //! Everything else the control does is reported once per kind as not run
-//! yet (calls, jumps, parameter arithmetic, offsets, compensation, fixed
+//! yet (macrocycles, parameter arithmetic, offsets, compensation, fixed
 //! cycles, transformations, threads), so that a total never silently leaves
 //! something out.
 
@@ -100,25 +103,177 @@ impl Trace {
     }
 }
 
-/// Runs the main body of a CNC8x6 program (blocks up to M02/M30) on
-/// `machine`. Parameters start at zero.
-pub fn run(parse: &Parse, machine: &MachineConfig) -> Trace {
+/// How many blocks a run executes at most before it stops: a jump loop
+/// that never ends or runaway recursion stops here with a finding.
+pub const DEFAULT_STEP_BUDGET: usize = 10_000_000;
+
+/// How deep subprogram calls nest before the run stops.
+const MAX_CALL_DEPTH: usize = 64;
+
+/// Runs a CNC8x6 program from its first block to M02/M30 on `machine`,
+/// following subprogram calls and jumps, for at most `budget` blocks.
+/// Parameters start at zero.
+pub fn run(parse: &Parse, machine: &MachineConfig, budget: usize) -> Trace {
+    let blocks: Vec<(TextRange, BlockData)> = parse
+        .tree()
+        .blocks()
+        .map(|block| (block.syntax().text_range(), BlockData::lower(block.syntax().green())))
+        .collect();
+    let units = Units::of(&blocks);
     let mut runner = Runner::new(machine);
-    for block in parse.tree().blocks() {
-        let node = block.syntax();
-        let data = BlockData::lower(node.green());
-        if runner.block(&data, node.text_range()) == Flow::End {
+    // Calls being run: where to return, how many runs remain, where the
+    // subprogram starts.
+    let mut calls: Vec<Call> = Vec::new();
+    // Jumps taken so far from each jump block, until its count runs out.
+    let mut jumps: std::collections::HashMap<usize, u32> = Default::default();
+    let mut at = 0;
+    let mut executed = 0;
+    while let Some((range, block)) = blocks.get(at) {
+        let range = *range;
+        if units.starts_subprogram(at) && calls.is_empty() {
+            runner.finding(range, "the main body runs into a subprogram: it has no M02 or M30 before it", false);
             break;
         }
+        executed += 1;
+        if executed > budget {
+            let message = format!("stopped after {budget} blocks: a jump loop that never ends or runaway calls?");
+            runner.finding(range, &message, true);
+            break;
+        }
+        let next = at + 1;
+        at = match runner.block(block, range) {
+            Flow::End => break,
+            Flow::Next => next,
+            Flow::Return => match calls.last_mut() {
+                Some(call) if call.remaining > 1 => {
+                    call.remaining -= 1;
+                    call.start
+                }
+                Some(_) => calls.pop().map_or(next, |call| call.back),
+                None => next,
+            },
+            Flow::Call { label, times } => match units.subprogram(label) {
+                Some(start) if calls.len() < MAX_CALL_DEPTH => {
+                    calls.push(Call { back: next, remaining: times, start });
+                    start
+                }
+                Some(_) => {
+                    runner.finding(
+                        range,
+                        &format!("calls nest deeper than {MAX_CALL_DEPTH}: runaway recursion?"),
+                        true,
+                    );
+                    break;
+                }
+                None => {
+                    runner.finding(
+                        range,
+                        &format!("there is no subprogram L{label} (G79 L{label}) in this file"),
+                        true,
+                    );
+                    break;
+                }
+            },
+            Flow::Jump { label, times } => match units.jump_target(at, label) {
+                Some(target) => {
+                    let taken = jumps.entry(at).or_default();
+                    if *taken < times {
+                        *taken += 1;
+                        target
+                    } else {
+                        // The count starts again when the section is reached anew.
+                        jumps.remove(&at);
+                        next
+                    }
+                }
+                None => {
+                    runner.finding(range, &format!("no block N{label} in this program unit to jump to"), true);
+                    break;
+                }
+            },
+        };
     }
     Trace { steps: runner.steps, findings: runner.findings, tools: runner.tools }
 }
 
-/// Whether a later block still runs.
+/// A subprogram call being run.
+struct Call {
+    /// The block after the call.
+    back: usize,
+    /// Runs left, this one included.
+    remaining: u32,
+    /// The subprogram's first block after its `G79`.
+    start: usize,
+}
+
+/// Where the subprograms start, and the block numbers of each unit.
+struct Units {
+    /// Subprogram starts (`G79 L`): the block index and the label.
+    starts: Vec<(usize, u32)>,
+    /// The unit of each block (0: the main body, then each subprogram).
+    unit_of: Vec<usize>,
+    /// Block numbers with their block, sorted.
+    numbers: Vec<(u64, usize)>,
+}
+
+impl Units {
+    fn of(blocks: &[(TextRange, BlockData)]) -> Units {
+        let label = |block: &BlockData| match block.word(b'L')?.value.as_ref()? {
+            Value::Literal(decimal) => u32::try_from(decimal.scaled(0)?).ok(),
+            Value::Parameter { .. } => None,
+        };
+        let (mut starts, mut unit_of, mut unit) = (Vec::new(), Vec::with_capacity(blocks.len()), 0);
+        for (index, (_, block)) in blocks.iter().enumerate() {
+            if block.has_code(b'G', 79) {
+                unit += 1;
+                starts.extend(label(block).map(|label| (index, label)));
+            }
+            unit_of.push(unit);
+        }
+        let mut numbers: Vec<(u64, usize)> =
+            blocks.iter().enumerate().filter_map(|(index, (_, block))| Some((block.number?.value?, index))).collect();
+        numbers.sort_unstable();
+        Units { starts, unit_of, numbers }
+    }
+
+    fn starts_subprogram(&self, index: usize) -> bool {
+        self.starts.iter().any(|&(at, _)| at == index)
+    }
+
+    /// The first block of subprogram `label`, after its `G79`.
+    fn subprogram(&self, label: u32) -> Option<usize> {
+        self.starts.iter().find(|&&(_, l)| l == label).map(|&(at, _)| at + 1)
+    }
+
+    /// The block numbered `label` in the unit of block `from`.
+    fn jump_target(&self, from: usize, label: u32) -> Option<usize> {
+        let (unit, label) = (self.unit_of[from], u64::from(label));
+        let first = self.numbers.partition_point(|&(number, _)| number < label);
+        self.numbers[first..]
+            .iter()
+            .take_while(|&&(number, _)| number == label)
+            .map(|&(_, at)| at)
+            .find(|&at| self.unit_of[at] == unit)
+    }
+}
+
+/// What runs after a block.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Flow {
-    Continue,
+    Next,
     End,
+    /// `G70`: back from a subprogram.
+    Return,
+    /// `G71 L`: run subprogram `label` `times` times.
+    Call {
+        label: u32,
+        times: u32,
+    },
+    /// `G73 L Q`: jump to block N`label`, `times` times in all.
+    Jump {
+        label: u32,
+        times: u32,
+    },
 }
 
 /// The control's state while a program runs.
@@ -186,8 +341,10 @@ impl<'a> Runner<'a> {
                 // Planes, block joining, cancelling and the priority
                 // codes change nothing the executor models yet.
                 (b'G', 4 | 17..=19 | 23 | 24 | 40 | 53 | 78 | 80 | 98) | (b'M', _) => {}
+                // Program flow, which the caller follows.
+                (b'G', 70 | 71 | 73 | 79) => {}
                 (b'G', 26..=29) => self.not_run("parameter arithmetic (G26–G29)", code_range),
-                (b'G', 71..=73) => self.not_run("subprogram calls, macrocycles and jumps (G71–G73)", code_range),
+                (b'G', 72) => self.not_run("macrocycle calls (G72)", code_range),
                 (b'G', 41 | 42) => self.not_run("radius compensation (G41/G42)", code_range),
                 (b'G', 33) => self.not_run("thread cutting (G33)", code_range),
                 (b'G', 81..=89) => self.not_run("fixed cycles (G81–G89)", code_range),
@@ -254,7 +411,23 @@ impl<'a> Runner<'a> {
             };
             self.params.set(index as usize, raw);
         }
-        if has(b'M', 2) || has(b'M', 30) { Flow::End } else { Flow::Continue }
+        if has(b'M', 2) || has(b'M', 30) {
+            return Flow::End;
+        }
+        // The call or jump comes at the end of the block; with G04, Q is
+        // the dwell and the call runs once (01 §4.8).
+        let label = block.word(b'L').and_then(|word| self.integer(word));
+        let count = block.word(b'Q').filter(|_| !has(b'G', 4)).and_then(|word| self.integer(word));
+        match label {
+            Some(label) if has(b'G', 71) => Flow::Call { label, times: count.unwrap_or(1).max(1) },
+            Some(label) if has(b'G', 73) => Flow::Jump { label, times: count.unwrap_or(1) },
+            _ if has(b'G', 70) => Flow::Return,
+            _ => Flow::Next,
+        }
+    }
+
+    fn finding(&mut self, range: TextRange, message: &str, fatal: bool) {
+        self.findings.push(Finding { range, message: message.to_owned(), fatal });
     }
 
     /// Length, duration and feed of a block's move.
@@ -426,7 +599,7 @@ mod tests {
     use crate::machine::MachineConfig;
 
     fn run_text(text: &str) -> Trace {
-        run(&Parse::new(text, Dialect::Cnc8x6), &MachineConfig::default())
+        run(&Parse::new(text, Dialect::Cnc8x6), &MachineConfig::default(), 1000)
     }
 
     /// Durations (s) and lengths (mm) of the blocks, rounded to a
@@ -534,6 +707,75 @@ mod tests {
         let x: Vec<f64> = trace.steps.iter().map(|step| step.end[usize::from(b'X' - b'A')]).collect();
         assert_eq!(x, [0.0, 20.0, -20.0, 50.0, 50.0]);
         close(trace.steps[1].duration, 1.0);
+    }
+
+    /// The block lines each step ran, in order.
+    fn lines_run(text: &str, trace: &Trace) -> Vec<String> {
+        trace.steps.iter().map(|step| text[step.range].trim_end().to_owned()).collect()
+    }
+
+    #[test]
+    fn a_subprogram_runs_q_times_and_returns_after_the_call() {
+        let text = "%1\nN1 G71 L7 Q2 F600\nN2 G00 X0\nN3 M30\nN10 G79 L7\nN11 G91 G01 X10\nN12 G90 G70\n*\n";
+        let trace = run_text(text);
+        assert_eq!(
+            lines_run(text, &trace),
+            [
+                "N1 G71 L7 Q2 F600",
+                "N11 G91 G01 X10",
+                "N12 G90 G70",
+                "N11 G91 G01 X10",
+                "N12 G90 G70",
+                "N2 G00 X0",
+                "N3 M30"
+            ]
+        );
+        // The subprogram's modal G01 and F carry on after it.
+        close(trace.time_in(Motion::Feed), 2.0);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    }
+
+    #[test]
+    fn a_jump_with_q_runs_the_section_q_plus_one_times() {
+        // The manual's example: N26…N54 with `G73 L26 Q3` runs four times.
+        let text = "%1\nN25 G91 F600\nN26 G01 X1\nN54 G73 L26 Q3\nN55 M30\n";
+        let trace = run_text(text);
+        assert_eq!(trace.steps.iter().filter(|step| &text[step.range] == "N26 G01 X1\n").count(), 4);
+        assert_eq!(trace.end_position()[usize::from(b'X' - b'A')], 4.0);
+        // Nested in a subprogram called twice, the count starts again.
+        let text = "%1\nN1 G71 L1 Q2 G91 F600\nN2 M30\nN3 G79 L1\nN4 G01 X1\nN5 G73 L4 Q1\nN6 G70\n";
+        assert_eq!(run_text(text).end_position()[usize::from(b'X' - b'A')], 4.0);
+    }
+
+    #[test]
+    fn dwell_takes_q_and_the_call_runs_once() {
+        let text = "%1\nN1 G04 G71 L5 Q200\nN2 M30\nN3 G79 L5\nN4 G01 X1 F60\nN5 G70\n";
+        let trace = run_text(text);
+        close(trace.time_in(Motion::Dwell), 2.0);
+        close(trace.time_in(Motion::Feed), 1.0);
+    }
+
+    #[test]
+    fn endless_loops_and_missing_targets_stop_the_run_where_they_are() {
+        let text = "%1\nN1 G71 L1\nN2 M30\nN3 G79 L1\nN4 G71 L1\nN5 G70\n";
+        let trace = run_text(text);
+        let fatal: Vec<(&str, &str)> =
+            trace.findings.iter().filter(|f| f.fatal).map(|f| (text[f.range].trim_end(), f.message.as_str())).collect();
+        assert_eq!(fatal, [("N4 G71 L1", "calls nest deeper than 64: runaway recursion?")]);
+
+        let text = "%1\nN1 G73 L1 Q9999\nN2 M30\n";
+        let trace = run(&Parse::new(text, Dialect::Cnc8x6), &MachineConfig::default(), 500);
+        assert_eq!(trace.steps.len(), 500);
+        assert!(trace.findings[0].message.starts_with("stopped after 500 blocks"), "{:?}", trace.findings);
+
+        for (text, message) in [
+            ("%1\nN1 G71 L9\nN2 M30\n", "there is no subprogram L9 (G79 L9) in this file"),
+            ("%1\nN1 G73 L5\nN2 M30\nN3 G79 L1\nN5 G70\n", "no block N5 in this program unit to jump to"),
+            ("%1\nN1 X1\nN3 G79 L1\nN5 G70\n", "the main body runs into a subprogram: it has no M02 or M30 before it"),
+        ] {
+            let trace = run_text(text);
+            assert_eq!(trace.findings.last().map(|f| f.message.as_str()), Some(message), "{text}");
+        }
     }
 
     #[test]
