@@ -509,7 +509,7 @@ fn lsp_benchmark(server: &std::path::Path, blocks: usize, edits: usize, as_json:
             "edit_to_diagnostics": diagnostics.json(),
             "hover": hovers.json(),
             "hover_after_pause": idle_hovers.json(),
-            "thread_wake_up_round_trip": machine.json(),
+            "thread_wake_up": machine.json(),
             "cpu_time_stolen": stolen,
             "empty_hovers": empty_hovers,
             "peak_rss_bytes": memory.map(|m| m.peak_rss),
