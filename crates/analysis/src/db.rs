@@ -87,27 +87,30 @@ pub struct BlockChunk<'db> {
 }
 
 impl<'db> BlockChunk<'db> {
+    /// The chunk's run node, when it is a run rather than a lone block.
+    fn run(self, db: &'db dyn Db) -> Option<&'db rowan::GreenNodeData> {
+        let node: &'db rowan::GreenNodeData = &self.green(db).0;
+        (node.kind() == SyntaxKind::BLOCK_RUN.into()).then_some(node)
+    }
+
     /// The chunk's blocks, in order.
     pub fn blocks(self, db: &'db dyn Db) -> impl Iterator<Item = &'db rowan::GreenNodeData> + 'db {
-        let node: &'db rowan::GreenNodeData = &self.green(db).0;
-        let run = node.kind() == SyntaxKind::BLOCK_RUN.into();
-        let in_run = run.then(|| node.children().filter_map(rowan::NodeOrToken::into_node)).into_iter().flatten();
-        (!run).then_some(node).into_iter().chain(in_run)
+        let run = self.run(db);
+        let lone = run.is_none().then(|| &*self.green(db).0);
+        let in_run = run.map(|run| run.children().filter_map(rowan::NodeOrToken::into_node)).into_iter().flatten();
+        lone.into_iter().chain(in_run)
     }
 
     /// Block `at` of the chunk.
     pub fn block(self, db: &'db dyn Db, at: usize) -> Option<&'db rowan::GreenNodeData> {
-        let node: &'db rowan::GreenNodeData = &self.green(db).0;
-        if node.kind() == SyntaxKind::BLOCK_RUN.into() {
-            node.children().nth(at)?.into_node()
-        } else {
-            (at == 0).then_some(node)
+        match self.run(db) {
+            Some(run) => run.children().nth(at)?.into_node(),
+            None => (at == 0).then(|| &*self.green(db).0),
         }
     }
 
     pub fn len(self, db: &'db dyn Db) -> usize {
-        let node = &self.green(db).0;
-        if node.kind() == SyntaxKind::BLOCK_RUN.into() { node.children().len() } else { 1 }
+        self.run(db).map_or(1, |run| run.children().len())
     }
 }
 

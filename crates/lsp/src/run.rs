@@ -51,7 +51,9 @@ pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
                 "rapid_length_mm": trace.length_in(Motion::Rapid),
                 "tools": trace.tools,
                 "end_position": position_json(&trace.end_position(), axes),
-                "blocks": trace.steps.iter().map(|step| json!({
+                "blocks": trace.steps.iter().map(|step| {
+                    let (start, end) = (position_json(&step.start, axes), position_json(&step.end, axes));
+                    json!({
                     "line": line(step.range.start()),
                     "motion": match step.motion {
                         Motion::None => "none",
@@ -65,9 +67,9 @@ pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
                     "feed_mm_min": step.feed,
                     // Program and machine coordinates coincide until the
                     // executor runs zero offsets.
-                    "start": { "program": position_json(&step.start, axes), "machine": position_json(&step.start, axes) },
-                    "end": { "program": position_json(&step.end, axes), "machine": position_json(&step.end, axes) },
-                })).collect::<Vec<Value>>(),
+                    "start": { "program": start.clone(), "machine": start },
+                    "end": { "program": end.clone(), "machine": end },
+                })}).collect::<Vec<Value>>(),
                 "findings": trace.findings.iter().map(|finding| json!({
                     "line": line(finding.range.start()),
                     "message": finding.message,

@@ -219,7 +219,7 @@ struct Units {
 impl Units {
     fn of(blocks: &[(TextRange, BlockData)]) -> Units {
         let label = |block: &BlockData| match block.word(b'L')?.value.as_ref()? {
-            Value::Literal(decimal) => u32::try_from(decimal.scaled(0)?).ok(),
+            Value::Literal(decimal) => whole_number(decimal),
             Value::Parameter { .. } => None,
         };
         let (mut starts, mut unit_of, mut unit) = (Vec::new(), Vec::with_capacity(blocks.len()), 0);
@@ -459,7 +459,7 @@ impl<'a> Runner<'a> {
                 } else {
                     "no feed F programmed before this motion: G01–G03 need one"
                 };
-                self.findings.push(Finding { range, message: why.to_owned(), fatal: false });
+                self.finding(range, why, false);
                 (Motion::Feed, length, 0.0, None)
             }
         }
@@ -473,7 +473,7 @@ impl<'a> Runner<'a> {
         letters.dedup();
         if letters.len() < 2 {
             let message = "an arc needs both coordinates of its plane, even when the end point equals the start";
-            self.findings.push(Finding { range, message: message.to_owned(), fatal: false });
+            self.finding(range, message, false);
             return None;
         }
         // The plane's first axis is the one I measures along: X of XY, Y of
@@ -491,7 +491,7 @@ impl<'a> Runner<'a> {
                 round3(end_radius),
                 round3(radius)
             );
-            self.findings.push(Finding { range, message, fatal: false });
+            self.finding(range, &message, false);
             return None;
         }
         let angle_of = |point: Vector2<f64>| (point.y - centre.y).atan2(point.x - centre.x);
@@ -539,8 +539,7 @@ impl<'a> Runner<'a> {
     /// parameter's raw digits.
     fn integer(&self, word: &Word) -> Option<u32> {
         match word.value.as_ref()? {
-            Value::Literal(decimal) if !decimal.has_point() => u32::try_from(decimal.scaled(0)?).ok(),
-            Value::Literal(_) => None,
+            Value::Literal(decimal) => whole_number(decimal),
             value => u32::try_from(self.raw(value)?).ok(),
         }
     }
@@ -559,8 +558,7 @@ impl<'a> Runner<'a> {
     fn not_run(&mut self, what: &str, range: TextRange) {
         if !self.reported.iter().any(|done| done == what) {
             self.reported.push(what.to_owned());
-            let message = format!("the executor does not run {what} yet: the time leaves them out");
-            self.findings.push(Finding { range, message, fatal: false });
+            self.finding(range, &format!("the executor does not run {what} yet: the time leaves them out"), false);
         }
     }
 }
@@ -583,6 +581,11 @@ fn plane(one: u8, other: u8) -> (u8, u8) {
         (b'Y', b'X') => (b'X', b'Y'),
         pair => pair,
     }
+}
+
+/// A dimensionless literal (a code, L, Q, T): written without a point.
+fn whole_number(decimal: &ncc_syntax::Decimal) -> Option<u32> {
+    if decimal.has_point() { None } else { u32::try_from(decimal.scaled(0)?).ok() }
 }
 
 fn round3(value: f64) -> f64 {

@@ -7,8 +7,8 @@
 //! `runs`), so only the touched runs and the root are rebuilt. Everything
 //! the edit could change beyond blocks (the header, the preamble, the
 //! physical end `*`, words before the first block) makes us return `None`
-//! and the caller parses the whole text again. A property test checks that the result always equals a
-//! full parse.
+//! and the caller parses the whole text again. A property test checks that
+//! the result always equals a full parse.
 
 use rowan::{NodeOrToken, TextRange, TextSize};
 
