@@ -15,7 +15,7 @@
 
 use std::{ops::Range, sync::Arc};
 
-use nc_exec::arith::{self, ArithConfig, ArithError, ControlWord, Parameters, Raw, UnknownMachine};
+use nc_exec::arith::{self, ArithError, BlockArithmetic, Parameters, Raw, UnknownMachine};
 use ncc_catalog::{AddressRole, Catalogue, Modality};
 use ncc_syntax::{Decimal, Sign, TextRange, TextSize};
 use rustc_hash::FxHashMap;
@@ -648,62 +648,36 @@ impl<'db> Walk<'db> {
 
     /// Applies the block's assignments and parameter arithmetic to `params`.
     fn assign(&self, block: &BlockData, offset: TextSize, params: &mut ParamState) -> Option<(TextRange, ArithError)> {
+        arith::assign(block, &mut params.values);
         for assignment in &block.assignments {
             let Some(index) = assignment.index.map(|i| i as usize).filter(|&i| i < arith::PARAMETER_COUNT) else {
                 continue;
             };
             let range = assignment.value_range.unwrap_or(assignment.range) + offset;
-            // Assigned even when the value is not known: it is no longer
-            // what an earlier program left.
-            let (value, origin) = match &assignment.value {
-                Some(Value::Literal(decimal)) => (
-                    crate::checks::block::parameter_raw(decimal),
-                    Origin { range, point: decimal.has_point(), computed: false },
-                ),
-                _ => (None, Origin { range, point: false, computed: false }),
-            };
-            params.values.set(index, value.filter(|raw| raw.abs() <= arith::MAX_RAW));
-            params.origins[index] = Some(origin);
+            let point = matches!(&assignment.value, Some(Value::Literal(decimal)) if decimal.has_point());
+            params.origins[index] = Some(Origin { range, point, computed: false });
         }
-        let function = block.codes(b'G').find(|(code, _)| (26..=29).contains(code));
-        let (code, word) = function?;
-        let count = (code - 25) as usize;
-        let range = word.range + offset;
-        let mut words = Vec::with_capacity(count);
-        for slot in 5..5 + count {
-            match params.values.get(slot).map(ControlWord::decode) {
-                Some(Ok(word)) => words.push(word),
-                Some(Err(error)) => return Some((range, error)),
-                None => {
-                    // An unknown control word may write any parameter.
-                    *params = ParamState::unknown();
-                    return None;
-                }
-            }
+        if !block.codes(b'G').any(|(code, _)| (26..=29).contains(&code)) {
+            return None;
         }
         let before = params.values.clone();
-        let r95 = params.values.get(95);
-        let config = ArithConfig { double_precision: double_precision(self.config, r95).unwrap_or(false) };
-        let result = arith::execute(&words, &mut params.values, &mut UnknownMachine, config);
-        let targets: Vec<usize> = words.iter().map(|word| usize::from(word.target)).collect();
-        for index in 0..arith::PARAMETER_COUNT {
-            if params.values.get(index) != before.get(index) || targets.contains(&index) {
-                params.origins[index] = Some(Origin { range, point: false, computed: true });
+        match arith::compute(block, &mut params.values, &mut UnknownMachine, &self.config.machine) {
+            BlockArithmetic::None => None,
+            BlockArithmetic::UnknownWord => {
+                *params = ParamState::unknown();
+                None
+            }
+            BlockArithmetic::Ran { function, words, result } => {
+                let range = function + offset;
+                let targets: Vec<usize> = words.iter().map(|word| usize::from(word.target)).collect();
+                for index in 0..arith::PARAMETER_COUNT {
+                    if params.values.get(index) != before.get(index) || targets.contains(&index) {
+                        params.origins[index] = Some(Origin { range, point: false, computed: true });
+                    }
+                }
+                result.err().map(|error| (range, error))
             }
         }
-        result.err().map(|(_, error)| (range, error))
-    }
-}
-
-/// Whether arithmetic reads fields 50–99 as double-precision pairs, per
-/// machine constant 283 decade 4 and, when that is 2, decade 1 of R95
-/// (`None`: not known).
-pub(crate) fn double_precision(config: &Config, r95: Option<Raw>) -> Option<bool> {
-    match config.machine.decade(283, 4) {
-        0 => Some(true),
-        1 => Some(false),
-        2 => r95.map(|r95| r95.rem_euclid(10) == 0),
-        _ => None,
     }
 }
 

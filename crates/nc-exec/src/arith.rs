@@ -63,6 +63,13 @@
 
 use std::fmt;
 
+use ncc_syntax::TextRange;
+
+use crate::{
+    lower::{BlockData, Value},
+    machine::MachineConfig,
+};
+
 /// A parameter value as the control stores it: a signed integer in thousandths.
 /// `R1=864` stores 864 (0.864 as a real value), `R1=864.` stores 864000.
 pub type Raw = i64;
@@ -435,6 +442,74 @@ pub fn execute(
         eval.params.join(&other);
     }
     Ok(())
+}
+
+/// What a block's G26–G29 did.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum BlockArithmetic {
+    /// The block has no G26–G29.
+    None,
+    /// A control word the block runs (R5–R8) is not known, so any
+    /// parameter may have changed.
+    UnknownWord,
+    /// The words ran; with `Err`, the one that failed (the words before it
+    /// kept their effects).
+    Ran {
+        /// The G26–G29 word, relative to the block.
+        function: TextRange,
+        words: Vec<ControlWord>,
+        result: Result<(), ArithError>,
+    },
+}
+
+/// Applies a block's `R=` assignments. A value that is not known (a
+/// parameter not known, or out of range) makes the parameter unknown: it
+/// no longer holds what it held before. The assignments run before the
+/// block's arithmetic and after its motion, which uses the values from
+/// before the block (02 §7.1).
+pub fn assign(block: &BlockData, params: &mut Parameters) {
+    for assignment in &block.assignments {
+        let Some(index) = assignment.index.map(|i| i as usize).filter(|&i| i < PARAMETER_COUNT) else { continue };
+        let value = match assignment.value.as_ref() {
+            Some(Value::Literal(decimal)) => literal_raw(decimal),
+            Some(value) => reference(value, params),
+            None => None,
+        };
+        params.set(index, value.filter(|raw| raw.abs() <= MAX_RAW));
+    }
+}
+
+/// The raw value a parameter reference (`R5`, `-R5`) reads, its sign
+/// applied; `None` for a literal or a parameter that is not known.
+pub fn reference(value: &Value, params: &Parameters) -> Option<Raw> {
+    let Value::Parameter { negative, index: Some(index), .. } = *value else { return None };
+    let raw = params.get(usize::try_from(index).ok().filter(|&i| i < PARAMETER_COUNT)?)?;
+    Some(if negative { -raw } else { raw })
+}
+
+/// Runs a block's G26–G29: 1–4 control words from the current R5–R8, in
+/// that order, after the block's assignments (02 §7.1).
+pub fn compute(
+    block: &BlockData,
+    params: &mut Parameters,
+    machine: &mut dyn Machine,
+    config: &MachineConfig,
+) -> BlockArithmetic {
+    let Some((code, word)) = block.codes(b'G').find(|(code, _)| (26..=29).contains(code)) else {
+        return BlockArithmetic::None;
+    };
+    let function = word.range;
+    let mut words = Vec::with_capacity(4);
+    for slot in 5..5 + (code - 25) as usize {
+        match params.get(slot).map(ControlWord::decode) {
+            Some(Ok(word)) => words.push(word),
+            Some(Err(error)) => return BlockArithmetic::Ran { function, words, result: Err(error) },
+            None => return BlockArithmetic::UnknownWord,
+        }
+    }
+    let double_precision = config.double_precision(params.get(95)).unwrap_or(false);
+    let result = execute(&words, params, machine, ArithConfig { double_precision }).map_err(|(_, error)| error);
+    BlockArithmetic::Ran { function, words, result }
 }
 
 /// How a sequence of words ended.

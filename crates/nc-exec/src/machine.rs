@@ -71,6 +71,18 @@ impl MachineConfig {
         Some(10u64.checked_pow(decade.saturating_sub(1)).map_or(0, |divisor| (raw / divisor % 10) as u8))
     }
 
+    /// Whether parameter arithmetic reads fields 50–99 as double-precision
+    /// pairs: machine constant 283 decade 4, and when that is 2, decade 1
+    /// of R95 (`r95`, raw) as the arithmetic starts (`None`: not known).
+    pub fn double_precision(&self, r95: Option<i64>) -> Option<bool> {
+        match self.decade(283, 4) {
+            0 => Some(true),
+            1 => Some(false),
+            2 => r95.map(|r95| r95.rem_euclid(10) == 0),
+            _ => None,
+        }
+    }
+
     /// Whether `letter` names a configured axis.
     pub fn is_axis(&self, letter: u8) -> bool {
         self.axes.contains(&letter.to_ascii_uppercase())

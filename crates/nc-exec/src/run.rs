@@ -9,14 +9,15 @@
 //! written (01 §6.4), absolute and incremental dimensions (G90, G91), feed
 //! per minute and per revolution with the decimal-point rules of F (G94,
 //! G95), the spindle speed S, dwell (G04 Q, in 10 ms), parameter
-//! assignments and references (a block's motion uses the values from before
-//! its own assignments). A block's time is its path
+//! assignments, arithmetic (G26–G29) and references (a block's motion uses
+//! the values from before its own assignments and arithmetic), and codes
+//! from parameters (`GR20`: 73 jumps, 78 does nothing). A block's time is its path
 //! length over its feed (G00: the longest axis travel over the machine's
 //! rapid rate), plus dwells; ramps and block joining are the velocity
 //! model's business.
 //!
 //! Everything else the control does is reported once per kind as not run
-//! yet (macrocycles, parameter arithmetic, offsets, compensation, fixed
+//! yet (macrocycles, offsets, compensation, fixed
 //! cycles, transformations, threads), so that a total never silently leaves
 //! something out.
 
@@ -25,7 +26,7 @@ use ncc_catalog::{AddressRole, Catalogue, Dialect};
 use ncc_syntax::{Parse, TextRange, ast::AstNode};
 
 use crate::{
-    arith::{self, Parameters, Raw},
+    arith::{self, BlockArithmetic, Machine, Message, Parameters, Raw},
     lower::{BlockData, Value, Word},
     machine::MachineConfig,
 };
@@ -143,7 +144,14 @@ pub fn run(parse: &Parse, machine: &MachineConfig, budget: usize) -> Trace {
         let next = at + 1;
         at = match runner.block(block, range) {
             Flow::End => break,
-            Flow::Next => next,
+            Flow::Next => {
+                // A jump block passed without jumping (`GRxx` read as G78)
+                // starts its count again next time.
+                if !jumps.is_empty() {
+                    jumps.remove(&at);
+                }
+                next
+            }
             Flow::Return => match calls.last_mut() {
                 Some(call) if call.remaining > 1 => {
                     call.remaining -= 1;
@@ -331,6 +339,17 @@ impl<'a> Runner<'a> {
             .filter_map(|word| Some((word.letter, self.integer(word)?, at(word.range))))
             .collect();
         let has = |letter: u8, number: u32| codes.iter().any(|&(l, n, _)| l == letter && n == number);
+        for word in &block.words {
+            if let Some(Value::Parameter { index: Some(index), .. }) = word.value
+                && (index as usize) < arith::PARAMETER_COUNT
+                && self.params.get(index as usize).is_none()
+            {
+                let message = format!(
+                    "R{index} holds a value the executor does not know (read from a table or register it does not model yet): words that use it are left out"
+                );
+                self.report_once(&format!("R{index}"), at(word.range), &message);
+            }
+        }
         for &(letter, number, code_range) in &codes {
             match (letter, number) {
                 (b'G', 0..=3) => self.motion = number,
@@ -341,9 +360,9 @@ impl<'a> Runner<'a> {
                 // Planes, block joining, cancelling and the priority
                 // codes change nothing the executor models yet.
                 (b'G', 4 | 17..=19 | 23 | 24 | 40 | 53 | 78 | 80 | 98) | (b'M', _) => {}
-                // Program flow, which the caller follows.
-                (b'G', 70 | 71 | 73 | 79) => {}
-                (b'G', 26..=29) => self.not_run("parameter arithmetic (G26–G29)", code_range),
+                // Program flow, which the caller follows, and the
+                // arithmetic, which runs after the motion.
+                (b'G', 26..=29 | 70 | 71 | 73 | 79) => {}
                 (b'G', 72) => self.not_run("macrocycle calls (G72)", code_range),
                 (b'G', 41 | 42) => self.not_run("radius compensation (G41/G42)", code_range),
                 (b'G', 33) => self.not_run("thread cutting (G33)", code_range),
@@ -358,7 +377,7 @@ impl<'a> Runner<'a> {
             match self.catalogue.role_of(word.letter) {
                 Some(AddressRole::Feed) => self.feed = self.feed_value(word),
                 Some(AddressRole::Speed) => {
-                    if let Some(speed) = self.number(word) {
+                    if let Some(speed) = self.count(word) {
                         self.speed = speed;
                     }
                 }
@@ -376,7 +395,7 @@ impl<'a> Runner<'a> {
         let axes: Vec<&Word> =
             block.words.iter().filter(|w| self.catalogue.role_of(w.letter) == Some(AddressRole::Axis)).collect();
         let (motion, length, duration, feed) = if has(b'G', 4) {
-            let dwell = block.word(b'Q').and_then(|q| self.number(q)).unwrap_or(0.0) * 0.01;
+            let dwell = block.word(b'Q').and_then(|q| self.count(q)).unwrap_or(0.0) * 0.01;
             (Motion::Dwell, 0.0, dwell, None)
         } else if axes.is_empty() {
             (Motion::None, 0.0, 0.0, None)
@@ -402,14 +421,21 @@ impl<'a> Runner<'a> {
             end: self.position,
         });
         self.time += duration;
-        // Assignments take effect after the block's motion.
-        for assignment in &block.assignments {
-            let (Some(index), Some(value)) = (assignment.index, &assignment.value) else { continue };
-            let raw = match value {
-                Value::Literal(decimal) => arith::literal_raw(decimal),
-                Value::Parameter { .. } => self.raw(value),
-            };
-            self.params.set(index as usize, raw);
+        // Assignments and arithmetic take effect after the block's motion.
+        arith::assign(block, &mut self.params);
+        let mut machine = ProgramMachine { machine: self.machine, position: &self.position };
+        match arith::compute(block, &mut self.params, &mut machine, self.machine) {
+            BlockArithmetic::None | BlockArithmetic::Ran { result: Ok(()), .. } => {}
+            BlockArithmetic::UnknownWord => {
+                let message =
+                    "a control word in R5–R8 has no value: it was computed from a value the executor does not know";
+                self.finding(range, message, true);
+                return Flow::End;
+            }
+            BlockArithmetic::Ran { function, result: Err(error), .. } => {
+                self.finding(at(function), &format!("parameter arithmetic failed: {error}"), true);
+                return Flow::End;
+            }
         }
         if has(b'M', 2) || has(b'M', 30) {
             return Flow::End;
@@ -535,6 +561,16 @@ impl<'a> Runner<'a> {
         }
     }
 
+    /// A dimensionless quantity (S in rpm, Q in 10 ms): the literal as
+    /// written, or a parameter's raw digits (`R27=300` and `R27=0.300` are
+    /// both S300, 03 §1.6).
+    fn count(&self, word: &Word) -> Option<f64> {
+        match word.value.as_ref()? {
+            Value::Literal(decimal) => Some(decimal.to_f64()),
+            value => self.raw(value).map(|raw| raw as f64),
+        }
+    }
+
     /// A dimensionless word's whole number (codes, T): the literal, or a
     /// parameter's raw digits.
     fn integer(&self, word: &Word) -> Option<u32> {
@@ -546,21 +582,49 @@ impl<'a> Runner<'a> {
 
     /// The raw value a parameter reference reads, sign applied.
     fn raw(&self, value: &Value) -> Option<Raw> {
-        match value {
-            Value::Parameter { negative, index: Some(index), .. } => {
-                let raw = self.params.get(*index as usize)?;
-                Some(if *negative { -raw } else { raw })
-            }
-            _ => None,
-        }
+        arith::reference(value, &self.params)
     }
 
     fn not_run(&mut self, what: &str, range: TextRange) {
-        if !self.reported.iter().any(|done| done == what) {
-            self.reported.push(what.to_owned());
-            self.finding(range, &format!("the executor does not run {what} yet: the time leaves them out"), false);
+        self.report_once(what, range, &format!("the executor does not run {what} yet: the time leaves them out"));
+    }
+
+    /// Reports a problem of kind `key` at its first place only.
+    fn report_once(&mut self, key: &str, range: TextRange, message: &str) {
+        if !self.reported.iter().any(|done| done == key) {
+            self.reported.push(key.to_owned());
+            self.finding(range, message, false);
         }
     }
+}
+
+/// What parameter arithmetic reads of the machine while a program runs:
+/// the programmed positions (the measured ones equal them, as the run has
+/// no following error) and the machine constants.
+struct ProgramMachine<'r> {
+    machine: &'r MachineConfig,
+    position: &'r Position,
+}
+
+impl Machine for ProgramMachine<'_> {
+    fn measured_position(&self, axis: u8) -> Option<Raw> {
+        self.programmed_position(axis)
+    }
+
+    fn programmed_position(&self, axis: u8) -> Option<Raw> {
+        let letter = *self.machine.axes.get(usize::from(axis).checked_sub(1)?)?;
+        Some((self.position[usize::from(letter - b'A')] * 1000.0).round() as Raw)
+    }
+
+    fn read_table(&self, table: u8, row: u16, _column: u16) -> Option<Raw> {
+        // Correction and offset tables and the block registers come with
+        // the tables the machine configuration loads.
+        (table == 3).then(|| self.machine.known_constant(u32::from(row))).flatten()
+    }
+
+    fn write_table(&mut self, _table: u8, _row: u16, _column: u16, _value: Raw) {}
+
+    fn message(&mut self, _message: Message) {}
 }
 
 /// A block's move from `start` to `end`, by the axis words `axes`.
@@ -779,6 +843,51 @@ mod tests {
             let trace = run_text(text);
             assert_eq!(trace.findings.last().map(|f| f.message.as_str()), Some(message), "{text}");
         }
+    }
+
+    #[test]
+    fn arithmetic_runs_after_the_motion_and_conditional_codes_jump_on_73() {
+        // R10 counts the passes: op 01 adds R11 (1.000) to it, op 17 writes
+        // 73 into R20 while R10 < R12 (3.000), so `GR20` jumps back twice
+        // and is G78 (no jump) the third time.
+        let text =
+            "%1\nN1 R10=0 R11=1. R12=3. G91 F600\nN2 G01 X1\nN3 G27 R5=1101110 R6=17101220\nN4 GR20 L2 Q9999\nN5 M30\n";
+        let trace = run_text(text);
+        assert_eq!(trace.steps.iter().filter(|step| &text[step.range] == "N2 G01 X1\n").count(), 3);
+        assert_eq!(trace.end_position()[usize::from(b'X' - b'A')], 3.0);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        // Op 26 reads the programmed position of axis 1 (X) after the
+        // block's motion: 12.5 mm, raw 12500.
+        let trace = run_text("%1\nN1 G00 X12.5 R5=26010010 G26\nN2 G01 YR10 F600\nN3 M30\n");
+        assert_eq!(trace.end_position()[usize::from(b'Y' - b'A')], 12.5);
+        // Op 49 reads correction D1, a table the run does not load yet: the
+        // word that uses the value is named and left out.
+        let text = "%1\nN1 R5=49110110 G26\nN2 G01 XR10 F100\nN3 M30\n";
+        let trace = run_text(text);
+        let found: Vec<(&str, bool)> = trace.findings.iter().map(|f| (&text[f.range], f.fatal)).collect();
+        assert_eq!(found, [("XR10", false)]);
+        assert!(trace.findings[0].message.starts_with("R10 holds a value the executor does not know"));
+    }
+
+    #[test]
+    fn an_arithmetic_error_stops_the_run_at_its_function() {
+        // Op 04 divides R1 by R2, which is zero.
+        let text = "%1\nN1 R1=1. R2=0 R5=4010203 G26\nN2 G00 X1\nN3 M30\n";
+        let trace = run_text(text);
+        let found: Vec<(&str, &str, bool)> =
+            trace.findings.iter().map(|f| (&text[f.range], f.message.as_str(), f.fatal)).collect();
+        assert_eq!(found, [("G26", "parameter arithmetic failed: division by zero", true)]);
+        assert_eq!(trace.steps.len(), 1);
+    }
+
+    #[test]
+    fn speed_and_dwell_read_a_parameter_as_its_digits() {
+        // R27=300 is S300 and R29=250 a dwell of 250 × 10 ms (03 §1.6);
+        // G95 F1. is 1 mm/rev, 300 mm/min at S300.
+        let trace = run_text("%1\nN1 R27=300 R29=250\nN2 SR27 G95 G01 X1 F1.\nN3 G04 QR29\nN4 M30\n");
+        assert_eq!(trace.steps[1].feed, Some(300.0));
+        close(trace.steps[1].duration, 0.2);
+        close(trace.time_in(Motion::Dwell), 2.5);
     }
 
     #[test]

@@ -21,7 +21,7 @@ use crate::{
         params,
     },
     diagnostic::declare_rules,
-    flow::{self, FlowCheck, Origin, Visit},
+    flow::{FlowCheck, Origin, Visit},
     lower::{Value, Word},
 };
 
@@ -172,7 +172,7 @@ impl<'v, 'a> Run<'v, 'a> {
             })
             .collect();
         let r95 = value_at_start(visit, 95).map(|(raw, _)| raw);
-        Run { visit, at: visit.range(word.range), words, double_precision: flow::double_precision(visit.config, r95) }
+        Run { visit, at: visit.range(word.range), words, double_precision: visit.config.machine.double_precision(r95) }
     }
 
     /// R5–R8 literals with a decimal point: the control stores them in
