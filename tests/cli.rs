@@ -417,3 +417,45 @@ fn run_stops_on_a_call_to_nothing() {
     let stderr = String::from_utf8(output.stderr).unwrap();
     assert!(stderr.ends_with("CALL.NCP:3: there is no subprogram L9 (G79 L9) in this file\n"), "{stderr}");
 }
+
+/// `G72 L9001` runs the macrocycle file `L9001` of the program's project
+/// (the directory of its ncc.toml); its blocks and findings name that file.
+#[test]
+fn run_finds_macrocycle_files_in_the_project() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("ncc.toml"), "").unwrap();
+    std::fs::create_dir(dir.path().join("macros")).unwrap();
+    std::fs::write(dir.path().join("macros/L9001"), "N1 G79 L9001\nN2 G91 G01 X10 F600\nN3 G90 G70\n").unwrap();
+    std::fs::create_dir(dir.path().join("parts")).unwrap();
+    let program = dir.path().join("parts/MAIN.NCP");
+    std::fs::write(&program, "%1\nN1 G72 L9001 Q3\nN2 G72 L9002\nN3 M30\n").unwrap();
+
+    let output = ncc(&["run", program.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(output.status.code(), Some(1));
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let places: Vec<(String, u64)> = json["blocks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| {
+            let file = b["file"].as_str().unwrap().replace('\\', "/");
+            (file.rsplit('/').next().unwrap().to_owned(), b["line"].as_u64().unwrap())
+        })
+        .collect();
+    // The failed call runs as a block too: the run stops after it.
+    let expected = [
+        ("MAIN.NCP", 2),
+        ("L9001", 2),
+        ("L9001", 3),
+        ("L9001", 2),
+        ("L9001", 3),
+        ("L9001", 2),
+        ("L9001", 3),
+        ("MAIN.NCP", 3),
+    ];
+    let expected: Vec<(String, u64)> = expected.into_iter().map(|(f, l)| (f.to_owned(), l)).collect();
+    assert_eq!(places, expected);
+    assert_eq!(json["end_position"]["X"], 30.0);
+    assert_eq!(json["findings"][0]["message"], "there is no macrocycle file L9002 to call");
+    assert_eq!(json["findings"][0]["line"], 3);
+}

@@ -226,10 +226,15 @@ fn is_partprogram(path: &Path) -> bool {
 }
 
 /// Macrocycle files: `L<number>`, with or without an extension.
-fn is_macrocycle(path: &Path) -> bool {
-    path.file_stem().and_then(|stem| stem.to_str()).is_some_and(|stem| {
-        stem.len() > 1 && stem.starts_with(['L', 'l']) && stem[1..].bytes().all(|b| b.is_ascii_digit())
-    })
+pub(crate) fn is_macrocycle(path: &Path) -> bool {
+    macrocycle_number(path).is_some()
+}
+
+/// The number of a macrocycle file `L<number>`.
+pub(crate) fn macrocycle_number(path: &Path) -> Option<u32> {
+    let stem = path.file_stem()?.to_str()?;
+    let digits = stem.strip_prefix(['L', 'l']).filter(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()))?;
+    digits.parse().ok()
 }
 
 #[cfg(test)]

@@ -3,11 +3,17 @@
 //! path lengths, the tools and the end position; `--format json` adds a
 //! record per block.
 
-use std::{path::Path, process::ExitCode};
+use std::{
+    cell::RefCell,
+    collections::BTreeMap,
+    path::{Path, PathBuf},
+    process::ExitCode,
+};
 
 use line_index::LineIndex;
 use nc_exec::run::{Motion, Position, Trace};
 use ncc_analysis::Config;
+use ncc_syntax::{Dialect, Parse, TextSize};
 use serde_json::{Value, json};
 
 use crate::check;
@@ -33,13 +39,14 @@ pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let parse = ncc_syntax::Parse::new(&text, ncc_syntax::Dialect::Cnc8x6);
-    let trace = nc_exec::run::run(&parse, &config.machine, step_budget);
-    let lines = LineIndex::new(&text);
-    let line = |offset| lines.line_col(offset).line + 1;
+    let parse = Parse::new(&text, Dialect::Cnc8x6);
+    let library = Library::for_program(path);
+    let trace = nc_exec::run::run(&parse, &|number| library.load(number), &config.machine, step_budget);
+    let sources = library.sources(path, text, &trace);
+    let place = |source: usize, offset| sources[source].place(offset);
     let axes = &config.machine.axes;
     match format {
-        Format::Human => print_summary(path, &trace, axes, &line),
+        Format::Human => print_summary(path, &trace, axes, &place),
         Format::Json => {
             let output = json!({
                 "file": path.display().to_string(),
@@ -54,7 +61,8 @@ pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
                 "blocks": trace.steps.iter().map(|step| {
                     let (start, end) = (position_json(&step.start, axes), position_json(&step.end, axes));
                     json!({
-                    "line": line(step.range.start()),
+                    "file": sources[step.source].path.display().to_string(),
+                    "line": sources[step.source].line(step.range.start()),
                     "motion": match step.motion {
                         Motion::None => "none",
                         Motion::Rapid => "rapid",
@@ -71,7 +79,8 @@ pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
                     "end": { "program": end.clone(), "machine": end },
                 })}).collect::<Vec<Value>>(),
                 "findings": trace.findings.iter().map(|finding| json!({
-                    "line": line(finding.range.start()),
+                    "file": sources[finding.source].path.display().to_string(),
+                    "line": sources[finding.source].line(finding.range.start()),
                     "message": finding.message,
                     "stopped": finding.fatal,
                 })).collect::<Vec<Value>>(),
@@ -82,9 +91,9 @@ pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
     if trace.findings.iter().any(|finding| finding.fatal) { ExitCode::FAILURE } else { ExitCode::SUCCESS }
 }
 
-fn print_summary(path: &Path, trace: &Trace, axes: &[u8], line: &dyn Fn(ncc_syntax::TextSize) -> u32) {
+fn print_summary(path: &Path, trace: &Trace, axes: &[u8], place: &dyn Fn(usize, TextSize) -> String) {
     for finding in &trace.findings {
-        eprintln!("{}:{}: {}", path.display(), line(finding.range.start()), finding.message);
+        eprintln!("{}: {}", place(finding.source, finding.range.start()), finding.message);
     }
     println!("{}", path.display());
     println!("  total time   {}", clock(trace.total_time()));
@@ -99,9 +108,64 @@ fn print_summary(path: &Path, trace: &Trace, axes: &[u8], line: &dyn Fn(ncc_synt
     println!("  end position {}", position.join(" "));
 }
 
+/// Where a run finds macrocycle files (`G72 L9001` calls the file `L9001`,
+/// with or without an extension): beside the program first, then anywhere
+/// in its project, the directory of its `ncc.toml`.
+struct Library {
+    candidates: Vec<PathBuf>,
+    /// The files read, by number, with their text.
+    read: RefCell<BTreeMap<u32, (PathBuf, String)>>,
+}
+
+impl Library {
+    fn for_program(path: &Path) -> Library {
+        let beside = check::macrocycles_beside(&[(path.to_path_buf(), String::new())]).into_iter().map(|(p, _)| p);
+        let project = Config::find_for(path).and_then(|config| Some(config.parent()?.to_path_buf()));
+        let in_project = project.map(|root| check::collect_files(&[root]).0).unwrap_or_default();
+        let candidates = beside.chain(in_project.into_iter().filter(|path| check::is_macrocycle(path))).collect();
+        Library { candidates, read: RefCell::default() }
+    }
+
+    fn load(&self, number: u32) -> Option<Parse> {
+        let path = self.candidates.iter().find(|path| check::macrocycle_number(path) == Some(number))?;
+        let text = check::read_program(path).ok()?;
+        let parse = Parse::new(&text, Dialect::Cnc8x6);
+        self.read.borrow_mut().insert(number, (path.clone(), text));
+        Some(parse)
+    }
+
+    /// The program and the macrocycle files in the trace's source order.
+    fn sources(&self, path: &Path, text: String, trace: &Trace) -> Vec<Source> {
+        let mut read = self.read.take();
+        let program = Source { path: path.to_path_buf(), lines: LineIndex::new(&text) };
+        let macrocycles = trace.macrocycles.iter().filter_map(|number| read.remove(number));
+        std::iter::once(program)
+            .chain(macrocycles.map(|(path, text)| Source { path, lines: LineIndex::new(&text) }))
+            .collect()
+    }
+}
+
+/// A file a run read, for locating its blocks.
+struct Source {
+    path: PathBuf,
+    lines: LineIndex,
+}
+
+impl Source {
+    fn line(&self, offset: TextSize) -> u32 {
+        self.lines.line_col(offset).line + 1
+    }
+
+    /// `path:line`.
+    fn place(&self, offset: TextSize) -> String {
+        format!("{}:{}", self.path.display(), self.line(offset))
+    }
+}
+
 /// `h:mm:ss.sss`.
 fn clock(seconds: f64) -> String {
-    let whole = seconds.max(0.0);
+    // An empty sum of floats is -0.0, which would print with a sign.
+    let whole = if seconds > 0.0 { seconds } else { 0.0 };
     let hours = (whole / 3600.0).floor();
     let minutes = ((whole - hours * 3600.0) / 60.0).floor();
     format!("{hours}:{minutes:02}:{:06.3}", whole - hours * 3600.0 - minutes * 60.0)

@@ -1,8 +1,8 @@
 //! Running a CNC8x6 program: the modal state, motion and time, block by
 //! block, in the order the control runs them.
 //!
-//! What runs so far: the program's flow (subprogram calls G71 L Q with
-//! their repetitions, jumps G73 L Q that run a section Q+1 times, G04 taking
+//! What runs so far: the program's flow (subprogram calls G71 L Q and
+//! macrocycle files G72 L Q with their repetitions, jumps G73 L Q that run a section Q+1 times, G04 taking
 //! Q from a call in its block, M02/M30, a step budget against endless
 //! loops), rapid and linear motion (G00, G01), arcs and helices
 //! (G02, G03) with the centre from I/J/K and the plane from the two axes
@@ -17,7 +17,7 @@
 //! model's business.
 //!
 //! Everything else the control does is reported once per kind as not run
-//! yet (macrocycles, offsets, compensation, fixed
+//! yet (offsets, compensation, fixed
 //! cycles, transformations, threads), so that a total never silently leaves
 //! something out.
 
@@ -48,6 +48,9 @@ pub enum Motion {
 /// One block as it ran.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Step {
+    /// The file the block is in: 0 for the program, k for the k-th
+    /// macrocycle file the run loaded ([`Trace::macrocycles`]).
+    pub source: usize,
     /// The block's text range.
     pub range: TextRange,
     pub motion: Motion,
@@ -67,6 +70,8 @@ pub struct Step {
 /// A problem found while running, at a text range.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Finding {
+    /// The file, as in [`Step::source`].
+    pub source: usize,
     pub range: TextRange,
     pub message: String,
     /// The run stopped here (an error the control stops on).
@@ -80,6 +85,9 @@ pub struct Trace {
     pub findings: Vec<Finding>,
     /// Tools called with T, in order of first use.
     pub tools: Vec<u32>,
+    /// The macrocycle files the run read, by number: source k is
+    /// `macrocycles[k - 1]`.
+    pub macrocycles: Vec<u32>,
 }
 
 impl Trace {
@@ -112,16 +120,17 @@ pub const DEFAULT_STEP_BUDGET: usize = 10_000_000;
 const MAX_CALL_DEPTH: usize = 64;
 
 /// Runs a CNC8x6 program from its first block to M02/M30 on `machine`,
-/// following subprogram calls and jumps, for at most `budget` blocks.
-/// Parameters start at zero.
-pub fn run(parse: &Parse, machine: &MachineConfig, budget: usize) -> Trace {
-    let blocks: Vec<(TextRange, BlockData)> = parse
-        .tree()
-        .blocks()
-        .map(|block| (block.syntax().text_range(), BlockData::lower(block.syntax().green())))
-        .collect();
-    let units = Units::of(&blocks);
+/// following subprogram calls, macrocycle calls (files from
+/// `macrocycle(number)`, loaded when first called) and jumps, for at most
+/// `budget` blocks. Parameters start at zero.
+pub fn run(parse: &Parse, macrocycle: &dyn Fn(u32) -> Option<Parse>, machine: &MachineConfig, budget: usize) -> Trace {
+    let mut program = Blocks::default();
+    program.add(parse);
     let mut runner = Runner::new(machine);
+    // Macrocycle numbers called, and where each file's body starts; the
+    // files read, in source order.
+    let mut loaded: Vec<(u32, Option<usize>)> = Vec::new();
+    let mut files: Vec<u32> = Vec::new();
     // Calls being run: where to return, how many runs remain, where the
     // subprogram starts.
     let mut calls: Vec<Call> = Vec::new();
@@ -129,9 +138,10 @@ pub fn run(parse: &Parse, machine: &MachineConfig, budget: usize) -> Trace {
     let mut jumps: std::collections::HashMap<usize, u32> = Default::default();
     let mut at = 0;
     let mut executed = 0;
-    while let Some((range, block)) = blocks.get(at) {
-        let range = *range;
-        if units.starts_subprogram(at) && calls.is_empty() {
+    while let Some(block) = program.blocks.get(at) {
+        let (range, source) = (block.range, block.source);
+        runner.source = source;
+        if program.units.starts_subprogram(at) && calls.is_empty() {
             runner.finding(range, "the main body runs into a subprogram: it has no M02 or M30 before it", false);
             break;
         }
@@ -142,7 +152,8 @@ pub fn run(parse: &Parse, machine: &MachineConfig, budget: usize) -> Trace {
             break;
         }
         let next = at + 1;
-        at = match runner.block(block, range) {
+        let flow = runner.block(&block.data, range);
+        at = match flow {
             Flow::End => break,
             Flow::Next => {
                 // A jump block passed without jumping (`GRxx` read as G78)
@@ -160,29 +171,48 @@ pub fn run(parse: &Parse, machine: &MachineConfig, budget: usize) -> Trace {
                 Some(_) => calls.pop().map_or(next, |call| call.back),
                 None => next,
             },
-            Flow::Call { label, times } => match units.subprogram(label) {
-                Some(start) if calls.len() < MAX_CALL_DEPTH => {
-                    calls.push(Call { back: next, remaining: times, start });
-                    start
+            Flow::Call { label, times, macrocycle: is_macrocycle } => {
+                let start = if is_macrocycle {
+                    let known = loaded.iter().find(|&&(number, _)| number == label).map(|&(_, start)| start);
+                    known.unwrap_or_else(|| {
+                        let start = macrocycle(label).and_then(|parse| {
+                            files.push(label);
+                            program.add(&parse)
+                        });
+                        loaded.push((label, start));
+                        start
+                    })
+                } else {
+                    program.units.subprogram(source, label)
+                };
+                match start {
+                    Some(start) if calls.len() < MAX_CALL_DEPTH => {
+                        calls.push(Call { back: next, remaining: times, start });
+                        start
+                    }
+                    Some(_) => {
+                        runner.finding(
+                            range,
+                            &format!("calls nest deeper than {MAX_CALL_DEPTH}: runaway recursion?"),
+                            true,
+                        );
+                        break;
+                    }
+                    None if is_macrocycle => {
+                        runner.finding(range, &format!("there is no macrocycle file L{label} to call"), true);
+                        break;
+                    }
+                    None => {
+                        runner.finding(
+                            range,
+                            &format!("there is no subprogram L{label} (G79 L{label}) in this file"),
+                            true,
+                        );
+                        break;
+                    }
                 }
-                Some(_) => {
-                    runner.finding(
-                        range,
-                        &format!("calls nest deeper than {MAX_CALL_DEPTH}: runaway recursion?"),
-                        true,
-                    );
-                    break;
-                }
-                None => {
-                    runner.finding(
-                        range,
-                        &format!("there is no subprogram L{label} (G79 L{label}) in this file"),
-                        true,
-                    );
-                    break;
-                }
-            },
-            Flow::Jump { label, times } => match units.jump_target(at, label) {
+            }
+            Flow::Jump { label, times } => match program.units.jump_target(at, label) {
                 Some(target) => {
                     let taken = jumps.entry(at).or_default();
                     if *taken < times {
@@ -200,57 +230,102 @@ pub fn run(parse: &Parse, machine: &MachineConfig, budget: usize) -> Trace {
                 }
             },
         };
+        let leaves_file = program.blocks.get(at).is_none_or(|block| block.source != source);
+        if source != 0 && flow == Flow::Next && leaves_file {
+            runner.finding(range, "the macrocycle file ends without G70", true);
+            break;
+        }
     }
-    Trace { steps: runner.steps, findings: runner.findings, tools: runner.tools }
+    Trace { steps: runner.steps, findings: runner.findings, tools: runner.tools, macrocycles: files }
 }
 
-/// A subprogram call being run.
+/// A subprogram or macrocycle call being run.
 struct Call {
     /// The block after the call.
     back: usize,
     /// Runs left, this one included.
     remaining: u32,
-    /// The subprogram's first block after its `G79`.
+    /// The body's first block after its `G79`.
     start: usize,
 }
 
+/// The blocks of the program and the macrocycle files loaded so far, one
+/// index space.
+#[derive(Default)]
+struct Blocks {
+    blocks: Vec<Block>,
+    units: Units,
+    /// Files added so far.
+    sources: usize,
+}
+
+struct Block {
+    source: usize,
+    range: TextRange,
+    data: BlockData,
+}
+
+impl Blocks {
+    /// Adds a file's blocks; returns where its body starts running (after
+    /// the `G79` a macrocycle file opens with), `None` for a file without
+    /// blocks.
+    fn add(&mut self, parse: &Parse) -> Option<usize> {
+        let first = self.blocks.len();
+        let source = self.sources;
+        self.sources += 1;
+        self.blocks.extend(parse.tree().blocks().map(|block| Block {
+            source,
+            range: block.syntax().text_range(),
+            data: BlockData::lower(block.syntax().green()),
+        }));
+        self.units.add(&self.blocks[first..], first);
+        let opening = self.blocks.get(first)?;
+        Some(if opening.data.has_code(b'G', 79) { first + 1 } else { first })
+    }
+}
+
 /// Where the subprograms start, and the block numbers of each unit.
+#[derive(Default)]
 struct Units {
-    /// Subprogram starts (`G79 L`): the block index and the label.
-    starts: Vec<(usize, u32)>,
-    /// The unit of each block (0: the main body, then each subprogram).
+    /// Subprogram starts (`G79 L`): the block index, its file and the label.
+    starts: Vec<(usize, usize, u32)>,
+    /// The unit of each block (each file's first unit is its main body or
+    /// macrocycle body, then one per subprogram).
     unit_of: Vec<usize>,
     /// Block numbers with their block, sorted.
     numbers: Vec<(u64, usize)>,
+    units: usize,
 }
 
 impl Units {
-    fn of(blocks: &[(TextRange, BlockData)]) -> Units {
+    /// Indexes a file's blocks, the first of which has index `first`.
+    fn add(&mut self, blocks: &[Block], first: usize) {
         let label = |block: &BlockData| match block.word(b'L')?.value.as_ref()? {
             Value::Literal(decimal) => whole_number(decimal),
             Value::Parameter { .. } => None,
         };
-        let (mut starts, mut unit_of, mut unit) = (Vec::new(), Vec::with_capacity(blocks.len()), 0);
-        for (index, (_, block)) in blocks.iter().enumerate() {
-            if block.has_code(b'G', 79) {
-                unit += 1;
-                starts.extend(label(block).map(|label| (index, label)));
+        self.units += 1;
+        for (index, block) in (first..).zip(blocks) {
+            // A macrocycle file's own `G79` opens its body, not a new unit.
+            if block.data.has_code(b'G', 79) && index != first {
+                self.units += 1;
+                self.starts.extend(label(&block.data).map(|label| (index, block.source, label)));
             }
-            unit_of.push(unit);
+            self.unit_of.push(self.units);
+            if let Some(number) = block.data.number.and_then(|number| number.value) {
+                self.numbers.push((number, index));
+            }
         }
-        let mut numbers: Vec<(u64, usize)> =
-            blocks.iter().enumerate().filter_map(|(index, (_, block))| Some((block.number?.value?, index))).collect();
-        numbers.sort_unstable();
-        Units { starts, unit_of, numbers }
+        self.numbers.sort_unstable();
     }
 
     fn starts_subprogram(&self, index: usize) -> bool {
-        self.starts.iter().any(|&(at, _)| at == index)
+        self.starts.iter().any(|&(at, _, _)| at == index)
     }
 
-    /// The first block of subprogram `label`, after its `G79`.
-    fn subprogram(&self, label: u32) -> Option<usize> {
-        self.starts.iter().find(|&&(_, l)| l == label).map(|&(at, _)| at + 1)
+    /// The first block of subprogram `label` of file `source`, after its `G79`.
+    fn subprogram(&self, source: usize, label: u32) -> Option<usize> {
+        self.starts.iter().find(|&&(_, file, l)| file == source && l == label).map(|&(at, _, _)| at + 1)
     }
 
     /// The block numbered `label` in the unit of block `from`.
@@ -272,10 +347,12 @@ enum Flow {
     End,
     /// `G70`: back from a subprogram.
     Return,
-    /// `G71 L`: run subprogram `label` `times` times.
+    /// `G71 L` (or `G72 L`, a macrocycle file): run subprogram `label`
+    /// `times` times.
     Call {
         label: u32,
         times: u32,
+        macrocycle: bool,
     },
     /// `G73 L Q`: jump to block N`label`, `times` times in all.
     Jump {
@@ -287,6 +364,8 @@ enum Flow {
 /// The control's state while a program runs.
 struct Runner<'a> {
     catalogue: &'static Catalogue,
+    /// The file of the block being run.
+    source: usize,
     machine: &'a MachineConfig,
     /// G00–G03.
     motion: u32,
@@ -313,6 +392,7 @@ impl<'a> Runner<'a> {
     fn new(machine: &'a MachineConfig) -> Self {
         Runner {
             catalogue: Dialect::Cnc8x6.catalogue(),
+            source: 0,
             machine,
             // The priority block: G01 G90 G94 F0 S0.
             motion: 1,
@@ -362,8 +442,7 @@ impl<'a> Runner<'a> {
                 (b'G', 4 | 17..=19 | 23 | 24 | 40 | 53 | 78 | 80 | 98) | (b'M', _) => {}
                 // Program flow, which the caller follows, and the
                 // arithmetic, which runs after the motion.
-                (b'G', 26..=29 | 70 | 71 | 73 | 79) => {}
-                (b'G', 72) => self.not_run("macrocycle calls (G72)", code_range),
+                (b'G', 26..=29 | 70..=73 | 79) => {}
                 (b'G', 41 | 42) => self.not_run("radius compensation (G41/G42)", code_range),
                 (b'G', 33) => self.not_run("thread cutting (G33)", code_range),
                 (b'G', 81..=89) => self.not_run("fixed cycles (G81–G89)", code_range),
@@ -411,6 +490,7 @@ impl<'a> Runner<'a> {
             self.moved(&Move { block, range, axes: &axes, start, end })
         };
         self.steps.push(Step {
+            source: self.source,
             range,
             motion,
             start_time: self.time,
@@ -445,7 +525,9 @@ impl<'a> Runner<'a> {
         let label = block.word(b'L').and_then(|word| self.integer(word));
         let count = block.word(b'Q').filter(|_| !has(b'G', 4)).and_then(|word| self.integer(word));
         match label {
-            Some(label) if has(b'G', 71) => Flow::Call { label, times: count.unwrap_or(1).max(1) },
+            Some(label) if has(b'G', 71) || has(b'G', 72) => {
+                Flow::Call { label, times: count.unwrap_or(1).max(1), macrocycle: has(b'G', 72) }
+            }
             Some(label) if has(b'G', 73) => Flow::Jump { label, times: count.unwrap_or(1) },
             _ if has(b'G', 70) => Flow::Return,
             _ => Flow::Next,
@@ -453,7 +535,7 @@ impl<'a> Runner<'a> {
     }
 
     fn finding(&mut self, range: TextRange, message: &str, fatal: bool) {
-        self.findings.push(Finding { range, message: message.to_owned(), fatal });
+        self.findings.push(Finding { source: self.source, range, message: message.to_owned(), fatal });
     }
 
     /// Length, duration and feed of a block's move.
@@ -666,7 +748,7 @@ mod tests {
     use crate::machine::MachineConfig;
 
     fn run_text(text: &str) -> Trace {
-        run(&Parse::new(text, Dialect::Cnc8x6), &MachineConfig::default(), 1000)
+        run(&Parse::new(text, Dialect::Cnc8x6), &|_| None, &MachineConfig::default(), 1000)
     }
 
     /// Durations (s) and lengths (mm) of the blocks, rounded to a
@@ -803,6 +885,30 @@ mod tests {
     }
 
     #[test]
+    fn a_macrocycle_file_runs_q_times_with_its_own_jumps() {
+        // The macro drills R21 holes R20 apart: its jump back to N20 is
+        // found in its own file, though the program has an N20 too.
+        let program = "%1\nN10 R20=10. R21=3. G91 F600\nN20 G72 L9001 Q2\nN30 M30\n";
+        let macro_text = "N1 G79 L9001\nN2 R22=0 R24=1.\nN20 G01 XR20\nN30 R5=1222422 R6=17222123 G27\nN40 GR23 L20 Q9999\nN50 G70\n";
+        let library = |number| (number == 9001).then(|| Parse::new(macro_text, Dialect::Cnc8x6));
+        let trace = run(&Parse::new(program, Dialect::Cnc8x6), &library, &MachineConfig::default(), 1000);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        assert_eq!(trace.macrocycles, [9001]);
+        // Two calls, three holes each.
+        let moves: Vec<usize> = trace.steps.iter().filter(|s| s.motion == Motion::Feed).map(|s| s.source).collect();
+        assert_eq!(moves, [1; 6]);
+        assert_eq!(trace.end_position()[usize::from(b'X' - b'A')], 60.0);
+
+        let trace = run(&Parse::new(program, Dialect::Cnc8x6), &|_| None, &MachineConfig::default(), 1000);
+        let messages: Vec<&str> = trace.findings.iter().map(|f| f.message.as_str()).collect();
+        assert_eq!(messages, ["there is no macrocycle file L9001 to call"]);
+        let unended = |_| Some(Parse::new("N1 G79 L9001\nN2 G00 X1\n", Dialect::Cnc8x6));
+        let trace = run(&Parse::new(program, Dialect::Cnc8x6), &unended, &MachineConfig::default(), 1000);
+        let messages: Vec<&str> = trace.findings.iter().map(|f| f.message.as_str()).collect();
+        assert_eq!(messages, ["the macrocycle file ends without G70"]);
+    }
+
+    #[test]
     fn a_jump_with_q_runs_the_section_q_plus_one_times() {
         // The manual's example: N26…N54 with `G73 L26 Q3` runs four times.
         let text = "%1\nN25 G91 F600\nN26 G01 X1\nN54 G73 L26 Q3\nN55 M30\n";
@@ -831,7 +937,7 @@ mod tests {
         assert_eq!(fatal, [("N4 G71 L1", "calls nest deeper than 64: runaway recursion?")]);
 
         let text = "%1\nN1 G73 L1 Q9999\nN2 M30\n";
-        let trace = run(&Parse::new(text, Dialect::Cnc8x6), &MachineConfig::default(), 500);
+        let trace = run(&Parse::new(text, Dialect::Cnc8x6), &|_| None, &MachineConfig::default(), 500);
         assert_eq!(trace.steps.len(), 500);
         assert!(trace.findings[0].message.starts_with("stopped after 500 blocks"), "{:?}", trace.findings);
 
