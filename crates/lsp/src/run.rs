@@ -6,15 +6,17 @@
 use std::{
     cell::RefCell,
     collections::BTreeMap,
+    fmt::Write as _,
+    io::{self, Write as _},
     path::{Path, PathBuf},
     process::ExitCode,
 };
 
 use line_index::LineIndex;
-use nc_exec::run::{Motion, Position, Trace};
+use nc_exec::run::{Motion, Position, Stop, Trace};
 use ncc_analysis::Config;
 use ncc_syntax::{Dialect, Parse, TextSize};
-use serde_json::{Value, json};
+use serde::Serialize;
 
 use crate::check;
 
@@ -43,69 +45,175 @@ pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
     let library = Library::for_program(path);
     let trace = nc_exec::run::run(&parse, &|number| library.load(number), &config.machine, step_budget);
     let sources = library.sources(path, text, &trace);
-    let place = |source: usize, offset| sources[source].place(offset);
     let axes = &config.machine.axes;
-    match format {
-        Format::Human => print_summary(path, &trace, axes, &place),
-        Format::Json => {
-            let output = json!({
-                "file": path.display().to_string(),
-                "total_time_s": trace.total_time(),
-                "cutting_time_s": trace.time_in(Motion::Feed),
-                "rapid_time_s": trace.time_in(Motion::Rapid),
-                "dwell_time_s": trace.time_in(Motion::Dwell),
-                "cutting_length_mm": trace.length_in(Motion::Feed),
-                "rapid_length_mm": trace.length_in(Motion::Rapid),
-                "tools": trace.tools,
-                "end_position": position_json(&trace.end_position(), axes),
-                "blocks": trace.steps.iter().map(|step| {
-                    let (start, end) = (position_json(&step.start, axes), position_json(&step.end, axes));
-                    json!({
-                    "file": sources[step.source].path.display().to_string(),
-                    "line": sources[step.source].line(step.range.start()),
-                    "motion": match step.motion {
-                        Motion::None => "none",
-                        Motion::Rapid => "rapid",
-                        Motion::Feed => "feed",
-                        Motion::Dwell => "dwell",
-                    },
-                    "start_time_s": step.start_time,
-                    "duration_s": step.duration,
-                    "length_mm": step.length,
-                    "feed_mm_min": step.feed,
-                    // Program and machine coordinates coincide until the
-                    // executor runs zero offsets.
-                    "start": { "program": start.clone(), "machine": start },
-                    "end": { "program": end.clone(), "machine": end },
-                })}).collect::<Vec<Value>>(),
-                "findings": trace.findings.iter().map(|finding| json!({
-                    "file": sources[finding.source].path.display().to_string(),
-                    "line": sources[finding.source].line(finding.range.start()),
-                    "message": finding.message,
-                    "stopped": finding.fatal,
-                })).collect::<Vec<Value>>(),
-            });
-            println!("{output:#}");
+    let written = match format {
+        Format::Human => {
+            for finding in &trace.findings {
+                eprintln!("{}: {}", sources[finding.source].place(finding.range.start()), finding.message);
+            }
+            let mut out = io::stdout().lock();
+            out.write_all(summary(path, &trace, axes).as_bytes()).and_then(|()| out.flush())
         }
+        Format::Json => {
+            let report = Report::new(path, &trace, &sources, axes);
+            let mut out = io::BufWriter::new(io::stdout().lock());
+            serde_json::to_writer_pretty(&mut out, &report)
+                .map_err(io::Error::from)
+                .and_then(|()| writeln!(out))
+                .and_then(|()| out.flush())
+        }
+    };
+    if let Err(error) = written
+        && error.kind() != io::ErrorKind::BrokenPipe
+    {
+        eprintln!("error: writing the output: {error}");
+        return ExitCode::from(2);
     }
     if trace.findings.iter().any(|finding| finding.fatal) { ExitCode::FAILURE } else { ExitCode::SUCCESS }
 }
 
-fn print_summary(path: &Path, trace: &Trace, axes: &[u8], place: &dyn Fn(usize, TextSize) -> String) {
-    for finding in &trace.findings {
-        eprintln!("{}: {}", place(finding.source, finding.range.start()), finding.message);
+fn summary(path: &Path, trace: &Trace, axes: &[u8]) -> String {
+    let mut out = String::new();
+    let (feed, rapid) = (Motion::Feed, Motion::Rapid);
+    let _ = writeln!(out, "{}", path.display());
+    let _ = writeln!(out, "  total time   {}", clock(trace.total_time()));
+    let _ = writeln!(out, "    cutting    {}  {:>12.3} mm", clock(trace.time_in(feed)), trace.length_in(feed));
+    let _ = writeln!(out, "    rapid      {}  {:>12.3} mm", clock(trace.time_in(rapid)), trace.length_in(rapid));
+    let _ = writeln!(out, "    dwell      {}", clock(trace.time_in(Motion::Dwell)));
+    let stops = |kind| trace.steps.iter().filter(|step| step.stop == Some(kind)).count();
+    let (program_stops, optional_stops) = (stops(Stop::Program), stops(Stop::Optional));
+    if program_stops + optional_stops > 0 {
+        let _ = writeln!(
+            out,
+            "  stops        {program_stops} × M00, {optional_stops} × M01 (the wait for the operator is not counted)"
+        );
     }
-    println!("{}", path.display());
-    println!("  total time   {}", clock(trace.total_time()));
-    println!("    cutting    {}  {:>12.3} mm", clock(trace.time_in(Motion::Feed)), trace.length_in(Motion::Feed));
-    println!("    rapid      {}  {:>12.3} mm", clock(trace.time_in(Motion::Rapid)), trace.length_in(Motion::Rapid));
-    println!("    dwell      {}", clock(trace.time_in(Motion::Dwell)));
     let tools: Vec<String> = trace.tools.iter().map(|tool| format!("T{tool}")).collect();
-    println!("  tools        {}", if tools.is_empty() { "none".to_owned() } else { tools.join(" ") });
+    let _ = writeln!(out, "  tools        {}", if tools.is_empty() { "none".to_owned() } else { tools.join(" ") });
     let end = trace.end_position();
     let position: Vec<String> =
         axes.iter().map(|&axis| format!("{}{:.3}", char::from(axis), end[usize::from(axis - b'A')])).collect();
-    println!("  end position {}", position.join(" "));
+    let _ = writeln!(out, "  end position {}", position.join(" "));
+    out
+}
+
+/// `ncc run --format json`, written as it is serialised: a run of a
+/// million blocks never holds its records in memory.
+#[derive(Serialize)]
+struct Report<'a> {
+    file: String,
+    total_time_s: f64,
+    cutting_time_s: f64,
+    rapid_time_s: f64,
+    dwell_time_s: f64,
+    cutting_length_mm: f64,
+    rapid_length_mm: f64,
+    tools: &'a [u32],
+    end_position: Axes<'a>,
+    blocks: Records<'a>,
+    findings: Vec<FindingRecord<'a>>,
+}
+
+impl<'a> Report<'a> {
+    fn new(path: &Path, trace: &'a Trace, sources: &'a [Source], axes: &'a [u8]) -> Report<'a> {
+        Report {
+            file: path.display().to_string(),
+            total_time_s: trace.total_time(),
+            cutting_time_s: trace.time_in(Motion::Feed),
+            rapid_time_s: trace.time_in(Motion::Rapid),
+            dwell_time_s: trace.time_in(Motion::Dwell),
+            cutting_length_mm: trace.length_in(Motion::Feed),
+            rapid_length_mm: trace.length_in(Motion::Rapid),
+            tools: &trace.tools,
+            end_position: Axes(trace.end_position(), axes),
+            blocks: Records { trace, sources, axes },
+            findings: trace
+                .findings
+                .iter()
+                .map(|finding| FindingRecord {
+                    file: &sources[finding.source].name,
+                    line: sources[finding.source].line(finding.range.start()),
+                    message: &finding.message,
+                    stopped: finding.fatal,
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The block records, serialised one by one.
+struct Records<'a> {
+    trace: &'a Trace,
+    sources: &'a [Source],
+    axes: &'a [u8],
+}
+
+impl Serialize for Records<'_> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_seq(self.trace.steps.iter().map(|step| {
+            let source = &self.sources[step.source];
+            BlockRecord {
+                file: &source.name,
+                line: source.line(step.range.start()),
+                motion: match step.motion {
+                    Motion::None => "none",
+                    Motion::Rapid => "rapid",
+                    Motion::Feed => "feed",
+                    Motion::Dwell => "dwell",
+                },
+                stop: step.stop.map(|stop| match stop {
+                    Stop::Program => "M00",
+                    Stop::Optional => "M01",
+                }),
+                start_time_s: step.start_time,
+                duration_s: step.duration,
+                length_mm: step.length,
+                feed_mm_min: step.feed,
+                // Program and machine coordinates coincide until the
+                // executor runs zero offsets.
+                start: Coordinates { program: Axes(step.start, self.axes), machine: Axes(step.start, self.axes) },
+                end: Coordinates { program: Axes(step.end, self.axes), machine: Axes(step.end, self.axes) },
+            }
+        }))
+    }
+}
+
+#[derive(Serialize)]
+struct BlockRecord<'a> {
+    file: &'a str,
+    line: u32,
+    motion: &'static str,
+    stop: Option<&'static str>,
+    start_time_s: f64,
+    duration_s: f64,
+    length_mm: f64,
+    feed_mm_min: Option<f64>,
+    start: Coordinates<'a>,
+    end: Coordinates<'a>,
+}
+
+#[derive(Serialize)]
+struct Coordinates<'a> {
+    program: Axes<'a>,
+    machine: Axes<'a>,
+}
+
+#[derive(Serialize)]
+struct FindingRecord<'a> {
+    file: &'a str,
+    line: u32,
+    message: &'a str,
+    stopped: bool,
+}
+
+/// A position as `{"X": …, "Y": …}` over the machine's axes.
+struct Axes<'a>(Position, &'a [u8]);
+
+impl Serialize for Axes<'_> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let Axes(position, axes) = self;
+        serializer.collect_map(axes.iter().map(|&axis| (char::from(axis), position[usize::from(axis - b'A')])))
+    }
 }
 
 /// Where a run finds macrocycle files (`G72 L9001` calls the file `L9001`,
@@ -137,17 +245,20 @@ impl Library {
     /// The program and the macrocycle files in the trace's source order.
     fn sources(&self, path: &Path, text: String, trace: &Trace) -> Vec<Source> {
         let mut read = self.read.take();
-        let program = Source { path: path.to_path_buf(), lines: LineIndex::new(&text) };
+        let program = Source { name: path.display().to_string(), lines: LineIndex::new(&text) };
         let macrocycles = trace.macrocycles.iter().filter_map(|number| read.remove(number));
         std::iter::once(program)
-            .chain(macrocycles.map(|(path, text)| Source { path, lines: LineIndex::new(&text) }))
+            .chain(
+                macrocycles
+                    .map(|(path, text)| Source { name: path.display().to_string(), lines: LineIndex::new(&text) }),
+            )
             .collect()
     }
 }
 
 /// A file a run read, for locating its blocks.
 struct Source {
-    path: PathBuf,
+    name: String,
     lines: LineIndex,
 }
 
@@ -158,19 +269,14 @@ impl Source {
 
     /// `path:line`.
     fn place(&self, offset: TextSize) -> String {
-        format!("{}:{}", self.path.display(), self.line(offset))
+        format!("{}:{}", self.name, self.line(offset))
     }
 }
 
 /// `h:mm:ss.sss`.
 fn clock(seconds: f64) -> String {
-    // An empty sum of floats is -0.0, which would print with a sign.
-    let whole = if seconds > 0.0 { seconds } else { 0.0 };
+    let whole = seconds.max(0.0);
     let hours = (whole / 3600.0).floor();
     let minutes = ((whole - hours * 3600.0) / 60.0).floor();
     format!("{hours}:{minutes:02}:{:06.3}", whole - hours * 3600.0 - minutes * 60.0)
-}
-
-fn position_json(position: &Position, axes: &[u8]) -> Value {
-    axes.iter().map(|&axis| (char::from(axis).to_string(), json!(position[usize::from(axis - b'A')]))).collect()
 }

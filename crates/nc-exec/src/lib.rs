@@ -17,4 +17,5 @@
 pub mod arith;
 pub mod lower;
 pub mod machine;
+pub mod modes;
 pub mod run;

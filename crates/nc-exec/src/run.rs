@@ -29,6 +29,7 @@ use crate::{
     arith::{self, BlockArithmetic, Machine, Message, Parameters, Raw},
     lower::{BlockData, Value, Word},
     machine::MachineConfig,
+    modes::{Group, Modes},
 };
 
 /// Axes by letter (index = letter − `A`); positions in mm (degrees for
@@ -65,6 +66,18 @@ pub struct Step {
     /// machine coordinates coincide until zero offsets run).
     pub start: Position,
     pub end: Position,
+    /// The program stops after the block (M00, M01) until the operator
+    /// starts it again; the run does not count the wait.
+    pub stop: Option<Stop>,
+}
+
+/// A program stop.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stop {
+    /// M00: always.
+    Program,
+    /// M01: when the operator has selected AUT-M01.
+    Optional,
 }
 
 /// A problem found while running, at a text range.
@@ -98,12 +111,13 @@ impl Trace {
 
     /// Seconds spent in blocks of one kind.
     pub fn time_in(&self, motion: Motion) -> f64 {
-        self.steps.iter().filter(|step| step.motion == motion).map(|step| step.duration).sum()
+        // Folded from +0.0: an empty `sum` of floats is -0.0.
+        self.steps.iter().filter(|step| step.motion == motion).fold(0.0, |sum, step| sum + step.duration)
     }
 
     /// Path length in mm of blocks of one kind.
     pub fn length_in(&self, motion: Motion) -> f64 {
-        self.steps.iter().filter(|step| step.motion == motion).map(|step| step.length).sum()
+        self.steps.iter().filter(|step| step.motion == motion).fold(0.0, |sum, step| sum + step.length)
     }
 
     /// The programmed position at the end.
@@ -367,14 +381,18 @@ struct Runner<'a> {
     /// The file of the block being run.
     source: usize,
     machine: &'a MachineConfig,
-    /// G00–G03.
-    motion: u32,
-    incremental: bool,
-    per_revolution: bool,
+    modes: Modes,
+    groups: Groups,
     /// F as programmed: mm/min (per minute) or mm/rev (per revolution).
     feed: Option<f64>,
-    /// S in rpm.
+    /// S as programmed: rpm, or the cutting speed under constant cutting
+    /// speed (0.1 m/min, or m/min as machine constant 329 selects).
     speed: f64,
+    /// The speed limit of constant cutting speed set by `G76 S`, in rpm.
+    speed_limit: Option<f64>,
+    /// The spindle speed constant cutting speed reached last, which S
+    /// takes when it ends (01 §6.9.1).
+    speed_reached: Option<f64>,
     position: Position,
     params: Parameters,
     time: f64,
@@ -390,16 +408,18 @@ const ARC_TOLERANCE: f64 = 0.001;
 
 impl<'a> Runner<'a> {
     fn new(machine: &'a MachineConfig) -> Self {
+        // The priority block: G01 G17 G90 G94 F0 S0 M05 ….
+        let modes = Modes::reset();
         Runner {
             catalogue: Dialect::Cnc8x6.catalogue(),
             source: 0,
             machine,
-            // The priority block: G01 G90 G94 F0 S0.
-            motion: 1,
-            incremental: false,
-            per_revolution: false,
+            groups: Groups::of(&modes),
+            modes,
             feed: None,
             speed: 0.0,
+            speed_limit: None,
+            speed_reached: None,
             position: [0.0; 26],
             params: Parameters::zeroed(),
             time: 0.0,
@@ -430,16 +450,14 @@ impl<'a> Runner<'a> {
                 self.report_once(&format!("R{index}"), at(word.range), &message);
             }
         }
+        let css_before = self.feed_mode().css;
         for &(letter, number, code_range) in &codes {
+            self.modes.set(letter, number);
             match (letter, number) {
-                (b'G', 0..=3) => self.motion = number,
-                (b'G', 90) => self.incremental = false,
-                (b'G', 91) => self.incremental = true,
-                (b'G', 94) => self.per_revolution = false,
-                (b'G', 95) => self.per_revolution = true,
-                // Planes, block joining, cancelling and the priority
-                // codes change nothing the executor models yet.
-                (b'G', 4 | 17..=19 | 23 | 24 | 40 | 53 | 78 | 80 | 98) | (b'M', _) => {}
+                // Modes the run reads where they matter; planes, block
+                // joining, cancelling and the priority codes change
+                // nothing the executor models yet.
+                (b'G', 0..=4 | 17..=19 | 23 | 24 | 40 | 53 | 76 | 78 | 80 | 90 | 91 | 94..=98) | (b'M', _) => {}
                 // Program flow, which the caller follows, and the
                 // arithmetic, which runs after the motion.
                 (b'G', 26..=29 | 70..=73 | 79) => {}
@@ -448,18 +466,18 @@ impl<'a> Runner<'a> {
                 (b'G', 81..=89) => self.not_run("fixed cycles (G81–G89)", code_range),
                 (b'G', 54..=59 | 92 | 93) => self.not_run("zero offsets (G54–G59, G92, G93)", code_range),
                 (b'G', 31 | 34..=39) => self.not_run("transformations (G31, G34–G39)", code_range),
-                (b'G', 96 | 97) => self.not_run("constant cutting speed (G96/G97)", code_range),
                 _ => self.not_run(&format!("G{number:02}"), code_range),
             }
         }
         for word in &block.words {
             match self.catalogue.role_of(word.letter) {
                 Some(AddressRole::Feed) => self.feed = self.feed_value(word),
-                Some(AddressRole::Speed) => {
-                    if let Some(speed) = self.count(word) {
-                        self.speed = speed;
-                    }
-                }
+                Some(AddressRole::Speed) => match self.count(word) {
+                    // `G76 S` limits the speed of constant cutting speed.
+                    Some(limit) if has(b'G', 76) => self.speed_limit = Some(limit),
+                    Some(speed) => self.speed = speed,
+                    None => {}
+                },
                 Some(AddressRole::Tool) => {
                     if let Some(tool) = self.integer(word)
                         && !self.tools.contains(&tool)
@@ -469,6 +487,11 @@ impl<'a> Runner<'a> {
                 }
                 _ => {}
             }
+        }
+        // When constant cutting speed ends, S keeps the speed it reached.
+        let writes_speed = block.words.iter().any(|w| self.catalogue.role_of(w.letter) == Some(AddressRole::Speed));
+        if css_before && !self.feed_mode().css && !writes_speed {
+            self.speed = self.speed_reached.take().unwrap_or(self.speed);
         }
         let start = self.position;
         let axes: Vec<&Word> =
@@ -483,7 +506,7 @@ impl<'a> Runner<'a> {
             for word in &axes {
                 if let Some(value) = self.number(word) {
                     let slot = &mut end[usize::from(word.letter - b'A')];
-                    *slot = if self.incremental { *slot + value } else { value };
+                    *slot = if self.incremental() { *slot + value } else { value };
                 }
             }
             self.position = end;
@@ -499,6 +522,13 @@ impl<'a> Runner<'a> {
             feed,
             start,
             end: self.position,
+            stop: if has(b'M', 0) {
+                Some(Stop::Program)
+            } else if has(b'M', 1) {
+                Some(Stop::Optional)
+            } else {
+                None
+            },
         });
         self.time += duration;
         // Assignments and arithmetic take effect after the block's motion.
@@ -543,29 +573,39 @@ impl<'a> Runner<'a> {
         let (range, start, end) = (step.range, step.start, step.end);
         let travel = |i: usize| end[i] - start[i];
         let straight = (0..26).map(|i| travel(i).powi(2)).sum::<f64>().sqrt();
-        if self.motion == 0 {
+        let motion = self.modes.active(self.groups.motion);
+        if motion == Some(0) {
             let longest = (0..26).map(|i| travel(i).abs()).fold(0.0, f64::max);
             return (Motion::Rapid, straight, longest / f64::from(self.machine.rapid_rate) * 60.0, None);
         }
-        let length = match self.motion {
-            2 | 3 => match self.arc_length(step) {
-                Some(length) => length,
+        let arc = match motion {
+            Some(2 | 3) => match self.arc(step, motion == Some(3)) {
+                Some(arc) => Some(arc),
                 None => return (Motion::Feed, straight, 0.0, None),
             },
-            _ => straight,
+            _ => None,
         };
-        let feed = match (self.feed, self.per_revolution) {
-            (Some(feed), true) => Some(feed * self.speed),
-            (feed, false) => feed,
-            (None, true) => None,
+        let length = arc.as_ref().map_or(straight, Arc::length);
+        let mode = self.feed_mode();
+        let minutes = match (self.feed.filter(|&feed| feed > 0.0), mode) {
+            (Some(feed), FeedMode { per_revolution: false, .. }) => Some(length / feed),
+            (Some(feed), FeedMode { per_revolution: true, css: false }) => {
+                (self.speed > 0.0).then(|| length / (feed * self.speed))
+            }
+            (Some(feed), FeedMode { per_revolution: true, css: true }) => self.css_minutes(step, arc.as_ref(), feed),
+            (None, _) => None,
         };
-        match feed.filter(|&feed| feed > 0.0) {
-            Some(feed) => (Motion::Feed, length, length / feed * 60.0, Some(feed)),
+        match minutes {
+            Some(minutes) => (Motion::Feed, length, minutes * 60.0, Some(length / minutes)),
             None => {
-                let why = if self.per_revolution && self.feed.is_some() {
-                    "feed per revolution (G95) with spindle speed S0: the axes cannot move"
-                } else {
-                    "no feed F programmed before this motion: G01–G03 need one"
+                let why = match mode {
+                    _ if self.feed.is_none_or(|feed| feed <= 0.0) => {
+                        "no feed F programmed before this motion: G01–G03 need one"
+                    }
+                    FeedMode { css: true, .. } => {
+                        "feed per revolution under constant cutting speed with cutting speed S0: the axes cannot move"
+                    }
+                    _ => "feed per revolution (G95) with spindle speed S0: the axes cannot move",
                 };
                 self.finding(range, why, false);
                 (Motion::Feed, length, 0.0, None)
@@ -573,9 +613,71 @@ impl<'a> Runner<'a> {
         }
     }
 
-    /// The length of an arc (with a helix's lead along a third axis), or
-    /// `None` after reporting why the block is not an arc.
-    fn arc_length(&mut self, step: &Move<'_>) -> Option<f64> {
+    /// Feed units and constant cutting speed from group G6, with the swap
+    /// of G96/G97 that machine constant 329 decade 3 selects (01 §6.9).
+    fn feed_mode(&self) -> FeedMode {
+        let swapped = matches!(self.machine.decade(329, 3), 1 | 3);
+        match self.modes.active(self.groups.feed_units) {
+            Some(95) => FeedMode { per_revolution: true, css: false },
+            Some(96) => FeedMode { per_revolution: swapped, css: true },
+            Some(97) => FeedMode { per_revolution: !swapped, css: true },
+            _ => FeedMode { per_revolution: false, css: false },
+        }
+    }
+
+    fn incremental(&self) -> bool {
+        self.modes.active(self.groups.dimensions) == Some(91)
+    }
+
+    /// Minutes a move takes with feed per revolution under constant cutting
+    /// speed: the spindle turns at v / (2π r), r the distance of the
+    /// controlling coordinate from the spindle axis, up to the `G76` limit
+    /// (else 9999 rpm, the largest S); `None` when the cutting speed is 0.
+    fn css_minutes(&mut self, step: &Move<'_>, arc: Option<&Arc>, feed: f64) -> Option<f64> {
+        // S in 0.1 m/min, or in m/min (decade 3 = 2 or 3); as mm/min.
+        let per_unit = if matches!(self.machine.decade(329, 3), 2 | 3) { 1000.0 } else { 100.0 };
+        let cutting_speed = self.speed * per_unit;
+        if cutting_speed <= 0.0 {
+            return None;
+        }
+        let limit = self.speed_limit.unwrap_or(MAX_SPINDLE_SPEED).min(MAX_SPINDLE_SPEED);
+        // Machine constant 67 names the controlling coordinate by a code
+        // the manual does not give; the run reads 1–6 as the axis number
+        // and takes axis 1 otherwise.
+        let axis = usize::try_from(self.machine.constant(67)).ok().filter(|n| (1..=6).contains(n)).unwrap_or(1);
+        let letter = self.machine.axes.get(axis - 1).or(self.machine.axes.first()).copied().unwrap_or(b'X');
+        let slot = usize::from(letter - b'A');
+        let coordinate = |t: f64| match arc {
+            Some(arc) => arc.coordinate(slot, t).unwrap_or(step.start[slot] + t * (step.end[slot] - step.start[slot])),
+            None => step.start[slot] + t * (step.end[slot] - step.start[slot]),
+        };
+        let rpm = |t: f64| (cutting_speed / (std::f64::consts::TAU * coordinate(t).abs())).min(limit);
+        self.speed_reached = Some(rpm(1.0));
+        let length =
+            arc.map_or_else(|| (0..26).map(|i| (step.end[i] - step.start[i]).powi(2)).sum::<f64>().sqrt(), Arc::length);
+        // Composite Simpson over the move: smooth except where the limit
+        // sets in, where 512 intervals keep the error far below a µs.
+        const INTERVALS: usize = 512;
+        let h = 1.0 / INTERVALS as f64;
+        let per_mm = |t: f64| 1.0 / (feed * rpm(t));
+        let sum: f64 = (0..=INTERVALS)
+            .map(|i| {
+                let weight = if i == 0 || i == INTERVALS {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                weight * per_mm(i as f64 * h)
+            })
+            .sum();
+        Some(length * sum * h / 3.0)
+    }
+
+    /// The arc of a G02/G03 block, or `None` after reporting why the block
+    /// is not one.
+    fn arc(&mut self, step: &Move<'_>, counter_clockwise: bool) -> Option<Arc> {
         let Move { block, range, axes, start, end } = *step;
         let mut letters: Vec<u8> = axes.iter().map(|word| word.letter).collect();
         letters.dedup();
@@ -603,18 +705,17 @@ impl<'a> Runner<'a> {
             return None;
         }
         let angle_of = |point: Vector2<f64>| (point.y - centre.y).atan2(point.x - centre.x);
-        let counter_clockwise = self.motion == 3;
-        let mut sweep = angle_of(to) - angle_of(from);
+        let start_angle = angle_of(from);
+        let mut sweep = angle_of(to) - start_angle;
         if counter_clockwise && sweep <= 0.0 {
             sweep += std::f64::consts::TAU;
         } else if !counter_clockwise && sweep >= 0.0 {
             sweep -= std::f64::consts::TAU;
         }
-        let arc = radius * sweep.abs();
         // A third axis written in the block moves along with the arc.
         let lead: f64 =
             letters[2..].iter().map(|&l| (end[usize::from(l - b'A')] - start[usize::from(l - b'A')]).powi(2)).sum();
-        Some((arc * arc + lead).sqrt())
+        Some(Arc { plane: (a, b), centre, radius, start_angle, sweep, lead: lead.sqrt() })
     }
 
     /// F in mm/min (per minute) or mm/rev (per revolution): without a
@@ -624,13 +725,15 @@ impl<'a> Runner<'a> {
         match &word.value {
             Some(Value::Literal(decimal)) => {
                 let value = decimal.to_f64();
-                Some(match (decimal.has_point(), self.per_revolution) {
+                Some(match (decimal.has_point(), self.feed_mode().per_revolution) {
                     (false, false) | (true, true) => value,
                     (true, false) => value * 1000.0,
                     (false, true) => value / 1000.0,
                 })
             }
-            value => self.raw(value.as_ref()?).map(|raw| raw as f64 / if self.per_revolution { 1000.0 } else { 1.0 }),
+            value => self
+                .raw(value.as_ref()?)
+                .map(|raw| raw as f64 / if self.feed_mode().per_revolution { 1000.0 } else { 1.0 }),
         }
     }
 
@@ -709,6 +812,62 @@ impl Machine for ProgramMachine<'_> {
     fn message(&mut self, _message: Message) {}
 }
 
+/// The groups the run reads, resolved once.
+struct Groups {
+    motion: Group,
+    feed_units: Group,
+    dimensions: Group,
+}
+
+impl Groups {
+    fn of(modes: &Modes) -> Groups {
+        Groups { motion: modes.group("G0"), feed_units: modes.group("G6"), dimensions: modes.group("G9") }
+    }
+}
+
+/// How F is read and the spindle turns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct FeedMode {
+    /// F is per revolution (mm/rev) instead of per minute.
+    per_revolution: bool,
+    /// Constant cutting speed: S is a cutting speed, the spindle follows
+    /// the controlling coordinate.
+    css: bool,
+}
+
+/// The largest spindle speed S can program, the limit of constant cutting
+/// speed without `G76` (the gear ranges' maxima are not configured).
+const MAX_SPINDLE_SPEED: f64 = 9999.0;
+
+/// An arc in the plane of axes (`a`, `b`) by slot, with a helix's lead.
+struct Arc {
+    plane: (usize, usize),
+    centre: Vector2<f64>,
+    radius: f64,
+    start_angle: f64,
+    /// Radians, positive counter-clockwise.
+    sweep: f64,
+    /// The travel of the other axes written, in mm.
+    lead: f64,
+}
+
+impl Arc {
+    fn length(&self) -> f64 {
+        (self.radius * self.sweep).hypot(self.lead)
+    }
+
+    /// The coordinate of slot `slot` at fraction `t` of the arc, when the
+    /// slot is one of the plane's.
+    fn coordinate(&self, slot: usize, t: f64) -> Option<f64> {
+        let angle = self.start_angle + t * self.sweep;
+        match slot {
+            _ if slot == self.plane.0 => Some(self.centre.x + self.radius * angle.cos()),
+            _ if slot == self.plane.1 => Some(self.centre.y + self.radius * angle.sin()),
+            _ => None,
+        }
+    }
+}
+
 /// A block's move from `start` to `end`, by the axis words `axes`.
 #[derive(Clone, Copy)]
 struct Move<'b> {
@@ -744,7 +903,7 @@ mod tests {
 
     use ncc_syntax::{Dialect, Parse};
 
-    use super::{Motion, Trace, run};
+    use super::{Motion, Stop, Trace, run};
     use crate::machine::MachineConfig;
 
     fn run_text(text: &str) -> Trace {
@@ -785,6 +944,48 @@ mod tests {
         let trace = run_text("%1\nN1 G95 S500 G01 X10 F200\nN2 X20 F0.5\nN3 M30\n");
         assert_eq!(timing(&trace)[..2], [(6.0, 10.0), (2.4, 10.0)]);
         assert_eq!(trace.steps[1].feed, Some(250.0));
+    }
+
+    #[test]
+    fn constant_cutting_speed_turns_the_spindle_by_the_radius() {
+        use std::f64::consts::TAU;
+        // G97: CSS with feed per revolution; S1000 is 100 m/min. Facing
+        // from X50 to X10 at 0.2 mm/rev: the time is the integral of
+        // 2πr / (f·v) over the path, 40 mm × 2π × 30 mm / (0.2 × 100,000).
+        let text = "%1\nN1 G00 X50 Z0\nN2 G97 S1000 G01 X10 F0.2\nN3 G95 X20 F0.1\nN4 M30\n";
+        let trace = run_text(text);
+        close6(trace.steps[1].duration, 40.0 * TAU * 30.0 / (0.2 * 100_000.0) * 60.0);
+        // When CSS ends without a new S, S keeps the speed reached at X10.
+        let reached = 100_000.0 / (TAU * 10.0);
+        close6(trace.steps[2].duration, 10.0 / (0.1 * reached) * 60.0);
+        // With `G76 S1000` the spindle stops speeding up at the radius
+        // where 100 m/min needs 1000 rpm.
+        let text = "%1\nN1 G00 X50 Z0\nN2 G76 S1000\nN3 G97 S1000 G01 X10 F0.2\nN4 M30\n";
+        let limit_radius = 100_000.0 / (TAU * 1000.0);
+        let expected = TAU * (50.0f64.powi(2) - limit_radius.powi(2)) / 2.0 / (0.2 * 100_000.0)
+            + (limit_radius - 10.0) / (0.2 * 1000.0);
+        close6(run_text(text).steps[2].duration, expected * 60.0);
+        // G96 is CSS with feed per minute: the spindle does not change the time.
+        let trace = run_text("%1\nN1 G00 X50\nN2 G96 S1000 G01 X10 F200\nN3 M30\n");
+        close6(trace.steps[1].duration, 12.0);
+        // Machine constant 329 decade 3 = 3 swaps G96/G97 and reads S in
+        // m/min: the manual's `G96 G1 F200 S90 X50` is 90 m/min, 0.2 mm/rev.
+        let mut machine = MachineConfig::default();
+        machine.constants.insert(329, 300);
+        let text = "%1\nN1 G00 X100\nN2 G96 G1 F200 S90 X50\nN3 M30\n";
+        let trace = run(&Parse::new(text, Dialect::Cnc8x6), &|_| None, &machine, 100);
+        close6(trace.steps[1].duration, 50.0 * TAU * 75.0 / (0.2 * 90_000.0) * 60.0);
+    }
+
+    fn close6(actual: f64, expected: f64) {
+        assert!((actual - expected).abs() < 1e-6 * expected.abs().max(1.0), "{actual} != {expected}");
+    }
+
+    #[test]
+    fn program_stops_are_marked_on_their_block() {
+        let trace = run_text("%1\nN1 G00 X1 M00\nN2 M01\nN3 M30\n");
+        let stops: Vec<Option<Stop>> = trace.steps.iter().map(|step| step.stop).collect();
+        assert_eq!(stops, [Some(Stop::Program), Some(Stop::Optional), None]);
     }
 
     #[test]

@@ -1,0 +1,87 @@
+//! The modal machine: the active code of every G and M group, as the
+//! catalogue defines the groups, their codes and their reset codes.
+
+use ncc_catalog::{Catalogue, Dialect, Modality};
+
+/// The active code of each group (by its index in the catalogue's groups);
+/// `None` for a group without a code in force (G74/G75 before either is
+/// written).
+#[derive(Debug, Clone)]
+pub struct Modes {
+    catalogue: &'static Catalogue,
+    active: Vec<Option<u32>>,
+}
+
+/// A group, resolved once by its id (`G0`, `M2`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Group(usize);
+
+impl Modes {
+    /// The state after reset and at program start: every group's reset
+    /// code (the priority block, 01 README decision 2).
+    pub fn reset() -> Modes {
+        let catalogue = Dialect::Cnc8x6.catalogue();
+        let active = catalogue.groups.iter().map(|group| default_code(group.default.as_deref())).collect();
+        Modes { catalogue, active }
+    }
+
+    /// The group with id `id`.
+    ///
+    /// # Panics
+    /// If the catalogue has no such group: the ids are fixed by the code
+    /// that asks, so this is a programming error.
+    pub fn group(&self, id: &str) -> Group {
+        let index = self.catalogue.groups.iter().position(|group| group.id == id);
+        Group(index.unwrap_or_else(|| panic!("the catalogue has no group {id}")))
+    }
+
+    /// The code in force in `group`.
+    pub fn active(&self, group: Group) -> Option<u32> {
+        self.active[group.0]
+    }
+
+    /// Puts a modal code in force in its group; block-only codes and codes
+    /// outside the groups change nothing.
+    pub fn set(&mut self, letter: u8, number: u32) {
+        let letter = char::from(letter);
+        let modal = self.catalogue.code(letter, number).is_none_or(|code| code.modality == Modality::Modal);
+        if !modal {
+            return;
+        }
+        let Some(group) = self.catalogue.group_of(letter, number) else { return };
+        if let Some(index) = self.catalogue.groups.iter().position(|g| std::ptr::eq(g, group)) {
+            self.active[index] = Some(number);
+        }
+    }
+
+    /// Puts the reset code of `group` in force (M00/M01 do so for a while,
+    /// M02/M30 for good).
+    pub fn reset_group(&mut self, group: Group) {
+        self.active[group.0] = default_code(self.catalogue.groups[group.0].default.as_deref());
+    }
+}
+
+fn default_code(default: Option<&str>) -> Option<u32> {
+    default.and_then(ncc_catalog::split_code).map(|(_, number)| number)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Modes;
+
+    #[test]
+    fn codes_replace_their_group_and_block_only_codes_hold_nothing() {
+        let mut modes = Modes::reset();
+        let (motion, units, spindle, flow) =
+            (modes.group("G0"), modes.group("G6"), modes.group("M2"), modes.group("M1"));
+        assert_eq!([modes.active(motion), modes.active(units), modes.active(spindle)], [Some(1), Some(94), Some(5)]);
+        modes.set(b'G', 0);
+        modes.set(b'G', 97);
+        modes.set(b'M', 3);
+        modes.set(b'M', 0);
+        assert_eq!([modes.active(motion), modes.active(units), modes.active(spindle)], [Some(0), Some(97), Some(3)]);
+        assert_eq!(modes.active(flow), None);
+        modes.reset_group(spindle);
+        assert_eq!(modes.active(spindle), Some(5));
+    }
+}
