@@ -11,10 +11,13 @@
 //! - [`arith`]: the parameter-arithmetic evaluator of G26–G29 (control words
 //!   in R5–R8, operations 0–51). It works on partly unknown parameters, so
 //!   the static analysis uses it as well.
+//! - [`cycles`]: the built-in fixed cycles G81–G89 (milling and lathe), as
+//!   lists of moves for the runner, when the machine loads no cycle file.
 //! - [`lower`]: blocks as plain data (words, parameter assignments,
 //!   comments), read from the syntax tree; the analysis uses it too.
 
 pub mod arith;
+pub mod cycles;
 pub mod lower;
 pub mod machine;
 pub mod modes;
