@@ -13,8 +13,11 @@
 //!   the static analysis uses it as well.
 //! - [`lower`]: blocks as plain data (words, parameter assignments,
 //!   comments), read from the syntax tree; the analysis uses it too.
+//! - [`compensation`]: the tool-centre path of radius compensation G41/G42
+//!   (equidistants, corners, start and cancel), for the runner to drive.
 
 pub mod arith;
+pub mod compensation;
 pub mod lower;
 pub mod machine;
 pub mod run;
