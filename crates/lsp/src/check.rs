@@ -226,7 +226,7 @@ fn is_partprogram(path: &Path) -> bool {
 }
 
 /// Macrocycle files: `L<number>`, with or without an extension.
-pub(crate) fn is_macrocycle(path: &Path) -> bool {
+fn is_macrocycle(path: &Path) -> bool {
     macrocycle_number(path).is_some()
 }
 

@@ -5,7 +5,6 @@
 
 use std::{
     cell::RefCell,
-    collections::BTreeMap,
     fmt::Write as _,
     io::{self, Write as _},
     path::{Path, PathBuf},
@@ -13,7 +12,7 @@ use std::{
 };
 
 use line_index::LineIndex;
-use nc_exec::run::{Motion, Position, Stop, Trace};
+use nc_exec::run::{Called, Files, Motion, Position, Stop, Trace};
 use ncc_analysis::Config;
 use ncc_syntax::{Dialect, Parse, TextSize};
 use serde::Serialize;
@@ -43,7 +42,7 @@ pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
     };
     let parse = Parse::new(&text, Dialect::Cnc8x6);
     let library = Library::for_program(path);
-    let trace = nc_exec::run::run(&parse, &|number| library.load(number), &config.machine, step_budget);
+    let trace = nc_exec::run::run(&parse, &library, &config.machine, step_budget);
     let sources = library.sources(path, text, &trace);
     let axes = &config.machine.axes;
     let written = match format {
@@ -216,43 +215,52 @@ impl Serialize for Axes<'_> {
     }
 }
 
-/// Where a run finds macrocycle files (`G72 L9001` calls the file `L9001`,
-/// with or without an extension): beside the program first, then anywhere
-/// in its project, the directory of its `ncc.toml`.
+/// Where a run finds the files a program uses: macrocycle files
+/// (`G72 L9001` calls the file `L9001`, with or without an extension) and
+/// the machine's cycle file, by name. It looks beside the program first,
+/// then anywhere in its project, the directory of its `ncc.toml`.
 struct Library {
     candidates: Vec<PathBuf>,
-    /// The files read, by number, with their text.
-    read: RefCell<BTreeMap<u32, (PathBuf, String)>>,
+    /// The files read, with their text.
+    read: RefCell<Vec<(Called, PathBuf, String)>>,
 }
 
 impl Library {
     fn for_program(path: &Path) -> Library {
-        let beside = check::macrocycles_beside(&[(path.to_path_buf(), String::new())]).into_iter().map(|(p, _)| p);
+        let directory = path.parent().filter(|dir| !dir.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        let beside = std::fs::read_dir(directory).into_iter().flatten().flatten().map(|entry| entry.path());
         let project = Config::find_for(path).and_then(|config| Some(config.parent()?.to_path_buf()));
         let in_project = project.map(|root| check::collect_files(&[root]).0).unwrap_or_default();
-        let candidates = beside.chain(in_project.into_iter().filter(|path| check::is_macrocycle(path))).collect();
+        let candidates = beside.chain(in_project).filter(|path| path.is_file()).collect();
         Library { candidates, read: RefCell::default() }
     }
 
-    fn load(&self, number: u32) -> Option<Parse> {
-        let path = self.candidates.iter().find(|path| check::macrocycle_number(path) == Some(number))?;
+    fn read(&self, called: Called, matches: impl Fn(&Path) -> bool) -> Option<Parse> {
+        let path = self.candidates.iter().find(|path| matches(path))?;
         let text = check::read_program(path).ok()?;
         let parse = Parse::new(&text, Dialect::Cnc8x6);
-        self.read.borrow_mut().insert(number, (path.clone(), text));
+        self.read.borrow_mut().push((called, path.clone(), text));
         Some(parse)
     }
 
-    /// The program and the macrocycle files in the trace's source order.
+    /// The program and the files the run read, in the trace's source order.
     fn sources(&self, path: &Path, text: String, trace: &Trace) -> Vec<Source> {
-        let mut read = self.read.take();
-        let program = Source { name: path.display().to_string(), lines: LineIndex::new(&text) };
-        let macrocycles = trace.macrocycles.iter().filter_map(|number| read.remove(number));
-        std::iter::once(program)
-            .chain(
-                macrocycles
-                    .map(|(path, text)| Source { name: path.display().to_string(), lines: LineIndex::new(&text) }),
-            )
-            .collect()
+        let read = self.read.take();
+        let source = |path: &Path, text: &str| Source { name: path.display().to_string(), lines: LineIndex::new(text) };
+        let files = trace.files.iter().filter_map(|called| read.iter().find(|(c, _, _)| c == called));
+        std::iter::once(source(path, &text)).chain(files.map(|(_, path, text)| source(path, text))).collect()
+    }
+}
+
+impl Files for Library {
+    fn macrocycle(&self, number: u32) -> Option<Parse> {
+        self.read(Called::Macrocycle(number), |path| check::macrocycle_number(path) == Some(number))
+    }
+
+    fn cycle_file(&self, name: &str) -> Option<Parse> {
+        let named =
+            |path: &Path| path.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.eq_ignore_ascii_case(name));
+        self.read(Called::CycleFile, named)
     }
 }
 

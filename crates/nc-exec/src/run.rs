@@ -1,25 +1,28 @@
 //! Running a CNC8x6 program: the modal state, motion and time, block by
 //! block, in the order the control runs them.
 //!
-//! What runs so far: the program's flow (subprogram calls G71 L Q and
-//! macrocycle files G72 L Q with their repetitions, jumps G73 L Q that run a section Q+1 times, G04 taking
-//! Q from a call in its block, M02/M30, a step budget against endless
-//! loops), rapid and linear motion (G00, G01), arcs and helices
-//! (G02, G03) with the centre from I/J/K and the plane from the two axes
-//! written (01 §6.4), absolute and incremental dimensions (G90, G91), feed
-//! per minute and per revolution with the decimal-point rules of F (G94,
-//! G95), the spindle speed S, dwell (G04 Q, in 10 ms), parameter
-//! assignments, arithmetic (G26–G29) and references (a block's motion uses
-//! the values from before its own assignments and arithmetic), and codes
-//! from parameters (`GR20`: 73 jumps, 78 does nothing). A block's time is its path
-//! length over its feed (G00: the longest axis travel over the machine's
-//! rapid rate), plus dwells; ramps and block joining are the velocity
-//! model's business.
+//! What runs:
+//! - The program's flow: subprogram calls G71 L Q and macrocycle files
+//!   G72 L Q with their repetitions, jumps G73 L Q that run a section Q+1
+//!   times, codes from parameters (`GR20`: 73 jumps, 78 does nothing), G04
+//!   taking Q from a call in its block, M00/M01 stops, M02/M30, and a step
+//!   budget against endless loops.
+//! - Motion: G00, G01, arcs and helices G02/G03 (the centre from I/J/K, the
+//!   plane from the two axes written, 01 §6.4), threads G33, G90/G91.
+//! - Feed and spindle: the modal machine of every group ([`Modes`]), F
+//!   with its decimal-point rules per minute or per revolution, S, constant
+//!   cutting speed G96/G97 with the G76 limit, dwell (G04 Q, in 10 ms).
+//! - Parameters: assignments and arithmetic G26–G29 take effect after the
+//!   block's motion, which reads the values from before them.
+//! - Fixed cycles G81–G89 after the block's motion until G80: the bodies of
+//!   the machine's cycle file with the state restored afterwards, or the
+//!   built-in cycles ([`crate::cycles`]).
 //!
-//! Everything else the control does is reported once per kind as not run
-//! yet (offsets, compensation, fixed
-//! cycles, transformations, threads), so that a total never silently leaves
-//! something out.
+//! A block's time is its path length over its feed (G00: the longest axis
+//! travel over the machine's rapid rate), plus dwells; ramps and block
+//! joining are the velocity model's business. Everything else the control
+//! does is reported once per kind as not run yet (offsets, compensation,
+//! transformations), so that a total never silently leaves something out.
 
 use nalgebra::Vector2;
 use ncc_catalog::{AddressRole, Catalogue, Dialect};
@@ -27,6 +30,7 @@ use ncc_syntax::{Parse, TextRange, ast::AstNode};
 
 use crate::{
     arith::{self, BlockArithmetic, Machine, Message, Parameters, Raw},
+    cycles::{self, CycleError, CycleInput, CycleKind, CycleStep, Spindle},
     lower::{BlockData, Value, Word},
     machine::MachineConfig,
     modes::{Group, Modes},
@@ -98,9 +102,9 @@ pub struct Trace {
     pub findings: Vec<Finding>,
     /// Tools called with T, in order of first use.
     pub tools: Vec<u32>,
-    /// The macrocycle files the run read, by number: source k is
-    /// `macrocycles[k - 1]`.
-    pub macrocycles: Vec<u32>,
+    /// The files the run read besides the program: source k is
+    /// `files[k - 1]`.
+    pub files: Vec<Called>,
 }
 
 impl Trace {
@@ -133,18 +137,50 @@ pub const DEFAULT_STEP_BUDGET: usize = 10_000_000;
 /// How deep subprogram calls nest before the run stops.
 const MAX_CALL_DEPTH: usize = 64;
 
+/// Where a run reads the files a program uses besides its own.
+pub trait Files {
+    /// The macrocycle file `L<number>`.
+    fn macrocycle(&self, number: u32) -> Option<Parse>;
+    /// The fixed-cycle file the machine names (`PCYKLYDG.NCP`).
+    fn cycle_file(&self, name: &str) -> Option<Parse>;
+}
+
+/// No files besides the program.
+#[derive(Debug, Clone, Copy)]
+pub struct NoFiles;
+
+impl Files for NoFiles {
+    fn macrocycle(&self, _number: u32) -> Option<Parse> {
+        None
+    }
+
+    fn cycle_file(&self, _name: &str) -> Option<Parse> {
+        None
+    }
+}
+
+/// A file of the run besides the program.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Called {
+    Macrocycle(u32),
+    /// The machine's fixed-cycle file.
+    CycleFile,
+}
+
 /// Runs a CNC8x6 program from its first block to M02/M30 on `machine`,
-/// following subprogram calls, macrocycle calls (files from
-/// `macrocycle(number)`, loaded when first called) and jumps, for at most
-/// `budget` blocks. Parameters start at zero.
-pub fn run(parse: &Parse, macrocycle: &dyn Fn(u32) -> Option<Parse>, machine: &MachineConfig, budget: usize) -> Trace {
+/// following subprogram calls, macrocycle calls, fixed cycles (the
+/// bodies of the machine's cycle file, or the built-in cycles) and jumps,
+/// for at most `budget` blocks. Files are read from `files` when first
+/// needed. Parameters start at zero.
+pub fn run(parse: &Parse, files: &dyn Files, machine: &MachineConfig, budget: usize) -> Trace {
     let mut program = Blocks::default();
     program.add(parse);
     let mut runner = Runner::new(machine);
     // Macrocycle numbers called, and where each file's body starts; the
-    // files read, in source order.
+    // cycle file's source once read; the files read, in source order.
     let mut loaded: Vec<(u32, Option<usize>)> = Vec::new();
-    let mut files: Vec<u32> = Vec::new();
+    let mut cycle_file: Option<Option<usize>> = None;
+    let mut called: Vec<Called> = Vec::new();
     // Calls being run: where to return, how many runs remain, where the
     // subprogram starts.
     let mut calls: Vec<Call> = Vec::new();
@@ -182,15 +218,48 @@ pub fn run(parse: &Parse, macrocycle: &dyn Fn(u32) -> Option<Parse>, machine: &M
                     call.remaining -= 1;
                     call.start
                 }
-                Some(_) => calls.pop().map_or(next, |call| call.back),
+                Some(_) => calls.pop().map_or(next, |call| {
+                    if let Some(snapshot) = call.restore {
+                        runner.restore(*snapshot);
+                    }
+                    call.back
+                }),
                 None => next,
             },
+            Flow::Cycle { number } => {
+                let name = machine.cycle_file.as_deref().unwrap_or_default();
+                let source = *cycle_file.get_or_insert_with(|| {
+                    let parse = files.cycle_file(name)?;
+                    called.push(Called::CycleFile);
+                    program.add(&parse)?;
+                    Some(program.sources - 1)
+                });
+                match source.and_then(|source| program.units.subprogram(source, number)) {
+                    Some(start) => {
+                        let restore = Some(Box::new(runner.snapshot()));
+                        runner.in_cycle = true;
+                        calls.push(Call { back: next, remaining: 1, start, restore });
+                        start
+                    }
+                    None => {
+                        let why = match source {
+                            None => format!("the cycle file {name} the machine names is not in the project"),
+                            Some(_) => format!("the cycle file {name} has no body G79 L{number}"),
+                        };
+                        runner.report_once(&why, range, &format!("{why}: the built-in cycle runs instead"));
+                        if !runner.built_in_cycle_or_stop(number, range) {
+                            break;
+                        }
+                        next
+                    }
+                }
+            }
             Flow::Call { label, times, macrocycle: is_macrocycle } => {
                 let start = if is_macrocycle {
                     let known = loaded.iter().find(|&&(number, _)| number == label).map(|&(_, start)| start);
                     known.unwrap_or_else(|| {
-                        let start = macrocycle(label).and_then(|parse| {
-                            files.push(label);
+                        let start = files.macrocycle(label).and_then(|parse| {
+                            called.push(Called::Macrocycle(label));
                             program.add(&parse)
                         });
                         loaded.push((label, start));
@@ -201,7 +270,7 @@ pub fn run(parse: &Parse, macrocycle: &dyn Fn(u32) -> Option<Parse>, machine: &M
                 };
                 match start {
                     Some(start) if calls.len() < MAX_CALL_DEPTH => {
-                        calls.push(Call { back: next, remaining: times, start });
+                        calls.push(Call { back: next, remaining: times, start, restore: None });
                         start
                     }
                     Some(_) => {
@@ -250,7 +319,7 @@ pub fn run(parse: &Parse, macrocycle: &dyn Fn(u32) -> Option<Parse>, machine: &M
             break;
         }
     }
-    Trace { steps: runner.steps, findings: runner.findings, tools: runner.tools, macrocycles: files }
+    Trace { steps: runner.steps, findings: runner.findings, tools: runner.tools, files: called }
 }
 
 /// A subprogram or macrocycle call being run.
@@ -261,6 +330,8 @@ struct Call {
     remaining: u32,
     /// The body's first block after its `G79`.
     start: usize,
+    /// A fixed cycle of the cycle file: the state to restore on return.
+    restore: Option<Box<Snapshot>>,
 }
 
 /// The blocks of the program and the macrocycle files loaded so far, one
@@ -320,8 +391,9 @@ impl Units {
         };
         self.units += 1;
         for (index, block) in (first..).zip(blocks) {
-            // A macrocycle file's own `G79` opens its body, not a new unit.
-            if block.data.has_code(b'G', 79) && index != first {
+            // Each `G79` opens a unit: a subprogram, a cycle file's body,
+            // or a macrocycle file's body (whose file opened one already).
+            if block.data.has_code(b'G', 79) {
                 self.units += 1;
                 self.starts.extend(label(&block.data).map(|label| (index, block.source, label)));
             }
@@ -368,6 +440,10 @@ enum Flow {
         times: u32,
         macrocycle: bool,
     },
+    /// A fixed cycle's body in the cycle file, after the block's motion.
+    Cycle {
+        number: u32,
+    },
     /// `G73 L Q`: jump to block N`label`, `times` times in all.
     Jump {
         label: u32,
@@ -383,11 +459,14 @@ struct Runner<'a> {
     machine: &'a MachineConfig,
     modes: Modes,
     groups: Groups,
-    /// F as programmed: mm/min (per minute) or mm/rev (per revolution).
-    feed: Option<f64>,
+    /// F as programmed; its unit follows the feed mode in force.
+    feed: Option<ProgrammedFeed>,
     /// S as programmed: rpm, or the cutting speed under constant cutting
     /// speed (0.1 m/min, or m/min as machine constant 329 selects).
     speed: f64,
+    /// A fixed cycle's body of the cycle file is running: cycles do not
+    /// start in it.
+    in_cycle: bool,
     /// The speed limit of constant cutting speed set by `G76 S`, in rpm.
     speed_limit: Option<f64>,
     /// The spindle speed constant cutting speed reached last, which S
@@ -420,6 +499,7 @@ impl<'a> Runner<'a> {
             speed: 0.0,
             speed_limit: None,
             speed_reached: None,
+            in_cycle: false,
             position: [0.0; 26],
             params: Parameters::zeroed(),
             time: 0.0,
@@ -457,13 +537,11 @@ impl<'a> Runner<'a> {
                 // Modes the run reads where they matter; planes, block
                 // joining, cancelling and the priority codes change
                 // nothing the executor models yet.
-                (b'G', 0..=4 | 17..=19 | 23 | 24 | 40 | 53 | 76 | 78 | 80 | 90 | 91 | 94..=98) | (b'M', _) => {}
+                (b'G', 0..=4 | 33 | 17..=19 | 23 | 24 | 40 | 53 | 76 | 78 | 80..=91 | 94..=98) | (b'M', _) => {}
                 // Program flow, which the caller follows, and the
                 // arithmetic, which runs after the motion.
                 (b'G', 26..=29 | 70..=73 | 79) => {}
                 (b'G', 41 | 42) => self.not_run("radius compensation (G41/G42)", code_range),
-                (b'G', 33) => self.not_run("thread cutting (G33)", code_range),
-                (b'G', 81..=89) => self.not_run("fixed cycles (G81–G89)", code_range),
                 (b'G', 54..=59 | 92 | 93) => self.not_run("zero offsets (G54–G59, G92, G93)", code_range),
                 (b'G', 31 | 34..=39) => self.not_run("transformations (G31, G34–G39)", code_range),
                 _ => self.not_run(&format!("G{number:02}"), code_range),
@@ -471,7 +549,7 @@ impl<'a> Runner<'a> {
         }
         for word in &block.words {
             match self.catalogue.role_of(word.letter) {
-                Some(AddressRole::Feed) => self.feed = self.feed_value(word),
+                Some(AddressRole::Feed) => self.feed = self.programmed_feed(word),
                 Some(AddressRole::Speed) => match self.count(word) {
                     // `G76 S` limits the speed of constant cutting speed.
                     Some(limit) if has(b'G', 76) => self.speed_limit = Some(limit),
@@ -512,25 +590,14 @@ impl<'a> Runner<'a> {
             self.position = end;
             self.moved(&Move { block, range, axes: &axes, start, end })
         };
-        self.steps.push(Step {
-            source: self.source,
-            range,
-            motion,
-            start_time: self.time,
-            duration,
-            length,
-            feed,
-            start,
-            end: self.position,
-            stop: if has(b'M', 0) {
-                Some(Stop::Program)
-            } else if has(b'M', 1) {
-                Some(Stop::Optional)
-            } else {
-                None
-            },
-        });
-        self.time += duration;
+        let stop = if has(b'M', 0) {
+            Some(Stop::Program)
+        } else if has(b'M', 1) {
+            Some(Stop::Optional)
+        } else {
+            None
+        };
+        self.record(range, motion, (start, self.position), length, duration, feed, stop);
         // Assignments and arithmetic take effect after the block's motion.
         arith::assign(block, &mut self.params);
         let mut machine = ProgramMachine { machine: self.machine, position: &self.position };
@@ -544,6 +611,17 @@ impl<'a> Runner<'a> {
             }
             BlockArithmetic::Ran { function, result: Err(error), .. } => {
                 self.finding(at(function), &format!("parameter arithmetic failed: {error}"), true);
+                return Flow::End;
+            }
+        }
+        // The active fixed cycle runs after the block's motion, in every
+        // block until G80 (03 §1.4), but not inside its own body.
+        let cycle = self.modes.active(self.groups.cycle).filter(|&number| (81..=89).contains(&number));
+        if let Some(number) = cycle.filter(|_| !self.in_cycle) {
+            if self.machine.cycle_file.is_some() {
+                return Flow::Cycle { number };
+            }
+            if !self.built_in_cycle_or_stop(number, range) {
                 return Flow::End;
             }
         }
@@ -564,6 +642,109 @@ impl<'a> Runner<'a> {
         }
     }
 
+    /// Adds a step of the block at `range` that starts now.
+    #[allow(clippy::too_many_arguments)] // One call per kind of step; a struct would only rename them.
+    fn record(
+        &mut self,
+        range: TextRange,
+        motion: Motion,
+        (start, end): (Position, Position),
+        length: f64,
+        duration: f64,
+        feed: Option<f64>,
+        stop: Option<Stop>,
+    ) {
+        let source = self.source;
+        let start_time = self.time;
+        self.steps.push(Step { source, range, motion, start_time, duration, length, feed, start, end, stop });
+        self.time += duration;
+    }
+
+    /// Runs a built-in cycle; `false` after reporting why it cannot run.
+    fn built_in_cycle_or_stop(&mut self, number: u32, range: TextRange) -> bool {
+        let result = self.built_in_cycle(number, range);
+        if let Err(error) = &result {
+            self.finding(range, &format!("the fixed cycle G{number} cannot run: {error}"), true);
+        }
+        result.is_ok()
+    }
+
+    /// Runs one pass of a built-in fixed cycle from where the block ended
+    /// and times its moves as steps of the block. Its F, S and spindle
+    /// changes stay inside it (03 §1.4 I6).
+    fn built_in_cycle(&mut self, number: u32, range: TextRange) -> Result<(), CycleError> {
+        let spindle = match self.modes.active(self.groups.spindle) {
+            Some(3) => Spindle::Clockwise,
+            Some(4) => Spindle::CounterClockwise,
+            Some(19) => Spindle::Oriented,
+            _ => Spindle::Stopped,
+        };
+        let input = CycleInput {
+            number,
+            kind: CycleKind::of(self.machine.cycle_file.as_deref()),
+            params: &self.params,
+            position: self.position,
+            incremental: self.incremental(),
+            per_revolution: self.feed_mode().per_revolution,
+            speed: self.speed,
+            spindle,
+            diameter: false,
+        };
+        let cycle = cycles::expand(&input)?;
+        let mut at = cycle.start;
+        for step in &cycle.steps {
+            let to = step.to().copied().unwrap_or(at);
+            let length = (0..26).map(|i| (to[i] - at[i]).powi(2)).sum::<f64>().sqrt();
+            let (motion, duration, feed) = match *step {
+                CycleStep::Rapid { .. } => (Motion::Rapid, self.rapid_seconds(&at, &to), None),
+                CycleStep::Feed { .. } | CycleStep::Thread { .. } => {
+                    let rate = step.feed_rate().filter(|&rate| rate > 0.0);
+                    let wait = match step {
+                        CycleStep::Thread { thread, .. } => 0.5 / thread.speed * 60.0,
+                        _ => 0.0,
+                    };
+                    (Motion::Feed, rate.map_or(0.0, |rate| length / rate * 60.0) + wait, rate)
+                }
+                CycleStep::Dwell { seconds } => (Motion::Dwell, seconds, None),
+                CycleStep::Spindle { .. } => continue,
+            };
+            self.record(range, motion, (at, to), length, duration, feed, None);
+            at = to;
+        }
+        self.position = cycle.end();
+        Ok(())
+    }
+
+    /// Seconds a rapid move takes: the longest axis travel at the rapid rate.
+    fn rapid_seconds(&self, start: &Position, end: &Position) -> f64 {
+        let longest = (0..26).map(|i| (end[i] - start[i]).abs()).fold(0.0, f64::max);
+        longest / f64::from(self.machine.rapid_rate) * 60.0
+    }
+
+    /// What a cycle of the cycle file keeps of the state before it: all of
+    /// it, restored when the cycle's body returns (03 §1.4 I6).
+    fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            modes: self.modes.clone(),
+            feed: self.feed,
+            speed: self.speed,
+            speed_limit: self.speed_limit,
+            params: self.params.clone(),
+        }
+    }
+
+    /// Back to the state before a cycle, where the cycle left the tool.
+    fn restore(&mut self, snapshot: Snapshot) {
+        Snapshot {
+            modes: self.modes,
+            feed: self.feed,
+            speed: self.speed,
+            speed_limit: self.speed_limit,
+            params: self.params,
+        } = snapshot;
+        self.in_cycle = false;
+    }
+
     fn finding(&mut self, range: TextRange, message: &str, fatal: bool) {
         self.findings.push(Finding { source: self.source, range, message: message.to_owned(), fatal });
     }
@@ -575,8 +756,7 @@ impl<'a> Runner<'a> {
         let straight = (0..26).map(|i| travel(i).powi(2)).sum::<f64>().sqrt();
         let motion = self.modes.active(self.groups.motion);
         if motion == Some(0) {
-            let longest = (0..26).map(|i| travel(i).abs()).fold(0.0, f64::max);
-            return (Motion::Rapid, straight, longest / f64::from(self.machine.rapid_rate) * 60.0, None);
+            return (Motion::Rapid, straight, self.rapid_seconds(&start, &end), None);
         }
         let arc = match motion {
             Some(2 | 3) => match self.arc(step, motion == Some(3)) {
@@ -587,7 +767,13 @@ impl<'a> Runner<'a> {
         };
         let length = arc.as_ref().map_or(straight, Arc::length);
         let mode = self.feed_mode();
-        let minutes = match (self.feed.filter(|&feed| feed > 0.0), mode) {
+        let feed = self.feed.map(|feed| feed.value(mode.per_revolution || motion == Some(33)));
+        let minutes = match (feed.filter(|&feed| feed > 0.0), mode) {
+            // A thread: the lead per revolution at S, after waiting for the
+            // spindle's zero pulse, on average half a revolution (01 §6.10).
+            (Some(lead), _) if motion == Some(33) => {
+                (self.speed > 0.0).then(|| length / (lead * self.speed) + 0.5 / self.speed)
+            }
             (Some(feed), FeedMode { per_revolution: false, .. }) => Some(length / feed),
             (Some(feed), FeedMode { per_revolution: true, css: false }) => {
                 (self.speed > 0.0).then(|| length / (feed * self.speed))
@@ -599,9 +785,10 @@ impl<'a> Runner<'a> {
             Some(minutes) => (Motion::Feed, length, minutes * 60.0, Some(length / minutes)),
             None => {
                 let why = match mode {
-                    _ if self.feed.is_none_or(|feed| feed <= 0.0) => {
+                    _ if feed.is_none_or(|feed| feed <= 0.0) => {
                         "no feed F programmed before this motion: G01–G03 need one"
                     }
+                    _ if motion == Some(33) => "a thread (G33) with spindle speed S0: the axes cannot move",
                     FeedMode { css: true, .. } => {
                         "feed per revolution under constant cutting speed with cutting speed S0: the axes cannot move"
                     }
@@ -718,22 +905,12 @@ impl<'a> Runner<'a> {
         Some(Arc { plane: (a, b), centre, radius, start_angle, sweep, lead: lead.sqrt() })
     }
 
-    /// F in mm/min (per minute) or mm/rev (per revolution): without a
-    /// decimal point mm/min or µm/rev, with one m/min or mm/rev (01 §6.6);
-    /// from a parameter, its raw value as the digits written.
-    fn feed_value(&self, word: &Word) -> Option<f64> {
-        match &word.value {
-            Some(Value::Literal(decimal)) => {
-                let value = decimal.to_f64();
-                Some(match (decimal.has_point(), self.feed_mode().per_revolution) {
-                    (false, false) | (true, true) => value,
-                    (true, false) => value * 1000.0,
-                    (false, true) => value / 1000.0,
-                })
-            }
-            value => self
-                .raw(value.as_ref()?)
-                .map(|raw| raw as f64 / if self.feed_mode().per_revolution { 1000.0 } else { 1.0 }),
+    /// F as written: a literal, or a parameter's raw value read as digits
+    /// without a point (`R26=0.200` is F200, 03 §1.6).
+    fn programmed_feed(&self, word: &Word) -> Option<ProgrammedFeed> {
+        match word.value.as_ref()? {
+            Value::Literal(decimal) => Some(ProgrammedFeed { value: decimal.to_f64(), point: decimal.has_point() }),
+            value => self.raw(value).map(|raw| ProgrammedFeed { value: raw as f64, point: false }),
         }
     }
 
@@ -816,12 +993,48 @@ impl Machine for ProgramMachine<'_> {
 struct Groups {
     motion: Group,
     feed_units: Group,
+    cycle: Group,
     dimensions: Group,
+    spindle: Group,
 }
 
 impl Groups {
     fn of(modes: &Modes) -> Groups {
-        Groups { motion: modes.group("G0"), feed_units: modes.group("G6"), dimensions: modes.group("G9") }
+        Groups {
+            motion: modes.group("G0"),
+            feed_units: modes.group("G6"),
+            cycle: modes.group("G8"),
+            dimensions: modes.group("G9"),
+            spindle: modes.group("M2"),
+        }
+    }
+}
+
+/// The state a fixed cycle of the cycle file restores when it returns.
+struct Snapshot {
+    modes: Modes,
+    feed: Option<ProgrammedFeed>,
+    speed: f64,
+    speed_limit: Option<f64>,
+    params: Parameters,
+}
+
+/// F as written: `value` without a decimal point is mm/min or µm/rev,
+/// with one m/min or mm/rev (01 §6.6).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct ProgrammedFeed {
+    value: f64,
+    point: bool,
+}
+
+impl ProgrammedFeed {
+    /// mm/rev when `per_revolution`, else mm/min.
+    fn value(self, per_revolution: bool) -> f64 {
+        match (self.point, per_revolution) {
+            (false, false) | (true, true) => self.value,
+            (true, false) => self.value * 1000.0,
+            (false, true) => self.value / 1000.0,
+        }
     }
 }
 
@@ -903,11 +1116,24 @@ mod tests {
 
     use ncc_syntax::{Dialect, Parse};
 
-    use super::{Motion, Stop, Trace, run};
+    use super::{Called, Files, Motion, NoFiles, Stop, Trace, run};
     use crate::machine::MachineConfig;
 
     fn run_text(text: &str) -> Trace {
-        run(&Parse::new(text, Dialect::Cnc8x6), &|_| None, &MachineConfig::default(), 1000)
+        run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &MachineConfig::default(), 1000)
+    }
+
+    /// The macrocycle file L9001, and a cycle file, with the same text.
+    struct Library(&'static str);
+
+    impl Files for Library {
+        fn macrocycle(&self, number: u32) -> Option<Parse> {
+            (number == 9001).then(|| Parse::new(self.0, Dialect::Cnc8x6))
+        }
+
+        fn cycle_file(&self, _name: &str) -> Option<Parse> {
+            Some(Parse::new(self.0, Dialect::Cnc8x6))
+        }
     }
 
     /// Durations (s) and lengths (mm) of the blocks, rounded to a
@@ -973,7 +1199,7 @@ mod tests {
         let mut machine = MachineConfig::default();
         machine.constants.insert(329, 300);
         let text = "%1\nN1 G00 X100\nN2 G96 G1 F200 S90 X50\nN3 M30\n";
-        let trace = run(&Parse::new(text, Dialect::Cnc8x6), &|_| None, &machine, 100);
+        let trace = run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &machine, 100);
         close6(trace.steps[1].duration, 50.0 * TAU * 75.0 / (0.2 * 90_000.0) * 60.0);
     }
 
@@ -986,6 +1212,76 @@ mod tests {
         let trace = run_text("%1\nN1 G00 X1 M00\nN2 M01\nN3 M30\n");
         let stops: Vec<Option<Stop>> = trace.steps.iter().map(|step| step.stop).collect();
         assert_eq!(stops, [Some(Stop::Program), Some(Stop::Optional), None]);
+    }
+
+    #[test]
+    fn a_thread_turns_at_its_lead_after_the_zero_pulse() {
+        // 15 mm at 1.5 mm/rev and S500: 0.02 min, plus half a revolution's
+        // wait for the zero pulse, 0.001 min.
+        let trace = run_text("%1\nN1 S500 M03 G00 X10 Z0\nN2 G33 Z-15. F1.5\nN3 M30\n");
+        close6(trace.steps[1].duration, (0.02 + 0.001) * 60.0);
+        assert_eq!(trace.steps[1].motion, Motion::Feed);
+    }
+
+    /// Drilling at X20 and X30 with G81 (RA Z2, RB Z-10, RC Z5, R26 F100),
+    /// cancelled by G80 at X40.
+    const DRILLING: &str = "%1\nN1 R26=100 R27=1000 R30=2. R31=-10. R32=5. M03\nN2 G00 X10 Y10 Z5\nN3 G81 X20\nN4 X30\nN5 G80 X40\nN6 M30\n";
+
+    /// What each step did: the block's line, the motion and Z at its end.
+    fn drilled(trace: &Trace) -> Vec<(String, Motion, f64)> {
+        let z = usize::from(b'Z' - b'A');
+        trace
+            .steps
+            .iter()
+            .map(|s| (DRILLING[s.range].split(' ').next().unwrap().to_owned(), s.motion, s.end[z]))
+            .collect()
+    }
+
+    #[test]
+    fn a_built_in_cycle_runs_after_each_block_until_g80() {
+        let trace = run_text(DRILLING);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let n = |s: &str| s.to_owned();
+        let drill = |block: &str| {
+            [(n(block), Motion::Rapid, 2.0), (n(block), Motion::Feed, -10.0), (n(block), Motion::Rapid, 5.0)]
+        };
+        let mut expected =
+            vec![(n("N1"), Motion::None, 0.0), (n("N2"), Motion::Rapid, 5.0), (n("N3"), Motion::Rapid, 5.0)];
+        expected.extend(drill("N3"));
+        expected.push((n("N4"), Motion::Rapid, 5.0));
+        expected.extend(drill("N4"));
+        expected.extend([(n("N5"), Motion::Rapid, 5.0), (n("N6"), Motion::None, 5.0)]);
+        assert_eq!(drilled(&trace), expected);
+        // 12 mm at F100, twice.
+        close(trace.time_in(Motion::Feed), 2.0 * 12.0 / 100.0 * 60.0);
+    }
+
+    #[test]
+    fn a_cycle_file_body_runs_and_the_state_before_it_returns() {
+        // The body feeds with G01 and R26; back in the program, G00 and no
+        // F are in force again, so N4 and N5 are rapids.
+        let body = "\"$PC\nN1 G79 L81\nN2 G00 G90 ZR30\nN3 G01 ZR31 FR26\nN4 G00 G70 ZR32\n*\n";
+        let machine = MachineConfig { cycle_file: Some("PC.NCP".to_owned()), ..MachineConfig::default() };
+        let trace = run(&Parse::new(DRILLING, Dialect::Cnc8x6), &Library(body), &machine, 1000);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        assert_eq!(trace.files, [Called::CycleFile]);
+        let lines: Vec<(usize, Motion)> = trace.steps.iter().map(|s| (s.source, s.motion)).collect();
+        let body_steps = [(1, Motion::Rapid), (1, Motion::Feed), (1, Motion::Rapid)];
+        let mut expected = vec![(0, Motion::None), (0, Motion::Rapid), (0, Motion::Rapid)];
+        expected.extend(body_steps);
+        expected.push((0, Motion::Rapid));
+        expected.extend(body_steps);
+        expected.extend([(0, Motion::Rapid), (0, Motion::None)]);
+        assert_eq!(lines, expected);
+        close(trace.time_in(Motion::Feed), 2.0 * 12.0 / 100.0 * 60.0);
+        // Without the file, the built-in cycle runs and says why.
+        let trace = run(&Parse::new(DRILLING, Dialect::Cnc8x6), &NoFiles, &machine, 1000);
+        let messages: Vec<&str> = trace.findings.iter().map(|f| f.message.as_str()).collect();
+        assert_eq!(
+            messages,
+            ["the cycle file PC.NCP the machine names is not in the project: the built-in cycle runs instead"]
+        );
+        close(trace.time_in(Motion::Feed), 2.0 * 12.0 / 100.0 * 60.0);
     }
 
     #[test]
@@ -1091,19 +1387,18 @@ mod tests {
         // found in its own file, though the program has an N20 too.
         let program = "%1\nN10 R20=10. R21=3. G91 F600\nN20 G72 L9001 Q2\nN30 M30\n";
         let macro_text = "N1 G79 L9001\nN2 R22=0 R24=1.\nN20 G01 XR20\nN30 R5=1222422 R6=17222123 G27\nN40 GR23 L20 Q9999\nN50 G70\n";
-        let library = |number| (number == 9001).then(|| Parse::new(macro_text, Dialect::Cnc8x6));
-        let trace = run(&Parse::new(program, Dialect::Cnc8x6), &library, &MachineConfig::default(), 1000);
+        let trace = run(&Parse::new(program, Dialect::Cnc8x6), &Library(macro_text), &MachineConfig::default(), 1000);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
-        assert_eq!(trace.macrocycles, [9001]);
+        assert_eq!(trace.files, [Called::Macrocycle(9001)]);
         // Two calls, three holes each.
         let moves: Vec<usize> = trace.steps.iter().filter(|s| s.motion == Motion::Feed).map(|s| s.source).collect();
         assert_eq!(moves, [1; 6]);
         assert_eq!(trace.end_position()[usize::from(b'X' - b'A')], 60.0);
 
-        let trace = run(&Parse::new(program, Dialect::Cnc8x6), &|_| None, &MachineConfig::default(), 1000);
+        let trace = run(&Parse::new(program, Dialect::Cnc8x6), &NoFiles, &MachineConfig::default(), 1000);
         let messages: Vec<&str> = trace.findings.iter().map(|f| f.message.as_str()).collect();
         assert_eq!(messages, ["there is no macrocycle file L9001 to call"]);
-        let unended = |_| Some(Parse::new("N1 G79 L9001\nN2 G00 X1\n", Dialect::Cnc8x6));
+        let unended = Library("N1 G79 L9001\nN2 G00 X1\n");
         let trace = run(&Parse::new(program, Dialect::Cnc8x6), &unended, &MachineConfig::default(), 1000);
         let messages: Vec<&str> = trace.findings.iter().map(|f| f.message.as_str()).collect();
         assert_eq!(messages, ["the macrocycle file ends without G70"]);
@@ -1138,7 +1433,7 @@ mod tests {
         assert_eq!(fatal, [("N4 G71 L1", "calls nest deeper than 64: runaway recursion?")]);
 
         let text = "%1\nN1 G73 L1 Q9999\nN2 M30\n";
-        let trace = run(&Parse::new(text, Dialect::Cnc8x6), &|_| None, &MachineConfig::default(), 500);
+        let trace = run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &MachineConfig::default(), 500);
         assert_eq!(trace.steps.len(), 500);
         assert!(trace.findings[0].message.starts_with("stopped after 500 blocks"), "{:?}", trace.findings);
 
