@@ -459,3 +459,34 @@ fn run_finds_macrocycle_files_in_the_project() {
     assert_eq!(json["findings"][0]["message"], "there is no macrocycle file L9002 to call");
     assert_eq!(json["findings"][0]["line"], 3);
 }
+
+/// `ncc expand` writes a program that runs the same moves in the same time
+/// (to F's whole mm/min), here with a macrocycle file and its dwells
+/// resolved; the expanded program passes `ncc check` without errors.
+#[test]
+fn expand_writes_a_program_with_the_same_moves() {
+    let dir = tempfile::tempdir().unwrap();
+    let expanded = dir.path().join("HOLES.NCP");
+    let expanded = expanded.to_str().unwrap();
+    let output = ncc(&["expand", "examples/milling/holes.NCP", "-o", expanded]);
+    assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
+    let moves = |program: &str| {
+        let output = ncc(&["run", program, "--format", "json"]);
+        let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+        let ends: Vec<String> = json["blocks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|b| b["motion"] != "none" && b["length_mm"].as_f64() != Some(0.0))
+            .map(|b| format!("{} {}", b["motion"], b["end"]["program"]))
+            .collect();
+        (ends, json["total_time_s"].as_f64().unwrap())
+    };
+    let (original, original_time) = moves("examples/milling/holes.NCP");
+    let (again, again_time) = moves(expanded);
+    assert_eq!(again, original);
+    assert!((again_time - original_time).abs() < 1e-3 * original_time, "{original_time} s, expanded {again_time} s");
+    let check = ncc(&["check", "--format", "short", expanded]);
+    let report = String::from_utf8(check.stdout).unwrap();
+    assert!(!report.contains(": error"), "{report}");
+}

@@ -76,11 +76,11 @@ enum Command {
     /// Run a program on the executor and print what the machine would do.
     ///
     /// The summary splits the time into cutting, rapid and dwell, with the
-    /// path lengths, the tools used and the end position. So far the
-    /// executor runs motion (G00–G03, helices), G90/G91, feed units, S,
-    /// dwell, parameter assignments, subprogram calls, jumps and the
-    /// program end; anything else it names as not run yet. Exit status 1
-    /// when the run stopped on an error.
+    /// path lengths, the tools used and the end position. The executor
+    /// runs motion, threads, feed units, constant cutting speed, dwell,
+    /// parameters and their arithmetic, subprograms, macrocycle files,
+    /// jumps and fixed cycles; anything else it names as not run yet. Exit
+    /// status 1 when the run stopped on an error.
     Run {
         /// The program to run.
         file: PathBuf,
@@ -89,6 +89,22 @@ enum Command {
         format: run::Format,
         /// Stop after running this many blocks (a jump loop that never
         /// ends, runaway calls).
+        #[arg(long, default_value_t = nc_exec::run::DEFAULT_STEP_BUDGET)]
+        step_budget: usize,
+    },
+    /// Write a program as the moves it runs: plain numbered blocks with
+    /// calls, jumps, cycles and parameters resolved.
+    ///
+    /// The output is a CNC8x6 program (G90, G94, F in mm/min) that runs the
+    /// same moves; findings of the run go to stderr, and the exit status is
+    /// 1 when the run stopped on an error.
+    Expand {
+        /// The program to expand.
+        file: PathBuf,
+        /// Write the program here instead of to stdout.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Stop after running this many blocks.
         #[arg(long, default_value_t = nc_exec::run::DEFAULT_STEP_BUDGET)]
         step_budget: usize,
     },
@@ -110,6 +126,7 @@ fn main() -> ExitCode {
         }
         Command::Lsp { log_level, .. } => server::run(log_level),
         Command::Run { file, format, step_budget } => run::run(&file, format, step_budget),
+        Command::Expand { file, output, step_budget } => run::expand(&file, output.as_deref(), step_budget),
         Command::Parse { file } => match check::read_program(&file) {
             Ok(text) => {
                 let parse = ncc_syntax::Parse::new(&text, ncc_syntax::Dialect::Cnc8x6);

@@ -25,36 +25,58 @@ pub(crate) enum Format {
     Json,
 }
 
-pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
-    let text = match check::read_program(path) {
-        Ok(text) => text,
-        Err(error) => {
+/// A program run on the machine of its project.
+struct Ran {
+    trace: Trace,
+    sources: Vec<Source>,
+    config: Config,
+    /// The program's number from its `%` header.
+    number: Option<u32>,
+}
+
+impl Ran {
+    /// Runs the program at `path`; the error is the exit code after the
+    /// message is printed.
+    fn new(path: &Path, step_budget: usize) -> Result<Ran, ExitCode> {
+        let text = check::read_program(path).map_err(|error| {
             eprintln!("error: {}: {error}", path.display());
-            return ExitCode::from(2);
-        }
-    };
-    let config = match Config::find_for(path).map(|config| check::load_config(&config)).transpose() {
-        Ok(config) => config.unwrap_or_default(),
-        Err(error) => {
+            ExitCode::from(2)
+        })?;
+        let config = Config::find_for(path).map(|config| check::load_config(&config)).transpose().map_err(|error| {
             eprintln!("error: {error}");
-            return ExitCode::from(2);
+            ExitCode::from(2)
+        })?;
+        let config = config.unwrap_or_default();
+        let parse = Parse::new(&text, Dialect::Cnc8x6);
+        let number =
+            parse.tree().header().and_then(|header| header.number()).and_then(|n| u32::try_from(n.scaled(0)?).ok());
+        let library = Library::for_program(path);
+        let trace = nc_exec::run::run(&parse, &library, &config.machine, step_budget);
+        let sources = library.sources(path, text, &trace);
+        for finding in &trace.findings {
+            eprintln!("{}: {}", sources[finding.source].place(finding.range.start()), finding.message);
         }
+        Ok(Ran { trace, sources, config, number })
+    }
+
+    fn exit_code(&self) -> ExitCode {
+        if self.trace.findings.iter().any(|finding| finding.fatal) { ExitCode::FAILURE } else { ExitCode::SUCCESS }
+    }
+}
+
+pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
+    let ran = match Ran::new(path, step_budget) {
+        Ok(ran) => ran,
+        Err(code) => return code,
     };
-    let parse = Parse::new(&text, Dialect::Cnc8x6);
-    let library = Library::for_program(path);
-    let trace = nc_exec::run::run(&parse, &library, &config.machine, step_budget);
-    let sources = library.sources(path, text, &trace);
-    let axes = &config.machine.axes;
+    let (trace, sources, axes) = (&ran.trace, &ran.sources, &ran.config.machine.axes);
     let written = match format {
         Format::Human => {
-            for finding in &trace.findings {
-                eprintln!("{}: {}", sources[finding.source].place(finding.range.start()), finding.message);
-            }
             let mut out = io::stdout().lock();
-            out.write_all(summary(path, &trace, axes).as_bytes()).and_then(|()| out.flush())
+            out.write_all(summary(path, trace, axes).as_bytes()).and_then(|()| out.flush())
         }
         Format::Json => {
-            let report = Report::new(path, &trace, &sources, axes);
+            let report = Report::new(path, trace, sources, axes);
             let mut out = io::BufWriter::new(io::stdout().lock());
             serde_json::to_writer_pretty(&mut out, &report)
                 .map_err(io::Error::from)
@@ -68,7 +90,33 @@ pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
         eprintln!("error: writing the output: {error}");
         return ExitCode::from(2);
     }
-    if trace.findings.iter().any(|finding| finding.fatal) { ExitCode::FAILURE } else { ExitCode::SUCCESS }
+    ran.exit_code()
+}
+
+/// `ncc expand`: the run written back as a program of plain motion blocks,
+/// to `output` or stdout.
+pub(crate) fn expand(path: &Path, output: Option<&Path>, step_budget: usize) -> ExitCode {
+    let ran = match Ran::new(path, step_budget) {
+        Ok(ran) => ran,
+        Err(code) => return code,
+    };
+    let name = path.file_name().map_or_else(|| path.display().to_string(), |name| name.to_string_lossy().into_owned());
+    let title = format!("EXPANDED FROM {name}");
+    let text = nc_exec::expand::write(&ran.trace, &ran.config.machine.axes, ran.number.unwrap_or(1), &title);
+    let written = match output {
+        Some(output) => std::fs::write(output, &text).map_err(|error| (output.display().to_string(), error)),
+        None => {
+            let mut out = io::stdout().lock();
+            out.write_all(text.as_bytes()).and_then(|()| out.flush()).map_err(|error| ("stdout".to_owned(), error))
+        }
+    };
+    match written {
+        Err((target, error)) if error.kind() != io::ErrorKind::BrokenPipe => {
+            eprintln!("error: writing {target}: {error}");
+            ExitCode::from(2)
+        }
+        _ => ran.exit_code(),
+    }
 }
 
 fn summary(path: &Path, trace: &Trace, axes: &[u8]) -> String {

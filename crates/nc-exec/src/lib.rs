@@ -11,6 +11,7 @@
 //!   (equidistants, corners, start and cancel), for the runner to drive.
 //! - [`cycles`]: the built-in fixed cycles G81–G89 (milling and lathe), as
 //!   lists of moves for the runner, when the machine loads no cycle file.
+//! - [`expand`]: a run written back as a program of plain motion blocks.
 //! - [`lower`]: blocks as plain data (words, parameter assignments,
 //!   comments), read from the syntax tree; the analysis uses it too.
 //! - [`machine`]: the machine a program runs on (axes, rates, constants).
@@ -20,6 +21,7 @@
 pub mod arith;
 pub mod compensation;
 pub mod cycles;
+pub mod expand;
 pub mod lower;
 pub mod machine;
 pub mod modes;

@@ -59,6 +59,8 @@ pub struct Step {
     /// The block's text range.
     pub range: TextRange,
     pub motion: Motion,
+    /// The shape of the move.
+    pub path: Path,
     /// Seconds since the program started, when the block starts.
     pub start_time: f64,
     pub duration: f64,
@@ -73,6 +75,24 @@ pub struct Step {
     /// The program stops after the block (M00, M01) until the operator
     /// starts it again; the run does not count the wait.
     pub stop: Option<Stop>,
+}
+
+/// The shape of a move from its start to its end.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Path {
+    Straight,
+    /// An arc (a helix when other axes move too) in the plane of two axes
+    /// (letters), turning about `centre` (absolute, in the plane's order).
+    Arc {
+        plane: (u8, u8),
+        centre: [f64; 2],
+        clockwise: bool,
+    },
+    /// A thread: `lead` mm per revolution at `speed` rpm.
+    Thread {
+        lead: f64,
+        speed: f64,
+    },
 }
 
 /// A program stop.
@@ -574,11 +594,11 @@ impl<'a> Runner<'a> {
         let start = self.position;
         let axes: Vec<&Word> =
             block.words.iter().filter(|w| self.catalogue.role_of(w.letter) == Some(AddressRole::Axis)).collect();
-        let (motion, length, duration, feed) = if has(b'G', 4) {
+        let moved = if has(b'G', 4) {
             let dwell = block.word(b'Q').and_then(|q| self.count(q)).unwrap_or(0.0) * 0.01;
-            (Motion::Dwell, 0.0, dwell, None)
+            Moved { motion: Motion::Dwell, length: 0.0, duration: dwell, feed: None, path: Path::Straight }
         } else if axes.is_empty() {
-            (Motion::None, 0.0, 0.0, None)
+            Moved { motion: Motion::None, length: 0.0, duration: 0.0, feed: None, path: Path::Straight }
         } else {
             let mut end = self.position;
             for word in &axes {
@@ -597,7 +617,7 @@ impl<'a> Runner<'a> {
         } else {
             None
         };
-        self.record(range, motion, (start, self.position), length, duration, feed, stop);
+        self.record(range, (start, self.position), moved, stop);
         // Assignments and arithmetic take effect after the block's motion.
         arith::assign(block, &mut self.params);
         let mut machine = ProgramMachine { machine: self.machine, position: &self.position };
@@ -643,20 +663,10 @@ impl<'a> Runner<'a> {
     }
 
     /// Adds a step of the block at `range` that starts now.
-    #[allow(clippy::too_many_arguments)] // One call per kind of step; a struct would only rename them.
-    fn record(
-        &mut self,
-        range: TextRange,
-        motion: Motion,
-        (start, end): (Position, Position),
-        length: f64,
-        duration: f64,
-        feed: Option<f64>,
-        stop: Option<Stop>,
-    ) {
-        let source = self.source;
-        let start_time = self.time;
-        self.steps.push(Step { source, range, motion, start_time, duration, length, feed, start, end, stop });
+    fn record(&mut self, range: TextRange, (start, end): (Position, Position), moved: Moved, stop: Option<Stop>) {
+        let Moved { motion, length, duration, feed, path } = moved;
+        let (source, start_time) = (self.source, self.time);
+        self.steps.push(Step { source, range, motion, path, start_time, duration, length, feed, start, end, stop });
         self.time += duration;
     }
 
@@ -694,21 +704,22 @@ impl<'a> Runner<'a> {
         let mut at = cycle.start;
         for step in &cycle.steps {
             let to = step.to().copied().unwrap_or(at);
-            let length = (0..26).map(|i| (to[i] - at[i]).powi(2)).sum::<f64>().sqrt();
-            let (motion, duration, feed) = match *step {
-                CycleStep::Rapid { .. } => (Motion::Rapid, self.rapid_seconds(&at, &to), None),
-                CycleStep::Feed { .. } | CycleStep::Thread { .. } => {
+            let length = distance(&at, &to);
+            let (motion, duration, feed, path) = match *step {
+                CycleStep::Rapid { .. } => (Motion::Rapid, self.rapid_seconds(&at, &to), None, Path::Straight),
+                CycleStep::Feed { .. } => {
                     let rate = step.feed_rate().filter(|&rate| rate > 0.0);
-                    let wait = match step {
-                        CycleStep::Thread { thread, .. } => 0.5 / thread.speed * 60.0,
-                        _ => 0.0,
-                    };
-                    (Motion::Feed, rate.map_or(0.0, |rate| length / rate * 60.0) + wait, rate)
+                    (Motion::Feed, rate.map_or(0.0, |rate| length / rate * 60.0), rate, Path::Straight)
                 }
-                CycleStep::Dwell { seconds } => (Motion::Dwell, seconds, None),
+                CycleStep::Thread { thread, .. } => {
+                    let minutes = length / (thread.lead * thread.speed) + 0.5 / thread.speed;
+                    let path = Path::Thread { lead: thread.lead, speed: thread.speed };
+                    (Motion::Feed, minutes * 60.0, Some(length / minutes), path)
+                }
+                CycleStep::Dwell { seconds } => (Motion::Dwell, seconds, None, Path::Straight),
                 CycleStep::Spindle { .. } => continue,
             };
-            self.record(range, motion, (at, to), length, duration, feed, None);
+            self.record(range, (at, to), Moved { motion, length, duration, feed, path }, None);
             at = to;
         }
         self.position = cycle.end();
@@ -750,18 +761,18 @@ impl<'a> Runner<'a> {
     }
 
     /// Length, duration and feed of a block's move.
-    fn moved(&mut self, step: &Move<'_>) -> (Motion, f64, f64, Option<f64>) {
+    fn moved(&mut self, step: &Move<'_>) -> Moved {
         let (range, start, end) = (step.range, step.start, step.end);
-        let travel = |i: usize| end[i] - start[i];
-        let straight = (0..26).map(|i| travel(i).powi(2)).sum::<f64>().sqrt();
+        let straight = distance(&start, &end);
         let motion = self.modes.active(self.groups.motion);
+        let moved = |motion, length, duration, feed, path| Moved { motion, length, duration, feed, path };
         if motion == Some(0) {
-            return (Motion::Rapid, straight, self.rapid_seconds(&start, &end), None);
+            return moved(Motion::Rapid, straight, self.rapid_seconds(&start, &end), None, Path::Straight);
         }
         let arc = match motion {
             Some(2 | 3) => match self.arc(step, motion == Some(3)) {
                 Some(arc) => Some(arc),
-                None => return (Motion::Feed, straight, 0.0, None),
+                None => return moved(Motion::Feed, straight, 0.0, None, Path::Straight),
             },
             _ => None,
         };
@@ -781,8 +792,17 @@ impl<'a> Runner<'a> {
             (Some(feed), FeedMode { per_revolution: true, css: true }) => self.css_minutes(step, arc.as_ref(), feed),
             (None, _) => None,
         };
+        let path = match (&arc, feed) {
+            (Some(arc), _) => Path::Arc {
+                plane: (arc.plane.0 as u8 + b'A', arc.plane.1 as u8 + b'A'),
+                centre: [arc.centre.x, arc.centre.y],
+                clockwise: arc.sweep < 0.0,
+            },
+            (None, Some(lead)) if motion == Some(33) => Path::Thread { lead, speed: self.speed },
+            _ => Path::Straight,
+        };
         match minutes {
-            Some(minutes) => (Motion::Feed, length, minutes * 60.0, Some(length / minutes)),
+            Some(minutes) => moved(Motion::Feed, length, minutes * 60.0, Some(length / minutes), path),
             None => {
                 let why = match mode {
                     _ if feed.is_none_or(|feed| feed <= 0.0) => {
@@ -795,7 +815,7 @@ impl<'a> Runner<'a> {
                     _ => "feed per revolution (G95) with spindle speed S0: the axes cannot move",
                 };
                 self.finding(range, why, false);
-                (Motion::Feed, length, 0.0, None)
+                moved(Motion::Feed, length, 0.0, None, path)
             }
         }
     }
@@ -840,8 +860,7 @@ impl<'a> Runner<'a> {
         };
         let rpm = |t: f64| (cutting_speed / (std::f64::consts::TAU * coordinate(t).abs())).min(limit);
         self.speed_reached = Some(rpm(1.0));
-        let length =
-            arc.map_or_else(|| (0..26).map(|i| (step.end[i] - step.start[i]).powi(2)).sum::<f64>().sqrt(), Arc::length);
+        let length = arc.map_or_else(|| distance(&step.start, &step.end), Arc::length);
         // Composite Simpson over the move: smooth except where the limit
         // sets in, where 512 intervals keep the error far below a µs.
         const INTERVALS: usize = 512;
@@ -1008,6 +1027,19 @@ impl Groups {
             spindle: modes.group("M2"),
         }
     }
+}
+
+/// What a block's move did.
+struct Moved {
+    motion: Motion,
+    length: f64,
+    duration: f64,
+    feed: Option<f64>,
+    path: Path,
+}
+
+fn distance(start: &Position, end: &Position) -> f64 {
+    (0..26).map(|i| (end[i] - start[i]).powi(2)).sum::<f64>().sqrt()
 }
 
 /// The state a fixed cycle of the cycle file restores when it returns.

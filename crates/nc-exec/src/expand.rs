@@ -1,0 +1,237 @@
+//! A run written back as a program (`ncc expand`): every move of the trace
+//! as a plain numbered block, with calls, jumps, cycles, parameters and
+//! offsets resolved, that any CNC8x6 accepts and that runs the same moves.
+//!
+//! The program is absolute (G90) with the feed per minute (G94): positions
+//! are written to the micrometre, F in whole mm/min (the average of a block
+//! whose feed varies, under constant cutting speed), threads with their
+//! lead and spindle speed, dwells in units of 10 ms, and the stops M00/M01
+//! where the run had them. Arc centres are rounded so that the end point
+//! stays on the circle within the control's 1 µm.
+
+use std::fmt::Write as _;
+
+use crate::run::{Motion, Path, Position, Stop, Trace};
+
+/// The longest line the control reads (000:612).
+const MAX_LINE: usize = 80;
+
+/// Writes the moves of `trace` over the machine's `axes` as program
+/// `%number`, with `title` as its header comment.
+pub fn write(trace: &Trace, axes: &[u8], number: u32, title: &str) -> String {
+    let mut out = String::new();
+    let title: String = title.chars().filter(|&c| c != '"' && !c.is_control()).collect();
+    let _ = writeln!(out, "%{number} \"{title}\"");
+    let mut writer = Writer { out, number: 0, at: [0.0; 26], feed: None, axes };
+    writer.block(vec!["G90".to_owned(), "G94".to_owned()]);
+    for step in &trace.steps {
+        let mut words = writer.words(step.motion, &step.path, &step.end, step.feed, step.duration);
+        match step.stop {
+            Some(Stop::Program) => words.push("M00".to_owned()),
+            Some(Stop::Optional) => words.push("M01".to_owned()),
+            None => {}
+        }
+        if !words.is_empty() {
+            writer.block(words);
+        }
+        if step.motion != Motion::None && step.motion != Motion::Dwell {
+            writer.at = rounded(&step.end);
+        }
+    }
+    writer.block(vec!["M30".to_owned()]);
+    writer.out.push_str("*\n");
+    writer.out
+}
+
+struct Writer<'a> {
+    out: String,
+    /// The last block number written.
+    number: u64,
+    /// Where the written program has the tool, rounded as written.
+    at: Position,
+    /// The F in force in the written program, mm/min.
+    feed: Option<i64>,
+    axes: &'a [u8],
+}
+
+impl Writer<'_> {
+    /// The words of one step; none for a step without motion or time.
+    fn words(&mut self, motion: Motion, path: &Path, end: &Position, feed: Option<f64>, duration: f64) -> Vec<String> {
+        let end = rounded(end);
+        let changed: Vec<u8> =
+            self.axes.iter().copied().filter(|&axis| end[slot(axis)] != self.at[slot(axis)]).collect();
+        let coordinate = |axis: u8| format!("{}{:.3}", char::from(axis), end[slot(axis)]);
+        match (motion, path) {
+            (Motion::None, _) => Vec::new(),
+            (Motion::Dwell, _) => vec!["G04".to_owned(), format!("Q{}", (duration * 100.0).round() as i64)],
+            (Motion::Rapid | Motion::Feed, _) if changed.is_empty() && !matches!(path, Path::Arc { .. }) => Vec::new(),
+            (Motion::Rapid, _) => {
+                std::iter::once("G00".to_owned()).chain(changed.into_iter().map(coordinate)).collect()
+            }
+            (Motion::Feed, Path::Thread { lead, speed }) => {
+                let mut words = vec!["G33".to_owned()];
+                words.extend(changed.into_iter().map(coordinate));
+                words.push(format!("F{lead:.3}"));
+                words.push(format!("S{}", speed.round() as i64));
+                // The lead replaced F in the written program.
+                self.feed = None;
+                words
+            }
+            (Motion::Feed, Path::Arc { plane: (a, b), centre, clockwise }) => {
+                let mut words = vec![if *clockwise { "G02" } else { "G03" }.to_owned()];
+                // The plane's axes first: the run takes the plane from the
+                // first two axes written.
+                words.extend([*a, *b].map(coordinate));
+                words.extend(changed.into_iter().filter(|axis| axis != a && axis != b).map(coordinate));
+                let (i, j) = self.centre_offsets((*a, *b), *centre, &end);
+                words.push(format!("I{i:.3}"));
+                words.push(format!("J{j:.3}"));
+                words.extend(self.feed_word(feed));
+                words
+            }
+            (Motion::Feed, Path::Straight) => {
+                let mut words = vec!["G01".to_owned()];
+                words.extend(changed.into_iter().map(coordinate));
+                words.extend(self.feed_word(feed));
+                words
+            }
+        }
+    }
+
+    /// F when the block's feed differs from the one in force.
+    fn feed_word(&mut self, feed: Option<f64>) -> Option<String> {
+        let feed = feed.map(|feed| (feed.round() as i64).max(1))?;
+        (self.feed != Some(feed)).then(|| {
+            self.feed = Some(feed);
+            format!("F{feed}")
+        })
+    }
+
+    /// I and J to the micrometre, chosen among the roundings of the centre
+    /// so that the written end lies on the written circle.
+    fn centre_offsets(&self, (a, b): (u8, u8), centre: [f64; 2], end: &Position) -> (f64, f64) {
+        let (start, end) = ([self.at[slot(a)], self.at[slot(b)]], [end[slot(a)], end[slot(b)]]);
+        let exact = [centre[0] - start[0], centre[1] - start[1]];
+        let mismatch = |(i, j): (f64, f64)| {
+            let (ci, cj) = (start[0] + i, start[1] + j);
+            (i.hypot(j) - (end[0] - ci).hypot(end[1] - cj)).abs()
+        };
+        // The plain rounding first, then its neighbours: the first within
+        // half the tolerance, else the best.
+        let near = |value: f64| [0.0, -0.001, 0.001].map(|delta| round3(value) + delta);
+        let candidates: Vec<(f64, f64)> =
+            near(exact[0]).into_iter().flat_map(|i| near(exact[1]).map(move |j| (i, j))).collect();
+        let good = candidates.iter().copied().find(|&candidate| mismatch(candidate) <= 0.0005);
+        let best = || candidates.iter().copied().min_by(|x, y| mismatch(*x).total_cmp(&mismatch(*y)));
+        good.or_else(best).unwrap_or((exact[0], exact[1]))
+    }
+
+    /// Writes a block, continuing on further lines past the line length.
+    fn block(&mut self, words: Vec<String>) {
+        self.number += 1;
+        let mut line = format!("N{}", self.number);
+        for word in words {
+            if line.len() + 1 + word.len() > MAX_LINE {
+                let _ = writeln!(self.out, "{line}");
+                line = String::from(" ");
+            }
+            line.push(' ');
+            line.push_str(&word);
+        }
+        let _ = writeln!(self.out, "{line}");
+    }
+}
+
+fn slot(axis: u8) -> usize {
+    usize::from(axis - b'A')
+}
+
+fn round3(value: f64) -> f64 {
+    (value * 1000.0).round() / 1000.0
+}
+
+fn rounded(position: &Position) -> Position {
+    position.map(round3)
+}
+
+#[cfg(test)]
+mod tests {
+    use expect_test::expect;
+    use ncc_syntax::{Dialect, Parse};
+
+    use super::write;
+    use crate::{
+        machine::MachineConfig,
+        run::{Motion, NoFiles, Trace, run},
+    };
+
+    fn run_text(text: &str) -> Trace {
+        run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &MachineConfig::default(), 10_000)
+    }
+
+    /// A program with everything `expand` resolves: a subprogram called
+    /// twice, a jump loop counting in a parameter, arithmetic, a drilling
+    /// cycle, arcs in two planes, a helix, feed per revolution with the
+    /// spindle, a thread, a dwell and a stop.
+    const PROGRAM: &str = "%7 \"DEMO\"
+N1 R10=0 R11=1. R12=2. R26=100 R27=800 R30=2. R31=-5. R32=5.
+N2 G00 X10 Y0 Z5 S500 M03
+N3 G71 L100 Q2
+N4 G01 X20 F300
+N5 R5=1101110 R6=17101220 G27
+N6 GR20 L4 Q9999
+N7 G81 X30
+N8 G80 X40 M00
+N9 G95 G03 X40 Z-5 I-5 J0 F0.2
+N10 G94 G02 X50 Y12 Z-7 I0 J10 F400
+N11 G33 Z-20. F1.5
+N12 G04 Q50
+N13 M30
+N100 G79 L100
+N101 G91 G01 X1 Y1 F600
+N102 G90 G70
+*
+";
+
+    #[test]
+    fn the_expanded_program_runs_the_same_moves() {
+        let original = run_text(PROGRAM);
+        assert!(original.findings.is_empty(), "{:?}", original.findings);
+        let axes = b"XYZ";
+        let expanded = write(&original, axes, 7, "DEMO EXPANDED");
+        let again = run_text(&expanded);
+        assert!(again.findings.is_empty(), "{:?}\n{expanded}", again.findings);
+        let moves = |trace: &Trace| -> Vec<[i64; 3]> {
+            trace
+                .steps
+                .iter()
+                .filter(|step| matches!(step.motion, Motion::Rapid | Motion::Feed) && step.length > 0.0)
+                .map(|step| axes.map(|axis| (step.end[usize::from(axis - b'A')] * 1000.0).round() as i64))
+                .collect()
+        };
+        assert_eq!(moves(&again), moves(&original), "{expanded}");
+        // F is written in whole mm/min: the times agree to 0.1 %.
+        let (before, after) = (original.total_time(), again.total_time());
+        assert!((after - before).abs() < 1e-3 * before, "{before} s, expanded {after} s");
+        expect![[r#"
+            %7 "DEMO EXPANDED"
+            N1 G90 G94
+            N2 G00 X10.000 Z5.000
+            N3 G01 X11.000 Y1.000 F600
+            N4 G01 X12.000 Y2.000
+            N5 G01 X20.000 F300
+            N6 G01 X30.000
+            N7 G00 Z2.000
+            N8 G01 Z-5.000 F100
+            N9 G00 Z5.000
+            N10 G01 X40.000 F300 M00
+            N11 G03 Z-5.000 X40.000 I-5.000 J0.000 F100
+            N12 G02 X50.000 Y12.000 Z-7.000 I0.000 J10.000 F400
+            N13 G33 Z-20.000 F1.500 S500
+            N14 G04 Q50
+            N15 M30
+            *
+        "#]]
+        .assert_eq(&expanded);
+    }
+}
