@@ -4,15 +4,16 @@
 //! record per block.
 
 use std::{
-    cell::RefCell,
+    cell::{OnceCell, RefCell},
     fmt::Write as _,
-    io::{self, Write as _},
+    io::{self, IsTerminal, Write as _},
     path::{Path, PathBuf},
     process::ExitCode,
 };
 
+use indicatif::{ProgressBar, ProgressStyle};
 use line_index::LineIndex;
-use nc_exec::run::{Called, Files, Motion, Position, Stop, Trace};
+use nc_exec::run::{Called, Environment, Motion, Position, Stop, Trace};
 use ncc_analysis::Config;
 use ncc_syntax::{Dialect, Parse, TextSize};
 use serde::Serialize;
@@ -52,6 +53,9 @@ impl Ran {
             parse.tree().header().and_then(|header| header.number()).and_then(|n| u32::try_from(n.scaled(0)?).ok());
         let library = Library::for_program(path);
         let trace = nc_exec::run::run(&parse, &library, &config.machine, step_budget);
+        if let Some(bar) = library.progress.get() {
+            bar.finish_and_clear();
+        }
         let sources = library.sources(path, text, &trace);
         for finding in &trace.findings {
             eprintln!("{}: {}", sources[finding.source].place(finding.range.start()), finding.message);
@@ -271,6 +275,9 @@ struct Library {
     candidates: Vec<PathBuf>,
     /// The files read, with their text.
     read: RefCell<Vec<(Called, PathBuf, String)>>,
+    /// A spinner on stderr once a run is long enough to wait for, when a
+    /// person is watching.
+    progress: OnceCell<ProgressBar>,
 }
 
 impl Library {
@@ -280,7 +287,7 @@ impl Library {
         let project = Config::find_for(path).and_then(|config| Some(config.parent()?.to_path_buf()));
         let in_project = project.map(|root| check::collect_files(&[root]).0).unwrap_or_default();
         let candidates = beside.chain(in_project).filter(|path| path.is_file()).collect();
-        Library { candidates, read: RefCell::default() }
+        Library { candidates, read: RefCell::default(), progress: OnceCell::new() }
     }
 
     fn read(&self, called: Called, matches: impl Fn(&Path) -> bool) -> Option<Parse> {
@@ -300,7 +307,7 @@ impl Library {
     }
 }
 
-impl Files for Library {
+impl Environment for Library {
     fn macrocycle(&self, number: u32) -> Option<Parse> {
         self.read(Called::Macrocycle(number), |path| check::macrocycle_number(path) == Some(number))
     }
@@ -309,6 +316,20 @@ impl Files for Library {
         let named =
             |path: &Path| path.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.eq_ignore_ascii_case(name));
         self.read(Called::CycleFile, named)
+    }
+
+    fn progress(&self, blocks_run: usize) {
+        let bar = self.progress.get_or_init(|| {
+            if !io::stderr().is_terminal() {
+                return ProgressBar::hidden();
+            }
+            let bar = ProgressBar::new_spinner();
+            if let Ok(style) = ProgressStyle::with_template("{spinner} running: {human_pos} blocks {elapsed}") {
+                bar.set_style(style);
+            }
+            bar
+        });
+        bar.set_position(blocks_run as u64);
     }
 }
 

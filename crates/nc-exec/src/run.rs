@@ -157,19 +157,25 @@ pub const DEFAULT_STEP_BUDGET: usize = 10_000_000;
 /// How deep subprogram calls nest before the run stops.
 const MAX_CALL_DEPTH: usize = 64;
 
-/// Where a run reads the files a program uses besides its own.
-pub trait Files {
+/// What a run needs from where it runs: the files a program uses besides
+/// its own, and someone to tell how far it got.
+pub trait Environment {
     /// The macrocycle file `L<number>`.
     fn macrocycle(&self, number: u32) -> Option<Parse>;
     /// The fixed-cycle file the machine names (`PCYKLYDG.NCP`).
     fn cycle_file(&self, name: &str) -> Option<Parse>;
+    /// Called every [`PROGRESS_INTERVAL`] blocks with the number run so far.
+    fn progress(&self, _blocks_run: usize) {}
 }
 
-/// No files besides the program.
+/// How often a run reports its progress, in blocks.
+pub const PROGRESS_INTERVAL: usize = 1 << 16;
+
+/// The program alone: no other files.
 #[derive(Debug, Clone, Copy)]
 pub struct NoFiles;
 
-impl Files for NoFiles {
+impl Environment for NoFiles {
     fn macrocycle(&self, _number: u32) -> Option<Parse> {
         None
     }
@@ -191,8 +197,9 @@ pub enum Called {
 /// following subprogram calls, macrocycle calls, fixed cycles (the
 /// bodies of the machine's cycle file, or the built-in cycles) and jumps,
 /// for at most `budget` blocks. Files are read from `files` when first
-/// needed. Parameters start at zero.
-pub fn run(parse: &Parse, files: &dyn Files, machine: &MachineConfig, budget: usize) -> Trace {
+/// needed, and the run reports its progress there. Parameters start at
+/// zero.
+pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budget: usize) -> Trace {
     let mut program = Blocks::default();
     program.add(parse);
     let mut runner = Runner::new(machine);
@@ -216,6 +223,9 @@ pub fn run(parse: &Parse, files: &dyn Files, machine: &MachineConfig, budget: us
             break;
         }
         executed += 1;
+        if executed % PROGRESS_INTERVAL == 0 {
+            files.progress(executed);
+        }
         if executed > budget {
             let message = format!("stopped after {budget} blocks: a jump loop that never ends or runaway calls?");
             runner.finding(range, &message, true);
@@ -1148,7 +1158,7 @@ mod tests {
 
     use ncc_syntax::{Dialect, Parse};
 
-    use super::{Called, Files, Motion, NoFiles, Stop, Trace, run};
+    use super::{Called, Environment, Motion, NoFiles, Stop, Trace, run};
     use crate::machine::MachineConfig;
 
     fn run_text(text: &str) -> Trace {
@@ -1158,7 +1168,7 @@ mod tests {
     /// The macrocycle file L9001, and a cycle file, with the same text.
     struct Library(&'static str);
 
-    impl Files for Library {
+    impl Environment for Library {
         fn macrocycle(&self, number: u32) -> Option<Parse> {
             (number == 9001).then(|| Parse::new(self.0, Dialect::Cnc8x6))
         }
