@@ -13,7 +13,7 @@ use std::{
 
 use indicatif::{ProgressBar, ProgressStyle};
 use line_index::LineIndex;
-use nc_exec::run::{Called, Environment, Motion, Position, Stop, Trace};
+use nc_exec::run::{Axes, Called, Environment, MAX_AXES, Motion, Stop, Trace};
 use ncc_analysis::Config;
 use ncc_syntax::{Dialect, Parse, TextSize};
 use serde::Serialize;
@@ -160,7 +160,7 @@ struct Report<'a> {
     cutting_length_mm: f64,
     rapid_length_mm: f64,
     tools: &'a [u32],
-    end_position: Axes<'a>,
+    end_position: Values<'a>,
     blocks: Records<'a>,
     findings: Vec<FindingRecord<'a>>,
 }
@@ -176,7 +176,7 @@ impl<'a> Report<'a> {
             cutting_length_mm: trace.length_in(Motion::Feed),
             rapid_length_mm: trace.length_in(Motion::Rapid),
             tools: &trace.tools,
-            end_position: Axes(trace.end_position(), axes),
+            end_position: Values(trace.steps.last().map_or([0.0; MAX_AXES], |step| step.end), axes),
             blocks: Records { trace, sources, axes },
             findings: trace
                 .findings
@@ -201,7 +201,7 @@ struct Records<'a> {
 
 impl Serialize for Records<'_> {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.collect_seq(self.trace.steps.iter().map(|step| {
+        serializer.collect_seq(self.trace.steps.iter().enumerate().map(|(index, step)| {
             let source = &self.sources[step.source];
             BlockRecord {
                 file: &source.name,
@@ -220,10 +220,8 @@ impl Serialize for Records<'_> {
                 duration_s: step.duration,
                 length_mm: step.length,
                 feed_mm_min: step.feed,
-                // Program and machine coordinates coincide until the
-                // executor runs zero offsets.
-                start: Coordinates { program: Axes(step.start, self.axes), machine: Axes(step.start, self.axes) },
-                end: Coordinates { program: Axes(step.end, self.axes), machine: Axes(step.end, self.axes) },
+                start: Coordinates::of(self.trace.start_of(index), self.axes),
+                end: Coordinates::of(step.end, self.axes),
             }
         }))
     }
@@ -245,8 +243,16 @@ struct BlockRecord<'a> {
 
 #[derive(Serialize)]
 struct Coordinates<'a> {
-    program: Axes<'a>,
-    machine: Axes<'a>,
+    program: Values<'a>,
+    machine: Values<'a>,
+}
+
+impl<'a> Coordinates<'a> {
+    /// Program and machine coordinates coincide until the executor runs
+    /// zero offsets.
+    fn of(values: Axes, axes: &'a [u8]) -> Coordinates<'a> {
+        Coordinates { program: Values(values, axes), machine: Values(values, axes) }
+    }
 }
 
 #[derive(Serialize)]
@@ -257,13 +263,13 @@ struct FindingRecord<'a> {
     stopped: bool,
 }
 
-/// A position as `{"X": …, "Y": …}` over the machine's axes.
-struct Axes<'a>(Position, &'a [u8]);
+/// Axis values as `{"X": …, "Y": …}`, in the machine's order.
+struct Values<'a>(Axes, &'a [u8]);
 
-impl Serialize for Axes<'_> {
+impl Serialize for Values<'_> {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let Axes(position, axes) = self;
-        serializer.collect_map(axes.iter().map(|&axis| (char::from(axis), position[usize::from(axis - b'A')])))
+        let Values(values, axes) = self;
+        serializer.collect_map(axes.iter().zip(values).map(|(&axis, value)| (char::from(axis), value)))
     }
 }
 

@@ -25,7 +25,8 @@ pub fn write(trace: &Trace, axes: &[u8], number: u32, title: &str) -> String {
     let mut writer = Writer { out, number: 0, at: [0.0; 26], feed: None, axes };
     writer.block(vec!["G90".to_owned(), "G94".to_owned()]);
     for step in &trace.steps {
-        let mut words = writer.words(step.motion, &step.path, &step.end, step.feed, step.duration);
+        let end = trace.position(&step.end);
+        let mut words = writer.words(step.motion, &step.path, &end, step.feed, step.duration);
         match step.stop {
             Some(Stop::Program) => words.push("M00".to_owned()),
             Some(Stop::Optional) => words.push("M01".to_owned()),
@@ -35,7 +36,7 @@ pub fn write(trace: &Trace, axes: &[u8], number: u32, title: &str) -> String {
             writer.block(words);
         }
         if step.motion != Motion::None && step.motion != Motion::Dwell {
-            writer.at = rounded(&step.end);
+            writer.at = rounded(&end);
         }
     }
     writer.block(vec!["M30".to_owned()]);
@@ -206,7 +207,7 @@ N102 G90 G70
                 .steps
                 .iter()
                 .filter(|step| matches!(step.motion, Motion::Rapid | Motion::Feed) && step.length > 0.0)
-                .map(|step| axes.map(|axis| (step.end[usize::from(axis - b'A')] * 1000.0).round() as i64))
+                .map(|step| axes.map(|axis| (trace.axis(&step.end, axis) * 1000.0).round() as i64))
                 .collect()
         };
         assert_eq!(moves(&again), moves(&original), "{expanded}");

@@ -68,14 +68,20 @@ pub struct Step {
     pub length: f64,
     /// The path feed in mm/min (`None` for rapid and non-motion blocks).
     pub feed: Option<f64>,
-    /// Programmed positions at the block's start and end (program and
-    /// machine coordinates coincide until zero offsets run).
-    pub start: Position,
-    pub end: Position,
+    /// The programmed position at the step's end, over the machine's axes
+    /// ([`Trace::axes`]); it starts where the step before it ended.
+    pub end: Axes,
     /// The program stops after the block (M00, M01) until the operator
     /// starts it again; the run does not count the wait.
     pub stop: Option<Stop>,
 }
+
+/// Positions over the machine's axes 1–6, in their order: what a step
+/// keeps, so that a run of a million blocks stays small.
+pub type Axes = [f64; MAX_AXES];
+
+/// The most axes a machine has (axes 1–6).
+pub const MAX_AXES: usize = 6;
 
 /// The shape of a move from its start to its end.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -118,6 +124,8 @@ pub struct Finding {
 /// A whole run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Trace {
+    /// The machine's axes, the order of [`Step::end`].
+    pub axes: Vec<u8>,
     pub steps: Vec<Step>,
     pub findings: Vec<Finding>,
     /// Tools called with T, in order of first use.
@@ -146,7 +154,28 @@ impl Trace {
 
     /// The programmed position at the end.
     pub fn end_position(&self) -> Position {
-        self.steps.last().map_or([0.0; 26], |step| step.end)
+        self.steps.last().map_or([0.0; 26], |step| self.position(&step.end))
+    }
+
+    /// Where step `index` starts: where the one before it ended, or the
+    /// origin.
+    pub fn start_of(&self, index: usize) -> Axes {
+        index.checked_sub(1).and_then(|before| self.steps.get(before)).map_or([0.0; MAX_AXES], |step| step.end)
+    }
+
+    /// Axis values as a position by letter.
+    pub fn position(&self, values: &Axes) -> Position {
+        let mut position = [0.0; 26];
+        for (&axis, &value) in self.axes.iter().zip(values) {
+            position[usize::from(axis - b'A')] = value;
+        }
+        position
+    }
+
+    /// The value of axis `letter` in `values`, 0 for a letter the machine
+    /// does not have.
+    pub fn axis(&self, values: &Axes, letter: u8) -> f64 {
+        self.axes.iter().position(|&axis| axis == letter).map_or(0.0, |i| values[i])
     }
 }
 
@@ -349,7 +378,8 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
             break;
         }
     }
-    Trace { steps: runner.steps, findings: runner.findings, tools: runner.tools, files: called }
+    let axes = machine.axes.iter().copied().take(MAX_AXES).collect();
+    Trace { axes, steps: runner.steps, findings: runner.findings, tools: runner.tools, files: called }
 }
 
 /// A subprogram or macrocycle call being run.
@@ -627,7 +657,7 @@ impl<'a> Runner<'a> {
         } else {
             None
         };
-        self.record(range, (start, self.position), moved, stop);
+        self.record(range, &self.position.clone(), moved, stop);
         // Assignments and arithmetic take effect after the block's motion.
         arith::assign(block, &mut self.params);
         let mut machine = ProgramMachine { machine: self.machine, position: &self.position };
@@ -672,11 +702,15 @@ impl<'a> Runner<'a> {
         }
     }
 
-    /// Adds a step of the block at `range` that starts now.
-    fn record(&mut self, range: TextRange, (start, end): (Position, Position), moved: Moved, stop: Option<Stop>) {
+    /// Adds a step of the block at `range` that starts now and ends at `end`.
+    fn record(&mut self, range: TextRange, end: &Position, moved: Moved, stop: Option<Stop>) {
         let Moved { motion, length, duration, feed, path } = moved;
         let (source, start_time) = (self.source, self.time);
-        self.steps.push(Step { source, range, motion, path, start_time, duration, length, feed, start, end, stop });
+        let mut values = [0.0; MAX_AXES];
+        for (value, &axis) in values.iter_mut().zip(&self.machine.axes) {
+            *value = end[usize::from(axis - b'A')];
+        }
+        self.steps.push(Step { source, range, motion, path, start_time, duration, length, feed, end: values, stop });
         self.time += duration;
     }
 
@@ -729,7 +763,7 @@ impl<'a> Runner<'a> {
                 CycleStep::Dwell { seconds } => (Motion::Dwell, seconds, None, Path::Straight),
                 CycleStep::Spindle { .. } => continue,
             };
-            self.record(range, (at, to), Moved { motion, length, duration, feed, path }, None);
+            self.record(range, &to, Moved { motion, length, duration, feed, path }, None);
             at = to;
         }
         self.position = cycle.end();
@@ -1275,7 +1309,7 @@ mod tests {
         trace
             .steps
             .iter()
-            .map(|s| (DRILLING[s.range].split(' ').next().unwrap().to_owned(), s.motion, s.end[z]))
+            .map(|s| (DRILLING[s.range].split(' ').next().unwrap().to_owned(), s.motion, trace.position(&s.end)[z]))
             .collect()
     }
 
@@ -1329,7 +1363,7 @@ mod tests {
     #[test]
     fn incremental_moves_add_to_the_position() {
         let trace = run_text("%1\nN1 G91 G01 X10 Y10 F600\nN2 X10\nN3 G90 X0\nN4 M30\n");
-        let x: Vec<f64> = trace.steps.iter().map(|step| step.end[usize::from(b'X' - b'A')]).collect();
+        let x: Vec<f64> = trace.steps.iter().map(|step| trace.axis(&step.end, b'X')).collect();
         assert_eq!(x, [10.0, 20.0, 0.0, 0.0]);
     }
 
@@ -1392,7 +1426,7 @@ mod tests {
         // R1=20000 is 20 mm (thousandths); the block that assigns 50 mm
         // still moves with 20.
         let trace = run_text("%1\nN1 R1=20000\nN2 G01 XR1 F1200\nN3 R1=50000 G01 X-R1\nN4 XR1\nN5 M30\n");
-        let x: Vec<f64> = trace.steps.iter().map(|step| step.end[usize::from(b'X' - b'A')]).collect();
+        let x: Vec<f64> = trace.steps.iter().map(|step| trace.axis(&step.end, b'X')).collect();
         assert_eq!(x, [0.0, 20.0, -20.0, 50.0, 50.0]);
         close(trace.steps[1].duration, 1.0);
     }
