@@ -13,8 +13,11 @@
 //!   the static analysis uses it as well.
 //! - [`lower`]: blocks as plain data (words, parameter assignments,
 //!   comments), read from the syntax tree; the analysis uses it too.
+//! - [`machine`]: the machine a program runs on, and [`tables`]: its zero
+//!   offsets and tool corrections with readers for the control's files.
 
 pub mod arith;
 pub mod lower;
 pub mod machine;
 pub mod run;
+pub mod tables;

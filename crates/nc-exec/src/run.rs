@@ -436,8 +436,13 @@ impl<'a> Runner<'a> {
         let travel = |i: usize| end[i] - start[i];
         let straight = (0..26).map(|i| travel(i).powi(2)).sum::<f64>().sqrt();
         if self.motion == 0 {
-            let longest = (0..26).map(|i| travel(i).abs()).fold(0.0, f64::max);
-            return (Motion::Rapid, straight, longest / f64::from(self.machine.rapid_rate) * 60.0, None);
+            // Every axis runs at its own rate: the slowest one to arrive sets the time.
+            let minutes = (b'A'..=b'Z')
+                .map(|letter| {
+                    travel(usize::from(letter - b'A')).abs() / f64::from(self.machine.axis_rapid_rate(letter))
+                })
+                .fold(0.0, f64::max);
+            return (Motion::Rapid, straight, minutes * 60.0, None);
         }
         let length = match self.motion {
             2 | 3 => match self.arc_length(step) {
@@ -787,5 +792,17 @@ mod tests {
         assert_eq!(trace.steps.len(), 3);
         let messages: Vec<&str> = trace.findings.iter().map(|f| f.message.as_str()).collect();
         assert_eq!(messages, ["the executor does not run radius compensation (G41/G42) yet: the time leaves them out"]);
+    }
+
+    #[test]
+    fn a_rapid_move_lasts_as_long_as_its_slowest_axis() {
+        let machine = MachineConfig { rapid_rates: [(b'Z', 5_000)].into(), ..MachineConfig::default() };
+        let trace = run(&Parse::new("%1\nN1 G00 X100 Z40\nN2 X0 Z0 Y200\nN3 M30\n", Dialect::Cnc8x6), &machine, 100);
+        // N1: X 100 mm at 10000 mm/min is 0.6 s, Z 40 mm at 5000 mm/min 0.48 s;
+        // N2: Y 200 mm at 10000 mm/min is 1.2 s.
+        close(trace.steps[0].duration, 0.6);
+        close(trace.steps[1].duration, 1.2);
+        let trace = run(&Parse::new("%1\nN1 G00 X50 Z40\nN2 M30\n", Dialect::Cnc8x6), &machine, 100);
+        close(trace.steps[0].duration, 0.48);
     }
 }
