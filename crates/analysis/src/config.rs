@@ -7,22 +7,37 @@
 //! non-canonical-word-order = "info"   # opt-in rules are off until named
 //!
 //! [machine]
+//! file = "machines/mill.toml"             # a machine file; the keys below override it
 //! axes = ["X", "Y", "Z", "U", "V", "C"]   # letters of axes 1-6
 //! feed-limit = 24000                      # mm/min
 //! rapid-rate = 10000                      # mm/min, every axis (G00)
+//! rapid-rates = { Z = 8000 }              # mm/min, axes with a rate of their own
+//! limits = { X = { min = "-10", max = "500.5" } }   # mm from the machine zero
 //! cycle-file = "PCYKLYDG.NCP"             # CNC836.KNF $17: what G81-G89 do
+//! offset-file = "TAB0.POS"                # zero offsets G53-G59
+//! tool-file = "TAB0.KOR"                  # tool corrections D1-D99
 //!
 //! [machine.constants]                      # as in TAB0.REK
 //! R339 = "01000000"                        # the eight decades
 //! R39 = "60.000"                           # or with the decimal point
 //! ```
+//!
+//! A machine file has the keys of `[machine]` except `file`, at its top
+//! level. Paths are relative to the file that writes them. Keys in
+//! `ncc.toml` replace the machine file's, and within `rapid-rates`,
+//! `limits` and `constants` key by key. Every mistake is an error that names
+//! the file, and the key or the line and column of a table file
+//! (`nc_exec::tables` has their formats); `docs/machine.md` documents every
+//! key.
 
 use std::{
     collections::BTreeMap,
+    io,
     path::{Path, PathBuf},
 };
 
-pub use nc_exec::machine::{MachineConfig, parse_constant};
+pub use nc_exec::machine::{MachineConfig, TravelLimits, parse_constant};
+use nc_exec::tables::{self, Finding, OffsetTable, ToolTable};
 use ncc_syntax::Severity;
 use serde::Deserialize;
 
@@ -71,61 +86,205 @@ struct ConfigFile {
     machine: Option<MachineFile>,
 }
 
+/// The `[machine]` section of `ncc.toml`, and a machine file.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields, rename_all = "kebab-case")]
 struct MachineFile {
+    /// The machine file these keys override (in `ncc.toml` only).
+    file: Option<PathBuf>,
     axes: Option<Vec<String>>,
     feed_limit: Option<u32>,
     rapid_rate: Option<u32>,
+    #[serde(default)]
+    rapid_rates: BTreeMap<String, u32>,
+    #[serde(default)]
+    limits: BTreeMap<String, LimitsFile>,
     cycle_file: Option<String>,
+    offset_file: Option<PathBuf>,
+    tool_file: Option<PathBuf>,
     #[serde(default)]
     constants: BTreeMap<String, String>,
 }
 
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LimitsFile {
+    min: Option<String>,
+    max: Option<String>,
+}
+
+/// A table file, and the key that names it for errors reading it.
+struct TableFile {
+    path: PathBuf,
+    named_by: String,
+}
+
+/// The table files the configuration names, read once the axes are known.
+#[derive(Default)]
+struct TableFiles {
+    offsets: Option<TableFile>,
+    tools: Option<TableFile>,
+}
+
+impl MachineFile {
+    /// Sets what the file gives. `path` is the file's, where its table
+    /// paths start from; errors name the keys after `section`.
+    fn apply(
+        self,
+        machine: &mut MachineConfig,
+        tables: &mut TableFiles,
+        path: &Path,
+        section: &str,
+    ) -> Result<(), String> {
+        let origin = path.display();
+        if let Some(axes) = self.axes {
+            let letters: Option<Vec<u8>> = axes.iter().map(|axis| axis_letter(axis)).collect();
+            match letters {
+                Some(letters) if (1..=6).contains(&letters.len()) => machine.axes = letters,
+                _ => return Err(format!("{origin}: {section}axes must list one to six axis letters")),
+            }
+        }
+        if let Some(limit) = self.feed_limit {
+            machine.feed_limit = limit;
+        }
+        if let Some(rate) = self.rapid_rate {
+            if rate == 0 {
+                return Err(format!("{origin}: {section}rapid-rate must be above 0 mm/min"));
+            }
+            machine.rapid_rate = rate;
+        }
+        for (axis, rate) in self.rapid_rates {
+            let letter = axis_letter(&axis)
+                .ok_or_else(|| format!("{origin}: {section}rapid-rates key `{axis}` is not an axis letter"))?;
+            if rate == 0 {
+                return Err(format!("{origin}: {section}rapid-rates.{axis} must be above 0 mm/min"));
+            }
+            machine.rapid_rates.insert(letter, rate);
+        }
+        for (axis, limits) in self.limits {
+            let letter = axis_letter(&axis)
+                .ok_or_else(|| format!("{origin}: {section}limits key `{axis}` is not an axis letter"))?;
+            let bound = |value: Option<String>, name: &str| {
+                value
+                    .map(|value| tables::coordinate(&value))
+                    .transpose()
+                    .map_err(|e| format!("{origin}: {section}limits.{axis}.{name}: {e}"))
+            };
+            let limits = TravelLimits { min: bound(limits.min, "min")?, max: bound(limits.max, "max")? };
+            if let (Some(min), Some(max)) = (limits.min, limits.max)
+                && min > max
+            {
+                return Err(format!("{origin}: {section}limits.{axis}: min is above max"));
+            }
+            machine.limits.insert(letter, limits);
+        }
+        if let Some(name) = self.cycle_file {
+            if name.trim().is_empty() {
+                return Err(format!("{origin}: {section}cycle-file must name a file, e.g. \"PCYKLYDG.NCP\""));
+            }
+            machine.cycle_file = Some(name);
+        }
+        let table = |key: &str, name: PathBuf| TableFile {
+            path: relative_to(path, &name),
+            named_by: format!("{origin}: {section}{key} `{}`", name.display()),
+        };
+        if let Some(name) = self.offset_file {
+            tables.offsets = Some(table("offset-file", name));
+        }
+        if let Some(name) = self.tool_file {
+            tables.tools = Some(table("tool-file", name));
+        }
+        for (name, value) in self.constants {
+            let number = name
+                .strip_prefix(['R', 'r'])
+                .and_then(|n| n.parse().ok())
+                .ok_or_else(|| format!("{origin}: {section}constants key `{name}` is not like `R339`"))?;
+            let raw = parse_constant(&value)
+                .ok_or_else(|| format!("{origin}: {section}constants.{name} = `{value}` is not a number"))?;
+            machine.constants.insert(number, raw);
+        }
+        Ok(())
+    }
+}
+
+impl TableFile {
+    /// Reads the table with `parse`; a line it does not understand is an
+    /// error located in the table file.
+    fn read<T>(
+        self,
+        read: impl Fn(&Path) -> io::Result<String>,
+        axes: &[u8],
+        parse: fn(&str, &[u8]) -> (T, Vec<Finding>),
+    ) -> Result<T, String> {
+        let text = read(&self.path).map_err(|e| format!("{}: {e}", self.named_by))?;
+        let (table, findings) = parse(&text, axes);
+        if findings.is_empty() {
+            return Ok(table);
+        }
+        let lines: Vec<String> = findings.iter().map(|finding| format!("{}:{finding}", self.path.display())).collect();
+        Err(lines.join("\n"))
+    }
+}
+
+/// A letter as configuration keys write an axis: `"X"`, or `"x"`.
+fn axis_letter(text: &str) -> Option<u8> {
+    match *text.as_bytes() {
+        [letter] if letter.is_ascii_alphabetic() => Some(letter.to_ascii_uppercase()),
+        _ => None,
+    }
+}
+
+/// Rates and limits may be given only for the machine's axes, which may
+/// come from another file than they do.
+fn check_axis_keys(machine: &MachineConfig) -> Result<(), String> {
+    let rates = machine.rapid_rates.keys().map(|&letter| ("rapid-rates", letter));
+    let limits = machine.limits.keys().map(|&letter| ("limits", letter));
+    match rates.chain(limits).find(|&(_, letter)| !machine.is_axis(letter)) {
+        Some((key, letter)) => Err(format!(
+            "the machine's {key} name `{}`, which is not an axis of it ({})",
+            char::from(letter),
+            tables::axis_list(&machine.axes)
+        )),
+        None => Ok(()),
+    }
+}
+
+/// `name` as written in the file at `path`: relative to its directory.
+fn relative_to(path: &Path, name: &Path) -> PathBuf {
+    path.parent().unwrap_or(Path::new("")).join(name)
+}
+
 impl Config {
-    /// Reads a configuration file's text; `origin` names it in errors.
-    pub fn from_toml(text: &str, origin: &str) -> Result<Config, String> {
+    /// Reads `ncc.toml`'s text. `path` names the file in errors and is where
+    /// the paths it holds start from; `read` reads the files they name.
+    pub fn from_toml(text: &str, path: &Path, read: impl Fn(&Path) -> io::Result<String>) -> Result<Config, String> {
+        let origin = path.display().to_string();
         let file: ConfigFile = toml::from_str(text).map_err(|e| format!("{origin}: {e}"))?;
         let mut config = Config { rules: file.rules, machine: MachineConfig::default() };
         if let Some(unknown) = config.rules.keys().find(|key| crate::Rule::find(key).is_none()) {
             return Err(format!("{origin}: [rules] names no rule `{unknown}` (see `ncc rules`)"));
         }
-        if let Some(machine) = file.machine {
-            if let Some(axes) = machine.axes {
-                let letters: Vec<u8> =
-                    axes.iter().map(|a| a.as_bytes().first().copied().unwrap_or(b'?').to_ascii_uppercase()).collect();
-                if axes.iter().any(|a| a.len() != 1 || !a.as_bytes()[0].is_ascii_alphabetic())
-                    || axes.is_empty()
-                    || axes.len() > 6
-                {
-                    return Err(format!("{origin}: machine.axes must list one to six axis letters"));
-                }
-                config.machine.axes = letters;
+        let Some(mut keys) = file.machine else {
+            return Ok(config);
+        };
+        let mut tables = TableFiles::default();
+        if let Some(name) = keys.file.take() {
+            let machine_path = relative_to(path, &name);
+            let machine_origin = machine_path.display().to_string();
+            let text = read(&machine_path).map_err(|e| format!("{origin}: machine.file `{}`: {e}", name.display()))?;
+            let machine: MachineFile = toml::from_str(&text).map_err(|e| format!("{machine_origin}: {e}"))?;
+            if machine.file.is_some() {
+                return Err(format!("{machine_origin}: a machine file cannot name another (`file`)"));
             }
-            if let Some(limit) = machine.feed_limit {
-                config.machine.feed_limit = limit;
-            }
-            if let Some(rate) = machine.rapid_rate {
-                if rate == 0 {
-                    return Err(format!("{origin}: machine.rapid-rate must be above 0 mm/min"));
-                }
-                config.machine.rapid_rate = rate;
-            }
-            if let Some(name) = machine.cycle_file {
-                if name.trim().is_empty() {
-                    return Err(format!("{origin}: machine.cycle-file must name a file, e.g. \"PCYKLYDG.NCP\""));
-                }
-                config.machine.cycle_file = Some(name);
-            }
-            for (name, value) in machine.constants {
-                let number = name
-                    .strip_prefix(['R', 'r'])
-                    .and_then(|n| n.parse().ok())
-                    .ok_or_else(|| format!("{origin}: machine.constants key `{name}` is not like `R339`"))?;
-                let raw = parse_constant(&value)
-                    .ok_or_else(|| format!("{origin}: machine constant {name} = `{value}` is not a number"))?;
-                config.machine.constants.insert(number, raw);
-            }
+            machine.apply(&mut config.machine, &mut tables, &machine_path, "")?;
+        }
+        keys.apply(&mut config.machine, &mut tables, path, "machine.")?;
+        check_axis_keys(&config.machine).map_err(|e| format!("{origin}: {e}"))?;
+        if let Some(table) = tables.offsets {
+            config.machine.offsets = table.read(&read, &config.machine.axes, OffsetTable::parse)?;
+        }
+        if let Some(table) = tables.tools {
+            config.machine.tools = table.read(&read, &config.machine.axes, ToolTable::parse)?;
         }
         Ok(config)
     }
@@ -156,13 +315,24 @@ impl Config {
 
 #[cfg(test)]
 mod tests {
+    use expect_test::expect;
+
     use super::*;
+
+    /// Loads `project/ncc.toml` with `text`, beside the other `files`.
+    fn load(text: &str, files: &[(&str, &str)]) -> Result<Config, String> {
+        let read = |path: &Path| {
+            let file = files.iter().find(|(name, _)| Path::new(name) == path);
+            file.map(|(_, text)| text.to_string()).ok_or_else(|| io::ErrorKind::NotFound.into())
+        };
+        Config::from_toml(text, Path::new("project/ncc.toml"), read)
+    }
 
     #[test]
     fn reads_rules_and_machine() {
-        let config = Config::from_toml(
+        let config = load(
             "[rules]\nS009 = \"off\"\nunknown-code = \"warning\"\n[machine]\naxes = [\"X\", \"Z\"]\nfeed-limit = 10000\nrapid-rate = 15000\n[machine.constants]\nR339 = \"01000000\"\nR39 = \"45.5\"\n",
-            "ncc.toml",
+            &[],
         )
         .unwrap();
         assert_eq!(config.rules.get("S009"), Some(&Level::Off));
@@ -175,13 +345,13 @@ mod tests {
 
     #[test]
     fn rejects_mistakes_with_a_clear_message() {
-        let error = Config::from_toml("[rules]\nno-such-rule = \"off\"\n", "ncc.toml").unwrap_err();
+        let error = load("[rules]\nno-such-rule = \"off\"\n", &[]).unwrap_err();
         assert!(error.contains("no-such-rule"), "{error}");
-        let error = Config::from_toml("[machine]\naxes = [\"XY\"]\n", "ncc.toml").unwrap_err();
+        let error = load("[machine]\naxes = [\"XY\"]\n", &[]).unwrap_err();
         assert!(error.contains("axis letters"), "{error}");
-        assert!(Config::from_toml("[machine.constants]\nR39 = \"abc\"\n", "x").is_err());
-        assert!(Config::from_toml("[unknown]\n", "x").is_err());
-        let error = Config::from_toml("[machine]\nrapid-rate = 0\n", "x").unwrap_err();
+        assert!(load("[machine.constants]\nR39 = \"abc\"\n", &[]).is_err());
+        assert!(load("[unknown]\n", &[]).is_err());
+        let error = load("[machine]\nrapid-rate = 0\n", &[]).unwrap_err();
         assert!(error.contains("rapid-rate"), "{error}");
     }
 
@@ -190,5 +360,82 @@ mod tests {
         let machine = MachineConfig::default();
         assert_eq!(machine.constant(39), 60_000, "R39 default 60.000");
         assert_eq!(machine.constant(339), 0);
+    }
+
+    const MILL: &str = r#"
+axes = ["X", "Y", "Z"]
+rapid-rate = 20000
+rapid-rates = { Z = 8000 }
+limits = { X = { min = "-10", max = "500.5" }, Z = { max = "0" } }
+cycle-file = "PCYKLYDG.NCP"
+offset-file = "TAB0.POS"
+tool-file = "TAB0.KOR"
+[constants]
+R39 = "30.000"
+R97 = "2"
+"#;
+
+    #[test]
+    fn a_machine_file_gives_the_machine_and_ncc_toml_overrides_it() {
+        let ncc = "[machine]\nfile = \"machines/mill.toml\"\ntool-file = \"TAB1.KOR\"\nrapid-rates = { Y = 12000 }\n[machine.constants]\nR39 = \"45.5\"\n";
+        let files = [
+            ("project/machines/mill.toml", MILL),
+            ("project/machines/TAB0.POS", "$POS\nG54: X=100.5 Y=-20.0\n"),
+            ("project/machines/TAB0.KOR", "$KOR\n01: R=5.0\n"),
+            ("project/TAB1.KOR", "$KOR\n02: R=0.8 Z=100.0\n"),
+        ];
+        let machine = load(ncc, &files).unwrap().machine;
+        assert_eq!(machine.axes, b"XYZ");
+        assert_eq!(
+            [b'X', b'Y', b'Z'].map(|letter| machine.axis_rapid_rate(letter)),
+            [20_000, 12_000, 8_000],
+            "the file's rates, and ncc.toml's for Y"
+        );
+        assert_eq!(machine.limits[&b'X'], TravelLimits { min: Some(-10_000), max: Some(500_500) });
+        assert_eq!(machine.limits[&b'Z'], TravelLimits { min: None, max: Some(0) });
+        assert_eq!(machine.cycle_file.as_deref(), Some("PCYKLYDG.NCP"));
+        assert_eq!(machine.offsets.offset(54), [100_500, -20_000, 0, 0, 0, 0], "beside the machine file");
+        // ncc.toml's tool file, beside ncc.toml, replaces the machine file's.
+        assert_eq!(machine.tools.entries.keys().copied().collect::<Vec<_>>(), [2]);
+        assert_eq!(machine.tools.entry(2).lengths[2], 100_000);
+        assert_eq!((machine.constant(39), machine.constant(97)), (45_500, 2), "constants key by key");
+    }
+
+    #[test]
+    fn mistakes_in_machine_and_table_files_name_the_place() {
+        let with_file = |machine: &str, files: &[(&str, &str)]| {
+            let ncc = format!("[machine]\nfile = \"m.toml\"\n{machine}");
+            let mut files = files.to_vec();
+            files.push(("project/m.toml", "axes = [\"X\", \"Z\"]\noffset-file = \"POS/TAB0.POS\"\n"));
+            load(&ncc, &files).unwrap_err()
+        };
+        let good_offsets = ("project/POS/TAB0.POS", "$POS\n");
+        let errors = [
+            load("[machine]\nfile = \"none.toml\"\n", &[]).unwrap_err(),
+            load("[machine]\nfile = \"m.toml\"\n", &[("project/m.toml", "axes = [\"X\"\n")]).unwrap_err(),
+            load("[machine]\nfile = \"m.toml\"\n", &[("project/m.toml", "file = \"n.toml\"\n")]).unwrap_err(),
+            with_file("", &[]),
+            with_file("", &[("project/POS/TAB0.POS", "$POS\nG54: X=1.0 Y=2.0\nG60: Z=1.0\n")]),
+            with_file("tool-file = \"TAB0.KOR\"\n", &[good_offsets, ("project/TAB0.KOR", "$KOR\n01: Z=1.0\n")]),
+            with_file("rapid-rates = { Y = 5000 }\n", &[good_offsets]),
+            with_file("[machine.limits]\nX = { min = \"1\", max = \"0\" }\n", &[good_offsets]),
+            with_file("[machine.limits]\nX = { min = \"0.0001\" }\n", &[good_offsets]),
+        ];
+        expect![[r#"
+            project/ncc.toml: machine.file `none.toml`: entity not found
+            project/m.toml: TOML parse error at line 1, column 12
+              |
+            1 | axes = ["X"
+              |            ^
+            unclosed array, expected `]`
+
+            project/m.toml: a machine file cannot name another (`file`)
+            project/m.toml: offset-file `POS/TAB0.POS`: entity not found
+            project/POS/TAB0.POS:2:12: `Y` is not an axis of this machine (axes X Z)
+            project/POS/TAB0.POS:3:1: `G60` names no row: the rows are G53 to G59
+            project/TAB0.KOR:2:5: `Z=` corrects axis 3 (the names stand for X, Y, Z, U in that order), but on this machine Z is axis 2: write `2=`
+            project/ncc.toml: the machine's rapid-rates name `Y`, which is not an axis of it (axes X Z)
+            project/ncc.toml: machine.limits.X: min is above max
+            project/ncc.toml: machine.limits.X.min: `0.0001` is finer than the control's 0.001"#]].assert_eq(&errors.join("\n"));
     }
 }

@@ -26,7 +26,8 @@ N210 G70
 /// The completions with the cursor at `$0` in the first file, on a machine
 /// configured by `config`.
 fn completions_with(config: &str, files: &[(&str, &str)]) -> (String, Vec<CompletionItem>) {
-    let config = Config::from_toml(config, "ncc.toml").expect("a valid configuration");
+    let config = Config::from_toml(config, "ncc.toml".as_ref(), |path| std::fs::read_to_string(path))
+        .expect("a valid configuration");
     let mut host = AnalysisHost::new(config);
     let mut cursor = None;
     for (path, text) in files {

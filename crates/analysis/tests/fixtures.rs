@@ -94,7 +94,7 @@ fn check(fixture: &PathBuf) -> Result<Vec<Diagnostic>, String> {
         (vec![fixture.clone()], fixture.with_extension("toml"))
     };
     let config = if config_path.exists() {
-        Config::from_toml(&fs::read_to_string(&config_path).unwrap(), &config_path.display().to_string())?
+        Config::from_toml(&fs::read_to_string(&config_path).unwrap(), &config_path, |path| fs::read_to_string(path))?
     } else {
         Config::default()
     };
@@ -186,7 +186,7 @@ fn examples_have_no_diagnostics() {
     }
     for (config_path, paths) in workspaces {
         let config = config_path
-            .map(|p| Config::from_toml(&fs::read_to_string(&p).unwrap(), &p.display().to_string()).unwrap())
+            .map(|p| Config::from_toml(&fs::read_to_string(&p).unwrap(), &p, |path| fs::read_to_string(path)).unwrap())
             .unwrap_or_default();
         let mut host = AnalysisHost::new(config);
         let files: Vec<_> = paths

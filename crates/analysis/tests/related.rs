@@ -1,10 +1,16 @@
 //! Related locations point into the file that explains the finding.
 
+use std::fs;
+
 use ncc_analysis::{AnalysisHost, Config};
 
 #[test]
 fn a_setting_made_in_a_macrocycle_points_at_the_call() {
-    let config = Config::from_toml("[machine]\naxes = [\"X\", \"Z\"]\nfeed-limit = 2000\n", "ncc.toml").unwrap();
+    let config =
+        Config::from_toml("[machine]\naxes = [\"X\", \"Z\"]\nfeed-limit = 2000\n", "ncc.toml".as_ref(), |path| {
+            fs::read_to_string(path)
+        })
+        .unwrap();
     let mut host = AnalysisHost::new(config);
     let main = "%1\nN10 G90 G95 G00 X60. Z2. M03\nN20 G72 L9001\nN30 G01 X5. F3000\nN40 M30\n*\n";
     let file = host.add_file("main.NCP", main);

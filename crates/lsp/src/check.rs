@@ -56,11 +56,12 @@ impl Checked {
 /// Below this many files a run is quick enough not to need a progress bar.
 const PROGRESS_BAR_MIN_FILES: usize = 200;
 
-/// Reads an `ncc.toml`; the error names the file.
+/// Reads an `ncc.toml` and the machine and table files it names; the error
+/// names the file.
 pub(crate) fn load_config(path: &Path) -> Result<Config, String> {
     std::fs::read_to_string(path)
         .map_err(|e| format!("{}: {e}", path.display()))
-        .and_then(|text| Config::from_toml(&text, &path.display().to_string()))
+        .and_then(|text| Config::from_toml(&text, path, read_program))
 }
 
 pub(crate) fn run(paths: &[PathBuf], format: Format) -> ExitCode {

@@ -14,7 +14,9 @@
 //! - [`expand`]: a run written back as a program of plain motion blocks.
 //! - [`lower`]: blocks as plain data (words, parameter assignments,
 //!   comments), read from the syntax tree; the analysis uses it too.
-//! - [`machine`]: the machine a program runs on (axes, rates, constants).
+//! - [`machine`]: the machine a program runs on (axes, rates, limits,
+//!   constants), and [`tables`]: its zero offsets and tool corrections with
+//!   readers for the control's files.
 //! - [`modes`]: the active code of every G and M group.
 //! - [`run`]: running a program block by block into a [`run::Trace`].
 
@@ -26,3 +28,4 @@ pub mod lower;
 pub mod machine;
 pub mod modes;
 pub mod run;
+pub mod tables;

@@ -1,11 +1,14 @@
-//! The machine a program runs on: its axes, rates, the fixed-cycle file
-//! and the machine constants (TAB0.REK). The analysis reads it from
-//! `ncc.toml`; the executor runs on it.
+//! The machine a program runs on: its axes, rates and travel limits, the
+//! fixed-cycle file, the machine constants (TAB0.REK) and the tables of
+//! zero offsets (TAB0.POS) and tool corrections (TAB0.KOR). The analysis
+//! reads it from `ncc.toml` and the machine file it names; the executor
+//! runs on it.
 
 use std::collections::BTreeMap;
 
 use ncc_catalog::Dialect;
-use ncc_syntax::{Decimal, Sign};
+
+use crate::tables::{self, OffsetTable, ToolTable};
 
 /// The machine the programs run on.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
@@ -14,10 +17,14 @@ pub struct MachineConfig {
     pub axes: Vec<u8>,
     /// Highest programmable feed in mm/min.
     pub feed_limit: u32,
-    /// The rapid traverse (G00) of every axis, in mm/min. The manual makes
-    /// it a machine constant without naming one or a value; the default is
-    /// an assumption.
+    /// The rapid traverse (G00) of every axis without a rate of its own, in
+    /// mm/min (degrees/min for a rotary axis). The manual makes it a machine
+    /// constant without naming one or a value; the default is an assumption.
     pub rapid_rate: u32,
+    /// Rapid traverse rates of single axes, by letter.
+    pub rapid_rates: BTreeMap<u8, u32>,
+    /// Travel limits of single axes, by letter.
+    pub limits: BTreeMap<u8, TravelLimits>,
     /// Machine constants set in the configuration, as raw values (the
     /// decades as digits: `00233.112` → 233112).
     pub constants: BTreeMap<u32, i64>,
@@ -25,6 +32,18 @@ pub struct MachineConfig {
     /// CNC836.KNF), e.g. `PCYKLYDG.NCP` (milling) or `PEVNECY5.NCP`
     /// (lathe): it decides what G81–G89 do.
     pub cycle_file: Option<String>,
+    /// The zero offsets G53-G59 as the control loads them from TAB0.POS.
+    pub offsets: OffsetTable,
+    /// The tool corrections D1-D99 as the control loads them from TAB0.KOR.
+    pub tools: ToolTable,
+}
+
+/// How far an axis may travel, in thousandths (µm, or thousandths of a
+/// degree) from the machine zero; `None` where it is not limited.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+pub struct TravelLimits {
+    pub min: Option<i32>,
+    pub max: Option<i32>,
 }
 
 impl Default for MachineConfig {
@@ -33,8 +52,12 @@ impl Default for MachineConfig {
             axes: b"XYZUVC".to_vec(),
             feed_limit: 24_000,
             rapid_rate: 10_000,
+            rapid_rates: BTreeMap::new(),
+            limits: BTreeMap::new(),
             constants: BTreeMap::new(),
             cycle_file: None,
+            offsets: OffsetTable::default(),
+            tools: ToolTable::default(),
         }
     }
 }
@@ -83,6 +106,11 @@ impl MachineConfig {
         }
     }
 
+    /// The rapid traverse of the axis `letter` in mm/min (degrees/min).
+    pub fn axis_rapid_rate(&self, letter: u8) -> u32 {
+        self.rapid_rates.get(&letter).copied().unwrap_or(self.rapid_rate)
+    }
+
     /// Whether `letter` names a configured axis.
     pub fn is_axis(&self, letter: u8) -> bool {
         self.axes.contains(&letter.to_ascii_uppercase())
@@ -92,12 +120,7 @@ impl MachineConfig {
 /// Reads a machine-constant value as written in TAB0.REK: with a decimal
 /// point in thousandths (`60.000`), without one as the raw decades.
 pub fn parse_constant(text: &str) -> Option<i64> {
-    let text = text.trim();
-    let (sign, digits) = match text.strip_prefix('-') {
-        Some(rest) => (Some(Sign::Minus), rest),
-        None => (None, text.strip_prefix('+').unwrap_or(text)),
-    };
-    let value = Decimal::parse(sign, digits)?;
+    let value = tables::signed_decimal(text.trim())?;
     let scale = if value.has_point() { 3 } else { 0 };
     i64::try_from(value.scaled(scale)?).ok()
 }

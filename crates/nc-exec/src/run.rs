@@ -770,10 +770,16 @@ impl<'a> Runner<'a> {
         Ok(())
     }
 
-    /// Seconds a rapid move takes: the longest axis travel at the rapid rate.
+    /// Seconds a rapid move takes: every axis runs at its own rate, and the
+    /// slowest to arrive sets the time.
     fn rapid_seconds(&self, start: &Position, end: &Position) -> f64 {
-        let longest = (0..26).map(|i| (end[i] - start[i]).abs()).fold(0.0, f64::max);
-        longest / f64::from(self.machine.rapid_rate) * 60.0
+        let minutes = (b'A'..=b'Z')
+            .map(|letter| {
+                let slot = usize::from(letter - b'A');
+                (end[slot] - start[slot]).abs() / f64::from(self.machine.axis_rapid_rate(letter))
+            })
+            .fold(0.0, f64::max);
+        minutes * 60.0
     }
 
     /// What a cycle of the cycle file keeps of the state before it: all of
@@ -1574,5 +1580,18 @@ mod tests {
         assert_eq!(trace.steps.len(), 3);
         let messages: Vec<&str> = trace.findings.iter().map(|f| f.message.as_str()).collect();
         assert_eq!(messages, ["the executor does not run radius compensation (G41/G42) yet: the time leaves them out"]);
+    }
+
+    #[test]
+    fn a_rapid_move_lasts_as_long_as_its_slowest_axis() {
+        let machine = MachineConfig { rapid_rates: [(b'Z', 5_000)].into(), ..MachineConfig::default() };
+        let trace =
+            run(&Parse::new("%1\nN1 G00 X100 Z40\nN2 X0 Z0 Y200\nN3 M30\n", Dialect::Cnc8x6), &NoFiles, &machine, 100);
+        // N1: X 100 mm at 10000 mm/min is 0.6 s, Z 40 mm at 5000 mm/min 0.48 s;
+        // N2: Y 200 mm at 10000 mm/min is 1.2 s.
+        close(trace.steps[0].duration, 0.6);
+        close(trace.steps[1].duration, 1.2);
+        let trace = run(&Parse::new("%1\nN1 G00 X50 Z40\nN2 M30\n", Dialect::Cnc8x6), &NoFiles, &machine, 100);
+        close(trace.steps[0].duration, 0.48);
     }
 }

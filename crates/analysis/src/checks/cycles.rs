@@ -566,7 +566,9 @@ mod tests {
     use crate::{AnalysisHost, Config, Diagnostic};
 
     fn diagnostics(config: &str, path: &str, text: &str) -> Vec<Diagnostic> {
-        let mut host = AnalysisHost::new(Config::from_toml(config, "ncc.toml").unwrap());
+        let mut host = AnalysisHost::new(
+            Config::from_toml(config, "ncc.toml".as_ref(), |path| std::fs::read_to_string(path)).unwrap(),
+        );
         let file = host.add_file(path, text);
         host.analysis().diagnostics(file)
     }
