@@ -220,8 +220,14 @@ impl Serialize for Records<'_> {
                 duration_s: step.duration,
                 length_mm: step.length,
                 feed_mm_min: step.feed,
-                start: Coordinates::of(self.trace.start_of(index), self.axes),
-                end: Coordinates::of(step.end, self.axes),
+                start: Coordinates {
+                    program: Values(self.trace.start_of(index), self.axes),
+                    machine: Values(self.trace.machine_start(index), self.axes),
+                },
+                end: Coordinates {
+                    program: Values(step.end, self.axes),
+                    machine: Values(self.trace.machine_end(index), self.axes),
+                },
             }
         }))
     }
@@ -245,14 +251,6 @@ struct BlockRecord<'a> {
 struct Coordinates<'a> {
     program: Values<'a>,
     machine: Values<'a>,
-}
-
-impl<'a> Coordinates<'a> {
-    /// Program and machine coordinates coincide until the executor runs
-    /// zero offsets.
-    fn of(values: Axes, axes: &'a [u8]) -> Coordinates<'a> {
-        Coordinates { program: Values(values, axes), machine: Values(values, axes) }
-    }
 }
 
 #[derive(Serialize)]

@@ -34,6 +34,7 @@ use crate::{
     lower::{BlockData, Value, Word},
     machine::MachineConfig,
     modes::{Group, Modes},
+    tables::{OffsetTable, ToolTable},
 };
 
 /// Axes by letter (index = letter − `A`); positions in mm (degrees for
@@ -71,6 +72,9 @@ pub struct Step {
     /// The programmed position at the step's end, over the machine's axes
     /// ([`Trace::axes`]); it starts where the step before it ended.
     pub end: Axes,
+    /// The translation from program to machine coordinates the step ran in:
+    /// `Trace::frames[frame]` (the zero offset and the length correction).
+    pub frame: usize,
     /// The program stops after the block (M00, M01) until the operator
     /// starts it again; the run does not count the wait.
     pub stop: Option<Stop>,
@@ -126,6 +130,8 @@ pub struct Finding {
 pub struct Trace {
     /// The machine's axes, the order of [`Step::end`].
     pub axes: Vec<u8>,
+    /// Machine minus program coordinates, per [`Step::frame`].
+    pub frames: Vec<Axes>,
     pub steps: Vec<Step>,
     pub findings: Vec<Finding>,
     /// Tools called with T, in order of first use.
@@ -157,10 +163,16 @@ impl Trace {
         self.steps.last().map_or([0.0; 26], |step| self.position(&step.end))
     }
 
-    /// Where step `index` starts: where the one before it ended, or the
-    /// origin.
+    /// Where step `index` starts in machine coordinates: where the one
+    /// before it ended, or the machine zero.
+    pub fn machine_start(&self, index: usize) -> Axes {
+        index.checked_sub(1).map_or([0.0; MAX_AXES], |before| self.machine_end(before))
+    }
+
+    /// Where step `index` starts in the program coordinates it runs in.
     pub fn start_of(&self, index: usize) -> Axes {
-        index.checked_sub(1).and_then(|before| self.steps.get(before)).map_or([0.0; MAX_AXES], |step| step.end)
+        let (start, frame) = (self.machine_start(index), &self.frames[self.steps[index].frame]);
+        std::array::from_fn(|i| start[i] - frame[i])
     }
 
     /// Axis values as a position by letter.
@@ -170,6 +182,13 @@ impl Trace {
             position[usize::from(axis - b'A')] = value;
         }
         position
+    }
+
+    /// Step `index`'s end in machine coordinates.
+    pub fn machine_end(&self, index: usize) -> Axes {
+        let step = &self.steps[index];
+        let frame = &self.frames[step.frame];
+        std::array::from_fn(|i| step.end[i] + frame[i])
     }
 
     /// The value of axis `letter` in `values`, 0 for a letter the machine
@@ -379,7 +398,14 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
         }
     }
     let axes = machine.axes.iter().copied().take(MAX_AXES).collect();
-    Trace { axes, steps: runner.steps, findings: runner.findings, tools: runner.tools, files: called }
+    Trace {
+        axes,
+        frames: runner.frames,
+        steps: runner.steps,
+        findings: runner.findings,
+        tools: runner.tools,
+        files: called,
+    }
 }
 
 /// A subprogram or macrocycle call being run.
@@ -527,6 +553,19 @@ struct Runner<'a> {
     /// A fixed cycle's body of the cycle file is running: cycles do not
     /// start in it.
     in_cycle: bool,
+    /// The zero-offset and correction tables, as the program changes them.
+    offsets: OffsetTable,
+    corrections: ToolTable,
+    /// The correction entry D and the length-compensation digits `&`.
+    correction: u8,
+    length_digits: u32,
+    /// Machine minus program coordinates per letter: the zero offset and
+    /// the length correction in force.
+    translation: Position,
+    /// The length correction in `translation`.
+    length_shift: Position,
+    /// The translations the steps ran in, and the index of the current one.
+    frames: Vec<Axes>,
     /// The speed limit of constant cutting speed set by `G76 S`, in rpm.
     speed_limit: Option<f64>,
     /// The spindle speed constant cutting speed reached last, which S
@@ -560,6 +599,13 @@ impl<'a> Runner<'a> {
             speed_limit: None,
             speed_reached: None,
             in_cycle: false,
+            offsets: machine.offsets.clone(),
+            corrections: machine.tools.clone(),
+            correction: 0,
+            length_digits: 0,
+            translation: [0.0; 26],
+            length_shift: [0.0; 26],
+            frames: vec![[0.0; MAX_AXES]],
             position: [0.0; 26],
             params: Parameters::zeroed(),
             time: 0.0,
@@ -597,12 +643,11 @@ impl<'a> Runner<'a> {
                 // Modes the run reads where they matter; planes, block
                 // joining, cancelling and the priority codes change
                 // nothing the executor models yet.
-                (b'G', 0..=4 | 33 | 17..=19 | 23 | 24 | 40 | 53 | 76 | 78 | 80..=91 | 94..=98) | (b'M', _) => {}
+                (b'G', 0..=4 | 33 | 17..=19 | 23 | 24 | 40 | 53..=59 | 76 | 78 | 80..=93 | 94..=98) | (b'M', _) => {}
                 // Program flow, which the caller follows, and the
                 // arithmetic, which runs after the motion.
                 (b'G', 26..=29 | 70..=73 | 79) => {}
                 (b'G', 41 | 42) => self.not_run("radius compensation (G41/G42)", code_range),
-                (b'G', 54..=59 | 92 | 93) => self.not_run("zero offsets (G54–G59, G92, G93)", code_range),
                 (b'G', 31 | 34..=39) => self.not_run("transformations (G31, G34–G39)", code_range),
                 _ => self.not_run(&format!("G{number:02}"), code_range),
             }
@@ -623,6 +668,16 @@ impl<'a> Runner<'a> {
                         self.tools.push(tool);
                     }
                 }
+                Some(AddressRole::Offset) => {
+                    if let Some(entry) = self.integer(word).and_then(|entry| u8::try_from(entry).ok()) {
+                        self.correction = entry;
+                    }
+                }
+                Some(AddressRole::LengthCompensation) => {
+                    if let Some(digits) = self.integer(word) {
+                        self.length_digits = digits;
+                    }
+                }
                 _ => {}
             }
         }
@@ -631,10 +686,20 @@ impl<'a> Runner<'a> {
         if css_before && !self.feed_mode().css && !writes_speed {
             self.speed = self.speed_reached.take().unwrap_or(self.speed);
         }
-        let start = self.position;
         let axes: Vec<&Word> =
             block.words.iter().filter(|w| self.catalogue.role_of(w.letter) == Some(AddressRole::Axis)).collect();
-        let moved = if has(b'G', 4) {
+        // A new zero offset holds from this block; a new length correction
+        // from its first block of linear or rapid motion (02 §1.18.2).
+        let motion = self.modes.active(self.groups.motion);
+        let shifts_length = !axes.is_empty() && matches!(motion, Some(0 | 1));
+        self.shift_frame(shifts_length);
+        let start = self.position;
+        let writes_table = has(b'G', 92) || has(b'G', 93);
+        let moved = if writes_table {
+            // G92/G93 write the table and move nothing (01 §5.6, §5.7).
+            self.write_table(block, has(b'G', 93));
+            Moved { motion: Motion::None, length: 0.0, duration: 0.0, feed: None, path: Path::Straight }
+        } else if has(b'G', 4) {
             let dwell = block.word(b'Q').and_then(|q| self.count(q)).unwrap_or(0.0) * 0.01;
             Moved { motion: Motion::Dwell, length: 0.0, duration: dwell, feed: None, path: Path::Straight }
         } else if axes.is_empty() {
@@ -660,7 +725,13 @@ impl<'a> Runner<'a> {
         self.record(range, &self.position.clone(), moved, stop);
         // Assignments and arithmetic take effect after the block's motion.
         arith::assign(block, &mut self.params);
-        let mut machine = ProgramMachine { machine: self.machine, position: &self.position };
+        let mut machine = ProgramMachine {
+            machine: self.machine,
+            position: &self.position,
+            translation: &self.translation,
+            offsets: &mut self.offsets,
+            corrections: &mut self.corrections,
+        };
         match arith::compute(block, &mut self.params, &mut machine, self.machine) {
             BlockArithmetic::None | BlockArithmetic::Ran { result: Ok(()), .. } => {}
             BlockArithmetic::UnknownWord => {
@@ -702,6 +773,103 @@ impl<'a> Runner<'a> {
         }
     }
 
+    /// Takes the zero offset in force, and the length correction when
+    /// `with_length` (a block of linear or rapid motion), into the
+    /// translation from program to machine coordinates. The tool stays
+    /// where it is, so its program position moves the other way.
+    fn shift_frame(&mut self, with_length: bool) {
+        if with_length {
+            self.length_shift = self.length_correction();
+        }
+        let row = self.modes.active(self.groups.zero_offset).and_then(|code| u8::try_from(code).ok()).unwrap_or(53);
+        let mut translation = self.length_shift;
+        for (&value, &axis) in self.offsets.offset(row).iter().zip(&self.machine.axes) {
+            translation[slot(axis)] += f64::from(value) / 1000.0;
+        }
+        if translation == self.translation {
+            return;
+        }
+        for (position, (new, old)) in self.position.iter_mut().zip(translation.iter().zip(&self.translation)) {
+            *position -= new - old;
+        }
+        self.translation = translation;
+        let mut frame = [0.0; MAX_AXES];
+        for (value, &axis) in frame.iter_mut().zip(&self.machine.axes) {
+            *value = translation[slot(axis)];
+        }
+        self.frames.push(frame);
+    }
+
+    /// The length correction `&` and `D` select: mode A (machine constant
+    /// 329 decade 7 = 0) adds (1) or subtracts (2) entry D's length per
+    /// digit of `&` for axes 1–4; otherwise D alone applies the entry's
+    /// lengths to every axis (mode B; mode C's switch is read as B).
+    fn length_correction(&self) -> Position {
+        let mut shift = [0.0; 26];
+        if self.correction == 0 {
+            return shift;
+        }
+        let entry = self.corrections.entry(self.correction);
+        let mode_a = self.machine.decade(329, 7) == 0;
+        for (index, (&axis, &length)) in self.machine.axes.iter().zip(&entry.lengths).enumerate() {
+            let sign = if mode_a {
+                // `&k1k2k3k4`, right-aligned: k1 is the thousands digit.
+                let digit = (index < 4).then(|| self.length_digits / 10u32.pow(3 - index as u32) % 10);
+                match digit {
+                    Some(1) => 1.0,
+                    Some(2) => -1.0,
+                    _ => 0.0,
+                }
+            } else {
+                1.0
+            };
+            shift[slot(axis)] = sign * f64::from(length) / 1000.0;
+        }
+        shift
+    }
+
+    /// G92 writes the programmed values into the zero-offset row of the
+    /// block's G5 code (or the one in force), or with D the R0–R4 of the
+    /// block into that correction entry; G93 sets the row so that the
+    /// programmed values become the tool's position (01 §5.6–5.7, 02 §1.4).
+    fn write_table(&mut self, block: &BlockData, relative_to_tool: bool) {
+        if !relative_to_tool
+            && block.words.iter().any(|w| self.catalogue.role_of(w.letter) == Some(AddressRole::Offset))
+        {
+            let mut entry = self.corrections.entry(self.correction);
+            for assignment in &block.assignments {
+                let (Some(index), Some(Value::Literal(value))) = (assignment.index, &assignment.value) else {
+                    continue;
+                };
+                let Some(raw) = arith::literal_raw(value).and_then(|raw| i32::try_from(raw).ok()) else { continue };
+                match index {
+                    0 => entry.radius = raw,
+                    1..=4 => entry.lengths[index as usize - 1] = raw,
+                    _ => {}
+                }
+            }
+            self.corrections.entries.insert(self.correction, entry);
+            return;
+        }
+        let row = self.modes.active(self.groups.zero_offset).and_then(|code| u8::try_from(code).ok()).unwrap_or(53);
+        let mut values = self.offsets.offset(row);
+        for word in block.words.iter().filter(|w| self.catalogue.role_of(w.letter) == Some(AddressRole::Axis)) {
+            let (Some(index), Some(value)) =
+                (self.machine.axes.iter().position(|&axis| axis == word.letter), self.number(word))
+            else {
+                continue;
+            };
+            let value = (value * 1000.0).round() as i32;
+            values[index] = if relative_to_tool {
+                let at = (self.position[slot(word.letter)] * 1000.0).round() as i32;
+                values[index] + at - value
+            } else {
+                value
+            };
+        }
+        self.offsets.rows.insert(row, values);
+    }
+
     /// Adds a step of the block at `range` that starts now and ends at `end`.
     fn record(&mut self, range: TextRange, end: &Position, moved: Moved, stop: Option<Stop>) {
         let Moved { motion, length, duration, feed, path } = moved;
@@ -710,7 +878,20 @@ impl<'a> Runner<'a> {
         for (value, &axis) in values.iter_mut().zip(&self.machine.axes) {
             *value = end[usize::from(axis - b'A')];
         }
-        self.steps.push(Step { source, range, motion, path, start_time, duration, length, feed, end: values, stop });
+        let frame = self.frames.len() - 1;
+        self.steps.push(Step {
+            source,
+            range,
+            motion,
+            path,
+            start_time,
+            duration,
+            length,
+            feed,
+            end: values,
+            frame,
+            stop,
+        });
         self.time += duration;
     }
 
@@ -1030,32 +1211,86 @@ impl<'a> Runner<'a> {
 }
 
 /// What parameter arithmetic reads of the machine while a program runs:
-/// the programmed positions (the measured ones equal them, as the run has
-/// no following error) and the machine constants.
+/// the programmed positions (the measured ones are the machine
+/// coordinates, as the run has no following error), the machine constants,
+/// and the zero-offset and correction tables, which it may write.
+///
+/// The manual numbers the tables' columns without naming them; the run
+/// reads an offset's column k as axis k, and a correction's column 1 as the
+/// radius and columns 2–7 as the lengths of axes 1–6, in thousandths.
 struct ProgramMachine<'r> {
     machine: &'r MachineConfig,
     position: &'r Position,
+    translation: &'r Position,
+    offsets: &'r mut OffsetTable,
+    corrections: &'r mut ToolTable,
+}
+
+impl ProgramMachine<'_> {
+    fn axis_slot(&self, axis: u8) -> Option<usize> {
+        Some(slot(*self.machine.axes.get(usize::from(axis).checked_sub(1)?)?))
+    }
 }
 
 impl Machine for ProgramMachine<'_> {
     fn measured_position(&self, axis: u8) -> Option<Raw> {
-        self.programmed_position(axis)
+        let slot = self.axis_slot(axis)?;
+        Some(((self.position[slot] + self.translation[slot]) * 1000.0).round() as Raw)
     }
 
     fn programmed_position(&self, axis: u8) -> Option<Raw> {
-        let letter = *self.machine.axes.get(usize::from(axis).checked_sub(1)?)?;
-        Some((self.position[usize::from(letter - b'A')] * 1000.0).round() as Raw)
+        Some((self.position[self.axis_slot(axis)?] * 1000.0).round() as Raw)
     }
 
-    fn read_table(&self, table: u8, row: u16, _column: u16) -> Option<Raw> {
-        // Correction and offset tables and the block registers come with
-        // the tables the machine configuration loads.
-        (table == 3).then(|| self.machine.known_constant(u32::from(row))).flatten()
+    fn read_table(&self, table: u8, row: u16, column: u16) -> Option<Raw> {
+        let column = usize::from(column);
+        match table {
+            1 => {
+                let entry = self.corrections.entry(u8::try_from(row).ok()?);
+                match column {
+                    1 => Some(Raw::from(entry.radius)),
+                    2..=7 => Some(Raw::from(entry.lengths[column - 2])),
+                    _ => None,
+                }
+            }
+            2 => {
+                let row = u8::try_from(row).ok().filter(|row| (53..=59).contains(row))?;
+                column.checked_sub(1).and_then(|axis| self.offsets.offset(row).get(axis).copied()).map(Raw::from)
+            }
+            3 => self.machine.known_constant(u32::from(row)),
+            // The block registers come with a model of the control's buffers.
+            _ => None,
+        }
     }
 
-    fn write_table(&mut self, _table: u8, _row: u16, _column: u16, _value: Raw) {}
+    fn write_table(&mut self, table: u8, row: u16, column: u16, value: Raw) {
+        let (Ok(row), Ok(value), column) = (u8::try_from(row), i32::try_from(value), usize::from(column)) else {
+            return;
+        };
+        match table {
+            1 => {
+                let mut entry = self.corrections.entry(row);
+                match column {
+                    1 => entry.radius = value,
+                    2..=7 => entry.lengths[column - 2] = value,
+                    _ => return,
+                }
+                self.corrections.entries.insert(row, entry);
+            }
+            2 if (53..=59).contains(&row) && (1..=6).contains(&column) => {
+                let mut values = self.offsets.offset(row);
+                values[column - 1] = value;
+                self.offsets.rows.insert(row, values);
+            }
+            _ => {}
+        }
+    }
 
     fn message(&mut self, _message: Message) {}
+}
+
+fn slot(axis: u8) -> usize {
+    usize::from(axis - b'A')
 }
 
 /// The groups the run reads, resolved once.
@@ -1065,6 +1300,7 @@ struct Groups {
     cycle: Group,
     dimensions: Group,
     spindle: Group,
+    zero_offset: Group,
 }
 
 impl Groups {
@@ -1075,6 +1311,7 @@ impl Groups {
             cycle: modes.group("G8"),
             dimensions: modes.group("G9"),
             spindle: modes.group("M2"),
+            zero_offset: modes.group("G5"),
         }
     }
 }
@@ -1366,6 +1603,45 @@ mod tests {
         close(trace.time_in(Motion::Feed), 2.0 * 12.0 / 100.0 * 60.0);
     }
 
+    /// Lengths of the steps, to the micrometre.
+    fn lengths(trace: &Trace) -> Vec<f64> {
+        trace.steps.iter().map(|step| (step.length * 1000.0).round() / 1000.0).collect()
+    }
+
+    #[test]
+    fn zero_offsets_move_the_program_zero() {
+        use crate::tables::OffsetTable;
+        // G54 is X+100: the same programmed X10 is 100 mm further.
+        let mut machine = MachineConfig::default();
+        (machine.offsets, _) = OffsetTable::parse("$POS\nG54: X=100.0\n", &machine.axes);
+        let parse = Parse::new("%1\nN1 G00 X10\nN2 G54 X10\nN3 M30\n", Dialect::Cnc8x6);
+        let trace = run(&parse, &NoFiles, &machine, 100);
+        assert_eq!(lengths(&trace)[..2], [10.0, 100.0]);
+        assert_eq!([trace.axis(&trace.steps[1].end, b'X'), trace.axis(&trace.machine_end(1), b'X')], [10.0, 110.0]);
+        assert_eq!(trace.axis(&trace.start_of(1), b'X'), -90.0);
+
+        // G92 writes the G55 row and moves nothing; the offset holds from
+        // the next block.
+        let trace = run_text("%1\nN1 G55 G92 X100.5 Y200.\nN2 G00 X0 Y0\nN3 M30\n");
+        assert_eq!(lengths(&trace)[..2], [0.0, 223.831]); // √(100.5² + 200²)
+
+        // G93 X10. at X30 puts the program zero 10 mm behind the tool: the
+        // row becomes 0 + 30 − 10 = 20 (01 §5.7, case 2).
+        let trace = run_text("%1\nN1 G00 X30\nN2 G55 G93 X10.\nN3 G00 X10\nN4 X0\nN5 M30\n");
+        assert_eq!(lengths(&trace)[..4], [30.0, 0.0, 0.0, 10.0]);
+        assert_eq!(trace.axis(&trace.machine_end(3), b'X'), 20.0);
+    }
+
+    #[test]
+    fn length_corrections_shift_the_path_from_their_first_linear_block() {
+        // D1 has Z length 50: `&0010` adds it to Z (axis 3) in the next G00
+        // block; `&0` takes it off again.
+        let text = "%1\nN1 G92 D1 R3=50.\nN2 D1 &0010 G00 Z0\nN3 Z10\nN4 &0\nN5 Z10\nN6 M30\n";
+        let trace = run_text(text);
+        assert_eq!(lengths(&trace)[..5], [0.0, 50.0, 10.0, 0.0, 50.0]);
+        assert_eq!(trace.axis(&trace.machine_end(2), b'Z'), 60.0);
+    }
+
     #[test]
     fn incremental_moves_add_to_the_position() {
         let trace = run_text("%1\nN1 G91 G01 X10 Y10 F600\nN2 X10\nN3 G90 X0\nN4 M30\n");
@@ -1544,9 +1820,9 @@ mod tests {
         // block's motion: 12.5 mm, raw 12500.
         let trace = run_text("%1\nN1 G00 X12.5 R5=26010010 G26\nN2 G01 YR10 F600\nN3 M30\n");
         assert_eq!(trace.end_position()[usize::from(b'Y' - b'A')], 12.5);
-        // Op 49 reads correction D1, a table the run does not load yet: the
-        // word that uses the value is named and left out.
-        let text = "%1\nN1 R5=49110110 G26\nN2 G01 XR10 F100\nN3 M30\n";
+        // Op 49 reads a block register (table 4), which the run does not
+        // model: the word that uses the value is named and left out.
+        let text = "%1\nN1 R5=49410110 G26\nN2 G01 XR10 F100\nN3 M30\n";
         let trace = run_text(text);
         let found: Vec<(&str, bool)> = trace.findings.iter().map(|f| (&text[f.range], f.fatal)).collect();
         assert_eq!(found, [("XR10", false)]);
