@@ -4,14 +4,15 @@
 //! cargo run --release -p ncc-bench -- parse [--blocks 1000000] [--runs 3]
 //! cargo run --release -p ncc-bench -- generate --blocks 1000000 --syntax cnc8x6 -o big.NCP
 //! cargo build --release -p ncc -p ncc-bench && target/release/ncc-bench lsp [--json]
+//! cargo build --release -p ncc -p ncc-bench && target/release/ncc-bench exec [--blocks 1000000] [--runs 3] [--json]
 //! ```
 #![allow(unsafe_code)] // The counting allocator below; nothing else.
 
 use std::{
     alloc::{GlobalAlloc, Layout},
     hint::black_box,
-    path::PathBuf,
-    process::Command as Process,
+    path::{Path, PathBuf},
+    process::{Command as Process, Stdio},
     sync::atomic::{AtomicUsize, Ordering::Relaxed},
     time::{Duration, Instant},
 };
@@ -22,6 +23,7 @@ use ncc_bench::{
     edits::{self, Lcg},
     lsp_client::{self, Client, Document},
     progen::{self, Syntax},
+    rs274,
 };
 use ncc_syntax::{Dialect, Parse};
 use serde_json::{Value, json};
@@ -107,6 +109,22 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Run a generated surfacing program with `ncc run` and the same
+    /// toolpath in NGC syntax with LinuxCNC's `rs274 -g`, each a process
+    /// whose output is discarded.
+    Exec {
+        /// The `ncc` binary [default: the one beside ncc-bench].
+        #[arg(long)]
+        ncc: Option<PathBuf>,
+        #[arg(long, default_value_t = 1_000_000)]
+        blocks: usize,
+        /// Timed runs of each; the best one counts.
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+        /// Print the results as one JSON object.
+        #[arg(long)]
+        json: bool,
+    },
     /// Parse a file once (for profilers such as perf or callgrind).
     ParseFile {
         path: PathBuf,
@@ -140,11 +158,10 @@ fn main() -> anyhow::Result<()> {
         Command::Reparse { blocks, edits } => reparse_benchmark(blocks, edits),
         Command::Check { blocks } => check_benchmark(blocks),
         Command::Lsp { server, blocks, edits, json } => {
-            let server = match server {
-                Some(server) => server,
-                None => std::env::current_exe()?.with_file_name(format!("ncc{}", std::env::consts::EXE_SUFFIX)),
-            };
-            lsp_benchmark(&server, blocks, edits, json)
+            lsp_benchmark(&server.map_or_else(ncc_beside_bench, Ok)?, blocks, edits, json)
+        }
+        Command::Exec { ncc, blocks, runs, json } => {
+            exec_benchmark(&ncc.map_or_else(ncc_beside_bench, Ok)?, blocks, runs.max(1), json)
         }
         Command::ParseFile { path, threads, gcode } => {
             let text = std::fs::read_to_string(&path)?;
@@ -170,6 +187,11 @@ fn main() -> anyhow::Result<()> {
             std::fs::write(&output, text).with_context(|| format!("writing {}", output.display()))
         }
     }
+}
+
+/// The `ncc` binary of the same build as this one.
+fn ncc_beside_bench() -> anyhow::Result<PathBuf> {
+    Ok(std::env::current_exe()?.with_file_name(format!("ncc{}", std::env::consts::EXE_SUFFIX)))
 }
 
 struct Measurement {
@@ -438,7 +460,7 @@ fn wake_ups(count: usize) -> Latencies {
     latencies
 }
 
-fn lsp_benchmark(server: &std::path::Path, blocks: usize, edits: usize, as_json: bool) -> anyhow::Result<()> {
+fn lsp_benchmark(server: &Path, blocks: usize, edits: usize, as_json: bool) -> anyhow::Result<()> {
     anyhow::ensure!(edits > 0, "--edits must be at least 1");
     let text = progen::write(&progen::surfacing(blocks), Syntax::Cnc8x6);
     let bytes = text.len();
@@ -566,4 +588,68 @@ fn g_code_near(text: &str, offset: usize, rng: &mut Lcg) -> Option<usize> {
         line_start += line.len();
     }
     None
+}
+
+fn exec_benchmark(ncc: &Path, blocks: usize, runs: usize, as_json: bool) -> anyhow::Result<()> {
+    let rs274 = rs274::find().context(rs274::MISSING)?;
+    anyhow::ensure!(ncc.is_file(), "{} not found: cargo build --release -p ncc", ncc.display());
+    let moves = progen::surfacing(blocks);
+    let dir = tempfile::tempdir()?;
+    let (cnc, ngc) = (dir.path().join("surface.NCP"), dir.path().join("surface.ngc"));
+    std::fs::write(&cnc, progen::write(&moves, Syntax::Cnc8x6))?;
+    std::fs::write(&ngc, progen::write(&moves, Syntax::Ngc))?;
+    drop(moves);
+    let mut ncc_run = Process::new(ncc);
+    ncc_run.arg("run").arg(&cnc).stdout(Stdio::null());
+    let mut rs274_run = Process::new(&rs274);
+    rs274_run.arg("-g").arg(&ngc).stdin(Stdio::null()).stdout(Stdio::null());
+
+    // Untimed first runs: both must reach the program end, and they bring
+    // the files into the page cache. What ncc does not run yet it names.
+    let ncc_output = ncc_run.output()?;
+    let ncc_notes = String::from_utf8_lossy(&ncc_output.stderr).replace(&format!("{}/", dir.path().display()), "");
+    anyhow::ensure!(ncc_output.status.success(), "ncc run failed:\n{ncc_notes}");
+    let rs274_output = rs274_run.output()?;
+    anyhow::ensure!(rs274_output.status.success(), "rs274 failed:\n{}", String::from_utf8_lossy(&rs274_output.stderr));
+
+    let timed = |process: &mut Process| -> anyhow::Result<Duration> {
+        let mut best = Duration::MAX;
+        for _ in 0..runs {
+            let start = Instant::now();
+            let status = process.stderr(Stdio::null()).status()?;
+            best = best.min(start.elapsed());
+            anyhow::ensure!(status.success(), "{process:?} ended with {status}");
+        }
+        Ok(best)
+    };
+    let ncc_time = timed(&mut ncc_run)?;
+    let rs274_time = timed(&mut rs274_run)?;
+    let rate = |time: Duration| blocks as f64 / time.as_secs_f64();
+    if as_json {
+        let output = json!({
+            "blocks": blocks,
+            "runs": runs,
+            "ncc_s": ncc_time.as_secs_f64(),
+            "rs274_s": rs274_time.as_secs_f64(),
+            "ncc_blocks_per_s": rate(ncc_time),
+            "rs274_blocks_per_s": rate(rs274_time),
+            "ratio": rate(ncc_time) / rate(rs274_time),
+            "ncc_notes": ncc_notes.lines().collect::<Vec<_>>(),
+        });
+        println!("{output:#}");
+    } else {
+        println!(
+            "exec benchmark: {blocks} blocks; CNC8x6 {:.1} MB, NGC {:.1} MB; best of {runs} runs",
+            std::fs::metadata(&cnc)?.len() as f64 / 1e6,
+            std::fs::metadata(&ngc)?.len() as f64 / 1e6
+        );
+        for (name, time) in [("ncc run", ncc_time), ("rs274 -g (LinuxCNC)", rs274_time)] {
+            println!("  {name:<20} {:>9.1} ms {:>12.0} blocks/s", time.as_secs_f64() * 1e3, rate(time));
+        }
+        println!("  speed ratio ncc/rs274: {:.2}x   goal >= 10x", rate(ncc_time) / rate(rs274_time));
+        for note in ncc_notes.lines() {
+            println!("  ncc: {note}");
+        }
+    }
+    Ok(())
 }

@@ -1,0 +1,280 @@
+//! Differential test of the executor against LinuxCNC's `rs274`
+//! interpreter: seeded random programs in the motion subset both dialects
+//! share (G00–G03 with I/J in the XY plane, helices, G90/G91, F), written
+//! as CNC8x6 for `ncc run --format json` and as NGC for `rs274 -g`. Every
+//! motion must end at the same point, with the same kind, feed and path
+//! length.
+//!
+//! Ignored by default because it needs `rs274` (Debian's linuxcnc-uspace);
+//! `.ci/run` installs it and runs this test.
+
+use std::{
+    f64::consts::TAU,
+    fmt::Write,
+    fs,
+    path::Path,
+    process::{Command, Stdio},
+};
+
+use ncc_bench::{edits::Lcg, rs274};
+use serde_json::{Value, json};
+
+const PROGRAMS: u64 = 40;
+const MOTIONS_PER_PROGRAM: usize = 250;
+
+/// Both sides read the same coordinates, exact on the 1 µm grid, and rs274
+/// prints four decimals (off by at most 0.05 µm); floating-point sums of
+/// G91 increments drift far less. A difference above the control's 1 µm
+/// arc tolerance is therefore a real one.
+const TOLERANCE_MM: f64 = 1e-3;
+
+/// One motion block in both dialects and where the generator meant it to
+/// end, in µm.
+struct Block {
+    cnc: String,
+    ngc: String,
+    end: [i64; 3],
+}
+
+/// A motion as one side ran it.
+#[derive(Debug)]
+struct Ran {
+    rapid: bool,
+    /// X, Y, Z in mm.
+    end: [f64; 3],
+    /// mm/min; `None` for rapids.
+    feed: Option<f64>,
+    length: f64,
+}
+
+impl Ran {
+    fn agrees_with(&self, other: &Ran) -> bool {
+        let close = |a: f64, b: f64| (a - b).abs() <= TOLERANCE_MM;
+        self.rapid == other.rapid
+            && self.feed == other.feed
+            && close(self.length, other.length)
+            && (0..3).all(|axis| close(self.end[axis], other.end[axis]))
+    }
+}
+
+#[test]
+#[ignore = "needs LinuxCNC's rs274; .ci/run installs it"]
+fn motion_matches_rs274() {
+    let rs274 = rs274::find().expect(rs274::MISSING);
+    let dir = tempfile::tempdir().unwrap();
+    let mut largest_difference: f64 = 0.0;
+    for seed in 1..=PROGRAMS {
+        let (cnc, ngc, blocks) = generate(seed);
+        let (cnc_file, ngc_file) = (dir.path().join(format!("{seed}.NCP")), dir.path().join(format!("{seed}.ngc")));
+        fs::write(&cnc_file, cnc).unwrap();
+        fs::write(&ngc_file, ngc).unwrap();
+        let ncc = ncc_motions(&cnc_file);
+        let peer = rs274_motions(&rs274, &ngc_file);
+        assert_eq!((ncc.len(), peer.len()), (blocks.len(), blocks.len()), "motions of seed {seed}: (ncc, rs274)");
+        for (index, ((block, ncc), peer)) in blocks.iter().zip(&ncc).zip(&peer).enumerate() {
+            let intended = block.end.map(|um| um as f64 / 1000.0);
+            let intended_reached = (0..3).all(|axis| (ncc.end[axis] - intended[axis]).abs() <= TOLERANCE_MM);
+            assert!(
+                ncc.agrees_with(peer) && intended_reached,
+                "seed {seed}, motion {}:\n  CNC8x6    {}\n  NGC       {}\n  intended  {intended:?}\n  ncc       \
+                 {ncc:?}\n  rs274     {peer:?}",
+                index + 1,
+                block.cnc,
+                block.ngc,
+            );
+            for axis in 0..3 {
+                largest_difference = largest_difference.max((ncc.end[axis] - peer.end[axis]).abs());
+            }
+        }
+    }
+    eprintln!(
+        "{PROGRAMS} programs, {} motions: largest end-point difference {:.4} µm",
+        PROGRAMS as usize * MOTIONS_PER_PROGRAM,
+        largest_difference * 1000.0
+    );
+}
+
+/// A program of random motion blocks as CNC8x6 and NGC text, and its
+/// blocks. Points are whole µm, which three decimals write exactly, so both
+/// texts mean the same numbers and G91 increments add up without rounding.
+fn generate(seed: u64) -> (String, String, Vec<Block>) {
+    let mut rng = Lcg::new(seed);
+    let mut cnc = String::from("%1\n");
+    let mut ngc = String::from("G21 G17 G90 G94\n");
+    let mut blocks = Vec::with_capacity(MOTIONS_PER_PROGRAM);
+    let mut at = [0; 3];
+    let (mut incremental, mut modal, mut feed_set) = (false, None, false);
+    for n in 1..=MOTIONS_PER_PROGRAM {
+        let mut words = Vec::new();
+        if rng.below(8) == 0 {
+            incremental = !incremental;
+            words.push(if incremental { "G91" } else { "G90" }.to_owned());
+        }
+        let code = [0, 0, 1, 1, 1, 1, 2, 2, 3, 3][rng.below(10)];
+        // Motion is modal: the G code may be left out when it repeats.
+        if modal != Some(code) || rng.below(3) > 0 {
+            words.push(format!("G0{code}"));
+        }
+        modal = Some(code);
+        let mut end = at;
+        let (written, centre_offset) = if code < 2 {
+            // A non-empty subset of X, Y, Z.
+            let axes = 1 + rng.below(7);
+            let written = [0, 1, 2].map(|axis| axes >> axis & 1 == 1);
+            for axis in (0..3).filter(|&axis| written[axis]) {
+                end[axis] = coordinate(&mut rng, axis);
+            }
+            (written, None)
+        } else {
+            let (xy, offset) = arc(&mut rng, at, code == 2, incremental);
+            end[..2].copy_from_slice(&xy);
+            // The plane comes from the axes written, so X and Y always are;
+            // with Z the arc becomes a helix.
+            let helix = rng.below(5) == 0;
+            if helix {
+                end[2] = coordinate(&mut rng, 2);
+            }
+            ([true, true, helix], Some(offset))
+        };
+        for axis in (0..3).filter(|&axis| written[axis]) {
+            let value = if incremental { end[axis] - at[axis] } else { end[axis] };
+            words.push(format!("{}{}", ['X', 'Y', 'Z'][axis], mm(value)));
+        }
+        if let Some([i, j]) = centre_offset {
+            words.push(format!("I{} J{}", mm(i), mm(j)));
+        }
+        // Whole mm/min: with a decimal point CNC8x6 reads F in m/min.
+        if code > 0 && (!feed_set || rng.below(5) == 0) {
+            words.push(format!("F{}", 1 + rng.below(20_000)));
+            feed_set = true;
+        }
+        let words = words.join(" ");
+        let block = Block { cnc: format!("N{n} {words}"), ngc: words, end };
+        writeln!(cnc, "{}", block.cnc).unwrap();
+        writeln!(ngc, "{}", block.ngc).unwrap();
+        blocks.push(block);
+        at = end;
+    }
+    writeln!(cnc, "N{} M30\n*", MOTIONS_PER_PROGRAM + 1).unwrap();
+    ngc.push_str("M2\n");
+    (cnc, ngc, blocks)
+}
+
+/// A random X or Y within ±150 mm, Z within ±30 mm, in µm.
+fn coordinate(rng: &mut Lcg, axis: usize) -> i64 {
+    let half_range = if axis == 2 { 30_000 } else { 150_000 };
+    rng.below(2 * half_range + 1) as i64 - half_range as i64
+}
+
+/// An arc in the XY plane from `start`: its end point and its centre
+/// relative to the start (I, J), in µm. Under G91 a full circle one time
+/// in eight, else a sweep of 2° to 358°, so that over 180° is common.
+///
+/// Full circles stay under G91 (X0 Y0) because the executor sums G91
+/// increments in floating point: after such moves a full circle written
+/// with the absolute end point (G90) ends a few ulp away from the start it
+/// computed, and it runs an arc of length ~0 instead of a whole turn, where
+/// rs274 (and the control, which counts in whole µm) turns once.
+fn arc(rng: &mut Lcg, start: [i64; 3], clockwise: bool, incremental: bool) -> ([i64; 2], [i64; 2]) {
+    let radius = 2_000.0 + rng.below(78_000) as f64;
+    let from_centre = (rng.below(360_000) as f64 / 1000.0).to_radians();
+    let offset = [(-radius * from_centre.cos()).round() as i64, (-radius * from_centre.sin()).round() as i64];
+    if incremental && rng.below(8) == 0 {
+        return ([start[0], start[1]], offset);
+    }
+    // The centre is on the grid; the end point rounded onto it moves off
+    // the circle by at most √½ µm, inside the control's 1 µm.
+    let centre = [start[0] + offset[0], start[1] + offset[1]];
+    let radius = (offset[0] as f64).hypot(offset[1] as f64);
+    let sweep = (2.0 + rng.below(356_000) as f64 / 1000.0).to_radians();
+    let to_end = (-offset[1] as f64).atan2(-offset[0] as f64) + if clockwise { -sweep } else { sweep };
+    let end = [centre[0] + (radius * to_end.cos()).round() as i64, centre[1] + (radius * to_end.sin()).round() as i64];
+    let off_circle = ((end[0] - centre[0]) as f64).hypot((end[1] - centre[1]) as f64) - radius;
+    assert!(off_circle.abs() < 1.0, "the arc's end is {off_circle} µm off its circle");
+    (end, offset)
+}
+
+/// µm as mm with three decimals.
+fn mm(um: i64) -> String {
+    let sign = if um < 0 { "-" } else { "" };
+    format!("{sign}{}.{:03}", um.abs() / 1000, um.abs() % 1000)
+}
+
+/// The motions of `ncc run --format json`.
+fn ncc_motions(file: &Path) -> Vec<Ran> {
+    let output = Command::new(env!("CARGO_BIN_EXE_ncc")).args(["run", "--format", "json"]).arg(file).output().unwrap();
+    assert!(output.status.success(), "ncc run {} failed:\n{}", file.display(), String::from_utf8_lossy(&output.stderr));
+    let run: Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(run["findings"], json!([]), "ncc run {}", file.display());
+    let blocks = run["blocks"].as_array().unwrap();
+    blocks
+        .iter()
+        .filter(|block| block["motion"] == "rapid" || block["motion"] == "feed")
+        .map(|block| Ran {
+            rapid: block["motion"] == "rapid",
+            end: ["X", "Y", "Z"].map(|axis| block["end"]["program"][axis].as_f64().unwrap()),
+            feed: block["feed_mm_min"].as_f64(),
+            length: block["length_mm"].as_f64().unwrap(),
+        })
+        .collect()
+}
+
+/// The motions of `rs274 -g`, from its canonical calls (in mm after G21):
+/// `SET_FEED_RATE(f)`, `STRAIGHT_TRAVERSE(x, y, z, a, b, c)`,
+/// `STRAIGHT_FEED(…)` likewise, and in the XY plane
+/// `ARC_FEED(x, y, centre x, centre y, rotation, z, a, b, c)`.
+fn rs274_motions(rs274: &Path, file: &Path) -> Vec<Ran> {
+    // Without -g it would wait for a key after an error.
+    let output = Command::new(rs274).arg("-g").arg(file).stdin(Stdio::null()).output().unwrap();
+    assert!(
+        output.status.success(),
+        "rs274 -g {} failed:\n{}",
+        file.display(),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let (mut at, mut feed, mut motions) = ([0.0; 3], 0.0, Vec::new());
+    for line in String::from_utf8(output.stdout).unwrap().lines() {
+        // `   14 N..... STRAIGHT_FEED(10.5000, 2.0000, 3.0000, 0.0000, 0.0000, 0.0000)`
+        let Some(call) = line.trim_start().splitn(3, ' ').nth(2) else { continue };
+        let Some((name, args)) = call.strip_suffix(')').and_then(|call| call.split_once('(')) else { continue };
+        let numbers = || -> Vec<f64> { args.split(", ").map(|arg| arg.parse().unwrap()).collect() };
+        let ran = match name {
+            "SET_FEED_RATE" => {
+                feed = numbers()[0];
+                continue;
+            }
+            "STRAIGHT_TRAVERSE" | "STRAIGHT_FEED" => {
+                let end = <[f64; 3]>::try_from(&numbers()[..3]).unwrap();
+                let length = (0..3).map(|axis| (end[axis] - at[axis]).powi(2)).sum::<f64>().sqrt();
+                let rapid = name == "STRAIGHT_TRAVERSE";
+                Ran { rapid, end, feed: (!rapid).then_some(feed), length }
+            }
+            "ARC_FEED" => {
+                let n = numbers();
+                let end = [n[0], n[1], n[5]];
+                Ran { rapid: false, end, feed: Some(feed), length: arc_length(at, end, [n[2], n[3]], n[4] as i32) }
+            }
+            _ => continue,
+        };
+        at = ran.end;
+        motions.push(ran);
+    }
+    motions
+}
+
+/// The length of an ARC_FEED in the XY plane: `rotation` turns
+/// counter-clockwise when positive, clockwise when negative, the last one
+/// ending at the end point (a full turn when it is the start); Z rises
+/// evenly along it.
+fn arc_length(start: [f64; 3], end: [f64; 3], centre: [f64; 2], rotation: i32) -> f64 {
+    let angle = |point: [f64; 3]| (point[1] - centre[1]).atan2(point[0] - centre[0]);
+    let mut sweep = angle(end) - angle(start);
+    if rotation > 0 && sweep <= 0.0 {
+        sweep += TAU;
+    } else if rotation < 0 && sweep >= 0.0 {
+        sweep -= TAU;
+    }
+    let turns = sweep.abs() + f64::from(rotation.abs() - 1) * TAU;
+    let radius = (start[0] - centre[0]).hypot(start[1] - centre[1]);
+    (radius * turns).hypot(end[2] - start[2])
+}
