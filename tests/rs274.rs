@@ -126,7 +126,7 @@ fn generate(seed: u64) -> (String, String, Vec<Block>) {
             }
             (written, None)
         } else {
-            let (xy, offset) = arc(&mut rng, at, code == 2, incremental);
+            let (xy, offset) = arc(&mut rng, at, code == 2);
             end[..2].copy_from_slice(&xy);
             // The plane comes from the axes written, so X and Y always are;
             // with Z the arc becomes a helix.
@@ -167,19 +167,14 @@ fn coordinate(rng: &mut Lcg, axis: usize) -> i64 {
 }
 
 /// An arc in the XY plane from `start`: its end point and its centre
-/// relative to the start (I, J), in µm. Under G91 a full circle one time
-/// in eight, else a sweep of 2° to 358°, so that over 180° is common.
-///
-/// Full circles stay under G91 (X0 Y0) because the executor sums G91
-/// increments in floating point: after such moves a full circle written
-/// with the absolute end point (G90) ends a few ulp away from the start it
-/// computed, and it runs an arc of length ~0 instead of a whole turn, where
-/// rs274 (and the control, which counts in whole µm) turns once.
-fn arc(rng: &mut Lcg, start: [i64; 3], clockwise: bool, incremental: bool) -> ([i64; 2], [i64; 2]) {
+/// relative to the start (I, J), in µm. A full circle one time in eight
+/// (under G90 its end is the start written absolutely, after G91 sums),
+/// else a sweep of 2° to 358°, so that over 180° is common.
+fn arc(rng: &mut Lcg, start: [i64; 3], clockwise: bool) -> ([i64; 2], [i64; 2]) {
     let radius = 2_000.0 + rng.below(78_000) as f64;
     let from_centre = (rng.below(360_000) as f64 / 1000.0).to_radians();
     let offset = [(-radius * from_centre.cos()).round() as i64, (-radius * from_centre.sin()).round() as i64];
-    if incremental && rng.below(8) == 0 {
+    if rng.below(8) == 0 {
         return ([start[0], start[1]], offset);
     }
     // The centre is on the grid; the end point rounded onto it moves off

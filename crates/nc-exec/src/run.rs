@@ -27,6 +27,7 @@
 use nalgebra::Vector2;
 use ncc_catalog::{AddressRole, Catalogue, Dialect};
 use ncc_syntax::{Parse, TextRange, ast::AstNode};
+use rowan::GreenNode;
 
 use crate::{
     arith::{self, BlockArithmetic, Machine, Message, Parameters, Raw},
@@ -251,6 +252,8 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
     let mut program = Blocks::default();
     program.add(parse);
     let mut runner = Runner::new(machine);
+    // Most programs run each block about once.
+    runner.steps.reserve(program.blocks.len());
     // Macrocycle numbers called, and where each file's body starts; the
     // cycle file's source once read; the files read, in source order.
     let mut loaded: Vec<(u32, Option<usize>)> = Vec::new();
@@ -280,7 +283,7 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
             break;
         }
         let next = at + 1;
-        let flow = runner.block(&block.data, range);
+        let flow = runner.block(&BlockData::lower(&block.green), range);
         at = match flow {
             Flow::End => break,
             Flow::Next => {
@@ -430,10 +433,13 @@ struct Blocks {
     sources: usize,
 }
 
+/// A block as the run keeps it: its syntax, lowered again each time it
+/// runs, so that a program of a million blocks costs little more memory
+/// than its tree.
 struct Block {
     source: usize,
     range: TextRange,
-    data: BlockData,
+    green: GreenNode,
 }
 
 impl Blocks {
@@ -444,14 +450,17 @@ impl Blocks {
         let first = self.blocks.len();
         let source = self.sources;
         self.sources += 1;
-        self.blocks.extend(parse.tree().blocks().map(|block| Block {
-            source,
-            range: block.syntax().text_range(),
-            data: BlockData::lower(block.syntax().green()),
-        }));
-        self.units.add(&self.blocks[first..], first);
-        let opening = self.blocks.get(first)?;
-        Some(if opening.data.has_code(b'G', 79) { first + 1 } else { first })
+        let mut opens_with_g79 = false;
+        for block in parse.tree().blocks() {
+            let green = block.syntax().green().to_owned();
+            let data = BlockData::lower(&green);
+            let index = self.blocks.len();
+            opens_with_g79 |= index == first && data.has_code(b'G', 79);
+            self.units.add(index, source, &data, index == first);
+            self.blocks.push(Block { source, range: block.syntax().text_range(), green });
+        }
+        self.units.numbers.sort_unstable();
+        (first < self.blocks.len()).then_some(if opens_with_g79 { first + 1 } else { first })
     }
 }
 
@@ -469,26 +478,26 @@ struct Units {
 }
 
 impl Units {
-    /// Indexes a file's blocks, the first of which has index `first`.
-    fn add(&mut self, blocks: &[Block], first: usize) {
-        let label = |block: &BlockData| match block.word(b'L')?.value.as_ref()? {
-            Value::Literal(decimal) => whole_number(decimal),
-            Value::Parameter { .. } => None,
-        };
-        self.units += 1;
-        for (index, block) in (first..).zip(blocks) {
-            // Each `G79` opens a unit: a subprogram, a cycle file's body,
-            // or a macrocycle file's body (whose file opened one already).
-            if block.data.has_code(b'G', 79) {
-                self.units += 1;
-                self.starts.extend(label(&block.data).map(|label| (index, block.source, label)));
-            }
-            self.unit_of.push(self.units);
-            if let Some(number) = block.data.number.and_then(|number| number.value) {
-                self.numbers.push((number, index));
-            }
+    /// Indexes block `index` of file `source`; `opens_file` for a file's
+    /// first block. The caller sorts `numbers` after the file.
+    fn add(&mut self, index: usize, source: usize, block: &BlockData, opens_file: bool) {
+        if opens_file {
+            self.units += 1;
         }
-        self.numbers.sort_unstable();
+        // Each `G79` opens a unit: a subprogram, a cycle file's body, or a
+        // macrocycle file's body (whose file opened one already).
+        if block.has_code(b'G', 79) {
+            self.units += 1;
+            let label = match block.word(b'L').and_then(|word| word.value.as_ref()) {
+                Some(Value::Literal(decimal)) => whole_number(decimal),
+                _ => None,
+            };
+            self.starts.extend(label.map(|label| (index, source, label)));
+        }
+        self.unit_of.push(self.units);
+        if let Some(number) = block.number.and_then(|number| number.value) {
+            self.numbers.push((number, index));
+        }
     }
 
     fn starts_subprogram(&self, index: usize) -> bool {
@@ -553,6 +562,9 @@ struct Runner<'a> {
     /// A fixed cycle's body of the cycle file is running: cycles do not
     /// start in it.
     in_cycle: bool,
+    /// Machine constant 329 decade 3: G96/G97 swapped (1, 3), S in m/min
+    /// (2, 3); read once, as every block asks.
+    css_setting: u8,
     /// The zero-offset and correction tables, as the program changes them.
     offsets: OffsetTable,
     corrections: ToolTable,
@@ -599,6 +611,7 @@ impl<'a> Runner<'a> {
             speed_limit: None,
             speed_reached: None,
             in_cycle: false,
+            css_setting: machine.decade(329, 3),
             offsets: machine.offsets.clone(),
             corrections: machine.tools.clone(),
             correction: 0,
@@ -709,7 +722,8 @@ impl<'a> Runner<'a> {
             for word in &axes {
                 if let Some(value) = self.number(word) {
                     let slot = &mut end[usize::from(word.letter - b'A')];
-                    *slot = if self.incremental() { *slot + value } else { value };
+                    // The control counts positions in whole µm.
+                    *slot = round3(if self.incremental() { *slot + value } else { value });
                 }
             }
             self.position = end;
@@ -1010,17 +1024,22 @@ impl<'a> Runner<'a> {
         let length = arc.as_ref().map_or(straight, Arc::length);
         let mode = self.feed_mode();
         let feed = self.feed.map(|feed| feed.value(mode.per_revolution || motion == Some(33)));
+        // Minutes, and the path feed in mm/min (the average where it varies).
+        let timed = |minutes: f64| (minutes, length / minutes);
         let minutes = match (feed.filter(|&feed| feed > 0.0), mode) {
             // A thread: the lead per revolution at S, after waiting for the
             // spindle's zero pulse, on average half a revolution (01 §6.10).
             (Some(lead), _) if motion == Some(33) => {
-                (self.speed > 0.0).then(|| length / (lead * self.speed) + 0.5 / self.speed)
+                (self.speed > 0.0).then(|| timed(length / (lead * self.speed) + 0.5 / self.speed))
             }
-            (Some(feed), FeedMode { per_revolution: false, .. }) => Some(length / feed),
+            (Some(feed), FeedMode { per_revolution: false, .. }) => Some((length / feed, feed)),
             (Some(feed), FeedMode { per_revolution: true, css: false }) => {
-                (self.speed > 0.0).then(|| length / (feed * self.speed))
+                let rate = feed * self.speed;
+                (rate > 0.0).then(|| (length / rate, rate))
             }
-            (Some(feed), FeedMode { per_revolution: true, css: true }) => self.css_minutes(step, arc.as_ref(), feed),
+            (Some(feed), FeedMode { per_revolution: true, css: true }) => {
+                self.css_minutes(step, arc.as_ref(), feed).map(timed)
+            }
             (None, _) => None,
         };
         let path = match (&arc, feed) {
@@ -1033,7 +1052,7 @@ impl<'a> Runner<'a> {
             _ => Path::Straight,
         };
         match minutes {
-            Some(minutes) => moved(Motion::Feed, length, minutes * 60.0, Some(length / minutes), path),
+            Some((minutes, rate)) => moved(Motion::Feed, length, minutes * 60.0, Some(rate), path),
             None => {
                 let why = match mode {
                     _ if feed.is_none_or(|feed| feed <= 0.0) => {
@@ -1054,7 +1073,7 @@ impl<'a> Runner<'a> {
     /// Feed units and constant cutting speed from group G6, with the swap
     /// of G96/G97 that machine constant 329 decade 3 selects (01 §6.9).
     fn feed_mode(&self) -> FeedMode {
-        let swapped = matches!(self.machine.decade(329, 3), 1 | 3);
+        let swapped = matches!(self.css_setting, 1 | 3);
         match self.modes.active(self.groups.feed_units) {
             Some(95) => FeedMode { per_revolution: true, css: false },
             Some(96) => FeedMode { per_revolution: swapped, css: true },
@@ -1073,7 +1092,7 @@ impl<'a> Runner<'a> {
     /// (else 9999 rpm, the largest S); `None` when the cutting speed is 0.
     fn css_minutes(&mut self, step: &Move<'_>, arc: Option<&Arc>, feed: f64) -> Option<f64> {
         // S in 0.1 m/min, or in m/min (decade 3 = 2 or 3); as mm/min.
-        let per_unit = if matches!(self.machine.decade(329, 3), 2 | 3) { 1000.0 } else { 100.0 };
+        let per_unit = if matches!(self.css_setting, 2 | 3) { 1000.0 } else { 100.0 };
         let cutting_speed = self.speed * per_unit;
         if cutting_speed <= 0.0 {
             return None;
