@@ -24,13 +24,14 @@
 //! does is reported once per kind as not run yet (offsets, compensation,
 //! transformations), so that a total never silently leaves something out.
 
-use nalgebra::Vector2;
+use nalgebra::{Point2, Vector2};
 use ncc_catalog::{AddressRole, Catalogue, Dialect};
 use ncc_syntax::{Parse, TextRange, ast::AstNode};
 use rowan::GreenNode;
 
 use crate::{
     arith::{self, BlockArithmetic, Machine, Message, Parameters, Raw},
+    compensation::{CompensationError, Compensator, Element, Settings, Side},
     cycles::{self, CycleError, CycleInput, CycleKind, CycleStep, Spindle},
     lower::{BlockData, Value, Word},
     machine::MachineConfig,
@@ -400,6 +401,13 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
             break;
         }
     }
+    // Compensation changes steps after they were recorded: the start times
+    // follow from the durations.
+    let mut time = 0.0;
+    for step in &mut runner.steps {
+        step.start_time = time;
+        time += step.duration;
+    }
     let axes = machine.axes.iter().copied().take(MAX_AXES).collect();
     Trace {
         axes,
@@ -562,6 +570,9 @@ struct Runner<'a> {
     /// A fixed cycle's body of the cycle file is running: cycles do not
     /// start in it.
     in_cycle: bool,
+    /// Radius compensation in force, and its machine constants.
+    compensator: Option<Compensator>,
+    compensation: Settings,
     /// Machine constant 329 decade 3: G96/G97 swapped (1, 3), S in m/min
     /// (2, 3); read once, as every block asks.
     css_setting: u8,
@@ -612,6 +623,8 @@ impl<'a> Runner<'a> {
             speed_reached: None,
             in_cycle: false,
             css_setting: machine.decade(329, 3),
+            compensator: None,
+            compensation: Settings::of(machine),
             offsets: machine.offsets.clone(),
             corrections: machine.tools.clone(),
             correction: 0,
@@ -656,11 +669,11 @@ impl<'a> Runner<'a> {
                 // Modes the run reads where they matter; planes, block
                 // joining, cancelling and the priority codes change
                 // nothing the executor models yet.
-                (b'G', 0..=4 | 33 | 17..=19 | 23 | 24 | 40 | 53..=59 | 76 | 78 | 80..=93 | 94..=98) | (b'M', _) => {}
+                (b'G', 0..=4 | 33 | 17..=19 | 23 | 24 | 40..=42 | 53..=59 | 76 | 78 | 80..=93 | 94..=98)
+                | (b'M', _) => {}
                 // Program flow, which the caller follows, and the
                 // arithmetic, which runs after the motion.
                 (b'G', 26..=29 | 70..=73 | 79) => {}
-                (b'G', 41 | 42) => self.not_run("radius compensation (G41/G42)", code_range),
                 (b'G', 31 | 34..=39) => self.not_run("transformations (G31, G34–G39)", code_range),
                 _ => self.not_run(&format!("G{number:02}"), code_range),
             }
@@ -736,7 +749,13 @@ impl<'a> Runner<'a> {
         } else {
             None
         };
+        let path = moved.path;
         self.record(range, &self.position.clone(), moved, stop);
+        if let Err(error) = self.compensate(start, path) {
+            let range = self.steps[error.block()].range;
+            self.finding(range, &format!("radius compensation: {error}"), true);
+            return Flow::End;
+        }
         // Assignments and arithmetic take effect after the block's motion.
         arith::assign(block, &mut self.params);
         let mut machine = ProgramMachine {
@@ -882,6 +901,64 @@ impl<'a> Runner<'a> {
             };
         }
         self.offsets.rows.insert(row, values);
+    }
+
+    /// Follows the last step with radius compensation G41/G42 (02 §1.6–1.9):
+    /// starts it on a line, passes each move in the plane to the
+    /// [`Compensator`], cancels it on G40, and puts the tool-centre path's
+    /// length and time on the steps it belongs to, one block late as the
+    /// control's look-ahead fixes them.
+    fn compensate(&mut self, start: Position, path: Path) -> Result<(), CompensationError> {
+        let index = self.steps.len() - 1;
+        let side = match self.modes.active(self.groups.compensation) {
+            Some(41) => Some(Side::Left),
+            Some(42) => Some(Side::Right),
+            _ => None,
+        };
+        let (a, b) = match self.modes.active(self.groups.plane) {
+            Some(18) => (slot(b'Z'), slot(b'X')),
+            Some(19) => (slot(b'Y'), slot(b'Z')),
+            _ => (slot(b'X'), slot(b'Y')),
+        };
+        let point = |position: &Position| Point2::new(position[a], position[b]);
+        let (from, to) = (point(&start), point(&self.position));
+        let moves_in_plane = from != to || matches!(path, Path::Arc { .. });
+        let linear = matches!(self.steps[index].motion, Motion::Rapid | Motion::Feed) && path == Path::Straight;
+        let pieces = match (self.compensator.take(), side) {
+            (None, Some(side)) if moves_in_plane && linear => {
+                let radius = f64::from(self.corrections.entry(self.correction).radius) / 1000.0;
+                self.compensator = Some(Compensator::start(self.compensation, side, radius, index, from, to));
+                return Ok(());
+            }
+            (Some(compensator), None) if moves_in_plane => compensator.cancel(index, to),
+            (Some(mut compensator), _) => {
+                let element = match path {
+                    Path::Arc { centre, clockwise, .. } => {
+                        Element::Arc { from, to, centre: Point2::new(centre[0], centre[1]), clockwise }
+                    }
+                    _ => Element::Line { from, to },
+                };
+                let pieces = if moves_in_plane { compensator.push(index, element)? } else { Vec::new() };
+                self.compensator = Some(compensator);
+                pieces
+            }
+            (None, _) => return Ok(()),
+        };
+        let mut charged: Vec<usize> = Vec::new();
+        for piece in pieces {
+            let step = &mut self.steps[piece.block];
+            if !charged.contains(&piece.block) {
+                charged.push(piece.block);
+                (step.length, step.duration) = (0.0, 0.0);
+            }
+            let length = piece.path.length();
+            step.length += length;
+            step.duration += match (step.motion, step.feed) {
+                (Motion::Feed, Some(feed)) => length / (feed * piece.feed_scale) * 60.0,
+                _ => length / f64::from(self.machine.rapid_rate) * 60.0,
+            };
+        }
+        Ok(())
     }
 
     /// Adds a step of the block at `range` that starts now and ends at `end`.
@@ -1320,6 +1397,8 @@ struct Groups {
     dimensions: Group,
     spindle: Group,
     zero_offset: Group,
+    plane: Group,
+    compensation: Group,
 }
 
 impl Groups {
@@ -1331,6 +1410,8 @@ impl Groups {
             dimensions: modes.group("G9"),
             spindle: modes.group("M2"),
             zero_offset: modes.group("G5"),
+            plane: modes.group("G1"),
+            compensation: modes.group("G3"),
         }
     }
 }
@@ -1659,6 +1740,26 @@ mod tests {
         let trace = run_text(text);
         assert_eq!(lengths(&trace)[..5], [0.0, 50.0, 10.0, 0.0, 50.0]);
         assert_eq!(trace.axis(&trace.machine_end(2), b'Z'), 60.0);
+    }
+
+    #[test]
+    fn radius_compensation_runs_the_tool_centre_path() {
+        // Radius 5 on the left (G41) of a corner turning left: the start
+        // move ends on the first line's normal at (0, 5), the inside corner
+        // is the intersection (45, 5), the last line ends on its normal at
+        // (45, 50), and G40 leaves from there for (70, 70).
+        let text =
+            "%1\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 X50\nN5 Y50\nN6 G40 X70 Y70\nN7 M30\n";
+        let trace = run_text(text);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        assert_eq!(lengths(&trace)[..6], [0.0, 20.0, 25.0, 45.0, 45.0, 32.016]);
+        close6(trace.steps[5].duration, 25.0f64.hypot(20.0) / 10.0);
+        close6(trace.total_time(), 20.0 / 10_000.0 * 60.0 + (25.0 + 45.0 + 45.0 + 25.0f64.hypot(20.0)) / 10.0);
+        // An arc too small for the tool on its inside stops the run there.
+        let text = "%1\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 G03 X0 Y6 I0 J3\nN5 G40 G01 X0 Y20\nN6 M30\n";
+        let trace = run_text(text);
+        let fatal: Vec<&str> = trace.findings.iter().filter(|f| f.fatal).map(|f| text[f.range].trim_end()).collect();
+        assert_eq!(fatal, ["N4 G03 X0 Y6 I0 J3"]);
     }
 
     #[test]
