@@ -1972,10 +1972,13 @@ mod tests {
 
     #[test]
     fn the_program_ends_at_m30_and_unmodelled_work_is_named_once() {
-        let trace = run_text("%1\nN1 G41 X1 F100\nN2 G42 X2\nN3 M30\nN4 G00 X500\n");
+        let trace = run_text("%1\nN1 G35 X1 F100\nN2 G36 X2\nN3 M30\nN4 G00 X500\n");
         assert_eq!(trace.steps.len(), 3);
         let messages: Vec<&str> = trace.findings.iter().map(|f| f.message.as_str()).collect();
-        assert_eq!(messages, ["the executor does not run radius compensation (G41/G42) yet: the time leaves them out"]);
+        assert_eq!(
+            messages,
+            ["the executor does not run transformations (G31, G34–G39) yet: the time leaves them out"]
+        );
     }
 
     #[test]
