@@ -13,7 +13,7 @@ use std::{
 
 use indicatif::{ProgressBar, ProgressStyle};
 use line_index::LineIndex;
-use nc_exec::run::{Axes, Called, Environment, MAX_AXES, Motion, Stop, Trace};
+use nc_exec::run::{Axes, Called, Environment, Motion, Stop, Trace};
 use ncc_analysis::Config;
 use ncc_syntax::{Dialect, Parse, TextSize};
 use serde::Serialize;
@@ -30,7 +30,6 @@ pub(crate) enum Format {
 struct Ran {
     trace: Trace,
     sources: Vec<Source>,
-    config: Config,
     /// The program's number from its `%` header.
     number: Option<u32>,
 }
@@ -60,7 +59,7 @@ impl Ran {
         for finding in &trace.findings {
             eprintln!("{}: {}", sources[finding.source].place(finding.range.start()), finding.message);
         }
-        Ok(Ran { trace, sources, config, number })
+        Ok(Ran { trace, sources, number })
     }
 
     fn exit_code(&self) -> ExitCode {
@@ -73,14 +72,14 @@ pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
         Ok(ran) => ran,
         Err(code) => return code,
     };
-    let (trace, sources, axes) = (&ran.trace, &ran.sources, &ran.config.machine.axes);
+    let (trace, sources) = (&ran.trace, &ran.sources);
     let written = match format {
         Format::Human => {
             let mut out = io::stdout().lock();
-            out.write_all(summary(path, trace, axes).as_bytes()).and_then(|()| out.flush())
+            out.write_all(summary(path, trace).as_bytes()).and_then(|()| out.flush())
         }
         Format::Json => {
-            let report = Report::new(path, trace, sources, axes);
+            let report = Report::new(path, trace, sources);
             let mut out = io::BufWriter::new(io::stdout().lock());
             serde_json::to_writer_pretty(&mut out, &report)
                 .map_err(io::Error::from)
@@ -106,7 +105,7 @@ pub(crate) fn expand(path: &Path, output: Option<&Path>, step_budget: usize) -> 
     };
     let name = path.file_name().map_or_else(|| path.display().to_string(), |name| name.to_string_lossy().into_owned());
     let title = format!("EXPANDED FROM {name}");
-    let text = nc_exec::expand::write(&ran.trace, &ran.config.machine.axes, ran.number.unwrap_or(1), &title);
+    let text = nc_exec::expand::write(&ran.trace, ran.number.unwrap_or(1), &title);
     let written = match output {
         Some(output) => std::fs::write(output, &text).map_err(|error| (output.display().to_string(), error)),
         None => {
@@ -123,7 +122,7 @@ pub(crate) fn expand(path: &Path, output: Option<&Path>, step_budget: usize) -> 
     }
 }
 
-fn summary(path: &Path, trace: &Trace, axes: &[u8]) -> String {
+fn summary(path: &Path, trace: &Trace) -> String {
     let mut out = String::new();
     let (feed, rapid) = (Motion::Feed, Motion::Rapid);
     let _ = writeln!(out, "{}", path.display());
@@ -141,9 +140,8 @@ fn summary(path: &Path, trace: &Trace, axes: &[u8]) -> String {
     }
     let tools: Vec<String> = trace.tools.iter().map(|tool| format!("T{tool}")).collect();
     let _ = writeln!(out, "  tools        {}", if tools.is_empty() { "none".to_owned() } else { tools.join(" ") });
-    let end = trace.end_position();
     let position: Vec<String> =
-        axes.iter().map(|&axis| format!("{}{:.3}", char::from(axis), end[usize::from(axis - b'A')])).collect();
+        trace.axes.iter().zip(trace.end()).map(|(&axis, value)| format!("{}{value:.3}", char::from(axis))).collect();
     let _ = writeln!(out, "  end position {}", position.join(" "));
     out
 }
@@ -166,7 +164,8 @@ struct Report<'a> {
 }
 
 impl<'a> Report<'a> {
-    fn new(path: &Path, trace: &'a Trace, sources: &'a [Source], axes: &'a [u8]) -> Report<'a> {
+    fn new(path: &Path, trace: &'a Trace, sources: &'a [Source]) -> Report<'a> {
+        let axes = &trace.axes;
         Report {
             file: path.display().to_string(),
             total_time_s: trace.total_time(),
@@ -176,8 +175,8 @@ impl<'a> Report<'a> {
             cutting_length_mm: trace.length_in(Motion::Feed),
             rapid_length_mm: trace.length_in(Motion::Rapid),
             tools: &trace.tools,
-            end_position: Values(trace.steps.last().map_or([0.0; MAX_AXES], |step| step.end), axes),
-            blocks: Records { trace, sources, axes },
+            end_position: Values(trace.end(), axes),
+            blocks: Records { trace, sources },
             findings: trace
                 .findings
                 .iter()
@@ -196,7 +195,6 @@ impl<'a> Report<'a> {
 struct Records<'a> {
     trace: &'a Trace,
     sources: &'a [Source],
-    axes: &'a [u8],
 }
 
 impl Serialize for Records<'_> {
@@ -221,12 +219,12 @@ impl Serialize for Records<'_> {
                 length_mm: step.length,
                 feed_mm_min: step.feed,
                 start: Coordinates {
-                    program: Values(self.trace.start_of(index), self.axes),
-                    machine: Values(self.trace.machine_start(index), self.axes),
+                    program: Values(self.trace.start_of(index), &self.trace.axes),
+                    machine: Values(self.trace.machine_start(index), &self.trace.axes),
                 },
                 end: Coordinates {
-                    program: Values(step.end, self.axes),
-                    machine: Values(self.trace.machine_end(index), self.axes),
+                    program: Values(step.end, &self.trace.axes),
+                    machine: Values(self.trace.machine_end(index), &self.trace.axes),
                 },
             }
         }))

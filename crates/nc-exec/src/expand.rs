@@ -11,18 +11,18 @@
 
 use std::fmt::Write as _;
 
-use crate::run::{Motion, Path, Position, Stop, Trace};
+use crate::run::{Motion, Path, Position, Stop, Trace, round3, slot};
 
 /// The longest line the control reads (000:612).
 const MAX_LINE: usize = 80;
 
-/// Writes the moves of `trace` over the machine's `axes` as program
+/// Writes the moves of `trace` over its machine's axes as program
 /// `%number`, with `title` as its header comment.
-pub fn write(trace: &Trace, axes: &[u8], number: u32, title: &str) -> String {
+pub fn write(trace: &Trace, number: u32, title: &str) -> String {
     let mut out = String::new();
     let title: String = title.chars().filter(|&c| c != '"' && !c.is_control()).collect();
     let _ = writeln!(out, "%{number} \"{title}\"");
-    let mut writer = Writer { out, number: 0, at: [0.0; 26], feed: None, axes };
+    let mut writer = Writer { out, number: 0, at: [0.0; 26], feed: None, axes: &trace.axes };
     writer.block(vec!["G90".to_owned(), "G94".to_owned()]);
     for step in &trace.steps {
         let end = trace.position(&step.end);
@@ -143,14 +143,6 @@ impl Writer<'_> {
     }
 }
 
-fn slot(axis: u8) -> usize {
-    usize::from(axis - b'A')
-}
-
-fn round3(value: f64) -> f64 {
-    (value * 1000.0).round() / 1000.0
-}
-
 fn rounded(position: &Position) -> Position {
     position.map(round3)
 }
@@ -198,8 +190,7 @@ N102 G90 G70
     fn the_expanded_program_runs_the_same_moves() {
         let original = run_text(PROGRAM);
         assert!(original.findings.is_empty(), "{:?}", original.findings);
-        let axes = b"XYZ";
-        let expanded = write(&original, axes, 7, "DEMO EXPANDED");
+        let expanded = write(&original, 7, "DEMO EXPANDED");
         let again = run_text(&expanded);
         assert!(again.findings.is_empty(), "{:?}\n{expanded}", again.findings);
         let moves = |trace: &Trace| -> Vec<[i64; 3]> {
@@ -207,7 +198,7 @@ N102 G90 G70
                 .steps
                 .iter()
                 .filter(|step| matches!(step.motion, Motion::Rapid | Motion::Feed) && step.length > 0.0)
-                .map(|step| axes.map(|axis| (trace.axis(&step.end, axis) * 1000.0).round() as i64))
+                .map(|step| b"XYZ".map(|axis| (trace.axis(&step.end, axis) * 1000.0).round() as i64))
                 .collect()
         };
         assert_eq!(moves(&again), moves(&original), "{expanded}");

@@ -18,11 +18,14 @@
 //!   the machine's cycle file with the state restored afterwards, or the
 //!   built-in cycles ([`crate::cycles`]).
 //!
-//! A block's time is its path length over its feed (G00: the longest axis
-//! travel over the machine's rapid rate), plus dwells; ramps and block
-//! joining are the velocity model's business. Everything else the control
-//! does is reported once per kind as not run yet (offsets, compensation,
-//! transformations), so that a total never silently leaves something out.
+//! - Offsets: zero offsets G53–G59 with G92/G93, length corrections D/&,
+//!   and radius compensation G41/G42 ([`crate::compensation`]).
+//!
+//! A block's time is its path length over its feed (G00: the slowest axis
+//! at its own rapid rate), plus dwells; ramps and block joining are the
+//! velocity model's business. Everything else the control does is reported
+//! once per kind as not run yet (transformations, diameter programming),
+//! so that a total never silently leaves something out.
 
 use nalgebra::{Point2, Vector2};
 use ncc_catalog::{AddressRole, Catalogue, Dialect};
@@ -36,7 +39,7 @@ use crate::{
     lower::{BlockData, Value, Word},
     machine::MachineConfig,
     modes::{Group, Modes},
-    tables::{OffsetTable, ToolTable},
+    tables::{OffsetTable, ToolEntry, ToolTable},
 };
 
 /// Axes by letter (index = letter − `A`); positions in mm (degrees for
@@ -56,8 +59,8 @@ pub enum Motion {
 /// One block as it ran.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Step {
-    /// The file the block is in: 0 for the program, k for the k-th
-    /// macrocycle file the run loaded ([`Trace::macrocycles`]).
+    /// The file the block is in: 0 for the program, k for the k-th other
+    /// file the run read ([`Trace::files`]).
     pub source: usize,
     /// The block's text range.
     pub range: TextRange,
@@ -160,9 +163,14 @@ impl Trace {
         self.steps.iter().filter(|step| step.motion == motion).fold(0.0, |sum, step| sum + step.length)
     }
 
-    /// The programmed position at the end.
+    /// The programmed position at the end, over the machine's axes.
+    pub fn end(&self) -> Axes {
+        self.steps.last().map_or([0.0; MAX_AXES], |step| step.end)
+    }
+
+    /// The programmed position at the end, by letter.
     pub fn end_position(&self) -> Position {
-        self.steps.last().map_or([0.0; 26], |step| self.position(&step.end))
+        self.position(&self.end())
     }
 
     /// Where step `index` starts in machine coordinates: where the one
@@ -401,8 +409,8 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
             break;
         }
     }
-    // Compensation changes steps after they were recorded: the start times
-    // follow from the durations.
+    // Compensation changes durations after the steps were recorded, so the
+    // start times are set once, here.
     let mut time = 0.0;
     for step in &mut runner.steps {
         step.start_time = time;
@@ -596,7 +604,6 @@ struct Runner<'a> {
     speed_reached: Option<f64>,
     position: Position,
     params: Parameters,
-    time: f64,
     steps: Vec<Step>,
     findings: Vec<Finding>,
     tools: Vec<u32>,
@@ -634,7 +641,6 @@ impl<'a> Runner<'a> {
             frames: vec![[0.0; MAX_AXES]],
             position: [0.0; 26],
             params: Parameters::zeroed(),
-            time: 0.0,
             steps: Vec::new(),
             findings: Vec::new(),
             tools: Vec::new(),
@@ -666,9 +672,8 @@ impl<'a> Runner<'a> {
         for &(letter, number, code_range) in &codes {
             self.modes.set(letter, number);
             match (letter, number) {
-                // Modes the run reads where they matter; planes, block
-                // joining, cancelling and the priority codes change
-                // nothing the executor models yet.
+                // Modes the run reads where they matter; block joining
+                // changes nothing before the velocity model.
                 (b'G', 0..=4 | 33 | 17..=19 | 23 | 24 | 40..=42 | 53..=59 | 76 | 78 | 80..=93 | 94..=98)
                 | (b'M', _) => {}
                 // Program flow, which the caller follows, and the
@@ -814,9 +819,8 @@ impl<'a> Runner<'a> {
         if with_length {
             self.length_shift = self.length_correction();
         }
-        let row = self.modes.active(self.groups.zero_offset).and_then(|code| u8::try_from(code).ok()).unwrap_or(53);
         let mut translation = self.length_shift;
-        for (&value, &axis) in self.offsets.offset(row).iter().zip(&self.machine.axes) {
+        for (&value, &axis) in self.offsets.offset(self.zero_offset_row()).iter().zip(&self.machine.axes) {
             translation[slot(axis)] += f64::from(value) / 1000.0;
         }
         if translation == self.translation {
@@ -826,11 +830,7 @@ impl<'a> Runner<'a> {
             *position -= new - old;
         }
         self.translation = translation;
-        let mut frame = [0.0; MAX_AXES];
-        for (value, &axis) in frame.iter_mut().zip(&self.machine.axes) {
-            *value = translation[slot(axis)];
-        }
-        self.frames.push(frame);
+        self.frames.push(self.machine_axes(&translation));
     }
 
     /// The length correction `&` and `D` select: mode A (machine constant
@@ -875,16 +875,17 @@ impl<'a> Runner<'a> {
                     continue;
                 };
                 let Some(raw) = arith::literal_raw(value).and_then(|raw| i32::try_from(raw).ok()) else { continue };
-                match index {
-                    0 => entry.radius = raw,
-                    1..=4 => entry.lengths[index as usize - 1] = raw,
-                    _ => {}
+                // R0 is the radius (column 1), R1–R4 the lengths of axes 1–4.
+                if index <= 4
+                    && let Some(datum) = datum(&mut entry, index as usize + 1)
+                {
+                    *datum = raw;
                 }
             }
             self.corrections.entries.insert(self.correction, entry);
             return;
         }
-        let row = self.modes.active(self.groups.zero_offset).and_then(|code| u8::try_from(code).ok()).unwrap_or(53);
+        let row = self.zero_offset_row();
         let mut values = self.offsets.offset(row);
         for word in block.words.iter().filter(|w| self.catalogue.role_of(w.letter) == Some(AddressRole::Axis)) {
             let (Some(index), Some(value)) =
@@ -961,29 +962,27 @@ impl<'a> Runner<'a> {
         Ok(())
     }
 
-    /// Adds a step of the block at `range` that starts now and ends at `end`.
+    /// Adds a step of the block at `range` that ends at `end`. Its start
+    /// time follows from the durations when the run ends.
     fn record(&mut self, range: TextRange, end: &Position, moved: Moved, stop: Option<Stop>) {
         let Moved { motion, length, duration, feed, path } = moved;
-        let (source, start_time) = (self.source, self.time);
+        let (source, end, frame) = (self.source, self.machine_axes(end), self.frames.len() - 1);
+        let start_time = 0.0;
+        self.steps.push(Step { source, range, motion, path, start_time, duration, length, feed, end, frame, stop });
+    }
+
+    /// A position by letter over the machine's axes, as steps keep it.
+    fn machine_axes(&self, position: &Position) -> Axes {
         let mut values = [0.0; MAX_AXES];
         for (value, &axis) in values.iter_mut().zip(&self.machine.axes) {
-            *value = end[usize::from(axis - b'A')];
+            *value = position[slot(axis)];
         }
-        let frame = self.frames.len() - 1;
-        self.steps.push(Step {
-            source,
-            range,
-            motion,
-            path,
-            start_time,
-            duration,
-            length,
-            feed,
-            end: values,
-            frame,
-            stop,
-        });
-        self.time += duration;
+        values
+    }
+
+    /// The row of the zero-offset table in force (G53–G59).
+    fn zero_offset_row(&self) -> u8 {
+        self.modes.active(self.groups.zero_offset).and_then(|code| u8::try_from(code).ok()).unwrap_or(53)
     }
 
     /// Runs a built-in cycle; `false` after reporting why it cannot run.
@@ -1028,7 +1027,7 @@ impl<'a> Runner<'a> {
                     (Motion::Feed, rate.map_or(0.0, |rate| length / rate * 60.0), rate, Path::Straight)
                 }
                 CycleStep::Thread { thread, .. } => {
-                    let minutes = length / (thread.lead * thread.speed) + 0.5 / thread.speed;
+                    let minutes = thread_minutes(length, thread.lead, thread.speed);
                     let path = Path::Thread { lead: thread.lead, speed: thread.speed };
                     (Motion::Feed, minutes * 60.0, Some(length / minutes), path)
                 }
@@ -1104,10 +1103,8 @@ impl<'a> Runner<'a> {
         // Minutes, and the path feed in mm/min (the average where it varies).
         let timed = |minutes: f64| (minutes, length / minutes);
         let minutes = match (feed.filter(|&feed| feed > 0.0), mode) {
-            // A thread: the lead per revolution at S, after waiting for the
-            // spindle's zero pulse, on average half a revolution (01 §6.10).
             (Some(lead), _) if motion == Some(33) => {
-                (self.speed > 0.0).then(|| timed(length / (lead * self.speed) + 0.5 / self.speed))
+                (self.speed > 0.0).then(|| timed(thread_minutes(length, lead, self.speed)))
             }
             (Some(feed), FeedMode { per_revolution: false, .. }) => Some((length / feed, feed)),
             (Some(feed), FeedMode { per_revolution: true, css: false }) => {
@@ -1115,7 +1112,7 @@ impl<'a> Runner<'a> {
                 (rate > 0.0).then(|| (length / rate, rate))
             }
             (Some(feed), FeedMode { per_revolution: true, css: true }) => {
-                self.css_minutes(step, arc.as_ref(), feed).map(timed)
+                self.css_minutes(step, arc.as_ref(), length, feed).map(timed)
             }
             (None, _) => None,
         };
@@ -1167,7 +1164,7 @@ impl<'a> Runner<'a> {
     /// speed: the spindle turns at v / (2π r), r the distance of the
     /// controlling coordinate from the spindle axis, up to the `G76` limit
     /// (else 9999 rpm, the largest S); `None` when the cutting speed is 0.
-    fn css_minutes(&mut self, step: &Move<'_>, arc: Option<&Arc>, feed: f64) -> Option<f64> {
+    fn css_minutes(&mut self, step: &Move<'_>, arc: Option<&Arc>, length: f64, feed: f64) -> Option<f64> {
         // S in 0.1 m/min, or in m/min (decade 3 = 2 or 3); as mm/min.
         let per_unit = if matches!(self.css_setting, 2 | 3) { 1000.0 } else { 100.0 };
         let cutting_speed = self.speed * per_unit;
@@ -1180,14 +1177,13 @@ impl<'a> Runner<'a> {
         // and takes axis 1 otherwise.
         let axis = usize::try_from(self.machine.constant(67)).ok().filter(|n| (1..=6).contains(n)).unwrap_or(1);
         let letter = self.machine.axes.get(axis - 1).or(self.machine.axes.first()).copied().unwrap_or(b'X');
-        let slot = usize::from(letter - b'A');
-        let coordinate = |t: f64| match arc {
-            Some(arc) => arc.coordinate(slot, t).unwrap_or(step.start[slot] + t * (step.end[slot] - step.start[slot])),
-            None => step.start[slot] + t * (step.end[slot] - step.start[slot]),
+        let slot = slot(letter);
+        let coordinate = |t: f64| {
+            let straight = step.start[slot] + t * (step.end[slot] - step.start[slot]);
+            arc.and_then(|arc| arc.coordinate(slot, t)).unwrap_or(straight)
         };
         let rpm = |t: f64| (cutting_speed / (std::f64::consts::TAU * coordinate(t).abs())).min(limit);
         self.speed_reached = Some(rpm(1.0));
-        let length = arc.map_or_else(|| distance(&step.start, &step.end), Arc::length);
         // Composite Simpson over the move: smooth except where the limit
         // sets in, where 512 intervals keep the error far below a µs.
         const INTERVALS: usize = 512;
@@ -1341,14 +1337,7 @@ impl Machine for ProgramMachine<'_> {
     fn read_table(&self, table: u8, row: u16, column: u16) -> Option<Raw> {
         let column = usize::from(column);
         match table {
-            1 => {
-                let entry = self.corrections.entry(u8::try_from(row).ok()?);
-                match column {
-                    1 => Some(Raw::from(entry.radius)),
-                    2..=7 => Some(Raw::from(entry.lengths[column - 2])),
-                    _ => None,
-                }
-            }
+            1 => datum(&mut self.corrections.entry(u8::try_from(row).ok()?), column).map(|datum| Raw::from(*datum)),
             2 => {
                 let row = u8::try_from(row).ok().filter(|row| (53..=59).contains(row))?;
                 column.checked_sub(1).and_then(|axis| self.offsets.offset(row).get(axis).copied()).map(Raw::from)
@@ -1366,12 +1355,10 @@ impl Machine for ProgramMachine<'_> {
         match table {
             1 => {
                 let mut entry = self.corrections.entry(row);
-                match column {
-                    1 => entry.radius = value,
-                    2..=7 => entry.lengths[column - 2] = value,
-                    _ => return,
+                if let Some(datum) = datum(&mut entry, column) {
+                    *datum = value;
+                    self.corrections.entries.insert(row, entry);
                 }
-                self.corrections.entries.insert(row, entry);
             }
             2 if (53..=59).contains(&row) && (1..=6).contains(&column) => {
                 let mut values = self.offsets.offset(row);
@@ -1385,7 +1372,18 @@ impl Machine for ProgramMachine<'_> {
     fn message(&mut self, _message: Message) {}
 }
 
-fn slot(axis: u8) -> usize {
+/// Column `column` of a correction entry: 1 the radius, 2–7 the lengths of
+/// axes 1–6.
+fn datum(entry: &mut ToolEntry, column: usize) -> Option<&mut i32> {
+    match column {
+        1 => Some(&mut entry.radius),
+        2..=7 => entry.lengths.get_mut(column - 2),
+        _ => None,
+    }
+}
+
+/// The index of an axis letter in a [`Position`].
+pub(crate) fn slot(axis: u8) -> usize {
     usize::from(axis - b'A')
 }
 
@@ -1414,6 +1412,13 @@ impl Groups {
             compensation: modes.group("G3"),
         }
     }
+}
+
+/// Minutes a thread of `length` mm takes: the lead per revolution at
+/// `speed` rpm, after waiting for the spindle's zero pulse, on average half
+/// a revolution (01 §6.10).
+fn thread_minutes(length: f64, lead: f64, speed: f64) -> f64 {
+    length / (lead * speed) + 0.5 / speed
 }
 
 /// What a block's move did.
@@ -1525,7 +1530,8 @@ fn whole_number(decimal: &ncc_syntax::Decimal) -> Option<u32> {
     if decimal.has_point() { None } else { u32::try_from(decimal.scaled(0)?).ok() }
 }
 
-fn round3(value: f64) -> f64 {
+/// A length on the control's µm grid.
+pub(crate) fn round3(value: f64) -> f64 {
     (value * 1000.0).round() / 1000.0
 }
 
