@@ -99,6 +99,7 @@ struct MachineFile {
     rapid_rates: BTreeMap<String, u32>,
     #[serde(default)]
     limits: BTreeMap<String, LimitsFile>,
+    diameter_axis: Option<String>,
     cycle_file: Option<String>,
     offset_file: Option<PathBuf>,
     tool_file: Option<PathBuf>,
@@ -178,6 +179,11 @@ impl MachineFile {
             }
             machine.limits.insert(letter, limits);
         }
+        if let Some(axis) = self.diameter_axis {
+            let letter = axis_letter(&axis)
+                .ok_or_else(|| format!("{origin}: {section}diameter-axis `{axis}` is not an axis letter"))?;
+            machine.diameter_axis = Some(letter);
+        }
         if let Some(name) = self.cycle_file {
             if name.trim().is_empty() {
                 return Err(format!("{origin}: {section}cycle-file must name a file, e.g. \"PCYKLYDG.NCP\""));
@@ -239,7 +245,8 @@ fn axis_letter(text: &str) -> Option<u8> {
 fn check_axis_keys(machine: &MachineConfig) -> Result<(), String> {
     let rates = machine.rapid_rates.keys().map(|&letter| ("rapid-rates", letter));
     let limits = machine.limits.keys().map(|&letter| ("limits", letter));
-    match rates.chain(limits).find(|&(_, letter)| !machine.is_axis(letter)) {
+    let diameter = machine.diameter_axis.map(|letter| ("diameter-axis", letter));
+    match rates.chain(limits).chain(diameter).find(|&(_, letter)| !machine.is_axis(letter)) {
         Some((key, letter)) => Err(format!(
             "the machine's {key} name `{}`, which is not an axis of it ({})",
             char::from(letter),
@@ -399,6 +406,9 @@ R97 = "2"
         assert_eq!(machine.tools.entries.keys().copied().collect::<Vec<_>>(), [2]);
         assert_eq!(machine.tools.entry(2).lengths[2], 100_000);
         assert_eq!((machine.constant(39), machine.constant(97)), (45_500, 2), "constants key by key");
+        assert_eq!(machine.diameter_axis, None);
+        let lathe = load("[machine]\naxes = [\"X\", \"Z\"]\ndiameter-axis = \"x\"\n", &[]).unwrap();
+        assert_eq!(lathe.machine.diameter_axis, Some(b'X'));
     }
 
     #[test]
@@ -418,6 +428,8 @@ R97 = "2"
             with_file("", &[("project/POS/TAB0.POS", "$POS\nG54: X=1.0 Y=2.0\nG60: Z=1.0\n")]),
             with_file("tool-file = \"TAB0.KOR\"\n", &[good_offsets, ("project/TAB0.KOR", "$KOR\n01: Z=1.0\n")]),
             with_file("rapid-rates = { Y = 5000 }\n", &[good_offsets]),
+            with_file("diameter-axis = \"Y\"\n", &[good_offsets]),
+            with_file("diameter-axis = \"XZ\"\n", &[good_offsets]),
             with_file("[machine.limits]\nX = { min = \"1\", max = \"0\" }\n", &[good_offsets]),
             with_file("[machine.limits]\nX = { min = \"0.0001\" }\n", &[good_offsets]),
         ];
@@ -435,6 +447,8 @@ R97 = "2"
             project/POS/TAB0.POS:3:1: `G60` names no row: the rows are G53 to G59
             project/TAB0.KOR:2:5: `Z=` corrects axis 3 (the names stand for X, Y, Z, U in that order), but on this machine Z is axis 2: write `2=`
             project/ncc.toml: the machine's rapid-rates name `Y`, which is not an axis of it (axes X Z)
+            project/ncc.toml: the machine's diameter-axis name `Y`, which is not an axis of it (axes X Z)
+            project/ncc.toml: machine.diameter-axis `XZ` is not an axis letter
             project/ncc.toml: machine.limits.X: min is above max
             project/ncc.toml: machine.limits.X.min: `0.0001` is finer than the control's 0.001"#]].assert_eq(&errors.join("\n"));
     }

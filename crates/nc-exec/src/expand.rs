@@ -2,7 +2,8 @@
 //! as a plain numbered block, with calls, jumps, cycles, parameters and
 //! offsets resolved, that any CNC8x6 accepts and that runs the same moves.
 //!
-//! The program is absolute (G90) with the feed per minute (G94): positions
+//! The program is absolute (G90) with the feed per minute (G94), in radius
+//! programming (G75) on a machine with a diameter axis: positions
 //! are written to the micrometre, F in whole mm/min (the average of a block
 //! whose feed varies, under constant cutting speed), threads with their
 //! lead and spindle speed, dwells in units of 10 ms, and the stops M00/M01
@@ -23,7 +24,12 @@ pub fn write(trace: &Trace, number: u32, title: &str) -> String {
     let title: String = title.chars().filter(|&c| c != '"' && !c.is_control()).collect();
     let _ = writeln!(out, "%{number} \"{title}\"");
     let mut writer = Writer { out, number: 0, at: [0.0; 26], feed: None, axes: &trace.axes };
-    writer.block(vec!["G90".to_owned(), "G94".to_owned()]);
+    let mut header = vec!["G90".to_owned(), "G94".to_owned()];
+    // The trace keeps radii on a lathe's diameter axis.
+    if trace.diameter_axis.is_some() {
+        header.push("G75".to_owned());
+    }
+    writer.block(header);
     for step in &trace.steps {
         let end = trace.position(&step.end);
         let mut words = writer.words(step.motion, &step.path, &end, step.feed, step.duration);

@@ -19,6 +19,9 @@
 //!   readers for the control's files.
 //! - [`modes`]: the active code of every G and M group.
 //! - [`run`]: running a program block by block into a [`run::Trace`].
+//! - [`transform`]: the coordinate recalculations G34–G37 and the
+//!   transformations G38/G39/G31, and the frames from program to machine
+//!   coordinates they make.
 
 pub mod arith;
 pub mod compensation;
@@ -29,3 +32,4 @@ pub mod machine;
 pub mod modes;
 pub mod run;
 pub mod tables;
+pub mod transform;

@@ -25,6 +25,9 @@ pub struct MachineConfig {
     pub rapid_rates: BTreeMap<u8, u32>,
     /// Travel limits of single axes, by letter.
     pub limits: BTreeMap<u8, TravelLimits>,
+    /// The axis a lathe programs as a diameter under G74 (X); the machine
+    /// starts in diameter programming, as the manual's lathe examples do.
+    pub diameter_axis: Option<u8>,
     /// Machine constants set in the configuration, as raw values (the
     /// decades as digits: `00233.112` → 233112).
     pub constants: BTreeMap<u32, i64>,
@@ -54,6 +57,7 @@ impl Default for MachineConfig {
             rapid_rate: 10_000,
             rapid_rates: BTreeMap::new(),
             limits: BTreeMap::new(),
+            diameter_axis: None,
             constants: BTreeMap::new(),
             cycle_file: None,
             offsets: OffsetTable::default(),

@@ -21,11 +21,16 @@
 //! - Offsets: zero offsets G53–G59 with G92/G93, length corrections D/&,
 //!   and radius compensation G41/G42 ([`crate::compensation`]).
 //!
+//! - Coordinates: diameter programming G74/G75 on the machine's diameter
+//!   axis (positions are radii), the recalculations G34–G37 and the
+//!   transformations G38/G39/G31 ([`crate::transform`]).
+//!
 //! A block's time is its path length over its feed (G00: the slowest axis
 //! at its own rapid rate), plus dwells; ramps and block joining are the
 //! velocity model's business. Everything else the control does is reported
-//! once per kind as not run yet (transformations, diameter programming),
-//! so that a total never silently leaves something out.
+//! once per kind as not run yet (copying G05–G07, axis slaving G08, the
+//! reference point G30), so that a total never silently leaves something
+//! out.
 
 use nalgebra::{Point2, Vector2};
 use ncc_catalog::{AddressRole, Catalogue, Dialect};
@@ -40,6 +45,7 @@ use crate::{
     machine::MachineConfig,
     modes::{Group, Modes},
     tables::{OffsetTable, ToolEntry, ToolTable},
+    transform::{self, Frame, Kind, Recalculation, Refused, Transformation, Transformations},
 };
 
 /// Axes by letter (index = letter − `A`); positions in mm (degrees for
@@ -77,8 +83,9 @@ pub struct Step {
     /// The programmed position at the step's end, over the machine's axes
     /// ([`Trace::axes`]); it starts where the step before it ended.
     pub end: Axes,
-    /// The translation from program to machine coordinates the step ran in:
-    /// `Trace::frames[frame]` (the zero offset and the length correction).
+    /// How program coordinates became machine ones in the step:
+    /// `Trace::frames[frame]` (the zero offset, G37, the length correction
+    /// and the transformations G38/G39/G31).
     pub frame: usize,
     /// The program stops after the block (M00, M01) until the operator
     /// starts it again; the run does not count the wait.
@@ -135,8 +142,11 @@ pub struct Finding {
 pub struct Trace {
     /// The machine's axes, the order of [`Step::end`].
     pub axes: Vec<u8>,
-    /// Machine minus program coordinates, per [`Step::frame`].
-    pub frames: Vec<Axes>,
+    /// The machine's diameter axis: positions on it are radii, whether the
+    /// program wrote diameters (G74) or radii (G75).
+    pub diameter_axis: Option<u8>,
+    /// From program to machine coordinates, per [`Step::frame`].
+    pub frames: Vec<Frame>,
     pub steps: Vec<Step>,
     pub findings: Vec<Finding>,
     /// Tools called with T, in order of first use.
@@ -181,24 +191,18 @@ impl Trace {
 
     /// Where step `index` starts in the program coordinates it runs in.
     pub fn start_of(&self, index: usize) -> Axes {
-        let (start, frame) = (self.machine_start(index), &self.frames[self.steps[index].frame]);
-        std::array::from_fn(|i| start[i] - frame[i])
+        self.frames[self.steps[index].frame].to_program(&self.machine_start(index), &self.axes)
     }
 
     /// Axis values as a position by letter.
     pub fn position(&self, values: &Axes) -> Position {
-        let mut position = [0.0; 26];
-        for (&axis, &value) in self.axes.iter().zip(values) {
-            position[usize::from(axis - b'A')] = value;
-        }
-        position
+        transform::by_letter(values, &self.axes)
     }
 
     /// Step `index`'s end in machine coordinates.
     pub fn machine_end(&self, index: usize) -> Axes {
         let step = &self.steps[index];
-        let frame = &self.frames[step.frame];
-        std::array::from_fn(|i| step.end[i] + frame[i])
+        self.frames[step.frame].to_machine(&step.end, &self.axes)
     }
 
     /// The value of axis `letter` in `values`, 0 for a letter the machine
@@ -419,6 +423,7 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
     let axes = machine.axes.iter().copied().take(MAX_AXES).collect();
     Trace {
         axes,
+        diameter_axis: machine.diameter_axis,
         frames: runner.frames,
         steps: runner.steps,
         findings: runner.findings,
@@ -590,13 +595,17 @@ struct Runner<'a> {
     /// The correction entry D and the length-compensation digits `&`.
     correction: u8,
     length_digits: u32,
-    /// Machine minus program coordinates per letter: the zero offset and
-    /// the length correction in force.
-    translation: Position,
-    /// The length correction in `translation`.
+    /// The length correction in force, by letter.
     length_shift: Position,
-    /// The translations the steps ran in, and the index of the current one.
-    frames: Vec<Axes>,
+    /// Mirroring, scale and offset G35–G37, and the transformations
+    /// G38/G39/G31.
+    recalculation: Recalculation,
+    transformations: Transformations,
+    /// Diameter programming G74 (G75: radius): the machine's diameter axis
+    /// is written as a diameter, and runs as a radius.
+    diameter: bool,
+    /// The frames the steps ran in; the last is in force.
+    frames: Vec<Frame>,
     /// The speed limit of constant cutting speed set by `G76 S`, in rpm.
     speed_limit: Option<f64>,
     /// The spindle speed constant cutting speed reached last, which S
@@ -636,9 +645,11 @@ impl<'a> Runner<'a> {
             corrections: machine.tools.clone(),
             correction: 0,
             length_digits: 0,
-            translation: [0.0; 26],
             length_shift: [0.0; 26],
-            frames: vec![[0.0; MAX_AXES]],
+            recalculation: Recalculation::default(),
+            transformations: Transformations::default(),
+            diameter: machine.diameter_axis.is_some(),
+            frames: vec![Frame::default()],
             position: [0.0; 26],
             params: Parameters::zeroed(),
             steps: Vec::new(),
@@ -679,7 +690,12 @@ impl<'a> Runner<'a> {
                 // Program flow, which the caller follows, and the
                 // arithmetic, which runs after the motion.
                 (b'G', 26..=29 | 70..=73 | 79) => {}
-                (b'G', 31 | 34..=39) => self.not_run("transformations (G31, G34–G39)", code_range),
+                // Transformations, which the block is about.
+                (b'G', 31 | 34..=39) => {}
+                // Group G10 also holds the block's own G04/G92/G93, so the
+                // programming mode is kept apart from it.
+                (b'G', 74) => self.diameter = true,
+                (b'G', 75) => self.diameter = false,
                 _ => self.not_run(&format!("G{number:02}"), code_range),
             }
         }
@@ -717,8 +733,19 @@ impl<'a> Runner<'a> {
         if css_before && !self.feed_mode().css && !writes_speed {
             self.speed = self.speed_reached.take().unwrap_or(self.speed);
         }
-        let axes: Vec<&Word> =
+        let mut axes: Vec<&Word> =
             block.words.iter().filter(|w| self.catalogue.role_of(w.letter) == Some(AddressRole::Axis)).collect();
+        // A block of group 11 names its axes as the function's parameters:
+        // it does not move (03 §3).
+        if let Some(&(_, code, code_range)) = codes.iter().find(|&&(l, n, _)| l == b'G' && matches!(n, 31 | 34..=39)) {
+            if let Err((message, fatal)) = self.transform(code, &axes, block) {
+                self.finding(code_range, &message, fatal);
+                if fatal {
+                    return Flow::End;
+                }
+            }
+            axes.clear();
+        }
         // A new zero offset holds from this block; a new length correction
         // from its first block of linear or rapid motion (02 §1.18.2).
         let motion = self.modes.active(self.groups.motion);
@@ -739,9 +766,12 @@ impl<'a> Runner<'a> {
             let mut end = self.position;
             for word in &axes {
                 if let Some(value) = self.number(word) {
+                    let value = self.recalculation.apply(word.letter, value);
+                    let written = self.written_per_unit(word.letter);
                     let slot = &mut end[usize::from(word.letter - b'A')];
-                    // The control counts positions in whole µm.
-                    *slot = round3(if self.incremental() { *slot + value } else { value });
+                    // The control counts positions in whole µm, of the
+                    // diameter on a diameter axis.
+                    *slot = round3(if self.incremental() { *slot * written + value } else { value }) / written;
                 }
             }
             self.position = end;
@@ -766,7 +796,7 @@ impl<'a> Runner<'a> {
         let mut machine = ProgramMachine {
             machine: self.machine,
             position: &self.position,
-            translation: &self.translation,
+            frame: &self.frames[self.frames.len() - 1],
             offsets: &mut self.offsets,
             corrections: &mut self.corrections,
         };
@@ -811,26 +841,93 @@ impl<'a> Runner<'a> {
         }
     }
 
-    /// Takes the zero offset in force, and the length correction when
-    /// `with_length` (a block of linear or rapid motion), into the
-    /// translation from program to machine coordinates. The tool stays
-    /// where it is, so its program position moves the other way.
+    /// Runs a block of group 11 with its axis words `axes`; the error says
+    /// why the control refuses it, and whether it stops the program there.
+    fn transform(&mut self, code: u32, axes: &[&Word], block: &BlockData) -> Result<(), (String, bool)> {
+        let values: Vec<(u8, f64)> = axes.iter().filter_map(|w| Some((w.letter, self.number(w)?))).collect();
+        let Some(kind) = Kind::of(code) else {
+            match code {
+                34 => self.recalculation = Recalculation::default(),
+                35 => self.recalculation.mirror(axes.iter().map(|word| word.letter)),
+                36 => {
+                    let factors: Vec<f64> = values.iter().map(|&(_, value)| value).collect();
+                    self.recalculation.set_scale(&factors).ok_or_else(|| {
+                        ("G36 with a scale of 0 or a zero denominator: the control refuses it".to_owned(), true)
+                    })?;
+                }
+                _ => self.recalculation.set_shift(values),
+            }
+            return Ok(());
+        };
+        let refused = |refused: Refused| {
+            let fatal = refused != Refused::NotSet;
+            let then = if fatal { "the control stops" } else { "the run goes on without it" };
+            (format!("G{code}: {refused}: {then}"), fatal)
+        };
+        let angle = |letter: u8| block.word(letter).and_then(|word| self.number(word));
+        if axes.is_empty() {
+            // Alone it activates; with `I0` it cancels (000:6701–6740).
+            return match angle(b'I') {
+                None => self.transformations.activate(kind).map_err(refused),
+                Some(0.0) => {
+                    self.transformations.deactivate(kind);
+                    Ok(())
+                }
+                Some(_) => Err((format!("G{code} with I but no axes neither sets, activates nor cancels it"), true)),
+            };
+        }
+        // E divides the angles, for finer steps than 0.001° (000:6674–6678).
+        let divisor = block.word(b'E').and_then(|word| self.number(word)).unwrap_or(1.0);
+        if divisor <= 0.0 {
+            return Err((format!("G{code}: the angle divisor E must be positive"), true));
+        }
+        let letters: &[u8] = if kind == Kind::Spatial { b"IJK" } else { b"I" };
+        let mut angles = [0.0; 3];
+        for (angle_of, &letter) in angles.iter_mut().zip(letters) {
+            *angle_of = angle(letter).ok_or_else(|| {
+                (format!("G{code} sets its parameters with {}: it is missing", char::from(letter)), true)
+            })? / divisor;
+        }
+        self.transformations.set(kind, Transformation::new(&values, angles)).map_err(refused)
+    }
+
+    /// Takes the zero offset in force, G37, the length correction when
+    /// `with_length` (a block of linear or rapid motion) and the active
+    /// transformations into the frame from program to machine coordinates.
+    /// The tool stays where it is, so its program position moves.
     fn shift_frame(&mut self, with_length: bool) {
         if with_length {
             self.length_shift = self.length_correction();
         }
-        let mut translation = self.length_shift;
-        for (&value, &axis) in self.offsets.offset(self.zero_offset_row()).iter().zip(&self.machine.axes) {
-            translation[slot(axis)] += f64::from(value) / 1000.0;
+        let axes = &self.machine.axes;
+        let offset = self.offsets.offset(self.zero_offset_row());
+        let mut translation = [0.0; MAX_AXES];
+        for ((value, &axis), &offset) in translation.iter_mut().zip(axes).zip(&offset) {
+            let letter = slot(axis);
+            *value = self.length_shift[letter] + f64::from(offset) / 1000.0 + self.recalculation.shift[letter];
         }
-        if translation == self.translation {
+        let frame = Frame { translation, transformations: self.transformations.active() };
+        let current = self.frame();
+        if frame == *current {
             return;
         }
-        for (position, (new, old)) in self.position.iter_mut().zip(translation.iter().zip(&self.translation)) {
-            *position -= new - old;
+        let position = self.machine_axes(&self.position);
+        let program: Axes = if frame.transformations == current.transformations {
+            // A translation alone moves the program position exactly.
+            std::array::from_fn(|i| position[i] - (frame.translation[i] - current.translation[i]))
+        } else {
+            // The control recomputes the position in whole µm (000:6248–6252).
+            frame.to_program(&current.to_machine(&position, axes), axes).map(round3)
+        };
+        for (&axis, value) in axes.iter().zip(program) {
+            self.position[slot(axis)] = value;
         }
-        self.translation = translation;
-        self.frames.push(self.machine_axes(&translation));
+        self.frames.push(frame);
+    }
+
+    /// The frame in force.
+    fn frame(&self) -> &Frame {
+        &self.frames[self.frames.len() - 1]
     }
 
     /// The length correction `&` and `D` select: mode A (machine constant
@@ -911,16 +1008,19 @@ impl<'a> Runner<'a> {
     /// control's look-ahead fixes them.
     fn compensate(&mut self, start: Position, path: Path) -> Result<(), CompensationError> {
         let index = self.steps.len() - 1;
+        let plane = match self.modes.active(self.groups.plane) {
+            Some(18) => (b'Z', b'X'),
+            Some(19) => (b'Y', b'Z'),
+            _ => (b'X', b'Y'),
+        };
+        // Mirrored in one axis of the plane, the tool changes side.
+        let flipped = self.recalculation.flips(plane);
         let side = match self.modes.active(self.groups.compensation) {
-            Some(41) => Some(Side::Left),
-            Some(42) => Some(Side::Right),
+            Some(41) => Some(if flipped { Side::Right } else { Side::Left }),
+            Some(42) => Some(if flipped { Side::Left } else { Side::Right }),
             _ => None,
         };
-        let (a, b) = match self.modes.active(self.groups.plane) {
-            Some(18) => (slot(b'Z'), slot(b'X')),
-            Some(19) => (slot(b'Y'), slot(b'Z')),
-            _ => (slot(b'X'), slot(b'Y')),
-        };
+        let (a, b) = (slot(plane.0), slot(plane.1));
         let point = |position: &Position| Point2::new(position[a], position[b]);
         let (from, to) = (point(&start), point(&self.position));
         let moves_in_plane = from != to || matches!(path, Path::Arc { .. });
@@ -973,11 +1073,7 @@ impl<'a> Runner<'a> {
 
     /// A position by letter over the machine's axes, as steps keep it.
     fn machine_axes(&self, position: &Position) -> Axes {
-        let mut values = [0.0; MAX_AXES];
-        for (value, &axis) in values.iter_mut().zip(&self.machine.axes) {
-            *value = position[slot(axis)];
-        }
-        values
+        transform::over_axes(position, &self.machine.axes)
     }
 
     /// The row of the zero-offset table in force (G53–G59).
@@ -994,6 +1090,12 @@ impl<'a> Runner<'a> {
         result.is_ok()
     }
 
+    /// How many units the program writes per mm the axis `letter` moves:
+    /// 2 on the diameter axis under diameter programming, else 1.
+    fn written_per_unit(&self, letter: u8) -> f64 {
+        if self.diameter && self.machine.diameter_axis == Some(letter) { 2.0 } else { 1.0 }
+    }
+
     /// Runs one pass of a built-in fixed cycle from where the block ended
     /// and times its moves as steps of the block. Its F, S and spindle
     /// changes stay inside it (03 §1.4 I6).
@@ -1004,21 +1106,31 @@ impl<'a> Runner<'a> {
             Some(19) => Spindle::Oriented,
             _ => Spindle::Stopped,
         };
+        // The cycles compute in the values as written (diameters under G74).
+        let written = self.machine.diameter_axis.map(|axis| (slot(axis), self.written_per_unit(axis)));
+        let scaled = |position: &Position, by: fn(f64, f64) -> f64| {
+            let mut position = *position;
+            if let Some((slot, factor)) = written {
+                position[slot] = by(position[slot], factor);
+            }
+            position
+        };
         let input = CycleInput {
             number,
             kind: CycleKind::of(self.machine.cycle_file.as_deref()),
             params: &self.params,
-            position: self.position,
+            position: scaled(&self.position, |value, factor| value * factor),
             incremental: self.incremental(),
             per_revolution: self.feed_mode().per_revolution,
             speed: self.speed,
             spindle,
-            diameter: false,
+            diameter: self.diameter,
         };
         let cycle = cycles::expand(&input)?;
-        let mut at = cycle.start;
+        let physical = |position: &Position| scaled(position, |value, factor| value / factor);
+        let mut at = physical(&cycle.start);
         for step in &cycle.steps {
-            let to = step.to().copied().unwrap_or(at);
+            let to = step.to().map_or(at, physical);
             let length = distance(&at, &to);
             let (motion, duration, feed, path) = match *step {
                 CycleStep::Rapid { .. } => (Motion::Rapid, self.rapid_seconds(&at, &to), None, Path::Straight),
@@ -1037,18 +1149,17 @@ impl<'a> Runner<'a> {
             self.record(range, &to, Moved { motion, length, duration, feed, path }, None);
             at = to;
         }
-        self.position = cycle.end();
+        self.position = physical(&cycle.end());
         Ok(())
     }
 
-    /// Seconds a rapid move takes: every axis runs at its own rate, and the
-    /// slowest to arrive sets the time.
+    /// Seconds a rapid move takes: every real axis runs at its own rate,
+    /// and the slowest to arrive sets the time.
     fn rapid_seconds(&self, start: &Position, end: &Position) -> f64 {
+        let mut delta: Position = std::array::from_fn(|slot| end[slot] - start[slot]);
+        self.frame().real_displacement(&mut delta);
         let minutes = (b'A'..=b'Z')
-            .map(|letter| {
-                let slot = usize::from(letter - b'A');
-                (end[slot] - start[slot]).abs() / f64::from(self.machine.axis_rapid_rate(letter))
-            })
+            .map(|letter| delta[slot(letter)].abs() / f64::from(self.machine.axis_rapid_rate(letter)))
             .fold(0.0, f64::max);
         minutes * 60.0
     }
@@ -1061,6 +1172,7 @@ impl<'a> Runner<'a> {
             feed: self.feed,
             speed: self.speed,
             speed_limit: self.speed_limit,
+            diameter: self.diameter,
             params: self.params.clone(),
         }
     }
@@ -1072,6 +1184,7 @@ impl<'a> Runner<'a> {
             feed: self.feed,
             speed: self.speed,
             speed_limit: self.speed_limit,
+            diameter: self.diameter,
             params: self.params,
         } = snapshot;
         self.in_cycle = false;
@@ -1219,10 +1332,16 @@ impl<'a> Runner<'a> {
         // YZ, Z of ZX (01 §6.4).
         let (first, second) = plane(letters[0], letters[1]);
         let (a, b) = (usize::from(first - b'A'), usize::from(second - b'A'));
-        let centre_offset = |letter: u8| block.word(letter).and_then(|word| self.number(word)).unwrap_or(0.0);
+        // I and J are recalculated as the axes they measure along, and an
+        // arc mirrored in one of its axes turns the other way.
+        let centre_offset = |letter: u8, axis: u8| {
+            let value = block.word(letter).and_then(|word| self.number(word)).unwrap_or(0.0);
+            self.recalculation.apply(axis, value)
+        };
+        let counter_clockwise = counter_clockwise != self.recalculation.flips((first, second));
         let from = Vector2::new(start[a], start[b]);
         let to = Vector2::new(end[a], end[b]);
-        let centre = from + Vector2::new(centre_offset(b'I'), centre_offset(b'J'));
+        let centre = from + Vector2::new(centre_offset(b'I', first), centre_offset(b'J', second));
         let (radius, end_radius) = ((from - centre).norm(), (to - centre).norm());
         if (radius - end_radius).abs() > ARC_TOLERANCE {
             let message = format!(
@@ -1313,7 +1432,7 @@ impl<'a> Runner<'a> {
 struct ProgramMachine<'r> {
     machine: &'r MachineConfig,
     position: &'r Position,
-    translation: &'r Position,
+    frame: &'r Frame,
     offsets: &'r mut OffsetTable,
     corrections: &'r mut ToolTable,
 }
@@ -1326,8 +1445,10 @@ impl ProgramMachine<'_> {
 
 impl Machine for ProgramMachine<'_> {
     fn measured_position(&self, axis: u8) -> Option<Raw> {
-        let slot = self.axis_slot(axis)?;
-        Some(((self.position[slot] + self.translation[slot]) * 1000.0).round() as Raw)
+        let index = usize::from(axis).checked_sub(1).filter(|&index| index < self.machine.axes.len())?;
+        let axes = &self.machine.axes;
+        let measured = self.frame.to_machine(&transform::over_axes(self.position, axes), axes);
+        Some((measured.get(index)? * 1000.0).round() as Raw)
     }
 
     fn programmed_position(&self, axis: u8) -> Option<Raw> {
@@ -1440,6 +1561,7 @@ struct Snapshot {
     feed: Option<ProgrammedFeed>,
     speed: f64,
     speed_limit: Option<f64>,
+    diameter: bool,
     params: Parameters,
 }
 
@@ -1541,7 +1663,7 @@ mod tests {
 
     use ncc_syntax::{Dialect, Parse};
 
-    use super::{Called, Environment, Motion, NoFiles, Stop, Trace, run};
+    use super::{Axes, Called, Environment, Motion, NoFiles, Path, Stop, Trace, round3, run};
     use crate::machine::MachineConfig;
 
     fn run_text(text: &str) -> Trace {
@@ -1626,6 +1748,35 @@ mod tests {
         let text = "%1\nN1 G00 X100\nN2 G96 G1 F200 S90 X50\nN3 M30\n";
         let trace = run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &machine, 100);
         close6(trace.steps[1].duration, 50.0 * TAU * 75.0 / (0.2 * 90_000.0) * 60.0);
+    }
+
+    #[test]
+    fn diameter_programming_halves_the_diameter_axis() {
+        use std::f64::consts::TAU;
+        let lathe = MachineConfig {
+            axes: b"XZ".to_vec(),
+            diameter_axis: Some(b'X'),
+            cycle_file: Some("PEVNECY5.NCP".to_owned()),
+            ..MachineConfig::default()
+        };
+        let run_lathe = |text: &str| run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &lathe, 1000);
+        let text = "%1\nN1 G00 X40 Z0\nN2 G01 X50 F600\nN3 G91 X10\nN4 G90 G75 X20\nN5 G74 X20.001\nN6 G04 Q1\nN7 X30\nN8 M30\n";
+        let trace = run_lathe(text);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let x: Vec<f64> = trace.steps.iter().map(|step| trace.axis(&step.end, b'X')).collect();
+        // G74 is the lathe's start; G04 in group G10 does not end it.
+        assert_eq!(x[..7], [20.0, 25.0, 30.0, 20.0, 10.0005, 10.0005, 15.0]);
+        assert_eq!(timing(&trace)[1], (0.5, 5.0));
+        // Constant cutting speed turns by the radius: facing from Ø100 to
+        // Ø20 takes what it takes from radius 50 to 10.
+        let trace = run_lathe("%1\nN1 G00 X100 Z0\nN2 G97 S1000 G01 X20 F0.2\nN3 M30\n");
+        close6(trace.steps[1].duration, 40.0 * TAU * 30.0 / (0.2 * 100_000.0) * 60.0);
+        // A built-in lathe cycle computes in diameters and runs in radii:
+        // G82's first chip ends at Ø62 (see the cycles' own test).
+        let text = "%1\nN1 G00 X104 Z2\nN2 R24=-4. R25=-2. R26=200 R27=0.001 R28=3. R29=2. R30=-40. R31=-10. G82\nN3 G80 M30\n";
+        let trace = run_lathe(text);
+        let x: Vec<f64> = trace.steps.iter().map(|step| trace.axis(&step.end, b'X')).collect();
+        assert_eq!(x[2..6], [52.0, 31.0, 31.0, 52.0]);
     }
 
     fn close6(actual: f64, expected: f64) {
@@ -1766,6 +1917,97 @@ mod tests {
         let trace = run_text(text);
         let fatal: Vec<&str> = trace.findings.iter().filter(|f| f.fatal).map(|f| text[f.range].trim_end()).collect();
         assert_eq!(fatal, ["N4 G03 X0 Y6 I0 J3"]);
+    }
+
+    #[test]
+    fn mirroring_reverses_axes_arcs_and_the_compensation_side() {
+        let trace = run_text("%1\nN1 G35 X0\nN2 G01 X10 Y5 F600\nN3 G02 X20 Y5 I5 J0\nN4 G34\nN5 G01 X0 Y0\nN6 M30\n");
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let ends: Vec<(f64, f64)> =
+            trace.steps.iter().map(|step| (trace.axis(&step.end, b'X'), trace.axis(&step.end, b'Y'))).collect();
+        assert_eq!(ends[..5], [(0.0, 0.0), (-10.0, 5.0), (-20.0, 5.0), (-20.0, 5.0), (0.0, 0.0)]);
+        // The clockwise half circle over the top turns counter-clockwise
+        // about the mirrored centre, still over the top.
+        assert_eq!(trace.steps[2].path, Path::Arc { plane: (b'X', b'Y'), centre: [-15.0, 5.0], clockwise: false });
+        close6(trace.steps[2].length, PI * 5.0);
+        // Compensation G41 on the mirrored contour runs on the right: the
+        // tool-centre path is the mirror image, with the same lengths.
+        let text = "%1\nN0 G35 X0\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 X50\nN5 Y50\nN6 G40 X70 Y70\nN7 M30\n";
+        let trace = run_text(text);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        assert_eq!(lengths(&trace)[1..7], [0.0, 20.0, 25.0, 45.0, 45.0, 32.016]);
+    }
+
+    #[test]
+    fn scale_multiplies_the_programmed_lengths() {
+        let trace = run_text("%1\nN1 G36 X2\nN2 G01 X10 F600\nN3 G36 X1 Y4\nN4 G91 X8\nN5 G36\nN6 X1\nN7 M30\n");
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let x: Vec<f64> = trace.steps.iter().map(|step| trace.axis(&step.end, b'X')).collect();
+        assert_eq!(x[..6], [0.0, 20.0, 20.0, 22.0, 22.0, 23.0]);
+        assert_eq!(timing(&trace)[1], (2.0, 20.0));
+        // A scale of 0 stops the run at its G36.
+        let text = "%1\nN1 G36 X1 Y0\nN2 G01 X10 F600\nN3 M30\n";
+        let trace = run_text(text);
+        let fatal: Vec<&str> = trace.findings.iter().filter(|f| f.fatal).map(|f| &text[f.range]).collect();
+        assert_eq!(fatal, ["G36"]);
+        assert_eq!(trace.steps.len(), 0);
+    }
+
+    #[test]
+    fn the_independent_offset_adds_to_the_zero_offset() {
+        let trace = run_text("%1\nN1 G37 X10 Y-5\nN2 G00 X1 Y1\nN3 G37\nN4 G00 X1 Y1\nN5 M30\n");
+        let machine = |index: usize| {
+            let end = trace.machine_end(index);
+            (trace.axis(&end, b'X'), trace.axis(&end, b'Y'))
+        };
+        // The tool stays at the machine zero when G37 comes: its program
+        // position moves the other way.
+        assert_eq!(
+            [machine(0), machine(1), machine(2), machine(3)],
+            [(0.0, 0.0), (11.0, -4.0), (11.0, -4.0), (1.0, 1.0)]
+        );
+        assert_eq!(trace.axis(&trace.start_of(1), b'X'), -10.0);
+        assert_eq!(lengths(&trace)[..4], [0.0, 137f64.sqrt(), 0.0, 125f64.sqrt()].map(round3));
+    }
+
+    #[test]
+    fn a_planar_transformation_turns_the_real_axes() {
+        // The real system turned 90° and shifted by (10, 0): the program
+        // runs in fictive coordinates, the axes move in real ones.
+        let machine = MachineConfig { rapid_rates: [(b'X', 5_000)].into(), ..MachineConfig::default() };
+        let text =
+            "%1\nN1 G38 X10 Y0 I90\nN2 G38\nN3\nN4 G00 X10 Y10\nN5 G01 X20 F600\nN6 G38 I0\nN7\nN8 G01 X0 Y0\nN9 M30\n";
+        let trace = run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &machine, 100);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let at = |values: Axes| (round3(trace.axis(&values, b'X')), round3(trace.axis(&values, b'Y')));
+        // Activated at the machine zero, the tool is at fictive (10, 0).
+        assert_eq!(at(trace.steps[2].end), (10.0, 0.0));
+        assert_eq!(at(trace.machine_end(2)), (0.0, 0.0));
+        // Fictive Y is real X, which rapids at half the rate.
+        assert_eq!(at(trace.machine_end(3)), (10.0, 0.0));
+        assert_eq!(timing(&trace)[3], (0.12, 10.0));
+        assert_eq!(at(trace.machine_end(4)), (10.0, -10.0));
+        // Cancelled, the program takes the real position again.
+        assert_eq!(at(trace.steps[6].end), (10.0, -10.0));
+        assert_eq!(lengths(&trace)[..8], [0.0, 0.0, 0.0, 10.0, 10.0, 0.0, 0.0, 200f64.sqrt()].map(round3));
+    }
+
+    #[test]
+    fn the_spatial_transformation_and_what_the_control_refuses() {
+        let text = "%1\nN1 G31 X0 Y0 Z0 I0 J0 K9000 E100\nN2 G31\nN3\nN4 G01 X10 F600\nN5 M30\n";
+        let trace = run_text(text);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let end = trace.machine_end(3);
+        let real = [b'X', b'Y', b'Z'].map(|axis| round3(trace.axis(&end, axis)));
+        assert_eq!(real, [0.0, -10.0, 0.0]);
+        // Activating without parameters goes on without it; setting them
+        // while active stops the run.
+        let text = "%1\nN1 G39\nN2 G39 X0 Y0 I30\nN3 G39\nN4 G39 X1 Y1 I30\nN5 M30\n";
+        let trace = run_text(text);
+        let findings: Vec<(&str, bool)> = trace.findings.iter().map(|f| (text[f.range].trim_end(), f.fatal)).collect();
+        assert_eq!(findings, [("G39", false), ("G39", true)]);
+        assert_eq!(&text[trace.findings[1].range.start().into()..][..2], "G3");
+        assert!(trace.findings[1].message.contains("cannot change while it is active"));
     }
 
     #[test]
@@ -1978,13 +2220,10 @@ mod tests {
 
     #[test]
     fn the_program_ends_at_m30_and_unmodelled_work_is_named_once() {
-        let trace = run_text("%1\nN1 G35 X1 F100\nN2 G36 X2\nN3 M30\nN4 G00 X500\n");
+        let trace = run_text("%1\nN1 G08 X1 F100\nN2 G08 X2\nN3 M30\nN4 G00 X500\n");
         assert_eq!(trace.steps.len(), 3);
         let messages: Vec<&str> = trace.findings.iter().map(|f| f.message.as_str()).collect();
-        assert_eq!(
-            messages,
-            ["the executor does not run transformations (G31, G34–G39) yet: the time leaves them out"]
-        );
+        assert_eq!(messages, ["the executor does not run G08 yet: the time leaves them out"]);
     }
 
     #[test]

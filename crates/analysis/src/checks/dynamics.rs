@@ -179,13 +179,16 @@ impl Arc {
 }
 
 /// How X positions map to path lengths: halved under diameter programming
-/// (G74). Without G74/G75 a machine with a Y axis is taken as a mill, which
-/// programs X as a coordinate; on a lathe the scale is then unknown.
+/// (G74). Without G74/G75 a machine with a diameter axis starts in diameter
+/// programming, and one with a Y axis is taken as a mill, which programs X
+/// as a coordinate; on another lathe the scale is then unknown.
 fn x_scale(visit: &Visit<'_>) -> Option<f64> {
+    let machine = &visit.config.machine;
     match visit.after.g(10) {
         Some(Some(74)) => Some(0.5),
         Some(_) => Some(1.0),
-        None => visit.config.machine.is_axis(b'Y').then_some(1.0),
+        None if machine.diameter_axis.is_some() => Some(0.5),
+        None => machine.is_axis(b'Y').then_some(1.0),
     }
 }
 
