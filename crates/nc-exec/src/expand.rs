@@ -8,11 +8,16 @@
 //! whose feed varies, under constant cutting speed), threads with their
 //! lead and spindle speed, dwells in units of 10 ms, and the stops M00/M01
 //! where the run had them. Arc centres are rounded so that the end point
-//! stays on the circle within the control's 1 µm.
+//! stays on the circle within the control's 1 µm. Under radius compensation
+//! the tool-centre path is written, so the program needs no correction
+//! table.
 
 use std::fmt::Write as _;
 
-use crate::run::{Motion, Path, Position, Stop, Trace, round3, slot};
+use crate::{
+    compensation::Element,
+    run::{Motion, Path, Position, Stop, Trace, round3, slot},
+};
 
 /// The longest line the control reads (000:612).
 const MAX_LINE: usize = 80;
@@ -30,19 +35,63 @@ pub fn write(trace: &Trace, number: u32, title: &str) -> String {
         header.push("G75".to_owned());
     }
     writer.block(header);
-    for step in &trace.steps {
+    let mut tool_centre = trace.tool_centre.iter().peekable();
+    let mut compensated = trace.compensated.iter().peekable();
+    for (index, step) in trace.steps.iter().enumerate() {
         let end = trace.position(&step.end);
-        let mut words = writer.words(step.motion, &step.path, &end, step.feed, step.duration);
-        match step.stop {
-            Some(Stop::Program) => words.push("M00".to_owned()),
-            Some(Stop::Optional) => words.push("M01".to_owned()),
-            None => {}
+        while compensated.next_if(|span| span.steps.end <= index).is_some() {}
+        let plane = compensated.peek().filter(|span| span.steps.contains(&index)).map(|span| span.plane);
+        // Under radius compensation the tool runs the pieces of the
+        // tool-centre path; the other axes move with the last of them.
+        let moves: Vec<(Path, Position, Option<f64>)> = match plane {
+            None => vec![(step.path, end, step.feed)],
+            Some((a, b)) => {
+                let mut pieces = Vec::new();
+                while let Some(piece) = tool_centre.next_if(|piece| piece.block == index) {
+                    pieces.push(piece);
+                }
+                let last = pieces.len().saturating_sub(1);
+                let mut moves: Vec<_> = pieces
+                    .iter()
+                    .enumerate()
+                    .map(|(k, piece)| {
+                        let mut to = if k == last { end } else { writer.at };
+                        let point = piece.path.end();
+                        (to[slot(a)], to[slot(b)]) = (point.x, point.y);
+                        let path = match piece.path {
+                            Element::Arc { centre, clockwise, .. } => {
+                                Path::Arc { plane: (a, b), centre: [centre.x, centre.y], clockwise }
+                            }
+                            Element::Line { .. } => Path::Straight,
+                        };
+                        (path, to, step.feed.map(|feed| feed * piece.feed_scale))
+                    })
+                    .collect();
+                if moves.is_empty() {
+                    let mut to = end;
+                    (to[slot(a)], to[slot(b)]) = (writer.at[slot(a)], writer.at[slot(b)]);
+                    moves.push((Path::Straight, to, step.feed));
+                }
+                moves
+            }
+        };
+        let mut blocks: Vec<Vec<String>> = Vec::new();
+        for (path, to, feed) in &moves {
+            blocks.push(writer.words(step.motion, path, to, *feed, step.duration));
+            if step.motion != Motion::None && step.motion != Motion::Dwell {
+                writer.at = rounded(to);
+            }
         }
-        if !words.is_empty() {
+        let stop = match step.stop {
+            Some(Stop::Program) => Some("M00".to_owned()),
+            Some(Stop::Optional) => Some("M01".to_owned()),
+            None => None,
+        };
+        if let (Some(stop), Some(last)) = (stop, blocks.last_mut()) {
+            last.push(stop);
+        }
+        for words in blocks.into_iter().filter(|words| !words.is_empty()) {
             writer.block(words);
-        }
-        if step.motion != Motion::None && step.motion != Motion::Dwell {
-            writer.at = rounded(&end);
         }
     }
     writer.block(vec!["M30".to_owned()]);
@@ -191,6 +240,43 @@ N101 G91 G01 X1 Y1 F600
 N102 G90 G70
 *
 ";
+
+    /// Under radius compensation the expansion writes the tool-centre path:
+    /// it runs without G41/G42, in the same time.
+    #[test]
+    fn compensation_is_written_as_the_tool_centre_path() {
+        let text = "%1\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 X50\nN5 G03 X70 Y20 I0 J20\nN6 G01 Y50\nN7 G40 X90 Y70\nN8 M30\n";
+        let original = run_text(text);
+        assert!(original.findings.is_empty(), "{:?}", original.findings);
+        let expanded = write(&original, 1, "CENTRE");
+        let again = run_text(&expanded);
+        assert!(again.findings.is_empty(), "{:?}\n{expanded}", again.findings);
+        let (before, after) = (original.total_time(), again.total_time());
+        assert!((after - before).abs() < 1e-3 * before, "{before} s, expanded {after} s");
+        let centre_ends: Vec<[i64; 2]> = original
+            .tool_centre
+            .iter()
+            .map(|piece| [piece.path.end().x, piece.path.end().y].map(|v| (v * 1000.0).round() as i64))
+            .collect();
+        let ends: Vec<[i64; 2]> = again.steps[2..again.steps.len() - 1]
+            .iter()
+            .map(|step| [b'X', b'Y'].map(|axis| (again.axis(&step.end, axis) * 1000.0).round() as i64))
+            .collect();
+        assert_eq!(ends, centre_ends, "{expanded}");
+        expect![[r#"
+            %1 "CENTRE"
+            N1 G90 G94
+            N2 G00 Y-20.000
+            N3 G01 Y5.000 F600
+            N4 G01 X50.000
+            N5 G03 X65.000 Y20.000 I0.000 J15.000 F450
+            N6 G01 Y50.000 F600
+            N7 G01 X90.000 Y70.000
+            N8 M30
+            *
+        "#]]
+        .assert_eq(&expanded);
+    }
 
     #[test]
     fn the_expanded_program_runs_the_same_moves() {

@@ -32,6 +32,8 @@
 //! reference point G30), so that a total never silently leaves something
 //! out.
 
+use std::ops::Range;
+
 use nalgebra::{Point2, Vector2};
 use ncc_catalog::{AddressRole, Catalogue, Dialect};
 use ncc_syntax::{Parse, TextRange, ast::AstNode};
@@ -39,7 +41,7 @@ use rowan::GreenNode;
 
 use crate::{
     arith::{self, BlockArithmetic, Machine, Message, Parameters, Raw},
-    compensation::{CompensationError, Compensator, Element, Settings, Side},
+    compensation::{CompensationError, Compensator, Element, Settings, Side, ToolElement},
     cycles::{self, CycleError, CycleInput, CycleKind, CycleStep, Spindle},
     lower::{BlockData, Value, Word},
     machine::MachineConfig,
@@ -90,6 +92,15 @@ pub struct Step {
     /// The program stops after the block (M00, M01) until the operator
     /// starts it again; the run does not count the wait.
     pub stop: Option<Stop>,
+}
+
+/// Steps that ran under radius compensation: their ends are the
+/// programmed contour, the tool ran on [`Trace::tool_centre`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Compensated {
+    pub steps: Range<usize>,
+    /// The plane's axes, the order of the tool-centre path's coordinates.
+    pub plane: (u8, u8),
 }
 
 /// Positions over the machine's axes 1–6, in their order: what a step
@@ -147,6 +158,10 @@ pub struct Trace {
     pub diameter_axis: Option<u8>,
     /// From program to machine coordinates, per [`Step::frame`].
     pub frames: Vec<Frame>,
+    /// The tool-centre path of radius compensation, piece by piece in the
+    /// order of their steps (`block` is the step's index).
+    pub tool_centre: Vec<ToolElement>,
+    pub compensated: Vec<Compensated>,
     pub steps: Vec<Step>,
     pub findings: Vec<Finding>,
     /// Tools called with T, in order of first use.
@@ -421,9 +436,13 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
         time += step.duration;
     }
     let axes = machine.axes.iter().copied().take(MAX_AXES).collect();
+    // Pieces come in the order compensation fixes them, a block late.
+    runner.tool_centre.sort_by_key(|piece| piece.block);
     Trace {
         axes,
         diameter_axis: machine.diameter_axis,
+        tool_centre: runner.tool_centre,
+        compensated: runner.compensated,
         frames: runner.frames,
         steps: runner.steps,
         findings: runner.findings,
@@ -586,6 +605,9 @@ struct Runner<'a> {
     /// Radius compensation in force, and its machine constants.
     compensator: Option<Compensator>,
     compensation: Settings,
+    /// The tool-centre path so far, and the steps compensation ran over.
+    tool_centre: Vec<ToolElement>,
+    compensated: Vec<Compensated>,
     /// Machine constant 329 decade 3: G96/G97 swapped (1, 3), S in m/min
     /// (2, 3); read once, as every block asks.
     css_setting: u8,
@@ -641,6 +663,8 @@ impl<'a> Runner<'a> {
             css_setting: machine.decade(329, 3),
             compensator: None,
             compensation: Settings::of(machine),
+            tool_centre: Vec::new(),
+            compensated: Vec::new(),
             offsets: machine.offsets.clone(),
             corrections: machine.tools.clone(),
             correction: 0,
@@ -1029,6 +1053,7 @@ impl<'a> Runner<'a> {
             (None, Some(side)) if moves_in_plane && linear => {
                 let radius = f64::from(self.corrections.entry(self.correction).radius) / 1000.0;
                 self.compensator = Some(Compensator::start(self.compensation, side, radius, index, from, to));
+                self.compensated.push(Compensated { steps: index..index + 1, plane });
                 return Ok(());
             }
             (Some(compensator), None) if moves_in_plane => compensator.cancel(index, to),
@@ -1045,20 +1070,33 @@ impl<'a> Runner<'a> {
             }
             (None, _) => return Ok(()),
         };
+        // Compensation was in force when the block came.
+        if let Some(compensated) = self.compensated.last_mut() {
+            compensated.steps.end = index + 1;
+        }
         let mut charged: Vec<usize> = Vec::new();
-        for piece in pieces {
+        for piece in &pieces {
+            let length = piece.path.length();
+            let duration = match (self.steps[piece.block].motion, self.steps[piece.block].feed) {
+                (Motion::Feed, Some(feed)) => length / (feed * piece.feed_scale) * 60.0,
+                _ => {
+                    let in_plane = |point: Point2<f64>| {
+                        let mut position = [0.0; 26];
+                        (position[a], position[b]) = (point.x, point.y);
+                        position
+                    };
+                    self.rapid_seconds(&in_plane(piece.path.start()), &in_plane(piece.path.end()))
+                }
+            };
             let step = &mut self.steps[piece.block];
             if !charged.contains(&piece.block) {
                 charged.push(piece.block);
                 (step.length, step.duration) = (0.0, 0.0);
             }
-            let length = piece.path.length();
             step.length += length;
-            step.duration += match (step.motion, step.feed) {
-                (Motion::Feed, Some(feed)) => length / (feed * piece.feed_scale) * 60.0,
-                _ => length / f64::from(self.machine.rapid_rate) * 60.0,
-            };
+            step.duration += duration;
         }
+        self.tool_centre.extend(pieces);
         Ok(())
     }
 
