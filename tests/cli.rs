@@ -370,7 +370,7 @@ fn explain_list_prints_the_counts() {
 fn run_prints_the_time_and_a_record_per_block() {
     let dir = tempfile::tempdir().unwrap();
     let program = dir.path().join("DEMO.NCP");
-    let text = "%1 \"DEMO\"\nN1 G00 X100 Y0 T1\nN2 G01 X100 Y100 F600\nN3 G02 X0 Y100 I-50\nN4 G04 Q150\nN5 G01 G08 X0\nN6 M30\n";
+    let text = "%1 \"DEMO\"\nN1 G00 X100 Y0 T1\nN2 G01 X100 Y100 F600\nN3 G02 X0 Y100 I-50\nN4 G04 Q150 R5=51073051 G26\nN5 G01 G08 X0\nN6 M30\n";
     std::fs::write(&program, text).unwrap();
     let program = program.to_str().unwrap();
 
@@ -383,6 +383,7 @@ fn run_prints_the_time_and_a_record_per_block() {
             cutting    0:00:25.708       257.080 mm
             rapid      0:00:00.600       100.000 mm
             dwell      0:00:01.500
+          messages     1 by operation 51 (codes 7)
           tools        T1
           end position X0.000 Y100.000 Z0.000 U0.000 V0.000 C0.000
     "#]]
@@ -401,6 +402,10 @@ fn run_prints_the_time_and_a_record_per_block() {
     assert_eq!(blocks[1]["start_time_s"], 0.6);
     assert_eq!(blocks[1]["end"]["program"]["Y"], 100.0);
     assert_eq!(blocks[1]["end"]["machine"]["Y"], 100.0);
+    // R30 is 0: the message shows it as it was when the block ran.
+    let message = &json["messages"][0];
+    assert_eq!((&message["line"], &message["code"], &message["value"]), (&5.into(), &7.into(), &0.0.into()));
+    assert_eq!(message["display"], "permanent");
 }
 
 /// A run that stops on an error says where, and exits with 1.

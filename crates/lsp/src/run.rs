@@ -13,7 +13,10 @@ use std::{
 
 use indicatif::{ProgressBar, ProgressStyle};
 use line_index::LineIndex;
-use nc_exec::run::{Axes, Called, Environment, Motion, Stop, Trace};
+use nc_exec::{
+    arith::{Message, MessageDisplay},
+    run::{Axes, Called, Environment, Motion, Stop, Trace},
+};
 use ncc_analysis::Config;
 use ncc_syntax::{Dialect, Parse, TextSize};
 use serde::Serialize;
@@ -138,6 +141,13 @@ fn summary(path: &Path, trace: &Trace) -> String {
             "  stops        {program_stops} × M00, {optional_stops} × M01 (the wait for the operator is not counted)"
         );
     }
+    if !trace.messages.is_empty() {
+        let mut codes: Vec<u8> = trace.messages.iter().map(|shown| shown.message.code).collect();
+        codes.sort_unstable();
+        codes.dedup();
+        let codes: Vec<String> = codes.iter().map(u8::to_string).collect();
+        let _ = writeln!(out, "  messages     {} by operation 51 (codes {})", trace.messages.len(), codes.join(", "));
+    }
     let tools: Vec<String> = trace.tools.iter().map(|tool| format!("T{tool}")).collect();
     let _ = writeln!(out, "  tools        {}", if tools.is_empty() { "none".to_owned() } else { tools.join(" ") });
     let position: Vec<String> =
@@ -160,6 +170,7 @@ struct Report<'a> {
     tools: &'a [u32],
     end_position: Values<'a>,
     blocks: Records<'a>,
+    messages: Vec<MessageRecord<'a>>,
     findings: Vec<FindingRecord<'a>>,
 }
 
@@ -177,6 +188,27 @@ impl<'a> Report<'a> {
             tools: &trace.tools,
             end_position: Values(trace.end(), axes),
             blocks: Records { trace, sources },
+            messages: trace
+                .messages
+                .iter()
+                .map(|shown| {
+                    let source = &sources[trace.steps[shown.step].source];
+                    let Message { code, parameter, value, display } = shown.message;
+                    MessageRecord {
+                        file: &source.name,
+                        line: source.line(trace.steps[shown.step].range.start()),
+                        code,
+                        parameter,
+                        value: value.map(|raw| raw as f64 / 1000.0),
+                        display: match display {
+                            MessageDisplay::Cancel => "cancel".to_owned(),
+                            MessageDisplay::Permanent => "permanent".to_owned(),
+                            MessageDisplay::OneBlock => "one block".to_owned(),
+                            MessageDisplay::Seconds(seconds) => format!("{seconds} s"),
+                        },
+                    }
+                })
+                .collect(),
             findings: trace
                 .findings
                 .iter()
@@ -249,6 +281,18 @@ struct BlockRecord<'a> {
 struct Coordinates<'a> {
     program: Values<'a>,
     machine: Values<'a>,
+}
+
+/// A message of operation 51: its code, the parameter it shows with the
+/// value it had, and how long it stays.
+#[derive(Serialize)]
+struct MessageRecord<'a> {
+    file: &'a str,
+    line: u32,
+    code: u8,
+    parameter: u8,
+    value: Option<f64>,
+    display: String,
 }
 
 #[derive(Serialize)]

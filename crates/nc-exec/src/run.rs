@@ -94,6 +94,15 @@ pub struct Step {
     pub stop: Option<Stop>,
 }
 
+/// A message operation 51 shows the operator; the program does not wait
+/// for it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OperatorMessage {
+    /// The step of the block that showed it.
+    pub step: usize,
+    pub message: Message,
+}
+
 /// Steps that ran under radius compensation: their ends are the
 /// programmed contour, the tool ran on [`Trace::tool_centre`].
 #[derive(Debug, Clone, PartialEq)]
@@ -162,6 +171,8 @@ pub struct Trace {
     /// order of their steps (`block` is the step's index).
     pub tool_centre: Vec<ToolElement>,
     pub compensated: Vec<Compensated>,
+    /// The technologist's messages of operation 51, in the order shown.
+    pub messages: Vec<OperatorMessage>,
     pub steps: Vec<Step>,
     pub findings: Vec<Finding>,
     /// Tools called with T, in order of first use.
@@ -443,6 +454,7 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
         diameter_axis: machine.diameter_axis,
         tool_centre: runner.tool_centre,
         compensated: runner.compensated,
+        messages: runner.messages,
         frames: runner.frames,
         steps: runner.steps,
         findings: runner.findings,
@@ -605,6 +617,8 @@ struct Runner<'a> {
     /// Radius compensation in force, and its machine constants.
     compensator: Option<Compensator>,
     compensation: Settings,
+    /// Messages of operation 51, with the step of their block.
+    messages: Vec<OperatorMessage>,
     /// The tool-centre path so far, and the steps compensation ran over.
     tool_centre: Vec<ToolElement>,
     compensated: Vec<Compensated>,
@@ -665,6 +679,7 @@ impl<'a> Runner<'a> {
             compensation: Settings::of(machine),
             tool_centre: Vec::new(),
             compensated: Vec::new(),
+            messages: Vec::new(),
             offsets: machine.offsets.clone(),
             corrections: machine.tools.clone(),
             correction: 0,
@@ -823,6 +838,8 @@ impl<'a> Runner<'a> {
             frame: &self.frames[self.frames.len() - 1],
             offsets: &mut self.offsets,
             corrections: &mut self.corrections,
+            messages: &mut self.messages,
+            step: self.steps.len() - 1,
         };
         match arith::compute(block, &mut self.params, &mut machine, self.machine) {
             BlockArithmetic::None | BlockArithmetic::Ran { result: Ok(()), .. } => {}
@@ -1473,6 +1490,9 @@ struct ProgramMachine<'r> {
     frame: &'r Frame,
     offsets: &'r mut OffsetTable,
     corrections: &'r mut ToolTable,
+    messages: &'r mut Vec<OperatorMessage>,
+    /// The step of the block whose arithmetic runs.
+    step: usize,
 }
 
 impl ProgramMachine<'_> {
@@ -1528,7 +1548,9 @@ impl Machine for ProgramMachine<'_> {
         }
     }
 
-    fn message(&mut self, _message: Message) {}
+    fn message(&mut self, message: Message) {
+        self.messages.push(OperatorMessage { step: self.step, message });
+    }
 }
 
 /// Column `column` of a correction entry: 1 the radius, 2–7 the lengths of
@@ -2046,6 +2068,22 @@ mod tests {
         assert_eq!(findings, [("G39", false), ("G39", true)]);
         assert_eq!(&text[trace.findings[1].range.start().into()..][..2], "G3");
         assert!(trace.findings[1].message.contains("cannot change while it is active"));
+    }
+
+    #[test]
+    fn operation_51_messages_are_kept_with_their_block() {
+        use crate::arith::{Message, MessageDisplay};
+        let trace = run_text("%1\nN1 G00 X10\nN2 R30=12.5 R5=51073053 G26\nN3 R5=51073050 G26\nN4 M30\n");
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let shown: Vec<(usize, Message)> = trace.messages.iter().map(|m| (m.step, m.message)).collect();
+        let message = |value, display| Message { code: 7, parameter: 30, value, display };
+        assert_eq!(
+            shown,
+            [
+                (1, message(Some(12_500), MessageDisplay::Seconds(5))),
+                (2, message(Some(12_500), MessageDisplay::Cancel))
+            ]
+        );
     }
 
     #[test]
