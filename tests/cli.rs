@@ -311,6 +311,26 @@ fn parse_prints_the_lossless_tree() {
     assert!(tree.contains("      WORD@51..54\n        LETTER@51..52 \"G\"\n        NUMBER@52..54 \"01\"\n"), "{tree}");
 }
 
+/// `ncc lower` prints each block as the executor reads it, after its line.
+#[test]
+fn lower_prints_the_blocks_as_the_executor_reads_them() {
+    let output = ncc(&["lower", "examples/milling/holes.NCP"]);
+    assert_eq!(output.status.code(), Some(0));
+    let text = stdout(&output);
+    let first: Vec<&str> = text.lines().take(5).collect();
+    expect![[r#"
+        [
+            "     5  N10 G90 G17 G80 G94 G54",
+            "     6  N20 T5 M06",
+            "     7  N30 G00 X20. Y20. S1200 M03",
+            "     8  N40 Z50. &0010 D5 M08",
+            "     9  N50 R20=30. R21=5 R22=2. R23=-2.5 R24=100 R25=30",
+        ]
+    "#]]
+    .assert_debug_eq(&first);
+    assert_eq!(ncc(&["lower", "no/such/program.NCP"]).status.code(), Some(2));
+}
+
 /// A CAM program of a million blocks (about 35 MB) is checked completely.
 #[test]
 fn checks_a_35_megabyte_program() {

@@ -108,6 +108,13 @@ enum Command {
         #[arg(long, default_value_t = nc_exec::run::DEFAULT_STEP_BUDGET)]
         step_budget: usize,
     },
+    /// Print the blocks as the executor reads them, one per line with its
+    /// line number: the lowered form, without comments and layout (see
+    /// docs/ir.md).
+    Lower {
+        /// The program to lower.
+        file: PathBuf,
+    },
     /// Print the syntax tree of a partprogram (a debugging aid).
     Parse {
         /// The program to parse.
@@ -127,6 +134,7 @@ fn main() -> ExitCode {
         Command::Lsp { log_level, .. } => server::run(log_level),
         Command::Run { file, format, step_budget } => run::run(&file, format, step_budget),
         Command::Expand { file, output, step_budget } => run::expand(&file, output.as_deref(), step_budget),
+        Command::Lower { file } => run::lower(&file),
         Command::Parse { file } => match check::read_program(&file) {
             Ok(text) => {
                 let parse = ncc_syntax::Parse::new(&text, ncc_syntax::Dialect::Cnc8x6);

@@ -15,10 +15,11 @@ use indicatif::{ProgressBar, ProgressStyle};
 use line_index::LineIndex;
 use nc_exec::{
     arith::{Message, MessageDisplay},
+    lower::BlockData,
     run::{Axes, Called, Environment, Motion, Stop, Trace},
 };
 use ncc_analysis::Config;
-use ncc_syntax::{Dialect, Parse, TextSize};
+use ncc_syntax::{Dialect, Parse, TextSize, ast::AstNode};
 use serde::Serialize;
 
 use crate::check;
@@ -122,6 +123,32 @@ pub(crate) fn expand(path: &Path, output: Option<&Path>, step_budget: usize) -> 
             ExitCode::from(2)
         }
         _ => ran.exit_code(),
+    }
+}
+
+/// `ncc lower FILE`: each block as the executor reads it, after its line.
+pub(crate) fn lower(path: &Path) -> ExitCode {
+    let text = match check::read_program(path) {
+        Ok(text) => text,
+        Err(error) => {
+            eprintln!("error: {}: {error}", path.display());
+            return ExitCode::from(2);
+        }
+    };
+    let parse = Parse::new(&text, Dialect::Cnc8x6);
+    let lines = LineIndex::new(&text);
+    let mut out = String::new();
+    for block in parse.tree().blocks() {
+        let line = lines.line_col(block.syntax().text_range().start()).line + 1;
+        let _ = writeln!(out, "{line:>6}  {}", BlockData::lower(block.syntax().green()));
+    }
+    let mut stdout = io::stdout().lock();
+    match stdout.write_all(out.as_bytes()).and_then(|()| stdout.flush()) {
+        Err(error) if error.kind() != io::ErrorKind::BrokenPipe => {
+            eprintln!("error: writing stdout: {error}");
+            ExitCode::from(2)
+        }
+        _ => ExitCode::SUCCESS,
     }
 }
 

@@ -5,6 +5,8 @@
 //! analysis re-lowers only the blocks an edit touched. The executor and the
 //! analysis read programs through this one lowering.
 
+use std::fmt;
+
 use ncc_catalog::{AddressRole, Dialect};
 use ncc_syntax::{Decimal, NcLanguage, Sign, SyntaxKind, TextRange, TextSize, ast};
 use rowan::{GreenNodeData, NodeOrToken};
@@ -267,5 +269,88 @@ fn number(item: GreenRef<'_>) -> Option<Decimal> {
     match item {
         NodeOrToken::Token(token) => Decimal::parse(None, token.text()),
         NodeOrToken::Node(_) => None,
+    }
+}
+
+/// The block as the executor reads it, on one line (what `ncc lower`
+/// prints): the block number, `/` when the block may be skipped, the words
+/// in order with their values as written (`R<n>` for a parameter, `?` for
+/// a missing value), then the parameter assignments, which take effect
+/// after the block's motion. Comments and layout are not part of it.
+impl fmt::Display for BlockData {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut words = self.words.iter().map(Word::to_string);
+        let number = self.number.and_then(|_| words.next());
+        let skip = (!self.skip.is_empty()).then(|| "/".to_owned());
+        let assignments = self.assignments.iter().map(Assignment::to_string);
+        let items: Vec<String> = number.into_iter().chain(skip).chain(words).chain(assignments).collect();
+        f.write_str(&items.join(" "))
+    }
+}
+
+impl fmt::Display for Word {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}{}", char::from(self.letter), Written(self.value.as_ref()))
+    }
+}
+
+impl fmt::Display for Assignment {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.index {
+            Some(index) => write!(f, "R{index}={}", Written(self.value.as_ref())),
+            None => write!(f, "R?={}", Written(self.value.as_ref())),
+        }
+    }
+}
+
+impl fmt::Display for Value {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Value::Literal(decimal) => write!(f, "{decimal}"),
+            Value::Parameter { negative, index, .. } => {
+                let sign = if *negative { "-" } else { "" };
+                match index {
+                    Some(index) => write!(f, "{sign}R{index}"),
+                    None => write!(f, "{sign}R?"),
+                }
+            }
+        }
+    }
+}
+
+/// A value that may be missing, as the IR prints it.
+struct Written<'a>(Option<&'a Value>);
+
+impl fmt::Display for Written<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.0 {
+            Some(value) => write!(f, "{value}"),
+            None => f.write_str("?"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use expect_test::expect;
+    use ncc_syntax::{Dialect, Parse, ast::AstNode};
+
+    use super::BlockData;
+
+    #[test]
+    fn blocks_print_as_the_executor_reads_them() {
+        // A block goes on over lines until the next N; `/` belongs to the
+        // block it follows the number of.
+        let text = "%1\nN10 / G01 X-R24 Y.5 \"A COMMENT\"\n  Z+2.50 F R5=1101110 R6=-R7\nN20 GR20 L10 Q9999 R=3\n";
+        let parse = Parse::new(text, Dialect::Cnc8x6);
+        let lowered: Vec<String> =
+            parse.tree().blocks().map(|block| BlockData::lower(block.syntax().green()).to_string()).collect();
+        expect![[r#"
+            [
+                "N10 / G01 X-R24 Y.5 Z+2.50 F? R5=1101110 R6=-R7",
+                "N20 GR20 L10 Q9999 R?=3",
+            ]
+        "#]]
+        .assert_debug_eq(&lowered);
     }
 }
