@@ -305,14 +305,16 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
     let mut jumps: std::collections::HashMap<usize, u32> = Default::default();
     let mut at = 0;
     let mut executed = 0;
+    // The rest of a block whose cycle of the cycle file has just run.
+    let mut resume: Option<Flow> = None;
     while let Some(block) = program.blocks.get(at) {
         let (range, source) = (block.range, block.source);
         runner.source = source;
-        if program.units.starts_subprogram(at) && calls.is_empty() {
+        if resume.is_none() && program.units.starts_subprogram(at) && calls.is_empty() {
             runner.finding(range, "the main body runs into a subprogram: it has no M02 or M30 before it", false);
             break;
         }
-        executed += 1;
+        executed += usize::from(resume.is_none());
         if executed % PROGRESS_INTERVAL == 0 {
             files.progress(executed);
         }
@@ -322,7 +324,11 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
             break;
         }
         let next = at + 1;
-        let flow = runner.block(&BlockData::lower(&block.green), range);
+        let flow = match resume.take() {
+            Some(flow) => flow,
+            None => runner.block(&BlockData::lower(&block.green), range),
+        };
+        let passes_on = flow == Flow::Next;
         at = match flow {
             Flow::End => break,
             Flow::Next => {
@@ -339,14 +345,15 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
                     call.start
                 }
                 Some(_) => calls.pop().map_or(next, |call| {
-                    if let Some(snapshot) = call.restore {
+                    if let Some((snapshot, then)) = call.cycle {
                         runner.restore(*snapshot);
+                        resume = Some(then);
                     }
                     call.back
                 }),
                 None => next,
             },
-            Flow::Cycle { number } => {
+            Flow::Cycle { number, then } => {
                 let name = machine.cycle_file.as_deref().unwrap_or_default();
                 let source = *cycle_file.get_or_insert_with(|| {
                     let parse = files.cycle_file(name)?;
@@ -356,9 +363,10 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
                 });
                 match source.and_then(|source| program.units.subprogram(source, number)) {
                     Some(start) => {
-                        let restore = Some(Box::new(runner.snapshot()));
+                        // Back to the calling block, to go on with its flow.
+                        let cycle = Some((Box::new(runner.snapshot()), *then));
                         runner.in_cycle = true;
-                        calls.push(Call { back: next, remaining: 1, start, restore });
+                        calls.push(Call { back: at, remaining: 1, start, cycle });
                         start
                     }
                     None => {
@@ -370,7 +378,8 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
                         if !runner.built_in_cycle_or_stop(number, range) {
                             break;
                         }
-                        next
+                        resume = Some(*then);
+                        at
                     }
                 }
             }
@@ -390,7 +399,7 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
                 };
                 match start {
                     Some(start) if calls.len() < MAX_CALL_DEPTH => {
-                        calls.push(Call { back: next, remaining: times, start, restore: None });
+                        calls.push(Call { back: next, remaining: times, start, cycle: None });
                         start
                     }
                     Some(_) => {
@@ -434,7 +443,7 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
             },
         };
         let leaves_file = program.blocks.get(at).is_none_or(|block| block.source != source);
-        if source != 0 && flow == Flow::Next && leaves_file {
+        if source != 0 && passes_on && leaves_file {
             runner.finding(range, "the macrocycle file ends without G70", true);
             break;
         }
@@ -471,8 +480,9 @@ struct Call {
     remaining: u32,
     /// The body's first block after its `G79`.
     start: usize,
-    /// A fixed cycle of the cycle file: the state to restore on return.
-    restore: Option<Box<Snapshot>>,
+    /// A fixed cycle of the cycle file: the state to restore on return, and
+    /// the flow of its block, which goes on then.
+    cycle: Option<(Box<Snapshot>, Flow)>,
 }
 
 /// The blocks of the program and the macrocycle files loaded so far, one
@@ -574,7 +584,7 @@ impl Units {
 }
 
 /// What runs after a block.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 enum Flow {
     Next,
     End,
@@ -587,9 +597,11 @@ enum Flow {
         times: u32,
         macrocycle: bool,
     },
-    /// A fixed cycle's body in the cycle file, after the block's motion.
+    /// A fixed cycle's body in the cycle file, after the block's motion;
+    /// then the block's own flow.
     Cycle {
         number: u32,
+        then: Box<Flow>,
     },
     /// `G73 L Q`: jump to block N`label`, `times` times in all.
     Jump {
@@ -859,17 +871,22 @@ impl<'a> Runner<'a> {
         let cycle = self.modes.active(self.groups.cycle).filter(|&number| (81..=89).contains(&number));
         if let Some(number) = cycle.filter(|_| !self.in_cycle) {
             if self.machine.cycle_file.is_some() {
-                return Flow::Cycle { number };
+                return Flow::Cycle { number, then: Box::new(self.flow_of(block, has)) };
             }
             if !self.built_in_cycle_or_stop(number, range) {
                 return Flow::End;
             }
         }
+        self.flow_of(block, has)
+    }
+
+    /// What follows the block once its work is done: M02/M30 end the
+    /// program; otherwise its call or jump runs, at the end of the block
+    /// (with G04, Q is the dwell and a call runs once, 01 §4.8).
+    fn flow_of(&self, block: &BlockData, has: impl Fn(u8, u32) -> bool) -> Flow {
         if has(b'M', 2) || has(b'M', 30) {
             return Flow::End;
         }
-        // The call or jump comes at the end of the block; with G04, Q is
-        // the dwell and the call runs once (01 §4.8).
         let label = block.word(b'L').and_then(|word| self.integer(word));
         let count = block.word(b'Q').filter(|_| !has(b'G', 4)).and_then(|word| self.integer(word));
         match label {
@@ -1910,6 +1927,18 @@ mod tests {
         expected.extend([(0, Motion::Rapid), (0, Motion::None)]);
         assert_eq!(lines, expected);
         close(trace.time_in(Motion::Feed), 2.0 * 12.0 / 100.0 * 60.0);
+        // The block's own flow goes on after the body: a jump that repeats
+        // the drilling block once, then M30 in a drilling block.
+        let text = "%1\nN1 R26=100 R27=1000 R30=2. R31=-10. R32=5. M03\nN2 G00 G81 X20\nN3 G91 X10 G73 L3 Q1\nN4 X10 M30\nN5 X500\n";
+        let trace = run(&Parse::new(text, Dialect::Cnc8x6), &Library(body), &machine, 1000);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let drilled_at: Vec<f64> = trace
+            .steps
+            .iter()
+            .filter(|step| step.motion == Motion::Feed)
+            .map(|step| trace.axis(&step.end, b'X'))
+            .collect();
+        assert_eq!(drilled_at, [20.0, 30.0, 40.0, 50.0]);
         // Without the file, the built-in cycle runs and says why.
         let trace = run(&Parse::new(DRILLING, Dialect::Cnc8x6), &NoFiles, &machine, 1000);
         let messages: Vec<&str> = trace.findings.iter().map(|f| f.message.as_str()).collect();
