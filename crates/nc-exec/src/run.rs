@@ -637,6 +637,8 @@ struct Runner<'a> {
     /// Machine constant 329 decade 3: G96/G97 swapped (1, 3), S in m/min
     /// (2, 3); read once, as every block asks.
     css_setting: u8,
+    /// Machine constant 329 decade 7: the length-compensation mode (0 = A).
+    length_setting: u8,
     /// The zero-offset and correction tables, as the program changes them.
     offsets: OffsetTable,
     corrections: ToolTable,
@@ -687,6 +689,7 @@ impl<'a> Runner<'a> {
             speed_reached: None,
             in_cycle: false,
             css_setting: machine.decade(329, 3),
+            length_setting: machine.decade(329, 7),
             compensator: None,
             compensation: Settings::of(machine),
             tool_centre: Vec::new(),
@@ -998,7 +1001,7 @@ impl<'a> Runner<'a> {
             return shift;
         }
         let entry = self.corrections.entry(self.correction);
-        let mode_a = self.machine.decade(329, 7) == 0;
+        let mode_a = self.length_setting == 0;
         for (index, (&axis, &length)) in self.machine.axes.iter().zip(&entry.lengths).enumerate() {
             let sign = if mode_a {
                 // `&k1k2k3k4`, right-aligned: k1 is the thousands digit.
