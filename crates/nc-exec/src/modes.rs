@@ -31,8 +31,12 @@ impl Modes {
     /// If the catalogue has no such group: the ids are fixed by the code
     /// that asks, so this is a programming error.
     pub fn group(&self, id: &str) -> Group {
-        let index = self.catalogue.groups.iter().position(|group| group.id == id);
-        Group(index.unwrap_or_else(|| panic!("the catalogue has no group {id}")))
+        self.find(id).unwrap_or_else(|| panic!("the catalogue has no group {id}"))
+    }
+
+    /// The group with id `id`, if the catalogue has one.
+    pub fn find(&self, id: &str) -> Option<Group> {
+        self.catalogue.groups.iter().position(|group| group.id == id).map(Group)
     }
 
     /// The code in force in `group`.

@@ -665,6 +665,8 @@ struct Runner<'a> {
     params: Parameters,
     steps: Vec<Step>,
     findings: Vec<Finding>,
+    /// T in force, and every T in order of first use.
+    tool: Option<u32>,
     tools: Vec<u32>,
     /// Kinds of work already reported as not run.
     reported: Vec<String>,
@@ -708,6 +710,7 @@ impl<'a> Runner<'a> {
             params: Parameters::zeroed(),
             steps: Vec::new(),
             findings: Vec::new(),
+            tool: None,
             tools: Vec::new(),
             reported: Vec::new(),
         }
@@ -763,10 +766,11 @@ impl<'a> Runner<'a> {
                     None => {}
                 },
                 Some(AddressRole::Tool) => {
-                    if let Some(tool) = self.integer(word)
-                        && !self.tools.contains(&tool)
-                    {
-                        self.tools.push(tool);
+                    if let Some(tool) = self.integer(word) {
+                        self.tool = Some(tool);
+                        if !self.tools.contains(&tool) {
+                            self.tools.push(tool);
+                        }
                     }
                 }
                 Some(AddressRole::Offset) => {
@@ -855,6 +859,12 @@ impl<'a> Runner<'a> {
             corrections: &mut self.corrections,
             messages: &mut self.messages,
             step: self.steps.len() - 1,
+            registers: Registers {
+                modes: &self.modes,
+                speed: self.speed,
+                tool: self.tool,
+                correction: self.correction,
+            },
         };
         match arith::compute(block, &mut self.params, &mut machine, self.machine) {
             BlockArithmetic::None | BlockArithmetic::Ran { result: Ok(()), .. } => {}
@@ -1513,6 +1523,37 @@ struct ProgramMachine<'r> {
     messages: &'r mut Vec<OperatorMessage>,
     /// The step of the block whose arithmetic runs.
     step: usize,
+    registers: Registers<'r>,
+}
+
+/// What the block registers BWRK and AWRK (op 49 tables 4 and 5) hold of
+/// the block that runs. The manual names their columns (M and G functions
+/// by group, P, H, S, T, Q, D) but not how the two registers differ; the
+/// arithmetic runs after the block's own codes took effect, so the run
+/// reads both as the state then. P, H and Q, which the run does not keep,
+/// are unknown.
+struct Registers<'r> {
+    modes: &'r Modes,
+    speed: f64,
+    tool: Option<u32>,
+    correction: u8,
+}
+
+impl Registers<'_> {
+    fn read(&self, group: u16, column: usize) -> Option<Raw> {
+        let code = |letter: char| {
+            let group = self.modes.find(&format!("{letter}{group}"))?;
+            self.modes.active(group).map(Raw::from)
+        };
+        match column {
+            1 => code('M'),
+            2 => code('G'),
+            5 => Some(self.speed.round() as Raw),
+            6 => self.tool.map(Raw::from),
+            8 => Some(Raw::from(self.correction)),
+            _ => None,
+        }
+    }
 }
 
 impl ProgramMachine<'_> {
@@ -1542,7 +1583,7 @@ impl Machine for ProgramMachine<'_> {
                 column.checked_sub(1).and_then(|axis| self.offsets.offset(row).get(axis).copied()).map(Raw::from)
             }
             3 => self.machine.known_constant(u32::from(row)),
-            // The block registers come with a model of the control's buffers.
+            4 | 5 => self.registers.read(row, column),
             _ => None,
         }
     }
@@ -2116,6 +2157,19 @@ mod tests {
                 (2, message(Some(12_500), MessageDisplay::Cancel))
             ]
         );
+    }
+
+    #[test]
+    fn operation_49_reads_the_block_registers() {
+        // S into R26 (F800), the motion code into R20 (G01), the spindle's
+        // M code into R21 (M04), T into R22 and D into R23; dwells show them.
+        let text = "%1\nN1 S800 M04 T3 D2\nN2 R5=49550026 G26\nN3 G01 X10 FR26\nN4 R5=49520020 R6=49510221 R7=49560022 R8=49580023 G29\nN5 G00 X0\nN6 GR20 X10\nN7 G04 QR21\nN8 G04 QR22\nN9 G04 QR23\nN10 M30\n";
+        let trace = run_text(text);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let times: Vec<f64> = timing(&trace).iter().map(|&(duration, _)| duration).collect();
+        assert_eq!(times[2], 0.75);
+        assert_eq!((trace.steps[5].motion, times[5]), (Motion::Feed, 0.75));
+        assert_eq!(times[6..9], [0.04, 0.03, 0.02]);
     }
 
     #[test]
