@@ -109,7 +109,14 @@ pub(crate) fn expand(path: &Path, output: Option<&Path>, step_budget: usize) -> 
     };
     let name = path.file_name().map_or_else(|| path.display().to_string(), |name| name.to_string_lossy().into_owned());
     let title = format!("EXPANDED FROM {name}");
-    let text = nc_exec::expand::write(&ran.trace, ran.number.unwrap_or(1), &title);
+    let text = match nc_exec::expand::write(&ran.trace, ran.number.unwrap_or(1), &title) {
+        Ok(text) => text,
+        Err(unwritable) => {
+            let step = &ran.trace.steps[unwritable.step];
+            eprintln!("error: {}: {unwritable}", ran.sources[step.source].place(step.range.start()));
+            return ExitCode::FAILURE;
+        }
+    };
     let written = match output {
         Some(output) => std::fs::write(output, &text).map_err(|error| (output.display().to_string(), error)),
         None => {

@@ -10,26 +10,42 @@
 //! where the run had them. Arc centres are rounded so that the end point
 //! stays on the circle within the control's 1 µm. Under radius compensation
 //! the tool-centre path is written, so the program needs no correction
-//! table.
+//! table; positions are written in the zero offset G53 of the machine's
+//! tables, with the zero offsets, length corrections, recalculations
+//! G35–G37 and transformations G38/G39/G31 the run had applied.
 
 use std::fmt::Write as _;
 
 use crate::{
     compensation::Element,
     run::{Motion, Path, Position, Stop, Trace, round3, slot},
+    transform::{Frame, by_letter, over_axes},
 };
 
 /// The longest line the control reads (000:612).
 const MAX_LINE: usize = 80;
 
+/// A move the written program cannot express.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Unwritable {
+    /// The step of the move.
+    pub step: usize,
+}
+
+impl std::fmt::Display for Unwritable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("an arc turned out of its plane by a transformation (G38/G39/G31) is no arc of any plane")
+    }
+}
+
 /// Writes the moves of `trace` over its machine's axes as program
 /// `%number`, with `title` as its header comment.
-pub fn write(trace: &Trace, number: u32, title: &str) -> String {
+pub fn write(trace: &Trace, number: u32, title: &str) -> Result<String, Unwritable> {
     let mut out = String::new();
     let title: String = title.chars().filter(|&c| c != '"' && !c.is_control()).collect();
     let _ = writeln!(out, "%{number} \"{title}\"");
     let mut writer = Writer { out, number: 0, at: [0.0; 26], feed: None, axes: &trace.axes };
-    let mut header = vec!["G90".to_owned(), "G94".to_owned()];
+    let mut header = vec!["G90".to_owned(), "G94".to_owned(), "G53".to_owned()];
     // The trace keeps radii on a lathe's diameter axis.
     if trace.diameter_axis.is_some() {
         header.push("G75".to_owned());
@@ -38,6 +54,7 @@ pub fn write(trace: &Trace, number: u32, title: &str) -> String {
     let mut tool_centre = trace.tool_centre.iter().peekable();
     let mut compensated = trace.compensated.iter().peekable();
     for (index, step) in trace.steps.iter().enumerate() {
+        let frames = Frames { step: &trace.frames[step.frame], written: &trace.reset_frame, axes: &trace.axes };
         let end = trace.position(&step.end);
         while compensated.next_if(|span| span.steps.end <= index).is_some() {}
         let plane = compensated.peek().filter(|span| span.steps.contains(&index)).map(|span| span.plane);
@@ -51,11 +68,13 @@ pub fn write(trace: &Trace, number: u32, title: &str) -> String {
                     pieces.push(piece);
                 }
                 let last = pieces.len().saturating_sub(1);
+                // Where the written program has the tool, in the step's frame.
+                let at = frames.to_step(&writer.at);
                 let mut moves: Vec<_> = pieces
                     .iter()
                     .enumerate()
                     .map(|(k, piece)| {
-                        let mut to = if k == last { end } else { writer.at };
+                        let mut to = if k == last { end } else { at };
                         let point = piece.path.end();
                         (to[slot(a)], to[slot(b)]) = (point.x, point.y);
                         let path = match piece.path {
@@ -69,7 +88,7 @@ pub fn write(trace: &Trace, number: u32, title: &str) -> String {
                     .collect();
                 if moves.is_empty() {
                     let mut to = end;
-                    (to[slot(a)], to[slot(b)]) = (writer.at[slot(a)], writer.at[slot(b)]);
+                    (to[slot(a)], to[slot(b)]) = (at[slot(a)], at[slot(b)]);
                     moves.push((Path::Straight, to, step.feed));
                 }
                 moves
@@ -77,9 +96,10 @@ pub fn write(trace: &Trace, number: u32, title: &str) -> String {
         };
         let mut blocks: Vec<Vec<String>> = Vec::new();
         for (path, to, feed) in &moves {
-            blocks.push(writer.words(step.motion, path, to, *feed, step.duration));
+            let (path, to) = (frames.path(path, to).ok_or(Unwritable { step: index })?, frames.to_written(to));
+            blocks.push(writer.words(step.motion, &path, &to, *feed, step.duration));
             if step.motion != Motion::None && step.motion != Motion::Dwell {
-                writer.at = rounded(to);
+                writer.at = rounded(&to);
             }
         }
         let stop = match step.stop {
@@ -96,7 +116,49 @@ pub fn write(trace: &Trace, number: u32, title: &str) -> String {
     }
     writer.block(vec!["M30".to_owned()]);
     writer.out.push_str("*\n");
-    writer.out
+    Ok(writer.out)
+}
+
+/// From the frame a step ran in to the frame the written program runs in:
+/// the zero offset G53 of the machine's tables, without length correction,
+/// recalculation or transformation, which the written positions resolve.
+struct Frames<'a> {
+    step: &'a Frame,
+    written: &'a Frame,
+    axes: &'a [u8],
+}
+
+impl Frames<'_> {
+    fn to_written(&self, position: &Position) -> Position {
+        let machine = self.step.to_machine(&over_axes(position, self.axes), self.axes);
+        by_letter(&self.written.to_program(&machine, self.axes), self.axes)
+    }
+
+    fn to_step(&self, position: &Position) -> Position {
+        let machine = self.written.to_machine(&over_axes(position, self.axes), self.axes);
+        by_letter(&self.step.to_program(&machine, self.axes), self.axes)
+    }
+
+    /// The path ending at `to` in the written frame; `None` for an arc that
+    /// a transformation turns out of its plane. A transformation keeps an
+    /// arc's plane when it holds neither of the plane's axes, or is a
+    /// planar one of exactly those two (a rotation in the plane keeps the
+    /// direction of turning).
+    fn path(&self, path: &Path, to: &Position) -> Option<Path> {
+        let Path::Arc { plane: (a, b), centre, clockwise } = *path else { return Some(*path) };
+        let keeps_plane = self.step.transformations.iter().all(|transformation| {
+            let letters = transformation.letters();
+            let held = [a, b].iter().filter(|letter| letters.contains(letter)).count();
+            held == 0 || (held == 2 && letters.len() == 2)
+        });
+        if !keeps_plane {
+            return None;
+        }
+        let mut point = *to;
+        (point[slot(a)], point[slot(b)]) = (centre[0], centre[1]);
+        let written = self.to_written(&point);
+        Some(Path::Arc { plane: (a, b), centre: [written[slot(a)], written[slot(b)]], clockwise })
+    }
 }
 
 struct Writer<'a> {
@@ -241,6 +303,38 @@ N102 G90 G70
 *
 ";
 
+    /// Offsets, recalculations and transformations are resolved: the
+    /// expansion runs in G53 the machine positions the original ran.
+    #[test]
+    fn offsets_and_transformations_are_written_as_machine_positions() {
+        use crate::tables::{OffsetTable, ToolTable};
+        let mut machine = MachineConfig::default();
+        (machine.offsets, _) = OffsetTable::parse("$POS\nG53: X=1.0\nG54: X=100.0 Y=-50.0\n", &machine.axes);
+        (machine.tools, _) = ToolTable::parse("$KOR\n01: R=0 X=0 Y=0 Z=25.0\n", &machine.axes);
+        let text = "%1\nN1 G54 G00 X10 Y10 Z5 D1 &0010\nN2 G37 X5\nN3 G35 Y0\nN4 G01 X20 Y20 F500\nN5 G02 X30 Y10 I5 J-5\nN6 G34\nN7 G38 X0 Y0 I30\nN8 G38\nN9\nN10 G91 G03 X10 Y0 I5 J0\nN11 G01 Z-2\nN12 G38 I0\nN13 M30\n";
+        let run_on = |text: &str| run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &machine, 1000);
+        let original = run_on(text);
+        assert!(original.findings.is_empty(), "{:?}", original.findings);
+        let expanded = write(&original, 1, "RESOLVED").unwrap();
+        let again = run_on(&expanded);
+        assert!(again.findings.is_empty(), "{:?}\n{expanded}", again.findings);
+        let moves = |trace: &Trace| -> Vec<[i64; 3]> {
+            (0..trace.steps.len())
+                .filter(|&i| matches!(trace.steps[i].motion, Motion::Rapid | Motion::Feed))
+                .map(|i| b"XYZ".map(|axis| (trace.axis(&trace.machine_end(i), axis) * 1000.0).round() as i64))
+                .collect()
+        };
+        assert_eq!(moves(&again), moves(&original), "{expanded}");
+        let (before, after) = (original.total_time(), again.total_time());
+        assert!((after - before).abs() < 1e-3 * before, "{before} s, expanded {after} s\n{expanded}");
+        // A planar transformation of X and Z turns an arc of XY out of its plane.
+        let text = "%1\nN1 G38 X0 Z0 I30\nN2 G38\nN3\nN4 G02 X10 Y0 I5 J0 F500\nN5 M30\n";
+        let trace = run_text(text);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let error = write(&trace, 1, "").unwrap_err();
+        assert_eq!(text[trace.steps[error.step].range].trim_end(), "N4 G02 X10 Y0 I5 J0 F500");
+    }
+
     /// Under radius compensation the expansion writes the tool-centre path:
     /// it runs without G41/G42, in the same time.
     #[test]
@@ -248,7 +342,7 @@ N102 G90 G70
         let text = "%1\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 X50\nN5 G03 X70 Y20 I0 J20\nN6 G01 Y50\nN7 G40 X90 Y70\nN8 M30\n";
         let original = run_text(text);
         assert!(original.findings.is_empty(), "{:?}", original.findings);
-        let expanded = write(&original, 1, "CENTRE");
+        let expanded = write(&original, 1, "CENTRE").unwrap();
         let again = run_text(&expanded);
         assert!(again.findings.is_empty(), "{:?}\n{expanded}", again.findings);
         let (before, after) = (original.total_time(), again.total_time());
@@ -265,7 +359,7 @@ N102 G90 G70
         assert_eq!(ends, centre_ends, "{expanded}");
         expect![[r#"
             %1 "CENTRE"
-            N1 G90 G94
+            N1 G90 G94 G53
             N2 G00 Y-20.000
             N3 G01 Y5.000 F600
             N4 G01 X50.000
@@ -282,7 +376,7 @@ N102 G90 G70
     fn the_expanded_program_runs_the_same_moves() {
         let original = run_text(PROGRAM);
         assert!(original.findings.is_empty(), "{:?}", original.findings);
-        let expanded = write(&original, 7, "DEMO EXPANDED");
+        let expanded = write(&original, 7, "DEMO EXPANDED").unwrap();
         let again = run_text(&expanded);
         assert!(again.findings.is_empty(), "{:?}\n{expanded}", again.findings);
         let moves = |trace: &Trace| -> Vec<[i64; 3]> {
@@ -299,7 +393,7 @@ N102 G90 G70
         assert!((after - before).abs() < 1e-3 * before, "{before} s, expanded {after} s");
         expect![[r#"
             %7 "DEMO EXPANDED"
-            N1 G90 G94
+            N1 G90 G94 G53
             N2 G00 X10.000 Z5.000
             N3 G01 X11.000 Y1.000 F600
             N4 G01 X12.000 Y2.000

@@ -167,6 +167,9 @@ pub struct Trace {
     pub diameter_axis: Option<u8>,
     /// From program to machine coordinates, per [`Step::frame`].
     pub frames: Vec<Frame>,
+    /// The frame of the priority block: the zero offset G53 of the machine's
+    /// tables as the run started.
+    pub reset_frame: Frame,
     /// The tool-centre path of radius compensation, piece by piece in the
     /// order of their steps (`block` is the step's index).
     pub tool_centre: Vec<ToolElement>,
@@ -291,6 +294,7 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
     let mut program = Blocks::default();
     program.add(parse);
     let mut runner = Runner::new(machine);
+    let reset_frame = runner.frame_in_force();
     // Most programs run each block about once.
     runner.steps.reserve(program.blocks.len());
     // Macrocycle numbers called, and where each file's body starts; the
@@ -465,6 +469,7 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
         compensated: runner.compensated,
         messages: runner.messages,
         frames: runner.frames,
+        reset_frame,
         steps: runner.steps,
         findings: runner.findings,
         tools: runner.tools,
@@ -971,13 +976,7 @@ impl<'a> Runner<'a> {
             self.length_shift = self.length_correction();
         }
         let axes = &self.machine.axes;
-        let offset = self.offsets.offset(self.zero_offset_row());
-        let mut translation = [0.0; MAX_AXES];
-        for ((value, &axis), &offset) in translation.iter_mut().zip(axes).zip(&offset) {
-            let letter = slot(axis);
-            *value = self.length_shift[letter] + f64::from(offset) / 1000.0 + self.recalculation.shift[letter];
-        }
-        let frame = Frame { translation, transformations: self.transformations.active() };
+        let frame = self.frame_in_force();
         let current = self.frame();
         if frame == *current {
             return;
@@ -996,7 +995,19 @@ impl<'a> Runner<'a> {
         self.frames.push(frame);
     }
 
-    /// The frame in force.
+    /// The frame the zero offset, G37, the length correction and the
+    /// transformations in force make.
+    fn frame_in_force(&self) -> Frame {
+        let offset = self.offsets.offset(self.zero_offset_row());
+        let mut translation = [0.0; MAX_AXES];
+        for ((value, &axis), &offset) in translation.iter_mut().zip(&self.machine.axes).zip(&offset) {
+            let letter = slot(axis);
+            *value = self.length_shift[letter] + f64::from(offset) / 1000.0 + self.recalculation.shift[letter];
+        }
+        Frame { translation, transformations: self.transformations.active() }
+    }
+
+    /// The frame the tool's program position is in.
     fn frame(&self) -> &Frame {
         &self.frames[self.frames.len() - 1]
     }
