@@ -19,7 +19,7 @@ use nc_exec::{
     run::{Axes, Called, Environment, Motion, Stop, Trace},
 };
 use ncc_analysis::Config;
-use ncc_syntax::{Dialect, Parse, TextSize, ast::AstNode};
+use ncc_syntax::{BlockParser, Dialect, Parse, TextSize, ast::AstNode};
 use serde::Serialize;
 
 use crate::check;
@@ -51,11 +51,12 @@ impl Ran {
             ExitCode::from(2)
         })?;
         let config = config.unwrap_or_default();
-        let parse = Parse::new(&text, Dialect::Cnc8x6);
-        let number =
-            parse.tree().header().and_then(|header| header.number()).and_then(|n| u32::try_from(n.scaled(0)?).ok());
+        let number = BlockParser::new(&text)
+            .header()
+            .and_then(|header| header.number())
+            .and_then(|n| u32::try_from(n.scaled(0)?).ok());
         let library = Library::for_program(path);
-        let trace = nc_exec::run::run(&parse, &library, &config.machine, step_budget);
+        let trace = nc_exec::run::run(&text, &library, &config.machine, step_budget);
         if let Some(bar) = library.progress.get() {
             bar.finish_and_clear();
         }
@@ -370,12 +371,11 @@ impl Library {
         Library { candidates, read: RefCell::default(), progress: OnceCell::new() }
     }
 
-    fn read(&self, called: Called, matches: impl Fn(&Path) -> bool) -> Option<Parse> {
+    fn read(&self, called: Called, matches: impl Fn(&Path) -> bool) -> Option<String> {
         let path = self.candidates.iter().find(|path| matches(path))?;
         let text = check::read_program(path).ok()?;
-        let parse = Parse::new(&text, Dialect::Cnc8x6);
-        self.read.borrow_mut().push((called, path.clone(), text));
-        Some(parse)
+        self.read.borrow_mut().push((called, path.clone(), text.clone()));
+        Some(text)
     }
 
     /// The program and the files the run read, in the trace's source order.
@@ -388,11 +388,11 @@ impl Library {
 }
 
 impl Environment for Library {
-    fn macrocycle(&self, number: u32) -> Option<Parse> {
+    fn macrocycle(&self, number: u32) -> Option<String> {
         self.read(Called::Macrocycle(number), |path| check::macrocycle_number(path) == Some(number))
     }
 
-    fn cycle_file(&self, name: &str) -> Option<Parse> {
+    fn cycle_file(&self, name: &str) -> Option<String> {
         let named =
             |path: &Path| path.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.eq_ignore_ascii_case(name));
         self.read(Called::CycleFile, named)

@@ -267,7 +267,6 @@ fn rounded(position: &Position) -> Position {
 #[cfg(test)]
 mod tests {
     use expect_test::expect;
-    use ncc_syntax::{Dialect, Parse};
 
     use super::write;
     use crate::{
@@ -276,7 +275,7 @@ mod tests {
     };
 
     fn run_text(text: &str) -> Trace {
-        run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &MachineConfig::default(), 10_000)
+        run(text, &NoFiles, &MachineConfig::default(), 10_000)
     }
 
     /// A program with everything `expand` resolves: a subprogram called
@@ -312,7 +311,7 @@ N102 G90 G70
         (machine.offsets, _) = OffsetTable::parse("$POS\nG53: X=1.0\nG54: X=100.0 Y=-50.0\n", &machine.axes);
         (machine.tools, _) = ToolTable::parse("$KOR\n01: R=0 X=0 Y=0 Z=25.0\n", &machine.axes);
         let text = "%1\nN1 G54 G00 X10 Y10 Z5 D1 &0010\nN2 G37 X5\nN3 G35 Y0\nN4 G01 X20 Y20 F500\nN5 G02 X30 Y10 I5 J-5\nN6 G34\nN7 G38 X0 Y0 I30\nN8 G38\nN9\nN10 G91 G03 X10 Y0 I5 J0\nN11 G01 Z-2\nN12 G38 I0\nN13 M30\n";
-        let run_on = |text: &str| run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &machine, 1000);
+        let run_on = |text: &str| run(text, &NoFiles, &machine, 1000);
         let original = run_on(text);
         assert!(original.findings.is_empty(), "{:?}", original.findings);
         let expanded = write(&original, 1, "RESOLVED").unwrap();

@@ -8,11 +8,11 @@
 use std::fmt;
 
 use ncc_catalog::{AddressRole, Dialect};
-use ncc_syntax::{Decimal, NcLanguage, Sign, SyntaxKind, TextRange, TextSize, ast};
-use rowan::{GreenNodeData, NodeOrToken};
+use ncc_syntax::{BlockParser, Decimal, NcLanguage, Sign, SyntaxKind, TextRange, TextSize, ast};
+use rowan::{GreenNode, GreenNodeData, NodeOrToken};
 
 /// One block.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[derive(Debug, Default, Clone, PartialEq, Eq, Hash)]
 pub struct BlockData {
     /// The block number, if the block has one.
     pub number: Option<Number>,
@@ -176,6 +176,208 @@ impl BlockData {
         let skip = usize::from(self.number.is_some());
         self.words.iter().skip(skip)
     }
+}
+
+/// Reads a program's blocks in order: plain blocks (see [`PlainReader`])
+/// from their text, the others from their syntax tree, which `each` gets
+/// with them to keep. No tree of the whole program is built.
+pub fn for_each_block(text: &str, mut each: impl FnMut(TextRange, &BlockData, Option<GreenNode>)) {
+    let plain = PlainReader::default();
+    let mut parser = BlockParser::new(text);
+    let body = parser.body();
+    let mut data = BlockData::default();
+    let mut at = body.start;
+    while at < body.end {
+        let (range, tree) = match plain.lower(text, at, body.end, &mut data) {
+            Some(end) => (TextRange::new(offset(at), offset(end)), None),
+            None => match parser.block_at(at) {
+                Some((range, tree)) => {
+                    data = BlockData::lower(&tree);
+                    (range, Some(tree))
+                }
+                None => break,
+            },
+        };
+        each(range, &data, tree);
+        at = range.end().into();
+    }
+}
+
+fn offset(at: usize) -> TextSize {
+    TextSize::from(at as u32)
+}
+
+/// Lowers blocks straight from their text when they have the shape CAM
+/// output is made of: the block number `N<digits>`, then words
+/// `<letter><sign?><number>` or `<letter><sign?>R<n>`, assignments
+/// `R<n>=<value>`, comments, spaces and line breaks. Any other block
+/// is left to its syntax tree and [`BlockData::lower`]; both read a block
+/// alike (a property test holds them to it). A large program runs without
+/// its tree this way.
+#[derive(Debug, Clone, Copy)]
+pub struct PlainReader {
+    block: u8,
+    parameter: u8,
+}
+
+impl Default for PlainReader {
+    fn default() -> Self {
+        let catalogue = Dialect::Cnc8x6.catalogue();
+        let letter = |role| catalogue.letter_with_role(role).unwrap_or(0);
+        PlainReader { block: letter(AddressRole::BlockNumber), parameter: letter(AddressRole::Parameter) }
+    }
+}
+
+impl PlainReader {
+    /// Lowers the block that starts at `at` in `text[..end]` into `data`
+    /// (reusing its buffers) and returns where the block ends: at the next
+    /// block number or at `end`. `None` when the block is not plain; `data`
+    /// is then unspecified.
+    pub fn lower(&self, text: &str, at: usize, end: usize, data: &mut BlockData) -> Option<usize> {
+        let bytes = &text.as_bytes()[..end];
+        let offset = |pos: usize| offset(pos - at);
+        let span = |from: usize, to: usize| TextRange::new(offset(from), offset(to));
+        data.words.clear();
+        data.assignments.clear();
+        data.comments.clear();
+        data.skip.clear();
+        data.skip_digits.clear();
+        if bytes.get(at) != Some(&self.block) {
+            return None;
+        }
+        let digits = digits_at(bytes, at + 1);
+        if digits == 0 || bytes.get(at + 1 + digits) == Some(&b'.') {
+            return None;
+        }
+        let number_end = at + 1 + digits;
+        let value = Decimal::parse(None, &text[at + 1..number_end]);
+        data.number = Some(Number {
+            value: value.and_then(|d| d.scaled(0)).and_then(|v| u64::try_from(v).ok()),
+            range: span(at, number_end),
+        });
+        data.words.push(Word {
+            letter: self.block,
+            value: value.map(Value::Literal),
+            range: span(at, number_end),
+            address_range: span(at, at + 1),
+            value_range: Some(span(at + 1, number_end)),
+        });
+        let mut pos = number_end;
+        let mut line_has_words = true;
+        loop {
+            let Some(&byte) = bytes.get(pos) else {
+                data.len = offset(pos);
+                return Some(pos);
+            };
+            match byte {
+                b' ' | b'\t' => pos += 1,
+                b'\n' => {
+                    line_has_words = false;
+                    pos += 1;
+                }
+                b'\r' if bytes.get(pos + 1) == Some(&b'\n') => {
+                    line_has_words = false;
+                    pos += 2;
+                }
+                b'"' => {
+                    let comment_end = memchr::memchr3(b'"', b'\n', b'\r', &bytes[pos + 1..])
+                        .map_or(end, |i| pos + 1 + i + usize::from(bytes[pos + 1 + i] == b'"'));
+                    let (body, closed) = ast::comment_parts(&text[pos..comment_end]);
+                    data.comments.push(Comment {
+                        range: span(pos, comment_end),
+                        closed,
+                        body: body.to_owned(),
+                        after_words: line_has_words,
+                    });
+                    pos = comment_end;
+                }
+                letter if letter == self.block => {
+                    data.len = offset(pos);
+                    return Some(pos);
+                }
+                letter if letter == self.parameter => {
+                    let index_digits = digits_at(bytes, pos + 1);
+                    let eq = pos + 1 + index_digits;
+                    if index_digits == 0 || bytes.get(eq) != Some(&b'=') {
+                        return None;
+                    }
+                    let (value, value_end) = self.value(text, end, eq + 1, &span)?;
+                    data.assignments.push(Assignment {
+                        index: index(&text[pos + 1..eq]),
+                        value: Some(value),
+                        range: span(pos, value_end),
+                        index_range: span(pos + 1, eq),
+                        value_range: Some(span(eq + 1, value_end)),
+                    });
+                    line_has_words = true;
+                    pos = value_end;
+                }
+                letter if letter.is_ascii_uppercase() => {
+                    let (value, value_end) = self.value(text, end, pos + 1, &span)?;
+                    data.words.push(Word {
+                        letter,
+                        value: Some(value),
+                        range: span(pos, value_end),
+                        address_range: span(pos, pos + 1),
+                        value_range: Some(span(pos + 1, value_end)),
+                    });
+                    line_has_words = true;
+                    pos = value_end;
+                }
+                _ => return None,
+            }
+        }
+    }
+
+    /// A value at `at`: a sign, then a number with at least one digit or a
+    /// parameter reference `R<n>` (not an assignment's `R<n>=`); and where
+    /// it ends.
+    fn value(
+        &self,
+        text: &str,
+        end: usize,
+        at: usize,
+        span: &impl Fn(usize, usize) -> TextRange,
+    ) -> Option<(Value, usize)> {
+        let bytes = &text.as_bytes()[..end];
+        let sign = match bytes.get(at) {
+            Some(b'-') => Some(Sign::Minus),
+            Some(b'+') => Some(Sign::Plus),
+            _ => None,
+        };
+        let start = at + usize::from(sign.is_some());
+        if bytes.get(start) == Some(&self.parameter) {
+            let digits = digits_at(bytes, start + 1);
+            let value_end = start + 1 + digits;
+            if digits == 0 || matches!(bytes.get(value_end), Some(b'.' | b'=')) {
+                return None;
+            }
+            let reference = Value::Parameter {
+                negative: sign == Some(Sign::Minus),
+                index: index(&text[start + 1..value_end]),
+                index_range: span(start + 1, value_end),
+            };
+            return Some((reference, value_end));
+        }
+        let int = digits_at(bytes, start);
+        let mut value_end = start + int;
+        if bytes.get(value_end) == Some(&b'.') {
+            value_end += 1 + digits_at(bytes, value_end + 1);
+        }
+        if value_end - start == usize::from(value_end > start + int) {
+            return None;
+        }
+        Decimal::parse(sign, &text[start..value_end]).map(|decimal| (Value::Literal(decimal), value_end))
+    }
+}
+
+fn digits_at(bytes: &[u8], at: usize) -> usize {
+    bytes.get(at..).map_or(0, |rest| rest.iter().take_while(|b| b.is_ascii_digit()).count())
+}
+
+/// A parameter number as the tree lowering reads it.
+fn index(digits: &str) -> Option<u32> {
+    Decimal::parse(None, digits).and_then(|d| d.scaled(0)).and_then(|v| u32::try_from(v).ok())
 }
 
 fn kind(raw: rowan::SyntaxKind) -> SyntaxKind {

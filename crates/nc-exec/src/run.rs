@@ -32,18 +32,18 @@
 //! reference point G30), so that a total never silently leaves something
 //! out.
 
-use std::ops::Range;
+use std::{borrow::Cow, ops::Range};
 
 use nalgebra::{Point2, Vector2};
 use ncc_catalog::{AddressRole, Catalogue, Dialect};
-use ncc_syntax::{Parse, TextRange, ast::AstNode};
+use ncc_syntax::TextRange;
 use rowan::GreenNode;
 
 use crate::{
     arith::{self, BlockArithmetic, Machine, Message, Parameters, Raw},
     compensation::{CompensationError, Compensator, Element, Settings, Side, ToolElement},
     cycles::{self, CycleError, CycleInput, CycleKind, CycleStep, Spindle},
-    lower::{BlockData, Value, Word},
+    lower::{self, BlockData, PlainReader, Value, Word},
     machine::MachineConfig,
     modes::{Group, Modes},
     tables::{OffsetTable, ToolEntry, ToolTable},
@@ -251,10 +251,10 @@ const MAX_CALL_DEPTH: usize = 64;
 /// What a run needs from where it runs: the files a program uses besides
 /// its own, and someone to tell how far it got.
 pub trait Environment {
-    /// The macrocycle file `L<number>`.
-    fn macrocycle(&self, number: u32) -> Option<Parse>;
-    /// The fixed-cycle file the machine names (`PCYKLYDG.NCP`).
-    fn cycle_file(&self, name: &str) -> Option<Parse>;
+    /// The text of the macrocycle file `L<number>`.
+    fn macrocycle(&self, number: u32) -> Option<String>;
+    /// The text of the fixed-cycle file the machine names (`PCYKLYDG.NCP`).
+    fn cycle_file(&self, name: &str) -> Option<String>;
     /// Called every [`PROGRESS_INTERVAL`] blocks with the number run so far.
     fn progress(&self, _blocks_run: usize) {}
 }
@@ -267,11 +267,11 @@ pub const PROGRESS_INTERVAL: usize = 1 << 16;
 pub struct NoFiles;
 
 impl Environment for NoFiles {
-    fn macrocycle(&self, _number: u32) -> Option<Parse> {
+    fn macrocycle(&self, _number: u32) -> Option<String> {
         None
     }
 
-    fn cycle_file(&self, _name: &str) -> Option<Parse> {
+    fn cycle_file(&self, _name: &str) -> Option<String> {
         None
     }
 }
@@ -284,15 +284,15 @@ pub enum Called {
     CycleFile,
 }
 
-/// Runs a CNC8x6 program from its first block to M02/M30 on `machine`,
+/// Runs the CNC8x6 program `text` from its first block to M02/M30 on `machine`,
 /// following subprogram calls, macrocycle calls, fixed cycles (the
 /// bodies of the machine's cycle file, or the built-in cycles) and jumps,
 /// for at most `budget` blocks. Files are read from `files` when first
 /// needed, and the run reports its progress there. Parameters start at
 /// zero.
-pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budget: usize) -> Trace {
+pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget: usize) -> Trace {
     let mut program = Blocks::default();
-    program.add(parse);
+    program.add(Cow::Borrowed(text));
     let mut runner = Runner::new(machine);
     let reset_frame = runner.frame_in_force();
     // Most programs run each block about once.
@@ -311,6 +311,7 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
     let mut executed = 0;
     // The rest of a block whose cycle of the cycle file has just run.
     let mut resume: Option<Flow> = None;
+    let mut data = BlockData::default();
     while let Some(block) = program.blocks.get(at) {
         let (range, source) = (block.range, block.source);
         runner.source = source;
@@ -330,7 +331,10 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
         let next = at + 1;
         let flow = match resume.take() {
             Some(flow) => flow,
-            None => runner.block(&BlockData::lower(&block.green), range),
+            None => {
+                program.lower(at, &mut data);
+                runner.block(&data, range)
+            }
         };
         let passes_on = flow == Flow::Next;
         at = match flow {
@@ -360,10 +364,10 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
             Flow::Cycle { number, then } => {
                 let name = machine.cycle_file.as_deref().unwrap_or_default();
                 let source = *cycle_file.get_or_insert_with(|| {
-                    let parse = files.cycle_file(name)?;
+                    let text = files.cycle_file(name)?;
                     called.push(Called::CycleFile);
-                    program.add(&parse)?;
-                    Some(program.sources - 1)
+                    program.add(Cow::Owned(text))?;
+                    Some(program.texts.len() - 1)
                 });
                 match source.and_then(|source| program.units.subprogram(source, number)) {
                     Some(start) => {
@@ -391,9 +395,9 @@ pub fn run(parse: &Parse, files: &dyn Environment, machine: &MachineConfig, budg
                 let start = if is_macrocycle {
                     let known = loaded.iter().find(|&&(number, _)| number == label).map(|&(_, start)| start);
                     known.unwrap_or_else(|| {
-                        let start = files.macrocycle(label).and_then(|parse| {
+                        let start = files.macrocycle(label).and_then(|text| {
                             called.push(Called::Macrocycle(label));
-                            program.add(&parse)
+                            program.add(Cow::Owned(text))
                         });
                         loaded.push((label, start));
                         start
@@ -493,41 +497,54 @@ struct Call {
 /// The blocks of the program and the macrocycle files loaded so far, one
 /// index space.
 #[derive(Default)]
-struct Blocks {
+struct Blocks<'a> {
     blocks: Vec<Block>,
     units: Units,
-    /// Files added so far.
-    sources: usize,
+    /// The text of each file added so far.
+    texts: Vec<Cow<'a, str>>,
+    plain: PlainReader,
 }
 
-/// A block as the run keeps it: its syntax, lowered again each time it
+/// A block as the run keeps it: where it is, lowered again each time it
 /// runs, so that a program of a million blocks costs little more memory
-/// than its tree.
+/// than its text. Plain blocks are read from the text, others from their
+/// syntax tree.
 struct Block {
     source: usize,
     range: TextRange,
-    green: GreenNode,
+    tree: Option<GreenNode>,
 }
 
-impl Blocks {
+impl<'a> Blocks<'a> {
     /// Adds a file's blocks; returns where its body starts running (after
     /// the `G79` a macrocycle file opens with), `None` for a file without
     /// blocks.
-    fn add(&mut self, parse: &Parse) -> Option<usize> {
+    fn add(&mut self, text: Cow<'a, str>) -> Option<usize> {
         let first = self.blocks.len();
-        let source = self.sources;
-        self.sources += 1;
+        let source = self.texts.len();
         let mut opens_with_g79 = false;
-        for block in parse.tree().blocks() {
-            let green = block.syntax().green().to_owned();
-            let data = BlockData::lower(&green);
+        lower::for_each_block(&text, |range, data, tree| {
             let index = self.blocks.len();
             opens_with_g79 |= index == first && data.has_code(b'G', 79);
-            self.units.add(index, source, &data, index == first);
-            self.blocks.push(Block { source, range: block.syntax().text_range(), green });
-        }
+            self.units.add(index, source, data, index == first);
+            self.blocks.push(Block { source, range, tree });
+        });
         self.units.numbers.sort_unstable();
+        self.texts.push(text);
         (first < self.blocks.len()).then_some(if opens_with_g79 { first + 1 } else { first })
+    }
+
+    /// Lowers block `index` into `data`.
+    fn lower(&self, index: usize, data: &mut BlockData) {
+        let block = &self.blocks[index];
+        match &block.tree {
+            Some(tree) => *data = BlockData::lower(tree),
+            None => {
+                let range = Range::<usize>::from(block.range);
+                let read = self.plain.lower(&self.texts[block.source], range.start, range.end, data);
+                debug_assert_eq!(read, Some(range.end), "a plain block reads alike every time");
+            }
+        }
     }
 }
 
@@ -1793,25 +1810,23 @@ pub(crate) fn round3(value: f64) -> f64 {
 mod tests {
     use std::f64::consts::PI;
 
-    use ncc_syntax::{Dialect, Parse};
-
     use super::{Axes, Called, Environment, Motion, NoFiles, Path, Stop, Trace, round3, run};
     use crate::machine::MachineConfig;
 
     fn run_text(text: &str) -> Trace {
-        run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &MachineConfig::default(), 1000)
+        run(text, &NoFiles, &MachineConfig::default(), 1000)
     }
 
     /// The macrocycle file L9001, and a cycle file, with the same text.
     struct Library(&'static str);
 
     impl Environment for Library {
-        fn macrocycle(&self, number: u32) -> Option<Parse> {
-            (number == 9001).then(|| Parse::new(self.0, Dialect::Cnc8x6))
+        fn macrocycle(&self, number: u32) -> Option<String> {
+            (number == 9001).then(|| self.0.to_owned())
         }
 
-        fn cycle_file(&self, _name: &str) -> Option<Parse> {
-            Some(Parse::new(self.0, Dialect::Cnc8x6))
+        fn cycle_file(&self, _name: &str) -> Option<String> {
+            Some(self.0.to_owned())
         }
     }
 
@@ -1878,7 +1893,7 @@ mod tests {
         let mut machine = MachineConfig::default();
         machine.constants.insert(329, 300);
         let text = "%1\nN1 G00 X100\nN2 G96 G1 F200 S90 X50\nN3 M30\n";
-        let trace = run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &machine, 100);
+        let trace = run(text, &NoFiles, &machine, 100);
         close6(trace.steps[1].duration, 50.0 * TAU * 75.0 / (0.2 * 90_000.0) * 60.0);
     }
 
@@ -1891,7 +1906,7 @@ mod tests {
             cycle_file: Some("PEVNECY5.NCP".to_owned()),
             ..MachineConfig::default()
         };
-        let run_lathe = |text: &str| run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &lathe, 1000);
+        let run_lathe = |text: &str| run(text, &NoFiles, &lathe, 1000);
         let text = "%1\nN1 G00 X40 Z0\nN2 G01 X50 F600\nN3 G91 X10\nN4 G90 G75 X20\nN5 G74 X20.001\nN6 G04 Q1\nN7 X30\nN8 M30\n";
         let trace = run_lathe(text);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
@@ -1970,7 +1985,7 @@ mod tests {
         // F are in force again, so N4 and N5 are rapids.
         let body = "\"$PC\nN1 G79 L81\nN2 G00 G90 ZR30\nN3 G01 ZR31 FR26\nN4 G00 G70 ZR32\n*\n";
         let machine = MachineConfig { cycle_file: Some("PC.NCP".to_owned()), ..MachineConfig::default() };
-        let trace = run(&Parse::new(DRILLING, Dialect::Cnc8x6), &Library(body), &machine, 1000);
+        let trace = run(DRILLING, &Library(body), &machine, 1000);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
         assert_eq!(trace.files, [Called::CycleFile]);
         let lines: Vec<(usize, Motion)> = trace.steps.iter().map(|s| (s.source, s.motion)).collect();
@@ -1985,7 +2000,7 @@ mod tests {
         // The block's own flow goes on after the body: a jump that repeats
         // the drilling block once, then M30 in a drilling block.
         let text = "%1\nN1 R26=100 R27=1000 R30=2. R31=-10. R32=5. M03\nN2 G00 G81 X20\nN3 G91 X10 G73 L3 Q1\nN4 X10 M30\nN5 X500\n";
-        let trace = run(&Parse::new(text, Dialect::Cnc8x6), &Library(body), &machine, 1000);
+        let trace = run(text, &Library(body), &machine, 1000);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
         let drilled_at: Vec<f64> = trace
             .steps
@@ -1995,7 +2010,7 @@ mod tests {
             .collect();
         assert_eq!(drilled_at, [20.0, 30.0, 40.0, 50.0]);
         // Without the file, the built-in cycle runs and says why.
-        let trace = run(&Parse::new(DRILLING, Dialect::Cnc8x6), &NoFiles, &machine, 1000);
+        let trace = run(DRILLING, &NoFiles, &machine, 1000);
         let messages: Vec<&str> = trace.findings.iter().map(|f| f.message.as_str()).collect();
         assert_eq!(
             messages,
@@ -2015,8 +2030,7 @@ mod tests {
         // G54 is X+100: the same programmed X10 is 100 mm further.
         let mut machine = MachineConfig::default();
         (machine.offsets, _) = OffsetTable::parse("$POS\nG54: X=100.0\n", &machine.axes);
-        let parse = Parse::new("%1\nN1 G00 X10\nN2 G54 X10\nN3 M30\n", Dialect::Cnc8x6);
-        let trace = run(&parse, &NoFiles, &machine, 100);
+        let trace = run("%1\nN1 G00 X10\nN2 G54 X10\nN3 M30\n", &NoFiles, &machine, 100);
         assert_eq!(lengths(&trace)[..2], [10.0, 100.0]);
         assert_eq!([trace.axis(&trace.steps[1].end, b'X'), trace.axis(&trace.machine_end(1), b'X')], [10.0, 110.0]);
         assert_eq!(trace.axis(&trace.start_of(1), b'X'), -90.0);
@@ -2121,7 +2135,7 @@ mod tests {
         let machine = MachineConfig { rapid_rates: [(b'X', 5_000)].into(), ..MachineConfig::default() };
         let text =
             "%1\nN1 G38 X10 Y0 I90\nN2 G38\nN3\nN4 G00 X10 Y10\nN5 G01 X20 F600\nN6 G38 I0\nN7\nN8 G01 X0 Y0\nN9 M30\n";
-        let trace = run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &machine, 100);
+        let trace = run(text, &NoFiles, &machine, 100);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
         let at = |values: Axes| (round3(trace.axis(&values, b'X')), round3(trace.axis(&values, b'Y')));
         // Activated at the machine zero, the tool is at fictive (10, 0).
@@ -2286,7 +2300,7 @@ mod tests {
         // found in its own file, though the program has an N20 too.
         let program = "%1\nN10 R20=10. R21=3. G91 F600\nN20 G72 L9001 Q2\nN30 M30\n";
         let macro_text = "N1 G79 L9001\nN2 R22=0 R24=1.\nN20 G01 XR20\nN30 R5=1222422 R6=17222123 G27\nN40 GR23 L20 Q9999\nN50 G70\n";
-        let trace = run(&Parse::new(program, Dialect::Cnc8x6), &Library(macro_text), &MachineConfig::default(), 1000);
+        let trace = run(program, &Library(macro_text), &MachineConfig::default(), 1000);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
         assert_eq!(trace.files, [Called::Macrocycle(9001)]);
         // Two calls, three holes each.
@@ -2294,11 +2308,11 @@ mod tests {
         assert_eq!(moves, [1; 6]);
         assert_eq!(trace.end_position()[usize::from(b'X' - b'A')], 60.0);
 
-        let trace = run(&Parse::new(program, Dialect::Cnc8x6), &NoFiles, &MachineConfig::default(), 1000);
+        let trace = run(program, &NoFiles, &MachineConfig::default(), 1000);
         let messages: Vec<&str> = trace.findings.iter().map(|f| f.message.as_str()).collect();
         assert_eq!(messages, ["there is no macrocycle file L9001 to call"]);
         let unended = Library("N1 G79 L9001\nN2 G00 X1\n");
-        let trace = run(&Parse::new(program, Dialect::Cnc8x6), &unended, &MachineConfig::default(), 1000);
+        let trace = run(program, &unended, &MachineConfig::default(), 1000);
         let messages: Vec<&str> = trace.findings.iter().map(|f| f.message.as_str()).collect();
         assert_eq!(messages, ["the macrocycle file ends without G70"]);
     }
@@ -2332,7 +2346,7 @@ mod tests {
         assert_eq!(fatal, [("N4 G71 L1", "calls nest deeper than 64: runaway recursion?")]);
 
         let text = "%1\nN1 G73 L1 Q9999\nN2 M30\n";
-        let trace = run(&Parse::new(text, Dialect::Cnc8x6), &NoFiles, &MachineConfig::default(), 500);
+        let trace = run(text, &NoFiles, &MachineConfig::default(), 500);
         assert_eq!(trace.steps.len(), 500);
         assert!(trace.findings[0].message.starts_with("stopped after 500 blocks"), "{:?}", trace.findings);
 
@@ -2402,13 +2416,12 @@ mod tests {
     #[test]
     fn a_rapid_move_lasts_as_long_as_its_slowest_axis() {
         let machine = MachineConfig { rapid_rates: [(b'Z', 5_000)].into(), ..MachineConfig::default() };
-        let trace =
-            run(&Parse::new("%1\nN1 G00 X100 Z40\nN2 X0 Z0 Y200\nN3 M30\n", Dialect::Cnc8x6), &NoFiles, &machine, 100);
+        let trace = run("%1\nN1 G00 X100 Z40\nN2 X0 Z0 Y200\nN3 M30\n", &NoFiles, &machine, 100);
         // N1: X 100 mm at 10000 mm/min is 0.6 s, Z 40 mm at 5000 mm/min 0.48 s;
         // N2: Y 200 mm at 10000 mm/min is 1.2 s.
         close(trace.steps[0].duration, 0.6);
         close(trace.steps[1].duration, 1.2);
-        let trace = run(&Parse::new("%1\nN1 G00 X50 Z40\nN2 M30\n", Dialect::Cnc8x6), &NoFiles, &machine, 100);
+        let trace = run("%1\nN1 G00 X50 Z40\nN2 M30\n", &NoFiles, &machine, 100);
         close(trace.steps[0].duration, 0.48);
     }
 }

@@ -26,7 +26,7 @@ pub use rowan::{TextRange, TextSize};
 pub use ncc_catalog::Dialect;
 
 pub use crate::{
-    cnc8x6::MAX_LINE_CHARS,
+    cnc8x6::{BlockParser, MAX_LINE_CHARS},
     decimal::{Decimal, Sign},
     error::{Severity, SyntaxError, SyntaxErrorKind},
     syntax_kind::{NcLanguage, SyntaxElement, SyntaxKind, SyntaxNode, SyntaxToken},

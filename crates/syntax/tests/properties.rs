@@ -3,7 +3,7 @@
 
 mod strategies;
 
-use ncc_syntax::{Dialect, Parse, TextEdit, TextRange, TextSize};
+use ncc_syntax::{BlockParser, Dialect, Parse, TextEdit, TextRange, TextSize, ast::AstNode};
 use proptest::prelude::*;
 use strategies::{block_program, program_text};
 
@@ -31,6 +31,24 @@ proptest! {
     #[test]
     fn program_like_text_round_trips(text in program_text()) {
         assert_well_formed(&text, &Parse::new(&text, Dialect::Cnc8x6));
+    }
+
+    #[test]
+    fn blocks_parsed_one_by_one_are_the_tree_blocks(text in prop_oneof![program_text(), block_program()]) {
+        let parse = Parse::new(&text, Dialect::Cnc8x6);
+        let tree = parse.tree();
+        let expected: Vec<_> =
+            tree.blocks().map(|block| (block.syntax().text_range(), block.syntax().green().to_owned())).collect();
+        let mut parser = BlockParser::new(&text);
+        let mut at = parser.body().start;
+        let mut blocks = Vec::new();
+        while let Some((range, green)) = parser.block_at(at) {
+            at = range.end().into();
+            blocks.push((range, green));
+        }
+        prop_assert_eq!(blocks, expected);
+        let header_text = |header: Option<ncc_syntax::ast::Header>| header.map(|header| header.syntax().to_string());
+        prop_assert_eq!(header_text(parser.header()), header_text(tree.header()));
     }
 
     #[test]

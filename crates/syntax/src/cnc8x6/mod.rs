@@ -45,6 +45,6 @@ pub(crate) fn is_block_letter(byte: u8) -> bool {
     grammar_letters().is_block(byte)
 }
 
-pub use parser::MAX_LINE_CHARS;
 pub(crate) use parser::parse_source_file;
+pub use parser::{BlockParser, MAX_LINE_CHARS};
 pub(crate) use reparse::reparse_blocks;

@@ -45,31 +45,8 @@ pub(crate) fn parse_source_file(text: &str) -> (GreenNode, Vec<SyntaxError>) {
 }
 
 fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, Vec<SyntaxError>) {
-    let mut front: Vec<GreenElement> = Vec::new();
-    let mut errors = Vec::new();
-
-    let header = find_outside_comments(text, 0, b'%');
-    let body_start = match header {
-        Some(at) => {
-            if at > 0 {
-                let preamble = &text[..at];
-                front.push(NodeOrToken::Token(rowan::GreenToken::new(PREAMBLE.into(), preamble)));
-                if !preamble.trim().is_empty() {
-                    errors.push(SyntaxError::new(
-                        E::IgnoredPreamble,
-                        range(0..at),
-                        "text before the program header `%` is skipped by the control",
-                    ));
-                }
-            }
-            let mut parser = Parser::new(text, at, text.len());
-            front.push(NodeOrToken::Node(parser.header()));
-            errors.append(&mut parser.errors);
-            parser.pos
-        }
-        None => 0,
-    };
-    let end = find_outside_comments(text, body_start, b'*').unwrap_or(text.len());
+    let Outline { mut front, mut errors, header, body } = outline(text);
+    let (body_start, end) = (body.start, body.end);
 
     // File-level trivia and words without a block number, up to the first block.
     let mut parser = Parser::new(text, body_start, end);
@@ -125,6 +102,96 @@ fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, 
 
     let children: Vec<GreenElement> = front.into_iter().chain(runs.finish()).chain(back).collect();
     (green::node(SOURCE_FILE, children), errors)
+}
+
+/// What surrounds a program's blocks: the preamble and the header, and the
+/// body, which runs from the header to the physical end `*`.
+struct Outline {
+    front: Vec<GreenElement>,
+    errors: Vec<SyntaxError>,
+    /// Where the header's `%` is.
+    header: Option<usize>,
+    body: Range<usize>,
+}
+
+fn outline(text: &str) -> Outline {
+    let mut front: Vec<GreenElement> = Vec::new();
+    let mut errors = Vec::new();
+    let header = find_outside_comments(text, 0, b'%');
+    let body_start = match header {
+        Some(at) => {
+            if at > 0 {
+                let preamble = &text[..at];
+                front.push(NodeOrToken::Token(rowan::GreenToken::new(PREAMBLE.into(), preamble)));
+                if !preamble.trim().is_empty() {
+                    errors.push(SyntaxError::new(
+                        E::IgnoredPreamble,
+                        range(0..at),
+                        "text before the program header `%` is skipped by the control",
+                    ));
+                }
+            }
+            let mut parser = Parser::new(text, at, text.len());
+            front.push(NodeOrToken::Node(parser.header()));
+            errors.append(&mut parser.errors);
+            parser.pos
+        }
+        None => 0,
+    };
+    let end = find_outside_comments(text, body_start, b'*').unwrap_or(text.len());
+    Outline { front, errors, header, body: body_start..end }
+}
+
+/// A program's blocks one at a time, each parsed only when asked for: for
+/// a reader that takes most blocks some faster way and needs the tree of
+/// only a few. The blocks and their ranges are those of the whole tree.
+pub struct BlockParser<'a> {
+    parser: Parser<'a>,
+    header: Option<GreenNode>,
+    body: Range<usize>,
+}
+
+impl std::fmt::Debug for BlockParser<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("BlockParser").field("body", &self.body).finish_non_exhaustive()
+    }
+}
+
+impl<'a> BlockParser<'a> {
+    pub fn new(text: &'a str) -> BlockParser<'a> {
+        let Outline { front, header, body, .. } = outline(text);
+        let header = header.and_then(|_| front.into_iter().find_map(NodeOrToken::into_node));
+        let mut parser = Parser::new(text, body.start, body.end);
+        // File-level trivia before the first block belongs to no block.
+        while let Some(Token { kind: WHITESPACE | NEWLINE | COMMENT, len }) = parser.peek() {
+            parser.pos += len;
+        }
+        let body = parser.pos..body.end;
+        BlockParser { parser, header, body }
+    }
+
+    /// The program header `%…`.
+    pub fn header(&self) -> Option<crate::ast::Header> {
+        let root = crate::SyntaxNode::new_root(self.header.clone()?);
+        <crate::ast::Header as crate::ast::AstNode>::cast(root)
+    }
+
+    /// Where the blocks are: from the first one to the physical end `*`.
+    /// Blocks start at a block number `N` (only the words before the first
+    /// one lack it) and run up to the next one.
+    pub fn body(&self) -> Range<usize> {
+        self.body.clone()
+    }
+
+    /// The block that starts at `at` with its range; `None` at the end of
+    /// the body.
+    pub fn block_at(&mut self, at: usize) -> Option<(TextRange, GreenNode)> {
+        self.parser.pos = at;
+        self.parser.peek()?;
+        let block = self.parser.block();
+        self.parser.errors.clear();
+        Some((range(at..self.parser.pos), block))
+    }
 }
 
 /// Boundaries that split `region` (which starts at a block) into about
