@@ -163,13 +163,13 @@ pub(crate) fn lower(path: &Path) -> ExitCode {
 fn summary(path: &Path, trace: &Trace) -> String {
     let mut out = String::new();
     let (feed, rapid) = (Motion::Feed, Motion::Rapid);
+    let totals = trace.totals();
     let _ = writeln!(out, "{}", path.display());
-    let _ = writeln!(out, "  total time   {}", clock(trace.total_time()));
-    let _ = writeln!(out, "    cutting    {}  {:>12.3} mm", clock(trace.time_in(feed)), trace.length_in(feed));
-    let _ = writeln!(out, "    rapid      {}  {:>12.3} mm", clock(trace.time_in(rapid)), trace.length_in(rapid));
-    let _ = writeln!(out, "    dwell      {}", clock(trace.time_in(Motion::Dwell)));
-    let stops = |kind| trace.steps.iter().filter(|step| step.stop == Some(kind)).count();
-    let (program_stops, optional_stops) = (stops(Stop::Program), stops(Stop::Optional));
+    let _ = writeln!(out, "  total time   {}", clock(totals.total_time));
+    let _ = writeln!(out, "    cutting    {}  {:>12.3} mm", clock(totals.time(feed)), totals.length(feed));
+    let _ = writeln!(out, "    rapid      {}  {:>12.3} mm", clock(totals.time(rapid)), totals.length(rapid));
+    let _ = writeln!(out, "    dwell      {}", clock(totals.time(Motion::Dwell)));
+    let (program_stops, optional_stops) = (totals.program_stops, totals.optional_stops);
     if program_stops + optional_stops > 0 {
         let _ = writeln!(
             out,
@@ -212,14 +212,15 @@ struct Report<'a> {
 impl<'a> Report<'a> {
     fn new(path: &Path, trace: &'a Trace, sources: &'a [Source]) -> Report<'a> {
         let axes = &trace.axes;
+        let totals = trace.totals();
         Report {
             file: path.display().to_string(),
-            total_time_s: trace.total_time(),
-            cutting_time_s: trace.time_in(Motion::Feed),
-            rapid_time_s: trace.time_in(Motion::Rapid),
-            dwell_time_s: trace.time_in(Motion::Dwell),
-            cutting_length_mm: trace.length_in(Motion::Feed),
-            rapid_length_mm: trace.length_in(Motion::Rapid),
+            total_time_s: totals.total_time,
+            cutting_time_s: totals.time(Motion::Feed),
+            rapid_time_s: totals.time(Motion::Rapid),
+            dwell_time_s: totals.time(Motion::Dwell),
+            cutting_length_mm: totals.length(Motion::Feed),
+            rapid_length_mm: totals.length(Motion::Rapid),
             tools: &trace.tools,
             end_position: Values(trace.end(), axes),
             blocks: Records { trace, sources },
@@ -266,7 +267,8 @@ struct Records<'a> {
 
 impl Serialize for Records<'_> {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.collect_seq(self.trace.steps.iter().enumerate().map(|(index, step)| {
+        let steps = self.trace.steps.iter().zip(self.trace.start_times()).enumerate();
+        serializer.collect_seq(steps.map(|(index, (step, start_time))| {
             let source = &self.sources[step.source];
             BlockRecord {
                 file: &source.name,
@@ -281,7 +283,7 @@ impl Serialize for Records<'_> {
                     Stop::Program => "M00",
                     Stop::Optional => "M01",
                 }),
-                start_time_s: step.start_time,
+                start_time_s: start_time,
                 duration_s: step.duration,
                 length_mm: step.length,
                 feed_mm_min: step.feed,

@@ -324,7 +324,7 @@ N102 G90 G70
                 .collect()
         };
         assert_eq!(moves(&again), moves(&original), "{expanded}");
-        let (before, after) = (original.total_time(), again.total_time());
+        let (before, after) = (original.totals().total_time, again.totals().total_time);
         assert!((after - before).abs() < 1e-3 * before, "{before} s, expanded {after} s\n{expanded}");
         // A planar transformation of X and Z turns an arc of XY out of its plane.
         let text = "%1\nN1 G38 X0 Z0 I30\nN2 G38\nN3\nN4 G02 X10 Y0 I5 J0 F500\nN5 M30\n";
@@ -344,7 +344,7 @@ N102 G90 G70
         let expanded = write(&original, 1, "CENTRE").unwrap();
         let again = run_text(&expanded);
         assert!(again.findings.is_empty(), "{:?}\n{expanded}", again.findings);
-        let (before, after) = (original.total_time(), again.total_time());
+        let (before, after) = (original.totals().total_time, again.totals().total_time);
         assert!((after - before).abs() < 1e-3 * before, "{before} s, expanded {after} s");
         let centre_ends: Vec<[i64; 2]> = original
             .tool_centre
@@ -388,7 +388,7 @@ N102 G90 G70
         };
         assert_eq!(moves(&again), moves(&original), "{expanded}");
         // F is written in whole mm/min: the times agree to 0.1 %.
-        let (before, after) = (original.total_time(), again.total_time());
+        let (before, after) = (original.totals().total_time, again.totals().total_time);
         assert!((after - before).abs() < 1e-3 * before, "{before} s, expanded {after} s");
         expect![[r#"
             %7 "DEMO EXPANDED"

@@ -179,27 +179,40 @@ impl BlockData {
 }
 
 /// Reads a program's blocks in order: plain blocks (see [`PlainReader`])
-/// from their text, the others from their syntax tree, which `each` gets
-/// with them to keep. No tree of the whole program is built.
-pub fn for_each_block(text: &str, mut each: impl FnMut(TextRange, &BlockData, Option<GreenNode>)) {
-    let plain = PlainReader::default();
-    let mut parser = BlockParser::new(text);
-    let body = parser.body();
-    let mut data = BlockData::default();
-    let mut at = body.start;
-    while at < body.end {
-        let (range, tree) = match plain.lower(text, at, body.end, &mut data) {
-            Some(end) => (TextRange::new(offset(at), offset(end)), None),
-            None => match parser.block_at(at) {
-                Some((range, tree)) => {
-                    data = BlockData::lower(&tree);
-                    (range, Some(tree))
-                }
-                None => break,
-            },
+/// from their text, the others from their syntax tree, which the reader
+/// hands over to keep. No tree of the whole program is built.
+#[derive(Debug)]
+pub struct BlockReader<'a> {
+    text: &'a str,
+    plain: PlainReader,
+    parser: BlockParser<'a>,
+    at: usize,
+    end: usize,
+}
+
+impl<'a> BlockReader<'a> {
+    pub fn new(text: &'a str) -> BlockReader<'a> {
+        let parser = BlockParser::new(text);
+        let body = parser.body();
+        BlockReader { text, plain: PlainReader::default(), parser, at: body.start, end: body.end }
+    }
+
+    /// Lowers the next block into `data` (reusing its buffers); returns
+    /// its range, and its syntax tree when it is not plain.
+    pub fn next_into(&mut self, data: &mut BlockData) -> Option<(TextRange, Option<GreenNode>)> {
+        if self.at >= self.end {
+            return None;
+        }
+        let (range, tree) = match self.plain.lower(self.text, self.at, self.end, data) {
+            Some(end) => (TextRange::new(offset(self.at), offset(end)), None),
+            None => {
+                let (range, tree) = self.parser.block_at(self.at)?;
+                *data = BlockData::lower(&tree);
+                (range, Some(tree))
+            }
         };
-        each(range, &data, tree);
-        at = range.end().into();
+        self.at = range.end().into();
+        Some((range, tree))
     }
 }
 

@@ -32,7 +32,12 @@
 //! reference point G30), so that a total never silently leaves something
 //! out.
 
-use std::{borrow::Cow, ops::Range};
+use std::{
+    borrow::Cow,
+    ops::Range,
+    sync::mpsc::{self, Receiver},
+    thread::{Scope, ScopedJoinHandle},
+};
 
 use nalgebra::{Point2, Vector2};
 use ncc_catalog::{AddressRole, Catalogue, Dialect};
@@ -43,7 +48,7 @@ use crate::{
     arith::{self, BlockArithmetic, Machine, Message, Parameters, Raw},
     compensation::{CompensationError, Compensator, Element, Settings, Side, ToolElement},
     cycles::{self, CycleError, CycleInput, CycleKind, CycleStep, Spindle},
-    lower::{self, BlockData, PlainReader, Value, Word},
+    lower::{BlockData, BlockReader, PlainReader, Value, Word},
     machine::MachineConfig,
     modes::{Group, Modes},
     tables::{OffsetTable, ToolEntry, ToolTable},
@@ -64,6 +69,31 @@ pub enum Motion {
     Dwell,
 }
 
+/// What a run adds up to.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Totals {
+    /// Seconds from the program's start to its end.
+    pub total_time: f64,
+    /// Seconds and mm by [`Motion`].
+    time: [f64; 4],
+    length: [f64; 4],
+    /// M00 and M01 stops.
+    pub program_stops: usize,
+    pub optional_stops: usize,
+}
+
+impl Totals {
+    /// Seconds spent in blocks of one kind.
+    pub fn time(&self, motion: Motion) -> f64 {
+        self.time[motion as usize]
+    }
+
+    /// Path length in mm of blocks of one kind.
+    pub fn length(&self, motion: Motion) -> f64 {
+        self.length[motion as usize]
+    }
+}
+
 /// One block as it ran.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Step {
@@ -75,8 +105,6 @@ pub struct Step {
     pub motion: Motion,
     /// The shape of the move.
     pub path: Path,
-    /// Seconds since the program started, when the block starts.
-    pub start_time: f64,
     pub duration: f64,
     /// Path length in mm.
     pub length: f64,
@@ -186,20 +214,30 @@ pub struct Trace {
 }
 
 impl Trace {
-    /// Total seconds.
-    pub fn total_time(&self) -> f64 {
-        self.steps.last().map_or(0.0, |step| step.start_time + step.duration)
+    /// When each step starts, in seconds since the program started.
+    pub fn start_times(&self) -> impl Iterator<Item = f64> + '_ {
+        self.steps.iter().scan(0.0, |time, step| {
+            let start = *time;
+            *time += step.duration;
+            Some(start)
+        })
     }
 
-    /// Seconds spent in blocks of one kind.
-    pub fn time_in(&self, motion: Motion) -> f64 {
-        // Folded from +0.0: an empty `sum` of floats is -0.0.
-        self.steps.iter().filter(|step| step.motion == motion).fold(0.0, |sum, step| sum + step.duration)
-    }
-
-    /// Path length in mm of blocks of one kind.
-    pub fn length_in(&self, motion: Motion) -> f64 {
-        self.steps.iter().filter(|step| step.motion == motion).fold(0.0, |sum, step| sum + step.length)
+    /// Time and length by kind of block, and the program stops, in one
+    /// pass over the steps (a long run's steps are hundreds of megabytes).
+    pub fn totals(&self) -> Totals {
+        let mut totals = Totals::default();
+        for step in &self.steps {
+            totals.total_time += step.duration;
+            totals.time[step.motion as usize] += step.duration;
+            totals.length[step.motion as usize] += step.length;
+            match step.stop {
+                Some(Stop::Program) => totals.program_stops += 1,
+                Some(Stop::Optional) => totals.optional_stops += 1,
+                None => {}
+            }
+        }
+        totals
     }
 
     /// The programmed position at the end, over the machine's axes.
@@ -291,12 +329,21 @@ pub enum Called {
 /// needed, and the run reports its progress there. Parameters start at
 /// zero.
 pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget: usize) -> Trace {
-    let mut program = Blocks::default();
-    program.add(Cow::Borrowed(text));
+    std::thread::scope(|scope| run_in(scope, text, files, machine, budget))
+}
+
+fn run_in<'a, 's>(
+    scope: &'s Scope<'s, 'a>,
+    text: &'a str,
+    files: &dyn Environment,
+    machine: &MachineConfig,
+    budget: usize,
+) -> Trace {
+    let mut index = Index::start(scope, text);
     let mut runner = Runner::new(machine);
     let reset_frame = runner.frame_in_force();
     // Most programs run each block about once.
-    runner.steps.reserve(program.blocks.len());
+    runner.steps.reserve(expected_blocks(text));
     // Macrocycle numbers called, and where each file's body starts; the
     // cycle file's source once read; the files read, in source order.
     let mut loaded: Vec<(u32, Option<usize>)> = Vec::new();
@@ -312,10 +359,9 @@ pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget:
     // The rest of a block whose cycle of the cycle file has just run.
     let mut resume: Option<Flow> = None;
     let mut data = BlockData::default();
-    while let Some(block) = program.blocks.get(at) {
-        let (range, source) = (block.range, block.source);
+    while let Some((range, source)) = index.block(at) {
         runner.source = source;
-        if resume.is_none() && program.units.starts_subprogram(at) && calls.is_empty() {
+        if resume.is_none() && calls.is_empty() && index.starts_subprogram(at) {
             runner.finding(range, "the main body runs into a subprogram: it has no M02 or M30 before it", false);
             break;
         }
@@ -332,7 +378,7 @@ pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget:
         let flow = match resume.take() {
             Some(flow) => flow,
             None => {
-                program.lower(at, &mut data);
+                index.lower(at, &mut data);
                 runner.block(&data, range)
             }
         };
@@ -362,6 +408,7 @@ pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget:
                 None => next,
             },
             Flow::Cycle { number, then } => {
+                let program = index.complete();
                 let name = machine.cycle_file.as_deref().unwrap_or_default();
                 let source = *cycle_file.get_or_insert_with(|| {
                     let text = files.cycle_file(name)?;
@@ -392,6 +439,7 @@ pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget:
                 }
             }
             Flow::Call { label, times, macrocycle: is_macrocycle } => {
+                let program = index.complete();
                 let start = if is_macrocycle {
                     let known = loaded.iter().find(|&&(number, _)| number == label).map(|&(_, start)| start);
                     known.unwrap_or_else(|| {
@@ -432,7 +480,7 @@ pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget:
                     }
                 }
             }
-            Flow::Jump { label, times } => match program.units.jump_target(at, label) {
+            Flow::Jump { label, times } => match index.complete().units.jump_target(at, label) {
                 Some(target) => {
                     let taken = jumps.entry(at).or_default();
                     if *taken < times {
@@ -450,18 +498,13 @@ pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget:
                 }
             },
         };
-        let leaves_file = program.blocks.get(at).is_none_or(|block| block.source != source);
-        if source != 0 && passes_on && leaves_file {
+        // Only another file's blocks can end without a way back.
+        let leaves_file =
+            |index: &mut Index<'_, '_>| index.complete().blocks.get(at).is_none_or(|block| block.source != source);
+        if source != 0 && passes_on && leaves_file(&mut index) {
             runner.finding(range, "the macrocycle file ends without G70", true);
             break;
         }
-    }
-    // Compensation changes durations after the steps were recorded, so the
-    // start times are set once, here.
-    let mut time = 0.0;
-    for step in &mut runner.steps {
-        step.start_time = time;
-        time += step.duration;
     }
     let axes = machine.axes.iter().copied().take(MAX_AXES).collect();
     // Pieces come in the order compensation fixes them, a block late.
@@ -520,15 +563,32 @@ impl<'a> Blocks<'a> {
     /// the `G79` a macrocycle file opens with), `None` for a file without
     /// blocks.
     fn add(&mut self, text: Cow<'a, str>) -> Option<usize> {
+        self.add_reading(text, |_, _, _| {})
+    }
+
+    /// Like [`Blocks::add`], and gives `each` each block as it is lowered,
+    /// with whether it starts a subprogram.
+    fn add_reading(
+        &mut self,
+        text: Cow<'a, str>,
+        mut each: impl FnMut(TextRange, &mut BlockData, bool),
+    ) -> Option<usize> {
         let first = self.blocks.len();
         let source = self.texts.len();
         let mut opens_with_g79 = false;
-        lower::for_each_block(&text, |range, data, tree| {
+        let expected = expected_blocks(&text);
+        self.blocks.reserve(expected);
+        self.units.unit_of.reserve(expected);
+        self.units.numbers.reserve(expected);
+        let mut reader = BlockReader::new(&text);
+        let mut data = BlockData::default();
+        while let Some((range, tree)) = reader.next_into(&mut data) {
             let index = self.blocks.len();
             opens_with_g79 |= index == first && data.has_code(b'G', 79);
-            self.units.add(index, source, data, index == first);
+            let starts_subprogram = self.units.add(index, source, &data, index == first);
             self.blocks.push(Block { source, range, tree });
-        });
+            each(range, &mut data, starts_subprogram);
+        }
         self.units.numbers.sort_unstable();
         self.texts.push(text);
         (first < self.blocks.len()).then_some(if opens_with_g79 { first + 1 } else { first })
@@ -548,6 +608,129 @@ impl<'a> Blocks<'a> {
     }
 }
 
+/// About as many blocks as a program of CAM output with this text has, or
+/// more: memory reserved and never used costs nothing, growing costs copies.
+fn expected_blocks(text: &str) -> usize {
+    text.len() / 24
+}
+
+/// Blocks the index pass hands to the run at a time.
+const STREAM_BATCH: usize = 1024;
+
+/// The program's blocks while the index pass still reads them on a
+/// thread of its own, then all blocks of the run. Going block after block,
+/// the run takes each block as the index pass lowered it, so a large
+/// program is lowered once and on two cores; the first call, jump or
+/// cycle waits for the whole index.
+enum Index<'a, 's> {
+    Streaming(Stream<'a, 's>),
+    Complete(Blocks<'a>),
+}
+
+struct Stream<'a, 's> {
+    batches: Receiver<Vec<Streamed>>,
+    batch: Vec<Streamed>,
+    /// Blocks of `batch` the run has taken.
+    taken: usize,
+    /// The index of `batch[taken]`.
+    next: usize,
+    index_pass: ScopedJoinHandle<'s, Blocks<'a>>,
+}
+
+/// A block of the program as the index pass lowered it.
+struct Streamed {
+    range: TextRange,
+    data: BlockData,
+    starts_subprogram: bool,
+}
+
+impl<'a, 's> Index<'a, 's> {
+    fn start(scope: &'s Scope<'s, 'a>, text: &'a str) -> Index<'a, 's> {
+        let (sender, batches) = mpsc::sync_channel::<Vec<Streamed>>(4);
+        let index_pass = scope.spawn(move || {
+            let mut blocks = Blocks::default();
+            let mut batch = Vec::with_capacity(STREAM_BATCH);
+            // Until the run stops taking blocks in order.
+            let mut streaming = true;
+            blocks.add_reading(Cow::Borrowed(text), |range, data, starts_subprogram| {
+                if streaming {
+                    batch.push(Streamed { range, data: std::mem::take(data), starts_subprogram });
+                    if batch.len() == STREAM_BATCH {
+                        let full = std::mem::replace(&mut batch, Vec::with_capacity(STREAM_BATCH));
+                        streaming = sender.send(full).is_ok();
+                    }
+                }
+            });
+            if streaming && !batch.is_empty() {
+                // The run may have ended already.
+                let _ = sender.send(batch);
+            }
+            blocks
+        });
+        Index::Streaming(Stream { batches, batch: Vec::new(), taken: 0, next: 0, index_pass })
+    }
+
+    /// The block at `at`, when it was streamed.
+    fn streamed(&mut self, at: usize) -> Option<&mut Streamed> {
+        let Index::Streaming(stream) = self else { return None };
+        if at != stream.next {
+            return None;
+        }
+        if stream.taken == stream.batch.len() {
+            // A closed channel: the index pass has sent every block.
+            stream.batch = stream.batches.recv().ok()?;
+            stream.taken = 0;
+        }
+        stream.batch.get_mut(stream.taken)
+    }
+
+    /// The range and the file of block `at`.
+    fn block(&mut self, at: usize) -> Option<(TextRange, usize)> {
+        if let Some(streamed) = self.streamed(at) {
+            return Some((streamed.range, 0));
+        }
+        self.complete().blocks.get(at).map(|block| (block.range, block.source))
+    }
+
+    fn starts_subprogram(&mut self, at: usize) -> bool {
+        match self.streamed(at) {
+            Some(streamed) => streamed.starts_subprogram,
+            None => self.complete().units.starts_subprogram(at),
+        }
+    }
+
+    /// Lowers block `at` into `data`.
+    fn lower(&mut self, at: usize, data: &mut BlockData) {
+        match self.streamed(at) {
+            Some(streamed) => {
+                std::mem::swap(data, &mut streamed.data);
+                if let Index::Streaming(stream) = self {
+                    stream.taken += 1;
+                    stream.next += 1;
+                }
+            }
+            None => self.complete().lower(at, data),
+        }
+    }
+
+    /// All blocks, once the index pass is done.
+    fn complete(&mut self) -> &mut Blocks<'a> {
+        if let Index::Streaming(_) = self {
+            let Index::Streaming(stream) = std::mem::replace(self, Index::Complete(Blocks::default())) else {
+                unreachable!()
+            };
+            // The index pass stops streaming and finishes the index.
+            drop(stream.batches);
+            let blocks = stream.index_pass.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            *self = Index::Complete(blocks);
+        }
+        match self {
+            Index::Complete(blocks) => blocks,
+            Index::Streaming(_) => unreachable!("the index is complete"),
+        }
+    }
+}
+
 /// Where the subprograms start, and the block numbers of each unit.
 #[derive(Default)]
 struct Units {
@@ -563,8 +746,9 @@ struct Units {
 
 impl Units {
     /// Indexes block `index` of file `source`; `opens_file` for a file's
-    /// first block. The caller sorts `numbers` after the file.
-    fn add(&mut self, index: usize, source: usize, block: &BlockData, opens_file: bool) {
+    /// first block. The caller sorts `numbers` after the file. Returns
+    /// whether the block starts a subprogram.
+    fn add(&mut self, index: usize, source: usize, block: &BlockData, opens_file: bool) -> bool {
         if opens_file {
             self.units += 1;
         }
@@ -582,6 +766,7 @@ impl Units {
         if let Some(number) = block.number.and_then(|number| number.value) {
             self.numbers.push((number, index));
         }
+        self.starts.last().is_some_and(|&(at, _, _)| at == index)
     }
 
     fn starts_subprogram(&self, index: usize) -> bool {
@@ -1180,8 +1365,7 @@ impl<'a> Runner<'a> {
     fn record(&mut self, range: TextRange, end: &Position, moved: Moved, stop: Option<Stop>) {
         let Moved { motion, length, duration, feed, path } = moved;
         let (source, end, frame) = (self.source, self.machine_axes(end), self.frames.len() - 1);
-        let start_time = 0.0;
-        self.steps.push(Step { source, range, motion, path, start_time, duration, length, feed, end, frame, stop });
+        self.steps.push(Step { source, range, motion, path, duration, length, feed, end, frame, stop });
     }
 
     /// A position by letter over the machine's axes, as steps keep it.
@@ -1849,9 +2033,9 @@ mod tests {
         assert_eq!(timing(&trace), [(0.6, 100.0), (10.0, 100.0), (5.0, 100.0), (0.0, 0.0)]);
         assert_eq!(trace.steps[1].feed, Some(600.0));
         assert_eq!(trace.steps[2].feed, Some(1200.0));
-        close(trace.total_time(), 15.6);
-        close(trace.time_in(Motion::Rapid), 0.6);
-        close(trace.length_in(Motion::Feed), 200.0);
+        close(trace.totals().total_time, 15.6);
+        close(trace.totals().time(Motion::Rapid), 0.6);
+        close(trace.totals().length(Motion::Feed), 200.0);
         let end = trace.end_position();
         assert_eq!([b'X', b'Y', b'Z'].map(|axis| end[usize::from(axis - b'A')]), [0.0, 100.0, 0.0]);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
@@ -1976,7 +2160,7 @@ mod tests {
         expected.extend([(n("N5"), Motion::Rapid, 5.0), (n("N6"), Motion::None, 5.0)]);
         assert_eq!(drilled(&trace), expected);
         // 12 mm at F100, twice.
-        close(trace.time_in(Motion::Feed), 2.0 * 12.0 / 100.0 * 60.0);
+        close(trace.totals().time(Motion::Feed), 2.0 * 12.0 / 100.0 * 60.0);
     }
 
     #[test]
@@ -1996,7 +2180,7 @@ mod tests {
         expected.extend(body_steps);
         expected.extend([(0, Motion::Rapid), (0, Motion::None)]);
         assert_eq!(lines, expected);
-        close(trace.time_in(Motion::Feed), 2.0 * 12.0 / 100.0 * 60.0);
+        close(trace.totals().time(Motion::Feed), 2.0 * 12.0 / 100.0 * 60.0);
         // The block's own flow goes on after the body: a jump that repeats
         // the drilling block once, then M30 in a drilling block.
         let text = "%1\nN1 R26=100 R27=1000 R30=2. R31=-10. R32=5. M03\nN2 G00 G81 X20\nN3 G91 X10 G73 L3 Q1\nN4 X10 M30\nN5 X500\n";
@@ -2016,7 +2200,7 @@ mod tests {
             messages,
             ["the cycle file PC.NCP the machine names is not in the project: the built-in cycle runs instead"]
         );
-        close(trace.time_in(Motion::Feed), 2.0 * 12.0 / 100.0 * 60.0);
+        close(trace.totals().time(Motion::Feed), 2.0 * 12.0 / 100.0 * 60.0);
     }
 
     /// Lengths of the steps, to the micrometre.
@@ -2069,7 +2253,7 @@ mod tests {
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
         assert_eq!(lengths(&trace)[..6], [0.0, 20.0, 25.0, 45.0, 45.0, 32.016]);
         close6(trace.steps[5].duration, 25.0f64.hypot(20.0) / 10.0);
-        close6(trace.total_time(), 20.0 / 10_000.0 * 60.0 + (25.0 + 45.0 + 45.0 + 25.0f64.hypot(20.0)) / 10.0);
+        close6(trace.totals().total_time, 20.0 / 10_000.0 * 60.0 + (25.0 + 45.0 + 45.0 + 25.0f64.hypot(20.0)) / 10.0);
         // An arc too small for the tool on its inside stops the run there.
         let text = "%1\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 G03 X0 Y6 I0 J3\nN5 G40 G01 X0 Y20\nN6 M30\n";
         let trace = run_text(text);
@@ -2255,7 +2439,7 @@ mod tests {
     fn dwell_is_q_times_ten_milliseconds() {
         let trace = run_text("%1\nN1 G04 Q150\nN2 M30\n");
         assert_eq!(trace.steps[0].motion, Motion::Dwell);
-        close(trace.time_in(Motion::Dwell), 1.5);
+        close(trace.totals().time(Motion::Dwell), 1.5);
     }
 
     #[test]
@@ -2290,7 +2474,7 @@ mod tests {
             ]
         );
         // The subprogram's modal G01 and F carry on after it.
-        close(trace.time_in(Motion::Feed), 2.0);
+        close(trace.totals().time(Motion::Feed), 2.0);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
     }
 
@@ -2333,8 +2517,8 @@ mod tests {
     fn dwell_takes_q_and_the_call_runs_once() {
         let text = "%1\nN1 G04 G71 L5 Q200\nN2 M30\nN3 G79 L5\nN4 G01 X1 F60\nN5 G70\n";
         let trace = run_text(text);
-        close(trace.time_in(Motion::Dwell), 2.0);
-        close(trace.time_in(Motion::Feed), 1.0);
+        close(trace.totals().time(Motion::Dwell), 2.0);
+        close(trace.totals().time(Motion::Feed), 1.0);
     }
 
     #[test]
@@ -2402,7 +2586,7 @@ mod tests {
         let trace = run_text("%1\nN1 R27=300 R29=250\nN2 SR27 G95 G01 X1 F1.\nN3 G04 QR29\nN4 M30\n");
         assert_eq!(trace.steps[1].feed, Some(300.0));
         close(trace.steps[1].duration, 0.2);
-        close(trace.time_in(Motion::Dwell), 2.5);
+        close(trace.totals().time(Motion::Dwell), 2.5);
     }
 
     #[test]

@@ -4,15 +4,18 @@
 #[path = "../../syntax/tests/strategies/mod.rs"]
 mod strategies;
 
-use nc_exec::lower::{BlockData, for_each_block};
+use nc_exec::lower::{BlockData, BlockReader};
 use ncc_syntax::{Dialect, Parse, TextRange, ast::AstNode};
 use proptest::prelude::*;
 use strategies::{block_program, program_text};
 
 /// Each block's range, lowering, and whether it was read from its text.
 fn read(text: &str) -> Vec<(TextRange, BlockData, bool)> {
+    let (mut reader, mut data) = (BlockReader::new(text), BlockData::default());
     let mut blocks = Vec::new();
-    for_each_block(text, |range, data, tree| blocks.push((range, data.clone(), tree.is_none())));
+    while let Some((range, tree)) = reader.next_into(&mut data) {
+        blocks.push((range, data.clone(), tree.is_none()));
+    }
     blocks
 }
 

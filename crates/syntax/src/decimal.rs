@@ -32,26 +32,34 @@ impl Decimal {
     /// Returns `None` when there is no digit at all (`.` alone) or the text
     /// has other characters.
     pub fn parse(sign: Option<Sign>, digits: &str) -> Option<Decimal> {
-        let (int, frac) = match digits.split_once('.') {
-            Some((int, frac)) => (int, Some(frac)),
-            None => (digits, None),
-        };
-        let frac_text = frac.unwrap_or("");
-        let all_digits = |s: &str| s.bytes().all(|b| b.is_ascii_digit());
-        if int.len() + frac_text.len() == 0 || !all_digits(int) || !all_digits(frac_text) {
+        // One pass: programs hold millions of numbers.
+        let mut mantissa = Some(0u64);
+        let mut point = None;
+        let mut leading_zeros = 0;
+        for (i, byte) in digits.bytes().enumerate() {
+            match byte {
+                b'0'..=b'9' => {
+                    if byte == b'0' && point.is_none() && leading_zeros == i {
+                        leading_zeros += 1;
+                    }
+                    mantissa = mantissa.and_then(|m| m.checked_mul(10)?.checked_add(u64::from(byte - b'0')));
+                }
+                b'.' if point.is_none() => point = Some(i),
+                _ => return None,
+            }
+        }
+        let int_len = point.unwrap_or(digits.len());
+        let frac_len = point.map_or(0, |point| digits.len() - point - 1);
+        if int_len + frac_len == 0 {
             return None;
         }
-        let mantissa = int
-            .bytes()
-            .chain(frac_text.bytes())
-            .try_fold(0u64, |acc, b| acc.checked_mul(10)?.checked_add(u64::from(b - b'0')));
         let count = |n: usize| u16::try_from(n).unwrap_or(u16::MAX);
         Some(Decimal {
             sign,
-            has_point: frac.is_some(),
-            int_digits: count(int.len()),
-            leading_zeros: count(int.bytes().take_while(|&b| b == b'0').count()),
-            frac_digits: count(frac_text.len()),
+            has_point: point.is_some(),
+            int_digits: count(int_len),
+            leading_zeros: count(leading_zeros),
+            frac_digits: count(frac_len),
             mantissa,
         })
     }
@@ -166,6 +174,27 @@ mod tests {
         }
         assert!(Decimal::parse(None, ".").is_none());
         assert!(Decimal::parse(None, "").is_none());
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn numbers_read_back_as_written(text in "[0-9]{0,9}(\\.[0-9]{0,9})?") {
+            let parsed = Decimal::parse(None, &text);
+            let has_digit = text.bytes().any(|b| b.is_ascii_digit());
+            proptest::prop_assert_eq!(parsed.is_some(), has_digit);
+            if let Some(decimal) = parsed {
+                proptest::prop_assert_eq!(decimal.to_string(), text.clone());
+                let zeros = text.bytes().take_while(|&b| b == b'0').count();
+                proptest::prop_assert_eq!(decimal.significant_int_digits() as usize, text.split('.').next().unwrap().len() - zeros);
+            }
+        }
+    }
+
+    #[test]
+    fn text_that_is_no_number_is_refused() {
+        for text in ["", ".", "1.2.3", "1a", "-1", " 1"] {
+            assert_eq!(Decimal::parse(None, text), None, "{text}");
+        }
     }
 
     #[test]
