@@ -2514,6 +2514,23 @@ mod tests {
     }
 
     #[test]
+    fn a_long_program_runs_alike_taken_from_the_index_pass_or_lowered_again() {
+        // Several batches from the index pass, then a jump back (which waits
+        // for the whole index), a call into a subprogram after the end, and
+        // comments, which the plain reading keeps.
+        let mut text = String::from("%1\nN1 G91 G01 F600\n");
+        for n in 2..3000 {
+            text.push_str(&format!("N{n} X1 \"STEP\"\n"));
+        }
+        text.push_str("N3000 G73 L2 Q1\nN3001 G71 L7 Q2\nN3002 M30\nN3003 G79 L7\nN3004 Y1\nN3005 G70\n");
+        let trace = run(&text, &NoFiles, &MachineConfig::default(), 100_000);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        assert_eq!(trace.steps.len(), 1 + 2 * 2999 + 1 + 2 * 2 + 1);
+        let end = trace.end_position();
+        assert_eq!((end[usize::from(b'X' - b'A')], end[usize::from(b'Y' - b'A')]), (2.0 * 2998.0, 2.0));
+    }
+
+    #[test]
     fn dwell_takes_q_and_the_call_runs_once() {
         let text = "%1\nN1 G04 G71 L5 Q200\nN2 M30\nN3 G79 L5\nN4 G01 X1 F60\nN5 G70\n";
         let trace = run_text(text);
