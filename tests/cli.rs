@@ -384,6 +384,18 @@ fn explain_list_prints_the_counts() {
     }
 }
 
+/// On a lathe the summary gives the end on the diameter axis as the
+/// diameter the program wrote (`N640 G00 X100. Z100.`), the JSON as a radius.
+#[test]
+fn run_shows_the_lathe_end_as_a_diameter() {
+    let output = ncc(&["run", "examples/lathe/shaft.NCP"]);
+    assert_eq!(output.status.code(), Some(0));
+    assert!(stdout(&output).contains("end position X100.000 Z100.000 (X as a diameter)\n"), "{}", stdout(&output));
+    let output = ncc(&["run", "examples/lathe/shaft.NCP", "--format", "json"]);
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(json["end_position"]["X"], 50.0);
+}
+
 /// `ncc run` prints the time split and the end; JSON has the total and a
 /// record per block with its source line.
 #[test]

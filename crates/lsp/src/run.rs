@@ -185,9 +185,16 @@ fn summary(path: &Path, trace: &Trace) -> String {
     }
     let tools: Vec<String> = trace.tools.iter().map(|tool| format!("T{tool}")).collect();
     let _ = writeln!(out, "  tools        {}", if tools.is_empty() { "none".to_owned() } else { tools.join(" ") });
-    let position: Vec<String> =
-        trace.axes.iter().zip(trace.end()).map(|(&axis, value)| format!("{}{value:.3}", char::from(axis))).collect();
-    let _ = writeln!(out, "  end position {}", position.join(" "));
+    // Turners read the diameter axis as a diameter; the trace keeps radii.
+    let as_written = |axis: u8, value: f64| if trace.diameter_axis == Some(axis) { 2.0 * value } else { value };
+    let position: Vec<String> = trace
+        .axes
+        .iter()
+        .zip(trace.end())
+        .map(|(&axis, value)| format!("{}{:.3}", char::from(axis), as_written(axis, value)))
+        .collect();
+    let diameter = trace.diameter_axis.map(|axis| format!(" ({} as a diameter)", char::from(axis))).unwrap_or_default();
+    let _ = writeln!(out, "  end position {}{diameter}", position.join(" "));
     out
 }
 
