@@ -411,13 +411,16 @@ fn run_prints_the_time_and_a_record_per_block() {
     let summary = stdout(&output).replace(program, "DEMO.NCP");
     expect![[r#"
         DEMO.NCP
-          total time   0:00:27.808
-            cutting    0:00:25.708       257.080 mm
-            rapid      0:00:00.600       100.000 mm
+          total time   0:00:28.055  (0:00:27.808 at the programmed feeds)
+            cutting    0:00:25.768       257.080 mm
+            rapid      0:00:00.787       100.000 mm
             dwell      0:00:01.500
           messages     1 by operation 51 (codes 7)
           tools        T1
           end position X0.000 Y100.000 Z0.000 U0.000 V0.000 C0.000
+          breaks       3 where the path speed drops (1 g98, 1 non-motion, 1 rapid), costing 0:00:00.090
+            DEMO.NCP:3  G98 joins no blocks: a stop and a pause before the next: 600 → 0 mm/min, 0.030 s
+            DEMO.NCP:4  a block without motion between moves: 600 → 0 mm/min, 0.025 s
     "#]]
     .assert_eq(&summary);
     let warnings = String::from_utf8(output.stderr).unwrap().replace(program, "DEMO.NCP");
@@ -425,13 +428,29 @@ fn run_prints_the_time_and_a_record_per_block() {
 
     let output = ncc(&["run", program, "--format", "json"]);
     let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let programmed = json["programmed_time_s"].as_f64().unwrap();
+    assert!((programmed - (0.6 + 10.0 + 50.0 * std::f64::consts::PI / 600.0 * 60.0 + 1.5)).abs() < 1e-9);
+    // The velocity model: 1000 mm/s² ramps and 20 ms pauses under G98.
+    let rapid = 2.0 * (10_000.0 / 60.0) / 1000.0 + (100.0 - (10_000.0f64 / 60.0).powi(2) / 1000.0) / (10_000.0 / 60.0);
     let total = json["total_time_s"].as_f64().unwrap();
-    assert!((total - (0.6 + 10.0 + 50.0 * std::f64::consts::PI / 600.0 * 60.0 + 1.5)).abs() < 1e-9, "{total}");
+    // The rapid's ramps and pause, each line's two 10 ms ramp halves and pause.
+    let extra = (rapid - 0.6 + 0.02) + (0.01 + 0.02) + (0.01 + 0.02);
+    assert!((total - (programmed + extra)).abs() < 1e-9, "{total}");
     let blocks = json["blocks"].as_array().unwrap();
     let lines: Vec<u64> = blocks.iter().map(|b| b["line"].as_u64().unwrap()).collect();
     assert_eq!(lines, [2, 3, 4, 5, 6, 7]);
     assert_eq!(blocks[1]["feed_mm_min"], 600.0);
-    assert_eq!(blocks[1]["start_time_s"], 0.6);
+    assert!((blocks[1]["start_time_s"].as_f64().unwrap() - (rapid + 0.02)).abs() < 1e-12);
+    assert!((blocks[1]["programmed_duration_s"].as_f64().unwrap() - 10.0).abs() < 1e-12);
+    let speeds = ["entry_speed_mm_min", "peak_speed_mm_min", "exit_speed_mm_min"].map(|key| blocks[1][key].as_f64());
+    assert_eq!(speeds, [Some(0.0), Some(600.0), Some(0.0)]);
+    let breaks: Vec<(u64, &str)> = json["breaks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| (b["line"].as_u64().unwrap(), b["reason"].as_str().unwrap()))
+        .collect();
+    assert_eq!(breaks, [(2, "rapid"), (3, "g98"), (4, "non-motion")]);
     assert_eq!(blocks[1]["end"]["program"]["Y"], 100.0);
     assert_eq!(blocks[1]["end"]["machine"]["Y"], 100.0);
     // R30 is 0: the message shows it as it was when the block ran.

@@ -13,6 +13,8 @@
 //! rapid-rate = 10000                      # mm/min, every axis (G00)
 //! rapid-rates = { Z = 8000 }              # mm/min, axes with a rate of their own
 //! limits = { X = { min = "-10", max = "500.5" } }   # mm from the machine zero
+//! block-pause-ms = 20                     # between blocks under G98
+//! settle-time-ms = 10                     # in-position wait after a stop
 //! cycle-file = "PCYKLYDG.NCP"             # CNC836.KNF $17: what G81-G89 do
 //! offset-file = "TAB0.POS"                # zero offsets G53-G59
 //! tool-file = "TAB0.KOR"                  # tool corrections D1-D99
@@ -100,6 +102,8 @@ struct MachineFile {
     #[serde(default)]
     limits: BTreeMap<String, LimitsFile>,
     diameter_axis: Option<String>,
+    block_pause_ms: Option<u32>,
+    settle_time_ms: Option<u32>,
     cycle_file: Option<String>,
     offset_file: Option<PathBuf>,
     tool_file: Option<PathBuf>,
@@ -147,6 +151,12 @@ impl MachineFile {
         }
         if let Some(limit) = self.feed_limit {
             machine.feed_limit = limit;
+        }
+        if let Some(pause) = self.block_pause_ms {
+            machine.block_pause_ms = pause;
+        }
+        if let Some(settle) = self.settle_time_ms {
+            machine.settle_time_ms = settle;
         }
         if let Some(rate) = self.rapid_rate {
             if rate == 0 {
@@ -407,6 +417,9 @@ R97 = "2"
         assert_eq!(machine.tools.entry(2).lengths[2], 100_000);
         assert_eq!((machine.constant(39), machine.constant(97)), (45_500, 2), "constants key by key");
         assert_eq!(machine.diameter_axis, None);
+        assert_eq!((machine.block_pause_ms, machine.settle_time_ms), (20, 10), "the defaults");
+        let timed = load("[machine]\nblock-pause-ms = 35\nsettle-time-ms = 0\n", &[]).unwrap().machine;
+        assert_eq!((timed.block_pause_ms, timed.settle_time_ms), (35, 0));
         let lathe = load("[machine]\naxes = [\"X\", \"Z\"]\ndiameter-axis = \"x\"\n", &[]).unwrap();
         assert_eq!(lathe.machine.diameter_axis, Some(b'X'));
     }

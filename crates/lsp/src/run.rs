@@ -17,6 +17,7 @@ use nc_exec::{
     arith::{Message, MessageDisplay},
     lower::BlockData,
     run::{Axes, Called, Environment, Motion, Stop, Trace},
+    velocity::{self, Dynamics, Timing},
 };
 use ncc_analysis::Config;
 use ncc_syntax::{BlockParser, Dialect, Parse, TextSize, ast::AstNode};
@@ -33,6 +34,8 @@ pub(crate) enum Format {
 /// A program run on the machine of its project.
 struct Ran {
     trace: Trace,
+    /// The trace timed with the control's velocity model.
+    timing: Timing,
     sources: Vec<Source>,
     /// The program's number from its `%` header.
     number: Option<u32>,
@@ -60,11 +63,12 @@ impl Ran {
         if let Some(bar) = library.progress.get() {
             bar.finish_and_clear();
         }
+        let timing = velocity::time(&trace, &Dynamics::of(&config.machine));
         let sources = library.sources(path, text, &trace);
         for finding in &trace.findings {
             eprintln!("{}: {}", sources[finding.source].place(finding.range.start()), finding.message);
         }
-        Ok(Ran { trace, sources, number })
+        Ok(Ran { trace, timing, sources, number })
     }
 
     fn exit_code(&self) -> ExitCode {
@@ -77,14 +81,13 @@ pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
         Ok(ran) => ran,
         Err(code) => return code,
     };
-    let (trace, sources) = (&ran.trace, &ran.sources);
     let written = match format {
         Format::Human => {
             let mut out = io::stdout().lock();
-            out.write_all(summary(path, trace).as_bytes()).and_then(|()| out.flush())
+            out.write_all(summary(path, &ran).as_bytes()).and_then(|()| out.flush())
         }
         Format::Json => {
-            let report = Report::new(path, trace, sources);
+            let report = Report::new(path, &ran);
             let mut out = io::BufWriter::new(io::stdout().lock());
             serde_json::to_writer_pretty(&mut out, &report)
                 .map_err(io::Error::from)
@@ -160,12 +163,18 @@ pub(crate) fn lower(path: &Path) -> ExitCode {
     }
 }
 
-fn summary(path: &Path, trace: &Trace) -> String {
+/// Breaks the summary lists: the costliest a program could avoid (rapid
+/// moves and threads always stop); JSON lists them all.
+const LISTED_BREAKS: usize = 10;
+
+fn summary(path: &Path, ran: &Ran) -> String {
+    let (trace, timing) = (&ran.trace, &ran.timing);
     let mut out = String::new();
     let (feed, rapid) = (Motion::Feed, Motion::Rapid);
-    let totals = trace.totals();
+    let totals = trace.totals_with(timing.profiles.iter().map(|profile| profile.duration));
     let _ = writeln!(out, "{}", path.display());
-    let _ = writeln!(out, "  total time   {}", clock(totals.total_time));
+    let at_feed = trace.totals().total_time;
+    let _ = writeln!(out, "  total time   {}  ({} at the programmed feeds)", clock(totals.total_time), clock(at_feed));
     let _ = writeln!(out, "    cutting    {}  {:>12.3} mm", clock(totals.time(feed)), totals.length(feed));
     let _ = writeln!(out, "    rapid      {}  {:>12.3} mm", clock(totals.time(rapid)), totals.length(rapid));
     let _ = writeln!(out, "    dwell      {}", clock(totals.time(Motion::Dwell)));
@@ -195,6 +204,64 @@ fn summary(path: &Path, trace: &Trace) -> String {
         .collect();
     let diameter = trace.diameter_axis.map(|axis| format!(" ({} as a diameter)", char::from(axis))).unwrap_or_default();
     let _ = writeln!(out, "  end position {}{diameter}", position.join(" "));
+    if !timing.breaks.is_empty() {
+        let lost: f64 = timing.breaks.iter().map(|b| b.lost).sum();
+        let count = timing.breaks.len();
+        let mut by_reason: Vec<(&str, usize)> = Vec::new();
+        for speed_break in &timing.breaks {
+            let code = speed_break.reason.code();
+            match by_reason.iter_mut().find(|(known, _)| *known == code) {
+                Some((_, n)) => *n += 1,
+                None => by_reason.push((code, 1)),
+            }
+        }
+        by_reason.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(b.0)));
+        let by_reason: Vec<String> = by_reason.iter().map(|(code, n)| format!("{n} {code}")).collect();
+        let _ = writeln!(
+            out,
+            "  breaks       {count} where the path speed drops ({}), costing {}",
+            by_reason.join(", "),
+            clock(lost)
+        );
+        // The costliest places the program could avoid: a block that runs
+        // many times (a loop, a subprogram) is one place.
+        let place_of = |speed_break: &velocity::Break| {
+            let step = &trace.steps[speed_break.step];
+            (step.source, step.range.start(), speed_break.reason.code())
+        };
+        let mut avoidable: Vec<&velocity::Break> =
+            timing.breaks.iter().filter(|speed_break| speed_break.reason.avoidable()).collect();
+        avoidable.sort_unstable_by_key(|speed_break| (place_of(speed_break), speed_break.step));
+        let mut places: Vec<(&velocity::Break, usize, f64)> = Vec::new();
+        for speed_break in avoidable {
+            match places.last_mut() {
+                Some((first, times, lost)) if place_of(first) == place_of(speed_break) => {
+                    *times += 1;
+                    *lost += speed_break.lost;
+                }
+                _ => places.push((speed_break, 1, speed_break.lost)),
+            }
+        }
+        let listed = places.len();
+        let by_cost = |a: &(&velocity::Break, usize, f64), b: &(&velocity::Break, usize, f64)| {
+            b.2.total_cmp(&a.2).then(a.0.step.cmp(&b.0.step))
+        };
+        if listed > LISTED_BREAKS {
+            places.select_nth_unstable_by(LISTED_BREAKS, by_cost);
+            places.truncate(LISTED_BREAKS);
+        }
+        places.sort_unstable_by(by_cost);
+        for (speed_break, times, lost) in places {
+            let step = &trace.steps[speed_break.step];
+            let place = ran.sources[step.source].place(step.range.start());
+            let times = if times > 1 { format!(" ({times} runs)") } else { String::new() };
+            let (reason, before, at) = (speed_break.reason, speed_break.before, speed_break.at);
+            let _ = writeln!(out, "    {place}  {reason}: {before:.0} → {at:.0} mm/min, {lost:.3} s{times}");
+        }
+        if listed > LISTED_BREAKS {
+            let _ = writeln!(out, "    … and {} more places (--format json lists every break)", listed - LISTED_BREAKS);
+        }
+    }
     out
 }
 
@@ -203,7 +270,9 @@ fn summary(path: &Path, trace: &Trace) -> String {
 #[derive(Serialize)]
 struct Report<'a> {
     file: String,
+    /// With the velocity model; `programmed_time_s` at the programmed feeds.
     total_time_s: f64,
+    programmed_time_s: f64,
     cutting_time_s: f64,
     rapid_time_s: f64,
     dwell_time_s: f64,
@@ -212,17 +281,20 @@ struct Report<'a> {
     tools: &'a [u32],
     end_position: Values<'a>,
     blocks: Records<'a>,
+    breaks: Vec<BreakRecord<'a>>,
     messages: Vec<MessageRecord<'a>>,
     findings: Vec<FindingRecord<'a>>,
 }
 
 impl<'a> Report<'a> {
-    fn new(path: &Path, trace: &'a Trace, sources: &'a [Source]) -> Report<'a> {
+    fn new(path: &Path, ran: &'a Ran) -> Report<'a> {
+        let (trace, timing, sources) = (&ran.trace, &ran.timing, &ran.sources);
         let axes = &trace.axes;
-        let totals = trace.totals();
+        let totals = trace.totals_with(timing.profiles.iter().map(|profile| profile.duration));
         Report {
             file: path.display().to_string(),
             total_time_s: totals.total_time,
+            programmed_time_s: trace.totals().total_time,
             cutting_time_s: totals.time(Motion::Feed),
             rapid_time_s: totals.time(Motion::Rapid),
             dwell_time_s: totals.time(Motion::Dwell),
@@ -230,7 +302,24 @@ impl<'a> Report<'a> {
             rapid_length_mm: totals.length(Motion::Rapid),
             tools: &trace.tools,
             end_position: Values(trace.end(), axes),
-            blocks: Records { trace, sources },
+            blocks: Records { trace, timing, sources },
+            breaks: timing
+                .breaks
+                .iter()
+                .map(|speed_break| {
+                    let step = &trace.steps[speed_break.step];
+                    let source = &sources[step.source];
+                    BreakRecord {
+                        file: &source.name,
+                        line: source.line(step.range.start()),
+                        reason: speed_break.reason.code(),
+                        message: speed_break.reason.to_string(),
+                        speed_before_mm_min: speed_break.before,
+                        speed_at_mm_min: speed_break.at,
+                        lost_s: speed_break.lost,
+                    }
+                })
+                .collect(),
             messages: trace
                 .messages
                 .iter()
@@ -269,13 +358,14 @@ impl<'a> Report<'a> {
 /// The block records, serialised one by one.
 struct Records<'a> {
     trace: &'a Trace,
+    timing: &'a Timing,
     sources: &'a [Source],
 }
 
 impl Serialize for Records<'_> {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let steps = self.trace.steps.iter().zip(self.trace.start_times()).enumerate();
-        serializer.collect_seq(steps.map(|(index, (step, start_time))| {
+        let steps = self.trace.steps.iter().zip(&self.timing.profiles).zip(self.timing.start_times()).enumerate();
+        serializer.collect_seq(steps.map(|(index, ((step, profile), start_time))| {
             let source = &self.sources[step.source];
             BlockRecord {
                 file: &source.name,
@@ -291,9 +381,13 @@ impl Serialize for Records<'_> {
                     Stop::Optional => "M01",
                 }),
                 start_time_s: start_time,
-                duration_s: step.duration,
+                duration_s: profile.duration,
+                programmed_duration_s: step.duration,
                 length_mm: step.length,
                 feed_mm_min: step.feed,
+                entry_speed_mm_min: profile.entry,
+                peak_speed_mm_min: profile.peak,
+                exit_speed_mm_min: profile.exit,
                 start: Coordinates {
                     program: Values(self.trace.start_of(index), &self.trace.axes),
                     machine: Values(self.trace.machine_start(index), &self.trace.axes),
@@ -314,9 +408,14 @@ struct BlockRecord<'a> {
     motion: &'static str,
     stop: Option<&'static str>,
     start_time_s: f64,
+    /// With the velocity model, and at the programmed feed.
     duration_s: f64,
+    programmed_duration_s: f64,
     length_mm: f64,
     feed_mm_min: Option<f64>,
+    entry_speed_mm_min: f64,
+    peak_speed_mm_min: f64,
+    exit_speed_mm_min: f64,
     start: Coordinates<'a>,
     end: Coordinates<'a>,
 }
@@ -337,6 +436,17 @@ struct MessageRecord<'a> {
     parameter: u8,
     value: Option<f64>,
     display: String,
+}
+
+#[derive(Serialize)]
+struct BreakRecord<'a> {
+    file: &'a str,
+    line: u32,
+    reason: &'static str,
+    message: String,
+    speed_before_mm_min: f64,
+    speed_at_mm_min: f64,
+    lost_s: f64,
 }
 
 #[derive(Serialize)]

@@ -33,3 +33,4 @@ pub mod modes;
 pub mod run;
 pub mod tables;
 pub mod transform;
+pub mod velocity;

@@ -39,6 +39,13 @@ pub struct MachineConfig {
     pub offsets: OffsetTable,
     /// The tool corrections D1-D99 as the control loads them from TAB0.KOR.
     pub tools: ToolTable,
+    /// The pause between blocks under G98, where the next block is not
+    /// prepared ahead, in ms. It depends on the hardware; the manual gives
+    /// no number, so the default is an assumption.
+    pub block_pause_ms: u32,
+    /// The wait after a stop for the in-position window of machine
+    /// constants R06–R07, in ms; the default is an assumption too.
+    pub settle_time_ms: u32,
 }
 
 /// How far an axis may travel, in thousandths (µm, or thousandths of a
@@ -62,6 +69,8 @@ impl Default for MachineConfig {
             cycle_file: None,
             offsets: OffsetTable::default(),
             tools: ToolTable::default(),
+            block_pause_ms: 20,
+            settle_time_ms: 10,
         }
     }
 }

@@ -120,6 +120,20 @@ pub struct Step {
     /// The program stops after the block (M00, M01) until the operator
     /// starts it again; the run does not count the wait.
     pub stop: Option<Stop>,
+    /// How the block joins the one before it (G group 2).
+    pub joining: Joining,
+}
+
+/// Block joining, group 2 (04 §1.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Joining {
+    /// G98, the basic state: every block ramps to a stop, with a pause
+    /// before the next (also under the group's other codes, G05–G10).
+    Basic,
+    /// G24: tight joining, a stop and the wait for the in-position window.
+    Tight,
+    /// G23: continuity, manual or recognised as machine constant R97 says.
+    Continuous,
 }
 
 /// A message operation 51 shows the operator; the program does not wait
@@ -226,10 +240,16 @@ impl Trace {
     /// Time and length by kind of block, and the program stops, in one
     /// pass over the steps (a long run's steps are hundreds of megabytes).
     pub fn totals(&self) -> Totals {
+        self.totals_with(self.steps.iter().map(|step| step.duration))
+    }
+
+    /// Like [`Trace::totals`], with the steps taking `durations` (those of
+    /// the velocity model).
+    pub fn totals_with(&self, durations: impl Iterator<Item = f64>) -> Totals {
         let mut totals = Totals::default();
-        for step in &self.steps {
-            totals.total_time += step.duration;
-            totals.time[step.motion as usize] += step.duration;
+        for (step, duration) in self.steps.iter().zip(durations) {
+            totals.total_time += duration;
+            totals.time[step.motion as usize] += duration;
             totals.length[step.motion as usize] += step.length;
             match step.stop {
                 Some(Stop::Program) => totals.program_stops += 1,
@@ -1365,7 +1385,12 @@ impl<'a> Runner<'a> {
     fn record(&mut self, range: TextRange, end: &Position, moved: Moved, stop: Option<Stop>) {
         let Moved { motion, length, duration, feed, path } = moved;
         let (source, end, frame) = (self.source, self.machine_axes(end), self.frames.len() - 1);
-        self.steps.push(Step { source, range, motion, path, duration, length, feed, end, frame, stop });
+        let joining = match self.modes.active(self.groups.joining) {
+            Some(23) => Joining::Continuous,
+            Some(24) => Joining::Tight,
+            _ => Joining::Basic,
+        };
+        self.steps.push(Step { source, range, motion, path, duration, length, feed, end, frame, stop, joining });
     }
 
     /// A position by letter over the machine's axes, as steps keep it.
@@ -1844,6 +1869,7 @@ pub(crate) fn slot(axis: u8) -> usize {
 /// The groups the run reads, resolved once.
 struct Groups {
     motion: Group,
+    joining: Group,
     feed_units: Group,
     cycle: Group,
     dimensions: Group,
@@ -1857,6 +1883,7 @@ impl Groups {
     fn of(modes: &Modes) -> Groups {
         Groups {
             motion: modes.group("G0"),
+            joining: modes.group("G2"),
             feed_units: modes.group("G6"),
             cycle: modes.group("G8"),
             dimensions: modes.group("G9"),

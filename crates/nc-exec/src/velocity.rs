@@ -1,0 +1,643 @@
+//! The CNC8x6 velocity model: how fast the control really runs a trace's
+//! moves, where the path speed must drop, and what each drop costs
+//! (cnc8x6-04 §1.2–§1.7, §1.11, §6.2).
+//!
+//! Every move ramps linearly (trapezoids). A junction between two moves is
+//! smooth or a stop:
+//!
+//! * smooth only between two working-feed moves (G01/G02/G03) where the
+//!   second is under G23 and machine constant R97 (decade 1) allows
+//!   continuity: manually (1) for every such junction, automatically (2)
+//!   when the angle between the motion directions is below R39 and neither
+//!   move runs axes beyond the first three; and both moves take at least
+//!   the minimum block duration of 60 ms at their programmed speed;
+//! * a stop otherwise: the move before ramps to zero, then waits for the
+//!   in-position window (G23/G24) or pauses for the next block to be
+//!   prepared (G98).
+//!
+//! A smooth junction runs at the lower of the two speeds, and the control
+//! looks one block ahead: the move after a junction must be able to stop
+//! within itself from the junction speed. Arcs run at most at the speed
+//! whose chord per 10 ms tick stays within 1 µm of the circle. Ramps use
+//! R236 under continuity, R52 for other working feed and R237 for rapid;
+//! threads (G33) run without ramps.
+
+use crate::{
+    machine::MachineConfig,
+    run::{Joining, MAX_AXES, Motion, Path, Trace},
+};
+
+/// The interpolator tick of the CNC8x6 (000:2749).
+const TICK: f64 = 0.01;
+/// The largest distance of a chord from its circle the control allows (000:2747).
+const CHORD_ERROR: f64 = 0.001;
+/// Moves shorter in time than these at their programmed speed cannot be
+/// joined smoothly (G23) or tightly (G24) on a CNC8x6 (000:7006, 000:6965).
+const MIN_SMOOTH_DURATION: f64 = 0.060;
+const MIN_TIGHT_DURATION: f64 = 0.030;
+
+/// What the model reads from the machine.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dynamics {
+    /// Machine constant R97, decade 1: 0 no continuity, 1 manual G23, 2
+    /// automatic recognition.
+    pub continuity: u8,
+    /// R39 in degrees.
+    pub tolerance_angle: f64,
+    /// R52, R236 (R52 when 0) and R237 in mm/s².
+    pub feed_acceleration: f64,
+    pub continuity_acceleration: f64,
+    pub rapid_acceleration: f64,
+    /// Seconds between blocks under G98, and for the in-position window
+    /// after a stop otherwise.
+    pub block_pause: f64,
+    pub settle_time: f64,
+}
+
+impl Dynamics {
+    pub fn of(machine: &MachineConfig) -> Dynamics {
+        let acceleration = |number| machine.constant(number).unsigned_abs() as f64;
+        let feed_acceleration = acceleration(52);
+        let continuity_acceleration = match acceleration(236) {
+            0.0 => feed_acceleration,
+            value => value,
+        };
+        Dynamics {
+            continuity: machine.decade(97, 1),
+            // Thousandths of a degree.
+            tolerance_angle: machine.constant(39) as f64 / 1000.0,
+            feed_acceleration,
+            continuity_acceleration,
+            rapid_acceleration: acceleration(237),
+            block_pause: f64::from(machine.block_pause_ms) / 1000.0,
+            settle_time: f64::from(machine.settle_time_ms) / 1000.0,
+        }
+    }
+}
+
+/// A move's speed through it, in mm/min: at its start, its highest, and at
+/// its end; with its duration in seconds.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Profile {
+    pub entry: f64,
+    pub peak: f64,
+    pub exit: f64,
+    pub duration: f64,
+}
+
+/// Why the path speed drops below the programmed feed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Reason {
+    /// G98: blocks are not joined; each ramps to a stop.
+    NoContinuity,
+    /// G24: each block ramps to a stop and waits for the in-position window.
+    TightJoining,
+    /// R97 decade 1 is 0: the control joins no blocks.
+    ContinuityOff,
+    /// The angle between the motion directions (degrees) is not below R39.
+    Corner { angle: f64, limit: f64 },
+    /// A rapid move at the junction.
+    Rapid,
+    /// A thread (G33) at the junction: it runs without ramps, from a stop.
+    Thread,
+    /// A block without motion (or a dwell) between two moves.
+    NonMotion,
+    /// A move shorter than the minimum duration for smooth joining.
+    ShortBlock { duration: f64 },
+    /// Automatic recognition works for the first three axes only.
+    BeyondThreeAxes,
+    /// One block of look-ahead: the next move must be able to stop within
+    /// itself, so the junction runs slower.
+    LookAhead,
+    /// An arc runs at most at the speed its chord error allows.
+    ArcLimit { radius: f64 },
+}
+
+impl Reason {
+    /// Whether the program could avoid the drop; rapid moves and threads
+    /// always start and end at rest.
+    pub fn avoidable(&self) -> bool {
+        !matches!(self, Reason::Rapid | Reason::Thread)
+    }
+
+    /// A short name for scripts.
+    pub fn code(&self) -> &'static str {
+        match self {
+            Reason::NoContinuity => "g98",
+            Reason::TightJoining => "g24",
+            Reason::ContinuityOff => "continuity-off",
+            Reason::Corner { .. } => "corner",
+            Reason::Rapid => "rapid",
+            Reason::Thread => "thread",
+            Reason::NonMotion => "non-motion",
+            Reason::ShortBlock { .. } => "short-block",
+            Reason::BeyondThreeAxes => "beyond-three-axes",
+            Reason::LookAhead => "look-ahead",
+            Reason::ArcLimit { .. } => "arc-limit",
+        }
+    }
+}
+
+/// The reason in the control's terms.
+impl std::fmt::Display for Reason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Reason::NoContinuity => f.write_str("G98 joins no blocks: a stop and a pause before the next"),
+            Reason::TightJoining => f.write_str("G24 tight joining: a stop and the in-position wait"),
+            Reason::ContinuityOff => f.write_str("G23 without continuity: machine constant R97 decade 1 is 0"),
+            Reason::Corner { angle, limit } => write!(f, "a corner of {angle:.1}°, not below R39 ({limit:.3}°)"),
+            Reason::Rapid => f.write_str("a rapid move (G00) is never joined smoothly"),
+            Reason::Thread => f.write_str("a thread (G33) runs from a stop, without ramps"),
+            Reason::NonMotion => f.write_str("a block without motion between moves"),
+            Reason::ShortBlock { duration } => write!(
+                f,
+                "a block of {:.0} ms at its feed, shorter than the {:.0} ms continuity needs",
+                duration * 1000.0,
+                MIN_SMOOTH_DURATION * 1000.0
+            ),
+            Reason::BeyondThreeAxes => f.write_str("continuity is recognised on the first three axes only"),
+            Reason::LookAhead => {
+                f.write_str("one block of look-ahead: the next block must be able to stop within itself")
+            }
+            Reason::ArcLimit { radius } => write!(
+                f,
+                "an arc of radius {radius:.3} mm: at most {:.0} µm chord error per {:.0} ms tick",
+                CHORD_ERROR * 1000.0,
+                TICK * 1000.0
+            ),
+        }
+    }
+}
+
+/// A place where the speed drops: at the end of `step` (or, for an arc
+/// limit, through it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Break {
+    pub step: usize,
+    pub reason: Reason,
+    /// mm/min before the drop and at it.
+    pub before: f64,
+    pub at: f64,
+    /// Seconds the drop costs against a smooth join at the programmed feed.
+    pub lost: f64,
+}
+
+/// The model's timing of a whole trace.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Timing {
+    /// One per step of the trace.
+    pub profiles: Vec<Profile>,
+    pub breaks: Vec<Break>,
+}
+
+impl Timing {
+    pub fn total_time(&self) -> f64 {
+        self.profiles.iter().map(|profile| profile.duration).sum()
+    }
+
+    /// When each step starts, in seconds since the program started.
+    pub fn start_times(&self) -> impl Iterator<Item = f64> + '_ {
+        self.profiles.iter().scan(0.0, |time, profile| {
+            let start = *time;
+            *time += profile.duration;
+            Some(start)
+        })
+    }
+}
+
+/// A move as the model sees it, speeds in mm/s.
+#[derive(Debug, Clone, Copy)]
+struct Move {
+    length: f64,
+    /// The programmed speed, and the speed the move may run at.
+    programmed: f64,
+    cruise: f64,
+    acceleration: f64,
+    /// Runs without ramps (threads).
+    no_ramps: bool,
+    kind: Kind,
+    joining: Joining,
+    beyond_three_axes: bool,
+    /// Unit directions at the start and at the end, over the first three axes.
+    start_direction: [f64; 3],
+    end_direction: [f64; 3],
+    arc_radius: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Feed,
+    Rapid,
+    Thread,
+    /// A dwell or a block without motion: its own time, no speed.
+    Still,
+}
+
+/// Times every step of `trace` with the velocity model of `dynamics`, in
+/// one pass that holds three moves at a time.
+pub fn time(trace: &Trace, dynamics: &Dynamics) -> Timing {
+    let count = trace.steps.len();
+    let mut timing = Timing { profiles: Vec::with_capacity(count), breaks: Vec::new() };
+    if count == 0 {
+        return timing;
+    }
+    let mut this = move_of(trace, 0, dynamics);
+    let mut entry = 0.0;
+    // The step before `this`, finished once the junction after `this` is known.
+    let mut waiting: Option<Timed> = None;
+    for index in 0..count {
+        let next = (index + 1 < count).then(|| move_of(trace, index + 1, dynamics));
+        let (exit, stop) = match &next {
+            None => (0.0, None),
+            Some(next) => match stop_reason(&this, next, dynamics) {
+                Some(reason) => (0.0, Some(reason)),
+                // One block of look-ahead: the next move must be able to
+                // stop within itself; and this one must reach the speed.
+                None => {
+                    let speed = this.cruise.min(next.cruise).min(stopping_speed(next, 0.0));
+                    (speed.min(stopping_speed(&this, entry)), None)
+                }
+            },
+        };
+        if let Some(before) = waiting.take() {
+            before.finish(Some(&this), exit, trace, dynamics, &mut timing);
+        }
+        waiting = Some(Timed { index, this, entry, exit, stop });
+        entry = exit;
+        match next {
+            Some(next) => this = next,
+            None => break,
+        }
+    }
+    if let Some(last) = waiting {
+        last.finish(None, 0.0, trace, dynamics, &mut timing);
+    }
+    timing
+}
+
+/// A move with the speeds it enters and leaves at.
+struct Timed {
+    index: usize,
+    this: Move,
+    entry: f64,
+    exit: f64,
+    /// Why it ends in a stop.
+    stop: Option<Reason>,
+}
+
+impl Timed {
+    /// Adds the move's profile and breaks; `next` is the move after it, and
+    /// `after` where that one ends.
+    fn finish(self, next: Option<&Move>, after: f64, trace: &Trace, dynamics: &Dynamics, timing: &mut Timing) {
+        let Timed { index, this, entry, exit, stop } = self;
+        let mut profile = profile(&this, entry, exit, trace.steps[index].duration);
+        match (stop, next) {
+            (Some(reason), Some(next)) if this.kind != Kind::Still => {
+                let pause = pause_after(&this, next, dynamics);
+                profile.duration += pause;
+                let (before, lost) = if next.kind == Kind::Still {
+                    // Without the still block the move would go on at its speed.
+                    let before = this.cruise.min(stopping_speed(&this, entry));
+                    (before, run_time(&this, entry, 0.0) - run_time(&this, entry, before))
+                } else {
+                    let before = this.cruise.min(next.cruise);
+                    (before, lost_time(&this, next, entry, exit, before, after))
+                };
+                let lost = lost.max(0.0) + pause;
+                timing.breaks.push(Break { step: index, reason, before: before * 60.0, at: 0.0, lost });
+            }
+            (None, Some(next)) if this.kind == Kind::Feed => {
+                let before = this.cruise.min(next.cruise);
+                if exit < before * (1.0 - 1e-9) {
+                    let lost = lost_time(&this, next, entry, exit, before, after);
+                    let reason = Reason::LookAhead;
+                    timing.breaks.push(Break { step: index, reason, before: before * 60.0, at: exit * 60.0, lost });
+                }
+            }
+            _ => {}
+        }
+        if let Some(radius) = this.arc_radius.filter(|_| this.cruise < this.programmed * (1.0 - 1e-9)) {
+            let lost = this.length / this.cruise - this.length / this.programmed;
+            let reason = Reason::ArcLimit { radius };
+            let (before, at) = (this.programmed * 60.0, this.cruise * 60.0);
+            timing.breaks.push(Break { step: index, reason, before, at, lost });
+        }
+        timing.profiles.push(profile);
+    }
+}
+
+/// The step as a move: its speeds, acceleration and directions.
+fn move_of(trace: &Trace, index: usize, dynamics: &Dynamics) -> Move {
+    let step = &trace.steps[index];
+    let start = if index == 0 { [0.0; MAX_AXES] } else { trace.steps[index - 1].end };
+    let kind = match (step.motion, step.path) {
+        (Motion::Feed, Path::Thread { .. }) => Kind::Thread,
+        (Motion::Feed, _) if step.length > 0.0 && step.duration > 0.0 => Kind::Feed,
+        (Motion::Rapid, _) if step.length > 0.0 && step.duration > 0.0 => Kind::Rapid,
+        _ => Kind::Still,
+    };
+    // The speed the trace timed the move at: the feed, or the rapid of its slowest axis.
+    let programmed = if step.duration > 0.0 { step.length / step.duration } else { 0.0 };
+    let mut chord = [0.0; 3];
+    for (i, value) in chord.iter_mut().enumerate() {
+        *value = step.end[i] - start[i];
+    }
+    let (mut start_direction, mut end_direction) = (unit(chord), unit(chord));
+    let mut arc_radius = None;
+    let mut cruise = programmed;
+    if let Path::Arc { plane, centre, clockwise } = step.path {
+        let slot = |letter: u8| trace.axes.iter().position(|&axis| axis == letter);
+        if let (Some(u), Some(v)) = (slot(plane.0), slot(plane.1)) {
+            let tangent = |point: &[f64; MAX_AXES]| {
+                let (du, dv) = (point[u] - centre[0], point[v] - centre[1]);
+                // Counter-clockwise turns the radius a quarter left.
+                let (tu, tv) = if clockwise { (dv, -du) } else { (-dv, du) };
+                let mut direction = [0.0; 3];
+                if u < 3 {
+                    direction[u] = tu;
+                }
+                if v < 3 {
+                    direction[v] = tv;
+                }
+                unit(direction)
+            };
+            start_direction = tangent(&start);
+            end_direction = tangent(&step.end);
+            let radius = (step.end[u] - centre[0]).hypot(step.end[v] - centre[1]);
+            if radius > 0.0 && kind == Kind::Feed {
+                let limit = (8.0 * radius * CHORD_ERROR).sqrt() / TICK;
+                if limit < cruise {
+                    cruise = limit;
+                }
+                arc_radius = Some(radius);
+            }
+        }
+    }
+    let acceleration = match (kind, step.joining) {
+        (Kind::Rapid, _) => dynamics.rapid_acceleration,
+        (Kind::Feed, Joining::Continuous) if dynamics.continuity > 0 => dynamics.continuity_acceleration,
+        _ => dynamics.feed_acceleration,
+    };
+    let beyond_three_axes = (3..MAX_AXES).any(|i| (step.end[i] - start[i]).abs() > 0.0);
+    Move {
+        length: step.length,
+        programmed,
+        cruise,
+        acceleration,
+        no_ramps: kind == Kind::Thread || acceleration <= 0.0,
+        kind,
+        joining: step.joining,
+        beyond_three_axes,
+        start_direction,
+        end_direction,
+        arc_radius,
+    }
+}
+
+fn unit(vector: [f64; 3]) -> [f64; 3] {
+    let norm = vector.iter().map(|c| c * c).sum::<f64>().sqrt();
+    if norm > 0.0 { vector.map(|c| c / norm) } else { vector }
+}
+
+/// Why the junction from `this` into `next` is a stop, or `None` when it
+/// is smooth.
+fn stop_reason(this: &Move, next: &Move, dynamics: &Dynamics) -> Option<Reason> {
+    for side in [this, next] {
+        match side.kind {
+            Kind::Still => return Some(Reason::NonMotion),
+            Kind::Rapid => return Some(Reason::Rapid),
+            Kind::Thread => return Some(Reason::Thread),
+            Kind::Feed => {}
+        }
+    }
+    match next.joining {
+        Joining::Basic => return Some(Reason::NoContinuity),
+        Joining::Tight => return Some(Reason::TightJoining),
+        Joining::Continuous if dynamics.continuity == 0 => return Some(Reason::ContinuityOff),
+        Joining::Continuous => {}
+    }
+    if dynamics.continuity == 2 {
+        if this.beyond_three_axes || next.beyond_three_axes {
+            return Some(Reason::BeyondThreeAxes);
+        }
+        let cosine: f64 = this.end_direction.iter().zip(&next.start_direction).map(|(a, b)| a * b).sum();
+        let angle = cosine.clamp(-1.0, 1.0).acos().to_degrees();
+        if angle >= dynamics.tolerance_angle {
+            return Some(Reason::Corner { angle, limit: dynamics.tolerance_angle });
+        }
+    }
+    for side in [this, next] {
+        let duration = side.length / side.programmed;
+        if duration < MIN_SMOOTH_DURATION {
+            return Some(Reason::ShortBlock { duration });
+        }
+    }
+    None
+}
+
+/// The highest speed at which `this` can be entered (from `entry`'s side:
+/// the speed it can still reach or stop from) within its length.
+fn stopping_speed(this: &Move, from: f64) -> f64 {
+    if this.no_ramps { f64::INFINITY } else { (from * from + 2.0 * this.acceleration * this.length).sqrt() }
+}
+
+/// The wait after `this` stops before `next` starts: the in-position
+/// window, or under G98 the pause for the next block to be prepared; a G24
+/// block too short to send the next one while it runs pauses as well.
+fn pause_after(this: &Move, next: &Move, dynamics: &Dynamics) -> f64 {
+    let too_short_to_prepare = this.joining == Joining::Tight && this.length / this.programmed < MIN_TIGHT_DURATION;
+    if next.joining == Joining::Basic || too_short_to_prepare { dynamics.block_pause } else { dynamics.settle_time }
+}
+
+/// The move's trapezoid from `entry` to `exit` (mm/s); `fallback` is the
+/// trace's own time for blocks without motion.
+fn profile(this: &Move, entry: f64, exit: f64, fallback: f64) -> Profile {
+    if this.kind == Kind::Still || this.length <= 0.0 {
+        return Profile { duration: fallback, ..Profile::default() };
+    }
+    let per_minute = |speed: f64| speed * 60.0;
+    if this.no_ramps {
+        let speed = this.cruise;
+        let duration = this.length / speed;
+        return Profile { entry: per_minute(speed), peak: per_minute(speed), exit: per_minute(speed), duration };
+    }
+    let duration = run_time(this, entry, exit);
+    let a = this.acceleration;
+    let peak = ((2.0 * a * this.length + entry * entry + exit * exit) / 2.0).sqrt().min(this.cruise);
+    Profile { entry: per_minute(entry), peak: per_minute(peak), exit: per_minute(exit), duration }
+}
+
+/// Seconds to run `this` from `entry` to `exit` (mm/s), at most at its
+/// cruise speed, with linear ramps.
+fn run_time(this: &Move, entry: f64, exit: f64) -> f64 {
+    if this.no_ramps {
+        return this.length / this.cruise;
+    }
+    let (a, length, cruise) = (this.acceleration, this.length, this.cruise);
+    let ramps = (cruise * cruise - entry * entry + cruise * cruise - exit * exit) / (2.0 * a);
+    if ramps <= length {
+        (cruise - entry) / a + (cruise - exit) / a + (length - ramps) / cruise
+    } else {
+        let peak = ((2.0 * a * length + entry * entry + exit * exit) / 2.0).sqrt();
+        (peak - entry) / a + (peak - exit) / a
+    }
+}
+
+/// What a drop to `exit` between `this` and `next` costs against joining
+/// them at `smooth` (mm/s), `after` being where `next` ends either way.
+fn lost_time(this: &Move, next: &Move, entry: f64, exit: f64, smooth: f64, after: f64) -> f64 {
+    let actual = run_time(this, entry, exit) + run_time(next, exit, after);
+    let smooth = smooth.min(stopping_speed(this, entry)).min(stopping_speed(next, after));
+    let ideal = run_time(this, entry, smooth) + run_time(next, smooth, after);
+    (actual - ideal).max(0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Dynamics, Reason, Timing, time};
+    use crate::{
+        machine::MachineConfig,
+        run::{NoFiles, run},
+    };
+
+    /// The default machine: R97 = 2, R39 = 60°, R52 = 1000, R236 = 400 and
+    /// R237 = 1000 mm/s², a 20 ms pause under G98 and a 10 ms settle.
+    fn timed(text: &str) -> Timing {
+        let machine = MachineConfig::default();
+        let trace = run(text, &NoFiles, &machine, 1000);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        time(&trace, &Dynamics::of(&machine))
+    }
+
+    fn close(actual: f64, expected: f64) {
+        assert!((actual - expected).abs() <= expected.abs() * 1e-9 + 1e-12, "{actual} != {expected}");
+    }
+
+    /// A move of `length` mm from rest to rest at `speed` mm/s with `a` mm/s².
+    fn rest_to_rest(length: f64, speed: f64, a: f64) -> f64 {
+        2.0 * speed / a + (length - speed * speed / a) / speed
+    }
+
+    #[test]
+    fn the_machine_defaults_are_read_from_the_catalogue() {
+        let dynamics = Dynamics::of(&MachineConfig::default());
+        assert_eq!((dynamics.continuity, dynamics.tolerance_angle), (2, 60.0));
+        let accelerations = (dynamics.feed_acceleration, dynamics.continuity_acceleration, dynamics.rapid_acceleration);
+        assert_eq!(accelerations, (1000.0, 400.0, 1000.0));
+    }
+
+    #[test]
+    fn one_long_line_ramps_up_and_down() {
+        // 100 mm at 100 mm/s: 5 mm of ramp at each end at 1000 mm/s².
+        let timing = timed("%1\nN1 G01 X100 F6000\nN2 M30\n");
+        let line = timing.profiles[0];
+        assert_eq!((line.entry, line.peak, line.exit), (0.0, 6000.0, 0.0));
+        close(line.duration, rest_to_rest(100.0, 100.0, 1000.0) + 0.020);
+        close(timing.total_time(), 1.1 + 0.020);
+        let reasons: Vec<Reason> = timing.breaks.iter().map(|b| b.reason).collect();
+        assert_eq!(reasons, [Reason::NonMotion]);
+        // The stop costs the ramp down, against going on at 100 mm/s.
+        close(timing.breaks[0].lost, 100.0 / 1000.0 / 2.0 + 0.020);
+        // Too short to reach the feed: a triangle.
+        let short = timed("%1\nN1 G01 X1 F6000\nN2 M30\n").profiles[0];
+        close(short.peak, (1000.0f64 * 1.0).sqrt() * 60.0);
+        close(short.duration, 2.0 * (1000.0f64).sqrt() / 1000.0 + 0.020);
+    }
+
+    #[test]
+    fn a_collinear_g23_chain_runs_through_at_the_feed() {
+        let timing = timed("%1\nN1 G23 G01 X10 F600\nN2 X20\nN3 X30\nN4 M30\n");
+        let speeds: Vec<(f64, f64)> = timing.profiles[..3].iter().map(|p| (p.entry, p.exit)).collect();
+        assert_eq!(speeds, [(0.0, 600.0), (600.0, 600.0), (600.0, 0.0)]);
+        // Under continuity the ramps take R236: 10 mm/s at 400 mm/s².
+        close(timing.total_time(), 3.0 + 10.0 / 400.0 + 0.010);
+        assert_eq!(timing.breaks.len(), 1);
+    }
+
+    #[test]
+    fn a_corner_below_r39_joins_and_one_above_stops() {
+        // 53.13° (3-4-5) and 63.43° (1-2) turns from the X axis.
+        let below = timed("%1\nN1 G23 G01 X10 F600\nN2 X13 Y4\nN3 M30\n");
+        assert_eq!(below.breaks.len(), 1);
+        close(below.total_time(), 15.0 / 10.0 + 10.0 / 400.0 + 0.010);
+        let above = timed("%1\nN1 G23 G01 X10 F600\nN2 X11 Y2\nN3 M30\n");
+        let Reason::Corner { angle, limit } = above.breaks[0].reason else { panic!("{:?}", above.breaks) };
+        close(angle, 2.0f64.atan().to_degrees());
+        assert_eq!(limit, 60.0);
+        let second = 5.0f64.sqrt();
+        let expected = rest_to_rest(10.0, 10.0, 400.0) + 0.010 + rest_to_rest(second, 10.0, 400.0) + 0.010;
+        close(above.total_time(), expected);
+        // Against a smooth join at 10 mm/s the corner costs a ramp down and
+        // up (10/400 s) and the settle.
+        close(above.breaks[0].lost, 10.0 / 400.0 + 0.010);
+    }
+
+    #[test]
+    fn g98_g24_and_g23_on_the_same_path() {
+        let path = |code: &str| timed(&format!("%1\nN1 {code} G01 X10 F600\nN2 X20\nN3 M30\n")).total_time();
+        // G98: R52 ramps and a 20 ms pause after each line; G24: the same
+        // ramps and a 10 ms settle; G23: one smooth run with R236 ramps.
+        close(path("G98"), 2.0 * rest_to_rest(10.0, 10.0, 1000.0) + 2.0 * 0.020);
+        close(path("G24"), 2.0 * rest_to_rest(10.0, 10.0, 1000.0) + 2.0 * 0.010);
+        close(path("G23"), 2.0 + 10.0 / 400.0 + 0.010);
+    }
+
+    #[test]
+    fn an_arc_runs_at_its_chord_limit() {
+        // Radius 1 mm: a 1 µm chord error per 10 ms allows sqrt(8 r e)/Ts.
+        let timing = timed("%1\nN1 G02 X2 Y0 I1 J0 F1000\nN2 M30\n");
+        let limit = (8.0f64 * 0.001).sqrt() / 0.01;
+        close(timing.profiles[0].peak, limit * 60.0);
+        let arc = timing.breaks.iter().find(|b| matches!(b.reason, Reason::ArcLimit { .. })).unwrap();
+        assert_eq!(arc.reason, Reason::ArcLimit { radius: 1.0 });
+        close(arc.at, limit * 60.0);
+        close(arc.before, 1000.0);
+        let length = std::f64::consts::PI;
+        close(timing.profiles[0].duration, rest_to_rest(length, limit, 1000.0) + 0.020);
+    }
+
+    #[test]
+    fn dwell_keeps_its_time_and_breaks_the_path() {
+        let timing = timed("%1\nN1 G23 G01 X10 F600\nN2 G04 Q150\nN3 X20\nN4 M30\n");
+        close(timing.profiles[1].duration, 1.5);
+        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason)).collect();
+        assert_eq!(reasons, [(0, Reason::NonMotion), (2, Reason::NonMotion)]);
+    }
+
+    #[test]
+    fn a_short_block_after_a_fast_one_limits_the_junction() {
+        // The control brakes one block ahead: the 0.5 mm block must be able
+        // to stop within itself, sqrt(2 * 400 * 0.5) = 20 mm/s.
+        let timing = timed("%1\nN1 G23 G01 X100 F3000\nN2 X100.5 F3000\nN3 X200\nN4 M30\n");
+        let reasons: Vec<Reason> = timing.breaks.iter().map(|b| b.reason).collect();
+        assert_eq!(reasons[0], Reason::ShortBlock { duration: 0.5 / 50.0 });
+        // 8 mm take 80 ms at 100 mm/s, but stop within themselves only
+        // from sqrt(2 * 400 * 8) = 80 mm/s.
+        let timing = timed("%1\nN1 G23 G01 X100 F6000\nN2 X108\nN3 X200\nN4 M30\n");
+        assert_eq!((timing.breaks[0].step, timing.breaks[0].reason), (0, Reason::LookAhead));
+        close(timing.breaks[0].at, 4800.0);
+        close(timing.profiles[1].entry, 4800.0);
+        // Long enough blocks, one slow: the fast one ends at the slow speed.
+        let timing = timed("%1\nN1 G23 G01 X100 F3000\nN2 X110 F600\nN3 M30\n");
+        assert_eq!(timing.profiles[0].exit, 600.0);
+        assert_eq!(timing.profiles[1].entry, 600.0);
+    }
+
+    #[test]
+    fn a_g24_block_too_short_to_send_the_next_pauses_as_under_g98() {
+        // 1 mm at 100 mm/s takes 10 ms, under the 30 ms G24 needs.
+        let timing = timed("%1\nN1 G24 G01 X1 F6000\nN2 X101\nN3 M30\n");
+        let first = 2.0 * (1000.0f64).sqrt() / 1000.0;
+        close(timing.profiles[0].duration, first + 0.020);
+        close(timing.profiles[1].duration, rest_to_rest(100.0, 100.0, 1000.0) + 0.010);
+    }
+
+    #[test]
+    fn rapid_moves_stop_at_both_ends() {
+        let timing = timed("%1\nN1 G23 G01 X10 F600\nN2 G00 X100\nN3 G01 X110\nN4 M30\n");
+        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason)).collect();
+        assert_eq!(reasons[..2], [(0, Reason::Rapid), (1, Reason::Rapid)]);
+        // 90 mm at the default 10 m/min rapid with R237 ramps.
+        close(timing.profiles[1].duration, rest_to_rest(90.0, 10_000.0 / 60.0, 1000.0) + 0.010);
+    }
+}
