@@ -229,28 +229,54 @@ fn summary(path: &Path, ran: &Ran) -> String {
             let step = &trace.steps[speed_break.step];
             (step.source, step.range.start(), speed_break.reason.code())
         };
-        let mut avoidable: Vec<&velocity::Break> =
-            timing.breaks.iter().filter(|speed_break| speed_break.reason.avoidable()).collect();
-        avoidable.sort_unstable_by_key(|speed_break| (place_of(speed_break), speed_break.step));
-        let mut places: Vec<(&velocity::Break, usize, f64)> = Vec::new();
+        // Grouped by place. A program without loops or calls meets its
+        // places in order, and needs no sort.
+        let avoidable = timing.breaks.iter().filter(|speed_break| speed_break.reason.avoidable());
+        let in_order = avoidable.clone().zip(avoidable.clone().skip(1)).all(|(a, b)| {
+            let (a, b) = (&trace.steps[a.step], &trace.steps[b.step]);
+            (a.source, a.range.start()) <= (b.source, b.range.start())
+        });
+        let avoidable: Box<dyn Iterator<Item = &velocity::Break>> = if in_order {
+            Box::new(avoidable)
+        } else {
+            let mut sorted: Vec<((usize, TextSize, &str), &velocity::Break)> =
+                avoidable.map(|speed_break| (place_of(speed_break), speed_break)).collect();
+            sorted.sort_by_key(|&(place, _)| place);
+            Box::new(sorted.into_iter().map(|(_, speed_break)| speed_break))
+        };
+        // Each place's first break, its runs and its cost; the costliest kept.
+        let mut top: Vec<(&velocity::Break, usize, f64)> = Vec::with_capacity(LISTED_BREAKS + 1);
+        let by_cost = |a: &(&velocity::Break, usize, f64), b: &(&velocity::Break, usize, f64)| {
+            b.2.total_cmp(&a.2).then(a.0.step.cmp(&b.0.step))
+        };
+        let mut keep = |place| {
+            if top.len() == LISTED_BREAKS && top.last().is_some_and(|last| by_cost(&place, last).is_ge()) {
+                return;
+            }
+            top.push(place);
+            top.sort_by(by_cost);
+            top.truncate(LISTED_BREAKS);
+        };
+        let mut listed = 0;
+        let mut current: Option<(&velocity::Break, usize, f64)> = None;
         for speed_break in avoidable {
-            match places.last_mut() {
+            match &mut current {
                 Some((first, times, lost)) if place_of(first) == place_of(speed_break) => {
                     *times += 1;
                     *lost += speed_break.lost;
                 }
-                _ => places.push((speed_break, 1, speed_break.lost)),
+                _ => {
+                    listed += 1;
+                    if let Some(place) = current.replace((speed_break, 1, speed_break.lost)) {
+                        keep(place);
+                    }
+                }
             }
         }
-        let listed = places.len();
-        let by_cost = |a: &(&velocity::Break, usize, f64), b: &(&velocity::Break, usize, f64)| {
-            b.2.total_cmp(&a.2).then(a.0.step.cmp(&b.0.step))
-        };
-        if listed > LISTED_BREAKS {
-            places.select_nth_unstable_by(LISTED_BREAKS, by_cost);
-            places.truncate(LISTED_BREAKS);
+        if let Some(place) = current {
+            keep(place);
         }
-        places.sort_unstable_by(by_cost);
+        let places = top;
         for (speed_break, times, lost) in places {
             let step = &trace.steps[speed_break.step];
             let place = ran.sources[step.source].place(step.range.start());

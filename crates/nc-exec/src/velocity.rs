@@ -10,7 +10,8 @@
 //!   continuity: manually (1) for every such junction, automatically (2)
 //!   when the angle between the motion directions is below R39 and neither
 //!   move runs axes beyond the first three; and both moves take at least
-//!   the minimum block duration of 60 ms at their programmed speed;
+//!   the minimum block duration of 60 ms at their programmed speed (4 ms on
+//!   a CNC8x9, which machine constant R338 decade 2 tells);
 //! * a stop otherwise: the move before ramps to zero, then waits for the
 //!   in-position window (G23/G24) or pauses for the next block to be
 //!   prepared (G98).
@@ -31,10 +32,17 @@ use crate::{
 const TICK: f64 = 0.01;
 /// The largest distance of a chord from its circle the control allows (000:2747).
 const CHORD_ERROR: f64 = 0.001;
-/// Moves shorter in time than these at their programmed speed cannot be
-/// joined smoothly (G23) or tightly (G24) on a CNC8x6 (000:7006, 000:6965).
-const MIN_SMOOTH_DURATION: f64 = 0.060;
-const MIN_TIGHT_DURATION: f64 = 0.030;
+/// Moves shorter in time (ms) than these at their programmed speed cannot
+/// be joined smoothly (G23) or tightly (G24), on a CNC8x6 and on a CNC8x9
+/// (000:7006, 000:6965).
+pub const MIN_CONTINUITY_MS: (f64, f64) = (60.0, 4.0);
+pub const MIN_TIGHT_JOINING_MS: (f64, f64) = (30.0, 2.0);
+
+/// The CNC8x6 or CNC8x9 value of a limit: envelope velocity (R338 decade
+/// 2) exists only on CNC8x9; otherwise the control is the CNC8x6.
+pub fn for_control(machine: &MachineConfig, (cnc8x6, cnc8x9): (f64, f64)) -> f64 {
+    if matches!(machine.known_decade(338, 2), Some(1 | 2)) { cnc8x9 } else { cnc8x6 }
+}
 
 /// What the model reads from the machine.
 #[derive(Debug, Clone, PartialEq)]
@@ -52,18 +60,31 @@ pub struct Dynamics {
     /// after a stop otherwise.
     pub block_pause: f64,
     pub settle_time: f64,
+    /// The shortest moves (s) continuity and tight joining join.
+    pub min_continuity: f64,
+    pub min_tight_joining: f64,
 }
+
+/// What the model assumes for machine constants the manual gives no value
+/// for, until the machine's configuration sets them: automatic continuity,
+/// R52 and R237 of 1000 mm/s², and the manual's example of 400 mm/s² for
+/// R236. The checker assumes nothing: its continuity rules wait for R97.
+const ASSUMED_CONTINUITY: u8 = 2;
+const ASSUMED_ACCELERATIONS: [(u32, i64); 3] = [(52, 1000), (236, 400), (237, 1000)];
 
 impl Dynamics {
     pub fn of(machine: &MachineConfig) -> Dynamics {
-        let acceleration = |number| machine.constant(number).unsigned_abs() as f64;
+        let acceleration = |number| {
+            let assumed = ASSUMED_ACCELERATIONS.iter().find(|&&(n, _)| n == number).map(|&(_, value)| value);
+            machine.known_constant(number).or(assumed).unwrap_or(0).unsigned_abs() as f64
+        };
         let feed_acceleration = acceleration(52);
         let continuity_acceleration = match acceleration(236) {
             0.0 => feed_acceleration,
             value => value,
         };
         Dynamics {
-            continuity: machine.decade(97, 1),
+            continuity: machine.known_decade(97, 1).unwrap_or(ASSUMED_CONTINUITY),
             // Thousandths of a degree.
             tolerance_angle: machine.constant(39) as f64 / 1000.0,
             feed_acceleration,
@@ -71,6 +92,8 @@ impl Dynamics {
             rapid_acceleration: acceleration(237),
             block_pause: f64::from(machine.block_pause_ms) / 1000.0,
             settle_time: f64::from(machine.settle_time_ms) / 1000.0,
+            min_continuity: for_control(machine, MIN_CONTINUITY_MS) / 1000.0,
+            min_tight_joining: for_control(machine, MIN_TIGHT_JOINING_MS) / 1000.0,
         }
     }
 }
@@ -102,8 +125,8 @@ pub enum Reason {
     Thread,
     /// A block without motion (or a dwell) between two moves.
     NonMotion,
-    /// A move shorter than the minimum duration for smooth joining.
-    ShortBlock { duration: f64 },
+    /// A move shorter (s) than the minimum duration for smooth joining.
+    ShortBlock { duration: f64, limit: f64 },
     /// Automatic recognition works for the first three axes only.
     BeyondThreeAxes,
     /// One block of look-ahead: the next move must be able to stop within
@@ -149,11 +172,11 @@ impl std::fmt::Display for Reason {
             Reason::Rapid => f.write_str("a rapid move (G00) is never joined smoothly"),
             Reason::Thread => f.write_str("a thread (G33) runs from a stop, without ramps"),
             Reason::NonMotion => f.write_str("a block without motion between moves"),
-            Reason::ShortBlock { duration } => write!(
+            Reason::ShortBlock { duration, limit } => write!(
                 f,
                 "a block of {:.0} ms at its feed, shorter than the {:.0} ms continuity needs",
                 duration * 1000.0,
-                MIN_SMOOTH_DURATION * 1000.0
+                limit * 1000.0
             ),
             Reason::BeyondThreeAxes => f.write_str("continuity is recognised on the first three axes only"),
             Reason::LookAhead => {
@@ -237,7 +260,9 @@ enum Kind {
 /// one pass that holds three moves at a time.
 pub fn time(trace: &Trace, dynamics: &Dynamics) -> Timing {
     let count = trace.steps.len();
-    let mut timing = Timing { profiles: Vec::with_capacity(count), breaks: Vec::new() };
+    // Breaks can come at every step: reserved room never touched costs
+    // nothing, growing copies.
+    let mut timing = Timing { profiles: Vec::with_capacity(count), breaks: Vec::with_capacity(count) };
     if count == 0 {
         return timing;
     }
@@ -421,15 +446,19 @@ fn stop_reason(this: &Move, next: &Move, dynamics: &Dynamics) -> Option<Reason> 
             return Some(Reason::BeyondThreeAxes);
         }
         let cosine: f64 = this.end_direction.iter().zip(&next.start_direction).map(|(a, b)| a * b).sum();
-        let angle = cosine.clamp(-1.0, 1.0).acos().to_degrees();
-        if angle >= dynamics.tolerance_angle {
-            return Some(Reason::Corner { angle, limit: dynamics.tolerance_angle });
+        let cosine = cosine.clamp(-1.0, 1.0);
+        // Not below R39; the angle itself only for the report.
+        if cosine <= dynamics.tolerance_angle.to_radians().cos() {
+            let angle = cosine.acos().to_degrees();
+            if angle >= dynamics.tolerance_angle {
+                return Some(Reason::Corner { angle, limit: dynamics.tolerance_angle });
+            }
         }
     }
     for side in [this, next] {
         let duration = side.length / side.programmed;
-        if duration < MIN_SMOOTH_DURATION {
-            return Some(Reason::ShortBlock { duration });
+        if duration < dynamics.min_continuity {
+            return Some(Reason::ShortBlock { duration, limit: dynamics.min_continuity });
         }
     }
     None
@@ -445,7 +474,8 @@ fn stopping_speed(this: &Move, from: f64) -> f64 {
 /// window, or under G98 the pause for the next block to be prepared; a G24
 /// block too short to send the next one while it runs pauses as well.
 fn pause_after(this: &Move, next: &Move, dynamics: &Dynamics) -> f64 {
-    let too_short_to_prepare = this.joining == Joining::Tight && this.length / this.programmed < MIN_TIGHT_DURATION;
+    let too_short_to_prepare =
+        this.joining == Joining::Tight && this.length / this.programmed < dynamics.min_tight_joining;
     if next.joining == Joining::Basic || too_short_to_prepare { dynamics.block_pause } else { dynamics.settle_time }
 }
 
@@ -519,7 +549,7 @@ mod tests {
     }
 
     #[test]
-    fn the_machine_defaults_are_read_from_the_catalogue() {
+    fn unset_constants_take_the_models_assumptions() {
         let dynamics = Dynamics::of(&MachineConfig::default());
         assert_eq!((dynamics.continuity, dynamics.tolerance_angle), (2, 60.0));
         let accelerations = (dynamics.feed_acceleration, dynamics.continuity_acceleration, dynamics.rapid_acceleration);
@@ -610,7 +640,7 @@ mod tests {
         // to stop within itself, sqrt(2 * 400 * 0.5) = 20 mm/s.
         let timing = timed("%1\nN1 G23 G01 X100 F3000\nN2 X100.5 F3000\nN3 X200\nN4 M30\n");
         let reasons: Vec<Reason> = timing.breaks.iter().map(|b| b.reason).collect();
-        assert_eq!(reasons[0], Reason::ShortBlock { duration: 0.5 / 50.0 });
+        assert_eq!(reasons[0], Reason::ShortBlock { duration: 0.5 / 50.0, limit: 0.060 });
         // 8 mm take 80 ms at 100 mm/s, but stop within themselves only
         // from sqrt(2 * 400 * 8) = 80 mm/s.
         let timing = timed("%1\nN1 G23 G01 X100 F6000\nN2 X108\nN3 X200\nN4 M30\n");

@@ -12,6 +12,7 @@
 
 use std::f64::consts::TAU;
 
+use nc_exec::velocity::{MIN_CONTINUITY_MS, MIN_TIGHT_JOINING_MS, for_control};
 use ncc_catalog::{AddressRole, Dialect};
 use ncc_syntax::{Decimal, TextRange, TextSize};
 
@@ -39,10 +40,6 @@ declare_rules! {
     BLOCK_SHORTER_THAN_R382 = "D913", "block-shorter-than-r382", Info, "A G23 block shorter than R382, where the control breaks continuity.";
 }
 
-/// Minimum block duration (ms) for smooth joining under G23, CNC8x6 and CNC8x9.
-const CONTINUITY_MIN_MS: (f64, f64) = (60.0, 4.0);
-/// Minimum block duration (ms) for tight joining under G24, CNC8x6 and CNC8x9.
-const TIGHT_JOINING_MIN_MS: (f64, f64) = (30.0, 2.0);
 /// How many short feed blocks in a row without continuity are "many": a
 /// contour divided that finely spends its time ramping down and up.
 const MANY_SHORT_BLOCKS: usize = 20;
@@ -72,12 +69,6 @@ fn joining(config: &Config) -> Option<Joining> {
         2 => Some(Joining::Automatic),
         _ => None,
     }
-}
-
-/// The CNC8x6 or CNC8x9 value of a limit: envelope velocity (R338 decade
-/// 2) exists only on CNC8x9; otherwise the control is the CNC8x6.
-fn for_control(config: &Config, (cnc8x6, cnc8x9): (f64, f64)) -> f64 {
-    if matches!(config.machine.known_decade(338, 2), Some(1 | 2)) { cnc8x9 } else { cnc8x6 }
 }
 
 /// A length limit in mm from a machine constant (R382, R383): `None` when
@@ -458,7 +449,7 @@ fn check_dynamic_set(visit: &Visit<'_>, out: &mut Vec<Diagnostic>) {
 /// G24 joins blocks tightly only when each lasts the minimum time.
 fn check_tight_joining(visit: &Visit<'_>, path: Option<&Path>, feed: Option<f64>, out: &mut Vec<Diagnostic>) {
     let (Some(path), Some(feed), Some(range)) = (path, feed, coordinates(visit)) else { return };
-    let minimum = for_control(visit.config, TIGHT_JOINING_MIN_MS);
+    let minimum = for_control(&visit.config.machine, MIN_TIGHT_JOINING_MS);
     let duration = duration_ms(path.length, feed);
     if duration < minimum {
         let diagnostic = Diagnostic::new(
@@ -484,7 +475,7 @@ impl Dynamics {
         feed: Option<f64>,
         out: &mut Vec<Diagnostic>,
     ) {
-        let minimum = for_control(visit.config, CONTINUITY_MIN_MS);
+        let minimum = for_control(&visit.config.machine, MIN_CONTINUITY_MS);
         let short = feed_move
             && !self.g23_seen
             && !self.continuity_advised
@@ -737,7 +728,7 @@ fn check_short_smooth_block(visit: &Visit<'_>, path: &Path, feed: Option<f64>, o
         return;
     }
     let Some(feed) = feed else { return };
-    let minimum = for_control(config, CONTINUITY_MIN_MS);
+    let minimum = for_control(&config.machine, MIN_CONTINUITY_MS);
     let duration = duration_ms(path.length, feed);
     if duration < minimum {
         let diagnostic = Diagnostic::new(
