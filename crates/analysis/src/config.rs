@@ -15,6 +15,8 @@
 //! limits = { X = { min = "-10", max = "500.5" } }   # mm from the machine zero
 //! block-pause-ms = 20                     # between blocks under G98
 //! settle-time-ms = 10                     # in-position wait after a stop
+//! m-function-ms = 200                     # each M function (M03, M08, …)
+//! tool-change-ms = 6000                   # M06
 //! cycle-file = "PCYKLYDG.NCP"             # CNC836.KNF $17: what G81-G89 do
 //! offset-file = "TAB0.POS"                # zero offsets G53-G59
 //! tool-file = "TAB0.KOR"                  # tool corrections D1-D99
@@ -104,6 +106,8 @@ struct MachineFile {
     diameter_axis: Option<String>,
     block_pause_ms: Option<u32>,
     settle_time_ms: Option<u32>,
+    m_function_ms: Option<u32>,
+    tool_change_ms: Option<u32>,
     cycle_file: Option<String>,
     offset_file: Option<PathBuf>,
     tool_file: Option<PathBuf>,
@@ -157,6 +161,12 @@ impl MachineFile {
         }
         if let Some(settle) = self.settle_time_ms {
             machine.settle_time_ms = settle;
+        }
+        if let Some(time) = self.m_function_ms {
+            machine.m_function_ms = time;
+        }
+        if let Some(time) = self.tool_change_ms {
+            machine.tool_change_ms = time;
         }
         if let Some(rate) = self.rapid_rate {
             if rate == 0 {
@@ -418,8 +428,14 @@ R97 = "2"
         assert_eq!((machine.constant(39), machine.constant(97)), (45_500, 2), "constants key by key");
         assert_eq!(machine.diameter_axis, None);
         assert_eq!((machine.block_pause_ms, machine.settle_time_ms), (20, 10), "the defaults");
-        let timed = load("[machine]\nblock-pause-ms = 35\nsettle-time-ms = 0\n", &[]).unwrap().machine;
+        let timed = load(
+            "[machine]\nblock-pause-ms = 35\nsettle-time-ms = 0\nm-function-ms = 200\ntool-change-ms = 6000\n",
+            &[],
+        )
+        .unwrap()
+        .machine;
         assert_eq!((timed.block_pause_ms, timed.settle_time_ms), (35, 0));
+        assert_eq!((timed.m_function_ms, timed.tool_change_ms), (200, 6000));
         let lathe = load("[machine]\naxes = [\"X\", \"Z\"]\ndiameter-axis = \"x\"\n", &[]).unwrap();
         assert_eq!(lathe.machine.diameter_axis, Some(b'X'));
     }

@@ -46,6 +46,10 @@ pub struct MachineConfig {
     /// The wait after a stop for the in-position window of machine
     /// constants R06–R07, in ms; the default is an assumption too.
     pub settle_time_ms: u32,
+    /// What an M function (besides stops and the tool change) and a tool
+    /// change M06 take, in ms: the machine's PLC decides, so none by default.
+    pub m_function_ms: u32,
+    pub tool_change_ms: u32,
 }
 
 /// How far an axis may travel, in thousandths (µm, or thousandths of a
@@ -71,6 +75,8 @@ impl Default for MachineConfig {
             tools: ToolTable::default(),
             block_pause_ms: 20,
             settle_time_ms: 10,
+            m_function_ms: 0,
+            tool_change_ms: 0,
         }
     }
 }

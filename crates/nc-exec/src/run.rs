@@ -122,6 +122,11 @@ pub struct Step {
     pub stop: Option<Stop>,
     /// How the block joins the one before it (G group 2).
     pub joining: Joining,
+    /// M functions the block runs besides program stops, ends and the tool
+    /// change, and whether it changes the tool (M06); each takes the
+    /// machine's time for it.
+    pub m_functions: u8,
+    pub tool_change: bool,
 }
 
 /// Block joining, group 2 (04 §1.2).
@@ -1070,7 +1075,9 @@ impl<'a> Runner<'a> {
             None
         };
         let path = moved.path;
-        self.record(range, &self.position.clone(), moved, stop);
+        let m_functions = codes.iter().filter(|&&(letter, code, _)| letter == b'M' && !matches!(code, 0..=2 | 6 | 30));
+        let functions = (u8::try_from(m_functions.count()).unwrap_or(u8::MAX), has(b'M', 6));
+        self.record(range, &self.position.clone(), moved, stop, functions);
         if let Err(error) = self.compensate(start, path) {
             let range = self.steps[error.block()].range;
             self.finding(range, &format!("radius compensation: {error}"), true);
@@ -1382,7 +1389,9 @@ impl<'a> Runner<'a> {
 
     /// Adds a step of the block at `range` that ends at `end`. Its start
     /// time follows from the durations when the run ends.
-    fn record(&mut self, range: TextRange, end: &Position, moved: Moved, stop: Option<Stop>) {
+    /// Records a step; `functions` are its M functions and tool change.
+    fn record(&mut self, range: TextRange, end: &Position, moved: Moved, stop: Option<Stop>, functions: (u8, bool)) {
+        let (m_functions, tool_change) = functions;
         let Moved { motion, length, duration, feed, path } = moved;
         let (source, end, frame) = (self.source, self.machine_axes(end), self.frames.len() - 1);
         let joining = match self.modes.active(self.groups.joining) {
@@ -1390,7 +1399,22 @@ impl<'a> Runner<'a> {
             Some(24) => Joining::Tight,
             _ => Joining::Basic,
         };
-        self.steps.push(Step { source, range, motion, path, duration, length, feed, end, frame, stop, joining });
+        let step = Step {
+            source,
+            range,
+            motion,
+            path,
+            duration,
+            length,
+            feed,
+            end,
+            frame,
+            stop,
+            joining,
+            m_functions,
+            tool_change,
+        };
+        self.steps.push(step);
     }
 
     /// A position by letter over the machine's axes, as steps keep it.
@@ -1468,7 +1492,7 @@ impl<'a> Runner<'a> {
                 CycleStep::Dwell { seconds } => (Motion::Dwell, seconds, None, Path::Straight),
                 CycleStep::Spindle { .. } => continue,
             };
-            self.record(range, &to, Moved { motion, length, duration, feed, path }, None);
+            self.record(range, &to, Moved { motion, length, duration, feed, path }, None, (0, false));
             at = to;
         }
         self.position = physical(&cycle.end());

@@ -63,6 +63,9 @@ pub struct Dynamics {
     /// The shortest moves (s) continuity and tight joining join.
     pub min_continuity: f64,
     pub min_tight_joining: f64,
+    /// Seconds an M function and a tool change take.
+    pub m_function_time: f64,
+    pub tool_change_time: f64,
 }
 
 /// What the model assumes for machine constants the manual gives no value
@@ -94,6 +97,8 @@ impl Dynamics {
             settle_time: f64::from(machine.settle_time_ms) / 1000.0,
             min_continuity: for_control(machine, MIN_CONTINUITY_MS) / 1000.0,
             min_tight_joining: for_control(machine, MIN_TIGHT_JOINING_MS) / 1000.0,
+            m_function_time: f64::from(machine.m_function_ms) / 1000.0,
+            tool_change_time: f64::from(machine.tool_change_ms) / 1000.0,
         }
     }
 }
@@ -315,7 +320,10 @@ impl Timed {
     /// `after` where that one ends.
     fn finish(self, next: Option<&Move>, after: f64, trace: &Trace, dynamics: &Dynamics, timing: &mut Timing) {
         let Timed { index, this, entry, exit, stop } = self;
-        let mut profile = profile(&this, entry, exit, trace.steps[index].duration);
+        let step = &trace.steps[index];
+        let mut profile = profile(&this, entry, exit, step.duration);
+        profile.duration += f64::from(step.m_functions) * dynamics.m_function_time
+            + if step.tool_change { dynamics.tool_change_time } else { 0.0 };
         match (stop, next) {
             (Some(reason), Some(next)) if this.kind != Kind::Still => {
                 let pause = pause_after(&this, next, dynamics);
@@ -660,6 +668,16 @@ mod tests {
         let first = 2.0 * (1000.0f64).sqrt() / 1000.0;
         close(timing.profiles[0].duration, first + 0.020);
         close(timing.profiles[1].duration, rest_to_rest(100.0, 100.0, 1000.0) + 0.010);
+    }
+
+    #[test]
+    fn m_functions_and_tool_changes_take_the_machines_times() {
+        let machine = MachineConfig { m_function_ms: 200, tool_change_ms: 6000, ..MachineConfig::default() };
+        // M06 is the tool change; M03 and M08 two M functions; M30 ends.
+        let trace = run("%1\nN1 T1 M06\nN2 M03 M08 S1000\nN3 M30\n", &NoFiles, &machine, 100);
+        let timing = time(&trace, &Dynamics::of(&machine));
+        let durations: Vec<f64> = timing.profiles.iter().map(|profile| profile.duration).collect();
+        assert_eq!(durations, [6.0, 0.4, 0.0]);
     }
 
     #[test]
