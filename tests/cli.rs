@@ -384,6 +384,31 @@ fn explain_list_prints_the_counts() {
     }
 }
 
+/// `ncc plot` draws the moves with their lines, rapids dashed, an arc as
+/// chords, the breaks marked and the total time in the legend.
+#[test]
+fn plot_draws_the_toolpath_as_svg() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("PLOT.NCP");
+    let text = "%1\nN1 G00 X10 Y0\nN2 G01 X20 F600\nN3 G03 X30 Y0 I5 J0\nN4 M30\n";
+    std::fs::write(&program, text).unwrap();
+    let svg = dir.path().join("plot.svg");
+    let output = ncc(&["plot", program.to_str().unwrap(), "-o", svg.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
+    let svg = std::fs::read_to_string(svg).unwrap();
+    assert!(svg.starts_with("<svg xmlns=\"http://www.w3.org/2000/svg\""), "{svg}");
+    assert!(svg.trim_end().ends_with("</svg>"));
+    let paths: Vec<&str> = svg.lines().filter(|line| line.starts_with("<path")).collect();
+    assert_eq!(paths.len(), 3, "{svg}");
+    assert!(paths[0].contains("data-line=\"2\"") && paths[0].contains("stroke-dasharray"), "the rapid: {}", paths[0]);
+    assert!(paths[1].contains("data-line=\"3\"") && paths[1].contains("line 3: 600 mm/min"), "{}", paths[1]);
+    // A half circle in chords of 5°: 36 chords, 37 points.
+    assert_eq!(paths[2].matches(" L").count(), 36, "{}", paths[2]);
+    // Stops after the rapid, between the G98 moves and before M30.
+    assert_eq!(svg.lines().filter(|line| line.starts_with("<circle data-line")).count(), 3, "{svg}");
+    assert!(svg.contains("XY plane · total time"), "{svg}");
+}
+
 /// On a lathe the summary gives the end on the diameter axis as the
 /// diameter the program wrote (`N640 G00 X100. Z100.`), the JSON as a radius.
 #[test]

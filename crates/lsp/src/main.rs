@@ -2,6 +2,7 @@
 
 mod check;
 mod explain;
+mod plot;
 mod report;
 mod rules;
 mod run;
@@ -92,6 +93,19 @@ enum Command {
         #[arg(long, default_value_t = nc_exec::run::DEFAULT_STEP_BUDGET)]
         step_budget: usize,
     },
+    /// Draw the toolpath as an SVG picture: XY (ZX on a lathe), feed moves
+    /// coloured by the speed of the velocity model, rapid moves dashed, the
+    /// breaks of the path speed marked, with a legend and the total time.
+    Plot {
+        /// The program to draw.
+        file: PathBuf,
+        /// The SVG file to write.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Stop after running this many blocks.
+        #[arg(long, default_value_t = nc_exec::run::DEFAULT_STEP_BUDGET)]
+        step_budget: usize,
+    },
     /// Write a program as the moves it runs: plain numbered blocks with
     /// calls, jumps, cycles and parameters resolved.
     ///
@@ -135,6 +149,7 @@ fn main() -> ExitCode {
         Command::Run { file, format, step_budget } => run::run(&file, format, step_budget),
         Command::Expand { file, output, step_budget } => run::expand(&file, output.as_deref(), step_budget),
         Command::Lower { file } => run::lower(&file),
+        Command::Plot { file, output, step_budget } => run::plot(&file, &output, step_budget),
         Command::Parse { file } => match check::read_program(&file) {
             Ok(text) => {
                 let parse = ncc_syntax::Parse::new(&text, ncc_syntax::Dialect::Cnc8x6);

@@ -137,6 +137,30 @@ pub(crate) fn expand(path: &Path, output: Option<&Path>, step_budget: usize) -> 
     }
 }
 
+/// `ncc plot FILE -o OUT`: the toolpath as an SVG picture.
+pub(crate) fn plot(path: &Path, output: &Path, step_budget: usize) -> ExitCode {
+    let ran = match Ran::new(path, step_budget) {
+        Ok(ran) => ran,
+        Err(code) => return code,
+    };
+    let title = format!("{} · ncc plot", path.display());
+    let svg = crate::plot::svg(&ran.trace, &ran.timing, &ran, &title);
+    match std::fs::write(output, svg) {
+        Ok(()) => ran.exit_code(),
+        Err(error) => {
+            eprintln!("error: writing {}: {error}", output.display());
+            ExitCode::from(2)
+        }
+    }
+}
+
+impl crate::plot::Lines for Ran {
+    fn line_of(&self, step: usize) -> u32 {
+        let step = &self.trace.steps[step];
+        self.sources[step.source].line(step.range.start())
+    }
+}
+
 /// `ncc lower FILE`: each block as the executor reads it, after its line.
 pub(crate) fn lower(path: &Path) -> ExitCode {
     let text = match check::read_program(path) {
@@ -576,7 +600,7 @@ impl Source {
 }
 
 /// `h:mm:ss.sss`.
-fn clock(seconds: f64) -> String {
+pub(crate) fn clock(seconds: f64) -> String {
     let whole = seconds.max(0.0);
     let hours = (whole / 3600.0).floor();
     let minutes = ((whole - hours * 3600.0) / 60.0).floor();
