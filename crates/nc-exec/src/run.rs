@@ -233,15 +233,6 @@ pub struct Trace {
 }
 
 impl Trace {
-    /// When each step starts, in seconds since the program started.
-    pub fn start_times(&self) -> impl Iterator<Item = f64> + '_ {
-        self.steps.iter().scan(0.0, |time, step| {
-            let start = *time;
-            *time += step.duration;
-            Some(start)
-        })
-    }
-
     /// Time and length by kind of block, and the program stops, in one
     /// pass over the steps (a long run's steps are hundreds of megabytes).
     pub fn totals(&self) -> Totals {
