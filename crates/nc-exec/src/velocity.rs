@@ -681,6 +681,18 @@ mod tests {
     }
 
     #[test]
+    fn a_subprogram_called_q_times_and_a_jump_loop() {
+        // Each run of the 10 mm move ends at the non-motion G70 or G73
+        // block: from rest to rest at R236, then the settle.
+        let one_run = rest_to_rest(10.0, 10.0, 400.0) + 0.010;
+        let called = timed("%1\nN1 G23 G01 F600 G71 L1 Q3\nN2 M30\nN3 G79 L1\nN4 G91 X10\nN5 G70\n");
+        close(called.total_time(), 3.0 * one_run);
+        let looped = timed("%1\nN1 G23 G91 G01 F600\nN2 X10\nN3 G73 L2 Q2\nN4 M30\n");
+        close(looped.total_time(), 3.0 * one_run);
+        assert_eq!(looped.breaks.len(), 3);
+    }
+
+    #[test]
     fn rapid_moves_stop_at_both_ends() {
         let timing = timed("%1\nN1 G23 G01 X10 F600\nN2 G00 X100\nN3 G01 X110\nN4 M30\n");
         let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason)).collect();
