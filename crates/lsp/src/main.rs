@@ -77,15 +77,18 @@ enum Command {
     /// Run a program on the executor and print what the machine would do.
     ///
     /// The summary splits the time into cutting, rapid and dwell, with the
-    /// path lengths, the tools used and the end position. The executor
-    /// runs motion, threads, feed units, constant cutting speed, dwell,
-    /// parameters and their arithmetic, subprograms, macrocycle files,
-    /// jumps and fixed cycles; anything else it names as not run yet. Exit
-    /// status 1 when the run stopped on an error.
+    /// path lengths, the tools used and the end position. Times follow the
+    /// control's velocity model (ramps, block joining G98/G24/G23, R39
+    /// corners, one block of look-ahead, the arc limit); the summary lists
+    /// the breaks where the path speed drops and what they cost. The
+    /// executor runs motion, threads, feed units, constant cutting speed,
+    /// dwell, parameters and their arithmetic, subprograms, macrocycle
+    /// files, jumps and fixed cycles; anything else it names as not run yet.
+    /// Exit status 1 when the run stopped on an error.
     Run {
         /// The program to run.
         file: PathBuf,
-        /// Output format: `json` adds a record per block.
+        /// Output format: `json` adds a record per block and every break.
         #[arg(long, value_enum, default_value_t = run::Format::Human)]
         format: run::Format,
         /// Stop after running this many blocks (a jump loop that never

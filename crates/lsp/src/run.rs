@@ -1,7 +1,9 @@
-//! `ncc run FILE`: runs a program on the executor and prints what the
-//! machine would do: the time split into cutting, rapid and dwell, the
-//! path lengths, the tools and the end position; `--format json` adds a
-//! record per block.
+//! `ncc run FILE`: runs a program on the executor, times it with the
+//! velocity model and prints what the machine would do: the time split
+//! into cutting, rapid and dwell, the path lengths, the tools, the end
+//! position and the breaks of the path speed; `--format json` adds a
+//! record per block and every break. `ncc expand`, `ncc plot` and
+//! `ncc lower` share the run.
 
 use std::{
     cell::{OnceCell, RefCell},
