@@ -38,6 +38,18 @@ const CHORD_ERROR: f64 = 0.001;
 pub const MIN_CONTINUITY_MS: (f64, f64) = (60.0, 4.0);
 pub const MIN_TIGHT_JOINING_MS: (f64, f64) = (30.0, 2.0);
 
+/// The spatial angle in degrees between the motion directions (unit
+/// vectors over the first three axes) at a junction, which the control
+/// compares with R39.
+pub fn junction_angle(before: [f64; 3], after: [f64; 3]) -> f64 {
+    before.iter().zip(after).map(|(a, b)| a * b).sum::<f64>().clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// Machine constant R39 in degrees (thousandths, the decimal point valid).
+pub fn tolerance_angle(machine: &MachineConfig) -> f64 {
+    machine.constant(39) as f64 / 1000.0
+}
+
 /// The CNC8x6 or CNC8x9 value of a limit: envelope velocity (R338 decade
 /// 2) exists only on CNC8x9; otherwise the control is the CNC8x6.
 pub fn for_control(machine: &MachineConfig, (cnc8x6, cnc8x9): (f64, f64)) -> f64 {
@@ -88,8 +100,7 @@ impl Dynamics {
         };
         Dynamics {
             continuity: machine.known_decade(97, 1).unwrap_or(ASSUMED_CONTINUITY),
-            // Thousandths of a degree.
-            tolerance_angle: machine.constant(39) as f64 / 1000.0,
+            tolerance_angle: tolerance_angle(machine),
             feed_acceleration,
             continuity_acceleration,
             rapid_acceleration: acceleration(237),
@@ -454,10 +465,9 @@ fn stop_reason(this: &Move, next: &Move, dynamics: &Dynamics) -> Option<Reason> 
             return Some(Reason::BeyondThreeAxes);
         }
         let cosine: f64 = this.end_direction.iter().zip(&next.start_direction).map(|(a, b)| a * b).sum();
-        let cosine = cosine.clamp(-1.0, 1.0);
-        // Not below R39; the angle itself only for the report.
-        if cosine <= dynamics.tolerance_angle.to_radians().cos() {
-            let angle = cosine.acos().to_degrees();
+        // Not below R39: the arc cosine only near and past the limit.
+        if cosine <= dynamics.tolerance_angle.to_radians().cos() + 1e-9 {
+            let angle = junction_angle(this.end_direction, next.start_direction);
             if angle >= dynamics.tolerance_angle {
                 return Some(Reason::Corner { angle, limit: dynamics.tolerance_angle });
             }

@@ -12,7 +12,7 @@
 
 use std::f64::consts::TAU;
 
-use nc_exec::velocity::{MIN_CONTINUITY_MS, MIN_TIGHT_JOINING_MS, for_control};
+use nc_exec::velocity::{MIN_CONTINUITY_MS, MIN_TIGHT_JOINING_MS, for_control, junction_angle, tolerance_angle};
 use ncc_catalog::{AddressRole, Dialect};
 use ncc_syntax::{Decimal, TextRange, TextSize};
 
@@ -658,9 +658,8 @@ fn check_junction_angle(visit: &Visit<'_>, previous: &SmoothBlock, path: Option<
     else {
         return;
     };
-    let cosine = before.iter().zip(after).map(|(a, b)| a * b).sum::<f64>().clamp(-1.0, 1.0);
-    let angle = cosine.acos().to_degrees();
-    let tolerance = visit.config.machine.constant(39) as f64 / 1000.0;
+    let angle = junction_angle(before, after);
+    let tolerance = tolerance_angle(&visit.config.machine);
     if angle >= tolerance {
         out.push(
             Diagnostic::new(
