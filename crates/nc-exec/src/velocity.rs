@@ -503,16 +503,24 @@ fn profile(this: &Move, entry: f64, exit: f64, fallback: f64) -> Profile {
     if this.kind == Kind::Still || this.length <= 0.0 {
         return Profile { duration: fallback, ..Profile::default() };
     }
+    // Without ramps the move runs at its speed from end to end.
+    let (entry, exit) = if this.no_ramps { (this.cruise, this.cruise) } else { (entry, exit) };
     let per_minute = |speed: f64| speed * 60.0;
-    if this.no_ramps {
-        let speed = this.cruise;
-        let duration = this.length / speed;
-        return Profile { entry: per_minute(speed), peak: per_minute(speed), exit: per_minute(speed), duration };
+    Profile {
+        entry: per_minute(entry),
+        peak: per_minute(peak_speed(this, entry, exit)),
+        exit: per_minute(exit),
+        duration: run_time(this, entry, exit),
     }
-    let duration = run_time(this, entry, exit);
-    let a = this.acceleration;
-    let peak = ((2.0 * a * this.length + entry * entry + exit * exit) / 2.0).sqrt().min(this.cruise);
-    Profile { entry: per_minute(entry), peak: per_minute(peak), exit: per_minute(exit), duration }
+}
+
+/// The highest speed of `this` between `entry` and `exit` (mm/s): its
+/// cruise speed, or the top of the triangle when it is too short for it.
+fn peak_speed(this: &Move, entry: f64, exit: f64) -> f64 {
+    if this.no_ramps {
+        return this.cruise;
+    }
+    ((2.0 * this.acceleration * this.length + entry * entry + exit * exit) / 2.0).sqrt().min(this.cruise)
 }
 
 /// Seconds to run `this` from `entry` to `exit` (mm/s), at most at its
@@ -526,7 +534,7 @@ fn run_time(this: &Move, entry: f64, exit: f64) -> f64 {
     if ramps <= length {
         (cruise - entry) / a + (cruise - exit) / a + (length - ramps) / cruise
     } else {
-        let peak = ((2.0 * a * length + entry * entry + exit * exit) / 2.0).sqrt();
+        let peak = peak_speed(this, entry, exit);
         (peak - entry) / a + (peak - exit) / a
     }
 }
