@@ -36,8 +36,8 @@ pub(crate) enum Format {
 /// A program run on the machine of its project.
 struct Ran {
     trace: Trace,
-    /// The trace timed with the control's velocity model.
-    timing: Timing,
+    /// The machine's dynamics, for the velocity model.
+    dynamics: Dynamics,
     sources: Vec<Source>,
     /// The program's number from its `%` header.
     number: Option<u32>,
@@ -65,12 +65,16 @@ impl Ran {
         if let Some(bar) = library.progress.get() {
             bar.finish_and_clear();
         }
-        let timing = velocity::time(&trace, &Dynamics::of(&config.machine));
         let sources = library.sources(path, text, &trace);
         for finding in &trace.findings {
             eprintln!("{}: {}", sources[finding.source].place(finding.range.start()), finding.message);
         }
-        Ok(Ran { trace, timing, sources, number })
+        Ok(Ran { trace, dynamics: Dynamics::of(&config.machine), sources, number })
+    }
+
+    /// The run timed with the control's velocity model.
+    fn timing(&self) -> Timing {
+        velocity::time(&self.trace, &self.dynamics)
     }
 
     fn exit_code(&self) -> ExitCode {
@@ -83,13 +87,14 @@ pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
         Ok(ran) => ran,
         Err(code) => return code,
     };
+    let timing = ran.timing();
     let written = match format {
         Format::Human => {
             let mut out = io::stdout().lock();
-            out.write_all(summary(path, &ran).as_bytes()).and_then(|()| out.flush())
+            out.write_all(summary(path, &ran, &timing).as_bytes()).and_then(|()| out.flush())
         }
         Format::Json => {
-            let report = Report::new(path, &ran);
+            let report = Report::new(path, &ran, &timing);
             let mut out = io::BufWriter::new(io::stdout().lock());
             serde_json::to_writer_pretty(&mut out, &report)
                 .map_err(io::Error::from)
@@ -146,7 +151,7 @@ pub(crate) fn plot(path: &Path, output: &Path, step_budget: usize) -> ExitCode {
         Err(code) => return code,
     };
     let title = format!("{} · ncc plot", path.display());
-    let svg = crate::plot::svg(&ran.trace, &ran.timing, &ran, &title);
+    let svg = crate::plot::svg(&ran.trace, &ran.timing(), &ran, &title);
     match std::fs::write(output, svg) {
         Ok(()) => ran.exit_code(),
         Err(error) => {
@@ -193,14 +198,14 @@ pub(crate) fn lower(path: &Path) -> ExitCode {
 /// moves and threads always stop); JSON lists them all.
 const LISTED_BREAKS: usize = 10;
 
-fn summary(path: &Path, ran: &Ran) -> String {
-    let (trace, timing) = (&ran.trace, &ran.timing);
+fn summary(path: &Path, ran: &Ran, timing: &Timing) -> String {
+    let trace = &ran.trace;
     let mut out = String::new();
     let (feed, rapid) = (Motion::Feed, Motion::Rapid);
     let totals = trace.totals_with(timing.profiles.iter().map(|profile| profile.duration));
     let _ = writeln!(out, "{}", path.display());
-    let at_feed = trace.totals().total_time;
-    let _ = writeln!(out, "  total time   {}  ({} at the programmed feeds)", clock(totals.total_time), clock(at_feed));
+    let (total, at_feed) = (clock(totals.total_time), clock(totals.programmed_time));
+    let _ = writeln!(out, "  total time   {total}  ({at_feed} at the programmed feeds)");
     let _ = writeln!(out, "    cutting    {}  {:>12.3} mm", clock(totals.time(feed)), totals.length(feed));
     let _ = writeln!(out, "    rapid      {}  {:>12.3} mm", clock(totals.time(rapid)), totals.length(rapid));
     let _ = writeln!(out, "    dwell      {}", clock(totals.time(Motion::Dwell)));
@@ -302,8 +307,7 @@ fn summary(path: &Path, ran: &Ran) -> String {
         if let Some(place) = current {
             keep(place);
         }
-        let places = top;
-        for (speed_break, times, lost) in places {
+        for (speed_break, times, lost) in top {
             let step = &trace.steps[speed_break.step];
             let place = ran.sources[step.source].place(step.range.start());
             let times = if times > 1 { format!(" ({times} runs)") } else { String::new() };
@@ -339,14 +343,14 @@ struct Report<'a> {
 }
 
 impl<'a> Report<'a> {
-    fn new(path: &Path, ran: &'a Ran) -> Report<'a> {
-        let (trace, timing, sources) = (&ran.trace, &ran.timing, &ran.sources);
+    fn new(path: &Path, ran: &'a Ran, timing: &'a Timing) -> Report<'a> {
+        let (trace, sources) = (&ran.trace, &ran.sources);
         let axes = &trace.axes;
         let totals = trace.totals_with(timing.profiles.iter().map(|profile| profile.duration));
         Report {
             file: path.display().to_string(),
             total_time_s: totals.total_time,
-            programmed_time_s: trace.totals().total_time,
+            programmed_time_s: totals.programmed_time,
             cutting_time_s: totals.time(Motion::Feed),
             rapid_time_s: totals.time(Motion::Rapid),
             dwell_time_s: totals.time(Motion::Dwell),

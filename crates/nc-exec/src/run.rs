@@ -74,6 +74,8 @@ pub enum Motion {
 pub struct Totals {
     /// Seconds from the program's start to its end.
     pub total_time: f64,
+    /// The same at the programmed feeds: the steps' own durations.
+    pub programmed_time: f64,
     /// Seconds and mm by [`Motion`].
     time: [f64; 4],
     length: [f64; 4],
@@ -245,6 +247,7 @@ impl Trace {
         let mut totals = Totals::default();
         for (step, duration) in self.steps.iter().zip(durations) {
             totals.total_time += duration;
+            totals.programmed_time += step.duration;
             totals.time[step.motion as usize] += duration;
             totals.length[step.motion as usize] += step.length;
             match step.stop {
