@@ -18,8 +18,9 @@ use line_index::LineIndex;
 use nc_exec::{
     arith::{Message, MessageDisplay},
     lower::BlockData,
-    run::{Axes, Called, Environment, Motion, Stop, Trace},
-    velocity::{self, Dynamics, Timing},
+    machine::MachineConfig,
+    run::{Axes, Called, Environment, Motion, Step, StepSink, Stop, Totals, Trace},
+    velocity::{self, Dynamics, Timer, Timing, TimingSink},
 };
 use ncc_analysis::Config;
 use ncc_syntax::{BlockParser, Dialect, Parse, TextSize, ast::AstNode};
@@ -43,10 +44,17 @@ struct Ran {
     number: Option<u32>,
 }
 
-impl Ran {
-    /// Runs the program at `path`; the error is the exit code after the
-    /// message is printed.
-    fn new(path: &Path, step_budget: usize) -> Result<Ran, ExitCode> {
+/// A program read with its project's machine, ready to run.
+struct Program<'a> {
+    path: &'a Path,
+    text: String,
+    machine: MachineConfig,
+}
+
+impl<'a> Program<'a> {
+    /// Reads the program at `path` and its project's configuration; the
+    /// error is the exit code after the message is printed.
+    fn read(path: &'a Path) -> Result<Program<'a>, ExitCode> {
         let text = check::read_program(path).map_err(|error| {
             eprintln!("error: {}: {error}", path.display());
             ExitCode::from(2)
@@ -55,13 +63,27 @@ impl Ran {
             eprintln!("error: {error}");
             ExitCode::from(2)
         })?;
-        let config = config.unwrap_or_default();
+        Ok(Program { path, text, machine: config.unwrap_or_default().machine })
+    }
+
+    /// Runs it keeping every step.
+    fn run(self, step_budget: usize) -> Ran {
+        self.run_into(step_budget, None)
+    }
+
+    /// Runs it handing the steps to `sink` as they come (the trace keeps
+    /// none), or keeping them.
+    fn run_into(self, step_budget: usize, sink: Option<&mut dyn StepSink>) -> Ran {
+        let Program { path, text, machine } = self;
         let number = BlockParser::new(&text)
             .header()
             .and_then(|header| header.number())
             .and_then(|n| u32::try_from(n.scaled(0)?).ok());
         let library = Library::for_program(path);
-        let trace = nc_exec::run::run(&text, &library, &config.machine, step_budget);
+        let trace = match sink {
+            Some(sink) => nc_exec::run::run_into(&text, &library, &machine, step_budget, sink),
+            None => nc_exec::run::run(&text, &library, &machine, step_budget),
+        };
         if let Some(bar) = library.progress.get() {
             bar.finish_and_clear();
         }
@@ -69,7 +91,24 @@ impl Ran {
         for finding in &trace.findings {
             eprintln!("{}: {}", sources[finding.source].place(finding.range.start()), finding.message);
         }
-        Ok(Ran { trace, dynamics: Dynamics::of(&config.machine), sources, number })
+        Ran { trace, dynamics: Dynamics::of(&machine), sources, number }
+    }
+
+    /// Runs it through the velocity model as the steps come, keeping only
+    /// what the summary shows.
+    fn tally(self, step_budget: usize) -> (Ran, Tally) {
+        let dynamics = Dynamics::of(&self.machine);
+        let axes = self.machine.step_axes().to_vec();
+        let mut timer = Timer::new(&axes, &dynamics, Tally::default());
+        let ran = self.run_into(step_budget, Some(&mut timer));
+        (ran, timer.finish())
+    }
+}
+
+impl Ran {
+    /// Runs the program at `path`, keeping every step.
+    fn new(path: &Path, step_budget: usize) -> Result<Ran, ExitCode> {
+        Ok(Program::read(path)?.run(step_budget))
     }
 
     /// The run timed with the control's velocity model.
@@ -83,23 +122,27 @@ impl Ran {
 }
 
 pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
-    let ran = match Ran::new(path, step_budget) {
-        Ok(ran) => ran,
+    let program = match Program::read(path) {
+        Ok(program) => program,
         Err(code) => return code,
     };
-    let timing = ran.timing();
-    let written = match format {
+    let (ran, written) = match format {
         Format::Human => {
+            let (ran, tally) = program.tally(step_budget);
             let mut out = io::stdout().lock();
-            out.write_all(summary(path, &ran, &timing).as_bytes()).and_then(|()| out.flush())
+            let written = out.write_all(summary(path, &ran, &tally).as_bytes()).and_then(|()| out.flush());
+            (ran, written)
         }
         Format::Json => {
+            let ran = program.run(step_budget);
+            let timing = ran.timing();
             let report = Report::new(path, &ran, &timing);
             let mut out = io::BufWriter::new(io::stdout().lock());
-            serde_json::to_writer_pretty(&mut out, &report)
+            let written = serde_json::to_writer_pretty(&mut out, &report)
                 .map_err(io::Error::from)
                 .and_then(|()| writeln!(out))
-                .and_then(|()| out.flush())
+                .and_then(|()| out.flush());
+            (ran, written)
         }
     };
     if let Err(error) = written
@@ -198,11 +241,48 @@ pub(crate) fn lower(path: &Path) -> ExitCode {
 /// moves and threads always stop); JSON lists them all.
 const LISTED_BREAKS: usize = 10;
 
-fn summary(path: &Path, ran: &Ran, timing: &Timing) -> String {
+/// What the summary shows of a run's steps, gathered as the velocity
+/// model times them: a long run never holds its steps.
+#[derive(Default)]
+struct Tally {
+    totals: Totals,
+    /// The programmed position at the end.
+    end: Axes,
+    breaks: Vec<PlacedBreak>,
+}
+
+/// A break with the file and the block it is at.
+struct PlacedBreak {
+    source: u32,
+    at: TextSize,
+    speed_break: velocity::Break,
+}
+
+impl PlacedBreak {
+    /// The place a break is at, by kind: a block that runs many times (a
+    /// loop, a subprogram) is one place.
+    fn place(&self) -> (u32, TextSize, &'static str) {
+        (self.source, self.at, self.speed_break.reason.code())
+    }
+}
+
+impl TimingSink for Tally {
+    fn speed_break(&mut self, step: &Step, speed_break: velocity::Break) {
+        let source = u32::try_from(step.source).unwrap_or(u32::MAX);
+        self.breaks.push(PlacedBreak { source, at: step.range.start(), speed_break });
+    }
+
+    fn timed(&mut self, step: &Step, profile: velocity::Profile) {
+        self.totals.add(step, profile.duration);
+        self.end = step.end;
+    }
+}
+
+fn summary(path: &Path, ran: &Ran, tally: &Tally) -> String {
     let trace = &ran.trace;
     let mut out = String::new();
     let (feed, rapid) = (Motion::Feed, Motion::Rapid);
-    let totals = trace.totals_with(timing.profiles.iter().map(|profile| profile.duration));
+    let totals = &tally.totals;
     let _ = writeln!(out, "{}", path.display());
     let (total, at_feed) = (clock(totals.total_time), clock(totals.programmed_time));
     let _ = writeln!(out, "  total time   {total}  ({at_feed} at the programmed feeds)");
@@ -230,17 +310,17 @@ fn summary(path: &Path, ran: &Ran, timing: &Timing) -> String {
     let position: Vec<String> = trace
         .axes
         .iter()
-        .zip(trace.end())
+        .zip(tally.end)
         .map(|(&axis, value)| format!("{}{:.3}", char::from(axis), as_written(axis, value)))
         .collect();
     let diameter = trace.diameter_axis.map(|axis| format!(" ({} as a diameter)", char::from(axis))).unwrap_or_default();
     let _ = writeln!(out, "  end position {}{diameter}", position.join(" "));
-    if !timing.breaks.is_empty() {
-        let lost: f64 = timing.breaks.iter().map(|b| b.lost).sum();
-        let count = timing.breaks.len();
+    let breaks = &tally.breaks;
+    if !breaks.is_empty() {
+        let lost: f64 = breaks.iter().map(|placed| placed.speed_break.lost).sum();
         let mut by_reason: Vec<(&str, usize)> = Vec::new();
-        for speed_break in &timing.breaks {
-            let code = speed_break.reason.code();
+        for placed in breaks {
+            let code = placed.speed_break.reason.code();
             match by_reason.iter_mut().find(|(known, _)| *known == code) {
                 Some((_, n)) => *n += 1,
                 None => by_reason.push((code, 1)),
@@ -250,35 +330,26 @@ fn summary(path: &Path, ran: &Ran, timing: &Timing) -> String {
         let by_reason: Vec<String> = by_reason.iter().map(|(code, n)| format!("{n} {code}")).collect();
         let _ = writeln!(
             out,
-            "  breaks       {count} where the path speed drops ({}), costing {}",
+            "  breaks       {} where the path speed drops ({}), costing {}",
+            breaks.len(),
             by_reason.join(", "),
             clock(lost)
         );
-        // The costliest places the program could avoid: a block that runs
-        // many times (a loop, a subprogram) is one place.
-        let place_of = |speed_break: &velocity::Break| {
-            let step = &trace.steps[speed_break.step];
-            (step.source, step.range.start(), speed_break.reason.code())
-        };
         // Grouped by place. A program without loops or calls meets its
         // places in order, and needs no sort.
-        let avoidable = timing.breaks.iter().filter(|speed_break| speed_break.reason.avoidable());
-        let in_order = avoidable.clone().zip(avoidable.clone().skip(1)).all(|(a, b)| {
-            let (a, b) = (&trace.steps[a.step], &trace.steps[b.step]);
-            (a.source, a.range.start()) <= (b.source, b.range.start())
-        });
-        let avoidable: Box<dyn Iterator<Item = &velocity::Break>> = if in_order {
+        let avoidable = breaks.iter().filter(|placed| placed.speed_break.reason.avoidable());
+        let in_order = avoidable.clone().zip(avoidable.clone().skip(1)).all(|(a, b)| a.place() <= b.place());
+        let avoidable: Box<dyn Iterator<Item = &PlacedBreak>> = if in_order {
             Box::new(avoidable)
         } else {
-            let mut sorted: Vec<((usize, TextSize, &str), &velocity::Break)> =
-                avoidable.map(|speed_break| (place_of(speed_break), speed_break)).collect();
-            sorted.sort_by_key(|&(place, _)| place);
-            Box::new(sorted.into_iter().map(|(_, speed_break)| speed_break))
+            let mut sorted: Vec<&PlacedBreak> = avoidable.collect();
+            sorted.sort_by_key(|placed| placed.place());
+            Box::new(sorted.into_iter())
         };
         // Each place's first break, its runs and its cost; the costliest kept.
-        let mut top: Vec<(&velocity::Break, usize, f64)> = Vec::with_capacity(LISTED_BREAKS + 1);
-        let by_cost = |a: &(&velocity::Break, usize, f64), b: &(&velocity::Break, usize, f64)| {
-            b.2.total_cmp(&a.2).then(a.0.step.cmp(&b.0.step))
+        let mut top: Vec<(&PlacedBreak, usize, f64)> = Vec::with_capacity(LISTED_BREAKS + 1);
+        let by_cost = |a: &(&PlacedBreak, usize, f64), b: &(&PlacedBreak, usize, f64)| {
+            b.2.total_cmp(&a.2).then(a.0.speed_break.step.cmp(&b.0.speed_break.step))
         };
         let mut keep = |place| {
             if top.len() == LISTED_BREAKS && top.last().is_some_and(|last| by_cost(&place, last).is_ge()) {
@@ -289,16 +360,17 @@ fn summary(path: &Path, ran: &Ran, timing: &Timing) -> String {
             top.truncate(LISTED_BREAKS);
         };
         let mut listed = 0;
-        let mut current: Option<(&velocity::Break, usize, f64)> = None;
-        for speed_break in avoidable {
+        let mut current: Option<(&PlacedBreak, usize, f64)> = None;
+        for placed in avoidable {
+            let lost = placed.speed_break.lost;
             match &mut current {
-                Some((first, times, lost)) if place_of(first) == place_of(speed_break) => {
+                Some((first, times, total)) if first.place() == placed.place() => {
                     *times += 1;
-                    *lost += speed_break.lost;
+                    *total += lost;
                 }
                 _ => {
                     listed += 1;
-                    if let Some(place) = current.replace((speed_break, 1, speed_break.lost)) {
+                    if let Some(place) = current.replace((placed, 1, lost)) {
                         keep(place);
                     }
                 }
@@ -307,11 +379,10 @@ fn summary(path: &Path, ran: &Ran, timing: &Timing) -> String {
         if let Some(place) = current {
             keep(place);
         }
-        for (speed_break, times, lost) in top {
-            let step = &trace.steps[speed_break.step];
-            let place = ran.sources[step.source].place(step.range.start());
+        for (placed, times, lost) in top {
+            let place = ran.sources[placed.source as usize].place(placed.at);
             let times = if times > 1 { format!(" ({times} runs)") } else { String::new() };
-            let (reason, before, at) = (speed_break.reason, speed_break.before, speed_break.at);
+            let velocity::Break { reason, before, at, .. } = placed.speed_break;
             let _ = writeln!(out, "    {place}  {reason}: {before:.0} → {at:.0} mm/min, {lost:.3} s{times}");
         }
         if listed > LISTED_BREAKS {

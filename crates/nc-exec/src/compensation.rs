@@ -278,6 +278,12 @@ impl Compensator {
         Compensator { settings, offset, start_block: block, start_from: from, start_to: to, pending: None }
     }
 
+    /// The first block whose tool path is not fixed yet: later pieces belong
+    /// to it or to blocks after it.
+    pub fn open_block(&self) -> usize {
+        self.pending.map_or(self.start_block, |pending| pending.block)
+    }
+
     /// Takes the next contour element, of `block`, and returns the tool path
     /// that is now fixed. On an error nothing changes.
     pub fn push(&mut self, block: usize, element: Element) -> Result<Vec<ToolElement>, CompensationError> {

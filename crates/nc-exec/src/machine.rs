@@ -82,6 +82,11 @@ impl Default for MachineConfig {
 }
 
 impl MachineConfig {
+    /// The axes a run's steps keep, in their order: axes 1–6.
+    pub fn step_axes(&self) -> &[u8] {
+        &self.axes[..self.axes.len().min(crate::run::MAX_AXES)]
+    }
+
     /// A machine constant's raw value: configured, else the catalogue's
     /// default, else zero.
     pub fn constant(&self, number: u32) -> i64 {

@@ -94,6 +94,19 @@ impl Totals {
     pub fn length(&self, motion: Motion) -> f64 {
         self.length[motion as usize]
     }
+
+    /// Counts `step`, which took `duration` seconds.
+    pub fn add(&mut self, step: &Step, duration: f64) {
+        self.total_time += duration;
+        self.programmed_time += step.duration;
+        self.time[step.motion as usize] += duration;
+        self.length[step.motion as usize] += step.length;
+        match step.stop {
+            Some(Stop::Program) => self.program_stops += 1,
+            Some(Stop::Optional) => self.optional_stops += 1,
+            None => {}
+        }
+    }
 }
 
 /// One block as it ran.
@@ -246,15 +259,7 @@ impl Trace {
     pub fn totals_with(&self, durations: impl Iterator<Item = f64>) -> Totals {
         let mut totals = Totals::default();
         for (step, duration) in self.steps.iter().zip(durations) {
-            totals.total_time += duration;
-            totals.programmed_time += step.duration;
-            totals.time[step.motion as usize] += duration;
-            totals.length[step.motion as usize] += step.length;
-            match step.stop {
-                Some(Stop::Program) => totals.program_stops += 1,
-                Some(Stop::Optional) => totals.optional_stops += 1,
-                None => {}
-            }
+            totals.add(step, duration);
         }
         totals
     }
@@ -348,8 +353,30 @@ pub enum Called {
 /// needed, and the run reports its progress there. Parameters start at
 /// zero.
 pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget: usize) -> Trace {
-    std::thread::scope(|scope| run_in(scope, text, files, machine, budget))
+    std::thread::scope(|scope| run_in(scope, text, files, machine, budget, None))
 }
+
+/// Takes the steps of a run in order, each once no later block can change
+/// it.
+pub trait StepSink {
+    fn step(&mut self, step: Step);
+}
+
+/// Like [`run`], handing the steps to `sink` as they are final instead of
+/// keeping them: the trace's `steps` stay empty, and a run of any length
+/// holds only the few steps radius compensation may still fix.
+pub fn run_into(
+    text: &str,
+    files: &dyn Environment,
+    machine: &MachineConfig,
+    budget: usize,
+    sink: &mut dyn StepSink,
+) -> Trace {
+    std::thread::scope(|scope| run_in(scope, text, files, machine, budget, Some(sink)))
+}
+
+/// Steps a streaming run gathers before it hands them on.
+const DELIVERY_BATCH: usize = 256;
 
 fn run_in<'a, 's>(
     scope: &'s Scope<'s, 'a>,
@@ -357,12 +384,13 @@ fn run_in<'a, 's>(
     files: &dyn Environment,
     machine: &MachineConfig,
     budget: usize,
+    mut sink: Option<&mut dyn StepSink>,
 ) -> Trace {
     let mut index = Index::start(scope, text);
     let mut runner = Runner::new(machine);
     let reset_frame = runner.frame_in_force();
     // Most programs run each block about once.
-    runner.steps.reserve(expected_blocks(text));
+    runner.steps.reserve(if sink.is_some() { DELIVERY_BATCH } else { expected_blocks(text) });
     // Macrocycle numbers called, and where each file's body starts; the
     // cycle file's source once read; the files read, in source order.
     let mut loaded: Vec<(u32, Option<usize>)> = Vec::new();
@@ -524,12 +552,19 @@ fn run_in<'a, 's>(
             runner.finding(range, "the macrocycle file ends without G70", true);
             break;
         }
+        if let Some(sink) = sink.as_deref_mut()
+            && runner.steps.len() >= DELIVERY_BATCH
+        {
+            runner.deliver(sink, false);
+        }
     }
-    let axes = machine.axes.iter().copied().take(MAX_AXES).collect();
+    if let Some(sink) = sink {
+        runner.deliver(sink, true);
+    }
     // Pieces come in the order compensation fixes them, a block late.
     runner.tool_centre.sort_by_key(|piece| piece.block);
     Trace {
-        axes,
+        axes: machine.step_axes().to_vec(),
         diameter_axis: machine.diameter_axis,
         tool_centre: runner.tool_centre,
         compensated: runner.compensated,
@@ -889,7 +924,9 @@ struct Runner<'a> {
     speed_reached: Option<f64>,
     position: Position,
     params: Parameters,
+    /// The steps not handed on yet: `steps[0]` is step `delivered`.
     steps: Vec<Step>,
+    delivered: usize,
     findings: Vec<Finding>,
     /// T in force, and every T in order of first use.
     tool: Option<u32>,
@@ -935,6 +972,7 @@ impl<'a> Runner<'a> {
             position: [0.0; 26],
             params: Parameters::zeroed(),
             steps: Vec::new(),
+            delivered: 0,
             findings: Vec::new(),
             tool: None,
             tools: Vec::new(),
@@ -1073,7 +1111,7 @@ impl<'a> Runner<'a> {
         let functions = (u8::try_from(m_functions.count()).unwrap_or(u8::MAX), has(b'M', 6));
         self.record(range, &self.position.clone(), moved, stop, functions);
         if let Err(error) = self.compensate(start, path) {
-            let range = self.steps[error.block()].range;
+            let range = self.step_mut(error.block()).range;
             self.finding(range, &format!("radius compensation: {error}"), true);
             return Flow::End;
         }
@@ -1086,7 +1124,7 @@ impl<'a> Runner<'a> {
             offsets: &mut self.offsets,
             corrections: &mut self.corrections,
             messages: &mut self.messages,
-            step: self.steps.len() - 1,
+            step: self.delivered + self.steps.len() - 1,
             registers: Registers {
                 modes: &self.modes,
                 speed: self.speed,
@@ -1312,7 +1350,7 @@ impl<'a> Runner<'a> {
     /// length and time on the steps it belongs to, one block late as the
     /// control's look-ahead fixes them.
     fn compensate(&mut self, start: Position, path: Path) -> Result<(), CompensationError> {
-        let index = self.steps.len() - 1;
+        let index = self.delivered + self.steps.len() - 1;
         let plane = match self.modes.active(self.groups.plane) {
             Some(18) => (b'Z', b'X'),
             Some(19) => (b'Y', b'Z'),
@@ -1329,7 +1367,7 @@ impl<'a> Runner<'a> {
         let point = |position: &Position| Point2::new(position[a], position[b]);
         let (from, to) = (point(&start), point(&self.position));
         let moves_in_plane = from != to || matches!(path, Path::Arc { .. });
-        let linear = matches!(self.steps[index].motion, Motion::Rapid | Motion::Feed) && path == Path::Straight;
+        let linear = matches!(self.step_mut(index).motion, Motion::Rapid | Motion::Feed) && path == Path::Straight;
         let pieces = match (self.compensator.take(), side) {
             (None, Some(side)) if moves_in_plane && linear => {
                 let radius = f64::from(self.corrections.entry(self.correction).radius) / 1000.0;
@@ -1358,7 +1396,8 @@ impl<'a> Runner<'a> {
         let mut charged: Vec<usize> = Vec::new();
         for piece in &pieces {
             let length = piece.path.length();
-            let duration = match (self.steps[piece.block].motion, self.steps[piece.block].feed) {
+            let step = self.step_mut(piece.block);
+            let duration = match (step.motion, step.feed) {
                 (Motion::Feed, Some(feed)) => length / (feed * piece.feed_scale) * 60.0,
                 _ => {
                     let in_plane = |point: Point2<f64>| {
@@ -1369,7 +1408,7 @@ impl<'a> Runner<'a> {
                     self.rapid_seconds(&in_plane(piece.path.start()), &in_plane(piece.path.end()))
                 }
             };
-            let step = &mut self.steps[piece.block];
+            let step = self.step_mut(piece.block);
             if !charged.contains(&piece.block) {
                 charged.push(piece.block);
                 (step.length, step.duration) = (0.0, 0.0);
@@ -1409,6 +1448,24 @@ impl<'a> Runner<'a> {
             tool_change,
         };
         self.steps.push(step);
+    }
+
+    /// Step `index` of the run, not handed on yet.
+    fn step_mut(&mut self, index: usize) -> &mut Step {
+        &mut self.steps[index - self.delivered]
+    }
+
+    /// Hands `sink` the steps no later block can change: all at the `end`,
+    /// else those before the first one radius compensation may still fix.
+    fn deliver(&mut self, sink: &mut dyn StepSink, end: bool) {
+        let open = match &self.compensator {
+            Some(compensator) if !end => compensator.open_block() - self.delivered,
+            _ => self.steps.len(),
+        };
+        self.delivered += open;
+        for step in self.steps.drain(..open) {
+            sink.step(step);
+        }
     }
 
     /// A position by letter over the machine's axes, as steps keep it.
@@ -2039,8 +2096,33 @@ pub(crate) fn round3(value: f64) -> f64 {
 mod tests {
     use std::f64::consts::PI;
 
-    use super::{Axes, Called, Environment, Motion, NoFiles, Path, Stop, Trace, round3, run};
+    use super::{Axes, Called, Environment, Motion, NoFiles, Path, Step, StepSink, Stop, Trace, round3, run, run_into};
     use crate::machine::MachineConfig;
+
+    impl StepSink for Vec<Step> {
+        fn step(&mut self, step: Step) {
+            self.push(step);
+        }
+    }
+
+    #[test]
+    fn a_streamed_run_hands_on_the_steps_a_kept_run_keeps() {
+        // A compensated contour longer than a delivery batch, whose steps
+        // compensation fixes a block late, then a loop of a subprogram.
+        let mut text = String::from("%1\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\n");
+        for i in 0..600 {
+            text.push_str(&format!("N{} X{} Y{}\n", 4 + i, (i + 1) * 2, (i % 2) * 3));
+        }
+        text.push_str("N700 G40 X1300 Y-30\nN701 G71 L5 Q40\nN702 M30\nN703 G79 L5\nN704 G91 X1\nN705 G90 G70\n");
+        let kept = run_text(&text);
+        assert!(kept.findings.is_empty(), "{:?}", kept.findings);
+        assert!(kept.steps.len() > 2 * 256);
+        let mut streamed = Vec::new();
+        let trace = run_into(&text, &NoFiles, &MachineConfig::default(), 1000, &mut streamed);
+        assert!(trace.steps.is_empty());
+        assert_eq!(streamed, kept.steps);
+        assert_eq!(Trace { steps: streamed, ..trace }, kept);
+    }
 
     fn run_text(text: &str) -> Trace {
         run(text, &NoFiles, &MachineConfig::default(), 1000)

@@ -25,7 +25,7 @@
 
 use crate::{
     machine::MachineConfig,
-    run::{Joining, MAX_AXES, Motion, Path, Trace},
+    run::{Axes, Joining, MAX_AXES, Motion, Path, Step, StepSink, Trace},
 };
 
 /// The interpolator tick of the CNC8x6 (000:2749).
@@ -62,8 +62,9 @@ pub struct Dynamics {
     /// Machine constant R97, decade 1: 0 no continuity, 1 manual G23, 2
     /// automatic recognition.
     pub continuity: u8,
-    /// R39 in degrees.
+    /// R39 in degrees, and its cosine, which junctions compare with.
     pub tolerance_angle: f64,
+    tolerance_cosine: f64,
     /// R52, R236 (R52 when 0) and R237 in mm/s².
     pub feed_acceleration: f64,
     pub continuity_acceleration: f64,
@@ -101,6 +102,7 @@ impl Dynamics {
         Dynamics {
             continuity: machine.known_decade(97, 1).unwrap_or(ASSUMED_CONTINUITY),
             tolerance_angle: tolerance_angle(machine),
+            tolerance_cosine: tolerance_angle(machine).to_radians().cos(),
             feed_acceleration,
             continuity_acceleration,
             rapid_acceleration: acceleration(237),
@@ -272,53 +274,113 @@ enum Kind {
     Still,
 }
 
-/// Times every step of `trace` with the velocity model of `dynamics`, in
-/// one pass that holds three moves at a time.
+/// Takes what the model finds, step by step in order.
+pub trait TimingSink {
+    /// A break at the step [`TimingSink::timed`] takes next.
+    fn speed_break(&mut self, step: &Step, speed_break: Break);
+    /// The next step and its profile.
+    fn timed(&mut self, step: &Step, profile: Profile);
+}
+
+impl TimingSink for Timing {
+    fn speed_break(&mut self, _step: &Step, speed_break: Break) {
+        self.breaks.push(speed_break);
+    }
+
+    fn timed(&mut self, _step: &Step, profile: Profile) {
+        self.profiles.push(profile);
+    }
+}
+
+/// Times every step of `trace` with the velocity model of `dynamics`.
 pub fn time(trace: &Trace, dynamics: &Dynamics) -> Timing {
     let count = trace.steps.len();
     // Breaks can come at every step: reserved room never touched costs
     // nothing, growing copies.
-    let mut timing = Timing { profiles: Vec::with_capacity(count), breaks: Vec::with_capacity(count) };
-    if count == 0 {
-        return timing;
+    let timing = Timing { profiles: Vec::with_capacity(count), breaks: Vec::with_capacity(count) };
+    let mut timer = Timer::new(&trace.axes, dynamics, timing);
+    for step in &trace.steps {
+        timer.push(step.clone());
     }
-    let mut this = move_of(trace, 0, dynamics);
-    let mut entry = 0.0;
-    // The step before `this`, finished once the junction after `this` is known.
-    let mut waiting: Option<Timed> = None;
-    for index in 0..count {
-        let next = (index + 1 < count).then(|| move_of(trace, index + 1, dynamics));
-        let (exit, stop) = match &next {
-            None => (0.0, None),
-            Some(next) => match stop_reason(&this, next, dynamics) {
-                Some(reason) => (0.0, Some(reason)),
-                // One block of look-ahead: the next move must be able to
-                // stop within itself; and this one must reach the speed.
-                None => {
-                    let speed = this.cruise.min(next.cruise).min(stopping_speed(next, 0.0));
-                    (speed.min(stopping_speed(&this, entry)), None)
-                }
-            },
+    timer.finish()
+}
+
+/// The model run over steps as they come, holding three at a time: the
+/// step before the junction being decided waits for the speed its
+/// successor ends at, which the lost time of a break needs.
+#[derive(Debug)]
+pub struct Timer<'a, S> {
+    axes: &'a [u8],
+    dynamics: &'a Dynamics,
+    sink: S,
+    /// Steps pushed so far, and where the last one ended.
+    count: usize,
+    end: Axes,
+    /// The last step pushed, whose exit the next step decides, and the
+    /// speed it enters at.
+    current: Option<(Step, Move)>,
+    entry: f64,
+    /// The step before it.
+    waiting: Option<Timed>,
+}
+
+impl<'a, S: TimingSink> Timer<'a, S> {
+    /// A timer for steps over the machine's `axes` ([`Trace::axes`]).
+    pub fn new(axes: &'a [u8], dynamics: &'a Dynamics, sink: S) -> Self {
+        Timer { axes, dynamics, sink, count: 0, end: [0.0; MAX_AXES], current: None, entry: 0.0, waiting: None }
+    }
+
+    /// Takes the next step of the run.
+    pub fn push(&mut self, step: Step) {
+        let dynamics = self.dynamics;
+        let next = move_of(&step, &self.end, self.axes, dynamics);
+        self.end = step.end;
+        self.count += 1;
+        let Some((this_step, this)) = self.current.replace((step, next)) else {
+            return;
         };
-        if let Some(before) = waiting.take() {
-            before.finish(Some(&this), exit, trace, dynamics, &mut timing);
+        let entry = self.entry;
+        let (exit, stop) = match stop_reason(&this, &next, dynamics) {
+            Some(reason) => (0.0, Some(reason)),
+            // One block of look-ahead: the next move must be able to stop
+            // within itself; and this one must reach the speed.
+            None => {
+                let speed = this.cruise.min(next.cruise).min(stopping_speed(&next, 0.0));
+                (speed.min(stopping_speed(&this, entry)), None)
+            }
+        };
+        if let Some(before) = self.waiting.take() {
+            before.finish(Some(&this), exit, dynamics, &mut self.sink);
         }
-        waiting = Some(Timed { index, this, entry, exit, stop });
-        entry = exit;
-        match next {
-            Some(next) => this = next,
-            None => break,
+        let index = self.count - 2;
+        self.waiting = Some(Timed { index, step: this_step, this, entry, exit, stop });
+        self.entry = exit;
+    }
+
+    /// Times the last steps, which end at rest, and hands back the sink.
+    pub fn finish(mut self) -> S {
+        if let Some((step, this)) = self.current.take() {
+            if let Some(before) = self.waiting.take() {
+                before.finish(Some(&this), 0.0, self.dynamics, &mut self.sink);
+            }
+            let last = Timed { index: self.count - 1, step, this, entry: self.entry, exit: 0.0, stop: None };
+            last.finish(None, 0.0, self.dynamics, &mut self.sink);
         }
+        self.sink
     }
-    if let Some(last) = waiting {
-        last.finish(None, 0.0, trace, dynamics, &mut timing);
+}
+
+impl<S: TimingSink> StepSink for Timer<'_, S> {
+    fn step(&mut self, step: Step) {
+        self.push(step);
     }
-    timing
 }
 
 /// A move with the speeds it enters and leaves at.
+#[derive(Debug)]
 struct Timed {
     index: usize,
+    step: Step,
     this: Move,
     entry: f64,
     exit: f64,
@@ -327,11 +389,10 @@ struct Timed {
 }
 
 impl Timed {
-    /// Adds the move's profile and breaks; `next` is the move after it, and
-    /// `after` where that one ends.
-    fn finish(self, next: Option<&Move>, after: f64, trace: &Trace, dynamics: &Dynamics, timing: &mut Timing) {
-        let Timed { index, this, entry, exit, stop } = self;
-        let step = &trace.steps[index];
+    /// Hands on the move's breaks and profile; `next` is the move after it,
+    /// and `after` where that one ends.
+    fn finish(self, next: Option<&Move>, after: f64, dynamics: &Dynamics, sink: &mut impl TimingSink) {
+        let Timed { index, step, this, entry, exit, stop } = self;
         let mut profile = profile(&this, entry, exit, step.duration);
         profile.duration += f64::from(step.m_functions) * dynamics.m_function_time
             + if step.tool_change { dynamics.tool_change_time } else { 0.0 };
@@ -348,14 +409,19 @@ impl Timed {
                     (before, lost_time(&this, next, entry, exit, before, after))
                 };
                 let lost = lost.max(0.0) + pause;
-                timing.breaks.push(Break { step: index, reason, before: before * 60.0, at: 0.0, lost });
+                sink.speed_break(&step, Break { step: index, reason, before: before * 60.0, at: 0.0, lost });
             }
             (None, Some(next)) if this.kind == Kind::Feed => {
-                let before = this.cruise.min(next.cruise);
+                // Below what the move reaches on its own only when the next
+                // one could not stop from it; still ramping up is no drop.
+                let before = this.cruise.min(next.cruise).min(stopping_speed(&this, entry));
                 if exit < before * (1.0 - 1e-9) {
                     let lost = lost_time(&this, next, entry, exit, before, after);
                     let reason = Reason::LookAhead;
-                    timing.breaks.push(Break { step: index, reason, before: before * 60.0, at: exit * 60.0, lost });
+                    sink.speed_break(
+                        &step,
+                        Break { step: index, reason, before: before * 60.0, at: exit * 60.0, lost },
+                    );
                 }
             }
             _ => {}
@@ -364,20 +430,19 @@ impl Timed {
             let lost = this.length / this.cruise - this.length / this.programmed;
             let reason = Reason::ArcLimit { radius };
             let (before, at) = (this.programmed * 60.0, this.cruise * 60.0);
-            timing.breaks.push(Break { step: index, reason, before, at, lost });
+            sink.speed_break(&step, Break { step: index, reason, before, at, lost });
         }
-        timing.profiles.push(profile);
+        sink.timed(&step, profile);
     }
 }
 
 /// The step as a move: its speeds, acceleration and directions.
-fn move_of(trace: &Trace, index: usize, dynamics: &Dynamics) -> Move {
-    let step = &trace.steps[index];
-    let start = if index == 0 { [0.0; MAX_AXES] } else { trace.steps[index - 1].end };
+fn move_of(step: &Step, start: &Axes, axes: &[u8], dynamics: &Dynamics) -> Move {
     let kind = match (step.motion, step.path) {
+        _ if step.length <= 0.0 || step.duration <= 0.0 => Kind::Still,
         (Motion::Feed, Path::Thread { .. }) => Kind::Thread,
-        (Motion::Feed, _) if step.length > 0.0 && step.duration > 0.0 => Kind::Feed,
-        (Motion::Rapid, _) if step.length > 0.0 && step.duration > 0.0 => Kind::Rapid,
+        (Motion::Feed, _) => Kind::Feed,
+        (Motion::Rapid, _) => Kind::Rapid,
         _ => Kind::Still,
     };
     // The speed the trace timed the move at: the feed, or the rapid of its slowest axis.
@@ -390,7 +455,7 @@ fn move_of(trace: &Trace, index: usize, dynamics: &Dynamics) -> Move {
     let mut arc_radius = None;
     let mut cruise = programmed;
     if let Path::Arc { plane, centre, clockwise } = step.path {
-        let slot = |letter: u8| trace.axes.iter().position(|&axis| axis == letter);
+        let slot = |letter: u8| axes.iter().position(|&axis| axis == letter);
         if let (Some(u), Some(v)) = (slot(plane.0), slot(plane.1)) {
             let tangent = |point: &[f64; MAX_AXES]| {
                 let (du, dv) = (point[u] - centre[0], point[v] - centre[1]);
@@ -405,7 +470,7 @@ fn move_of(trace: &Trace, index: usize, dynamics: &Dynamics) -> Move {
                 }
                 unit(direction)
             };
-            start_direction = tangent(&start);
+            start_direction = tangent(start);
             end_direction = tangent(&step.end);
             let radius = (step.end[u] - centre[0]).hypot(step.end[v] - centre[1]);
             if radius > 0.0 && kind == Kind::Feed {
@@ -466,7 +531,7 @@ fn stop_reason(this: &Move, next: &Move, dynamics: &Dynamics) -> Option<Reason> 
         }
         let cosine: f64 = this.end_direction.iter().zip(&next.start_direction).map(|(a, b)| a * b).sum();
         // Not below R39: the arc cosine only near and past the limit.
-        if cosine <= dynamics.tolerance_angle.to_radians().cos() + 1e-9 {
+        if cosine <= dynamics.tolerance_cosine + 1e-9 {
             let angle = junction_angle(this.end_direction, next.start_direction);
             if angle >= dynamics.tolerance_angle {
                 return Some(Reason::Corner { angle, limit: dynamics.tolerance_angle });
@@ -677,6 +742,25 @@ mod tests {
         let timing = timed("%1\nN1 G23 G01 X100 F3000\nN2 X110 F600\nN3 M30\n");
         assert_eq!(timing.profiles[0].exit, 600.0);
         assert_eq!(timing.profiles[1].entry, 600.0);
+    }
+
+    #[test]
+    fn a_move_still_ramping_up_into_a_junction_is_no_break() {
+        // 8 mm from rest under G23 reach sqrt(2 * 400 * 8) = 80 mm/s of the
+        // 100 programmed, and the long next move takes that speed over.
+        let timing = timed("%1\nN1 G23 G01 X8 F6000\nN2 X200\nN3 M30\n");
+        close(timing.profiles[0].exit, 4800.0);
+        close(timing.profiles[1].entry, 4800.0);
+        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason)).collect();
+        assert_eq!(reasons, [(1, Reason::NonMotion)]);
+    }
+
+    #[test]
+    fn a_thread_block_without_motion_is_a_non_motion_block() {
+        // X10 again: a G33 block that does not move.
+        let timing = timed("%1\nN1 M03 S500\nN2 G23 G01 X10 F600\nN3 G33 X10 K1\nN4 G01 X20\nN5 M30\n");
+        let reasons: Vec<(usize, &str)> = timing.breaks.iter().map(|b| (b.step, b.reason.code())).collect();
+        assert_eq!(reasons, [(1, "non-motion"), (3, "non-motion")]);
     }
 
     #[test]
