@@ -366,8 +366,8 @@ impl Ramp {
         self.jerk.is_finite() && self.jerk > 0.0
     }
 
-    /// Seconds and mm to change speed between `from` and `to`, starting and
-    /// ending without acceleration: a trapezoid's ramp, or the S-curve's
+    /// Seconds and mm for one move to change speed between `from` and `to`,
+    /// starting and ending without acceleration: a trapezoid's ramp, or the S-curve's
     /// t = 2·sqrt(Δv/J) up to Δv = A²/J and Δv/A + A/J beyond (04 §1.10).
     /// Both are symmetric, so the distance is the mean speed times t.
     fn change(&self, from: f64, to: f64) -> (f64, f64) {
@@ -386,40 +386,64 @@ impl Ramp {
     }
 
     /// The highest speed reached from `from` over `distance` mm (or the
-    /// highest from which `from` is reached), with no acceleration at
-    /// either end: the inverse of [`Ramp::change`].
+    /// highest from which `from` is reached), starting without acceleration:
+    /// the jerk raises it to A, then A holds. This is a section's ramp over
+    /// several blocks; its rounding into the next speed is left to the
+    /// moves' profiles.
     fn reach(&self, from: f64, distance: f64) -> f64 {
-        if !self.limited() {
-            return f64::INFINITY;
+        self.section(from, distance).1
+    }
+
+    /// Seconds and the speed at `distance` mm along the section's ramp from
+    /// `from` (see [`Ramp::reach`]). Under a jerk limit a slower start gains
+    /// more over a short distance (the acceleration has longer to build), so
+    /// a speed cap of `from` also allows the ramp from rest: the higher of
+    /// the two keeps the envelope rising with its cap, which the planning
+    /// passes rely on.
+    fn section(&self, from: f64, distance: f64) -> (f64, f64) {
+        let own = self.ramp_from(from, distance);
+        if from > 0.0 && self.jerk_limited() {
+            let rest = self.ramp_from(0.0, distance);
+            if rest.1 > own.1 {
+                return rest;
+            }
         }
-        if distance <= 0.0 {
-            return from;
+        own
+    }
+
+    fn ramp_from(&self, from: f64, distance: f64) -> (f64, f64) {
+        if !self.limited() {
+            return (0.0, f64::INFINITY);
         }
         let (a, j, v) = (self.acceleration, self.jerk, from);
-        if !self.jerk_limited() {
-            return (v * v + 2.0 * a * distance).sqrt();
+        if distance <= 0.0 {
+            return (0.0, from);
         }
-        let knee = a * a / j;
-        if distance <= (2.0 * v + knee) * a / j {
-            // With u = sqrt(Δv/J) the distance is 2·v·u + J·u³: Newton from
-            // above converges monotonically on this convex cubic.
-            let mut u = (distance / j).cbrt();
+        if !self.jerk_limited() {
+            let speed = (v * v + 2.0 * a * distance).sqrt();
+            return ((speed - v) / a, speed);
+        }
+        let knee = a / j;
+        let knee_distance = v * knee + j * knee * knee * knee / 6.0;
+        if distance <= knee_distance {
+            // v·t + J·t³/6 = distance: Newton from above converges
+            // monotonically on this convex cubic.
+            let mut t = (6.0 * distance / j).cbrt();
             if v > 0.0 {
-                u = u.min(distance / (2.0 * v));
+                t = t.min(distance / v);
             }
             for _ in 0..64 {
-                let step = (j * u * u * u + 2.0 * v * u - distance) / (3.0 * j * u * u + 2.0 * v);
-                if !step.is_finite() || step <= u * 1e-15 {
+                let step = (j * t * t * t / 6.0 + v * t - distance) / (j * t * t / 2.0 + v);
+                if !step.is_finite() || step <= t * 1e-15 {
                     break;
                 }
-                u -= step;
+                t -= step;
             }
-            v + j * u * u
+            (t, v + j * t * t / 2.0)
         } else {
-            // (2v + Δv)/2 · (Δv/A + A/J) = distance, a quadratic in Δv.
-            let b = 2.0 * v / a + a / j;
-            let c = 2.0 * v * a / j - 2.0 * distance;
-            v + (-b + (b * b - 4.0 * c / a).sqrt()) * a / 2.0
+            let knee_speed = v + a * knee / 2.0;
+            let speed = (knee_speed * knee_speed + 2.0 * a * (distance - knee_distance)).sqrt();
+            (knee + (speed - knee_speed) / a, speed)
         }
     }
 }
@@ -648,6 +672,12 @@ impl Planner {
     fn emit(&mut self) -> Option<(usize, Planned)> {
         let slot = self.window.pop_front()?;
         let end = if self.finished { Limit::End } else { Limit::WindowEnd };
+        let end_of_move = slot.start + slot.length;
+        let through = match self.window.front() {
+            Some(next) if next.back_anchor.ramp == slot.ramp => next.back_anchor,
+            Some(next) => Anchor { speed: next.back, at: end_of_move, ramp: slot.ramp, limit: next.limit },
+            None => Anchor { speed: 0.0, at: end_of_move, ramp: slot.ramp, limit: Limit::End },
+        };
         let (exit, limit, reference) = match self.window.front() {
             Some(next) if matches!(next.kind, MoveKind::Feed | MoveKind::Rapid) => {
                 (next.speed, next.limit, slot.programmed.min(next.programmed))
@@ -657,7 +687,7 @@ impl Planner {
         };
         let limit = if limit == Limit::WindowEnd { end } else { limit };
         self.entry = exit;
-        let profile = self.profile(&slot, slot.speed, exit);
+        let profile = self.profile(&slot, &through, slot.speed, exit);
         let moving = matches!(slot.kind, MoveKind::Feed | MoveKind::Rapid);
         let planned = Planned {
             profile,
@@ -667,13 +697,14 @@ impl Planner {
         Some((slot.index, planned))
     }
 
-    /// The move's profile from `entry` to `exit` (mm/s).
-    fn profile(&self, slot: &Slot, entry: f64, exit: f64) -> Profile {
+    /// The move's profile from `entry` to `exit` (mm/s); `through` is the
+    /// backward pass's envelope through it.
+    fn profile(&self, slot: &Slot, through: &Anchor, entry: f64, exit: f64) -> Profile {
         let per_minute = |speed: f64| speed * 60.0;
         let (peak, duration) = match slot.kind {
             MoveKind::Still { duration } => return Profile { duration: length_of(duration), ..Profile::default() },
             MoveKind::Thread => (slot.cruise, slot.length / slot.cruise),
-            MoveKind::Feed | MoveKind::Rapid => self.run(slot, entry, exit),
+            MoveKind::Feed | MoveKind::Rapid => self.run(slot, through, entry, exit),
         };
         Profile { entry: per_minute(entry), peak: per_minute(peak), exit: per_minute(exit), duration }
     }
@@ -681,7 +712,7 @@ impl Planner {
     /// The peak speed and the seconds of a move from `entry` to `exit`: up to
     /// at most its cruise speed and down again within its length, unless
     /// R395 keeps it at its junction speeds.
-    fn run(&self, slot: &Slot, entry: f64, exit: f64) -> (f64, f64) {
+    fn run(&self, slot: &Slot, through: &Anchor, entry: f64, exit: f64) -> (f64, f64) {
         let (ramp, length) = (&slot.ramp, slot.length);
         let low = entry.max(exit);
         let cruise = slot.cruise.max(low);
@@ -697,9 +728,7 @@ impl Planner {
             if peak > 0.0 { ramps + (length - distance).max(0.0) / peak } else { ramps }
         };
         if span(low).1 > length * (1.0 + 1e-9) + 1e-12 {
-            // Part of a ramp over several blocks: the section's speed changes
-            // through the move, at about a constant rate.
-            return (low, 2.0 * length / (entry + exit));
+            return section(slot, through, cruise);
         }
         let peak = if span(cruise).1 <= length {
             cruise
@@ -735,5 +764,347 @@ impl Planner {
             }
         }
         (peak, rise)
+    }
+}
+
+/// The peak speed and the seconds of a move within a section's ramps over
+/// several blocks: up the forward envelope, at most at its cruise speed,
+/// and down the backward one (`through`), where they cross.
+fn section(slot: &Slot, through: &Anchor, cruise: f64) -> (f64, f64) {
+    let (up, down) = (&slot.forward, through);
+    let (start, end) = (slot.start, slot.start + slot.length);
+    let rising = |s: f64| up.ramp.section(up.speed, s - up.at);
+    let falling = |s: f64| down.ramp.section(down.speed, down.at - s);
+    // The last point in [from, to] where `below` holds, by bisection.
+    let last = |from: f64, to: f64, below: &dyn Fn(f64) -> bool| {
+        if below(to) {
+            return to;
+        }
+        let (mut low, mut high) = (from, to);
+        for _ in 0..100 {
+            let middle = (low + high) / 2.0;
+            if below(middle) {
+                low = middle
+            } else {
+                high = middle
+            }
+            if high - low <= high.abs().max(1.0) * 1e-14 {
+                break;
+            }
+        }
+        low
+    };
+    let cross = last(start, end, &|s| rising(s).1 <= falling(s).1);
+    let top = rising(cross).1.min(falling(cross).1);
+    let (climb, descent) = if top > cruise {
+        (last(start, cross, &|s| rising(s).1 <= cruise), end - last(cross, end, &|s| falling(s).1 > cruise))
+    } else {
+        (cross, end - cross)
+    };
+    let descent_start = end - descent;
+    let entry_exit = (slot.speed, rising(end).1.min(falling(end).1));
+    let time = (rising(climb).0 - rising(start).0).abs()
+        + (descent_start - climb).max(0.0) / cruise
+        + (falling(descent_start).0 - falling(end).0).abs();
+    let peak = top.min(cruise).max(entry_exit.0).max(entry_exit.1);
+    // Near a stop the two ramps from a cap can disagree: the mean speed.
+    if time.is_finite() && time > 0.0 {
+        (peak, time)
+    } else {
+        (peak, 2.0 * slot.length / (entry_exit.0 + entry_exit.1))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::{Envelope, EnvelopeMove, Limit, MoveKind, Planned, Planner, ProfileKind, corner_cap};
+    use crate::{
+        machine::MachineConfig,
+        run::{NoFiles, run},
+        velocity::{Dynamics, time},
+    };
+
+    /// A machine with these constants (raw values) besides the defaults:
+    /// R52 = 1000, R236 = 400 and R237 = 1000 mm/s², Ts = 2 ms.
+    fn machine(constants: &[(u32, i64)]) -> MachineConfig {
+        let mut machine = MachineConfig::default();
+        machine.constants.extend(constants.iter().copied());
+        machine
+    }
+
+    fn linear() -> Envelope {
+        Envelope::of(&machine(&[(338, 10)])).unwrap()
+    }
+
+    fn parabolic() -> Envelope {
+        Envelope::of(&machine(&[(338, 20)])).unwrap()
+    }
+
+    const X: [f64; 3] = [1.0, 0.0, 0.0];
+
+    /// A G23 line of `length` mm at `speed` mm/s in `direction`.
+    fn line(length: f64, speed: f64, direction: [f64; 3]) -> EnvelopeMove {
+        EnvelopeMove {
+            length,
+            speed,
+            kind: MoveKind::Feed,
+            start_direction: direction,
+            end_direction: direction,
+            arc_radius: None,
+            stop_before: false,
+            continuity: true,
+            set: 1,
+            mergeable: false,
+        }
+    }
+
+    /// Plans `moves` and checks that every index comes back once, in order.
+    fn plan(envelope: Envelope, moves: &[EnvelopeMove]) -> Vec<Planned> {
+        let mut planner = Planner::new(envelope);
+        let mut planned: Vec<(usize, Planned)> = moves.iter().filter_map(|&mv| planner.push(mv)).collect();
+        planned.extend(planner.finish());
+        assert!(planned.iter().map(|&(index, _)| index).eq(0..moves.len()));
+        planned.into_iter().map(|(_, planned)| planned).collect()
+    }
+
+    fn total(planned: &[Planned]) -> f64 {
+        planned.iter().map(|p| p.profile.duration).sum()
+    }
+
+    fn close(actual: f64, expected: f64) {
+        assert!((actual - expected).abs() <= expected.abs() * 1e-3, "{actual} != {expected} within 0.1%");
+    }
+
+    #[test]
+    fn the_envelope_follows_r338_and_reads_the_sets() {
+        assert_eq!(Envelope::of(&MachineConfig::default()), None);
+        let envelope = linear();
+        assert_eq!((envelope.profile, envelope.depth, envelope.tick), (ProfileKind::Linear, 500, 0.002));
+        let set = envelope.sets[0];
+        assert_eq!((set.ramp.acceleration, set.ramp.jerk), (400.0, f64::INFINITY));
+        assert_eq!((set.accuracy, set.overload, envelope.hold_time), (0.008, 10_000.0, 0.5));
+        // Parabolic with the sets on: set 2 has its own A and falls back to
+        // set 1 for P; rapid moves take R430–R432.
+        let sets = [(338, 20), (406, 1), (407, 10_000), (408, 800), (411, 1_000_4000), (412, 1), (414, 300)];
+        let envelope = Envelope::of(&machine(&[&sets[..], &[(430, 1), (432, 2000)]].concat())).unwrap();
+        let jerk = 10_000.0 / 32.768;
+        assert_eq!((envelope.sets[0].ramp.acceleration, envelope.sets[0].ramp.jerk), (800.0, jerk));
+        assert_eq!((envelope.sets[1].ramp.acceleration, envelope.sets[1].ramp.jerk), (300.0, jerk));
+        assert_eq!(envelope.sets[0].centrifugal, 400.0);
+        assert_eq!((envelope.rapid.acceleration, envelope.rapid.jerk), (2000.0, jerk));
+    }
+
+    #[test]
+    fn one_long_line_is_a_trapezoid() {
+        // 100 mm at 100 mm/s with R236 = 400 mm/s²: 12.5 mm of ramp at each end.
+        let planned = plan(linear(), &[line(100.0, 100.0, X)]);
+        let profile = planned[0].profile;
+        assert_eq!((profile.entry, profile.peak, profile.exit), (0.0, 6000.0, 0.0));
+        close(profile.duration, 2.0 * 100.0 / 400.0 + (100.0 - 100.0 * 100.0 / 400.0) / 100.0);
+        assert_eq!(planned[0].exit_limit, Some(Limit::End));
+    }
+
+    #[test]
+    fn one_long_line_is_an_s_curve() {
+        // P = 50000 (J = P/32.768) and A = 400: 200 mm/s is above A²/J, so
+        // the ramps have their linear part: t = v/A + A/J + L/v.
+        let (a, j, v, length) = (400.0, 50_000.0 / 32.768, 200.0, 200.0);
+        let planned = plan(parabolic(), &[line(length, v, X)]);
+        assert_eq!(planned[0].profile.peak, v * 60.0);
+        close(planned[0].profile.duration, v / a + a / j + length / v);
+    }
+
+    #[test]
+    fn a_short_move_does_not_reach_its_speed() {
+        // Trapezoid: a triangle up to sqrt(A·L).
+        let short = plan(linear(), &[line(1.0, 100.0, X)])[0].profile;
+        close(short.peak, (400.0f64 * 1.0).sqrt() * 60.0);
+        close(short.duration, 2.0 * 20.0 / 400.0);
+        let (a, j): (f64, f64) = (400.0, 50_000.0 / 32.768);
+        // S-curve without reaching A: two parabolas to the peak and two back,
+        // L = 2·v^1.5/sqrt(J).
+        let peak = (1.0 * j.sqrt() / 2.0f64).powf(2.0 / 3.0);
+        assert!(peak < a * a / j);
+        let short = plan(parabolic(), &[line(1.0, 200.0, X)])[0].profile;
+        close(short.peak, peak * 60.0);
+        close(short.duration, 4.0 * (peak / j).sqrt());
+        // S-curve reaching A but not the speed: L = v·(v/A + A/J).
+        let length = 100.0;
+        let peak = (-a / j + ((a / j) * (a / j) + 4.0 * length / a).sqrt()) * a / 2.0;
+        assert!(peak > a * a / j && peak < 200.0);
+        let short = plan(parabolic(), &[line(length, 200.0, X)])[0].profile;
+        close(short.peak, peak * 60.0);
+        close(short.duration, 2.0 * (peak / a + a / j));
+    }
+
+    #[test]
+    fn a_collinear_chain_of_short_blocks_runs_at_the_feed() {
+        // 100 blocks of 1 mm at 100 mm/s: the look-ahead ramps over many
+        // blocks, as one 100 mm line would.
+        let chain = vec![line(1.0, 100.0, X); 100];
+        let planned = plan(linear(), &chain);
+        close(total(&planned), 2.0 * 100.0 / 400.0 + (100.0 - 100.0 * 100.0 / 400.0) / 100.0);
+        assert_eq!(planned[50].profile.entry, 6000.0);
+        // Below the feed only while rising from the start or braking for the end.
+        let limits = |p: &Planned| p.exit_limit.is_none_or(|limit| matches!(limit, Limit::Ramp | Limit::End));
+        assert!(planned.iter().all(limits));
+        // The CNC8x6 model stops at every 10 ms block (60 ms is its shortest).
+        let program: String = (1..=100).map(|x| format!("N{x} X{x}\n")).collect();
+        let machine = MachineConfig::default();
+        let trace = run(&format!("%1\nN0 G23 G01 F6000\n{program}M30\n"), &NoFiles, &machine, 1000);
+        let cnc8x6 = time(&trace, &Dynamics::of(&machine)).total_time();
+        assert!(cnc8x6 > 3.0 * total(&planned), "{cnc8x6}");
+        // Parabolic: the sections' ramps over several blocks, within 3% of
+        // one 100 mm S-curve.
+        let (a, j): (f64, f64) = (400.0, 50_000.0 / 32.768);
+        let planned = plan(parabolic(), &chain);
+        let one_line = 100.0 / a + a / j + 100.0 / 100.0;
+        let ratio = total(&planned) / one_line;
+        assert!((0.97..1.03).contains(&ratio), "{ratio}");
+        assert_eq!(planned[50].profile.entry, 6000.0);
+    }
+
+    #[test]
+    fn a_corner_runs_at_the_accuracy_criterion() {
+        // 45°: Lm / (Ts·tan 22.5°) with 8 µm and 2 ms is 9.66 mm/s, below
+        // the dynamic criterion's 10000·Ts / (2·sin 22.5°) = 26.1 mm/s.
+        let turned = [45f64.to_radians().cos(), 45f64.to_radians().sin(), 0.0];
+        let planned = plan(linear(), &[line(50.0, 100.0, X), line(50.0, 100.0, turned)]);
+        let speed = 0.008 / (0.002 * 22.5f64.to_radians().tan());
+        close(planned[0].profile.exit, speed * 60.0);
+        close(planned[1].profile.entry, speed * 60.0);
+        let Some(Limit::Accuracy { angle }) = planned[0].exit_limit else { panic!("{:?}", planned[0]) };
+        close(angle, 45.0);
+        let ramps = |from: f64| (100.0 - from) / 400.0 + (100.0 - from) * (100.0 + from) / 2.0 / 400.0 / -100.0;
+        close(total(&planned), 2.0 * (ramps(0.0) + ramps(speed) + 50.0 / 100.0));
+        // With a higher accuracy limit the dynamic criterion takes over.
+        let (cap, limit) = corner_cap(&linear().sets[0], 0.002, 45f64.to_radians());
+        let loose = corner_cap(&super::DynamicSet { accuracy: 0.05, ..linear().sets[0] }, 0.002, 45f64.to_radians());
+        assert_eq!(limit, Limit::Accuracy { angle: 45.0 });
+        assert!(matches!(loose.1, Limit::Overload { .. }) && loose.0 > cap);
+        close(loose.0, 10_000.0 * 0.002 / (2.0 * 22.5f64.to_radians().sin()));
+    }
+
+    #[test]
+    fn the_window_end_forces_a_stop() {
+        // Three blocks ahead: the 100 mm line must be able to stop within the
+        // two 1 mm blocks after it, sqrt(2·400·2) = 40 mm/s.
+        let moves = [line(100.0, 100.0, X), line(1.0, 100.0, X), line(1.0, 100.0, X), line(100.0, 100.0, X)];
+        let shallow = plan(Envelope { depth: 3, ..linear() }, &moves);
+        close(shallow[0].profile.exit, 40.0 * 60.0);
+        assert_eq!(shallow[0].exit_limit, Some(Limit::WindowEnd));
+        let deep = plan(linear(), &moves);
+        assert_eq!((deep[0].profile.exit, deep[0].exit_limit), (6000.0, None));
+        assert!(total(&shallow) > total(&deep));
+    }
+
+    #[test]
+    fn a_million_moves_in_bounded_memory() {
+        let mut planner = Planner::new(Envelope { depth: 50, ..linear() });
+        let (mut emitted, mut most) = (0usize, 0usize);
+        for i in 0..1_000_000 {
+            // Every tenth block turns a little: caps now and then.
+            let direction = if i % 10 == 0 { [0.99, 0.141, 0.0] } else { X };
+            if let Some((index, _)) = planner.push(line(10.0, 100.0, direction)) {
+                assert_eq!(index, emitted);
+                emitted += 1;
+            }
+            most = most.max(planner.held());
+        }
+        assert_eq!(most, 50);
+        assert_eq!(emitted + planner.finish().count(), 1_000_000);
+    }
+
+    #[test]
+    fn stops_short_blocks_and_merged_blocks() {
+        // A rapid move and the caller's stop both stop; a 2 µm block merged
+        // by R383 does not hold the chain to 2 µm / 4 ms.
+        let rapid = EnvelopeMove { kind: MoveKind::Rapid, ..line(10.0, 150.0, X) };
+        let stopped = EnvelopeMove { stop_before: true, ..line(10.0, 100.0, X) };
+        let planned = plan(linear(), &[line(10.0, 100.0, X), rapid, stopped]);
+        assert_eq!(planned.iter().map(|p| p.profile.exit).collect::<Vec<_>>(), [0.0, 0.0, 0.0]);
+        assert_eq!(planned[0].exit_limit, Some(Limit::Stop));
+        let tiny = EnvelopeMove { mergeable: true, ..line(0.002, 100.0, X) };
+        let planned = plan(linear(), &[line(50.0, 100.0, X), tiny, line(50.0, 100.0, X)]);
+        assert_eq!(planned[0].profile.exit, 6000.0);
+        let unmerged = plan(linear(), &[line(50.0, 100.0, X), line(0.002, 100.0, X), line(50.0, 100.0, X)]);
+        close(unmerged[0].profile.exit, 0.002 / 0.004 * 60.0);
+        assert_eq!(unmerged[1].cruise_limit, Some(Limit::MinDuration));
+        // R382: a block shorter than 1 mm stops at both ends.
+        let short = Envelope { short_block: 1.0, ..linear() };
+        let planned = plan(short, &[line(50.0, 100.0, X), line(0.5, 100.0, X), line(50.0, 100.0, X)]);
+        assert_eq!((planned[0].profile.exit, planned[1].profile.exit), (0.0, 0.0));
+        assert_eq!(planned[0].exit_limit, Some(Limit::ShortBlock));
+    }
+
+    #[test]
+    fn arcs_run_at_their_limits() {
+        // Radius 1 mm: a 1 µm chord per 2 ms tick allows sqrt(8·r·e)/Ts.
+        let arc = EnvelopeMove { arc_radius: Some(1.0), ..line(10.0, 100.0, X) };
+        let planned = plan(linear(), &[arc]);
+        let limit = (8.0f64 * 0.001).sqrt() / 0.002;
+        close(planned[0].profile.peak, limit * 60.0);
+        assert_eq!(planned[0].cruise_limit, Some(Limit::ChordError { radius: 1.0 }));
+    }
+
+    fn moves() -> impl Strategy<Value = Vec<EnvelopeMove>> {
+        let direction = (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64).prop_map(|(x, y, z)| {
+            let norm = (x * x + y * y + z * z).sqrt();
+            if norm > 1e-3 { [x / norm, y / norm, z / norm] } else { X }
+        });
+        let kind = prop_oneof![
+            6 => Just(MoveKind::Feed),
+            1 => Just(MoveKind::Rapid),
+            1 => Just(MoveKind::Thread),
+            1 => (0.0..2.0f64).prop_map(|duration| MoveKind::Still { duration: duration + 1e-3 }),
+        ];
+        let one = (1e-4..500.0f64, 1e-2..2000.0f64, kind, direction.clone(), direction, any::<bool>(), 1..=4u8)
+            .prop_map(|(length, speed, kind, start, end, stop_before, set)| EnvelopeMove {
+                length,
+                speed,
+                kind,
+                start_direction: start,
+                end_direction: end,
+                arc_radius: (set == 2).then_some(length),
+                stop_before: stop_before && set == 3,
+                continuity: set != 4,
+                set,
+                mergeable: set == 1,
+            });
+        prop::collection::vec(one, 1..60)
+    }
+
+    proptest! {
+        #[test]
+        fn durations_are_finite_and_speeds_within_the_caps(
+            moves in moves(),
+            parabolic_profile in any::<bool>(),
+            depth in 1..20usize,
+        ) {
+            let envelope = if parabolic_profile { parabolic() } else { linear() };
+            let planned = plan(Envelope { depth, ..envelope }, &moves);
+            for (i, (mv, p)) in moves.iter().zip(&planned).enumerate() {
+                let profile = p.profile;
+                prop_assert!(profile.duration.is_finite() && profile.duration > 0.0, "{i}: {profile:?}");
+                let cap = mv.speed * 60.0 * (1.0 + 1e-9);
+                prop_assert!(profile.entry <= cap && profile.exit <= cap && profile.peak <= cap, "{i}: {p:?}");
+                let peak = profile.peak * (1.0 + 1e-9);
+                prop_assert!(profile.entry <= peak && profile.exit <= peak, "{i}: {p:?}");
+                if let Some(next) = planned.get(i + 1) {
+                    prop_assert_eq!(profile.exit, next.profile.entry);
+                    let next_move = &moves[i + 1];
+                    if next_move.stop_before || mv.kind != MoveKind::Feed || next_move.kind != MoveKind::Feed {
+                        prop_assert_eq!(profile.exit, 0.0);
+                    } else if next_move.mergeable && next_move.length >= 0.005 || !next_move.mergeable {
+                        let angle = super::angle_between(mv.end_direction, next_move.start_direction);
+                        let set = &envelope.sets[usize::from(next_move.set) - 1];
+                        let corner = corner_cap(set, envelope.tick, angle).0 * 60.0;
+                        prop_assert!(profile.exit <= corner * (1.0 + 1e-9), "{i}: {p:?} above {corner}");
+                    }
+                }
+            }
+        }
     }
 }
