@@ -703,7 +703,12 @@ impl Planner {
         let per_minute = |speed: f64| speed * 60.0;
         let (peak, duration) = match slot.kind {
             MoveKind::Still { duration } => return Profile { duration: length_of(duration), ..Profile::default() },
-            MoveKind::Thread => (slot.cruise, slot.length / slot.cruise),
+            // Without ramps a thread runs at its speed from end to end.
+            MoveKind::Thread => {
+                let speed = per_minute(slot.cruise);
+                let duration = slot.length / slot.cruise;
+                return Profile { entry: speed, peak: speed, exit: speed, duration };
+            }
             MoveKind::Feed | MoveKind::Rapid => self.run(slot, through, entry, exit),
         };
         Profile { entry: per_minute(entry), peak: per_minute(peak), exit: per_minute(exit), duration }
@@ -886,8 +891,9 @@ mod tests {
         assert_eq!((set.ramp.acceleration, set.ramp.jerk), (400.0, f64::INFINITY));
         assert_eq!((set.accuracy, set.overload, envelope.hold_time), (0.008, 10_000.0, 0.5));
         // Parabolic with the sets on: set 2 has its own A and falls back to
-        // set 1 for P; rapid moves take R430–R432.
-        let sets = [(338, 20), (406, 1), (407, 10_000), (408, 800), (411, 1_000_4000), (412, 1), (414, 300)];
+        // set 1 for P; rapid moves take R430–R432. R411 with decade 8 = 1
+        // is the centrifugal acceleration ×10.
+        let sets = [(338, 20), (406, 1), (407, 10_000), (408, 800), (411, 10_004_000), (412, 1), (414, 300)];
         let envelope = Envelope::of(&machine(&[&sets[..], &[(430, 1), (432, 2000)]].concat())).unwrap();
         let jerk = 10_000.0 / 32.768;
         assert_eq!((envelope.sets[0].ramp.acceleration, envelope.sets[0].ramp.jerk), (800.0, jerk));
@@ -1093,11 +1099,14 @@ mod tests {
                 let peak = profile.peak * (1.0 + 1e-9);
                 prop_assert!(profile.entry <= peak && profile.exit <= peak, "{i}: {p:?}");
                 if let Some(next) = planned.get(i + 1) {
-                    prop_assert_eq!(profile.exit, next.profile.entry);
                     let next_move = &moves[i + 1];
+                    // A thread shows its own speed at both ends; it starts and ends at a stop.
+                    let speed = |kind, speed| if kind == MoveKind::Thread { 0.0 } else { speed };
+                    let exit = speed(mv.kind, profile.exit);
+                    prop_assert_eq!(exit, speed(next_move.kind, next.profile.entry));
                     if next_move.stop_before || mv.kind != MoveKind::Feed || next_move.kind != MoveKind::Feed {
-                        prop_assert_eq!(profile.exit, 0.0);
-                    } else if next_move.mergeable && next_move.length >= 0.005 || !next_move.mergeable {
+                        prop_assert_eq!(exit, 0.0);
+                    } else if !next_move.mergeable || next_move.length >= 0.005 {
                         let angle = super::angle_between(mv.end_direction, next_move.start_direction);
                         let set = &envelope.sets[usize::from(next_move.set) - 1];
                         let corner = corner_cap(set, envelope.tick, angle).0 * 60.0;
