@@ -962,13 +962,14 @@ mod tests {
         let trace = run(&format!("%1\nN0 G23 G01 F6000\n{program}M30\n"), &NoFiles, &machine, 1000);
         let cnc8x6 = time(&trace, &Dynamics::of(&machine)).total_time();
         assert!(cnc8x6 > 3.0 * total(&planned), "{cnc8x6}");
-        // Parabolic: the sections' ramps over several blocks, within 3% of
-        // one 100 mm S-curve.
+        // Parabolic: the sections' ramps over several blocks come within 2%
+        // of one 100 mm S-curve (1.5% faster: a section's ramp is not
+        // rounded into the feed).
         let (a, j): (f64, f64) = (400.0, 50_000.0 / 32.768);
         let planned = plan(parabolic(), &chain);
         let one_line = 100.0 / a + a / j + 100.0 / 100.0;
         let ratio = total(&planned) / one_line;
-        assert!((0.97..1.03).contains(&ratio), "{ratio}");
+        assert!((0.98..1.0).contains(&ratio), "{ratio}");
         assert_eq!(planned[50].profile.entry, 6000.0);
     }
 
@@ -1053,6 +1054,35 @@ mod tests {
         let limit = (8.0f64 * 0.001).sqrt() / 0.002;
         close(planned[0].profile.peak, limit * 60.0);
         assert_eq!(planned[0].cruise_limit, Some(Limit::ChordError { radius: 1.0 }));
+    }
+
+    #[test]
+    fn degenerate_dynamics_never_panic() {
+        // No acceleration (no ramps), a tick of zero (every corner stops),
+        // and extreme ramps: finite durations all the same.
+        let mut flat = linear();
+        flat.sets[0].ramp.acceleration = 0.0;
+        flat.basic.acceleration = f64::NAN;
+        flat.tick = 0.0;
+        let turned = [0.0, 1.0, 0.0];
+        let moves = [line(10.0, 100.0, X), line(0.0, 100.0, turned), line(f64::INFINITY, f64::NAN, X)];
+        for envelope in [
+            flat,
+            Envelope {
+                sets: [super::DynamicSet {
+                    ramp: super::Ramp { acceleration: 1e300, jerk: 1e-300 },
+                    ..parabolic().sets[0]
+                }; 4],
+                ..parabolic()
+            },
+        ] {
+            let planned = plan(envelope, &moves);
+            assert!(planned.iter().all(|p| p.profile.duration.is_finite() && p.profile.duration >= 0.0), "{planned:?}");
+        }
+        // Without ramps a move runs at its speed throughout.
+        let mut flat = linear();
+        flat.sets[0].ramp.acceleration = 0.0;
+        close(plan(flat, &[line(10.0, 100.0, X)])[0].profile.duration, 0.1);
     }
 
     fn moves() -> impl Strategy<Value = Vec<EnvelopeMove>> {
