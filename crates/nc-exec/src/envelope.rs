@@ -94,9 +94,9 @@ pub struct Envelope {
     pub hold_time: f64,
     /// Sets 1 to 4 (G23 I1 … I4).
     pub sets: [DynamicSet; 4],
-    /// Ramps of rapid moves (R237, or the set R430–R432) and of feed moves
-    /// outside continuity (R52).
+    /// Ramps of rapid moves: R237, or the set R430–R432.
     pub rapid: Ramp,
+    /// Ramps of feed moves outside continuity: R52.
     pub basic: Ramp,
 }
 
@@ -154,13 +154,15 @@ impl Envelope {
                 let new_method = value.unsigned_abs() / 10_000_000 % 10 == 1;
                 if new_method { digits(value, 7) / 10.0 } else { 0.0 }
             };
+            // Set 1's unknown values (in program parameters) keep what the
+            // control uses without the sets.
             set = DynamicSet {
                 ramp: Ramp {
-                    acceleration: value(0, 2).map_or(0.0, |a| digits(a, 8)),
-                    jerk: value(0, 1).map_or(f64::INFINITY, jerk_of),
+                    acceleration: value(0, 2).map_or(set.ramp.acceleration, |a| digits(a, 8)),
+                    jerk: value(0, 1).map_or(set.ramp.jerk, jerk_of),
                 },
-                accuracy: value(0, 3).map_or(0.0, |v| digits(v, 4) / 1000.0),
-                overload: value(0, 4).map_or(0.0, |v| digits(v, 7)),
+                accuracy: value(0, 3).map_or(set.accuracy, |v| digits(v, 4) / 1000.0),
+                overload: value(0, 4).map_or(set.overload, |v| digits(v, 7)),
                 centrifugal: value(0, 5).map_or(0.0, centrifugal),
             };
             for (n, slot) in sets.iter_mut().enumerate() {
@@ -367,9 +369,9 @@ impl Ramp {
     }
 
     /// Seconds and mm for one move to change speed between `from` and `to`,
-    /// starting and ending without acceleration: a trapezoid's ramp, or the S-curve's
-    /// t = 2·sqrt(Δv/J) up to Δv = A²/J and Δv/A + A/J beyond (04 §1.10).
-    /// Both are symmetric, so the distance is the mean speed times t.
+    /// starting and ending without acceleration: a trapezoid's ramp, or the
+    /// S-curve's t = 2·sqrt(Δv/J) up to Δv = A²/J and Δv/A + A/J beyond
+    /// (04 §1.10). Both are symmetric: the distance is the mean speed × t.
     fn change(&self, from: f64, to: f64) -> (f64, f64) {
         if !self.limited() {
             return (0.0, 0.0);
