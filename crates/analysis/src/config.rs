@@ -17,6 +17,8 @@
 //! settle-time-ms = 10                     # in-position wait after a stop
 //! m-function-ms = 200                     # each M function (M03, M08, …)
 //! tool-change-ms = 6000                   # M06
+//! look-ahead-blocks = 500                 # envelope velocity (CNC8x9): blocks planned ahead
+//! envelope-tick-us = 2000                 # envelope velocity: interpolator tick Ts
 //! cycle-file = "PCYKLYDG.NCP"             # CNC836.KNF $17: what G81-G89 do
 //! offset-file = "TAB0.POS"                # zero offsets G53-G59
 //! tool-file = "TAB0.KOR"                  # tool corrections D1-D99
@@ -108,6 +110,8 @@ struct MachineFile {
     settle_time_ms: Option<u32>,
     m_function_ms: Option<u32>,
     tool_change_ms: Option<u32>,
+    look_ahead_blocks: Option<u32>,
+    envelope_tick_us: Option<u32>,
     cycle_file: Option<String>,
     offset_file: Option<PathBuf>,
     tool_file: Option<PathBuf>,
@@ -167,6 +171,18 @@ impl MachineFile {
         }
         if let Some(time) = self.tool_change_ms {
             machine.tool_change_ms = time;
+        }
+        if let Some(blocks) = self.look_ahead_blocks {
+            if !(1..=500).contains(&blocks) {
+                return Err(format!("{origin}: {section}look-ahead-blocks must be 1 to 500 (the control's most)"));
+            }
+            machine.look_ahead_blocks = blocks;
+        }
+        if let Some(tick) = self.envelope_tick_us {
+            if tick == 0 {
+                return Err(format!("{origin}: {section}envelope-tick-us must be above 0 µs"));
+            }
+            machine.envelope_tick_us = tick;
         }
         if let Some(rate) = self.rapid_rate {
             if rate == 0 {
@@ -436,6 +452,11 @@ R97 = "2"
         .machine;
         assert_eq!((timed.block_pause_ms, timed.settle_time_ms), (35, 0));
         assert_eq!((timed.m_function_ms, timed.tool_change_ms), (200, 6000));
+        let envelope = load("[machine]\nlook-ahead-blocks = 50\nenvelope-tick-us = 500\n", &[]).unwrap().machine;
+        assert_eq!((envelope.look_ahead_blocks, envelope.envelope_tick_us), (50, 500));
+        assert_eq!((machine.look_ahead_blocks, machine.envelope_tick_us), (500, 2000), "the defaults");
+        assert!(load("[machine]\nlook-ahead-blocks = 501\n", &[]).is_err());
+        assert!(load("[machine]\nenvelope-tick-us = 0\n", &[]).is_err());
         let lathe = load("[machine]\naxes = [\"X\", \"Z\"]\ndiameter-axis = \"x\"\n", &[]).unwrap();
         assert_eq!(lathe.machine.diameter_axis, Some(b'X'));
     }

@@ -11,6 +11,8 @@
 //!   (equidistants, corners, start and cancel), for the runner to drive.
 //! - [`cycles`]: the built-in fixed cycles G81–G89 (milling and lathe), as
 //!   lists of moves for the runner, when the machine loads no cycle file.
+//! - [`envelope`]: the CNC8x9 envelope velocity, a streaming look-ahead
+//!   planner of up to 500 blocks with linear or jerk-limited ramps.
 //! - [`expand`]: a run written back as a program of plain motion blocks.
 //! - [`lower`]: blocks as plain data (words, parameter assignments,
 //!   comments), read from the syntax tree; the analysis uses it too.
@@ -26,6 +28,7 @@
 pub mod arith;
 pub mod compensation;
 pub mod cycles;
+pub mod envelope;
 pub mod expand;
 pub mod lower;
 pub mod machine;

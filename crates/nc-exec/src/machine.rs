@@ -50,6 +50,16 @@ pub struct MachineConfig {
     /// change M06 take, in ms: the machine's PLC decides, so none by default.
     pub m_function_ms: u32,
     pub tool_change_ms: u32,
+    /// How many blocks the envelope velocity (CNC8x9, machine constant
+    /// R338 decade 2) plans ahead, the current one included: the control
+    /// looks up to 500 ahead (04 §1.9), so 500 is the default and the most.
+    pub look_ahead_blocks: u32,
+    /// The CNC8x9 interpolator tick Ts in µs, which the envelope criteria
+    /// use. The manual gives only the CNC8x6's 10 ms; 2 ms is an assumption:
+    /// the CNC8x9's shortest G24 block, and the tick at which the manual's
+    /// R385 example (10000 mm/s²) takes over from the accuracy criterion
+    /// at about 20 µm, as it says R385 does when R384 is off or 50 µm.
+    pub envelope_tick_us: u32,
 }
 
 /// How far an axis may travel, in thousandths (µm, or thousandths of a
@@ -77,6 +87,8 @@ impl Default for MachineConfig {
             settle_time_ms: 10,
             m_function_ms: 0,
             tool_change_ms: 0,
+            look_ahead_blocks: 500,
+            envelope_tick_us: 2000,
         }
     }
 }
