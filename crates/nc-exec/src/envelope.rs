@@ -109,7 +109,7 @@ impl Envelope {
             Some(2) => ProfileKind::Parabolic,
             _ => return None,
         };
-        let dynamics = Dynamics::of(machine);
+        let dynamics = Dynamics::cnc8x6(machine);
         let raw = |number: u32| {
             let assumed = ASSUMED.iter().find(|&&(n, _)| n == number).map(|&(_, value)| value);
             machine.known_constant(number).or(assumed).unwrap_or(0)
@@ -452,7 +452,10 @@ impl Ramp {
 
 impl Anchor {
     fn speed_at(&self, position: f64) -> f64 {
-        self.ramp.reach(self.speed, (position - self.at).abs())
+        let distance = (position - self.at).abs();
+        // At the anchor itself even one without ramps (a stop at a block
+        // without motion) has its own speed.
+        if distance == 0.0 { self.speed } else { self.ramp.reach(self.speed, distance) }
     }
 }
 

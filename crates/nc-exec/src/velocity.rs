@@ -23,7 +23,10 @@
 //! R236 under continuity, R52 for other working feed and R237 for rapid;
 //! threads (G33) run without ramps.
 
+use std::collections::VecDeque;
+
 use crate::{
+    envelope::{Envelope, EnvelopeMove, Limit, MoveKind, Planned, Planner},
     machine::MachineConfig,
     run::{Axes, Joining, MAX_AXES, Motion, Path, Step, StepSink, Trace},
 };
@@ -79,6 +82,9 @@ pub struct Dynamics {
     /// Seconds an M function and a tool change take.
     pub m_function_time: f64,
     pub tool_change_time: f64,
+    /// The CNC8x9 envelope velocity, when machine constant R338 switches it
+    /// on: it plans the moves instead of the one-block look-ahead.
+    pub envelope: Option<Envelope>,
 }
 
 /// What the model assumes for machine constants the manual gives no value
@@ -90,6 +96,11 @@ const ASSUMED_ACCELERATIONS: [(u32, i64); 3] = [(52, 1000), (236, 400), (237, 10
 
 impl Dynamics {
     pub fn of(machine: &MachineConfig) -> Dynamics {
+        Dynamics { envelope: Envelope::of(machine), ..Dynamics::cnc8x6(machine) }
+    }
+
+    /// The CNC8x6 model's constants, which the envelope builds on.
+    pub(crate) fn cnc8x6(machine: &MachineConfig) -> Dynamics {
         let acceleration = |number| {
             let assumed = ASSUMED_ACCELERATIONS.iter().find(|&&(n, _)| n == number).map(|&(_, value)| value);
             machine.known_constant(number).or(assumed).unwrap_or(0).unsigned_abs() as f64
@@ -112,6 +123,7 @@ impl Dynamics {
             min_tight_joining: for_control(machine, MIN_TIGHT_JOINING_MS) / 1000.0,
             m_function_time: f64::from(machine.m_function_ms) / 1000.0,
             tool_change_time: f64::from(machine.tool_change_ms) / 1000.0,
+            envelope: None,
         }
     }
 }
@@ -136,7 +148,10 @@ pub enum Reason {
     /// R97 decade 1 is 0: the control joins no blocks.
     ContinuityOff,
     /// The angle between the motion directions (degrees) is not below R39.
-    Corner { angle: f64, limit: f64 },
+    Corner {
+        angle: f64,
+        limit: f64,
+    },
     /// A rapid move at the junction.
     Rapid,
     /// A thread (G33) at the junction: it runs without ramps, from a stop.
@@ -144,14 +159,40 @@ pub enum Reason {
     /// A block without motion (or a dwell) between two moves.
     NonMotion,
     /// A move shorter (s) than the minimum duration for smooth joining.
-    ShortBlock { duration: f64, limit: f64 },
+    ShortBlock {
+        duration: f64,
+        limit: f64,
+    },
     /// Automatic recognition works for the first three axes only.
     BeyondThreeAxes,
     /// One block of look-ahead: the next move must be able to stop within
     /// itself, so the junction runs slower.
     LookAhead,
     /// An arc runs at most at the speed its chord error allows.
-    ArcLimit { radius: f64 },
+    ArcLimit {
+        radius: f64,
+    },
+    /// Envelope velocity (CNC8x9): a corner of `angle` degrees, limited by
+    /// the accuracy criterion R384 or the dynamic criterion R385.
+    Accuracy {
+        angle: f64,
+    },
+    Overload {
+        angle: f64,
+    },
+    /// Envelope velocity: the centrifugal acceleration on an arc.
+    Centrifugal {
+        radius: f64,
+    },
+    /// Envelope velocity: the look-ahead of `blocks` ends, and the last
+    /// block planned must be able to stop.
+    WindowEnd {
+        blocks: usize,
+    },
+    /// Envelope velocity: a block shorter than R382 (mm) breaks continuity.
+    ContinuityLength {
+        limit: f64,
+    },
 }
 
 impl Reason {
@@ -175,6 +216,11 @@ impl Reason {
             Reason::BeyondThreeAxes => "beyond-three-axes",
             Reason::LookAhead => "look-ahead",
             Reason::ArcLimit { .. } => "arc-limit",
+            Reason::Accuracy { .. } => "accuracy",
+            Reason::Overload { .. } => "overload",
+            Reason::Centrifugal { .. } => "centrifugal",
+            Reason::WindowEnd { .. } => "window-end",
+            Reason::ContinuityLength { .. } => "continuity-length",
         }
     }
 }
@@ -202,10 +248,24 @@ impl std::fmt::Display for Reason {
             }
             Reason::ArcLimit { radius } => write!(
                 f,
-                "an arc of radius {radius:.3} mm: at most {:.0} µm chord error per {:.0} ms tick",
+                "an arc of radius {radius:.3} mm: at most {:.0} µm chord error per interpolator tick",
                 CHORD_ERROR * 1000.0,
-                TICK * 1000.0
             ),
+            Reason::Accuracy { angle } => {
+                write!(f, "a corner of {angle:.1}°: the accuracy criterion R384 limits the speed")
+            }
+            Reason::Overload { angle } => {
+                write!(f, "a corner of {angle:.1}°: the dynamic criterion R385 limits the overload")
+            }
+            Reason::Centrifugal { radius } => {
+                write!(f, "an arc of radius {radius:.3} mm: the centrifugal criterion limits the speed")
+            }
+            Reason::WindowEnd { blocks } => {
+                write!(f, "the look-ahead of {blocks} blocks ends: the last block planned must be able to stop")
+            }
+            Reason::ContinuityLength { limit } => {
+                write!(f, "a block shorter than R382 ({limit:.3} mm) breaks continuity")
+            }
         }
     }
 }
@@ -305,9 +365,10 @@ pub fn time(trace: &Trace, dynamics: &Dynamics) -> Timing {
     timer.finish()
 }
 
-/// The model run over steps as they come, holding three at a time: the
-/// step before the junction being decided waits for the speed its
-/// successor ends at, which the lost time of a break needs.
+/// The model run over steps as they come: the CNC8x6 model holds three at
+/// a time (the step before the junction being decided waits for the speed
+/// its successor ends at, which the lost time of a break needs), the
+/// envelope velocity its look-ahead window.
 #[derive(Debug)]
 pub struct Timer<'a, S> {
     axes: &'a [u8],
@@ -316,6 +377,18 @@ pub struct Timer<'a, S> {
     /// Steps pushed so far, and where the last one ended.
     count: usize,
     end: Axes,
+    model: Model,
+}
+
+#[derive(Debug)]
+enum Model {
+    OneBlock(OneBlock),
+    Envelope(Box<Planning>),
+}
+
+/// The CNC8x6 one-block look-ahead.
+#[derive(Debug, Default)]
+struct OneBlock {
     /// The last step pushed, whose exit the next step decides, and the
     /// speed it enters at.
     current: Option<(Step, Move)>,
@@ -327,7 +400,11 @@ pub struct Timer<'a, S> {
 impl<'a, S: TimingSink> Timer<'a, S> {
     /// A timer for steps over the machine's `axes` ([`Trace::axes`]).
     pub fn new(axes: &'a [u8], dynamics: &'a Dynamics, sink: S) -> Self {
-        Timer { axes, dynamics, sink, count: 0, end: [0.0; MAX_AXES], current: None, entry: 0.0, waiting: None }
+        let model = match &dynamics.envelope {
+            Some(envelope) => Model::Envelope(Box::new(Planning::new(envelope.clone()))),
+            None => Model::OneBlock(OneBlock::default()),
+        };
+        Timer { axes, dynamics, sink, count: 0, end: [0.0; MAX_AXES], model }
     }
 
     /// Takes the next step of the run.
@@ -336,6 +413,24 @@ impl<'a, S: TimingSink> Timer<'a, S> {
         let next = move_of(&step, &self.end, self.axes, dynamics);
         self.end = step.end;
         self.count += 1;
+        match &mut self.model {
+            Model::OneBlock(model) => model.push(self.count - 1, step, next, dynamics, &mut self.sink),
+            Model::Envelope(planning) => planning.push(step, next, dynamics, &mut self.sink),
+        }
+    }
+
+    /// Times the last steps, which end at rest, and hands back the sink.
+    pub fn finish(mut self) -> S {
+        match self.model {
+            Model::OneBlock(model) => model.finish(self.count, self.dynamics, &mut self.sink),
+            Model::Envelope(planning) => planning.finish(self.dynamics, &mut self.sink),
+        }
+        self.sink
+    }
+}
+
+impl OneBlock {
+    fn push(&mut self, index: usize, step: Step, next: Move, dynamics: &Dynamics, sink: &mut impl TimingSink) {
         let Some((this_step, this)) = self.current.replace((step, next)) else {
             return;
         };
@@ -350,23 +445,170 @@ impl<'a, S: TimingSink> Timer<'a, S> {
             }
         };
         if let Some(before) = self.waiting.take() {
-            before.finish(Some(&this), exit, dynamics, &mut self.sink);
+            before.finish(Some(&this), exit, dynamics, sink);
         }
-        let index = self.count - 2;
-        self.waiting = Some(Timed { index, step: this_step, this, entry, exit, stop });
+        self.waiting = Some(Timed { index: index - 1, step: this_step, this, entry, exit, stop });
         self.entry = exit;
     }
 
-    /// Times the last steps, which end at rest, and hands back the sink.
-    pub fn finish(mut self) -> S {
+    fn finish(mut self, count: usize, dynamics: &Dynamics, sink: &mut impl TimingSink) {
         if let Some((step, this)) = self.current.take() {
             if let Some(before) = self.waiting.take() {
-                before.finish(Some(&this), 0.0, self.dynamics, &mut self.sink);
+                before.finish(Some(&this), 0.0, dynamics, sink);
             }
-            let last = Timed { index: self.count - 1, step, this, entry: self.entry, exit: 0.0, stop: None };
-            last.finish(None, 0.0, self.dynamics, &mut self.sink);
+            let last = Timed { index: count - 1, step, this, entry: self.entry, exit: 0.0, stop: None };
+            last.finish(None, 0.0, dynamics, sink);
         }
-        self.sink
+    }
+}
+
+/// The CNC8x9 envelope velocity: the planner's window, the steps in it,
+/// and the last step planned, which waits for its successor's time.
+#[derive(Debug)]
+struct Planning {
+    planner: Planner,
+    steps: PlannedSteps,
+}
+
+#[derive(Debug, Default)]
+struct PlannedSteps {
+    /// The steps in the window, each with why the junction before it stops.
+    window: VecDeque<(Step, Move, Option<Reason>)>,
+    previous: Option<Move>,
+    held: Option<Held>,
+}
+
+/// A planned step whose exit break waits for the time its successor loses
+/// to the same drop.
+#[derive(Debug)]
+struct Held {
+    step: Step,
+    profile: Profile,
+    exit: Option<Break>,
+    through: Option<Break>,
+}
+
+impl Planning {
+    fn new(envelope: Envelope) -> Planning {
+        Planning { planner: Planner::new(envelope), steps: PlannedSteps::default() }
+    }
+
+    fn push(&mut self, step: Step, this: Move, dynamics: &Dynamics, sink: &mut impl TimingSink) {
+        let steps = &mut self.steps;
+        let stop = steps.previous.and_then(|previous| stop_reason(&previous, &this, dynamics));
+        // The planner caps short blocks by their duration itself.
+        let stop_before = stop.is_some_and(|reason| !matches!(reason, Reason::ShortBlock { .. }));
+        let planned = EnvelopeMove {
+            length: this.length,
+            speed: this.programmed,
+            kind: match this.kind {
+                Kind::Feed => MoveKind::Feed,
+                Kind::Rapid => MoveKind::Rapid,
+                Kind::Thread => MoveKind::Thread,
+                Kind::Still => MoveKind::Still { duration: step.duration },
+            },
+            start_direction: this.start_direction,
+            end_direction: this.end_direction,
+            arc_radius: this.arc_radius,
+            stop_before,
+            continuity: this.joining == Joining::Continuous && dynamics.continuity > 0,
+            set: 1,
+            // Whether a block has technology functions the trace does not
+            // keep: R383 merges nothing.
+            mergeable: false,
+        };
+        steps.previous = Some(this);
+        steps.window.push_back((step, this, stop.filter(|_| stop_before)));
+        if let Some((index, planned)) = self.planner.push(planned) {
+            steps.planned(index, planned, dynamics, sink);
+        }
+    }
+
+    fn finish(self: Box<Self>, dynamics: &Dynamics, sink: &mut impl TimingSink) {
+        let Planning { planner, mut steps } = *self;
+        for (index, planned) in planner.finish() {
+            steps.planned(index, planned, dynamics, sink);
+        }
+        if let Some(held) = steps.held.take() {
+            held.hand_on(sink);
+        }
+    }
+}
+
+impl PlannedSteps {
+    /// Hands on the step before the one planned, now that the time this one
+    /// loses to the drop between them is known.
+    fn planned(&mut self, index: usize, planned: Planned, dynamics: &Dynamics, sink: &mut impl TimingSink) {
+        let Some((step, this, _)) = self.window.pop_front() else { return };
+        let next = self.window.front();
+        let mut profile = planned.profile;
+        profile.duration += extra_time(&step, dynamics);
+        let pause = match next {
+            Some((_, next, Some(_))) if this.kind != Kind::Still => pause_after(&this, next, dynamics),
+            _ => 0.0,
+        };
+        profile.duration += pause;
+        let moving = this.kind != Kind::Still && this.length > 0.0;
+        // Against the move at its programmed speed from end to end.
+        let deficit = if moving { (planned.profile.duration - this.length / this.programmed).max(0.0) } else { 0.0 };
+        let envelope = dynamics.envelope.as_ref();
+        let through = planned.cruise_limit.filter(|_| moving).and_then(|limit| {
+            let reason = match limit {
+                Limit::Centrifugal { radius } => Reason::Centrifugal { radius },
+                Limit::ChordError { radius } => Reason::ArcLimit { radius },
+                Limit::MinDuration => {
+                    Reason::ShortBlock { duration: this.length / this.programmed, limit: dynamics.min_continuity }
+                }
+                _ => return None,
+            };
+            let cruise = profile.peak / 60.0;
+            let lost = (this.length / cruise - this.length / this.programmed).clamp(0.0, deficit);
+            Some(Break { step: index, reason, before: this.programmed * 60.0, at: profile.peak, lost })
+        });
+        let exit = next.filter(|_| moving).zip(planned.exit_limit).and_then(|((_, next, stop), limit)| {
+            let reason = match limit {
+                Limit::Stop => stop.unwrap_or(Reason::NonMotion),
+                Limit::ShortBlock => Reason::ContinuityLength { limit: envelope.map_or(0.0, |e| e.short_block) },
+                Limit::Accuracy { angle } => Reason::Accuracy { angle },
+                Limit::Overload { angle } => Reason::Overload { angle },
+                Limit::Centrifugal { radius } => Reason::Centrifugal { radius },
+                Limit::ChordError { radius } => Reason::ArcLimit { radius },
+                Limit::MinDuration => Reason::ShortBlock {
+                    duration: (this.length / this.programmed).min(next.length / next.programmed),
+                    limit: dynamics.min_continuity,
+                },
+                Limit::WindowEnd => Reason::WindowEnd { blocks: envelope.map_or(0, |e| e.depth) },
+                Limit::Feed | Limit::End | Limit::Ramp => return None,
+            };
+            let before = if next.kind == Kind::Still { this.programmed } else { this.programmed.min(next.programmed) };
+            Some(Break { step: index, reason, before: before * 60.0, at: profile.exit, lost: pause })
+        });
+        // What the move loses besides a limit through it goes to the drops
+        // at its ends, as the square of each end's shortfall weighs (a
+        // linear ramp from v loses (feed − v)² / (2 a feed)); a ramp from
+        // the program's start or a still block is no drop's.
+        let remaining = deficit - through.map_or(0.0, |through| through.lost);
+        let shortfall = |speed: f64| (this.programmed - speed / 60.0).max(0.0).powi(2);
+        let (at_entry, at_exit) = (shortfall(profile.entry), shortfall(profile.exit));
+        let share = |part: f64| if at_entry + at_exit > 0.0 { remaining * part / (at_entry + at_exit) } else { 0.0 };
+        let (to_entry, to_exit) = (share(at_entry), share(at_exit));
+        if let Some(mut held) = self.held.take() {
+            if let Some(drop) = &mut held.exit {
+                drop.lost += to_entry;
+            }
+            held.hand_on(sink);
+        }
+        let exit = exit.map(|drop| Break { lost: drop.lost + to_exit, ..drop });
+        self.held = Some(Held { step, profile, exit, through });
+    }
+}
+
+impl Held {
+    fn hand_on(self, sink: &mut impl TimingSink) {
+        for speed_break in self.exit.into_iter().chain(self.through) {
+            sink.speed_break(&self.step, speed_break);
+        }
+        sink.timed(&self.step, self.profile);
     }
 }
 
@@ -394,8 +636,7 @@ impl Timed {
     fn finish(self, next: Option<&Move>, after: f64, dynamics: &Dynamics, sink: &mut impl TimingSink) {
         let Timed { index, step, this, entry, exit, stop } = self;
         let mut profile = profile(&this, entry, exit, step.duration);
-        profile.duration += f64::from(step.m_functions) * dynamics.m_function_time
-            + if step.tool_change { dynamics.tool_change_time } else { 0.0 };
+        profile.duration += extra_time(&step, dynamics);
         match (stop, next) {
             (Some(reason), Some(next)) if this.kind != Kind::Still => {
                 let pause = pause_after(&this, next, dynamics);
@@ -434,6 +675,12 @@ impl Timed {
         }
         sink.timed(&step, profile);
     }
+}
+
+/// Seconds the step's M functions and tool change add.
+fn extra_time(step: &Step, dynamics: &Dynamics) -> f64 {
+    f64::from(step.m_functions) * dynamics.m_function_time
+        + if step.tool_change { dynamics.tool_change_time } else { 0.0 }
 }
 
 /// The step as a move: its speeds, acceleration and directions.
@@ -742,6 +989,55 @@ mod tests {
         let timing = timed("%1\nN1 G23 G01 X100 F3000\nN2 X110 F600\nN3 M30\n");
         assert_eq!(timing.profiles[0].exit, 600.0);
         assert_eq!(timing.profiles[1].entry, 600.0);
+    }
+
+    /// A CNC8x9 with the envelope velocity and the linear profile (R338
+    /// decade 2 = 1).
+    fn enveloped(text: &str) -> Timing {
+        let machine = MachineConfig { constants: [(338, 10)].into(), ..MachineConfig::default() };
+        let dynamics = Dynamics::of(&machine);
+        assert!(dynamics.envelope.is_some());
+        let trace = run(text, &NoFiles, &machine, 1000);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        time(&trace, &dynamics)
+    }
+
+    #[test]
+    fn the_envelope_runs_a_chain_of_short_blocks_at_the_feed() {
+        // 100 blocks of 1 mm at 100 mm/s: 10 ms each, far below the CNC8x6's
+        // 60 ms, but the envelope plans across them as one 100 mm line
+        // ramping at R236 = 400 mm/s², with the 10 ms settle at the end.
+        let mut text = String::from("%1\nN1 G23 G01 X1 F6000\n");
+        for i in 2..=100 {
+            text.push_str(&format!("N{i} X{i}\n"));
+        }
+        text.push_str("N101 M30\n");
+        let timing = enveloped(&text);
+        let expected = rest_to_rest(100.0, 100.0, 400.0) + 0.010;
+        assert!((timing.total_time() - expected).abs() < expected * 1e-3, "{} != {expected}", timing.total_time());
+        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason)).collect();
+        assert_eq!(reasons, [(99, Reason::NonMotion)]);
+        // The CNC8x6 stops after every block.
+        assert!(timed(&text).total_time() > 3.0 * expected);
+    }
+
+    #[test]
+    fn the_envelope_slows_a_corner_by_the_accuracy_criterion() {
+        // 45° below R39: R384 = 8 µm at Ts = 2 ms allows
+        // 0.008 / (0.002 tan 22.5°) mm/s, below R385's 10000 · 0.002 /
+        // (2 sin 22.5°).
+        let timing = enveloped("%1\nN1 G23 G01 X100 F6000\nN2 X200 Y100\nN3 M30\n");
+        let corner = timing.breaks[0];
+        assert_eq!(corner.step, 0);
+        let Reason::Accuracy { angle } = corner.reason else { panic!("{:?}", corner.reason) };
+        assert!((angle - 45.0).abs() < 1e-9);
+        let limit = 0.008 / (0.002 * 22.5f64.to_radians().tan()) * 60.0;
+        assert!((corner.at - limit).abs() < limit * 1e-3, "{} != {limit}", corner.at);
+        assert!((timing.profiles[1].entry - corner.at).abs() < 1e-9);
+        // The drop costs both moves' ramps against passing at 100 mm/s.
+        let (v, a) = (limit / 60.0, 400.0);
+        let ramps = 2.0 * ((100.0 - v) / a - (100.0 * 100.0 - v * v) / (2.0 * a) / 100.0);
+        assert!((corner.lost - ramps).abs() < ramps * 1e-3, "{} != {ramps}", corner.lost);
     }
 
     #[test]
