@@ -394,6 +394,13 @@ fn the_plot_command_draws_the_document_as_edited() {
     assert_eq!(error["message"], "the run stopped at line 4: there is no macrocycle file L9002 to call", "{error}");
     assert_eq!(plotted_moves(error["data"]["svg"].as_str().unwrap()), [(2, None), (3, None)], "{error}");
     assert_eq!(error["data"]["findings"][0]["stopped"], true, "{error}");
+
+    // A new document that is no file yet is drawn too, without a project.
+    let untitled = Document::new("untitled:Untitled-1".into(), "%1\nN10 G01 X5 F100\nN20 M30\n".into());
+    client.notify("textDocument/didOpen", untitled.did_open()).unwrap();
+    let answer = plot(&mut client, json!([untitled.uri]));
+    let result = answer.result().unwrap_or_else(|| panic!("{}", answer.json));
+    assert_eq!(plotted_moves(result["svg"].as_str().unwrap()), [(2, None)], "{result}");
     assert_serving(&mut client, &dir);
 }
 
