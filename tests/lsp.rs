@@ -302,6 +302,108 @@ fn rapid_edits_end_in_the_diagnostics_of_the_final_text_without_growing() {
     assert_same_as_a_fresh_copy(&mut client, &dir, &doc, &edited);
 }
 
+/// `workspace/executeCommand` `ncc.plot`.
+fn plot(client: &mut Client, arguments: Value) -> Message {
+    client.call("workspace/executeCommand", json!({ "command": "ncc.plot", "arguments": arguments })).unwrap()
+}
+
+/// The lines of an SVG picture's moves (`<path data-line=...`), with the
+/// file they name when it is not the program.
+fn plotted_moves(svg: &str) -> Vec<(u64, Option<String>)> {
+    let attribute = |line: &str, name: &str| {
+        let start = line.find(&format!(" {name}=\""))? + name.len() + 3;
+        Some(line[start..][..line[start..].find('"')?].to_owned())
+    };
+    svg.lines()
+        .filter(|line| line.starts_with("<path "))
+        .map(|line| {
+            let number = attribute(line, "data-line").and_then(|n| n.parse().ok());
+            (number.unwrap_or_else(|| panic!("a move without data-line: {line}")), attribute(line, "data-file"))
+        })
+        .collect()
+}
+
+/// `ncc.plot` draws what `ncc plot` draws, from the open document's text
+/// with its unsaved edits; a document the server does not have, and a run
+/// that stops, are errors that say why.
+#[test]
+fn the_plot_command_draws_the_document_as_edited() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut client = server();
+    let initialized = client.initialize(dir.path(), None).unwrap();
+    let commands = &initialized.result().unwrap()["capabilities"]["executeCommandProvider"]["commands"];
+    assert!(commands.as_array().is_some_and(|c| c.contains(&json!("ncc.plot"))), "{commands}");
+
+    // The macrocycle file is on disk beside the program; the program is
+    // not: only the editor has its text.
+    let macro_path = dir.path().join("L9001");
+    std::fs::write(&macro_path, "N1 G79 L9001\nN2 G91 G01 X10 F600\nN3 G90 G70\n").unwrap();
+    let program = dir.path().join("PLOT.NCP");
+    let mut doc =
+        Document::new(file_uri(&program), "%1\nN10 G00 X10 Y0\nN20 G01 X20 F600\nN30 G72 L9001\nN40 M30\n".into());
+    open(&mut client, &doc);
+
+    let answer = plot(&mut client, json!([doc.uri]));
+    let result = answer.result().unwrap_or_else(|| panic!("{}", answer.json));
+    let svg = result["svg"].as_str().unwrap();
+    assert!(svg.starts_with("<svg xmlns=\"http://www.w3.org/2000/svg\""), "{svg}");
+    let macro_file = Some(macro_path.display().to_string());
+    assert_eq!(plotted_moves(svg), [(2, None), (3, None), (2, macro_file.clone())], "{svg}");
+    let first_time = result["totalTimeS"].as_f64().unwrap();
+    assert!(first_time > 0.0, "{result}");
+    assert_eq!(result["findings"], json!([]));
+
+    // An edit that is not saved: a move on a new line 5.
+    let n40 = doc.text().find("N40").unwrap();
+    client.notify("textDocument/didChange", doc.change(n40..n40, "N35 G01 Y30\n")).unwrap();
+    let answer = plot(&mut client, json!([doc.uri]));
+    let result = answer.result().unwrap_or_else(|| panic!("{}", answer.json));
+    let svg = result["svg"].as_str().unwrap();
+    assert_eq!(plotted_moves(svg), [(2, None), (3, None), (2, macro_file), (5, None)], "{svg}");
+    assert!(result["totalTimeS"].as_f64().unwrap() > first_time, "{result}");
+
+    // The same picture as `ncc plot` draws of that text saved.
+    std::fs::write(&program, doc.text()).unwrap();
+    let out = dir.path().join("plot.svg");
+    let status =
+        Command::new(env!("CARGO_BIN_EXE_ncc")).arg("plot").arg(&program).arg("-o").arg(&out).status().unwrap();
+    assert!(status.success());
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), svg, "ncc plot and ncc.plot differ");
+
+    // Documents the server does not have, and arguments that name none.
+    let elsewhere = file_uri(&dir.path().join("NOT-OPEN.NCP"));
+    for (arguments, expected) in [
+        (json!([elsewhere]), "is not open"),
+        (json!(["not a uri"]), "is not a URI"),
+        (json!([]), "takes one argument"),
+        (json!([{ "uri": doc.uri }]), "takes one argument"),
+    ] {
+        let answer = plot(&mut client, arguments.clone());
+        assert_eq!(answer.error_code(), Some(INVALID_PARAMS), "{arguments}: {}", answer.json);
+        let message = answer.json["error"]["message"].as_str().unwrap();
+        assert!(message.contains("ncc.plot") && message.contains(expected), "{arguments}: {message}");
+    }
+
+    // A run that stops: the error says where and why, and its data holds
+    // the picture of the run up to there.
+    let l9001 = doc.text().find("L9001").unwrap();
+    client.notify("textDocument/didChange", doc.change(l9001..l9001 + 5, "L9002")).unwrap();
+    let answer = plot(&mut client, json!([doc.uri]));
+    assert_eq!(answer.error_code(), Some(-32803), "RequestFailed: {}", answer.json);
+    let error = &answer.json["error"];
+    assert_eq!(error["message"], "the run stopped at line 4: there is no macrocycle file L9002 to call", "{error}");
+    assert_eq!(plotted_moves(error["data"]["svg"].as_str().unwrap()), [(2, None), (3, None)], "{error}");
+    assert_eq!(error["data"]["findings"][0]["stopped"], true, "{error}");
+
+    // A new document that is no file yet is drawn too, without a project.
+    let untitled = Document::new("untitled:Untitled-1".into(), "%1\nN10 G01 X5 F100\nN20 M30\n".into());
+    client.notify("textDocument/didOpen", untitled.did_open()).unwrap();
+    let answer = plot(&mut client, json!([untitled.uri]));
+    let result = answer.result().unwrap_or_else(|| panic!("{}", answer.json));
+    assert_eq!(plotted_moves(result["svg"].as_str().unwrap()), [(2, None)], "{result}");
+    assert_serving(&mut client, &dir);
+}
+
 #[test]
 fn shutdown_then_exit_ends_with_success() {
     let (mut client, dir) = session();

@@ -1,5 +1,6 @@
 // Bundles the extension and its runtime dependencies into one file, so the
-// package ships without node_modules.
+// package ships without node_modules, and the toolpath view's page script
+// into another, for the webview.
 import { build } from 'esbuild';
 
 await build({
@@ -10,6 +11,18 @@ await build({
   format: 'cjs',
   target: 'node20',
   external: ['vscode'],
+  minify: true,
+  sourcemap: false,
+  logLevel: 'warning',
+});
+
+await build({
+  entryPoints: ['src/webview/main.ts'],
+  outfile: 'dist/toolpath.js',
+  bundle: true,
+  platform: 'browser',
+  format: 'iife',
+  target: 'es2022',
   minify: true,
   sourcemap: false,
   logLevel: 'warning',

@@ -2,7 +2,10 @@
 //! plane (ZX on a lathe), feed moves coloured by the speed the velocity
 //! model gives them, rapid moves dashed, and the breaks of the path speed
 //! marked; every move and mark carries its source line (`data-line`) and a
-//! tooltip, so that a viewer can jump to the block.
+//! tooltip, so that a viewer can jump to the block. A move that a
+//! macrocycle file or the cycle file makes also names that file
+//! (`data-file`): its line is a line of that file. The picture is data
+//! only, without scripts or styles; the editor's toolpath view adds those.
 
 use std::fmt::Write as _;
 
@@ -18,9 +21,21 @@ const LEGEND_HEIGHT: f64 = 70.0;
 /// Slow to fast.
 const PALETTE: [&str; 5] = ["#3b4cc0", "#6f9bf5", "#a9c66a", "#f4a259", "#d1342f"];
 
-/// Where a step's line is, for the marks' `data-line`.
+/// Where a step's line is, for the marks' `data-line` and `data-file`.
 pub(crate) trait Lines {
+    /// The line, counted from 1, in the step's file.
     fn line_of(&self, step: usize) -> u32;
+    /// The step's file when it is not the program itself.
+    fn file_of(&self, step: usize) -> Option<&str>;
+}
+
+/// ` data-line="…"`, and ` data-file="…"` outside the program.
+fn source_attributes(lines: &impl Lines, step: usize) -> String {
+    let line = lines.line_of(step);
+    match lines.file_of(step) {
+        Some(file) => format!(r#" data-line="{line}" data-file="{}""#, escape(file)),
+        None => format!(r#" data-line="{line}""#),
+    }
 }
 
 /// The SVG text of `trace` timed by `timing`, titled `title`.
@@ -73,9 +88,10 @@ pub(crate) fn svg(trace: &Trace, timing: &Timing, lines: &impl Lines, title: &st
             let _ = write!(d, "{}{x:.2} {y:.2}", if i == 0 { "M" } else { " L" });
         }
         let line = lines.line_of(index);
+        let source = source_attributes(lines, index);
         let _ = writeln!(
             out,
-            r#"<path data-line="{line}" d="{d}" fill="none" {style} stroke-width="1.5"><title>line {line}: {:.0} mm/min, {:.3} s</title></path>"#,
+            r#"<path{source} d="{d}" fill="none" {style} stroke-width="1.5"><title>line {line}: {:.0} mm/min, {:.3} s</title></path>"#,
             profile.peak, profile.duration
         );
     }
@@ -84,9 +100,10 @@ pub(crate) fn svg(trace: &Trace, timing: &Timing, lines: &impl Lines, title: &st
         let (x, y) = pixel(end);
         let fill = if speed_break.at == 0.0 { "#d1342f" } else { "#f4a259" };
         let line = lines.line_of(speed_break.step);
+        let source = source_attributes(lines, speed_break.step);
         let _ = writeln!(
             out,
-            r#"<circle data-line="{line}" cx="{x:.2}" cy="{y:.2}" r="3" fill="{fill}"><title>line {line}: {}: {:.0} → {:.0} mm/min, {:.3} s lost</title></circle>"#,
+            r#"<circle{source} cx="{x:.2}" cy="{y:.2}" r="3" fill="{fill}"><title>line {line}: {}: {:.0} → {:.0} mm/min, {:.3} s lost</title></circle>"#,
             escape(&speed_break.reason.to_string()),
             speed_break.before,
             speed_break.at,

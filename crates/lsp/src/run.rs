@@ -3,7 +3,9 @@
 //! into cutting, rapid and dwell, the path lengths, the tools, the end
 //! position and the breaks of the path speed; `--format json` adds a
 //! record per block and every break. `ncc expand`, `ncc plot` and
-//! `ncc lower` share the run.
+//! `ncc lower` share the run, and so does the language server's `ncc.plot`
+//! command, which runs an editor's text ([`Program`]) and draws it with
+//! [`Ran::plot`] as `ncc plot` does.
 
 use std::{
     cell::{OnceCell, RefCell},
@@ -34,8 +36,22 @@ pub(crate) enum Format {
     Json,
 }
 
+/// A program to run: its text, and where it comes from.
+pub(crate) struct Program<'a> {
+    /// Its file, beside which (and in whose project) the run finds the
+    /// macrocycle files and the cycle file; `None` for a text that is no
+    /// file (an editor's new document).
+    pub path: Option<&'a Path>,
+    /// What messages, `data-file` attributes and titles call it.
+    pub name: String,
+    /// The text to run: an editor's may differ from the file's.
+    pub text: &'a str,
+    /// The `ncc.toml` that applies, whose directory is the project.
+    pub config: Option<&'a Path>,
+}
+
 /// A program run on the machine of its project.
-struct Ran {
+pub(crate) struct Ran {
     trace: Trace,
     /// The machine's dynamics, for the velocity model.
     dynamics: Dynamics,
@@ -44,71 +60,93 @@ struct Ran {
     number: Option<u32>,
 }
 
-/// A program read with its project's machine, ready to run.
-struct Program<'a> {
-    path: &'a Path,
-    text: String,
-    machine: MachineConfig,
+impl Program<'_> {
+    /// The machine its configuration describes.
+    fn machine(&self) -> Result<MachineConfig, String> {
+        Ok(self.config.map(check::load_config).transpose()?.unwrap_or_default().machine)
+    }
 }
 
-impl<'a> Program<'a> {
-    /// Reads the program at `path` and its project's configuration; the
-    /// error is the exit code after the message is printed.
-    fn read(path: &'a Path) -> Result<Program<'a>, ExitCode> {
-        let text = check::read_program(path).map_err(|error| {
-            eprintln!("error: {}: {error}", path.display());
-            ExitCode::from(2)
-        })?;
-        let config = Config::find_for(path).map(|config| check::load_config(&config)).transpose().map_err(|error| {
-            eprintln!("error: {error}");
-            ExitCode::from(2)
-        })?;
-        Ok(Program { path, text, machine: config.unwrap_or_default().machine })
+/// Reads the program at `path`; the error is the exit code after the
+/// message is printed.
+fn read(path: &Path) -> Result<String, ExitCode> {
+    check::read_program(path).map_err(|error| {
+        eprintln!("error: {}: {error}", path.display());
+        ExitCode::from(2)
+    })
+}
+
+/// The program at `path` with the `ncc.toml` found for it.
+fn program_at<'a>(path: &'a Path, text: &'a str, config: Option<&'a Path>) -> Program<'a> {
+    Program { path: Some(path), name: path.display().to_string(), text, config }
+}
+
+/// Prints a configuration error; the exit code says so.
+fn config_error(error: String) -> ExitCode {
+    eprintln!("error: {error}");
+    ExitCode::from(2)
+}
+
+impl Ran {
+    /// Runs the program at `path` with the `ncc.toml` found for it, and
+    /// prints the run's findings; the error is the exit code after the
+    /// message is printed.
+    fn new(path: &Path, step_budget: usize) -> Result<Ran, ExitCode> {
+        let text = read(path)?;
+        let config = Config::find_for(path);
+        let program = program_at(path, &text, config.as_deref());
+        let ran = Ran::of(&program, step_budget, Progress::OnTerminal).map_err(config_error)?;
+        ran.print_findings();
+        Ok(ran)
     }
 
-    /// Runs it keeping every step.
-    fn run(self, step_budget: usize) -> Ran {
-        self.run_into(step_budget, None)
+    fn print_findings(&self) {
+        for finding in self.findings() {
+            eprintln!("{}:{}: {}", finding.file, finding.line, finding.message);
+        }
     }
 
-    /// Runs it handing the steps to `sink` as they come (the trace keeps
-    /// none), or keeping them.
-    fn run_into(self, step_budget: usize, sink: Option<&mut dyn StepSink>) -> Ran {
-        let Program { path, text, machine } = self;
-        let number = BlockParser::new(&text)
+    /// Runs `program` on the machine its configuration describes. The
+    /// error is a configuration that cannot be read; a program that stops
+    /// on an error has its run up to there (see [`Ran::stop`]).
+    pub(crate) fn of(program: &Program<'_>, step_budget: usize, progress: Progress) -> Result<Ran, String> {
+        Ok(Ran::run(program, &program.machine()?, step_budget, progress, None))
+    }
+
+    /// Like [`Ran::of`], through the velocity model as the steps come,
+    /// keeping only what the summary shows: the trace keeps no steps.
+    fn tally(program: &Program<'_>, step_budget: usize, progress: Progress) -> Result<(Ran, Tally), String> {
+        let machine = program.machine()?;
+        let dynamics = Dynamics::of(&machine);
+        let mut timer = Timer::new(machine.step_axes(), &dynamics, Tally::default());
+        let ran = Ran::run(program, &machine, step_budget, progress, Some(&mut timer));
+        Ok((ran, timer.finish()))
+    }
+
+    /// Runs `program` handing the steps to `sink` as they come, or keeping
+    /// them.
+    fn run(
+        program: &Program<'_>,
+        machine: &MachineConfig,
+        step_budget: usize,
+        progress: Progress,
+        sink: Option<&mut dyn StepSink>,
+    ) -> Ran {
+        let text = program.text;
+        let number = BlockParser::new(text)
             .header()
             .and_then(|header| header.number())
             .and_then(|n| u32::try_from(n.scaled(0)?).ok());
-        let library = Library::for_program(path);
+        let library = Library::for_program(program, progress);
         let trace = match sink {
-            Some(sink) => nc_exec::run::run_into(&text, &library, &machine, step_budget, sink),
-            None => nc_exec::run::run(&text, &library, &machine, step_budget),
+            Some(sink) => nc_exec::run::run_into(text, &library, machine, step_budget, sink),
+            None => nc_exec::run::run(text, &library, machine, step_budget),
         };
         if let Some(bar) = library.progress.get() {
             bar.finish_and_clear();
         }
-        let sources = library.sources(path, text, &trace);
-        for finding in &trace.findings {
-            eprintln!("{}: {}", sources[finding.source].place(finding.range.start()), finding.message);
-        }
-        Ran { trace, dynamics: Dynamics::of(&machine), sources, number }
-    }
-
-    /// Runs it through the velocity model as the steps come, keeping only
-    /// what the summary shows.
-    fn tally(self, step_budget: usize) -> (Ran, Tally) {
-        let dynamics = Dynamics::of(&self.machine);
-        let axes = self.machine.step_axes().to_vec();
-        let mut timer = Timer::new(&axes, &dynamics, Tally::default());
-        let ran = self.run_into(step_budget, Some(&mut timer));
-        (ran, timer.finish())
-    }
-}
-
-impl Ran {
-    /// Runs the program at `path`, keeping every step.
-    fn new(path: &Path, step_budget: usize) -> Result<Ran, ExitCode> {
-        Ok(Program::read(path)?.run(step_budget))
+        let sources = library.sources(&program.name, text, &trace);
+        Ran { trace, dynamics: Dynamics::of(machine), sources, number }
     }
 
     /// The run timed with the control's velocity model.
@@ -117,24 +155,90 @@ impl Ran {
     }
 
     fn exit_code(&self) -> ExitCode {
-        if self.trace.findings.iter().any(|finding| finding.fatal) { ExitCode::FAILURE } else { ExitCode::SUCCESS }
+        if self.stop().is_some() { ExitCode::FAILURE } else { ExitCode::SUCCESS }
+    }
+
+    /// The run's findings in the order they came, each with its file (the
+    /// program's name for the program), its line and whether the run
+    /// stopped there.
+    pub(crate) fn findings(&self) -> impl Iterator<Item = RunFinding<'_>> {
+        self.trace.findings.iter().map(|finding| {
+            let source = &self.sources[finding.source];
+            RunFinding {
+                file: &source.name,
+                in_program: finding.source == 0,
+                line: source.line(finding.range.start()),
+                message: &finding.message,
+                stopped: finding.fatal,
+            }
+        })
+    }
+
+    /// The error the run stopped on, if it did.
+    pub(crate) fn stop(&self) -> Option<RunFinding<'_>> {
+        self.findings().find(|finding| finding.stopped)
+    }
+
+    /// The picture `ncc plot` writes, titled with the program's name.
+    pub(crate) fn plot(&self) -> Plot {
+        let timing = self.timing();
+        let title = format!("{} · ncc plot", self.sources[0].name);
+        Plot { svg: crate::plot::svg(&self.trace, &timing, self, &title), total_time: timing.total_time() }
     }
 }
 
+/// What a run found at a place: an instruction it does not run yet, an
+/// error the control stops on.
+pub(crate) struct RunFinding<'a> {
+    pub file: &'a str,
+    /// In the program itself, not in a file it called.
+    pub in_program: bool,
+    /// Counted from 1.
+    pub line: u32,
+    pub message: &'a str,
+    pub stopped: bool,
+}
+
+/// The toolpath picture of a run, and the total time its legend shows.
+pub(crate) struct Plot {
+    pub svg: String,
+    /// Seconds, with the velocity model.
+    pub total_time: f64,
+}
+
+/// Whether a long run shows a spinner.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Progress {
+    /// On stderr, when it is a terminal (the command line).
+    OnTerminal,
+    /// Never (the language server, whose stderr is its log).
+    Hidden,
+}
+
 pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
-    let program = match Program::read(path) {
-        Ok(program) => program,
+    let text = match read(path) {
+        Ok(text) => text,
         Err(code) => return code,
     };
+    let config = Config::find_for(path);
+    let program = program_at(path, &text, config.as_deref());
     let (ran, written) = match format {
         Format::Human => {
-            let (ran, tally) = program.tally(step_budget);
+            let (ran, tally) = match Ran::tally(&program, step_budget, Progress::OnTerminal) {
+                Ok(ran) => ran,
+                Err(error) => return config_error(error),
+            };
+            ran.print_findings();
             let mut out = io::stdout().lock();
             let written = out.write_all(summary(path, &ran, &tally).as_bytes()).and_then(|()| out.flush());
             (ran, written)
         }
         Format::Json => {
-            let ran = program.run(step_budget);
+            let ran = match Ran::of(&program, step_budget, Progress::OnTerminal) {
+                Ok(ran) => ran,
+                Err(error) => return config_error(error),
+            };
+            ran.print_findings();
             let timing = ran.timing();
             let report = Report::new(path, &ran, &timing);
             let mut out = io::BufWriter::new(io::stdout().lock());
@@ -193,9 +297,7 @@ pub(crate) fn plot(path: &Path, output: &Path, step_budget: usize) -> ExitCode {
         Ok(ran) => ran,
         Err(code) => return code,
     };
-    let title = format!("{} · ncc plot", path.display());
-    let svg = crate::plot::svg(&ran.trace, &ran.timing(), &ran, &title);
-    match std::fs::write(output, svg) {
+    match std::fs::write(output, ran.plot().svg) {
         Ok(()) => ran.exit_code(),
         Err(error) => {
             eprintln!("error: writing {}: {error}", output.display());
@@ -208,6 +310,11 @@ impl crate::plot::Lines for Ran {
     fn line_of(&self, step: usize) -> u32 {
         let step = &self.trace.steps[step];
         self.sources[step.source].line(step.range.start())
+    }
+
+    fn file_of(&self, step: usize) -> Option<&str> {
+        let source = self.trace.steps[step].source;
+        (source != 0).then(|| self.sources[source].name.as_str())
     }
 }
 
@@ -608,13 +715,22 @@ struct Library {
 }
 
 impl Library {
-    fn for_program(path: &Path) -> Library {
-        let directory = path.parent().filter(|dir| !dir.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        let beside = std::fs::read_dir(directory).into_iter().flatten().flatten().map(|entry| entry.path());
-        let project = Config::find_for(path).and_then(|config| Some(config.parent()?.to_path_buf()));
-        let in_project = project.map(|root| check::collect_files(&[root]).0).unwrap_or_default();
-        let candidates = beside.chain(in_project).filter(|path| path.is_file()).collect();
-        Library { candidates, read: RefCell::default(), progress: OnceCell::new() }
+    fn for_program(program: &Program<'_>, progress: Progress) -> Library {
+        let candidates = match program.path {
+            Some(path) => {
+                let directory = path.parent().filter(|dir| !dir.as_os_str().is_empty()).unwrap_or(Path::new("."));
+                let beside = std::fs::read_dir(directory).into_iter().flatten().flatten().map(|entry| entry.path());
+                let project = program.config.and_then(Path::parent).map(Path::to_path_buf);
+                let in_project = project.map(|root| check::collect_files(&[root]).0).unwrap_or_default();
+                beside.chain(in_project).filter(|path| path.is_file()).collect()
+            }
+            None => Vec::new(),
+        };
+        let progress = match progress {
+            Progress::OnTerminal => OnceCell::new(),
+            Progress::Hidden => OnceCell::from(ProgressBar::hidden()),
+        };
+        Library { candidates, read: RefCell::default(), progress }
     }
 
     fn read(&self, called: Called, matches: impl Fn(&Path) -> bool) -> Option<String> {
@@ -625,11 +741,12 @@ impl Library {
     }
 
     /// The program and the files the run read, in the trace's source order.
-    fn sources(&self, path: &Path, text: String, trace: &Trace) -> Vec<Source> {
+    fn sources(&self, name: &str, text: &str, trace: &Trace) -> Vec<Source> {
         let read = self.read.take();
-        let source = |path: &Path, text: &str| Source { name: path.display().to_string(), lines: LineIndex::new(text) };
+        let source = |name: String, text: &str| Source { name, lines: LineIndex::new(text) };
         let files = trace.files.iter().filter_map(|called| read.iter().find(|(c, _, _)| c == called));
-        std::iter::once(source(path, &text)).chain(files.map(|(_, path, text)| source(path, text))).collect()
+        let files = files.map(|(_, path, text)| source(path.display().to_string(), text));
+        std::iter::once(source(name.to_owned(), text)).chain(files).collect()
     }
 }
 

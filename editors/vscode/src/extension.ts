@@ -2,8 +2,10 @@
 
 import * as os from 'node:os';
 import * as vscode from 'vscode';
-import { LanguageClient, State } from 'vscode-languageclient/node';
+import { ExecuteCommandRequest, LanguageClient, State } from 'vscode-languageclient/node';
 import { type Environment, type Launch, readSettings, serverLaunch } from './server';
+import { PLOT_COMMAND } from './toolpath';
+import { ToolpathViews } from './toolpathView';
 
 const LANGUAGE_ID = 'cnc8x6';
 
@@ -11,12 +13,17 @@ let server: Server | undefined;
 
 export function activate(context: vscode.ExtensionContext): Promise<void> {
   const output = vscode.window.createOutputChannel('ncc', { log: true });
-  server = new Server(output);
+  const views = new ToolpathViews(context.extensionUri, (uri) =>
+    server ? server.plot(uri) : Promise.reject(new Error('The ncc language server is not running.')),
+  );
+  server = new Server(output, () => views.refresh());
   context.subscriptions.push(
     output,
     server,
+    views,
     vscode.commands.registerCommand('ncc.restartServer', () => server?.restart()),
     vscode.commands.registerCommand('ncc.showOutput', () => output.show(true)),
+    vscode.commands.registerCommand('ncc.showToolpath', (resource?: unknown) => showToolpath(views, resource)),
     vscode.workspace.onDidChangeConfiguration((event) => {
       // The trace setting is read by the language client itself.
       if (event.affectsConfiguration('ncc.server') || event.affectsConfiguration('ncc.machine')) {
@@ -29,6 +36,26 @@ export function activate(context: vscode.ExtensionContext): Promise<void> {
 
 export function deactivate(): Promise<void> | undefined {
   return server?.stop();
+}
+
+/**
+ * `ncc.showToolpath`: the view of the document the editor title menu names
+ * (`resource`), or of the active editor's.
+ */
+async function showToolpath(views: ToolpathViews, resource: unknown): Promise<void> {
+  const active = vscode.window.activeTextEditor;
+  let document = active?.document;
+  let column = active?.viewColumn;
+  if (resource instanceof vscode.Uri && resource.toString() !== document?.uri.toString()) {
+    const shown = vscode.window.visibleTextEditors.find((e) => e.document.uri.toString() === resource.toString());
+    document = shown?.document ?? (await vscode.workspace.openTextDocument(resource));
+    column = shown?.viewColumn;
+  }
+  if (document?.languageId !== LANGUAGE_ID) {
+    void vscode.window.showWarningMessage('ncc: the toolpath is drawn for CNC8x6 programs; open one first.');
+    return;
+  }
+  views.show(document, column);
 }
 
 type Status =
@@ -45,7 +72,11 @@ class Server implements vscode.Disposable {
   private stopping = false;
   private restarting: Promise<void> = Promise.resolve();
 
-  constructor(private readonly output: vscode.LogOutputChannel) {
+  constructor(
+    private readonly output: vscode.LogOutputChannel,
+    /** Called each time a server is running. */
+    private readonly onRunning: () => void,
+  ) {
     this.item = vscode.window.createStatusBarItem('ncc.status', vscode.StatusBarAlignment.Left);
     this.item.name = 'ncc';
     this.item.command = 'ncc.showOutput';
@@ -90,6 +121,7 @@ class Server implements vscode.Disposable {
           break;
         case State.Running:
           this.show({ state: 'running', launch: launch.value });
+          this.onRunning();
           break;
         case State.Stopped:
           if (!this.stopping) {
@@ -133,6 +165,21 @@ class Server implements vscode.Disposable {
       this.stopping = false;
       this.show({ state: 'stopped' });
     }
+  }
+
+  /**
+   * The picture of the open document at `uri`, drawn by the server from its
+   * current text (`ncc.plot`). Rejects with the server's error, whose `data`
+   * may hold the picture of a run that stopped.
+   */
+  async plot(uri: string): Promise<unknown> {
+    // A restart in progress brings a client to ask.
+    await this.restarting;
+    const client = this.client;
+    if (client === undefined || !client.isRunning()) {
+      throw new Error('The ncc language server is not running.');
+    }
+    return client.sendRequest(ExecuteCommandRequest.type, { command: PLOT_COMMAND, arguments: [uri] });
   }
 
   /** Stops the server if it runs, and starts it. */

@@ -14,6 +14,7 @@ import {
   DidChangeTextDocumentNotification,
   DidOpenTextDocumentNotification,
   DiagnosticSeverity,
+  ExecuteCommandRequest,
   ExitNotification,
   HoverRequest,
   InitializedNotification,
@@ -29,6 +30,7 @@ import {
   TextDocumentSyncKind,
 } from 'vscode-languageserver-protocol/node';
 import { type Launch, readSettings, serverLaunch } from '../src/server';
+import { failureMessage, PLOT_COMMAND, parsePlotted, plotMessage } from '../src/toolpath';
 
 /** How long one answer from a debug build may take. */
 const TIMEOUT_MS = 20_000;
@@ -193,6 +195,9 @@ describe('a session with ncc lsp', () => {
       'documentFormattingProvider',
     ] as const;
     const missing: string[] = providers.filter((provider) => !capabilities[provider]);
+    if (!capabilities.executeCommandProvider?.commands.includes(PLOT_COMMAND)) {
+      missing.push(`executeCommandProvider ${PLOT_COMMAND}`);
+    }
     const semanticTokens = capabilities.semanticTokensProvider;
     if (!semanticTokens?.full || semanticTokens.legend.tokenTypes.length === 0) {
       missing.push('semanticTokensProvider');
@@ -249,6 +254,31 @@ describe('a session with ncc lsp', () => {
       'empty diagnostics after the fix',
       (p) => p.uri === uri() && p.version === 2 && p.diagnostics.length === 0,
     );
+  });
+
+  test('ncc.plot draws the edited text, as the toolpath view asks for it', async () => {
+    // The fixed text: N10 is a rapid move to X-5 on line 2.
+    const answer = await within(
+      'answer to ncc.plot',
+      connection.sendRequest(ExecuteCommandRequest.type, { command: PLOT_COMMAND, arguments: [uri()] }),
+    );
+    const plotted = parsePlotted(answer);
+    assert.ok(plotted, `a picture in ${JSON.stringify(answer)}`);
+    assert.match(plotted.svg, /<path data-line="2" d="[^"]*"[^>]*stroke-dasharray/);
+    const message = plotMessage(plotted);
+    assert.ok(message.type === 'plot' && /^Total time \d+:\d\d:\d\d\.\d{3}$/.test(message.summary), message.type);
+
+    const notOpen = pathToFileURL(path.join(scratch, 'programs', 'P2.NCP')).href;
+    const failed = await within(
+      'error of ncc.plot',
+      connection.sendRequest(ExecuteCommandRequest.type, { command: PLOT_COMMAND, arguments: [notOpen] }).then(
+        () => assert.fail('ncc.plot of a document that is not open succeeded'),
+        (error: unknown) => error,
+      ),
+    );
+    const shown = failureMessage(failed);
+    assert.match(shown.message, /P2\.NCP is not open/);
+    assert.equal(shown.svg, undefined);
   });
 
   test('shutdown and exit end the server with status 0', async () => {

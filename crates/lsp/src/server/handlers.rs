@@ -40,6 +40,10 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
             },
         )),
         document_formatting_provider: Some(lsp::OneOf::Left(true)),
+        execute_command_provider: Some(lsp::ExecuteCommandOptions {
+            commands: vec![super::plot::COMMAND.to_owned()],
+            ..Default::default()
+        }),
         ..Default::default()
     }
 }

@@ -15,6 +15,7 @@
 mod convert;
 mod frames;
 mod handlers;
+mod plot;
 mod semantic;
 mod workspace;
 
@@ -515,6 +516,13 @@ impl LanguageServer for Server {
     async fn code_action(&self, params: lsp::CodeActionParams) -> jsonrpc::Result<Option<lsp::CodeActionResponse>> {
         let uri = params.text_document.uri.clone();
         self.query(&uri, move |s| handlers::code_actions(s, params.range)).await.map(Some)
+    }
+
+    async fn execute_command(&self, params: lsp::ExecuteCommandParams) -> jsonrpc::Result<Option<lsp::LSPAny>> {
+        match params.command.as_str() {
+            plot::COMMAND => plot::execute(self, params.arguments).await,
+            command => Err(invalid_params(format!("unknown command `{command}`"))),
+        }
     }
 }
 

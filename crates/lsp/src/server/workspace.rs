@@ -52,6 +52,11 @@ impl Workspaces {
         &mut self.list[index].host
     }
 
+    /// The `ncc.toml` whose configuration workspace `index` has, if any.
+    pub fn config_path(&self, index: usize) -> Option<&Path> {
+        self.list[index].config_path.as_deref()
+    }
+
     /// The workspace whose configuration applies to `path`; errors reading
     /// a configuration file are returned, and its defaults used.
     fn workspace_for(&mut self, path: Option<&Path>, errors: &mut Vec<String>) -> usize {

@@ -1,0 +1,121 @@
+//! The `ncc.plot` command (`workspace/executeCommand`): the picture
+//! `ncc plot` draws, of an open document's current text, unsaved edits
+//! included, for the editor's toolpath view.
+//!
+//! Arguments: the document's URI. The answer is `{ svg, totalTimeS,
+//! findings }`. A run that stops on an error answers a `RequestFailed`
+//! error whose message says where and why, with the picture of the run
+//! up to there as its `data`.
+
+use std::{path::PathBuf, sync::Arc};
+
+use serde::Serialize;
+use serde_json::Value;
+use tower_lsp_server::{
+    jsonrpc::{self, ErrorCode},
+    ls_types::Uri,
+};
+
+use super::{Server, invalid_params};
+use crate::run::{Program, Progress, Ran};
+
+/// The command's name.
+pub(crate) const COMMAND: &str = "ncc.plot";
+
+/// LSP's `RequestFailed`: the request was valid, the program cannot run.
+const REQUEST_FAILED: i64 = -32803;
+
+/// The answer, as the extension reads it.
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct Plotted {
+    svg: String,
+    /// Seconds, with the velocity model.
+    total_time_s: f64,
+    /// What the run did not run, and where it stopped.
+    findings: Vec<Finding>,
+}
+
+#[derive(Serialize)]
+struct Finding {
+    /// Set when the finding is in another file than the document (a
+    /// macrocycle file): that file's path.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    file: Option<String>,
+    /// Counted from 1.
+    line: u32,
+    message: String,
+    stopped: bool,
+}
+
+/// What the run needs from the server's state, taken under its lock.
+struct Job {
+    text: Arc<String>,
+    path: Option<PathBuf>,
+    name: String,
+    config: Option<PathBuf>,
+}
+
+/// Runs the command: `arguments` is `[uri]`.
+pub(crate) async fn execute(server: &Server, arguments: Vec<Value>) -> jsonrpc::Result<Option<Value>> {
+    let uri = match arguments.as_slice() {
+        [Value::String(uri)] => {
+            uri.parse::<Uri>().map_err(|error| invalid_params(format!("{COMMAND}: `{uri}` is not a URI: {error}")))?
+        }
+        _ => return Err(invalid_params(format!("{COMMAND} takes one argument, the document's URI"))),
+    };
+    let job = {
+        let state = server.state();
+        let document = state
+            .documents
+            .get(&uri)
+            .ok_or_else(|| invalid_params(format!("{COMMAND}: {} is not open", uri.as_str())))?;
+        let path = uri.to_file_path().map(|path| path.into_owned());
+        let name = path.as_ref().map_or_else(|| uri.as_str().to_owned(), |path| path.display().to_string());
+        let config = state.workspaces.config_path(document.workspace).map(PathBuf::from);
+        Job { text: document.map.text.clone(), path, name, config }
+    };
+    // A run takes as long as the program's blocks; the blocking pool keeps
+    // it off the threads that answer the other requests.
+    let task = tokio::task::spawn_blocking(move || plot(job));
+    match task.await {
+        Ok(answer) => answer.map(Some),
+        Err(join_error) => {
+            tracing::error!("{COMMAND} failed: {join_error}");
+            Err(jsonrpc::Error::internal_error())
+        }
+    }
+}
+
+fn plot(job: Job) -> jsonrpc::Result<Value> {
+    // The text of our own, so that an edit during the run need not copy it.
+    let text = Arc::unwrap_or_clone(job.text);
+    let program = Program { path: job.path.as_deref(), name: job.name, text: &text, config: job.config.as_deref() };
+    let ran = Ran::of(&program, nc_exec::run::DEFAULT_STEP_BUDGET, Progress::Hidden).map_err(|error| {
+        jsonrpc::Error { code: ErrorCode::ServerError(REQUEST_FAILED), message: error.into(), data: None }
+    })?;
+    let picture = ran.plot();
+    let findings = ran
+        .findings()
+        .map(|finding| Finding {
+            file: (!finding.in_program).then(|| finding.file.to_owned()),
+            line: finding.line,
+            message: finding.message.to_owned(),
+            stopped: finding.stopped,
+        })
+        .collect();
+    let stop = ran.stop().map(|stop| {
+        let place = if stop.in_program { String::new() } else { format!("{} ", stop.file) };
+        format!("the run stopped at {place}line {}: {}", stop.line, stop.message)
+    });
+    let plotted = Plotted { svg: picture.svg, total_time_s: picture.total_time, findings };
+    let plotted = serde_json::to_value(plotted).map_err(|_| jsonrpc::Error::internal_error())?;
+    match stop {
+        Some(message) => Err(jsonrpc::Error {
+            code: ErrorCode::ServerError(REQUEST_FAILED),
+            message: message.into(),
+            data: Some(plotted),
+        }),
+        None => Ok(plotted),
+    }
+}
