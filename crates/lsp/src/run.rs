@@ -21,7 +21,7 @@ use nc_exec::{
     arith::{Message, MessageDisplay},
     lower::BlockData,
     machine::MachineConfig,
-    run::{Axes, Called, Environment, Motion, Step, StepSink, Stop, Totals, Trace},
+    run::{Axes, Called, Environment, Motion, Step, Stop, Totals, Trace, expected_blocks},
     velocity::{self, Dynamics, Timer, Timing, TimingSink},
 };
 use ncc_analysis::Config;
@@ -110,7 +110,10 @@ impl Ran {
     /// error is a configuration that cannot be read; a program that stops
     /// on an error has its run up to there (see [`Ran::stop`]).
     pub(crate) fn of(program: &Program<'_>, step_budget: usize, progress: Progress) -> Result<Ran, String> {
-        Ok(Ran::run(program, &program.machine()?, step_budget, progress, None))
+        let machine = program.machine()?;
+        Ok(Ran::run(program, &machine, progress, |text, library| {
+            nc_exec::run::run(text, library, &machine, step_budget)
+        }))
     }
 
     /// Like [`Ran::of`], through the velocity model as the steps come,
@@ -118,19 +121,27 @@ impl Ran {
     fn tally(program: &Program<'_>, step_budget: usize, progress: Progress) -> Result<(Ran, Tally), String> {
         let machine = program.machine()?;
         let dynamics = Dynamics::of(&machine);
-        let mut timer = Timer::new(machine.step_axes(), &dynamics, Tally::default());
-        let ran = Ran::run(program, &machine, step_budget, progress, Some(&mut timer));
-        Ok((ran, timer.finish()))
+        // Breaks can come at every block: room reserved and never touched
+        // costs nothing, growing copies.
+        let tally = Tally { breaks: Vec::with_capacity(expected_blocks(program.text)), ..Tally::default() };
+        let timer = Timer::new(machine.step_axes(), &dynamics, tally);
+        let mut timed = None;
+        let ran = Ran::run(program, &machine, progress, |text, library| {
+            // The model runs beside the executor, on the other core.
+            let (trace, timer) = nc_exec::run::run_beside(text, library, &machine, step_budget, timer);
+            timed = Some(timer.finish());
+            trace
+        });
+        Ok((ran, timed.unwrap_or_default()))
     }
 
-    /// Runs `program` handing the steps to `sink` as they come, or keeping
-    /// them.
+    /// Runs `program` with `execute` (which keeps the steps or hands them
+    /// on) and the files of its project.
     fn run(
         program: &Program<'_>,
         machine: &MachineConfig,
-        step_budget: usize,
         progress: Progress,
-        sink: Option<&mut dyn StepSink>,
+        execute: impl FnOnce(&str, &Library) -> Trace,
     ) -> Ran {
         let text = program.text;
         let number = BlockParser::new(text)
@@ -138,10 +149,7 @@ impl Ran {
             .and_then(|header| header.number())
             .and_then(|n| u32::try_from(n.scaled(0)?).ok());
         let library = Library::for_program(program, progress);
-        let trace = match sink {
-            Some(sink) => nc_exec::run::run_into(text, &library, machine, step_budget, sink),
-            None => nc_exec::run::run(text, &library, machine, step_budget),
-        };
+        let trace = execute(text, &library);
         if let Some(bar) = library.progress.get() {
             bar.finish_and_clear();
         }
@@ -358,25 +366,32 @@ struct Tally {
     breaks: Vec<PlacedBreak>,
 }
 
-/// A break with the file and the block it is at.
+/// A break with the file and the block it is at, small: a long program
+/// can break at every block.
 struct PlacedBreak {
     source: u32,
     at: TextSize,
-    speed_break: velocity::Break,
+    reason: velocity::Reason,
+    /// mm/min, as shown.
+    speed_before: f32,
+    speed_at: f32,
+    lost: f64,
 }
 
 impl PlacedBreak {
     /// The place a break is at, by kind: a block that runs many times (a
     /// loop, a subprogram) is one place.
     fn place(&self) -> (u32, TextSize, &'static str) {
-        (self.source, self.at, self.speed_break.reason.code())
+        (self.source, self.at, self.reason.code())
     }
 }
 
 impl TimingSink for Tally {
     fn speed_break(&mut self, step: &Step, speed_break: velocity::Break) {
         let source = u32::try_from(step.source).unwrap_or(u32::MAX);
-        self.breaks.push(PlacedBreak { source, at: step.range.start(), speed_break });
+        let velocity::Break { reason, before, at, lost, .. } = speed_break;
+        let (speed_before, speed_at) = (before as f32, at as f32);
+        self.breaks.push(PlacedBreak { source, at: step.range.start(), reason, speed_before, speed_at, lost });
     }
 
     fn timed(&mut self, step: &Step, profile: velocity::Profile) {
@@ -424,10 +439,10 @@ fn summary(path: &Path, ran: &Ran, tally: &Tally) -> String {
     let _ = writeln!(out, "  end position {}{diameter}", position.join(" "));
     let breaks = &tally.breaks;
     if !breaks.is_empty() {
-        let lost: f64 = breaks.iter().map(|placed| placed.speed_break.lost).sum();
+        let lost: f64 = breaks.iter().map(|placed| placed.lost).sum();
         let mut by_reason: Vec<(&str, usize)> = Vec::new();
         for placed in breaks {
-            let code = placed.speed_break.reason.code();
+            let code = placed.reason.code();
             match by_reason.iter_mut().find(|(known, _)| *known == code) {
                 Some((_, n)) => *n += 1,
                 None => by_reason.push((code, 1)),
@@ -443,9 +458,11 @@ fn summary(path: &Path, ran: &Ran, tally: &Tally) -> String {
             clock(lost)
         );
         // Grouped by place. A program without loops or calls meets its
-        // places in order, and needs no sort.
-        let avoidable = breaks.iter().filter(|placed| placed.speed_break.reason.avoidable());
-        let in_order = avoidable.clone().zip(avoidable.clone().skip(1)).all(|(a, b)| a.place() <= b.place());
+        // blocks in order, and needs no sort; the breaks of one block (of
+        // different kinds, or of a cycle's moves) come together.
+        let avoidable = breaks.iter().filter(|placed| placed.reason.avoidable());
+        let in_order =
+            avoidable.clone().zip(avoidable.clone().skip(1)).all(|(a, b)| (a.source, a.at) <= (b.source, b.at));
         let avoidable: Box<dyn Iterator<Item = &PlacedBreak>> = if in_order {
             Box::new(avoidable)
         } else {
@@ -456,7 +473,7 @@ fn summary(path: &Path, ran: &Ran, tally: &Tally) -> String {
         // Each place's first break, its runs and its cost; the costliest kept.
         let mut top: Vec<(&PlacedBreak, usize, f64)> = Vec::with_capacity(LISTED_BREAKS + 1);
         let by_cost = |a: &(&PlacedBreak, usize, f64), b: &(&PlacedBreak, usize, f64)| {
-            b.2.total_cmp(&a.2).then(a.0.speed_break.step.cmp(&b.0.speed_break.step))
+            b.2.total_cmp(&a.2).then(a.0.place().cmp(&b.0.place()))
         };
         let mut keep = |place| {
             if top.len() == LISTED_BREAKS && top.last().is_some_and(|last| by_cost(&place, last).is_ge()) {
@@ -467,29 +484,27 @@ fn summary(path: &Path, ran: &Ran, tally: &Tally) -> String {
             top.truncate(LISTED_BREAKS);
         };
         let mut listed = 0;
-        let mut current: Option<(&PlacedBreak, usize, f64)> = None;
+        // The places of the block at hand, one per kind of break.
+        let mut block: Vec<(&PlacedBreak, usize, f64)> = Vec::new();
         for placed in avoidable {
-            let lost = placed.speed_break.lost;
-            match &mut current {
-                Some((first, times, total)) if first.place() == placed.place() => {
+            if block.first().is_some_and(|(first, ..)| (first.source, first.at) != (placed.source, placed.at)) {
+                listed += block.len();
+                block.drain(..).for_each(&mut keep);
+            }
+            match block.iter_mut().find(|(first, ..)| first.place() == placed.place()) {
+                Some((_, times, total)) => {
                     *times += 1;
-                    *total += lost;
+                    *total += placed.lost;
                 }
-                _ => {
-                    listed += 1;
-                    if let Some(place) = current.replace((placed, 1, lost)) {
-                        keep(place);
-                    }
-                }
+                None => block.push((placed, 1, placed.lost)),
             }
         }
-        if let Some(place) = current {
-            keep(place);
-        }
+        listed += block.len();
+        block.into_iter().for_each(keep);
         for (placed, times, lost) in top {
             let place = ran.sources[placed.source as usize].place(placed.at);
             let times = if times > 1 { format!(" ({times} runs)") } else { String::new() };
-            let velocity::Break { reason, before, at, .. } = placed.speed_break;
+            let (reason, before, at) = (placed.reason, placed.speed_before, placed.speed_at);
             let _ = writeln!(out, "    {place}  {reason}: {before:.0} → {at:.0} mm/min, {lost:.3} s{times}");
         }
         if listed > LISTED_BREAKS {

@@ -43,6 +43,7 @@ use nalgebra::{Point2, Vector2};
 use ncc_catalog::{AddressRole, Catalogue, Dialect};
 use ncc_syntax::TextRange;
 use rowan::GreenNode;
+use smallvec::SmallVec;
 
 use crate::{
     arith::{self, BlockArithmetic, Machine, Message, Parameters, Raw},
@@ -375,6 +376,57 @@ pub fn run_into(
     std::thread::scope(|scope| run_in(scope, text, files, machine, budget, Some(sink)))
 }
 
+/// Like [`run_into`], with `sink` on a thread of its own, so that what it
+/// does with the steps (the velocity model) runs beside the executor;
+/// returns the trace and the sink.
+pub fn run_beside<S: StepSink + Send>(
+    text: &str,
+    files: &dyn Environment,
+    machine: &MachineConfig,
+    budget: usize,
+    mut sink: S,
+) -> (Trace, S) {
+    std::thread::scope(|scope| {
+        let (sender, batches) = mpsc::sync_channel::<Vec<Step>>(8);
+        let (recycle, emptied) = mpsc::sync_channel::<Vec<Step>>(8);
+        let beside = scope.spawn(move || {
+            for mut batch in batches {
+                batch.drain(..).for_each(|step| sink.step(step));
+                let _ = recycle.try_send(batch);
+            }
+            sink
+        });
+        let mut handing = Batches { batch: Vec::with_capacity(DELIVERY_BATCH), sender, emptied };
+        let trace = run_in(scope, text, files, machine, budget, Some(&mut handing));
+        let Batches { batch, sender, .. } = handing;
+        // The sink's thread ends when the last batch is in and the channel
+        // closes.
+        let _ = sender.send(batch);
+        drop(sender);
+        (trace, beside.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
+    })
+}
+
+/// Steps gathered for a sink on another thread, in batches it hands back
+/// emptied: memory used again costs less than new memory.
+struct Batches {
+    batch: Vec<Step>,
+    sender: mpsc::SyncSender<Vec<Step>>,
+    emptied: Receiver<Vec<Step>>,
+}
+
+impl StepSink for Batches {
+    fn step(&mut self, step: Step) {
+        self.batch.push(step);
+        if self.batch.len() == DELIVERY_BATCH {
+            let next = self.emptied.try_recv().unwrap_or_else(|_| Vec::with_capacity(DELIVERY_BATCH));
+            let full = std::mem::replace(&mut self.batch, next);
+            // A sink that panicked has closed the channel: the join says so.
+            let _ = self.sender.send(full);
+        }
+    }
+}
+
 /// Steps a streaming run gathers before it hands them on.
 const DELIVERY_BATCH: usize = 256;
 
@@ -664,7 +716,7 @@ impl<'a> Blocks<'a> {
 
 /// About as many blocks as a program of CAM output with this text has, or
 /// more: memory reserved and never used costs nothing, growing costs copies.
-fn expected_blocks(text: &str) -> usize {
+pub fn expected_blocks(text: &str) -> usize {
     text.len() / 24
 }
 
@@ -683,6 +735,9 @@ enum Index<'a, 's> {
 
 struct Stream<'a, 's> {
     batches: Receiver<Vec<Streamed>>,
+    /// Batches taken, back to the index pass with the run's spent block
+    /// data, whose room it fills again.
+    taken_batches: mpsc::SyncSender<Vec<Streamed>>,
     batch: Vec<Streamed>,
     /// Blocks of `batch` the run has taken.
     taken: usize,
@@ -701,16 +756,25 @@ struct Streamed {
 impl<'a, 's> Index<'a, 's> {
     fn start(scope: &'s Scope<'s, 'a>, text: &'a str) -> Index<'a, 's> {
         let (sender, batches) = mpsc::sync_channel::<Vec<Streamed>>(4);
+        let (taken_batches, returned) = mpsc::sync_channel::<Vec<Streamed>>(4);
         let index_pass = scope.spawn(move || {
             let mut blocks = Blocks::default();
             let mut batch = Vec::with_capacity(STREAM_BATCH);
+            // A batch the run took, whose block data the next blocks reuse.
+            let mut spent: Vec<Streamed> = Vec::new();
             // Until the run stops taking blocks in order.
             let mut streaming = true;
             blocks.add_reading(Cow::Borrowed(text), |range, data, starts_subprogram| {
                 if streaming {
-                    batch.push(Streamed { range, data: std::mem::take(data), starts_subprogram });
+                    let room = spent.pop().map(|spent| spent.data).unwrap_or_default();
+                    batch.push(Streamed { range, data: std::mem::replace(data, room), starts_subprogram });
                     if batch.len() == STREAM_BATCH {
-                        let full = std::mem::replace(&mut batch, Vec::with_capacity(STREAM_BATCH));
+                        let mut next = match returned.try_recv() {
+                            Ok(taken) => std::mem::replace(&mut spent, taken),
+                            Err(_) => Vec::with_capacity(STREAM_BATCH),
+                        };
+                        next.clear();
+                        let full = std::mem::replace(&mut batch, next);
                         streaming = sender.send(full).is_ok();
                     }
                 }
@@ -721,7 +785,7 @@ impl<'a, 's> Index<'a, 's> {
             }
             blocks
         });
-        Index::Streaming(Stream { batches, batch: Vec::new(), taken: 0, next: 0, index_pass })
+        Index::Streaming(Stream { batches, taken_batches, batch: Vec::new(), taken: 0, next: 0, index_pass })
     }
 
     /// The block at `at`, when it was streamed.
@@ -731,6 +795,8 @@ impl<'a, 's> Index<'a, 's> {
             return None;
         }
         if stream.taken == stream.batch.len() {
+            let taken = std::mem::take(&mut stream.batch);
+            let _ = stream.taken_batches.try_send(taken);
             // A closed channel: the index pass has sent every block.
             stream.batch = stream.batches.recv().ok()?;
             stream.taken = 0;
@@ -982,7 +1048,7 @@ impl<'a> Runner<'a> {
 
     fn block(&mut self, block: &BlockData, range: TextRange) -> Flow {
         let at = |local: TextRange| local + range.start();
-        let codes: Vec<(u8, u32, TextRange)> = block
+        let codes: SmallVec<[(u8, u32, TextRange); 8]> = block
             .words
             .iter()
             .filter(|word| matches!(word.letter, b'G' | b'M'))
@@ -1055,7 +1121,7 @@ impl<'a> Runner<'a> {
         if css_before && !self.feed_mode().css && !writes_speed {
             self.speed = self.speed_reached.take().unwrap_or(self.speed);
         }
-        let mut axes: Vec<&Word> =
+        let mut axes: SmallVec<[&Word; 8]> =
             block.words.iter().filter(|w| self.catalogue.role_of(w.letter) == Some(AddressRole::Axis)).collect();
         // A block of group 11 names its axes as the function's parameters:
         // it does not move (03 §3).
