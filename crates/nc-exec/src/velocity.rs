@@ -381,9 +381,10 @@ pub struct Timer<'a, S> {
 }
 
 #[derive(Debug)]
+#[allow(clippy::large_enum_variant, reason = "one per run, never moved while it runs")]
 enum Model {
     OneBlock(OneBlock),
-    Envelope(Box<Planning>),
+    Envelope(Planning),
 }
 
 /// The CNC8x6 one-block look-ahead.
@@ -401,7 +402,7 @@ impl<'a, S: TimingSink> Timer<'a, S> {
     /// A timer for steps over the machine's `axes` ([`Trace::axes`]).
     pub fn new(axes: &'a [u8], dynamics: &'a Dynamics, sink: S) -> Self {
         let model = match &dynamics.envelope {
-            Some(envelope) => Model::Envelope(Box::new(Planning::new(envelope.clone()))),
+            Some(envelope) => Model::Envelope(Planning::new(envelope.clone())),
             None => Model::OneBlock(OneBlock::default()),
         };
         Timer { axes, dynamics, sink, count: 0, end: [0.0; MAX_AXES], model }
@@ -524,8 +525,8 @@ impl Planning {
         }
     }
 
-    fn finish(self: Box<Self>, dynamics: &Dynamics, sink: &mut impl TimingSink) {
-        let Planning { planner, mut steps } = *self;
+    fn finish(self, dynamics: &Dynamics, sink: &mut impl TimingSink) {
+        let Planning { planner, mut steps } = self;
         for (index, planned) in planner.finish() {
             steps.planned(index, planned, dynamics, sink);
         }
