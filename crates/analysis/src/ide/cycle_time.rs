@@ -260,9 +260,9 @@ impl Estimate {
         self.blocks[..after].last().filter(|block| block.range.contains_inclusive(offset))
     }
 
-    /// The hints of the blocks that touch `range` (of every block without
-    /// one), at the end of each block's last line in `text`: its time, and
-    /// a marker per reason the speed drops there.
+    /// The hints in `range` (everywhere without one), at the end of each
+    /// block's last line in `text`: its time, and a marker per reason the
+    /// speed drops there.
     pub fn inlay_hints(&self, text: &str, range: Option<TextRange>, mode: CycleTimeHints) -> Vec<InlayHint> {
         if mode == CycleTimeHints::Off {
             return Vec::new();
@@ -277,6 +277,11 @@ impl Estimate {
                 continue;
             }
             let offset = line_end(text, block.range);
+            // A block that ends where the range starts has its hints on
+            // the line before.
+            if range.is_some_and(|range| !range.contains_inclusive(offset)) {
+                continue;
+            }
             let label = match mode {
                 CycleTimeHints::Cumulative => format!("Σ {}", short_time(block.end)),
                 _ => short_time(block.total),
@@ -573,20 +578,19 @@ mod tests {
         "#]]
         .assert_debug_eq(&cumulative);
         assert!(estimate.inlay_hints(program, None, CycleTimeHints::Off).is_empty());
-        // Only the blocks the range touches.
+        // Only the hints in the range: the line of N20, not N10's before it.
         let n20 = TextSize::from(program.find("N20").unwrap() as u32);
-        let ranged =
-            estimate.inlay_hints(program, Some(TextRange::empty(n20 + TextSize::from(2))), CycleTimeHints::PerBlock);
-        assert!(ranged.iter().all(|hint| hint.offset > n20), "{ranged:?}");
-        assert!(!ranged.is_empty());
+        let line = TextRange::new(n20, TextSize::from(program.find("\nN30").unwrap() as u32));
+        let ranged: Vec<String> =
+            estimate.inlay_hints(program, Some(line), CycleTimeHints::PerBlock).into_iter().map(|h| h.label).collect();
+        assert_eq!(ranged, ["1.03 s", "▼ non-motion −22 ms"]);
         expect![[r#"
             **Predicted time:** takes 1.03 s, starts at 1.03 s
 
             **Speed:** entry 0 → peak 600 → exit 0 mm/min over 1.03 s
 
             **Speed drops** (non-motion): a block without motion between moves. 600 → 0 mm/min; 22 ms lost against a smooth join."#]].assert_eq(&estimate.hover(n20 + TextSize::from(5)).unwrap());
-        expect!["Cycle time 2.07 s · cutting 2.07 s · rapid 0 s · 2 breaks cost 57 ms"]
-            .assert_eq(&estimate.headline());
+        expect!["Cycle time 2.07 s · cutting 2.07 s · rapid 0 s · 2 breaks cost 57 ms"].assert_eq(&estimate.headline());
         assert_eq!(estimate.hover(TextSize::from(0)), None, "the header is no block");
     }
 
