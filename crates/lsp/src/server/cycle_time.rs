@@ -6,7 +6,8 @@
 //! snapshot: it reads the text, the machine and the workspace's files
 //! first, and an edit meanwhile only makes its result stale. A result is
 //! kept only if the document is still at its version; then the client is
-//! asked to refresh its inlay hints and code lenses.
+//! asked to refresh its inlay hints and code lenses. The worker runs at the
+//! lower priority of the flow walk.
 
 use std::{
     collections::HashMap,
@@ -17,7 +18,7 @@ use ncc_analysis::{Cancelled, Estimate, TextRange, TextSize};
 use tokio::sync::mpsc;
 use tower_lsp_server::{Client, ls_types::Uri};
 
-use super::{State, lock};
+use super::{State, background_priority, lock};
 
 /// Blocks a run executes at most: a million steps hold a few hundred
 /// megabytes while the model times them; a program that runs longer (a
@@ -82,6 +83,9 @@ impl Timer {
         let timer = Timer { jobs: Arc::default() };
         let jobs = timer.jobs.clone();
         let spawned = std::thread::Builder::new().name("ncc-cycle-time".into()).spawn(move || {
+            // Diagnostics and hovers of the edit come first: on two cores a
+            // run at normal priority doubles their latency.
+            background_priority();
             loop {
                 let (uri, version) = {
                     let (lock, ready) = &*jobs;

@@ -301,8 +301,9 @@ impl Server {
     }
 }
 
-/// Lowers the calling thread's priority (nice 10): the flow walk and the
-/// state preparation take hundreds of milliseconds on a large program, and
+/// Lowers the calling thread's priority (nice 10): the flow walk, the
+/// state preparation and the cycle-time run take up to hundreds of
+/// milliseconds on a large program, and
 /// edits and hovers must not wait for a core behind them. Not the idle
 /// scheduling class: on a busy machine (a build running) that starves the
 /// walk, and the complete diagnostics would not come until the machine is
