@@ -431,3 +431,120 @@ fn closing_stdin_ends_the_server() {
     client.close_stdin();
     client.wait_exit(Duration::from_secs(10)).unwrap();
 }
+
+/// A corner under continuity: N20 turns 90° from N10, and N30 again.
+const CORNERS: &str = "%1\nN10 G23 G01 X10 F600\nN20 Y10 R1=5 \"SIDE\"\nN30 X20\nN40 M30\n*\n";
+
+/// The hints of `CORNERS`, by line: the parameter value, each block's time
+/// (1035 ms: 10 mm at 10 mm/s with R236 ramps and the settle) and where
+/// the speed drops. The times equal `ncc run`'s velocity model.
+const PER_BLOCK: [&str; 7] = [
+    "1: 1.03 s",
+    "1: ▼ corner −35 ms",
+    "2: = 0.005",
+    "2: 1.03 s",
+    "2: ▼ corner −35 ms",
+    "3: 1.03 s",
+    "3: ▼ non-motion −22 ms",
+];
+const CUMULATIVE: [&str; 3] = ["1: Σ 1.03 s", "2: Σ 2.07 s", "3: Σ 3.10 s"];
+const CUMULATIVE_AT_F1200: [&str; 3] = ["1: Σ 560 ms", "2: Σ 1.12 s", "3: Σ 1.68 s"];
+const CORNER_TOOLTIP: &str = "**Speed drops** (corner): a corner of 90.0°, not below R39 (60.000°). 600 → 0 mm/min; 35 ms lost against a smooth join.";
+const HEADLINE: &str = "Cycle time 3.10 s · cutting 3.10 s · rapid 0 s · 3 breaks cost 92 ms";
+const N20_HOVER: &str = "**Predicted time:** takes 1.03 s, starts at 1.03 s\n\n\
+    **Speed:** entry 0 → peak 600 → exit 0 mm/min over 1.03 s\n\n\
+    **Speed drops** (corner): a corner of 90.0°, not below R39 (60.000°). 600 → 0 mm/min; 35 ms lost against a smooth join.";
+
+/// Waits until the server asks for fresh inlay hints: an estimate is ready.
+fn estimated(client: &mut Client) {
+    client
+        .wait_for("an inlay hint refresh", client.timeout, |m| m.method() == Some("workspace/inlayHint/refresh"))
+        .unwrap();
+}
+
+/// The inlay hints of the whole document, as `line: label`, and their
+/// tooltips.
+fn inlay_hints(client: &mut Client, doc: &Document) -> (Vec<String>, Vec<String>) {
+    let params = json!({ "textDocument": doc.id(), "range": doc.range(0..doc.text().len()) });
+    let answer = client.call("textDocument/inlayHint", params).unwrap();
+    let hints = answer.result().and_then(Value::as_array).unwrap_or_else(|| panic!("{}", answer.json));
+    let labels = hints.iter().map(|hint| format!("{}: {}", hint["position"]["line"], hint["label"].as_str().unwrap()));
+    let tooltips = hints.iter().map(|hint| hint["tooltip"]["value"].as_str().unwrap_or_default().to_owned());
+    (labels.collect(), tooltips.collect())
+}
+
+#[test]
+fn cycle_time_inlay_hints_per_block_cumulative_and_off() {
+    let (mut client, dir) = session();
+    let doc = document(&dir, "corners.NCP", CORNERS);
+    client.notify("textDocument/didOpen", doc.did_open()).unwrap();
+    estimated(&mut client);
+    let (labels, tooltips) = inlay_hints(&mut client, &doc);
+    // Each block's time at its line's end, after the parameter value, and
+    // a marker where the speed drops.
+    assert_eq!(labels, PER_BLOCK, "{tooltips:#?}");
+    let marker = &tooltips[labels.iter().position(|label| label.contains('▼')).unwrap()];
+    assert_eq!(marker, CORNER_TOOLTIP);
+
+    let configure = |client: &mut Client, hints: &str| {
+        let settings = json!({ "settings": { "ncc": { "cycleTime": { "inlayHints": hints } } } });
+        client.notify("workspace/didChangeConfiguration", settings).unwrap();
+        estimated(client);
+    };
+    configure(&mut client, "cumulative");
+    let (labels, _) = inlay_hints(&mut client, &doc);
+    let times: Vec<&String> = labels.iter().filter(|label| label.contains('Σ')).collect();
+    assert_eq!(times, CUMULATIVE);
+    configure(&mut client, "off");
+    assert_eq!(inlay_hints(&mut client, &doc).0, ["2: = 0.005"]);
+}
+
+#[test]
+fn cycle_time_setting_from_initialization_options_and_edits_update_the_hints() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut client = server();
+    client.initialize(dir.path(), Some(json!({ "cycleTime": { "inlayHints": "cumulative" } }))).unwrap();
+    let mut doc = document(&dir, "corners.NCP", CORNERS);
+    client.notify("textDocument/didOpen", doc.did_open()).unwrap();
+    estimated(&mut client);
+    let (labels, _) = inlay_hints(&mut client, &doc);
+    assert_eq!(labels.iter().filter(|label| label.contains('Σ')).collect::<Vec<_>>(), CUMULATIVE);
+    // Twice the feed: every move takes about half as long.
+    let feed = doc.text().find("F600").unwrap();
+    client.notify("textDocument/didChange", doc.change(feed + 1..feed + 2, "12")).unwrap();
+    estimated(&mut client);
+    let (labels, _) = inlay_hints(&mut client, &doc);
+    assert_eq!(labels.iter().filter(|label| label.contains('Σ')).collect::<Vec<_>>(), CUMULATIVE_AT_F1200);
+}
+
+#[test]
+fn the_program_total_is_a_code_lens_on_the_header() {
+    let (mut client, dir) = session();
+    let doc = document(&dir, "corners.NCP", CORNERS);
+    client.notify("textDocument/didOpen", doc.did_open()).unwrap();
+    estimated(&mut client);
+    let answer = client.call("textDocument/codeLens", json!({ "textDocument": doc.id() })).unwrap();
+    let lenses = answer.result().unwrap_or_else(|| panic!("{}", answer.json));
+    assert_eq!(lenses.as_array().map(Vec::len), Some(1), "{lenses}");
+    assert_eq!(lenses[0]["range"]["start"], json!({ "line": 0, "character": 0 }));
+    assert_eq!(lenses[0]["command"]["title"], HEADLINE);
+}
+
+#[test]
+fn hover_on_a_block_adds_its_speed_profile() {
+    let (mut client, dir) = session();
+    let doc = document(&dir, "corners.NCP", CORNERS);
+    client.notify("textDocument/didOpen", doc.did_open()).unwrap();
+    estimated(&mut client);
+    let hover = |client: &mut Client, at: &str| {
+        let answer = client.call("textDocument/hover", doc.at(doc.position(doc.text().find(at).unwrap()))).unwrap();
+        answer.result().and_then(|r| r["contents"]["value"].as_str()).unwrap_or_default().to_owned()
+    };
+    // On a word: the catalogue's text and modal state, then the time.
+    let on_y = hover(&mut client, "Y10");
+    let (documentation, time) = on_y.rsplit_once("\n\n---\n\n").unwrap();
+    assert!(documentation.contains("**Modal state before this block:**"), "{on_y}");
+    assert_eq!(time, N20_HOVER);
+    // Anywhere else in the block: the time alone.
+    assert_eq!(hover(&mut client, "SIDE"), N20_HOVER);
+}

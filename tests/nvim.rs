@@ -136,7 +136,8 @@ fn neovim_detects_programs_and_shows_diagnostics_and_hover() {
     assert_eq!(clients.len(), 1, "{context}");
     assert_eq!(clients[0]["name"], "ncc", "{context}");
     assert_eq!(clients[0]["root_dir"], json!(project), "{context}");
-    assert_eq!(clients[0]["init_options"], json!({ "configFile": config }), "{context}");
+    let init_options = json!({ "configFile": config, "cycleTime": { "inlayHints": "perBlock" } });
+    assert_eq!(clients[0]["init_options"], init_options, "{context}");
     assert_eq!(clients[0]["buffers"], json!({ "program": true, "macro": true }), "{context}");
 
     let space_after_sign = json!({

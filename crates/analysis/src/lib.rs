@@ -29,6 +29,10 @@ use salsa::Setter;
 use crate::db::{Db, Settings};
 pub use crate::ide::{
     completion::{CompletionItem, CompletionKind},
+    cycle_time::{
+        BlockTime, BreakAt, CycleTimeHints, CycleTotals, Estimate, RunInput, WorkspaceFiles, clock, estimate,
+        short_time,
+    },
     folding::{Fold, FoldKind},
     highlight::{HighlightKind, HighlightRange},
     inlay::{InlayHint, InlayHintKind},
@@ -244,6 +248,18 @@ impl Analysis {
     /// without one).
     pub fn inlay_hints(&self, file: FileId, range: Option<TextRange>) -> Vec<InlayHint> {
         ide::inlay::inlay_hints(&self.db, file, range)
+    }
+
+    /// What a run of the program `file` needs (its text, the machine, the
+    /// workspace's macrocycle and cycle files), to estimate its cycle time
+    /// without holding this snapshot; `None` for a macrocycle or cycle file.
+    pub fn run_input(&self, file: FileId) -> Option<RunInput> {
+        ide::cycle_time::run_input(&self.db, file)
+    }
+
+    /// Where a program's totals belong: its `%` header, or its first block.
+    pub fn program_head(&self, file: FileId) -> Option<TextRange> {
+        ide::cycle_time::program_head(&self.db, file)
     }
 
     pub fn path(&self, file: FileId) -> String {

@@ -231,9 +231,8 @@ impl Client {
 
     /// The first message, received earlier or within `timeout`, that
     /// satisfies `accept`. Other messages stay in the backlog for later
-    /// waits. Requests from the server are answered with MethodNotFound
-    /// as they arrive (the client announces no capability that invites
-    /// them) and kept in the backlog too.
+    /// waits. Requests from the server are answered as they arrive (see
+    /// [`Client::answer`]) and kept in the backlog too.
     pub fn wait_for(
         &mut self,
         what: &str,
@@ -254,10 +253,7 @@ impl Client {
                 }
                 Err(RecvTimeoutError::Disconnected) => bail!("waiting for {what}: the server closed its output"),
             };
-            if let (Some(method), Some(id)) = (message.method(), message.id()) {
-                let error = json!({ "code": -32601, "message": format!("unsupported request {method}") });
-                self.send(&json!({ "jsonrpc": "2.0", "id": id, "error": error }))?;
-            }
+            self.answer(&message)?;
             if accept(&message) {
                 return Ok(message);
             }
@@ -265,9 +261,25 @@ impl Client {
         }
     }
 
-    /// Moves everything received so far, unclaimed, out of the client.
+    /// Answers a request from the server: the refreshes the client
+    /// announces with success, anything else with MethodNotFound.
+    fn answer(&mut self, message: &Message) -> anyhow::Result<()> {
+        let (Some(method), Some(id)) = (message.method(), message.id()) else { return Ok(()) };
+        let answer = if REFRESHES.contains(&method) {
+            json!({ "jsonrpc": "2.0", "id": id, "result": null })
+        } else {
+            let error = json!({ "code": -32601, "message": format!("unsupported request {method}") });
+            json!({ "jsonrpc": "2.0", "id": id, "error": error })
+        };
+        self.send(&answer).map(drop)
+    }
+
+    /// Moves everything received so far, unclaimed, out of the client;
+    /// requests among it are answered.
     pub fn take_received(&mut self) -> Vec<Message> {
         while let Ok(Ok(message)) = self.incoming.try_recv() {
+            // A server that stopped reading fails the next wait instead.
+            let _ = self.answer(&message);
             self.backlog.push_back(message);
         }
         self.backlog.drain(..).collect()
@@ -341,9 +353,13 @@ impl Drop for Client {
     }
 }
 
+/// The requests a server may send that the client takes: it fetches inlay
+/// hints and code lenses again when asked.
+pub const REFRESHES: [&str; 2] = ["workspace/inlayHint/refresh", "workspace/codeLens/refresh"];
+
 /// The `initialize` parameters of a minimal client: UTF-16 positions,
-/// versioned diagnostics, Markdown hovers; nothing that makes the server
-/// send requests to the client.
+/// versioned diagnostics, Markdown hovers, inlay hints and code lenses
+/// that the server may ask to refresh ([`REFRESHES`]).
 pub fn initialize_params(root: &Path, options: Option<Value>) -> Value {
     let uri = file_uri(root);
     json!({
@@ -354,6 +370,10 @@ pub fn initialize_params(root: &Path, options: Option<Value>) -> Value {
         "initializationOptions": options,
         "capabilities": {
             "general": { "positionEncodings": ["utf-16"] },
+            "workspace": {
+                "inlayHint": { "refreshSupport": true },
+                "codeLens": { "refreshSupport": true },
+            },
             "textDocument": {
                 "synchronization": { "dynamicRegistration": false },
                 "publishDiagnostics": {
@@ -362,6 +382,8 @@ pub fn initialize_params(root: &Path, options: Option<Value>) -> Value {
                     "tagSupport": { "valueSet": [1, 2] },
                 },
                 "hover": { "contentFormat": ["markdown", "plaintext"] },
+                "inlayHint": { "dynamicRegistration": false },
+                "codeLens": { "dynamicRegistration": false },
             },
         },
     })

@@ -95,8 +95,9 @@ enum Command {
     },
     /// Drive the language server (`ncc lsp`) through an editing session on a
     /// generated program: time from each single-character edit to its
-    /// diagnostics, of a hover after each edit, and of hovers anywhere
-    /// after a pause.
+    /// diagnostics, of a hover after each edit, of hovers anywhere after a
+    /// pause, and from an edit that changes a block's time to the inlay
+    /// hint that shows the new time.
     Lsp {
         /// The `ncc` binary [default: the one beside ncc-bench].
         #[arg(long)]
@@ -340,6 +341,7 @@ fn check_benchmark(blocks: usize) -> anyhow::Result<()> {
 /// The latency goals of the language server.
 const EDIT_GOAL: Duration = Duration::from_millis(16);
 const HOVER_GOAL: Duration = Duration::from_millis(2);
+const CYCLE_TIME_GOAL: Duration = Duration::from_millis(50);
 /// The pause after the edits, and the hovers at random places after it.
 const IDLE: Duration = Duration::from_secs(3);
 const IDLE_HOVERS: usize = 100;
@@ -517,6 +519,7 @@ fn lsp_benchmark(server: &Path, blocks: usize, edits: usize, as_json: bool) -> a
         anyhow::ensure!(response.error_code().is_none(), "hover failed: {}", response.json);
         idle_hovers.samples.push(response.received - request.sent);
     }
+    let (cycle_times, unchanged_times) = cycle_time_latencies(&mut client, &mut doc, edits, &mut rng)?;
     let memory = client.memory();
     let stolen = cpu_before.zip(CpuTimes::now()).map(|(before, after)| after.stolen_since(&before));
     let exit = client.shutdown()?;
@@ -531,6 +534,8 @@ fn lsp_benchmark(server: &Path, blocks: usize, edits: usize, as_json: bool) -> a
             "edit_to_diagnostics": diagnostics.json(),
             "hover": hovers.json(),
             "hover_after_pause": idle_hovers.json(),
+            "edit_to_cycle_time_hint": cycle_times.json(),
+            "edits_without_a_new_time": unchanged_times,
             "thread_wake_up": machine.json(),
             "cpu_time_stolen": stolen,
             "empty_hovers": empty_hovers,
@@ -544,6 +549,10 @@ fn lsp_benchmark(server: &Path, blocks: usize, edits: usize, as_json: bool) -> a
         diagnostics.print();
         hovers.print();
         idle_hovers.print();
+        cycle_times.print();
+        if unchanged_times > 0 {
+            println!("  {unchanged_times} of {edits} coordinate edits left their line's time as it was");
+        }
         machine.print();
         if let Some(stolen) = stolen {
             println!("  CPU time stolen        {:>9.1} %  (the hypervisor ran other guests)", stolen * 100.0);
@@ -558,6 +567,110 @@ fn lsp_benchmark(server: &Path, blocks: usize, edits: usize, as_json: bool) -> a
     }
     anyhow::ensure!(exit.success(), "the server ended with {exit} after shutdown and exit");
     Ok(())
+}
+
+/// Edits that change a block's time, each timed until the inlay hints of
+/// its line show a new time: a digit typed before a coordinate's digits
+/// (`X12.4` to `X712.4`) lengthens the move. The server asks the client to
+/// refresh the hints when an estimate is ready; each refresh is answered
+/// by asking for the hints of the edited line. An edit whose line shows
+/// the same time (or none) a second after the last refresh is counted
+/// apart, not timed.
+fn cycle_time_latencies(
+    client: &mut Client,
+    doc: &mut Document,
+    edits: usize,
+    rng: &mut Lcg,
+) -> anyhow::Result<(Latencies, usize)> {
+    let mut latencies = Latencies::new("edit → cycle-time hint", CYCLE_TIME_GOAL, edits);
+    let mut unchanged = 0;
+    for _ in 0..edits {
+        let at = coordinate_digits(doc.text(), rng).context("no coordinate to edit")?;
+        let line = doc.text()[..at].rfind('\n').map_or(0, |i| i + 1);
+        let line_end = doc.text()[at..].find('\n').map_or(doc.text().len(), |i| at + i);
+        let before = block_time_hint(client, doc, line..line_end)?;
+        client.take_received();
+        let sent = client.notify("textDocument/didChange", doc.change(at..at, "7"))?;
+        let line_end = line_end + 1;
+        // The first refresh may take a long time on a slow machine; a later
+        // one for the same edit would come soon.
+        let mut wait = client.timeout;
+        loop {
+            let refreshed =
+                client.wait_for("an inlay hint refresh", wait, |m| m.method() == Some("workspace/inlayHint/refresh"));
+            if refreshed.is_err() && wait < client.timeout {
+                unchanged += 1;
+                break;
+            }
+            refreshed?;
+            let request = client.request(
+                "textDocument/inlayHint",
+                json!({
+                    "textDocument": doc.id(),
+                    "range": doc.range(line..line_end),
+                }),
+            )?;
+            let response = client.response(&request)?;
+            let now = block_time_label(&response);
+            if now.is_some() && now != before {
+                latencies.samples.push(response.received - sent);
+                break;
+            }
+            wait = Duration::from_secs(1);
+        }
+    }
+    anyhow::ensure!(!latencies.samples.is_empty(), "no edit changed a block's time hint");
+    Ok((latencies, unchanged))
+}
+
+/// The label of the block-time hint in the hints of `range`.
+fn block_time_hint(
+    client: &mut Client,
+    doc: &Document,
+    range: std::ops::Range<usize>,
+) -> anyhow::Result<Option<String>> {
+    let response =
+        client.call("textDocument/inlayHint", json!({ "textDocument": doc.id(), "range": doc.range(range) }))?;
+    Ok(block_time_label(&response))
+}
+
+/// A block's time is the hint that is neither a parameter value (`= …`)
+/// nor a speed break (`▼ …`).
+fn block_time_label(response: &lsp_client::Message) -> Option<String> {
+    response
+        .result()?
+        .as_array()?
+        .iter()
+        .filter_map(|hint| hint["label"].as_str())
+        .find(|label| !label.starts_with('=') && !label.starts_with('▼'))
+        .map(str::to_owned)
+}
+
+/// Where a digit typed into the X, Y or Z value of a random straight move
+/// goes: before its first digit. Not before an arc, whose start would move
+/// off its circle, and the run would stop there.
+fn coordinate_digits(text: &str, rng: &mut Lcg) -> Option<usize> {
+    for _ in 0..1000 {
+        let at = rng.below(text.len().max(1));
+        let start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+        let end = text[start..].find('\n').map_or(text.len(), |i| start + i);
+        let line = &text[start..end];
+        let next = text.get(end + 1..).and_then(|rest| rest.lines().next()).unwrap_or_default();
+        let arc = |line: &str| line.split(' ').any(|word| word.starts_with(['I', 'J']));
+        if !line.starts_with('N') || !line.contains(" G1 ") || arc(next) {
+            continue;
+        }
+        let mut word_start = start;
+        for word in line.split(' ') {
+            if word.starts_with(['X', 'Y', 'Z'])
+                && let Some(digit) = word.find(|c: char| c.is_ascii_digit())
+            {
+                return Some(word_start + digit);
+            }
+            word_start += word.len() + 1;
+        }
+    }
+    None
 }
 
 /// The offset of a random character of the first G word at or after a

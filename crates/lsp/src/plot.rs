@@ -190,7 +190,7 @@ fn legend(out: &mut String, top: f64, fastest: f64, timing: &Timing, (across, up
         MARGIN + 260.0,
         char::from(across),
         char::from(up),
-        crate::run::clock(timing.total_time()),
+        ncc_analysis::clock(timing.total_time()),
         timing.breaks.len()
     );
 }

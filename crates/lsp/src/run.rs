@@ -24,7 +24,7 @@ use nc_exec::{
     run::{Axes, Called, Environment, Motion, Step, Stop, Totals, Trace, expected_blocks},
     velocity::{self, Dynamics, Timer, Timing, TimingSink},
 };
-use ncc_analysis::Config;
+use ncc_analysis::{Config, clock};
 use ncc_syntax::{BlockParser, Dialect, Parse, TextSize, ast::AstNode};
 use serde::Serialize;
 
@@ -806,12 +806,4 @@ impl Source {
     fn place(&self, offset: TextSize) -> String {
         format!("{}:{}", self.name, self.line(offset))
     }
-}
-
-/// `h:mm:ss.sss`.
-pub(crate) fn clock(seconds: f64) -> String {
-    let whole = seconds.max(0.0);
-    let hours = (whole / 3600.0).floor();
-    let minutes = ((whole - hours * 3600.0) / 60.0).floor();
-    format!("{hours}:{minutes:02}:{:06.3}", whole - hours * 3600.0 - minutes * 60.0)
 }

@@ -111,6 +111,9 @@ class Server implements vscode.Disposable {
           { scheme: 'untitled', language: LANGUAGE_ID },
         ],
         initializationOptions,
+        // `ncc.cycleTime` changes reach the running server as
+        // workspace/didChangeConfiguration.
+        synchronize: { configurationSection: 'ncc' },
         outputChannel: this.output,
       },
     );

@@ -12,6 +12,12 @@ export type LogLevel = (typeof LOG_LEVELS)[number];
 /** What `package.json` declares as the default of `ncc.server.logLevel`. */
 const DEFAULT_LOG_LEVEL: LogLevel = 'warn';
 
+const CYCLE_TIME_HINTS = ['perBlock', 'cumulative', 'off'] as const;
+export type CycleTimeHints = (typeof CYCLE_TIME_HINTS)[number];
+
+/** What `package.json` declares as the default of `ncc.cycleTime.inlayHints`. */
+const DEFAULT_CYCLE_TIME_HINTS: CycleTimeHints = 'perBlock';
+
 /** The settings that decide how the server starts. */
 export interface Settings {
   /** `ncc.server.path`; empty: `ncc` on PATH. */
@@ -20,11 +26,17 @@ export interface Settings {
   logLevel: LogLevel;
   /** `ncc.machine.configFile`; empty: each program's own `ncc.toml`. */
   configFile: string;
+  /** `ncc.cycleTime.inlayHints`. */
+  cycleTimeHints: CycleTimeHints;
 }
 
-/** What the server reads from `initialize`'s `initializationOptions`. */
+/**
+ * What the server reads from `initialize`'s `initializationOptions`. Later
+ * changes of `cycleTime` reach it as `workspace/didChangeConfiguration`.
+ */
 export interface InitializationOptions {
   configFile?: string;
+  cycleTime: { inlayHints: CycleTimeHints };
 }
 
 /** A server command line and its initialization options. */
@@ -61,10 +73,14 @@ export function readSettings(get: (key: string) => unknown): Settings {
     return typeof value === 'string' ? value.trim() : '';
   };
   const level = text('server.logLevel');
+  const hints = text('cycleTime.inlayHints');
   return {
     serverPath: text('server.path'),
     logLevel: isLogLevel(level) ? level : DEFAULT_LOG_LEVEL,
     configFile: text('machine.configFile'),
+    cycleTimeHints: (CYCLE_TIME_HINTS as readonly string[]).includes(hints)
+      ? (hints as CycleTimeHints)
+      : DEFAULT_CYCLE_TIME_HINTS,
   };
 }
 
@@ -162,15 +178,16 @@ async function executable(file: string, platform: NodeJS.Platform): Promise<Exec
 
 /** The options the server reads at `initialize`. */
 export function initializationOptions(settings: Settings, environment: Environment): Result<InitializationOptions> {
+  const cycleTime = { inlayHints: settings.cycleTimeHints };
   if (settings.configFile === '') {
-    return { ok: true, value: {} };
+    return { ok: true, value: { cycleTime } };
   }
   const configFile = resolveSettingPath(settings.configFile, environment);
   if (configFile === undefined) {
     const setting = 'ncc.machine.configFile';
     return { ok: false, setting, message: noFolder(setting, settings.configFile) };
   }
-  return { ok: true, value: { configFile } };
+  return { ok: true, value: { configFile, cycleTime } };
 }
 
 /** How long `ncc lsp --version` may take: a cold start from a slow disk. */

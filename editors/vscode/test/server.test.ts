@@ -46,7 +46,7 @@ after(async () => {
 });
 
 function settings(overrides: Partial<Settings> = {}): Settings {
-  return { serverPath: '', logLevel: 'warn', configFile: '', ...overrides };
+  return { serverPath: '', logLevel: 'warn', configFile: '', cycleTimeHints: 'perBlock', ...overrides };
 }
 
 function environment(overrides: Partial<Environment> = {}): Environment {
@@ -59,16 +59,21 @@ describe('readSettings', () => {
       'server.path': ' /opt/ncc/bin/ncc ',
       'server.logLevel': 'debug',
       'machine.configFile': 'ncc.toml',
+      'cycleTime.inlayHints': 'cumulative',
     };
     assert.deepEqual(
       readSettings((key) => values[key]),
-      { serverPath: '/opt/ncc/bin/ncc', logLevel: 'debug', configFile: 'ncc.toml' },
+      { serverPath: '/opt/ncc/bin/ncc', logLevel: 'debug', configFile: 'ncc.toml', cycleTimeHints: 'cumulative' },
     );
   });
 
   test('takes unset and mistyped values as their defaults', () => {
     assert.deepEqual(readSettings(() => undefined), settings());
-    const values: Record<string, unknown> = { 'server.path': 42, 'server.logLevel': 'verbose' };
+    const values: Record<string, unknown> = {
+      'server.path': 42,
+      'server.logLevel': 'verbose',
+      'cycleTime.inlayHints': 'everywhere',
+    };
     assert.deepEqual(readSettings((key) => values[key]), settings());
   });
 });
@@ -140,10 +145,11 @@ describe('findServer', () => {
 
 describe('initializationOptions', () => {
   test('passes the configuration file as an absolute path, or nothing', () => {
-    assert.deepEqual(initializationOptions(settings(), environment()), { ok: true, value: {} });
+    const cycleTime = { inlayHints: 'perBlock' };
+    assert.deepEqual(initializationOptions(settings(), environment()), { ok: true, value: { cycleTime } });
     assert.deepEqual(initializationOptions(settings({ configFile: 'machines/ncc.toml' }), environment()), {
       ok: true,
-      value: { configFile: path.join(scratch, 'machines', 'ncc.toml') },
+      value: { configFile: path.join(scratch, 'machines', 'ncc.toml'), cycleTime },
     });
     const result = initializationOptions(settings({ configFile: 'ncc.toml' }), environment({ base: undefined }));
     assert.equal(!result.ok && result.setting, 'ncc.machine.configFile');
@@ -178,7 +184,10 @@ describe('serverLaunch', { skip: !posix }, () => {
       value: {
         command: path.join(bin, 'ncc'),
         args: ['lsp', '--log-level', 'trace'],
-        initializationOptions: { configFile: path.join(scratch, 'ncc.toml') },
+        initializationOptions: {
+          configFile: path.join(scratch, 'ncc.toml'),
+          cycleTime: { inlayHints: 'perBlock' },
+        },
         version: 'ncc 9.8.7',
       },
     });

@@ -37,6 +37,10 @@ pub struct InlayHint {
 pub enum InlayHintKind {
     /// The value a parameter assignment stores.
     ParameterValue,
+    /// A block's predicted time, or the time at its end.
+    BlockTime,
+    /// A drop of the path speed at a block.
+    SpeedBreak,
 }
 
 /// The hints of the blocks that `range` touches (all blocks without one).

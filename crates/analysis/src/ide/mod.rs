@@ -7,6 +7,7 @@
 //! them all.
 
 pub(crate) mod completion;
+pub(crate) mod cycle_time;
 pub(crate) mod folding;
 pub(crate) mod format;
 pub(crate) mod highlight;

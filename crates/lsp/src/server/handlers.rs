@@ -27,6 +27,7 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
             ..Default::default()
         }),
         inlay_hint_provider: Some(lsp::OneOf::Left(true)),
+        code_lens_provider: Some(lsp::CodeLensOptions { resolve_provider: Some(false) }),
         references_provider: Some(lsp::OneOf::Left(true)),
         document_highlight_provider: Some(lsp::OneOf::Left(true)),
         document_symbol_provider: Some(lsp::OneOf::Left(true)),
@@ -48,11 +49,23 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
     }
 }
 
+/// The analysis's hover, then the predicted time and speed of the block.
 pub(crate) fn hover(s: &Snapshot, position: lsp::Position) -> Option<lsp::Hover> {
-    let hover = s.analysis.hover(s.file, s.map.offset(position))?;
+    let offset = s.map.offset(position);
+    let hover = s.analysis.hover(s.file, offset);
+    let timed = s.cycle.as_ref().filter(|cycle| cycle.holds_at(offset)).and_then(|cycle| {
+        let block = cycle.estimate.block_at(offset)?;
+        Some((block.range, cycle.estimate.hover(offset)?))
+    });
+    let (range, markdown) = match (hover, timed) {
+        (Some(hover), Some((_, time))) => (hover.range, format!("{}\n\n---\n\n{time}", hover.markdown)),
+        (Some(hover), None) => (hover.range, hover.markdown),
+        (None, Some((block, time))) => (block, time),
+        (None, None) => return None,
+    };
     Some(lsp::Hover {
-        contents: lsp::HoverContents::Markup(convert::markdown(hover.markdown)),
-        range: Some(s.map.range(hover.range)),
+        contents: lsp::HoverContents::Markup(convert::markdown(markdown)),
+        range: Some(s.map.range(range)),
     })
 }
 
@@ -120,9 +133,18 @@ pub(crate) fn formatting(s: &Snapshot) -> Vec<lsp::TextEdit> {
     s.analysis.format(s.file).iter().map(|edit| s.map.text_edit(edit)).collect()
 }
 
+/// The parameter values and, where the estimate holds, the cycle time.
 pub(crate) fn inlay_hints(s: &Snapshot, range: lsp::Range) -> Vec<lsp::InlayHint> {
-    s.analysis
-        .inlay_hints(s.file, Some(s.map.range_offsets(range)))
+    let range = s.map.range_offsets(range);
+    let mut hints = s.analysis.inlay_hints(s.file, Some(range));
+    if let Some(cycle) = &s.cycle {
+        let timed = cycle.estimate.inlay_hints(&s.map.text, Some(range), s.cycle_hints);
+        hints.extend(timed.into_iter().filter(|hint| cycle.holds_at(hint.offset)));
+        // Parameter values and times can share a line; the client wants
+        // them in order.
+        hints.sort_by_key(|hint| hint.offset);
+    }
+    hints
         .into_iter()
         .map(|hint| lsp::InlayHint {
             position: s.map.position(hint.offset),
@@ -135,6 +157,19 @@ pub(crate) fn inlay_hints(s: &Snapshot, range: lsp::Range) -> Vec<lsp::InlayHint
             data: None,
         })
         .collect()
+}
+
+/// The program's predicted total on its header.
+pub(crate) fn code_lenses(s: &Snapshot) -> Vec<lsp::CodeLens> {
+    let (Some(cycle), Some(head)) = (&s.cycle, s.analysis.program_head(s.file)) else { return Vec::new() };
+    // A lens spans one line: the header's first.
+    let start = s.map.position(head.start());
+    vec![lsp::CodeLens {
+        range: lsp::Range::new(start, start),
+        // A title to show; no command runs when it is clicked.
+        command: Some(lsp::Command { title: cycle.estimate.headline(), command: String::new(), arguments: None }),
+        data: None,
+    }]
 }
 
 pub(crate) fn references(

@@ -11,8 +11,12 @@
 //! no flow walk as soon as the edited chunk is checked (with the previous
 //! flow findings moved along with the edit), then the complete set when
 //! the flow walk is done — unless a newer edit came first.
+//!
+//! The predicted cycle time (`cycle_time.rs`) is estimated on a thread of
+//! its own after each edit; inlay hints, a code lens and hover show it.
 
 mod convert;
+mod cycle_time;
 mod frames;
 mod handlers;
 mod plot;
@@ -29,7 +33,7 @@ use std::{
     },
 };
 
-use ncc_analysis::{Analysis, Cancelled, Diagnostic, FileId};
+use ncc_analysis::{Analysis, Cancelled, CycleTimeHints, Diagnostic, FileId, TextRange, TextSize};
 use tokio::sync::mpsc;
 use tower_lsp_server::{
     Client, LanguageServer, LspService,
@@ -112,12 +116,16 @@ struct Document {
     /// The flow findings last computed, moved along with later edits until
     /// they are computed again.
     flow: Vec<Diagnostic>,
+    cycle: cycle_time::Cycle,
 }
 
 #[derive(Debug, Default)]
 struct State {
     workspaces: Workspaces,
     documents: HashMap<Uri, Document>,
+    /// `ncc.cycleTime.inlayHints`.
+    cycle_hints: CycleTimeHints,
+    refresh: cycle_time::Refresh,
 }
 
 #[derive(Debug)]
@@ -126,6 +134,9 @@ pub(crate) struct Server {
     state: Arc<Mutex<State>>,
     shut_down: Arc<AtomicBool>,
     publisher: mpsc::UnboundedSender<Publication>,
+    timer: cycle_time::Timer,
+    /// Asks the client to refresh what shows the cycle time.
+    refresh: mpsc::UnboundedSender<()>,
 }
 
 /// Diagnostics of one version of a document, to send.
@@ -152,13 +163,20 @@ struct Snapshot {
     file: FileId,
     map: LineMap,
     uri: Uri,
+    /// The cycle-time estimate, where it holds.
+    cycle: Option<cycle_time::View>,
+    cycle_hints: CycleTimeHints,
 }
 
 impl Server {
     fn new(client: Client, shut_down: Arc<AtomicBool>) -> Server {
         let (publisher, publications) = mpsc::unbounded_channel();
         tokio::spawn(publish(client.clone(), publications));
-        Server { client, state: Arc::default(), shut_down, publisher }
+        let state: Arc<Mutex<State>> = Arc::default();
+        let (refresh, refreshes) = mpsc::unbounded_channel();
+        tokio::spawn(cycle_time::refresh(client.clone(), state.clone(), refreshes));
+        let timer = cycle_time::Timer::start(state.clone(), refresh.clone());
+        Server { client, state, shut_down, publisher, timer, refresh }
     }
 
     fn state(&self) -> MutexGuard<'_, State> {
@@ -174,6 +192,8 @@ impl Server {
             file: document.file,
             map: document.map.clone(),
             uri: uri.clone(),
+            cycle: cycle_time::View::of(&document.cycle),
+            cycle_hints: state.cycle_hints,
         })
     }
 
@@ -282,8 +302,9 @@ impl Server {
     }
 }
 
-/// Lowers the calling thread's priority (nice 10): the flow walk and the
-/// state preparation take hundreds of milliseconds on a large program, and
+/// Lowers the calling thread's priority (nice 10): the flow walk, the
+/// state preparation and the cycle-time run take up to hundreds of
+/// milliseconds on a large program, and
 /// edits and hovers must not wait for a core behind them. Not the idle
 /// scheduling class: on a busy machine (a build running) that starves the
 /// walk, and the complete diagnostics would not come until the machine is
@@ -312,6 +333,25 @@ struct InitializationOptions {
     /// The `ncc.toml` to use for every document, instead of finding one
     /// upwards from each document.
     config_file: Option<PathBuf>,
+    #[serde(default)]
+    cycle_time: CycleTimeSettings,
+}
+
+/// `ncc.cycleTime`: in the initialization options, and in the settings of
+/// `workspace/didChangeConfiguration` (below `ncc`).
+#[derive(Debug, Default, serde::Deserialize)]
+#[serde(rename_all = "camelCase")]
+struct CycleTimeSettings {
+    inlay_hints: Option<CycleTimeHints>,
+}
+
+impl CycleTimeSettings {
+    /// The settings in a `didChangeConfiguration` payload, `{ "ncc": { … } }`
+    /// or the section itself; `None` when it holds none.
+    fn changed(settings: &serde_json::Value) -> Option<Result<CycleTimeSettings, serde_json::Error>> {
+        let section = settings.get("ncc").unwrap_or(settings).get("cycleTime")?;
+        Some(serde_json::from_value(section.clone()))
+    }
 }
 
 impl LanguageServer for Server {
@@ -333,9 +373,17 @@ impl LanguageServer for Server {
         } else {
             roots
         };
+        // Refresh requests only to a client that takes them.
+        let workspace = params.capabilities.workspace.as_ref();
+        let refresh = cycle_time::Refresh {
+            inlay_hints: workspace.and_then(|w| w.inlay_hint.as_ref()?.refresh_support).unwrap_or(false),
+            code_lenses: workspace.and_then(|w| w.code_lens.as_ref()?.refresh_support).unwrap_or(false),
+        };
         let errors = {
             let mut state = self.state();
             state.workspaces.configure(options.config_file);
+            state.cycle_hints = options.cycle_time.inlay_hints.unwrap_or_default();
+            state.refresh = refresh;
             state.workspaces.load_roots(&roots)
         };
         for error in errors {
@@ -359,12 +407,12 @@ impl LanguageServer for Server {
             let mut state = self.state();
             let (workspace, file, errors) = state.workspaces.open(&document.uri, document.text);
             let map = LineMap::new(state.workspaces.get(workspace).analysis().text(file));
-            let flow = Vec::new();
-            state
-                .documents
-                .insert(document.uri.clone(), Document { workspace, file, version: document.version, map, flow });
+            let (flow, cycle) = Default::default();
+            let version = document.version;
+            state.documents.insert(document.uri.clone(), Document { workspace, file, version, map, flow, cycle });
             errors
         };
+        self.timer.request(document.uri.clone(), document.version);
         self.analyze(document.uri, true);
         for error in errors {
             self.client.show_message(lsp::MessageType::ERROR, error).await;
@@ -393,9 +441,11 @@ impl LanguageServer for Server {
                     .into_iter()
                     .filter_map(|diagnostic| diagnostic.moved_through(&edit))
                     .collect();
+                document.cycle.edited(TextRange::at(edit.delete.start(), TextSize::of(&edit.insert)));
             }
             document.version = params.text_document.version;
             tracing::debug!("{} v{}: edits applied in {:?}", uri.as_str(), document.version, started.elapsed());
+            self.timer.request(uri.clone(), document.version);
         }
         self.analyze(uri, false);
     }
@@ -408,6 +458,7 @@ impl LanguageServer for Server {
                 state.workspaces.close(document.workspace, &uri, document.file);
             }
         }
+        self.timer.forget(&uri);
         self.client.publish_diagnostics(uri, Vec::new(), None).await;
     }
 
@@ -443,6 +494,24 @@ impl LanguageServer for Server {
 
     async fn inlay_hint(&self, params: lsp::InlayHintParams) -> jsonrpc::Result<Option<Vec<lsp::InlayHint>>> {
         self.query(&params.text_document.uri, move |s| handlers::inlay_hints(s, params.range)).await.map(Some)
+    }
+
+    async fn code_lens(&self, params: lsp::CodeLensParams) -> jsonrpc::Result<Option<Vec<lsp::CodeLens>>> {
+        self.query(&params.text_document.uri, handlers::code_lenses).await.map(Some)
+    }
+
+    async fn did_change_configuration(&self, params: lsp::DidChangeConfigurationParams) {
+        match CycleTimeSettings::changed(&params.settings) {
+            Some(Ok(settings)) => {
+                let hints = settings.inlay_hints.unwrap_or_default();
+                let changed = std::mem::replace(&mut self.state().cycle_hints, hints) != hints;
+                if changed {
+                    let _ = self.refresh.send(());
+                }
+            }
+            Some(Err(error)) => tracing::warn!("ncc.cycleTime: {error}"),
+            None => {}
+        }
     }
 
     async fn references(&self, params: lsp::ReferenceParams) -> jsonrpc::Result<Option<Vec<lsp::Location>>> {

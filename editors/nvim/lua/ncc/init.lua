@@ -6,7 +6,7 @@ local M = {}
 
 local uv = vim.uv or vim.loop
 
-local option_names = { "cmd", "config_file", "log_level", "capabilities", "on_attach" }
+local option_names = { "cmd", "config_file", "log_level", "cycle_time_hints", "capabilities", "on_attach" }
 
 -- The project root: the nearest directory that holds either marker.
 local root_markers = { "ncc.toml", ".git" }
@@ -31,14 +31,33 @@ local function root_dir(bufnr)
   end
 end
 
+-- The predicted cycle time: inlay hints (Neovim 0.10 and later, which
+-- also refresh them when the server asks) and the program's total as a
+-- code lens, fetched again when the buffer is entered or left, and when
+-- typing pauses.
+local function show_cycle_time(bufnr)
+  if vim.lsp.inlay_hint and vim.lsp.inlay_hint.enable then
+    pcall(vim.lsp.inlay_hint.enable, true, { bufnr = bufnr })
+  end
+  local refresh = function()
+    pcall(vim.lsp.codelens.refresh, { bufnr = bufnr })
+  end
+  vim.api.nvim_create_autocmd({ "BufEnter", "InsertLeave", "CursorHold" }, {
+    group = vim.api.nvim_create_augroup("ncc_codelens_" .. bufnr, { clear = true }),
+    buffer = bufnr,
+    callback = refresh,
+  })
+  refresh()
+end
+
 local function client_config(opts, bufnr)
   local cmd = vim.deepcopy(opts.cmd)
   if opts.log_level then
     vim.list_extend(cmd, { "--log-level", opts.log_level })
   end
-  local init_options
+  local init_options = { cycleTime = { inlayHints = opts.cycle_time_hints } }
   if opts.config_file then
-    init_options = { configFile = vim.fn.fnamemodify(vim.fn.expand(opts.config_file), ":p") }
+    init_options.configFile = vim.fn.fnamemodify(vim.fn.expand(opts.config_file), ":p")
   end
   return {
     name = "ncc",
@@ -46,7 +65,14 @@ local function client_config(opts, bufnr)
     root_dir = root_dir(bufnr),
     init_options = init_options,
     capabilities = opts.capabilities,
-    on_attach = opts.on_attach,
+    on_attach = function(client, attached)
+      if opts.cycle_time_hints ~= "off" then
+        show_cycle_time(attached)
+      end
+      if opts.on_attach then
+        opts.on_attach(client, attached)
+      end
+    end,
   }
 end
 
@@ -79,6 +105,8 @@ end
 --- - log_level: the server's log level ("error", "warn", "info", "debug" or
 ---   "trace"). The server logs to stderr, which Neovim copies into its LSP
 ---   log, `vim.lsp.get_log_path()`.
+--- - cycle_time_hints: "perBlock" (default), "cumulative" or "off": the
+---   predicted time of each block, or the time at its end, as inlay hints.
 --- - capabilities, on_attach: passed to the client as they are.
 function M.setup(opts)
   opts = opts or {}
@@ -90,7 +118,7 @@ function M.setup(opts)
       )
     end
   end
-  opts = vim.tbl_extend("keep", opts, { cmd = { "ncc", "lsp" } })
+  opts = vim.tbl_extend("keep", opts, { cmd = { "ncc", "lsp" }, cycle_time_hints = "perBlock" })
 
   vim.api.nvim_create_autocmd("FileType", {
     group = vim.api.nvim_create_augroup("ncc", { clear = true }),

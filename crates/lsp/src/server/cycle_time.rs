@@ -1,0 +1,179 @@
+//! The predicted cycle time of open programs, estimated in the background.
+//!
+//! An edit (or an open) leaves a job per document; one worker thread runs
+//! the newest job of each document, so typing faster than a run takes
+//! skips the versions in between, as a debounce would. The run holds no
+//! snapshot: it reads the text, the machine and the workspace's files
+//! first, and an edit meanwhile only makes its result stale. A result is
+//! kept only if the document is still at its version; then the client is
+//! asked to refresh its inlay hints and code lenses. The worker runs at the
+//! lower priority of the flow walk.
+
+use std::{
+    collections::HashMap,
+    sync::{Arc, Condvar, Mutex},
+};
+
+use ncc_analysis::{Cancelled, Estimate, TextRange, TextSize};
+use tokio::sync::mpsc;
+use tower_lsp_server::{Client, ls_types::Uri};
+
+use super::{State, background_priority, lock};
+
+/// Blocks a run executes at most: a million steps hold a few hundred
+/// megabytes while the model times them; a program that runs longer (a
+/// jump loop without end) shows that its run stopped.
+const STEP_BUDGET: usize = 1_000_000;
+
+/// A document's estimate, as the server keeps it.
+#[derive(Debug, Default)]
+pub(crate) struct Cycle {
+    pub estimate: Option<Arc<Estimate>>,
+    /// Where the text first differs from the estimate's text, after edits
+    /// since its version: answers before it still hold.
+    pub stale_from: Option<TextSize>,
+    /// What the edit since the estimate wrote, when there was one edit.
+    edit: Option<TextRange>,
+}
+
+impl Cycle {
+    /// Notes an edit that wrote `written` (a range of the new text).
+    pub fn edited(&mut self, written: TextRange) {
+        self.edit = if self.stale_from.is_none() { Some(written) } else { None };
+        let start = written.start();
+        self.stale_from = Some(self.stale_from.map_or(start, |stale| stale.min(start)));
+    }
+}
+
+/// The estimate a request may use, and up to where.
+#[derive(Debug, Clone)]
+pub(crate) struct View {
+    pub estimate: Arc<Estimate>,
+    pub valid_before: TextSize,
+}
+
+impl View {
+    pub fn of(cycle: &Cycle) -> Option<View> {
+        let estimate = cycle.estimate.clone()?;
+        Some(View { estimate, valid_before: cycle.stale_from.unwrap_or(TextSize::from(u32::MAX)) })
+    }
+
+    /// Whether the estimate still holds for the block at `offset`.
+    pub fn holds_at(&self, offset: TextSize) -> bool {
+        self.estimate.block_at(offset).is_some_and(|block| block.range.end() <= self.valid_before)
+    }
+}
+
+/// The newest version of each document to estimate.
+#[derive(Debug, Default)]
+struct Jobs {
+    pending: HashMap<Uri, i32>,
+}
+
+/// The worker and its queue.
+#[derive(Debug, Clone)]
+pub(crate) struct Timer {
+    jobs: Arc<(Mutex<Jobs>, Condvar)>,
+}
+
+impl Timer {
+    /// Starts the worker; results go into `state`, and a message on
+    /// `refresh` asks the client to show them.
+    pub fn start(state: Arc<Mutex<State>>, refresh: mpsc::UnboundedSender<()>) -> Timer {
+        let timer = Timer { jobs: Arc::default() };
+        let jobs = timer.jobs.clone();
+        let spawned = std::thread::Builder::new().name("ncc-cycle-time".into()).spawn(move || {
+            // Diagnostics and hovers of the edit come first: on two cores a
+            // run at normal priority doubles their latency.
+            background_priority();
+            loop {
+                let (uri, version) = {
+                    let (lock, ready) = &*jobs;
+                    let mut guard = lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+                    loop {
+                        if let Some(uri) = guard.pending.keys().next().cloned() {
+                            let version = guard.pending.remove(&uri).expect("the key was just found");
+                            break (uri, version);
+                        }
+                        guard = ready.wait(guard).unwrap_or_else(|poisoned| poisoned.into_inner());
+                    }
+                };
+                // A failed run must not end the worker: later edits may run.
+                match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&state, &uri, version))) {
+                    Ok(true) => {
+                        let _ = refresh.send(());
+                    }
+                    Ok(false) => {}
+                    Err(_) => tracing::error!("{} v{version}: estimating the cycle time failed", uri.as_str()),
+                }
+            }
+        });
+        if let Err(error) = spawned {
+            tracing::error!("cannot start the cycle-time thread: {error}");
+        }
+        timer
+    }
+
+    /// Asks for an estimate of `uri` at `version`, instead of any older one
+    /// not yet started.
+    pub fn request(&self, uri: Uri, version: i32) {
+        let (lock, ready) = &*self.jobs;
+        lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).pending.insert(uri, version);
+        ready.notify_one();
+    }
+
+    pub fn forget(&self, uri: &Uri) {
+        let (lock, _) = &*self.jobs;
+        lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).pending.remove(uri);
+    }
+}
+
+/// Estimates one version; whether the result was kept.
+fn run(state: &Mutex<State>, uri: &Uri, version: i32) -> bool {
+    let (analysis, file, previous, edit) = {
+        let state = lock(state);
+        let Some(document) = state.documents.get(uri).filter(|document| document.version == version) else {
+            return false;
+        };
+        let cycle = &document.cycle;
+        (state.workspaces.get(document.workspace).analysis(), document.file, cycle.estimate.clone(), cycle.edit)
+    };
+    let started = std::time::Instant::now();
+    // Read, then let go of the snapshot: the run may take a while.
+    let Ok(input) = Cancelled::catch(|| analysis.run_input(file)) else { return false };
+    drop(analysis);
+    let Some(input) = input else { return false };
+    let estimate = Arc::new(input.estimate(previous.as_deref(), edit, STEP_BUDGET));
+    drop(input);
+    tracing::debug!("{} v{version}: cycle time estimated in {:?}", uri.as_str(), started.elapsed());
+    let mut state = lock(state);
+    match state.documents.get_mut(uri) {
+        Some(document) if document.version == version => {
+            document.cycle = Cycle { estimate: Some(estimate), stale_from: None, edit: None };
+            true
+        }
+        _ => false,
+    }
+}
+
+/// What the client said it can do with refresh requests.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Refresh {
+    pub inlay_hints: bool,
+    pub code_lenses: bool,
+}
+
+/// Asks the client to fetch inlay hints and code lenses again whenever an
+/// estimate is ready (one request for several that came meanwhile).
+pub(crate) async fn refresh(client: Client, state: Arc<Mutex<State>>, mut ready: mpsc::UnboundedReceiver<()>) {
+    while ready.recv().await.is_some() {
+        while ready.try_recv().is_ok() {}
+        let can = lock(&state).refresh;
+        if can.inlay_hints && client.inlay_hint_refresh().await.is_err() {
+            tracing::debug!("the client refused to refresh inlay hints");
+        }
+        if can.code_lenses && client.code_lens_refresh().await.is_err() {
+            tracing::debug!("the client refused to refresh code lenses");
+        }
+    }
+}
