@@ -12,8 +12,8 @@
 use std::{fmt::Write as _, sync::Arc};
 
 use nc_exec::{
-    run::{Environment, Motion, Trace},
-    velocity::{self, Dynamics, Reason, Timing},
+    run::{Environment, Motion, Step, Totals},
+    velocity::{self, Break, Dynamics, Reason, Timer, TimingSink},
 };
 use ncc_syntax::{TextRange, TextSize, ast::AstNode};
 use rustc_hash::FxHashMap;
@@ -169,57 +169,73 @@ pub fn estimate(
     budget: usize,
 ) -> Estimate {
     let _resume_from = (previous, edit);
-    let trace = nc_exec::run::run(text, files, machine, budget);
-    let timing = velocity::time(&trace, &Dynamics::of(machine));
-    of_run(&trace, &timing)
+    let dynamics = Dynamics::of(machine);
+    // The model times the steps beside the run, which keeps none of them.
+    let timer = Timer::new(machine.step_axes(), &dynamics, Charges::default());
+    let (trace, timer) = nc_exec::run::run_beside(text, files, machine, budget, timer);
+    let charges = timer.finish();
+    let mut blocks = charges.blocks;
+    blocks.sort_by_key(|block| block.range.start());
+    let totals = charges.totals;
+    Estimate {
+        blocks,
+        totals: CycleTotals {
+            total: totals.total_time,
+            cutting: totals.time(Motion::Feed),
+            rapid: totals.time(Motion::Rapid),
+            dwell: totals.time(Motion::Dwell),
+            breaks: charges.breaks,
+            lost: charges.lost,
+        },
+        stopped: trace.findings.iter().find(|finding| finding.fatal).map(|finding| finding.message.clone()),
+    }
 }
 
-/// Charges every step to a block of the file, and adds up.
-fn of_run(trace: &Trace, timing: &Timing) -> Estimate {
-    let mut blocks: Vec<BlockTime> = Vec::new();
-    let mut index_of: FxHashMap<TextSize, usize> = FxHashMap::default();
-    // The block charged for each step, and the block of the last step of
-    // this file (a new execution starts when another block's step comes).
-    let mut charged: Vec<Option<usize>> = Vec::with_capacity(trace.steps.len());
-    let mut current: Option<usize> = None;
-    let steps = trace.steps.iter().zip(&timing.profiles).zip(timing.start_times());
-    for ((step, profile), start) in steps {
-        if step.source == 0 {
-            let index = *index_of.entry(step.range.start()).or_insert_with(|| {
-                blocks.push(BlockTime {
-                    range: step.range,
-                    start,
-                    end: start,
-                    total: 0.0,
-                    executions: 0,
-                    profile: velocity::Profile::default(),
-                    breaks: Vec::new(),
-                });
-                blocks.len() - 1
+/// Every step charged to a block of the file as the model times it, and
+/// the sums.
+#[derive(Default)]
+struct Charges {
+    blocks: Vec<BlockTime>,
+    index_of: FxHashMap<TextSize, usize>,
+    /// The block of the last step of this file: steps of other files are
+    /// its, and a new execution starts when another block's step comes.
+    current: Option<usize>,
+    /// Seconds since the program's start.
+    clock: f64,
+    totals: Totals,
+    breaks: usize,
+    lost: f64,
+}
+
+impl Charges {
+    /// The block a step is charged to: its own in this file, found or
+    /// added, else the block that ran last.
+    fn block_of(&mut self, step: &Step) -> Option<usize> {
+        if step.source != 0 {
+            return self.current;
+        }
+        let Charges { blocks, index_of, clock, .. } = self;
+        Some(*index_of.entry(step.range.start()).or_insert_with(|| {
+            blocks.push(BlockTime {
+                range: step.range,
+                start: *clock,
+                end: *clock,
+                total: 0.0,
+                executions: 0,
+                profile: velocity::Profile::default(),
+                breaks: Vec::new(),
             });
-            let block = &mut blocks[index];
-            if current == Some(index) {
-                block.profile.peak = block.profile.peak.max(profile.peak);
-                block.profile.exit = profile.exit;
-                block.profile.duration += profile.duration;
-            } else {
-                block.executions += 1;
-                block.profile = *profile;
-            }
-            current = Some(index);
-        }
-        charged.push(current);
-        if let Some(block) = current.map(|index| &mut blocks[index]) {
-            block.total += profile.duration;
-            if block.executions == 1 {
-                block.end = start + profile.duration;
-            }
-        }
+            blocks.len() - 1
+        }))
     }
-    for speed_break in &timing.breaks {
-        let Some(block) = charged.get(speed_break.step).copied().flatten().map(|index| &mut blocks[index]) else {
-            continue;
-        };
+}
+
+impl TimingSink for Charges {
+    fn speed_break(&mut self, step: &Step, speed_break: Break) {
+        self.breaks += 1;
+        self.lost += speed_break.lost;
+        let Some(index) = self.block_of(step) else { return };
+        let block = &mut self.blocks[index];
         let code = speed_break.reason.code();
         match block.breaks.iter_mut().find(|known| known.reason.code() == code) {
             Some(known) => {
@@ -237,19 +253,32 @@ fn of_run(trace: &Trace, timing: &Timing) -> Estimate {
             }),
         }
     }
-    blocks.sort_by_key(|block| block.range.start());
-    let totals = trace.totals_with(timing.profiles.iter().map(|profile| profile.duration));
-    Estimate {
-        blocks,
-        totals: CycleTotals {
-            total: totals.total_time,
-            cutting: totals.time(Motion::Feed),
-            rapid: totals.time(Motion::Rapid),
-            dwell: totals.time(Motion::Dwell),
-            breaks: timing.breaks.len(),
-            lost: timing.breaks.iter().map(|speed_break| speed_break.lost).sum(),
-        },
-        stopped: trace.findings.iter().find(|finding| finding.fatal).map(|finding| finding.message.clone()),
+
+    fn timed(&mut self, step: &Step, profile: velocity::Profile) {
+        let start = self.clock;
+        self.clock += profile.duration;
+        self.totals.add(step, profile.duration);
+        let index = self.block_of(step);
+        if step.source == 0
+            && let Some(own) = index
+        {
+            let block = &mut self.blocks[own];
+            if self.current == index {
+                block.profile.peak = block.profile.peak.max(profile.peak);
+                block.profile.exit = profile.exit;
+                block.profile.duration += profile.duration;
+            } else {
+                block.executions += 1;
+                block.profile = profile;
+            }
+            self.current = index;
+        }
+        if let Some(block) = index.map(|index| &mut self.blocks[index]) {
+            block.total += profile.duration;
+            if block.executions == 1 {
+                block.end = start + profile.duration;
+            }
+        }
     }
 }
 
