@@ -421,6 +421,30 @@ fn run_shows_the_lathe_end_as_a_diameter() {
     assert_eq!(json["end_position"]["X"], 50.0);
 }
 
+/// A block that runs many times is one place in the summary's list of
+/// breaks, with its runs and their cost added up; blocks that come back
+/// out of order need every break kept.
+#[test]
+fn run_lists_a_subprograms_breaks_once_with_their_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("LOOP.NCP");
+    let text = "%1 \"LOOP\"\nN1 G01 G98 X10 F600\nN2 G71 L5 Q3\nN3 G01 X0\nN4 M30\nN5 G79 L5\nN6 G91 G01 X5 F600\nN7 X-5\nN8 G90 G70\n";
+    std::fs::write(&program, text).unwrap();
+    let program = program.to_str().unwrap();
+    let output = ncc(&["run", program]);
+    assert_eq!(output.status.code(), Some(0));
+    let summary = stdout(&output).replace(program, "LOOP.NCP");
+    let breaks = &summary[summary.find("breaks ").unwrap()..];
+    expect![[r#"
+        breaks       8 where the path speed drops (5 non-motion, 3 g98), costing 0:00:00.215
+            LOOP.NCP:7  G98 joins no blocks: a stop and a pause before the next: 600 → 0 mm/min, 0.090 s (3 runs)
+            LOOP.NCP:8  a block without motion between moves: 600 → 0 mm/min, 0.075 s (3 runs)
+            LOOP.NCP:2  a block without motion between moves: 600 → 0 mm/min, 0.025 s
+            LOOP.NCP:4  a block without motion between moves: 600 → 0 mm/min, 0.025 s
+    "#]]
+    .assert_eq(breaks);
+}
+
 /// `ncc run` prints the time split and the end; JSON has the total and a
 /// record per block with its source line.
 #[test]

@@ -121,18 +121,34 @@ impl Ran {
     fn tally(program: &Program<'_>, step_budget: usize, progress: Progress) -> Result<(Ran, Tally), String> {
         let machine = program.machine()?;
         let dynamics = Dynamics::of(&machine);
-        // Breaks can come at every block: room reserved and never touched
-        // costs nothing, growing copies.
-        let tally = Tally { breaks: Vec::with_capacity(expected_blocks(program.text)), ..Tally::default() };
-        let timer = Timer::new(machine.step_axes(), &dynamics, tally);
-        let mut timed = None;
-        let ran = Ran::run(program, &machine, progress, |text, library| {
-            // The model runs beside the executor, on the other core.
-            let (trace, timer) = nc_exec::run::run_beside(text, library, &machine, step_budget, timer);
-            timed = Some(timer.finish());
-            trace
-        });
-        Ok((ran, timed.unwrap_or_default()))
+        let tally_with = |places: Places| {
+            let timer = Timer::new(machine.step_axes(), &dynamics, Tally { places, ..Tally::default() });
+            let mut timed = None;
+            let ran = Ran::run(program, &machine, progress, |text, library| {
+                // The model runs beside the executor, on the other core.
+                let (trace, timer) = nc_exec::run::run_beside(text, library, &machine, step_budget, timer);
+                timed = Some(timer.finish());
+                trace
+            });
+            (ran, timed.unwrap_or_default())
+        };
+        let (ran, mut tally) = tally_with(Places::InOrder(Grouping::default()));
+        if let Places::InOrder(grouping) = &mut tally.places {
+            grouping.close_block();
+            return Ok((ran, tally));
+        }
+        // A loop or a call came back to a block: the run again, keeping
+        // every break to sort (breaks can come at every block: room
+        // reserved and never touched costs nothing, growing copies).
+        let (ran, mut tally) = tally_with(Places::Kept(Vec::with_capacity(expected_blocks(program.text))));
+        if let Places::Kept(mut kept) = std::mem::replace(&mut tally.places, Places::OutOfOrder) {
+            kept.sort_by_key(PlacedBreak::place);
+            let mut grouping = Grouping::default();
+            kept.into_iter().for_each(|placed| grouping.add(placed));
+            grouping.close_block();
+            tally.places = Places::InOrder(grouping);
+        }
+        Ok((ran, tally))
     }
 
     /// Runs `program` with `execute` (which keeps the steps or hands them
@@ -363,7 +379,81 @@ struct Tally {
     totals: Totals,
     /// The programmed position at the end.
     end: Axes,
-    breaks: Vec<PlacedBreak>,
+    /// Breaks by kind (in the order first met) and what they cost.
+    by_reason: Vec<(&'static str, usize)>,
+    breaks: usize,
+    lost: f64,
+    places: Places,
+}
+
+/// The places where a program could avoid its breaks (rapid moves and
+/// threads always stop), grouped: a block that runs many times (a loop, a
+/// subprogram) is one place.
+enum Places {
+    /// As they come, while the blocks come in order (a program without
+    /// loops or calls), holding only the costliest.
+    InOrder(Grouping),
+    /// A break came back to an earlier block: the grouping so far is not
+    /// the whole story.
+    OutOfOrder,
+    /// Every break, to sort.
+    Kept(Vec<PlacedBreak>),
+}
+
+impl Default for Places {
+    fn default() -> Places {
+        Places::InOrder(Grouping::default())
+    }
+}
+
+/// Breaks grouped by place as they come in order of place; the breaks of
+/// one block (of different kinds, or of a cycle's moves) come together.
+#[derive(Default)]
+struct Grouping {
+    /// Each place's first break, its runs and its cost: the block at
+    /// hand's, one per kind, and the costliest of those before.
+    block: Vec<(PlacedBreak, usize, f64)>,
+    top: Vec<(PlacedBreak, usize, f64)>,
+    /// Places met.
+    places: usize,
+}
+
+impl Grouping {
+    /// Whether `placed` can follow: it is at the block at hand or after it.
+    fn in_order(&self, placed: &PlacedBreak) -> bool {
+        self.block.first().is_none_or(|(first, ..)| (first.source, first.at) <= (placed.source, placed.at))
+    }
+
+    fn add(&mut self, placed: PlacedBreak) {
+        if self.block.first().is_some_and(|(first, ..)| (first.source, first.at) != (placed.source, placed.at)) {
+            self.close_block();
+        }
+        match self.block.iter_mut().find(|(first, ..)| first.place() == placed.place()) {
+            Some((_, times, total)) => {
+                *times += 1;
+                *total += placed.lost;
+            }
+            None => {
+                let lost = placed.lost;
+                self.block.push((placed, 1, lost));
+            }
+        }
+    }
+
+    fn close_block(&mut self) {
+        let by_cost = |a: &(PlacedBreak, usize, f64), b: &(PlacedBreak, usize, f64)| {
+            b.2.total_cmp(&a.2).then(a.0.place().cmp(&b.0.place()))
+        };
+        self.places += self.block.len();
+        for place in self.block.drain(..) {
+            if self.top.len() == LISTED_BREAKS && self.top.last().is_some_and(|last| by_cost(&place, last).is_ge()) {
+                continue;
+            }
+            self.top.push(place);
+            self.top.sort_by(by_cost);
+            self.top.truncate(LISTED_BREAKS);
+        }
+    }
 }
 
 /// A break with the file and the block it is at, small: a long program
@@ -388,10 +478,25 @@ impl PlacedBreak {
 
 impl TimingSink for Tally {
     fn speed_break(&mut self, step: &Step, speed_break: velocity::Break) {
-        let source = u32::try_from(step.source).unwrap_or(u32::MAX);
         let velocity::Break { reason, before, at, lost, .. } = speed_break;
+        self.breaks += 1;
+        self.lost += lost;
+        match self.by_reason.iter_mut().find(|(code, _)| *code == reason.code()) {
+            Some((_, count)) => *count += 1,
+            None => self.by_reason.push((reason.code(), 1)),
+        }
+        if !reason.avoidable() {
+            return;
+        }
+        let source = u32::try_from(step.source).unwrap_or(u32::MAX);
         let (speed_before, speed_at) = (before as f32, at as f32);
-        self.breaks.push(PlacedBreak { source, at: step.range.start(), reason, speed_before, speed_at, lost });
+        let placed = PlacedBreak { source, at: step.range.start(), reason, speed_before, speed_at, lost };
+        match &mut self.places {
+            Places::InOrder(grouping) if grouping.in_order(&placed) => grouping.add(placed),
+            Places::InOrder(_) => self.places = Places::OutOfOrder,
+            Places::OutOfOrder => {}
+            Places::Kept(kept) => kept.push(placed),
+        }
     }
 
     fn timed(&mut self, step: &Step, profile: velocity::Profile) {
@@ -437,78 +542,28 @@ fn summary(path: &Path, ran: &Ran, tally: &Tally) -> String {
         .collect();
     let diameter = trace.diameter_axis.map(|axis| format!(" ({} as a diameter)", char::from(axis))).unwrap_or_default();
     let _ = writeln!(out, "  end position {}{diameter}", position.join(" "));
-    let breaks = &tally.breaks;
-    if !breaks.is_empty() {
-        let lost: f64 = breaks.iter().map(|placed| placed.lost).sum();
-        let mut by_reason: Vec<(&str, usize)> = Vec::new();
-        for placed in breaks {
-            let code = placed.reason.code();
-            match by_reason.iter_mut().find(|(known, _)| *known == code) {
-                Some((_, n)) => *n += 1,
-                None => by_reason.push((code, 1)),
-            }
-        }
+    if tally.breaks > 0 {
+        let mut by_reason = tally.by_reason.clone();
         by_reason.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(b.0)));
         let by_reason: Vec<String> = by_reason.iter().map(|(code, n)| format!("{n} {code}")).collect();
         let _ = writeln!(
             out,
             "  breaks       {} where the path speed drops ({}), costing {}",
-            breaks.len(),
+            tally.breaks,
             by_reason.join(", "),
-            clock(lost)
+            clock(tally.lost)
         );
-        // Grouped by place. A program without loops or calls meets its
-        // blocks in order, and needs no sort; the breaks of one block (of
-        // different kinds, or of a cycle's moves) come together.
-        let avoidable = breaks.iter().filter(|placed| placed.reason.avoidable());
-        let in_order =
-            avoidable.clone().zip(avoidable.clone().skip(1)).all(|(a, b)| (a.source, a.at) <= (b.source, b.at));
-        let avoidable: Box<dyn Iterator<Item = &PlacedBreak>> = if in_order {
-            Box::new(avoidable)
-        } else {
-            let mut sorted: Vec<&PlacedBreak> = avoidable.collect();
-            sorted.sort_by_key(|placed| placed.place());
-            Box::new(sorted.into_iter())
-        };
-        // Each place's first break, its runs and its cost; the costliest kept.
-        let mut top: Vec<(&PlacedBreak, usize, f64)> = Vec::with_capacity(LISTED_BREAKS + 1);
-        let by_cost = |a: &(&PlacedBreak, usize, f64), b: &(&PlacedBreak, usize, f64)| {
-            b.2.total_cmp(&a.2).then(a.0.place().cmp(&b.0.place()))
-        };
-        let mut keep = |place| {
-            if top.len() == LISTED_BREAKS && top.last().is_some_and(|last| by_cost(&place, last).is_ge()) {
-                return;
+        if let Places::InOrder(grouping) = &tally.places {
+            for (placed, times, lost) in &grouping.top {
+                let place = ran.sources[placed.source as usize].place(placed.at);
+                let times = if *times > 1 { format!(" ({times} runs)") } else { String::new() };
+                let (reason, before, at) = (placed.reason, placed.speed_before, placed.speed_at);
+                let _ = writeln!(out, "    {place}  {reason}: {before:.0} → {at:.0} mm/min, {lost:.3} s{times}");
             }
-            top.push(place);
-            top.sort_by(by_cost);
-            top.truncate(LISTED_BREAKS);
-        };
-        let mut listed = 0;
-        // The places of the block at hand, one per kind of break.
-        let mut block: Vec<(&PlacedBreak, usize, f64)> = Vec::new();
-        for placed in avoidable {
-            if block.first().is_some_and(|(first, ..)| (first.source, first.at) != (placed.source, placed.at)) {
-                listed += block.len();
-                block.drain(..).for_each(&mut keep);
+            if grouping.places > LISTED_BREAKS {
+                let more = grouping.places - LISTED_BREAKS;
+                let _ = writeln!(out, "    … and {more} more places (--format json lists every break)");
             }
-            match block.iter_mut().find(|(first, ..)| first.place() == placed.place()) {
-                Some((_, times, total)) => {
-                    *times += 1;
-                    *total += placed.lost;
-                }
-                None => block.push((placed, 1, placed.lost)),
-            }
-        }
-        listed += block.len();
-        block.into_iter().for_each(keep);
-        for (placed, times, lost) in top {
-            let place = ran.sources[placed.source as usize].place(placed.at);
-            let times = if times > 1 { format!(" ({times} runs)") } else { String::new() };
-            let (reason, before, at) = (placed.reason, placed.speed_before, placed.speed_at);
-            let _ = writeln!(out, "    {place}  {reason}: {before:.0} → {at:.0} mm/min, {lost:.3} s{times}");
-        }
-        if listed > LISTED_BREAKS {
-            let _ = writeln!(out, "    … and {} more places (--format json lists every break)", listed - LISTED_BREAKS);
         }
     }
     out
