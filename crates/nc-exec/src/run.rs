@@ -361,6 +361,11 @@ pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget:
 /// it.
 pub trait StepSink {
     fn step(&mut self, step: Step);
+
+    /// Takes every step of `steps` in order, leaving it empty.
+    fn steps(&mut self, steps: &mut Vec<Step>) {
+        steps.drain(..).for_each(|step| self.step(step));
+    }
 }
 
 /// Like [`run`], handing the steps to `sink` as they are final instead of
@@ -415,14 +420,32 @@ struct Batches {
     emptied: Receiver<Vec<Step>>,
 }
 
+impl Batches {
+    /// Sends `full` on, with an emptied batch in its place.
+    fn send(&mut self, full: &mut Vec<Step>) {
+        let next = self.emptied.try_recv().unwrap_or_else(|_| Vec::with_capacity(DELIVERY_BATCH));
+        let full = std::mem::replace(full, next);
+        // A sink that panicked has closed the channel: the join says so.
+        let _ = self.sender.send(full);
+    }
+}
+
 impl StepSink for Batches {
     fn step(&mut self, step: Step) {
         self.batch.push(step);
         if self.batch.len() == DELIVERY_BATCH {
-            let next = self.emptied.try_recv().unwrap_or_else(|_| Vec::with_capacity(DELIVERY_BATCH));
-            let full = std::mem::replace(&mut self.batch, next);
-            // A sink that panicked has closed the channel: the join says so.
-            let _ = self.sender.send(full);
+            let mut full = std::mem::take(&mut self.batch);
+            self.send(&mut full);
+            self.batch = full;
+        }
+    }
+
+    /// A whole batch goes as it is, without copying its steps.
+    fn steps(&mut self, steps: &mut Vec<Step>) {
+        if self.batch.is_empty() {
+            self.send(steps);
+        } else {
+            steps.drain(..).for_each(|step| self.step(step));
         }
     }
 }
@@ -1529,8 +1552,10 @@ impl<'a> Runner<'a> {
             _ => self.steps.len(),
         };
         self.delivered += open;
-        for step in self.steps.drain(..open) {
-            sink.step(step);
+        if open == self.steps.len() {
+            sink.steps(&mut self.steps);
+        } else {
+            self.steps.drain(..open).for_each(|step| sink.step(step));
         }
     }
 
