@@ -170,9 +170,10 @@ pub fn estimate(
 ) -> Estimate {
     let _resume_from = (previous, edit);
     let dynamics = Dynamics::of(machine);
-    // The model times the steps beside the run, which keeps none of them.
-    let timer = Timer::new(machine.step_axes(), &dynamics, Charges::default());
-    let (trace, timer) = nc_exec::run::run_beside(text, files, machine, budget, timer);
+    // The model times the steps as they come: the run keeps none. It runs
+    // on the run's thread, leaving the other core to the editor's requests.
+    let mut timer = Timer::new(machine.step_axes(), &dynamics, Charges::default());
+    let trace = nc_exec::run::run_into(text, files, machine, budget, &mut timer);
     let charges = timer.finish();
     let mut blocks = charges.blocks;
     blocks.sort_by_key(|block| block.range.start());
