@@ -396,7 +396,7 @@ pub fn run_beside<S: StepSink + Send>(
         let (recycle, emptied) = mpsc::sync_channel::<Vec<Step>>(8);
         let beside = scope.spawn(move || {
             for mut batch in batches {
-                batch.drain(..).for_each(|step| sink.step(step));
+                sink.steps(&mut batch);
                 let _ = recycle.try_send(batch);
             }
             sink
