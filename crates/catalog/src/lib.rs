@@ -128,7 +128,13 @@ pub struct Catalogue {
     pub cycles: Vec<Cycle>,
     codes_by_number: HashMap<(char, u32), usize>,
     roles: [Option<AddressRole>; 128],
+    /// [`Catalogue::modal_group_index`] of G and M codes below
+    /// [`DENSE_CODES`], which every block asks for.
+    modal_groups: [[Option<u8>; DENSE_CODES as usize]; 2],
 }
+
+/// G and M numbers looked up in a table rather than a map.
+const DENSE_CODES: u32 = 128;
 
 impl Catalogue {
     fn load(files: &DataFiles) -> Catalogue {
@@ -152,7 +158,7 @@ impl Catalogue {
                 roles[usize::from(byte.to_ascii_lowercase())] = Some(address.role);
             }
         }
-        Catalogue {
+        let mut catalogue = Catalogue {
             groups: codes.groups,
             codes: codes.codes,
             addresses: addresses.addresses,
@@ -163,7 +169,37 @@ impl Catalogue {
             cycles: cycles.cycles,
             codes_by_number,
             roles,
+            modal_groups: [[None; DENSE_CODES as usize]; 2],
+        };
+        for (table, letter) in [(0, 'G'), (1, 'M')] {
+            for number in 0..DENSE_CODES {
+                catalogue.modal_groups[table][number as usize] =
+                    catalogue.find_modal_group(letter, number).and_then(|index| u8::try_from(index).ok());
+            }
         }
+        catalogue
+    }
+
+    /// The index in [`Catalogue::groups`] of the group a code puts itself in
+    /// force in: `None` for block-only codes and codes outside the groups.
+    pub fn modal_group_index(&self, letter: char, number: u32) -> Option<usize> {
+        let table = match letter.to_ascii_uppercase() {
+            'G' => 0,
+            'M' => 1,
+            _ => return self.find_modal_group(letter, number),
+        };
+        match self.modal_groups[table].get(number as usize) {
+            Some(index) => index.map(usize::from),
+            None => self.find_modal_group(letter, number),
+        }
+    }
+
+    fn find_modal_group(&self, letter: char, number: u32) -> Option<usize> {
+        if self.code(letter, number).is_some_and(|code| code.modality != Modality::Modal) {
+            return None;
+        }
+        let group = self.group_of(letter, number)?;
+        self.groups.iter().position(|g| std::ptr::eq(g, group))
     }
 
     /// The code `letter` + `number` (`'G', 1` is G01), if the catalogue lists it.

@@ -158,6 +158,27 @@ fn groups_are_consistent() {
 }
 
 #[test]
+fn modal_codes_put_themselves_in_force_in_their_group() {
+    let catalogue = catalogue();
+    let index_of = |id: &str| catalogue.groups.iter().position(|group| group.id == id);
+    for code in &catalogue.codes {
+        let (letter, number) = split_code(&code.code).expect("checked above");
+        let expected = match code.modality {
+            Modality::Modal => code.group.as_deref().and_then(index_of),
+            Modality::Block => None,
+        };
+        assert_eq!(catalogue.modal_group_index(letter, number), expected, "{}", code.code);
+    }
+    // Unlisted M codes of the open range belong to the open group (M14),
+    // above the dense table too; G codes outside the groups to none.
+    let open = catalogue.groups.iter().rposition(|group| group.open && group.id.starts_with('M'));
+    assert_eq!(catalogue.modal_group_index('M', 77), open);
+    assert_eq!(catalogue.modal_group_index('m', 77), open);
+    assert_eq!(catalogue.modal_group_index('G', 99), None);
+    assert_eq!(catalogue.modal_group_index('G', 1000), None);
+}
+
+#[test]
 fn references_between_entries_resolve() {
     let catalogue = catalogue();
     let known_addresses: BTreeSet<String> = catalogue.addresses.iter().map(|a| a.letter.to_ascii_uppercase()).collect();

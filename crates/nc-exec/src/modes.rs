@@ -1,7 +1,7 @@
 //! The modal machine: the active code of every G and M group, as the
 //! catalogue defines the groups, their codes and their reset codes.
 
-use ncc_catalog::{Catalogue, Dialect, Modality};
+use ncc_catalog::{Catalogue, Dialect};
 
 /// The active code of each group (by its index in the catalogue's groups);
 /// `None` for a group without a code in force (G74/G75 before either is
@@ -47,13 +47,7 @@ impl Modes {
     /// Puts a modal code in force in its group; block-only codes and codes
     /// outside the groups change nothing.
     pub fn set(&mut self, letter: u8, number: u32) {
-        let letter = char::from(letter);
-        let modal = self.catalogue.code(letter, number).is_none_or(|code| code.modality == Modality::Modal);
-        if !modal {
-            return;
-        }
-        let Some(group) = self.catalogue.group_of(letter, number) else { return };
-        if let Some(index) = self.catalogue.groups.iter().position(|g| std::ptr::eq(g, group)) {
+        if let Some(index) = self.catalogue.modal_group_index(char::from(letter), number) {
             self.active[index] = Some(number);
         }
     }

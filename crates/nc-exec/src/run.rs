@@ -421,10 +421,10 @@ struct Batches {
 }
 
 impl Batches {
-    /// Sends `full` on, with an emptied batch in its place.
-    fn send(&mut self, full: &mut Vec<Step>) {
+    /// Sends the gathered batch on, with an emptied one in its place.
+    fn send(&mut self) {
         let next = self.emptied.try_recv().unwrap_or_else(|_| Vec::with_capacity(DELIVERY_BATCH));
-        let full = std::mem::replace(full, next);
+        let full = std::mem::replace(&mut self.batch, next);
         // A sink that panicked has closed the channel: the join says so.
         let _ = self.sender.send(full);
     }
@@ -434,16 +434,16 @@ impl StepSink for Batches {
     fn step(&mut self, step: Step) {
         self.batch.push(step);
         if self.batch.len() == DELIVERY_BATCH {
-            let mut full = std::mem::take(&mut self.batch);
-            self.send(&mut full);
-            self.batch = full;
+            self.send();
         }
     }
 
-    /// A whole batch goes as it is, without copying its steps.
+    /// A whole batch goes as it is, without copying its steps; `steps`
+    /// gets an emptied batch's room.
     fn steps(&mut self, steps: &mut Vec<Step>) {
         if self.batch.is_empty() {
-            self.send(steps);
+            std::mem::swap(&mut self.batch, steps);
+            self.send();
         } else {
             steps.drain(..).for_each(|step| self.step(step));
         }
@@ -451,7 +451,7 @@ impl StepSink for Batches {
 }
 
 /// Steps a streaming run gathers before it hands them on.
-const DELIVERY_BATCH: usize = 256;
+const DELIVERY_BATCH: usize = 1024;
 
 fn run_in<'a, 's>(
     scope: &'s Scope<'s, 'a>,
@@ -621,8 +621,7 @@ fn run_in<'a, 's>(
             },
         };
         // Only another file's blocks can end without a way back.
-        let leaves_file =
-            |index: &mut Index<'_, '_>| index.complete().blocks.get(at).is_none_or(|block| block.source != source);
+        let leaves_file = |index: &mut Index<'_, '_>| index.complete().block(at).is_none_or(|(_, file)| file != source);
         if source != 0 && passes_on && leaves_file(&mut index) {
             runner.finding(range, "the macrocycle file ends without G70", true);
             break;
@@ -667,24 +666,23 @@ struct Call {
 }
 
 /// The blocks of the program and the macrocycle files loaded so far, one
-/// index space.
+/// index space. A block is kept as where it is and lowered again each time
+/// it runs, so that a program of a million blocks costs little more memory
+/// than its text: plain blocks are read from the text, others from their
+/// syntax tree.
 #[derive(Default)]
 struct Blocks<'a> {
-    blocks: Vec<Block>,
+    /// Each block's text range in its file.
+    ranges: Vec<TextRange>,
+    /// The first block of each file, in file order.
+    file_starts: Vec<usize>,
+    /// The syntax trees of the blocks the plain reader does not read, by
+    /// block, in block order (few in CAM output).
+    trees: Vec<(usize, GreenNode)>,
     units: Units,
     /// The text of each file added so far.
     texts: Vec<Cow<'a, str>>,
     plain: PlainReader,
-}
-
-/// A block as the run keeps it: where it is, lowered again each time it
-/// runs, so that a program of a million blocks costs little more memory
-/// than its text. Plain blocks are read from the text, others from their
-/// syntax tree.
-struct Block {
-    source: usize,
-    range: TextRange,
-    tree: Option<GreenNode>,
 }
 
 impl<'a> Blocks<'a> {
@@ -702,35 +700,42 @@ impl<'a> Blocks<'a> {
         text: Cow<'a, str>,
         mut each: impl FnMut(TextRange, &mut BlockData, bool),
     ) -> Option<usize> {
-        let first = self.blocks.len();
-        let source = self.texts.len();
+        let first = self.ranges.len();
         let mut opens_with_g79 = false;
         let expected = expected_blocks(&text);
-        self.blocks.reserve(expected);
+        self.ranges.reserve(expected);
         self.units.unit_of.reserve(expected);
         self.units.numbers.reserve(expected);
+        self.file_starts.push(first);
         let mut reader = BlockReader::new(&text);
         let mut data = BlockData::default();
         while let Some((range, tree)) = reader.next_into(&mut data) {
-            let index = self.blocks.len();
+            let index = self.ranges.len();
             opens_with_g79 |= index == first && data.has_code(b'G', 79);
-            let starts_subprogram = self.units.add(index, source, &data, index == first);
-            self.blocks.push(Block { source, range, tree });
+            let starts_subprogram = self.units.add(index, self.texts.len(), &data, index == first);
+            self.ranges.push(range);
+            self.trees.extend(tree.map(|tree| (index, tree)));
             each(range, &mut data, starts_subprogram);
         }
         self.units.numbers.sort_unstable();
         self.texts.push(text);
-        (first < self.blocks.len()).then_some(if opens_with_g79 { first + 1 } else { first })
+        (first < self.ranges.len()).then_some(if opens_with_g79 { first + 1 } else { first })
+    }
+
+    /// The range and the file of block `index`.
+    fn block(&self, index: usize) -> Option<(TextRange, usize)> {
+        let range = *self.ranges.get(index)?;
+        Some((range, self.file_starts.partition_point(|&start| start <= index) - 1))
     }
 
     /// Lowers block `index` into `data`.
     fn lower(&self, index: usize, data: &mut BlockData) {
-        let block = &self.blocks[index];
-        match &block.tree {
-            Some(tree) => *data = BlockData::lower(tree),
-            None => {
-                let range = Range::<usize>::from(block.range);
-                let read = self.plain.lower(&self.texts[block.source], range.start, range.end, data);
+        match self.trees.binary_search_by_key(&index, |&(at, _)| at) {
+            Ok(tree) => *data = BlockData::lower(&self.trees[tree].1),
+            Err(_) => {
+                let Some((range, source)) = self.block(index) else { return };
+                let range = Range::<usize>::from(range);
+                let read = self.plain.lower(&self.texts[source], range.start, range.end, data);
                 debug_assert_eq!(read, Some(range.end), "a plain block reads alike every time");
             }
         }
@@ -832,7 +837,7 @@ impl<'a, 's> Index<'a, 's> {
         if let Some(streamed) = self.streamed(at) {
             return Some((streamed.range, 0));
         }
-        self.complete().blocks.get(at).map(|block| (block.range, block.source))
+        self.complete().block(at)
     }
 
     fn starts_subprogram(&mut self, at: usize) -> bool {
@@ -881,10 +886,11 @@ struct Units {
     starts: Vec<(usize, usize, u32)>,
     /// The unit of each block (each file's first unit is its main body or
     /// macrocycle body, then one per subprogram).
-    unit_of: Vec<usize>,
-    /// Block numbers with their block, sorted.
-    numbers: Vec<(u64, usize)>,
-    units: usize,
+    unit_of: Vec<u32>,
+    /// Block numbers with their block, sorted; only numbers a jump can
+    /// name (`L` is at most 4 digits), in a million-block program's index.
+    numbers: Vec<(u32, u32)>,
+    units: u32,
 }
 
 impl Units {
@@ -906,7 +912,8 @@ impl Units {
             self.starts.extend(label.map(|label| (index, source, label)));
         }
         self.unit_of.push(self.units);
-        if let Some(number) = block.number.and_then(|number| number.value) {
+        let number = block.number.and_then(|number| u32::try_from(number.value?).ok());
+        if let Some((number, index)) = number.zip(u32::try_from(index).ok()) {
             self.numbers.push((number, index));
         }
         self.starts.last().is_some_and(|&(at, _, _)| at == index)
@@ -923,12 +930,12 @@ impl Units {
 
     /// The block numbered `label` in the unit of block `from`.
     fn jump_target(&self, from: usize, label: u32) -> Option<usize> {
-        let (unit, label) = (self.unit_of[from], u64::from(label));
+        let unit = self.unit_of[from];
         let first = self.numbers.partition_point(|&(number, _)| number < label);
         self.numbers[first..]
             .iter()
             .take_while(|&&(number, _)| number == label)
-            .map(|&(_, at)| at)
+            .map(|&(_, at)| at as usize)
             .find(|&at| self.unit_of[at] == unit)
     }
 }

@@ -125,7 +125,11 @@ impl Decimal {
     /// The value as written (decimal point respected, no unit applied).
     pub fn to_f64(&self) -> f64 {
         let magnitude = match self.mantissa {
-            Some(m) => m as f64 / 10f64.powi(i32::from(self.frac_digits)),
+            Some(m) => {
+                const POWERS: [f64; 10] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
+                let divisor = POWERS.get(usize::from(self.frac_digits)).copied();
+                m as f64 / divisor.unwrap_or_else(|| 10f64.powi(i32::from(self.frac_digits)))
+            }
             None => f64::INFINITY,
         };
         if self.sign == Some(Sign::Minus) { -magnitude } else { magnitude }
