@@ -197,6 +197,11 @@ impl<'a> BlockReader<'a> {
         BlockReader { text, plain: PlainReader::default(), parser, at: body.start, end: body.end }
     }
 
+    /// Goes on at byte `at` (a block's start) when that is further on.
+    pub fn skip_to(&mut self, at: usize) {
+        self.at = self.at.max(at);
+    }
+
     /// Lowers the next block into `data` (reusing its buffers); returns
     /// its range, and its syntax tree when it is not plain.
     pub fn next_into(&mut self, data: &mut BlockData) -> Option<(TextRange, Option<GreenNode>)> {

@@ -12,6 +12,13 @@ pub struct Modes {
     active: Vec<Option<u32>>,
 }
 
+impl PartialEq for Modes {
+    /// The same codes in force (of the same catalogue).
+    fn eq(&self, other: &Modes) -> bool {
+        std::ptr::eq(self.catalogue, other.catalogue) && self.active == other.active
+    }
+}
+
 /// A group, resolved once by its id (`G0`, `M2`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Group(usize);

@@ -34,14 +34,14 @@
 
 use std::{
     borrow::Cow,
-    ops::Range,
+    ops::{ControlFlow, Range},
     sync::mpsc::{self, Receiver},
     thread::{Scope, ScopedJoinHandle},
 };
 
 use nalgebra::{Point2, Vector2};
 use ncc_catalog::{AddressRole, Catalogue, Dialect};
-use ncc_syntax::TextRange;
+use ncc_syntax::{TextRange, TextSize};
 use rowan::GreenNode;
 use smallvec::SmallVec;
 
@@ -354,7 +354,7 @@ pub enum Called {
 /// needed, and the run reports its progress there. Parameters start at
 /// zero.
 pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget: usize) -> Trace {
-    std::thread::scope(|scope| run_in(scope, text, files, machine, budget, None))
+    std::thread::scope(|scope| run_in(scope, text, files, machine, budget, None, None))
 }
 
 /// Takes the steps of a run in order, each once no later block can change
@@ -366,6 +366,90 @@ pub trait StepSink {
     fn steps(&mut self, steps: &mut Vec<Step>) {
         steps.drain(..).for_each(|step| self.step(step));
     }
+
+    /// Whether to take a [`Checkpoint`] before block `block`, which starts
+    /// at `offset`; asked only where the run can take one.
+    fn checkpoint_wanted(&mut self, _block: usize, _offset: TextSize) -> bool {
+        false
+    }
+
+    /// Takes the checkpoint asked for, once it has every step before it;
+    /// `Break` ends the run there.
+    fn checkpoint(&mut self, _checkpoint: Checkpoint) -> ControlFlow<()> {
+        ControlFlow::Continue(())
+    }
+}
+
+/// The run between two blocks of the program's main body while it goes
+/// block after block (no call, jump, file or radius compensation in
+/// force): enough to run on from there, over the same text or one that
+/// differs only before that block. A run resumed from it reports what
+/// happens after it: its trace's findings, messages and tool-centre path
+/// start there.
+#[derive(Clone)]
+pub struct Checkpoint {
+    runner: Box<Runner>,
+    /// The next block, and where it starts.
+    block: usize,
+    offset: TextSize,
+    /// Blocks run before it, for the step budget.
+    executed: usize,
+}
+
+impl std::fmt::Debug for Checkpoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Checkpoint")
+            .field("block", &self.block)
+            .field("offset", &self.offset)
+            .field("executed", &self.executed)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Checkpoint {
+    /// Where the next block starts.
+    pub fn offset(&self) -> TextSize {
+        self.offset
+    }
+
+    /// The index of the next block in the program.
+    pub fn block(&self) -> usize {
+        self.block
+    }
+
+    /// Steps the run made before it.
+    pub fn steps(&self) -> usize {
+        self.runner.delivered
+    }
+
+    /// Whether a run from here goes on as one from `other` does over the
+    /// same text after their offsets: the same modes, position,
+    /// parameters, tables and frames; the blocks and steps before them and
+    /// what was reported may differ.
+    pub fn same_course(&self, other: &Checkpoint) -> bool {
+        self.runner.same_course(&other.runner)
+    }
+
+    /// This checkpoint in a text where its block starts `text` bytes
+    /// later, after `blocks` more blocks and `steps` more steps.
+    pub fn shifted(&self, text: i64, blocks: i64, steps: i64) -> Checkpoint {
+        let mut shifted = self.clone();
+        shifted.offset = shift_offset(self.offset, text);
+        shifted.block = shift_count(self.block, blocks);
+        shifted.executed = shift_count(self.executed, blocks);
+        shifted.runner.delivered = shift_count(self.runner.delivered, steps);
+        shifted
+    }
+}
+
+/// `offset` moved by `by` bytes, held inside the text's range.
+pub fn shift_offset(offset: TextSize, by: i64) -> TextSize {
+    TextSize::from(u32::try_from((i64::from(u32::from(offset)) + by).max(0)).unwrap_or(u32::MAX))
+}
+
+/// `count` moved by `by`, never below zero.
+pub fn shift_count(count: usize, by: i64) -> usize {
+    usize::try_from((count as i64 + by).max(0)).unwrap_or(usize::MAX)
 }
 
 /// Like [`run`], handing the steps to `sink` as they are final instead of
@@ -378,7 +462,21 @@ pub fn run_into(
     budget: usize,
     sink: &mut dyn StepSink,
 ) -> Trace {
-    std::thread::scope(|scope| run_in(scope, text, files, machine, budget, Some(sink)))
+    std::thread::scope(|scope| run_in(scope, text, files, machine, budget, Some(sink), None))
+}
+
+/// Like [`run_into`], from `checkpoint` (a checkpoint of a run on the
+/// same machine over a text that differs from `text` only after it), or
+/// from the start without one.
+pub fn resume_into(
+    checkpoint: Option<&Checkpoint>,
+    text: &str,
+    files: &dyn Environment,
+    machine: &MachineConfig,
+    budget: usize,
+    sink: &mut dyn StepSink,
+) -> Trace {
+    std::thread::scope(|scope| run_in(scope, text, files, machine, budget, Some(sink), checkpoint))
 }
 
 /// Like [`run_into`], with `sink` on a thread of its own, so that what it
@@ -402,7 +500,7 @@ pub fn run_beside<S: StepSink + Send>(
             sink
         });
         let mut handing = Batches { batch: Vec::with_capacity(DELIVERY_BATCH), sender, emptied };
-        let trace = run_in(scope, text, files, machine, budget, Some(&mut handing));
+        let trace = run_in(scope, text, files, machine, budget, Some(&mut handing), None);
         let Batches { batch, sender, .. } = handing;
         // The sink's thread ends when the last batch is in and the channel
         // closes.
@@ -460,10 +558,19 @@ fn run_in<'a, 's>(
     machine: &MachineConfig,
     budget: usize,
     mut sink: Option<&mut dyn StepSink>,
+    checkpoint: Option<&Checkpoint>,
 ) -> Trace {
-    let mut index = Index::start(scope, text);
-    let mut runner = Runner::new(machine);
-    let reset_frame = runner.frame_in_force();
+    let fresh = Runner::new(std::sync::Arc::new(machine.clone()));
+    let reset_frame = fresh.frame_in_force();
+    let (mut runner, mut index, mut at, mut executed) = match checkpoint {
+        Some(checkpoint) if *checkpoint.runner.machine == *machine => (
+            (*checkpoint.runner).clone(),
+            Index::start(scope, text, Some((checkpoint.offset, checkpoint.block))),
+            checkpoint.block,
+            checkpoint.executed,
+        ),
+        _ => (fresh, Index::start(scope, text, None), 0, 0),
+    };
     // Most programs run each block about once.
     runner.steps.reserve(if sink.is_some() { DELIVERY_BATCH } else { expected_blocks(text) });
     // Macrocycle numbers called, and where each file's body starts; the
@@ -476,12 +583,27 @@ fn run_in<'a, 's>(
     let mut calls: Vec<Call> = Vec::new();
     // Jumps taken so far from each jump block, until its count runs out.
     let mut jumps: std::collections::HashMap<usize, u32> = Default::default();
-    let mut at = 0;
-    let mut executed = 0;
     // The rest of a block whose cycle of the cycle file has just run.
     let mut resume: Option<Flow> = None;
     let mut data = BlockData::default();
     while let Some((range, source)) = index.block(at) {
+        if let Some(sink) = sink.as_deref_mut()
+            && source == 0
+            && resume.is_none()
+            && calls.is_empty()
+            && jumps.is_empty()
+            && called.is_empty()
+            && runner.compensator.is_none()
+            && index.streams(at)
+            && sink.checkpoint_wanted(at, range.start())
+        {
+            runner.deliver(sink, false);
+            let checkpoint =
+                Checkpoint { runner: Box::new(runner.for_checkpoint()), block: at, offset: range.start(), executed };
+            if sink.checkpoint(checkpoint).is_break() {
+                break;
+            }
+        }
         runner.source = source;
         if resume.is_none() && calls.is_empty() && index.starts_subprogram(at) {
             runner.finding(range, "the main body runs into a subprogram: it has no M02 or M30 before it", false);
@@ -690,14 +812,16 @@ impl<'a> Blocks<'a> {
     /// the `G79` a macrocycle file opens with), `None` for a file without
     /// blocks.
     fn add(&mut self, text: Cow<'a, str>) -> Option<usize> {
-        self.add_reading(text, |_, _, _| {})
+        self.add_reading(text, 0, |_, _, _| {})
     }
 
     /// Like [`Blocks::add`], and gives `each` each block as it is lowered,
-    /// with whether it starts a subprogram.
+    /// with whether it starts a subprogram; reads from byte `from` on (a
+    /// block's start).
     fn add_reading(
         &mut self,
         text: Cow<'a, str>,
+        from: usize,
         mut each: impl FnMut(TextRange, &mut BlockData, bool),
     ) -> Option<usize> {
         let first = self.ranges.len();
@@ -708,6 +832,7 @@ impl<'a> Blocks<'a> {
         self.units.numbers.reserve(expected);
         self.file_starts.push(first);
         let mut reader = BlockReader::new(&text);
+        reader.skip_to(from);
         let mut data = BlockData::default();
         while let Some((range, tree)) = reader.next_into(&mut data) {
             let index = self.ranges.len();
@@ -762,6 +887,11 @@ enum Index<'a, 's> {
 }
 
 struct Stream<'a, 's> {
+    /// The program, and whether the stream starts at a checkpoint after
+    /// its first block (the index pass then indexes the blocks after it
+    /// only).
+    text: &'a str,
+    resumed: bool,
     batches: Receiver<Vec<Streamed>>,
     /// Batches taken, back to the index pass with the run's spent block
     /// data, whose room it fills again.
@@ -782,7 +912,10 @@ struct Streamed {
 }
 
 impl<'a, 's> Index<'a, 's> {
-    fn start(scope: &'s Scope<'s, 'a>, text: &'a str) -> Index<'a, 's> {
+    /// Starts the index pass over `text`, from the start or from `from`:
+    /// a block's offset and index.
+    fn start(scope: &'s Scope<'s, 'a>, text: &'a str, from: Option<(TextSize, usize)>) -> Index<'a, 's> {
+        let (offset, first) = from.map_or((0, 0), |(offset, block)| (usize::from(offset), block));
         let (sender, batches) = mpsc::sync_channel::<Vec<Streamed>>(4);
         let (taken_batches, returned) = mpsc::sync_channel::<Vec<Streamed>>(4);
         let index_pass = scope.spawn(move || {
@@ -792,7 +925,7 @@ impl<'a, 's> Index<'a, 's> {
             let mut spent: Vec<Streamed> = Vec::new();
             // Until the run stops taking blocks in order.
             let mut streaming = true;
-            blocks.add_reading(Cow::Borrowed(text), |range, data, starts_subprogram| {
+            blocks.add_reading(Cow::Borrowed(text), offset, |range, data, starts_subprogram| {
                 if streaming {
                     let room = spent.pop().map(|spent| spent.data).unwrap_or_default();
                     batch.push(Streamed { range, data: std::mem::replace(data, room), starts_subprogram });
@@ -813,7 +946,23 @@ impl<'a, 's> Index<'a, 's> {
             }
             blocks
         });
-        Index::Streaming(Stream { batches, taken_batches, batch: Vec::new(), taken: 0, next: 0, index_pass })
+        let resumed = first > 0;
+        Index::Streaming(Stream {
+            text,
+            resumed,
+            batches,
+            taken_batches,
+            batch: Vec::new(),
+            taken: 0,
+            next: first,
+            index_pass,
+        })
+    }
+
+    /// Whether block `at` comes from the stream: the run goes block after
+    /// block.
+    fn streams(&self, at: usize) -> bool {
+        matches!(self, Index::Streaming(stream) if stream.next == at)
     }
 
     /// The block at `at`, when it was streamed.
@@ -869,7 +1018,12 @@ impl<'a, 's> Index<'a, 's> {
             };
             // The index pass stops streaming and finishes the index.
             drop(stream.batches);
-            let blocks = stream.index_pass.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            let mut blocks = stream.index_pass.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            if stream.resumed {
+                // Jumps and calls may go to blocks before the checkpoint.
+                blocks = Blocks::default();
+                blocks.add(Cow::Borrowed(stream.text));
+            }
             *self = Index::Complete(blocks);
         }
         match self {
@@ -968,11 +1122,12 @@ enum Flow {
 }
 
 /// The control's state while a program runs.
-struct Runner<'a> {
+#[derive(Clone)]
+struct Runner {
     catalogue: &'static Catalogue,
     /// The file of the block being run.
     source: usize,
-    machine: &'a MachineConfig,
+    machine: std::sync::Arc<MachineConfig>,
     modes: Modes,
     groups: Groups,
     /// F as programmed; its unit follows the feed mode in force.
@@ -1034,14 +1189,13 @@ struct Runner<'a> {
 /// Tolerance of the arc end point's distance from the centre (1 µm, 01 §6.4).
 const ARC_TOLERANCE: f64 = 0.001;
 
-impl<'a> Runner<'a> {
-    fn new(machine: &'a MachineConfig) -> Self {
+impl Runner {
+    fn new(machine: std::sync::Arc<MachineConfig>) -> Self {
         // The priority block: G01 G17 G90 G94 F0 S0 M05 ….
         let modes = Modes::reset();
         Runner {
             catalogue: Dialect::Cnc8x6.catalogue(),
             source: 0,
-            machine,
             groups: Groups::of(&modes),
             modes,
             feed: None,
@@ -1052,7 +1206,7 @@ impl<'a> Runner<'a> {
             css_setting: machine.decade(329, 3),
             length_setting: machine.decade(329, 7),
             compensator: None,
-            compensation: Settings::of(machine),
+            compensation: Settings::of(&machine),
             tool_centre: Vec::new(),
             compensated: Vec::new(),
             messages: Vec::new(),
@@ -1073,7 +1227,85 @@ impl<'a> Runner<'a> {
             tool: None,
             tools: Vec::new(),
             reported: Vec::new(),
+            machine,
         }
+    }
+
+    /// A copy to go on from, without what the run reported so far.
+    fn for_checkpoint(&self) -> Runner {
+        let mut copy = self.clone();
+        copy.findings.clear();
+        copy.messages.clear();
+        copy.tool_centre.clear();
+        copy.compensated.clear();
+        copy.tools.clear();
+        copy
+    }
+
+    /// See [`Checkpoint::same_course`].
+    fn same_course(&self, other: &Runner) -> bool {
+        // Every field named, so that a new one must be placed here.
+        let Runner {
+            catalogue: _,
+            source,
+            machine,
+            modes,
+            groups: _,
+            feed,
+            speed,
+            in_cycle,
+            compensator,
+            compensation: _,
+            messages: _,
+            tool_centre: _,
+            compensated: _,
+            css_setting: _,
+            length_setting: _,
+            offsets,
+            corrections,
+            correction,
+            length_digits,
+            length_shift,
+            recalculation,
+            transformations,
+            diameter,
+            frames,
+            speed_limit,
+            speed_reached,
+            position,
+            params,
+            steps,
+            delivered: _,
+            findings: _,
+            tool,
+            tools: _,
+            reported,
+        } = self;
+        *source == other.source
+            && **machine == *other.machine
+            && *modes == other.modes
+            && *feed == other.feed
+            && *speed == other.speed
+            && *in_cycle == other.in_cycle
+            && compensator.is_none()
+            && other.compensator.is_none()
+            && *offsets == other.offsets
+            && *corrections == other.corrections
+            && *correction == other.correction
+            && *length_digits == other.length_digits
+            && *length_shift == other.length_shift
+            && *recalculation == other.recalculation
+            && *transformations == other.transformations
+            && *diameter == other.diameter
+            && *frames == other.frames
+            && *speed_limit == other.speed_limit
+            && *speed_reached == other.speed_reached
+            && *position == other.position
+            && *params == other.params
+            && steps.is_empty()
+            && other.steps.is_empty()
+            && *tool == other.tool
+            && *reported == other.reported
     }
 
     fn block(&mut self, block: &BlockData, range: TextRange) -> Flow {
@@ -1214,7 +1446,7 @@ impl<'a> Runner<'a> {
         // Assignments and arithmetic take effect after the block's motion.
         arith::assign(block, &mut self.params);
         let mut machine = ProgramMachine {
-            machine: self.machine,
+            machine: &self.machine,
             position: &self.position,
             frame: &self.frames[self.frames.len() - 1],
             offsets: &mut self.offsets,
@@ -1228,7 +1460,7 @@ impl<'a> Runner<'a> {
                 correction: self.correction,
             },
         };
-        match arith::compute(block, &mut self.params, &mut machine, self.machine) {
+        match arith::compute(block, &mut self.params, &mut machine, &self.machine) {
             BlockArithmetic::None | BlockArithmetic::Ran { result: Ok(()), .. } => {}
             BlockArithmetic::UnknownWord => {
                 let message =
@@ -2040,6 +2272,7 @@ pub(crate) fn slot(axis: u8) -> usize {
 }
 
 /// The groups the run reads, resolved once.
+#[derive(Clone)]
 struct Groups {
     motion: Group,
     joining: Group,
@@ -2194,7 +2427,14 @@ pub(crate) fn round3(value: f64) -> f64 {
 mod tests {
     use std::f64::consts::PI;
 
-    use super::{Axes, Called, Environment, Motion, NoFiles, Path, Step, StepSink, Stop, Trace, round3, run, run_into};
+    use std::ops::ControlFlow;
+
+    use ncc_syntax::TextSize;
+
+    use super::{
+        Axes, Called, Checkpoint, DELIVERY_BATCH, Environment, Motion, NoFiles, Path, Step, StepSink, Stop, Trace,
+        resume_into, round3, run, run_into,
+    };
     use crate::machine::MachineConfig;
 
     impl StepSink for Vec<Step> {
@@ -2208,18 +2448,100 @@ mod tests {
         // A compensated contour longer than a delivery batch, whose steps
         // compensation fixes a block late, then a loop of a subprogram.
         let mut text = String::from("%1\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\n");
-        for i in 0..600 {
+        for i in 0..2200 {
             text.push_str(&format!("N{} X{} Y{}\n", 4 + i, (i + 1) * 2, (i % 2) * 3));
         }
-        text.push_str("N700 G40 X1300 Y-30\nN701 G71 L5 Q40\nN702 M30\nN703 G79 L5\nN704 G91 X1\nN705 G90 G70\n");
-        let kept = run_text(&text);
+        text.push_str("N3000 G40 X5000 Y-30\nN3001 G71 L5 Q40\nN3002 M30\nN3003 G79 L5\nN3004 G91 X1\nN3005 G90 G70\n");
+        let kept = run(&text, &NoFiles, &MachineConfig::default(), 10_000);
         assert!(kept.findings.is_empty(), "{:?}", kept.findings);
-        assert!(kept.steps.len() > 2 * 256);
+        assert!(kept.steps.len() > 2 * DELIVERY_BATCH);
         let mut streamed = Vec::new();
-        let trace = run_into(&text, &NoFiles, &MachineConfig::default(), 1000, &mut streamed);
+        let trace = run_into(&text, &NoFiles, &MachineConfig::default(), 10_000, &mut streamed);
         assert!(trace.steps.is_empty());
         assert_eq!(streamed, kept.steps);
         assert_eq!(Trace { steps: streamed, ..trace }, kept);
+    }
+
+    /// The steps of a run after its first `before`, and a checkpoint
+    /// every `every` blocks (none for 0).
+    #[derive(Default)]
+    struct Checkpoints {
+        before: usize,
+        steps: Vec<Step>,
+        taken: Vec<Checkpoint>,
+        every: usize,
+    }
+
+    impl StepSink for Checkpoints {
+        fn step(&mut self, step: Step) {
+            self.steps.push(step);
+        }
+
+        fn checkpoint_wanted(&mut self, block: usize, _offset: TextSize) -> bool {
+            self.every > 0 && block % self.every == 0
+        }
+
+        fn checkpoint(&mut self, checkpoint: Checkpoint) -> ControlFlow<()> {
+            assert_eq!(checkpoint.steps(), self.before + self.steps.len(), "every step before it is handed on");
+            self.taken.push(checkpoint);
+            ControlFlow::Continue(())
+        }
+    }
+
+    /// Modal state, a parameter and a zero offset set early, then blocks
+    /// in order, then a jump back and a subprogram call.
+    fn resumable_program(first_x: &str) -> String {
+        let mut text = format!("%1\nN1 G54 G90 G00 X{first_x} Y0 Z5 M03 S1000\nN2 R10=5.\nN3 G01 Z-1 F300\n");
+        for i in 0..40 {
+            text.push_str(&format!("N{} X{} YR10\n", 4 + i, i * 3));
+        }
+        text.push_str("N60 G91 X2\nN61 G90 G73 L30 Q2\nN62 G71 L7 Q2\nN63 M30\n");
+        text.push_str("N70 G79 L7\nN71 G91 X1\nN72 G90 G70\n");
+        text
+    }
+
+    #[test]
+    fn a_run_resumed_from_a_checkpoint_goes_on_as_the_whole_run() {
+        let machine = MachineConfig::default();
+        let text = resumable_program("0");
+        let mut whole = Checkpoints { every: 7, ..Checkpoints::default() };
+        let trace = resume_into(None, &text, &NoFiles, &machine, 10_000, &mut whole);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        // Blocks 0, 7, …, 42: none once the jump has run.
+        assert_eq!(whole.taken.iter().map(Checkpoint::block).collect::<Vec<_>>(), [0, 7, 14, 21, 28, 35, 42]);
+        for checkpoint in &whole.taken {
+            let mut resumed = Checkpoints { before: checkpoint.steps(), every: 7, ..Checkpoints::default() };
+            let trace = resume_into(Some(checkpoint), &text, &NoFiles, &machine, 10_000, &mut resumed);
+            assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+            assert_eq!(resumed.steps, whole.steps[checkpoint.steps()..], "from block {}", checkpoint.block());
+            let later: Vec<_> = whole.taken.iter().filter(|c| c.block() >= checkpoint.block()).collect();
+            assert_eq!(resumed.taken.len(), later.len());
+            for (again, first) in resumed.taken.iter().zip(later) {
+                assert!(again.same_course(first) && again.offset() == first.offset());
+            }
+        }
+    }
+
+    #[test]
+    fn checkpoints_after_an_edit_take_the_same_course_once_the_edit_no_longer_matters() {
+        let machine = MachineConfig::default();
+        let checkpoints = |text: &str| {
+            let mut sink = Checkpoints { every: 7, ..Checkpoints::default() };
+            resume_into(None, text, &NoFiles, &machine, 10_000, &mut sink);
+            sink.taken
+        };
+        let before = checkpoints(&resumable_program("0"));
+        // An absolute move written longer: the course is the same from the
+        // next move on, three bytes later.
+        let after = checkpoints(&resumable_program("1234"));
+        for (after, before) in after.iter().zip(&before).skip(1) {
+            let shifted = before.shifted(3, 0, 0);
+            assert_eq!(after.offset(), shifted.offset());
+            assert!(after.same_course(&shifted));
+        }
+        // Incremental coordinates carry the difference to the end.
+        let incremental = checkpoints(&resumable_program("0").replace("N3 G01", "N3 G91 G01"));
+        assert!(incremental.iter().zip(&before).skip(1).all(|(after, before)| !after.same_course(before)));
     }
 
     fn run_text(text: &str) -> Trace {

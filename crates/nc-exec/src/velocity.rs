@@ -23,12 +23,14 @@
 //! R236 under continuity, R52 for other working feed and R237 for rapid;
 //! threads (G33) run without ramps.
 
-use std::collections::VecDeque;
+use std::{collections::VecDeque, ops::ControlFlow};
+
+use ncc_syntax::{TextRange, TextSize};
 
 use crate::{
     envelope::{Envelope, EnvelopeMove, Limit, MoveKind, Planned, Planner},
     machine::MachineConfig,
-    run::{Axes, Joining, MAX_AXES, Motion, Path, Step, StepSink, Trace},
+    run::{Axes, Checkpoint, Joining, MAX_AXES, Motion, Path, Step, StepSink, Trace, shift_count, shift_offset},
 };
 
 /// The interpolator tick of the CNC8x6 (000:2749).
@@ -307,7 +309,7 @@ impl Timing {
 }
 
 /// A move as the model sees it, speeds in mm/s.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 struct Move {
     length: f64,
     /// The programmed speed, and the speed the move may run at.
@@ -340,6 +342,17 @@ pub trait TimingSink {
     fn speed_break(&mut self, step: &Step, speed_break: Break);
     /// The next step and its profile.
     fn timed(&mut self, step: &Step, profile: Profile);
+
+    /// See [`StepSink::checkpoint_wanted`].
+    fn checkpoint_wanted(&mut self, _block: usize, _offset: TextSize) -> bool {
+        false
+    }
+
+    /// A checkpoint of the run with the model's state there, which
+    /// [`Timer::resume`] goes on from; see [`StepSink::checkpoint`].
+    fn checkpoint(&mut self, _run: Checkpoint, _model: TimerState) -> ControlFlow<()> {
+        ControlFlow::Continue(())
+    }
 }
 
 impl TimingSink for Timing {
@@ -388,7 +401,7 @@ enum Model {
 }
 
 /// The CNC8x6 one-block look-ahead.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone, PartialEq)]
 struct OneBlock {
     /// The last step pushed, whose exit the next step decides, and the
     /// speed it enters at.
@@ -617,10 +630,71 @@ impl<S: TimingSink> StepSink for Timer<'_, S> {
     fn step(&mut self, step: Step) {
         self.push(step);
     }
+
+    /// Only the CNC8x6 model goes on from checkpoints; the envelope
+    /// velocity's window is not kept.
+    fn checkpoint_wanted(&mut self, block: usize, offset: TextSize) -> bool {
+        matches!(self.model, Model::OneBlock(_)) && self.sink.checkpoint_wanted(block, offset)
+    }
+
+    fn checkpoint(&mut self, checkpoint: Checkpoint) -> ControlFlow<()> {
+        match &self.model {
+            Model::OneBlock(model) => {
+                let state = TimerState { count: self.count, end: self.end, model: model.clone() };
+                self.sink.checkpoint(checkpoint, state)
+            }
+            Model::Envelope(_) => ControlFlow::Continue(()),
+        }
+    }
+}
+
+/// The CNC8x6 model between two steps: the steps it holds, and how many
+/// came before.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimerState {
+    count: usize,
+    end: Axes,
+    model: OneBlock,
+}
+
+impl TimerState {
+    /// This state in a text where its steps' blocks start `text` bytes
+    /// later, after `steps` more steps.
+    pub fn shifted(&self, text: i64, steps: i64) -> TimerState {
+        let mut shifted = self.clone();
+        shifted.count = shift_count(self.count, steps);
+        let move_step = |step: &mut Step| {
+            step.range = TextRange::new(shift_offset(step.range.start(), text), shift_offset(step.range.end(), text));
+        };
+        if let Some((step, _)) = &mut shifted.model.current {
+            move_step(step);
+        }
+        if let Some(waiting) = &mut shifted.model.waiting {
+            move_step(&mut waiting.step);
+            waiting.index = shift_count(waiting.index, steps);
+        }
+        shifted
+    }
+
+    /// Whether the model goes on from here as from `other`, whose steps'
+    /// blocks start `text` bytes earlier.
+    pub fn same_course(&self, other: &TimerState, text: i64) -> bool {
+        let steps = self.count as i64 - other.count as i64;
+        *self == other.shifted(text, steps)
+    }
+}
+
+impl<'a, S: TimingSink> Timer<'a, S> {
+    /// A timer that goes on from `state`, taken at a checkpoint of a run
+    /// on the same machine.
+    pub fn resume(axes: &'a [u8], dynamics: &'a Dynamics, state: TimerState, sink: S) -> Self {
+        let TimerState { count, end, model } = state;
+        Timer { axes, dynamics, sink, count, end, model: Model::OneBlock(model) }
+    }
 }
 
 /// A move with the speeds it enters and leaves at.
-#[derive(Debug)]
+#[derive(Debug, Clone, PartialEq)]
 struct Timed {
     index: usize,
     step: Step,
