@@ -96,6 +96,21 @@ impl Totals {
         self.length[motion as usize]
     }
 
+    /// These totals of a run whose part up to a point summed to `from`,
+    /// after that part changed to sum to `to`.
+    pub fn moved(&self, from: &Totals, to: &Totals) -> Totals {
+        let shift = |value: f64, from: f64, to: f64| value - from + to;
+        let count = |value: usize, from: usize, to: usize| (value + to).saturating_sub(from);
+        Totals {
+            total_time: shift(self.total_time, from.total_time, to.total_time),
+            programmed_time: shift(self.programmed_time, from.programmed_time, to.programmed_time),
+            time: std::array::from_fn(|i| shift(self.time[i], from.time[i], to.time[i])),
+            length: std::array::from_fn(|i| shift(self.length[i], from.length[i], to.length[i])),
+            program_stops: count(self.program_stops, from.program_stops, to.program_stops),
+            optional_stops: count(self.optional_stops, from.optional_stops, to.optional_stops),
+        }
+    }
+
     /// Counts `step`, which took `duration` seconds.
     pub fn add(&mut self, step: &Step, duration: f64) {
         self.total_time += duration;
@@ -415,6 +430,11 @@ impl Checkpoint {
     /// The index of the next block in the program.
     pub fn block(&self) -> usize {
         self.block
+    }
+
+    /// The machine the run ran on.
+    pub fn machine(&self) -> &MachineConfig {
+        &self.runner.machine
     }
 
     /// Steps the run made before it.

@@ -9,11 +9,11 @@
 //! The run needs no database: [`RunInput`] takes what it reads from a
 //! snapshot, so a long run never holds one (an edit would wait for it).
 
-use std::{fmt::Write as _, sync::Arc};
+use std::{fmt::Write as _, ops::ControlFlow, sync::Arc};
 
 use nc_exec::{
-    run::{Environment, Motion, Step, Totals},
-    velocity::{self, Break, Dynamics, Reason, Timer, TimingSink},
+    run::{Checkpoint, Environment, Motion, Step, Totals, shift_count, shift_offset},
+    velocity::{self, Break, Dynamics, Reason, Timer, TimerState, TimingSink},
 };
 use ncc_syntax::{TextRange, TextSize, ast::AstNode};
 use rustc_hash::FxHashMap;
@@ -39,13 +39,21 @@ pub enum CycleTimeHints {
 
 /// A program's predicted run, per block of the file and in total. Owned
 /// and self-contained, so that a later estimate can start from it.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default)]
 pub struct Estimate {
     /// The blocks of the file that ran, in the order they are written.
     pub blocks: Vec<BlockTime>,
     pub totals: CycleTotals,
     /// Why the run stopped before the program's end, if it did.
     pub stopped: Option<String>,
+    /// The part of the text this estimate's run went through; the rest is
+    /// a previous estimate's.
+    pub rerun: std::ops::Range<TextSize>,
+    /// Where a later estimate may go on from, in text order, and what the
+    /// run read.
+    checkpoints: Vec<Stored>,
+    text: Arc<String>,
+    files: WorkspaceFiles,
 }
 
 /// One block of the file as it ran.
@@ -101,7 +109,7 @@ pub struct RunInput {
 }
 
 /// The macrocycle files and possible cycle files of a workspace.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct WorkspaceFiles {
     macrocycles: FxHashMap<u32, Arc<String>>,
     /// Every other file by its name without directory and extension, for
@@ -151,76 +159,218 @@ pub(crate) fn program_head(db: &dyn Db, file: SourceFile) -> Option<TextRange> {
 }
 
 impl RunInput {
-    pub fn estimate(&self, previous: Option<&Estimate>, edit: Option<TextRange>, budget: usize) -> Estimate {
-        estimate(previous, &self.text, edit, &self.files, &self.machine, budget)
+    /// The estimate of this input; `previous`, an estimate of an earlier
+    /// text of the same file, lets the run resume where the texts part.
+    pub fn estimate(&self, previous: Option<&Estimate>, budget: usize) -> Estimate {
+        estimate(previous, &self.text, &self.files, &self.machine, budget)
     }
 }
 
-/// The one way to an estimate. `previous` is the estimate of the text
-/// before `edit` (the changed range in the new text, `None` when unknown):
-/// they are where a run will resume from a checkpoint before the edit;
-/// for now every estimate runs the program from its start.
+/// Blocks between two checkpoints of a run going block after block: an
+/// edit reruns about this many blocks when the run comes back to the
+/// course it took before.
+const CHECKPOINT_INTERVAL: usize = 1000;
+
+/// The one way to an estimate. With `previous`, the estimate of an earlier
+/// text on the same machine and files, the run resumes from the last
+/// checkpoint before the first changed byte, and stops at the first
+/// checkpoint after the last one where it takes the course it took before:
+/// the rest is the previous estimate's, moved.
 pub fn estimate(
     previous: Option<&Estimate>,
-    text: &str,
-    edit: Option<TextRange>,
-    files: &dyn Environment,
+    text: &Arc<String>,
+    files: &WorkspaceFiles,
     machine: &MachineConfig,
     budget: usize,
 ) -> Estimate {
-    let _resume_from = (previous, edit);
     let dynamics = Dynamics::of(machine);
+    let axes = machine.step_axes();
+    let change = previous.and_then(|previous| Change::between(previous, text, files, machine));
+    let resumed = change.as_ref().and_then(|change| {
+        let previous = change.previous;
+        let index = previous.checkpoints.partition_point(|stored| stored.run.offset() <= change.start);
+        Some((index.checked_sub(1)?, previous))
+    });
+    let rerun_from = resumed.map_or(TextSize::default(), |(index, previous)| previous.checkpoints[index].run.offset());
+    let mut charges = Charges::new(change);
     // The model times the steps as they come: the run keeps none. It runs
     // on the run's thread, leaving the other core to the editor's requests.
-    let mut timer = Timer::new(machine.step_axes(), &dynamics, Charges::default());
-    let trace = nc_exec::run::run_into(text, files, machine, budget, &mut timer);
-    let charges = timer.finish();
-    let mut blocks = charges.blocks;
-    blocks.sort_by_key(|block| block.range.start());
-    let totals = charges.totals;
-    Estimate {
-        blocks,
-        totals: CycleTotals {
-            total: totals.total_time,
-            cutting: totals.time(Motion::Feed),
-            rapid: totals.time(Motion::Rapid),
-            dwell: totals.time(Motion::Dwell),
-            breaks: charges.breaks,
-            lost: charges.lost,
-        },
-        stopped: trace.findings.iter().find(|finding| finding.fatal).map(|finding| finding.message.clone()),
+    let trace = match resumed {
+        Some((index, previous)) => {
+            let stored = &previous.checkpoints[index];
+            charges.resume(previous, index);
+            let mut timer = Timer::resume(axes, &dynamics, stored.model.clone(), charges);
+            let trace = nc_exec::run::resume_into(Some(&stored.run), text, files, machine, budget, &mut timer);
+            charges = timer.finish();
+            trace
+        }
+        None => {
+            let mut timer = Timer::new(axes, &dynamics, charges);
+            let trace = nc_exec::run::run_into(text, files, machine, budget, &mut timer);
+            charges = timer.finish();
+            trace
+        }
+    };
+    let stopped = trace.findings.iter().find(|finding| finding.fatal).map(|finding| finding.message.clone());
+    let mut estimate = charges.into_estimate(text, files, stopped);
+    estimate.rerun.start = rerun_from;
+    estimate
+}
+
+/// How a text differs from the text of a previous estimate: one changed
+/// range, and the rest alike.
+struct Change<'a> {
+    previous: &'a Estimate,
+    /// The changed range starts at `start` in both texts and ends `end`
+    /// bytes before the new text's end.
+    start: TextSize,
+    end: TextSize,
+    /// The new text's length minus the old one's.
+    shift: i64,
+}
+
+impl<'a> Change<'a> {
+    /// `None` when the machine or the files changed, or nothing did.
+    fn between(
+        previous: &'a Estimate,
+        text: &str,
+        files: &WorkspaceFiles,
+        machine: &MachineConfig,
+    ) -> Option<Change<'a>> {
+        if previous.files != *files || previous.checkpoints.first()?.run.machine() != machine {
+            return None;
+        }
+        let (old, new) = (previous.text.as_bytes(), text.as_bytes());
+        let common = old.iter().zip(new).take_while(|(a, b)| a == b).count();
+        let room = old.len().min(new.len()) - common;
+        let common_end = old.iter().rev().zip(new.iter().rev()).take(room).take_while(|(a, b)| a == b).count();
+        let offset = |at: usize| TextSize::try_from(at).ok();
+        Some(Change {
+            previous,
+            start: offset(common)?,
+            end: offset(new.len() - common_end)?,
+            shift: new.len() as i64 - old.len() as i64,
+        })
     }
 }
 
-/// Every step charged to a block of the file as the model times it, and
-/// the sums.
-#[derive(Default)]
-struct Charges {
-    blocks: Vec<BlockTime>,
-    index_of: FxHashMap<TextSize, usize>,
-    /// The block of the last step of this file: steps of other files are
-    /// its, and a new execution starts when another block's step comes.
-    current: Option<usize>,
-    /// Seconds since the program's start.
-    clock: f64,
+/// A checkpoint of the run, the model's state and the charges there.
+#[derive(Debug, Clone)]
+struct Stored {
+    run: Checkpoint,
+    model: TimerState,
+    charges: Mark,
+}
+
+/// The charges at a checkpoint.
+#[derive(Debug, Clone)]
+struct Mark {
+    /// Blocks charged so far; the last one may be charged more (its
+    /// steps may wait in the model).
+    blocks: usize,
+    last: Option<BlockTime>,
     totals: Totals,
     breaks: usize,
     lost: f64,
 }
 
-impl Charges {
+impl Stored {
+    /// This checkpoint in the new text of a run that took the course of
+    /// `from` at `to`.
+    fn moved(&self, from: &Stored, to: &Stored, shift: i64) -> Stored {
+        let blocks = to.charges.blocks as i64 - from.charges.blocks as i64;
+        let steps = to.run.steps() as i64 - from.run.steps() as i64;
+        let run_blocks = to.run.block() as i64 - from.run.block() as i64;
+        let clock = to.charges.totals.total_time - from.charges.totals.total_time;
+        let (from, to) = (&from.charges, &to.charges);
+        Stored {
+            run: self.run.shifted(shift, run_blocks, steps),
+            model: self.model.shifted(shift, steps),
+            charges: Mark {
+                blocks: shift_count(self.charges.blocks, blocks),
+                last: self.charges.last.as_ref().map(|last| last.moved(shift, clock)),
+                totals: self.charges.totals.moved(&from.totals, &to.totals),
+                breaks: (self.charges.breaks + to.breaks).saturating_sub(from.breaks),
+                lost: self.charges.lost - from.lost + to.lost,
+            },
+        }
+    }
+}
+
+impl BlockTime {
+    /// The block in a text where it starts `shift` bytes later, its runs
+    /// `clock` seconds later.
+    fn moved(&self, shift: i64, clock: f64) -> BlockTime {
+        let range = TextRange::new(shift_offset(self.range.start(), shift), shift_offset(self.range.end(), shift));
+        BlockTime { range, start: self.start + clock, end: self.end + clock, ..self.clone() }
+    }
+
+    /// The block as charged so far, without when it ran.
+    fn charged(&self, shift: i64) -> BlockTime {
+        BlockTime { start: 0.0, end: 0.0, ..self.moved(shift, 0.0) }
+    }
+}
+
+/// Every step charged to a block of the file as the model times it, and
+/// the sums; the checkpoints of the run.
+struct Charges<'a> {
+    blocks: Vec<BlockTime>,
+    index_of: FxHashMap<TextSize, usize>,
+    /// The block of the last step of this file: steps of other files are
+    /// its, and a new execution starts when another block's step comes.
+    current: Option<usize>,
+    totals: Totals,
+    breaks: usize,
+    lost: f64,
+    checkpoints: Vec<Stored>,
+    change: Option<Change<'a>>,
+    /// The previous estimate's checkpoint where the run took its course
+    /// again, once it has.
+    rejoined: Option<usize>,
+}
+
+impl<'a> Charges<'a> {
+    fn new(change: Option<Change<'a>>) -> Charges<'a> {
+        Charges {
+            blocks: Vec::new(),
+            index_of: FxHashMap::default(),
+            current: None,
+            totals: Totals::default(),
+            breaks: 0,
+            lost: 0.0,
+            checkpoints: Vec::new(),
+            change,
+            rejoined: None,
+        }
+    }
+
+    /// Starts from checkpoint `index` of `previous`: its blocks before it
+    /// and their sums, and its checkpoints before it.
+    fn resume(&mut self, previous: &Estimate, index: usize) {
+        let mark = &previous.checkpoints[index].charges;
+        let charged = mark.blocks.saturating_sub(1);
+        self.blocks = previous.blocks[..charged].to_vec();
+        self.blocks.extend(mark.last.clone());
+        self.index_of = self.blocks.iter().enumerate().map(|(index, block)| (block.range.start(), index)).collect();
+        self.current = self.blocks.len().checked_sub(1);
+        self.totals = mark.totals;
+        self.breaks = mark.breaks;
+        self.lost = mark.lost;
+        self.checkpoints = previous.checkpoints[..index].to_vec();
+    }
+
     /// The block a step is charged to: its own in this file, found or
     /// added, else the block that ran last.
     fn block_of(&mut self, step: &Step) -> Option<usize> {
         if step.source != 0 {
             return self.current;
         }
-        let Charges { blocks, index_of, clock, .. } = self;
+        let Charges { blocks, index_of, totals, .. } = self;
         Some(*index_of.entry(step.range.start()).or_insert_with(|| {
             blocks.push(BlockTime {
                 range: step.range,
-                start: *clock,
-                end: *clock,
+                start: totals.total_time,
+                end: totals.total_time,
                 total: 0.0,
                 executions: 0,
                 profile: velocity::Profile::default(),
@@ -229,9 +379,96 @@ impl Charges {
             blocks.len() - 1
         }))
     }
+
+    fn mark(&self) -> Mark {
+        Mark {
+            blocks: self.blocks.len(),
+            last: self.blocks.last().cloned(),
+            totals: self.totals,
+            breaks: self.breaks,
+            lost: self.lost,
+        }
+    }
+
+    /// The previous estimate's checkpoint at `offset`, when the text after
+    /// it is alike and the run there may take its course again.
+    fn counterpart(&self, offset: TextSize) -> Option<usize> {
+        let change = self.change.as_ref().filter(|change| change.previous.stopped.is_none())?;
+        if offset < change.end {
+            return None;
+        }
+        let old = shift_offset(offset, -change.shift);
+        let checkpoints = &change.previous.checkpoints;
+        let index = checkpoints.partition_point(|stored| stored.run.offset() < old);
+        checkpoints.get(index).filter(|stored| stored.run.offset() == old).map(|_| index)
+    }
+
+    fn into_estimate(mut self, text: &Arc<String>, files: &WorkspaceFiles, stopped: Option<String>) -> Estimate {
+        let mut totals = cycle_totals(&self.totals, self.breaks, self.lost);
+        let mut stopped = stopped;
+        let mut rerun_end = TextSize::of(text.as_str());
+        // The rejoining checkpoint is the run's last.
+        let rejoined = self.rejoined.zip(self.checkpoints.last().cloned());
+        if let (Some((index, to)), Some(change)) = (rejoined, &self.change) {
+            // The model's last steps were timed as the end of the program:
+            // the previous estimate has them, and all after them.
+            let previous = change.previous;
+            let (from, to) = (&previous.checkpoints[index], &to);
+            rerun_end = to.run.offset();
+            let clock = to.charges.totals.total_time - from.charges.totals.total_time;
+            let kept = to.charges.blocks.saturating_sub(1);
+            self.blocks.truncate(kept);
+            let first_old = from.charges.blocks.saturating_sub(1);
+            self.blocks.extend(previous.blocks[first_old..].iter().map(|block| block.moved(change.shift, clock)));
+            let later = previous.checkpoints[index + 1..].iter().map(|stored| stored.moved(from, to, change.shift));
+            self.checkpoints.extend(later.collect::<Vec<_>>());
+            let (old, new) = (
+                cycle_totals(&from.charges.totals, from.charges.breaks, from.charges.lost),
+                cycle_totals(&to.charges.totals, to.charges.breaks, to.charges.lost),
+            );
+            totals = previous.totals.moved(&old, &new);
+            stopped.clone_from(&previous.stopped);
+        }
+        self.blocks.sort_by_key(|block| block.range.start());
+        Estimate {
+            blocks: self.blocks,
+            totals,
+            stopped,
+            rerun: TextSize::default()..rerun_end,
+            checkpoints: self.checkpoints,
+            text: text.clone(),
+            files: files.clone(),
+        }
+    }
 }
 
-impl TimingSink for Charges {
+fn cycle_totals(totals: &Totals, breaks: usize, lost: f64) -> CycleTotals {
+    CycleTotals {
+        total: totals.total_time,
+        cutting: totals.time(Motion::Feed),
+        rapid: totals.time(Motion::Rapid),
+        dwell: totals.time(Motion::Dwell),
+        breaks,
+        lost,
+    }
+}
+
+impl CycleTotals {
+    /// See [`Totals::moved`].
+    fn moved(&self, from: &CycleTotals, to: &CycleTotals) -> CycleTotals {
+        let shift = |value: f64, from: f64, to: f64| value - from + to;
+        CycleTotals {
+            total: shift(self.total, from.total, to.total),
+            cutting: shift(self.cutting, from.cutting, to.cutting),
+            rapid: shift(self.rapid, from.rapid, to.rapid),
+            dwell: shift(self.dwell, from.dwell, to.dwell),
+            breaks: (self.breaks + to.breaks).saturating_sub(from.breaks),
+            lost: shift(self.lost, from.lost, to.lost),
+        }
+    }
+}
+
+impl TimingSink for Charges<'_> {
     fn speed_break(&mut self, step: &Step, speed_break: Break) {
         self.breaks += 1;
         self.lost += speed_break.lost;
@@ -256,8 +493,7 @@ impl TimingSink for Charges {
     }
 
     fn timed(&mut self, step: &Step, profile: velocity::Profile) {
-        let start = self.clock;
-        self.clock += profile.duration;
+        let start = self.totals.total_time;
         self.totals.add(step, profile.duration);
         let index = self.block_of(step);
         if step.source == 0
@@ -280,6 +516,28 @@ impl TimingSink for Charges {
                 block.end = start + profile.duration;
             }
         }
+    }
+
+    fn checkpoint_wanted(&mut self, block: usize, offset: TextSize) -> bool {
+        block.is_multiple_of(CHECKPOINT_INTERVAL) || self.counterpart(offset).is_some()
+    }
+
+    fn checkpoint(&mut self, run: Checkpoint, model: TimerState) -> ControlFlow<()> {
+        let counterpart = self.counterpart(run.offset());
+        let stored = Stored { run, model, charges: self.mark() };
+        let rejoins = counterpart.zip(self.change.as_ref()).is_some_and(|(index, change)| {
+            let old = &change.previous.checkpoints[index];
+            let charged = |mark: &Mark, shift| mark.last.as_ref().map(|last| last.charged(shift));
+            stored.run.same_course(&old.run)
+                && stored.model.same_course(&old.model, change.shift)
+                && charged(&stored.charges, 0) == charged(&old.charges, change.shift)
+        });
+        self.checkpoints.push(stored);
+        if rejoins {
+            self.rejoined = counterpart;
+            return ControlFlow::Break(());
+        }
+        ControlFlow::Continue(())
     }
 }
 
@@ -461,7 +719,7 @@ mod tests {
             host.add_file(*path, *text);
         }
         let input = host.analysis().run_input(file).expect("a program");
-        input.estimate(None, None, nc_exec::run::DEFAULT_STEP_BUDGET)
+        input.estimate(None, nc_exec::run::DEFAULT_STEP_BUDGET)
     }
 
     /// One line per block: its first line, when it starts, its time, its
@@ -622,6 +880,118 @@ mod tests {
             **Speed drops** (non-motion): a block without motion between moves. 600 → 0 mm/min; 22 ms lost against a smooth join."#]].assert_eq(&estimate.hover(n20 + TextSize::from(5)).unwrap());
         expect!["Cycle time 2.07 s · cutting 2.07 s · rapid 0 s · 2 breaks cost 57 ms"].assert_eq(&estimate.headline());
         assert_eq!(estimate.hover(TextSize::from(0)), None, "the header is no block");
+    }
+
+    /// A CAM-like program of `blocks` moves: absolute contours with
+    /// corners, rapids, a dwell now and then.
+    fn long_program(blocks: usize) -> String {
+        let mut text = String::from("%1\nN1 G54 G90 G00 X0 Y0 Z5 M03 S8000\nN2 G01 Z-1 F1200\n");
+        for i in 0..blocks {
+            let (x, y) = ((i % 97) as f64 * 0.7, (i / 97) as f64 * 1.3 + (i % 5) as f64 * 0.2);
+            let block = match i % 50 {
+                17 => "G04 Q10".to_owned(),
+                31 => format!("G00 X{x:.3} Y{y:.3}"),
+                32 => format!("G01 X{x:.3} Y{y:.3} F900"),
+                _ => format!("X{x:.3} Y{y:.3}"),
+            };
+            text.push_str(&format!("N{} {block}\n", i + 3));
+        }
+        text.push_str("N99999 G00 Z5 M30\n");
+        text
+    }
+
+    fn estimate_of(text: &str, previous: Option<&Estimate>) -> Estimate {
+        let machine = MachineConfig::default();
+        estimate(previous, &Arc::new(text.to_owned()), &WorkspaceFiles::default(), &machine, 1_000_000)
+    }
+
+    /// The estimates agree on every block and total, to rounding.
+    fn assert_alike(resumed: &Estimate, whole: &Estimate) {
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * (1.0 + a.abs().max(b.abs()));
+        assert_eq!(resumed.blocks.len(), whole.blocks.len());
+        for (r, w) in resumed.blocks.iter().zip(&whole.blocks) {
+            assert_eq!((r.range, r.executions, &r.profile), (w.range, w.executions, &w.profile));
+            assert!(close(r.start, w.start) && close(r.end, w.end) && close(r.total, w.total), "{r:?} vs {w:?}");
+            assert_eq!(r.breaks.len(), w.breaks.len(), "{r:?} vs {w:?}");
+            for (r, w) in r.breaks.iter().zip(&w.breaks) {
+                assert_eq!((r.reason.code(), r.count), (w.reason.code(), w.count));
+                assert!(close(r.lost, w.lost));
+            }
+        }
+        let (r, w) = (&resumed.totals, &whole.totals);
+        assert_eq!(r.breaks, w.breaks);
+        for (a, b) in
+            [(r.total, w.total), (r.cutting, w.cutting), (r.rapid, w.rapid), (r.dwell, w.dwell), (r.lost, w.lost)]
+        {
+            assert!(close(a, b), "{r:?} vs {w:?}");
+        }
+        assert_eq!(resumed.stopped, whole.stopped);
+    }
+
+    #[test]
+    fn an_edit_reruns_from_the_checkpoint_before_it_to_where_the_run_takes_its_course_again() {
+        let text = long_program(5000);
+        let first = estimate_of(&text, None);
+        assert_eq!(first.rerun, TextSize::default()..TextSize::of(text.as_str()));
+        assert!(first.checkpoints.len() >= 5, "{} checkpoints", first.checkpoints.len());
+        // A digit typed into an absolute coordinate in the middle.
+        let at = text.find("N2503 X").expect("the block") + "N2503 X".len();
+        let edited = format!("{}7{}", &text[..at], &text[at..]);
+        let resumed = estimate_of(&edited, Some(&first));
+        let whole = estimate_of(&edited, None);
+        assert_alike(&resumed, &whole);
+        assert!(resumed.totals.total > first.totals.total, "the move got longer");
+        // From the checkpoint at block 2000 (N2001) to the one at block 3000.
+        let rerun = usize::from(resumed.rerun.start)..usize::from(resumed.rerun.end);
+        assert!(edited[rerun.clone()].starts_with("N2001 ") && edited[rerun.end..].starts_with("N3001 "), "{rerun:?}");
+        // Edited again, from the resumed estimate: its checkpoints hold.
+        let at = edited.find("N4321 X").expect("the block") + "N4321 X".len();
+        let again = format!("{}{}", &edited[..at], &edited[at + 1..]);
+        let resumed = estimate_of(&again, Some(&resumed));
+        assert_alike(&resumed, &estimate_of(&again, None));
+        assert!(resumed.rerun.end < TextSize::of(again.as_str()));
+    }
+
+    #[test]
+    fn an_edit_that_changes_everything_after_it_reruns_to_the_end() {
+        let text = long_program(3000);
+        let first = estimate_of(&text, None);
+        let edited = text.replacen("N1500 ", "N1500 G91 ", 1);
+        let resumed = estimate_of(&edited, Some(&first));
+        assert_eq!(resumed.rerun.end, TextSize::of(edited.as_str()));
+        assert!(resumed.rerun.start > TextSize::default());
+        assert_alike(&resumed, &estimate_of(&edited, None));
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(12))]
+
+        /// Resumed estimates equal whole runs, edit after edit: digits
+        /// typed or deleted, blocks inserted or removed, a jump back or
+        /// forward inserted.
+        #[test]
+        fn resumed_estimates_equal_whole_runs(
+            edits in proptest::collection::vec((0.0f64..1.0, 0u8..5), 1..4),
+        ) {
+            let mut text = long_program(2500);
+            let mut previous = estimate_of(&text, None);
+            for (place, kind) in edits {
+                let line_start = text[..(place * text.len() as f64) as usize].rfind('\n').map_or(0, |i| i + 1);
+                let line_end = text[line_start..].find('\n').map_or(text.len(), |i| line_start + i + 1);
+                let word = text[line_start..line_end].find(" X").map(|i| line_start + i + 2);
+                match (kind, word) {
+                    (0, Some(at)) => text.insert(at, '3'),
+                    (1, Some(at)) => { text.remove(at); }
+                    (2, _) => text.insert_str(line_start, "N5 G01 X1 Y1 F2000\n"),
+                    (3, _) if line_start > 0 => text.insert_str(line_start, "N6 G73 L1000 Q1\n"),
+                    _ if line_start > 0 && line_end < text.len() => text.replace_range(line_start..line_end, ""),
+                    _ => {}
+                }
+                let resumed = estimate_of(&text, Some(&previous));
+                assert_alike(&resumed, &estimate_of(&text, None));
+                previous = resumed;
+            }
+        }
     }
 
     #[test]

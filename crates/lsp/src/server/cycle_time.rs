@@ -32,14 +32,11 @@ pub(crate) struct Cycle {
     /// Where the text first differs from the estimate's text, after edits
     /// since its version: answers before it still hold.
     pub stale_from: Option<TextSize>,
-    /// What the edit since the estimate wrote, when there was one edit.
-    edit: Option<TextRange>,
 }
 
 impl Cycle {
     /// Notes an edit that wrote `written` (a range of the new text).
     pub fn edited(&mut self, written: TextRange) {
-        self.edit = if self.stale_from.is_none() { Some(written) } else { None };
         let start = written.start();
         self.stale_from = Some(self.stale_from.map_or(start, |stale| stale.min(start)));
     }
@@ -130,26 +127,26 @@ impl Timer {
 
 /// Estimates one version; whether the result was kept.
 fn run(state: &Mutex<State>, uri: &Uri, version: i32) -> bool {
-    let (analysis, file, previous, edit) = {
+    let (analysis, file, previous) = {
         let state = lock(state);
         let Some(document) = state.documents.get(uri).filter(|document| document.version == version) else {
             return false;
         };
         let cycle = &document.cycle;
-        (state.workspaces.get(document.workspace).analysis(), document.file, cycle.estimate.clone(), cycle.edit)
+        (state.workspaces.get(document.workspace).analysis(), document.file, cycle.estimate.clone())
     };
     let started = std::time::Instant::now();
     // Read, then let go of the snapshot: the run may take a while.
     let Ok(input) = Cancelled::catch(|| analysis.run_input(file)) else { return false };
     drop(analysis);
     let Some(input) = input else { return false };
-    let estimate = Arc::new(input.estimate(previous.as_deref(), edit, STEP_BUDGET));
+    let estimate = Arc::new(input.estimate(previous.as_deref(), STEP_BUDGET));
     drop(input);
     tracing::debug!("{} v{version}: cycle time estimated in {:?}", uri.as_str(), started.elapsed());
     let mut state = lock(state);
     match state.documents.get_mut(uri) {
         Some(document) if document.version == version => {
-            document.cycle = Cycle { estimate: Some(estimate), stale_from: None, edit: None };
+            document.cycle = Cycle { estimate: Some(estimate), stale_from: None };
             true
         }
         _ => false,
