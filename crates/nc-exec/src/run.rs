@@ -35,7 +35,10 @@
 use std::{
     borrow::Cow,
     ops::{ControlFlow, Range},
-    sync::mpsc::{self, Receiver},
+    sync::{
+        atomic::{AtomicBool, Ordering},
+        mpsc::{self, Receiver},
+    },
     thread::{Scope, ScopedJoinHandle},
 };
 
@@ -832,17 +835,17 @@ impl<'a> Blocks<'a> {
     /// the `G79` a macrocycle file opens with), `None` for a file without
     /// blocks.
     fn add(&mut self, text: Cow<'a, str>) -> Option<usize> {
-        self.add_reading(text, 0, |_, _, _| {})
+        self.add_reading(text, 0, |_, _, _| ControlFlow::Continue(()))
     }
 
     /// Like [`Blocks::add`], and gives `each` each block as it is lowered,
-    /// with whether it starts a subprogram; reads from byte `from` on (a
-    /// block's start).
+    /// with whether it starts a subprogram, until it breaks; reads from
+    /// byte `from` on (a block's start).
     fn add_reading(
         &mut self,
         text: Cow<'a, str>,
         from: usize,
-        mut each: impl FnMut(TextRange, &mut BlockData, bool),
+        mut each: impl FnMut(TextRange, &mut BlockData, bool) -> ControlFlow<()>,
     ) -> Option<usize> {
         let first = self.ranges.len();
         let mut opens_with_g79 = false;
@@ -860,7 +863,9 @@ impl<'a> Blocks<'a> {
             let starts_subprogram = self.units.add(index, self.texts.len(), &data, index == first);
             self.ranges.push(range);
             self.trees.extend(tree.map(|tree| (index, tree)));
-            each(range, &mut data, starts_subprogram);
+            if each(range, &mut data, starts_subprogram).is_break() {
+                break;
+            }
         }
         self.units.numbers.sort_unstable();
         self.texts.push(text);
@@ -912,6 +917,9 @@ struct Stream<'a, 's> {
     /// only).
     text: &'a str,
     resumed: bool,
+    /// Set when the run needs every block: the index pass then goes on
+    /// once it stops streaming; else it stops with the run.
+    whole_index_wanted: std::sync::Arc<AtomicBool>,
     batches: Receiver<Vec<Streamed>>,
     /// Batches taken, back to the index pass with the run's spent block
     /// data, whose room it fills again.
@@ -938,7 +946,10 @@ impl<'a, 's> Index<'a, 's> {
         let (offset, first) = from.map_or((0, 0), |(offset, block)| (usize::from(offset), block));
         let (sender, batches) = mpsc::sync_channel::<Vec<Streamed>>(4);
         let (taken_batches, returned) = mpsc::sync_channel::<Vec<Streamed>>(4);
+        let whole_index_wanted = std::sync::Arc::new(AtomicBool::new(false));
+        let wanted = whole_index_wanted.clone();
         let index_pass = scope.spawn(move || {
+            let whole_index_wanted = wanted;
             let mut blocks = Blocks::default();
             let mut batch = Vec::with_capacity(STREAM_BATCH);
             // A batch the run took, whose block data the next blocks reuse.
@@ -946,19 +957,25 @@ impl<'a, 's> Index<'a, 's> {
             // Until the run stops taking blocks in order.
             let mut streaming = true;
             blocks.add_reading(Cow::Borrowed(text), offset, |range, data, starts_subprogram| {
-                if streaming {
-                    let room = spent.pop().map(|spent| spent.data).unwrap_or_default();
-                    batch.push(Streamed { range, data: std::mem::replace(data, room), starts_subprogram });
-                    if batch.len() == STREAM_BATCH {
-                        let mut next = match returned.try_recv() {
-                            Ok(taken) => std::mem::replace(&mut spent, taken),
-                            Err(_) => Vec::with_capacity(STREAM_BATCH),
-                        };
-                        next.clear();
-                        let full = std::mem::replace(&mut batch, next);
-                        streaming = sender.send(full).is_ok();
+                if !streaming {
+                    return ControlFlow::Continue(());
+                }
+                let room = spent.pop().map(|spent| spent.data).unwrap_or_default();
+                batch.push(Streamed { range, data: std::mem::replace(data, room), starts_subprogram });
+                if batch.len() == STREAM_BATCH {
+                    let mut next = match returned.try_recv() {
+                        Ok(taken) => std::mem::replace(&mut spent, taken),
+                        Err(_) => Vec::with_capacity(STREAM_BATCH),
+                    };
+                    next.clear();
+                    let full = std::mem::replace(&mut batch, next);
+                    streaming = sender.send(full).is_ok();
+                    // A run that ended needs no index.
+                    if !streaming && !whole_index_wanted.load(Ordering::SeqCst) {
+                        return ControlFlow::Break(());
                     }
                 }
+                ControlFlow::Continue(())
             });
             if streaming && !batch.is_empty() {
                 // The run may have ended already.
@@ -970,6 +987,7 @@ impl<'a, 's> Index<'a, 's> {
         Index::Streaming(Stream {
             text,
             resumed,
+            whole_index_wanted,
             batches,
             taken_batches,
             batch: Vec::new(),
@@ -1036,7 +1054,9 @@ impl<'a, 's> Index<'a, 's> {
             let Index::Streaming(stream) = std::mem::replace(self, Index::Complete(Blocks::default())) else {
                 unreachable!()
             };
-            // The index pass stops streaming and finishes the index.
+            // The index pass stops streaming and finishes the index, but
+            // for a resumed run, whose index starts at its checkpoint.
+            stream.whole_index_wanted.store(!stream.resumed, Ordering::SeqCst);
             drop(stream.batches);
             let mut blocks = stream.index_pass.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
             if stream.resumed {

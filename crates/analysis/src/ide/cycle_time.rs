@@ -17,6 +17,7 @@ use nc_exec::{
 };
 use ncc_syntax::{TextRange, TextSize, ast::AstNode};
 use rustc_hash::FxHashMap;
+use smallvec::SmallVec;
 
 use crate::{
     InlayHint, InlayHintKind, MachineConfig,
@@ -70,7 +71,7 @@ pub struct BlockTime {
     /// Its own motion in its last execution.
     pub profile: velocity::Profile,
     /// The speed breaks at it, one per reason.
-    pub breaks: Vec<BreakAt>,
+    pub breaks: SmallVec<[BreakAt; 1]>,
 }
 
 /// The drops of the path speed at a block for one reason, over all its
@@ -315,6 +316,8 @@ impl BlockTime {
 /// the sums; the checkpoints of the run.
 struct Charges<'a> {
     blocks: Vec<BlockTime>,
+    /// Whether `blocks` are in text order, else where each one is.
+    in_order: bool,
     index_of: FxHashMap<TextSize, usize>,
     /// The block of the last step of this file: steps of other files are
     /// its, and a new execution starts when another block's step comes.
@@ -333,6 +336,7 @@ impl<'a> Charges<'a> {
     fn new(change: Option<Change<'a>>) -> Charges<'a> {
         Charges {
             blocks: Vec::new(),
+            in_order: true,
             index_of: FxHashMap::default(),
             current: None,
             totals: Totals::default(),
@@ -351,7 +355,6 @@ impl<'a> Charges<'a> {
         let charged = mark.blocks.saturating_sub(1);
         self.blocks = previous.blocks[..charged].to_vec();
         self.blocks.extend(mark.last.clone());
-        self.index_of = self.blocks.iter().enumerate().map(|(index, block)| (block.range.start(), index)).collect();
         self.current = self.blocks.len().checked_sub(1);
         self.totals = mark.totals;
         self.breaks = mark.breaks;
@@ -365,19 +368,38 @@ impl<'a> Charges<'a> {
         if step.source != 0 {
             return self.current;
         }
-        let Charges { blocks, index_of, totals, .. } = self;
-        Some(*index_of.entry(step.range.start()).or_insert_with(|| {
-            blocks.push(BlockTime {
-                range: step.range,
-                start: totals.total_time,
-                end: totals.total_time,
-                total: 0.0,
-                executions: 0,
-                profile: velocity::Profile::default(),
-                breaks: Vec::new(),
-            });
-            blocks.len() - 1
-        }))
+        let start = step.range.start();
+        if self.in_order {
+            // While blocks come in text order, their place finds them.
+            let found = self.blocks.binary_search_by_key(&start, |block| block.range.start());
+            match found {
+                Ok(index) => return Some(index),
+                Err(place) if place == self.blocks.len() => return Some(self.add_block(step)),
+                Err(_) => {
+                    self.in_order = false;
+                    self.index_of = self.blocks.iter().enumerate().map(|(i, block)| (block.range.start(), i)).collect();
+                }
+            }
+        }
+        if let Some(&index) = self.index_of.get(&start) {
+            return Some(index);
+        }
+        let index = self.add_block(step);
+        self.index_of.insert(start, index);
+        Some(index)
+    }
+
+    fn add_block(&mut self, step: &Step) -> usize {
+        self.blocks.push(BlockTime {
+            range: step.range,
+            start: self.totals.total_time,
+            end: self.totals.total_time,
+            total: 0.0,
+            executions: 0,
+            profile: velocity::Profile::default(),
+            breaks: SmallVec::new(),
+        });
+        self.blocks.len() - 1
     }
 
     fn mark(&self) -> Mark {
@@ -429,7 +451,9 @@ impl<'a> Charges<'a> {
             totals = previous.totals.moved(&old, &new);
             stopped.clone_from(&previous.stopped);
         }
-        self.blocks.sort_by_key(|block| block.range.start());
+        if !self.in_order {
+            self.blocks.sort_by_key(|block| block.range.start());
+        }
         Estimate {
             blocks: self.blocks,
             totals,
