@@ -161,6 +161,21 @@ pub struct Step {
     /// machine's time for it.
     pub m_functions: u8,
     pub tool_change: bool,
+    /// The envelope velocity's dynamic set in force, 1 to 4 (`G23 I1` …
+    /// `I4`; 1 after reset).
+    pub dynamic_set: u8,
+    /// A G01 line without technology functions (M, S, T, D), without F
+    /// and not under G91, which machine constant R383 may merge into the
+    /// move before it (04 §1.9.4).
+    pub mergeable: bool,
+}
+
+/// What else a block does besides its motion, as its step records it.
+#[derive(Debug, Clone, Copy, Default)]
+struct Functions {
+    m_functions: u8,
+    tool_change: bool,
+    mergeable: bool,
 }
 
 /// Block joining, group 2 (04 §1.2).
@@ -1194,6 +1209,8 @@ struct Runner {
     /// The zero-offset and correction tables, as the program changes them.
     offsets: OffsetTable,
     corrections: ToolTable,
+    /// The envelope velocity's dynamic set, `G23 I1` … `I4`.
+    dynamic_set: u8,
     /// The correction entry D and the length-compensation digits `&`.
     correction: u8,
     length_digits: u32,
@@ -1252,6 +1269,7 @@ impl Runner {
             messages: Vec::new(),
             offsets: machine.offsets.clone(),
             corrections: machine.tools.clone(),
+            dynamic_set: 1,
             correction: 0,
             length_digits: 0,
             length_shift: [0.0; 26],
@@ -1303,6 +1321,7 @@ impl Runner {
             length_setting: _,
             offsets,
             corrections,
+            dynamic_set,
             correction,
             length_digits,
             length_shift,
@@ -1331,6 +1350,7 @@ impl Runner {
             && other.compensator.is_none()
             && *offsets == other.offsets
             && *corrections == other.corrections
+            && *dynamic_set == other.dynamic_set
             && *correction == other.correction
             && *length_digits == other.length_digits
             && *length_shift == other.length_shift
@@ -1439,6 +1459,17 @@ impl Runner {
         // A new zero offset holds from this block; a new length correction
         // from its first block of linear or rapid motion (02 §1.18.2).
         let motion = self.modes.active(self.groups.motion);
+        // `G23 I1` … `I4` selects the envelope velocity's dynamic set (04
+        // §2.2); in an arc block I is the centre.
+        if has(b'G', 23)
+            && !matches!(motion, Some(2 | 3))
+            && let Some((set, word)) = block.word(b'I').and_then(|word| Some((self.integer(word)?, word)))
+        {
+            match u8::try_from(set) {
+                Ok(set @ 1..=4) => self.dynamic_set = set,
+                _ => self.finding(at(word.range), &format!("G23 I{set}: the dynamic sets are I1 to I4: the set in force stays"), false),
+            }
+        }
         let shifts_length = !axes.is_empty() && matches!(motion, Some(0 | 1));
         self.shift_frame(shifts_length);
         let start = self.position;
@@ -1476,7 +1507,21 @@ impl Runner {
         };
         let path = moved.path;
         let m_functions = codes.iter().filter(|&&(letter, code, _)| letter == b'M' && !matches!(code, 0..=2 | 6 | 30));
-        let functions = (u8::try_from(m_functions.count()).unwrap_or(u8::MAX), has(b'M', 6));
+        let technology = block.words.iter().any(|word| {
+            word.letter == b'M'
+                || matches!(
+                    self.catalogue.role_of(word.letter),
+                    Some(AddressRole::Feed | AddressRole::Speed | AddressRole::Tool | AddressRole::Offset)
+                )
+        });
+        let functions = Functions {
+            m_functions: u8::try_from(m_functions.count()).unwrap_or(u8::MAX),
+            tool_change: has(b'M', 6),
+            mergeable: moved.motion == Motion::Feed
+                && motion == Some(1)
+                && !technology
+                && !self.incremental(),
+        };
         self.record(range, &self.position.clone(), moved, stop, functions);
         if let Err(error) = self.compensate(start, path) {
             let range = self.step_mut(error.block()).range;
@@ -1791,8 +1836,8 @@ impl Runner {
     /// Adds a step of the block at `range` that ends at `end`. Its start
     /// time follows from the durations when the run ends.
     /// Records a step; `functions` are its M functions and tool change.
-    fn record(&mut self, range: TextRange, end: &Position, moved: Moved, stop: Option<Stop>, functions: (u8, bool)) {
-        let (m_functions, tool_change) = functions;
+    fn record(&mut self, range: TextRange, end: &Position, moved: Moved, stop: Option<Stop>, functions: Functions) {
+        let Functions { m_functions, tool_change, mergeable } = functions;
         let Moved { motion, length, duration, feed, path } = moved;
         let (source, end, frame) = (self.source, self.machine_axes(end), self.frames.len() - 1);
         let joining = match self.modes.active(self.groups.joining) {
@@ -1814,6 +1859,8 @@ impl Runner {
             joining,
             m_functions,
             tool_change,
+            dynamic_set: self.dynamic_set,
+            mergeable,
         };
         self.steps.push(step);
     }
@@ -1913,7 +1960,7 @@ impl Runner {
                 CycleStep::Dwell { seconds } => (Motion::Dwell, seconds, None, Path::Straight),
                 CycleStep::Spindle { .. } => continue,
             };
-            self.record(range, &to, Moved { motion, length, duration, feed, path }, None, (0, false));
+            self.record(range, &to, Moved { motion, length, duration, feed, path }, None, Functions::default());
             at = to;
         }
         self.position = physical(&cycle.end());
@@ -2966,6 +3013,19 @@ mod tests {
         assert_eq!(times[2], 0.75);
         assert_eq!((trace.steps[5].motion, times[5]), (Motion::Feed, 0.75));
         assert_eq!(times[6..9], [0.04, 0.03, 0.02]);
+    }
+
+    #[test]
+    fn g23_i_selects_the_dynamic_set_and_steps_tell_which_lines_may_merge() {
+        let trace = run_text(
+            "%1\nN1 G23 I2 G01 X10 F600\nN2 X20\nN3 G23 I1 X30\nN4 G23 I7 X40\nN5 X40.003\nN6 X41 S500\nN7 G91 X1\nN8 G90 G00 X0\nN9 M30\n",
+        );
+        let sets: Vec<u8> = trace.steps.iter().map(|step| step.dynamic_set).collect();
+        assert_eq!(sets, [2, 2, 1, 1, 1, 1, 1, 1, 1]);
+        let mergeable: Vec<bool> = trace.steps.iter().map(|step| step.mergeable).collect();
+        assert_eq!(mergeable, [false, true, true, true, true, false, false, false, false]);
+        let messages: Vec<&str> = trace.findings.iter().map(|finding| finding.message.as_str()).collect();
+        assert_eq!(messages, ["G23 I7: the dynamic sets are I1 to I4: the set in force stays"]);
     }
 
     #[test]

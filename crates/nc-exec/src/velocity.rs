@@ -526,10 +526,8 @@ impl Planning {
             arc_radius: this.arc_radius,
             stop_before,
             continuity: this.joining == Joining::Continuous && dynamics.continuity > 0,
-            set: 1,
-            // Whether a block has technology functions the trace does not
-            // keep: R383 merges nothing.
-            mergeable: false,
+            set: step.dynamic_set,
+            mergeable: step.mergeable,
         };
         steps.previous = Some(this);
         steps.window.push_back((step, this, stop.filter(|_| stop_before)));
@@ -1094,6 +1092,48 @@ mod tests {
         assert_eq!(reasons, [(99, Reason::NonMotion)]);
         // The CNC8x6 stops after every block.
         assert!(timed(&text).total_time() > 3.0 * expected);
+    }
+
+    #[test]
+    fn the_envelope_merges_a_tiny_line_by_r383_unless_it_may_not() {
+        // A 3 µm line inside a 100 mm one at 100 mm/s: merged, the path is
+        // one line; on its own it would take the 4 ms minimum duration
+        // (0.75 mm/s), braking from and ramping back to the feed.
+        let program = |middle: &str| format!("%1\nN1 G23 G01 X50 F6000\nN2 {middle}\nN3 X100\nN4 M30\n");
+        let merged = enveloped(&program("X50.003")).total_time();
+        let expected = rest_to_rest(100.0, 100.0, 400.0) + 0.010;
+        assert!((merged - expected).abs() < expected * 1e-3, "{merged} != {expected}");
+        // Braking to a near stop and back costs about v/A against passing.
+        let ramps = 100.0 / 400.0;
+        // A technology function keeps it a block of its own.
+        let with_speed = enveloped(&program("X50.003 S1000")).total_time();
+        assert!(with_speed > merged + 0.9 * ramps, "{with_speed} vs {merged}");
+        // A minus sign blocks R383.
+        let machine = MachineConfig { constants: [(338, 10), (383, -5)].into(), ..MachineConfig::default() };
+        let trace = run(&program("X50.003"), &NoFiles, &machine, 1000);
+        let blocked = time(&trace, &Dynamics::of(&machine)).total_time();
+        assert!(blocked > merged + 0.9 * ramps, "{blocked} vs {merged}");
+    }
+
+    #[test]
+    fn g23_i_selects_the_dynamic_set_of_the_parabolic_envelope() {
+        // Sets on (R406, R412), parabolic profile: set 1 ramps at R408 =
+        // 600 mm/s², set 2 at R414 = 100 mm/s², with the same P.
+        let constants = [(338, 20), (406, 1), (407, 50_000), (408, 600), (412, 1), (413, 50_000), (414, 100)];
+        let machine = MachineConfig { constants: constants.into(), ..MachineConfig::default() };
+        let timed = |set: u8| {
+            let text = format!("%1\nN1 G23 I{set} G01 X100 F6000\nN2 M30\n");
+            let trace = run(&text, &NoFiles, &machine, 1000);
+            assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+            time(&trace, &Dynamics::of(&machine)).total_time()
+        };
+        let (first, second) = (timed(1), timed(2));
+        // J = P / 32.768. Set 2 reaches A: v/A + A/J + L/v (04 §2.2); set 1
+        // reaches 100 mm/s before A = 600 mm/s² (A²/J > v): 2·sqrt(v/J) + L/v.
+        let jerk: f64 = 50_000.0 / 32.768;
+        let (one, two) = (2.0 * (100.0 / jerk).sqrt() + 1.0 + 0.010, 100.0 / 100.0 + 100.0 / jerk + 1.0 + 0.010);
+        assert!((first - one).abs() < one * 1e-3, "{first} != {one}");
+        assert!((second - two).abs() < two * 1e-3, "{second} != {two}");
     }
 
     #[test]
