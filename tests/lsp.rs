@@ -518,6 +518,27 @@ fn cycle_time_setting_from_initialization_options_and_edits_update_the_hints() {
 }
 
 #[test]
+fn an_edit_of_a_macrocycle_file_updates_the_times_of_the_program_that_calls_it() {
+    let (mut client, dir) = session();
+    let mut macrocycle = document(&dir, "L9001", "N1 G79 L9001\nN2 G01 X10\nN3 G70\n*\n");
+    client.notify("textDocument/didOpen", macrocycle.did_open()).unwrap();
+    let program = document(&dir, "main.NCP", "%1\nN10 G91 G01 F600\nN20 G72 L9001\nN30 M30\n*\n");
+    client.notify("textDocument/didOpen", program.did_open()).unwrap();
+    estimated(&mut client);
+    let call_time = |client: &mut Client| {
+        let (labels, _) = inlay_hints(client, &program);
+        labels.into_iter().find(|label| label.starts_with("2: ") && !label.contains('▼'))
+    };
+    // 10 mm at 10 mm/s, with its ramps and the stop after it.
+    assert_eq!(call_time(&mut client).as_deref(), Some("2: 1.03 s"));
+    // Twice the way in the macrocycle: the calling block takes longer.
+    let x = macrocycle.text().find("X10").unwrap();
+    client.notify("textDocument/didChange", macrocycle.change(x + 1..x + 3, "20")).unwrap();
+    estimated(&mut client);
+    assert_eq!(call_time(&mut client).as_deref(), Some("2: 2.03 s"));
+}
+
+#[test]
 fn the_program_total_is_a_code_lens_on_the_header() {
     let (mut client, dir) = session();
     let doc = document(&dir, "corners.NCP", CORNERS);

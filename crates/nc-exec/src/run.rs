@@ -1467,7 +1467,11 @@ impl Runner {
         {
             match u8::try_from(set) {
                 Ok(set @ 1..=4) => self.dynamic_set = set,
-                _ => self.finding(at(word.range), &format!("G23 I{set}: the dynamic sets are I1 to I4: the set in force stays"), false),
+                _ => self.finding(
+                    at(word.range),
+                    &format!("G23 I{set}: the dynamic sets are I1 to I4: the set in force stays"),
+                    false,
+                ),
             }
         }
         let shifts_length = !axes.is_empty() && matches!(motion, Some(0 | 1));
@@ -1517,10 +1521,7 @@ impl Runner {
         let functions = Functions {
             m_functions: u8::try_from(m_functions.count()).unwrap_or(u8::MAX),
             tool_change: has(b'M', 6),
-            mergeable: moved.motion == Motion::Feed
-                && motion == Some(1)
-                && !technology
-                && !self.incremental(),
+            mergeable: moved.motion == Motion::Feed && motion == Some(1) && !technology && !self.incremental(),
         };
         self.record(range, &self.position.clone(), moved, stop, functions);
         if let Err(error) = self.compensate(start, path) {

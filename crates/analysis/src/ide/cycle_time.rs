@@ -113,8 +113,8 @@ pub struct RunInput {
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct WorkspaceFiles {
     macrocycles: FxHashMap<u32, Arc<String>>,
-    /// Every other file by its name without directory and extension, for
-    /// the cycle file the machine names.
+    /// The files named as the machine's cycle file, by their name without
+    /// directory and extension.
     by_stem: Vec<(String, Arc<String>)>,
 }
 
@@ -142,12 +142,18 @@ pub(crate) fn run_input(db: &dyn Db, file: SourceFile) -> Option<RunInput> {
             files.macrocycles.insert(number, first.text(db).clone());
         }
     }
-    for &other in settings.files(db) {
-        if other != file {
-            files.by_stem.push((model::file_stem(other.path(db)).to_owned(), other.text(db).clone()));
+    let machine = &settings.config(db).machine;
+    // Only the cycle file the machine names: an edit of another program
+    // leaves this one's estimate as it is.
+    if let Some(cycle_file) = machine.cycle_file.as_deref().map(model::file_stem) {
+        for &other in settings.files(db) {
+            let stem = model::file_stem(other.path(db));
+            if other != file && stem.eq_ignore_ascii_case(cycle_file) {
+                files.by_stem.push((stem.to_owned(), other.text(db).clone()));
+            }
         }
     }
-    Some(RunInput { text: file.text(db).clone(), machine: settings.config(db).machine.clone(), files })
+    Some(RunInput { text: file.text(db).clone(), machine: machine.clone(), files })
 }
 
 /// Where the program's total is shown: the `%` header, or the first block.
@@ -164,6 +170,16 @@ impl RunInput {
     /// text of the same file, lets the run resume where the texts part.
     pub fn estimate(&self, previous: Option<&Estimate>, budget: usize) -> Estimate {
         estimate(previous, &self.text, &self.files, &self.machine, budget)
+    }
+}
+
+impl Estimate {
+    /// Whether this estimate is the one of `input`: the same text, files
+    /// and machine.
+    pub fn holds_for(&self, input: &RunInput) -> bool {
+        self.text == input.text
+            && self.files == input.files
+            && self.checkpoints.first().is_some_and(|stored| *stored.run.machine() == input.machine)
     }
 }
 
@@ -231,14 +247,16 @@ struct Change<'a> {
 }
 
 impl<'a> Change<'a> {
-    /// `None` when the machine or the files changed, or nothing did.
+    /// `None` when the machine changed. When the files changed, the change
+    /// reaches to the text's end: the program calls them only after its
+    /// checkpoints, and everything after may differ.
     fn between(
         previous: &'a Estimate,
         text: &str,
         files: &WorkspaceFiles,
         machine: &MachineConfig,
     ) -> Option<Change<'a>> {
-        if previous.files != *files || previous.checkpoints.first()?.run.machine() != machine {
+        if previous.checkpoints.first()?.run.machine() != machine {
             return None;
         }
         let (old, new) = (previous.text.as_bytes(), text.as_bytes());
@@ -246,12 +264,8 @@ impl<'a> Change<'a> {
         let room = old.len().min(new.len()) - common;
         let common_end = old.iter().rev().zip(new.iter().rev()).take(room).take_while(|(a, b)| a == b).count();
         let offset = |at: usize| TextSize::try_from(at).ok();
-        Some(Change {
-            previous,
-            start: offset(common)?,
-            end: offset(new.len() - common_end)?,
-            shift: new.len() as i64 - old.len() as i64,
-        })
+        let end = if previous.files == *files { new.len() - common_end } else { new.len() };
+        Some(Change { previous, start: offset(common)?, end: offset(end)?, shift: new.len() as i64 - old.len() as i64 })
     }
 }
 
@@ -985,6 +999,29 @@ mod tests {
         assert_eq!(resumed.rerun.end, TextSize::of(edited.as_str()));
         assert!(resumed.rerun.start > TextSize::default());
         assert_alike(&resumed, &estimate_of(&edited, None));
+    }
+
+    #[test]
+    fn a_changed_macrocycle_file_reruns_from_the_last_checkpoint() {
+        let text = long_program(2500).replace("N99999 G00 Z5 M30", "N99998 G72 L9001\nN99999 G00 Z5 M30");
+        let files = |x: &str| WorkspaceFiles {
+            macrocycles: [(9001, Arc::new(format!("N1 G79 L9001\nN2 G91 G01 X{x}\nN3 G90 G70\n*\n")))]
+                .into_iter()
+                .collect(),
+            by_stem: Vec::new(),
+        };
+        let machine = MachineConfig::default();
+        let text = Arc::new(text);
+        let first = estimate(None, &text, &files("10"), &machine, 1_000_000);
+        assert!(first.holds_for(&RunInput { text: text.clone(), machine: machine.clone(), files: files("10") }));
+        let changed = files("30");
+        assert!(!first.holds_for(&RunInput { text: text.clone(), machine: machine.clone(), files: changed.clone() }));
+        let resumed = estimate(Some(&first), &text, &changed, &machine, 1_000_000);
+        assert!(resumed.rerun.start > TextSize::default());
+        assert_alike(&resumed, &estimate(None, &text, &changed, &machine, 1_000_000));
+        // 20 mm more at the last feed, 900 mm/min.
+        let longer = resumed.totals.total - first.totals.total;
+        assert!((longer - 20.0 / 15.0).abs() < 0.05, "{longer}");
     }
 
     proptest::proptest! {

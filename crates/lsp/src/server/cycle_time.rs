@@ -140,6 +140,10 @@ fn run(state: &Mutex<State>, uri: &Uri, version: i32) -> bool {
     let Ok(input) = Cancelled::catch(|| analysis.run_input(file)) else { return false };
     drop(analysis);
     let Some(input) = input else { return false };
+    // Another document changed, but none this program reads.
+    if previous.as_ref().is_some_and(|previous| previous.holds_for(&input)) {
+        return false;
+    }
     let estimate = Arc::new(input.estimate(previous.as_deref(), STEP_BUDGET));
     drop(input);
     tracing::debug!("{} v{version}: cycle time estimated in {:?}", uri.as_str(), started.elapsed());

@@ -446,6 +446,14 @@ impl LanguageServer for Server {
             document.version = params.text_document.version;
             tracing::debug!("{} v{}: edits applied in {:?}", uri.as_str(), document.version, started.elapsed());
             self.timer.request(uri.clone(), document.version);
+            // A macrocycle or cycle file the other programs of the
+            // workspace call may have changed: their runs tell.
+            let workspace = document.workspace;
+            for (other, document) in &state.documents {
+                if document.workspace == workspace && *other != uri {
+                    self.timer.request(other.clone(), document.version);
+                }
+            }
         }
         self.analyze(uri, false);
     }
