@@ -248,7 +248,9 @@ pub struct EnvelopeMove {
 }
 
 /// Why the speed at a junction (or through a move) is below the programmed
-/// speed.
+/// speed, as the planner knows it: the velocity model says it in the
+/// control's terms, with the machine constants and the CNC8x6 stop rules
+/// (`velocity::Reason`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Limit {
     /// The caller's stop, a rapid move, thread or still block at the

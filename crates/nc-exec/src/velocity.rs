@@ -547,6 +547,28 @@ impl Planning {
     }
 }
 
+/// A limit the planner found, in the control's terms: at the junction
+/// after `this`, with the move after it and the stop the CNC8x6 rules make
+/// there, or through `this` without them. `None` for what is no drop.
+fn reason_of(limit: Limit, this: &Move, next: Option<(&Move, Option<Reason>)>, dynamics: &Dynamics) -> Option<Reason> {
+    let envelope = dynamics.envelope.as_ref();
+    Some(match limit {
+        Limit::Stop => next?.1.unwrap_or(Reason::NonMotion),
+        Limit::ShortBlock => Reason::ContinuityLength { limit: envelope.map_or(0.0, |e| e.short_block) },
+        Limit::Accuracy { angle } => Reason::Accuracy { angle },
+        Limit::Overload { angle } => Reason::Overload { angle },
+        Limit::Centrifugal { radius } => Reason::Centrifugal { radius },
+        Limit::ChordError { radius } => Reason::ArcLimit { radius },
+        Limit::MinDuration => {
+            let duration = this.length / this.programmed;
+            let shorter = next.map_or(duration, |(next, _)| duration.min(next.length / next.programmed));
+            Reason::ShortBlock { duration: shorter, limit: dynamics.min_continuity }
+        }
+        Limit::WindowEnd => Reason::WindowEnd { blocks: envelope.map_or(0, |e| e.depth) },
+        Limit::Feed | Limit::End | Limit::Ramp => return None,
+    })
+}
+
 impl PlannedSteps {
     /// Hands on the step before the one planned, now that the time this one
     /// loses to the drop between them is known.
@@ -563,35 +585,14 @@ impl PlannedSteps {
         let moving = this.kind != Kind::Still && this.length > 0.0;
         // Against the move at its programmed speed from end to end.
         let deficit = if moving { (planned.profile.duration - this.length / this.programmed).max(0.0) } else { 0.0 };
-        let envelope = dynamics.envelope.as_ref();
         let through = planned.cruise_limit.filter(|_| moving).and_then(|limit| {
-            let reason = match limit {
-                Limit::Centrifugal { radius } => Reason::Centrifugal { radius },
-                Limit::ChordError { radius } => Reason::ArcLimit { radius },
-                Limit::MinDuration => {
-                    Reason::ShortBlock { duration: this.length / this.programmed, limit: dynamics.min_continuity }
-                }
-                _ => return None,
-            };
+            let reason = reason_of(limit, &this, None, dynamics)?;
             let cruise = profile.peak / 60.0;
             let lost = (this.length / cruise - this.length / this.programmed).clamp(0.0, deficit);
             Some(Break { step: index, reason, before: this.programmed * 60.0, at: profile.peak, lost })
         });
         let exit = next.filter(|_| moving).zip(planned.exit_limit).and_then(|((_, next, stop), limit)| {
-            let reason = match limit {
-                Limit::Stop => stop.unwrap_or(Reason::NonMotion),
-                Limit::ShortBlock => Reason::ContinuityLength { limit: envelope.map_or(0.0, |e| e.short_block) },
-                Limit::Accuracy { angle } => Reason::Accuracy { angle },
-                Limit::Overload { angle } => Reason::Overload { angle },
-                Limit::Centrifugal { radius } => Reason::Centrifugal { radius },
-                Limit::ChordError { radius } => Reason::ArcLimit { radius },
-                Limit::MinDuration => Reason::ShortBlock {
-                    duration: (this.length / this.programmed).min(next.length / next.programmed),
-                    limit: dynamics.min_continuity,
-                },
-                Limit::WindowEnd => Reason::WindowEnd { blocks: envelope.map_or(0, |e| e.depth) },
-                Limit::Feed | Limit::End | Limit::Ramp => return None,
-            };
+            let reason = reason_of(limit, &this, Some((next, *stop)), dynamics)?;
             let before = if next.kind == Kind::Still { this.programmed } else { this.programmed.min(next.programmed) };
             Some(Break { step: index, reason, before: before * 60.0, at: profile.exit, lost: pause })
         });
