@@ -2566,7 +2566,7 @@ mod tests {
         }
 
         fn checkpoint_wanted(&mut self, block: usize, _offset: TextSize) -> bool {
-            self.every > 0 && block % self.every == 0
+            self.every > 0 && block.is_multiple_of(self.every)
         }
 
         fn checkpoint(&mut self, checkpoint: Checkpoint) -> ControlFlow<()> {
