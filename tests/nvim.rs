@@ -72,7 +72,7 @@ fn nvim_logs(state: &Path) -> String {
 }
 
 #[test]
-fn neovim_detects_programs_and_shows_diagnostics_and_hover() {
+fn neovim_detects_programs_and_shows_diagnostics_hover_and_the_cycle_time() {
     let Some(version) = nvim_version() else {
         if std::env::var("NCC_REQUIRE_NVIM").as_deref() == Ok("1") {
             panic!("nvim is not on the PATH, and NCC_REQUIRE_NVIM=1 requires it");
@@ -148,6 +148,14 @@ fn neovim_detects_programs_and_shows_diagnostics_and_hover() {
         "character": line.find("- ").unwrap(),
     });
     assert_eq!(output["diagnostics"], json!([space_after_sign]), "{context}");
+
+    // The predicted total on the header: 5 mm at 100 mm/min, with its
+    // ramps and the stop at the end.
+    assert_eq!(
+        output["code_lenses"],
+        json!(["Cycle time 3.02 s · cutting 3.02 s · rapid 0 s · 1 break costs 21 ms"]),
+        "{context}"
+    );
 
     let explain = Command::new(env!("CARGO_BIN_EXE_ncc")).args(["explain", "G01"]).output().unwrap();
     let explain = String::from_utf8(explain.stdout).unwrap();
