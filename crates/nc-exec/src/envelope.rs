@@ -299,7 +299,7 @@ pub struct Planned {
 
 /// The streaming planner: [`Planner::push`] each move, then
 /// [`Planner::finish`].
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct Planner {
     envelope: Envelope,
     window: VecDeque<Slot>,
@@ -356,6 +356,16 @@ struct Tail {
     cruise_limit: Limit,
     /// Stops after it: not a feed move, or shorter than R382.
     stops: Option<Limit>,
+}
+
+impl Planner {
+    /// The planner of a stream with `by` more moves before the ones it
+    /// holds.
+    pub fn shift_indices(&mut self, by: i64) {
+        let shift = |index: usize| usize::try_from((index as i64 + by).max(0)).unwrap_or(usize::MAX);
+        self.next_index = shift(self.next_index);
+        self.window.iter_mut().for_each(|slot| slot.index = shift(slot.index));
+    }
 }
 
 impl Ramp {

@@ -393,7 +393,7 @@ pub struct Timer<'a, S> {
     model: Model,
 }
 
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 #[allow(clippy::large_enum_variant, reason = "one per run, never moved while it runs")]
 enum Model {
     OneBlock(OneBlock),
@@ -478,13 +478,13 @@ impl OneBlock {
 
 /// The CNC8x9 envelope velocity: the planner's window, the steps in it,
 /// and the last step planned, which waits for its successor's time.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 struct Planning {
     planner: Planner,
     steps: PlannedSteps,
 }
 
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 struct PlannedSteps {
     /// The steps in the window, each with why the junction before it stops.
     window: VecDeque<(Step, Move, Option<Reason>)>,
@@ -494,7 +494,7 @@ struct PlannedSteps {
 
 /// A planned step whose exit break waits for the time its successor loses
 /// to the same drop.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 struct Held {
     step: Step,
     profile: Profile,
@@ -630,30 +630,23 @@ impl<S: TimingSink> StepSink for Timer<'_, S> {
         self.push(step);
     }
 
-    /// Only the CNC8x6 model goes on from checkpoints; the envelope
-    /// velocity's window is not kept.
     fn checkpoint_wanted(&mut self, block: usize, offset: TextSize) -> bool {
-        matches!(self.model, Model::OneBlock(_)) && self.sink.checkpoint_wanted(block, offset)
+        self.sink.checkpoint_wanted(block, offset)
     }
 
     fn checkpoint(&mut self, checkpoint: Checkpoint) -> ControlFlow<()> {
-        match &self.model {
-            Model::OneBlock(model) => {
-                let state = TimerState { count: self.count, end: self.end, model: model.clone() };
-                self.sink.checkpoint(checkpoint, state)
-            }
-            Model::Envelope(_) => ControlFlow::Continue(()),
-        }
+        let state = TimerState { count: self.count, end: self.end, model: self.model.clone() };
+        self.sink.checkpoint(checkpoint, state)
     }
 }
 
-/// The CNC8x6 model between two steps: the steps it holds, and how many
-/// came before.
-#[derive(Debug, Clone, PartialEq)]
+/// The model between two steps: the steps it holds (the CNC8x6 model two,
+/// the envelope velocity its look-ahead window), and how many came before.
+#[derive(Debug, Clone)]
 pub struct TimerState {
     count: usize,
     end: Axes,
-    model: OneBlock,
+    model: Model,
 }
 
 impl TimerState {
@@ -665,21 +658,40 @@ impl TimerState {
         let move_step = |step: &mut Step| {
             step.range = TextRange::new(shift_offset(step.range.start(), text), shift_offset(step.range.end(), text));
         };
-        if let Some((step, _)) = &mut shifted.model.current {
-            move_step(step);
-        }
-        if let Some(waiting) = &mut shifted.model.waiting {
-            move_step(&mut waiting.step);
-            waiting.index = shift_count(waiting.index, steps);
+        match &mut shifted.model {
+            Model::OneBlock(model) => {
+                if let Some((step, _)) = &mut model.current {
+                    move_step(step);
+                }
+                if let Some(waiting) = &mut model.waiting {
+                    move_step(&mut waiting.step);
+                    waiting.index = shift_count(waiting.index, steps);
+                }
+            }
+            Model::Envelope(planning) => {
+                planning.planner.shift_indices(steps);
+                planning.steps.window.iter_mut().for_each(|(step, _, _)| move_step(step));
+                if let Some(held) = &mut planning.steps.held {
+                    move_step(&mut held.step);
+                    for speed_break in held.exit.iter_mut().chain(&mut held.through) {
+                        speed_break.step = shift_count(speed_break.step, steps);
+                    }
+                }
+            }
         }
         shifted
     }
 
     /// Whether the model goes on from here as from `other`, whose steps'
-    /// blocks start `text` bytes earlier.
+    /// blocks start `text` bytes earlier. Only the CNC8x6 model tells: the
+    /// envelope velocity's window holds positions along the whole path,
+    /// which an edit before it moves.
     pub fn same_course(&self, other: &TimerState, text: i64) -> bool {
         let steps = self.count as i64 - other.count as i64;
-        *self == other.shifted(text, steps)
+        match (&self.model, &other.shifted(text, steps).model) {
+            (Model::OneBlock(this), Model::OneBlock(that)) => self.end == other.end && this == that,
+            _ => false,
+        }
     }
 }
 
@@ -688,7 +700,7 @@ impl<'a, S: TimingSink> Timer<'a, S> {
     /// on the same machine.
     pub fn resume(axes: &'a [u8], dynamics: &'a Dynamics, state: TimerState, sink: S) -> Self {
         let TimerState { count, end, model } = state;
-        Timer { axes, dynamics, sink, count, end, model: Model::OneBlock(model) }
+        Timer { axes, dynamics, sink, count, end, model }
     }
 }
 

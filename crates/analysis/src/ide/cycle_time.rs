@@ -53,6 +53,7 @@ pub struct Estimate {
     /// Where a later estimate may go on from, in text order, and what the
     /// run read.
     checkpoints: Vec<Stored>,
+    revisited: Option<TextSize>,
     text: Arc<String>,
     files: WorkspaceFiles,
 }
@@ -340,6 +341,10 @@ struct Charges<'a> {
     breaks: usize,
     lost: f64,
     checkpoints: Vec<Stored>,
+    /// The first block in the text that ran again after other blocks (a
+    /// jump back): a checkpoint after its start no longer has the final
+    /// charges of the blocks before it.
+    revisited: Option<TextSize>,
     change: Option<Change<'a>>,
     /// The previous estimate's checkpoint where the run took its course
     /// again, once it has.
@@ -357,6 +362,7 @@ impl<'a> Charges<'a> {
             breaks: 0,
             lost: 0.0,
             checkpoints: Vec::new(),
+            revisited: None,
             change,
             rejoined: None,
         }
@@ -464,7 +470,11 @@ impl<'a> Charges<'a> {
             );
             totals = previous.totals.moved(&old, &new);
             stopped.clone_from(&previous.stopped);
+            // The run before the checkpoint went block after block.
+            self.revisited = previous.revisited.map(|first| shift_offset(first, change.shift));
         }
+        let revisited = self.revisited;
+        self.checkpoints.retain(|stored| revisited.is_none_or(|first| stored.run.offset() <= first));
         if !self.in_order {
             self.blocks.sort_by_key(|block| block.range.start());
         }
@@ -474,6 +484,7 @@ impl<'a> Charges<'a> {
             stopped,
             rerun: TextSize::default()..rerun_end,
             checkpoints: self.checkpoints,
+            revisited,
             text: text.clone(),
             files: files.clone(),
         }
@@ -545,6 +556,10 @@ impl TimingSink for Charges<'_> {
             } else {
                 block.executions += 1;
                 block.profile = profile;
+                if block.executions > 1 {
+                    let start = block.range.start();
+                    self.revisited = Some(self.revisited.map_or(start, |first| first.min(start)));
+                }
             }
             self.current = index;
         }
@@ -991,6 +1006,23 @@ mod tests {
     }
 
     #[test]
+    fn checkpoints_after_the_first_block_a_jump_goes_back_to_are_not_used() {
+        // N1000 … N2502 run twice: a checkpoint after N1000 does not have
+        // their final charges.
+        let text = long_program(2500).replace("N99999 G00", "N99998 G73 L1000 Q1\nN99999 G00");
+        let first = estimate_of(&text, None);
+        let n1000 = TextSize::of(&text[..text.find("N1000 ").expect("the block")]);
+        assert!(first.checkpoints.iter().all(|stored| stored.run.offset() <= n1000));
+        for (edit, at) in [("", "N2000 X"), ("7", "N2000 X"), ("7", "N900 X")] {
+            let at = text.find(at).expect("the block") + 7;
+            let edited = format!("{}{edit}{}", &text[..at], &text[at..]);
+            let resumed = estimate_of(&edited, Some(&first));
+            assert_alike(&resumed, &estimate_of(&edited, None));
+            assert!(resumed.blocks.iter().any(|block| block.executions == 2));
+        }
+    }
+
+    #[test]
     fn an_edit_that_changes_everything_after_it_reruns_to_the_end() {
         let text = long_program(3000);
         let first = estimate_of(&text, None);
@@ -999,6 +1031,20 @@ mod tests {
         assert_eq!(resumed.rerun.end, TextSize::of(edited.as_str()));
         assert!(resumed.rerun.start > TextSize::default());
         assert_alike(&resumed, &estimate_of(&edited, None));
+    }
+
+    #[test]
+    fn under_the_envelope_velocity_an_edit_reruns_from_the_checkpoint_before_it_to_the_end() {
+        let machine = MachineConfig { constants: [(338, 20)].into(), ..MachineConfig::default() };
+        let files = WorkspaceFiles::default();
+        let text = Arc::new(long_program(3000));
+        let first = estimate(None, &text, &files, &machine, 1_000_000);
+        let at = text.find("N1503 X").expect("the block") + "N1503 X".len();
+        let edited = Arc::new(format!("{}7{}", &text[..at], &text[at..]));
+        let resumed = estimate(Some(&first), &edited, &files, &machine, 1_000_000);
+        assert!(edited[usize::from(resumed.rerun.start)..].starts_with("N1001 "));
+        assert_eq!(resumed.rerun.end, TextSize::of(edited.as_str()));
+        assert_alike(&resumed, &estimate(None, &edited, &files, &machine, 1_000_000));
     }
 
     #[test]
