@@ -279,6 +279,9 @@ pub struct Trace {
     /// The files the run read besides the program: source k is
     /// `files[k - 1]`.
     pub files: Vec<Called>,
+    /// Blocks the run executed, the ones before a checkpoint it resumed
+    /// from included (the step budget counts them).
+    pub blocks_run: usize,
 }
 
 impl Trace {
@@ -453,6 +456,11 @@ impl Checkpoint {
     /// The machine the run ran on.
     pub fn machine(&self) -> &MachineConfig {
         &self.runner.machine
+    }
+
+    /// Blocks the run executed before it.
+    pub fn blocks_run(&self) -> usize {
+        self.executed
     }
 
     /// Steps the run made before it.
@@ -809,6 +817,7 @@ fn run_in<'a, 's>(
         findings: runner.findings,
         tools: runner.tools,
         files: called,
+        blocks_run: executed,
     }
 }
 

@@ -54,6 +54,8 @@ pub struct Estimate {
     /// run read.
     checkpoints: Vec<Stored>,
     revisited: Option<TextSize>,
+    /// Blocks the run executed, for the step budget of a later run.
+    blocks_run: usize,
     text: Arc<String>,
     files: WorkspaceFiles,
 }
@@ -203,10 +205,12 @@ pub fn estimate(
 ) -> Estimate {
     let dynamics = Dynamics::of(machine);
     let axes = machine.step_axes();
-    let change = previous.and_then(|previous| Change::between(previous, text, files, machine));
+    let change = previous.and_then(|previous| Change::between(previous, text, files, machine, budget));
     let resumed = change.as_ref().and_then(|change| {
         let previous = change.previous;
-        let index = previous.checkpoints.partition_point(|stored| stored.run.offset() <= change.start);
+        // Strictly before: the block before a checkpoint may end where it
+        // does because of the byte after it.
+        let index = previous.checkpoints.partition_point(|stored| stored.run.offset() < change.start);
         Some((index.checked_sub(1)?, previous))
     });
     let rerun_from = resumed.map_or(TextSize::default(), |(index, previous)| previous.checkpoints[index].run.offset());
@@ -230,7 +234,7 @@ pub fn estimate(
         }
     };
     let stopped = trace.findings.iter().find(|finding| finding.fatal).map(|finding| finding.message.clone());
-    let mut estimate = charges.into_estimate(text, files, stopped);
+    let mut estimate = charges.into_estimate(text, files, stopped, trace.blocks_run);
     estimate.rerun.start = rerun_from;
     estimate
 }
@@ -245,6 +249,8 @@ struct Change<'a> {
     end: TextSize,
     /// The new text's length minus the old one's.
     shift: i64,
+    /// The step budget of the new run.
+    budget: usize,
 }
 
 impl<'a> Change<'a> {
@@ -256,6 +262,7 @@ impl<'a> Change<'a> {
         text: &str,
         files: &WorkspaceFiles,
         machine: &MachineConfig,
+        budget: usize,
     ) -> Option<Change<'a>> {
         if previous.checkpoints.first()?.run.machine() != machine {
             return None;
@@ -266,7 +273,8 @@ impl<'a> Change<'a> {
         let common_end = old.iter().rev().zip(new.iter().rev()).take(room).take_while(|(a, b)| a == b).count();
         let offset = |at: usize| TextSize::try_from(at).ok();
         let end = if previous.files == *files { new.len() - common_end } else { new.len() };
-        Some(Change { previous, start: offset(common)?, end: offset(end)?, shift: new.len() as i64 - old.len() as i64 })
+        let shift = new.len() as i64 - old.len() as i64;
+        Some(Change { previous, start: offset(common)?, end: offset(end)?, shift, budget })
     }
 }
 
@@ -445,7 +453,14 @@ impl<'a> Charges<'a> {
         checkpoints.get(index).filter(|stored| stored.run.offset() == old).map(|_| index)
     }
 
-    fn into_estimate(mut self, text: &Arc<String>, files: &WorkspaceFiles, stopped: Option<String>) -> Estimate {
+    fn into_estimate(
+        mut self,
+        text: &Arc<String>,
+        files: &WorkspaceFiles,
+        stopped: Option<String>,
+        blocks_run: usize,
+    ) -> Estimate {
+        let mut blocks_run = blocks_run;
         let mut totals = cycle_totals(&self.totals, self.breaks, self.lost);
         let mut stopped = stopped;
         let mut rerun_end = TextSize::of(text.as_str());
@@ -470,6 +485,7 @@ impl<'a> Charges<'a> {
             );
             totals = previous.totals.moved(&old, &new);
             stopped.clone_from(&previous.stopped);
+            blocks_run = previous.blocks_run - from.run.blocks_run() + to.run.blocks_run();
             // The run before the checkpoint went block after block.
             self.revisited = previous.revisited.map(|first| shift_offset(first, change.shift));
         }
@@ -485,6 +501,7 @@ impl<'a> Charges<'a> {
             rerun: TextSize::default()..rerun_end,
             checkpoints: self.checkpoints,
             revisited,
+            blocks_run,
             text: text.clone(),
             files: files.clone(),
         }
@@ -581,7 +598,11 @@ impl TimingSink for Charges<'_> {
         let rejoins = counterpart.zip(self.change.as_ref()).is_some_and(|(index, change)| {
             let old = &change.previous.checkpoints[index];
             let charged = |mark: &Mark, shift| mark.last.as_ref().map(|last| last.charged(shift));
-            stored.run.same_course(&old.run)
+            // The blocks the previous run ran after its checkpoint still
+            // fit in the budget.
+            let blocks_run = change.previous.blocks_run - old.run.blocks_run() + stored.run.blocks_run();
+            blocks_run <= change.budget
+                && stored.run.same_course(&old.run)
                 && stored.model.same_course(&old.model, change.shift)
                 && charged(&stored.charges, 0) == charged(&old.charges, change.shift)
         });
@@ -1020,6 +1041,22 @@ mod tests {
             assert_alike(&resumed, &estimate_of(&edited, None));
             assert!(resumed.blocks.iter().any(|block| block.executions == 2));
         }
+    }
+
+    #[test]
+    fn a_block_more_in_a_program_that_fills_the_step_budget_stops_the_run() {
+        let machine = MachineConfig::default();
+        let files = WorkspaceFiles::default();
+        let text = Arc::new(long_program(2500));
+        let budget = estimate(None, &text, &files, &machine, 1_000_000).blocks_run;
+        let first = estimate(None, &text, &files, &machine, budget);
+        assert_eq!(first.stopped, None);
+        let at = text.find("N1503 ").expect("the block");
+        let edited = Arc::new(format!("{}N5 X1 Y1\n{}", &text[..at], &text[at..]));
+        let resumed = estimate(Some(&first), &edited, &files, &machine, budget);
+        let whole = estimate(None, &edited, &files, &machine, budget);
+        assert!(whole.stopped.is_some());
+        assert_alike(&resumed, &whole);
     }
 
     #[test]
