@@ -54,8 +54,9 @@ pub struct Estimate {
     /// run read.
     checkpoints: Vec<Stored>,
     revisited: Option<TextSize>,
-    /// Blocks the run executed, for the step budget of a later run.
+    /// Blocks the run executed, and the most it could.
     blocks_run: usize,
+    budget: usize,
     text: Arc<String>,
     files: WorkspaceFiles,
 }
@@ -234,7 +235,7 @@ pub fn estimate(
         }
     };
     let stopped = trace.findings.iter().find(|finding| finding.fatal).map(|finding| finding.message.clone());
-    let mut estimate = charges.into_estimate(text, files, stopped, trace.blocks_run);
+    let mut estimate = charges.into_estimate(text, files, stopped, (trace.blocks_run, budget));
     estimate.rerun.start = rerun_from;
     estimate
 }
@@ -443,7 +444,7 @@ impl<'a> Charges<'a> {
     /// The previous estimate's checkpoint at `offset`, when the text after
     /// it is alike and the run there may take its course again.
     fn counterpart(&self, offset: TextSize) -> Option<usize> {
-        let change = self.change.as_ref().filter(|change| change.previous.stopped.is_none())?;
+        let change = self.change.as_ref()?;
         if offset < change.end {
             return None;
         }
@@ -458,7 +459,7 @@ impl<'a> Charges<'a> {
         text: &Arc<String>,
         files: &WorkspaceFiles,
         stopped: Option<String>,
-        blocks_run: usize,
+        (blocks_run, budget): (usize, usize),
     ) -> Estimate {
         let mut blocks_run = blocks_run;
         let mut totals = cycle_totals(&self.totals, self.breaks, self.lost);
@@ -502,6 +503,7 @@ impl<'a> Charges<'a> {
             checkpoints: self.checkpoints,
             revisited,
             blocks_run,
+            budget,
             text: text.clone(),
             files: files.clone(),
         }
@@ -598,10 +600,14 @@ impl TimingSink for Charges<'_> {
         let rejoins = counterpart.zip(self.change.as_ref()).is_some_and(|(index, change)| {
             let old = &change.previous.checkpoints[index];
             let charged = |mark: &Mark, shift| mark.last.as_ref().map(|last| last.charged(shift));
-            // The blocks the previous run ran after its checkpoint still
-            // fit in the budget.
-            let blocks_run = change.previous.blocks_run - old.run.blocks_run() + stored.run.blocks_run();
-            blocks_run <= change.budget
+            // The previous run did not stop for the budget, and the blocks
+            // it ran after its checkpoint still fit in it: an error it
+            // stopped at, the run stops at again.
+            let previous = change.previous;
+            let blocks_run = previous.blocks_run - old.run.blocks_run() + stored.run.blocks_run();
+            previous.budget == change.budget
+                && previous.blocks_run <= change.budget
+                && blocks_run <= change.budget
                 && stored.run.same_course(&old.run)
                 && stored.model.same_course(&old.model, change.shift)
                 && charged(&stored.charges, 0) == charged(&old.charges, change.shift)
@@ -1112,10 +1118,10 @@ mod tests {
 
         /// Resumed estimates equal whole runs, edit after edit: digits
         /// typed or deleted, blocks inserted or removed, a jump back or
-        /// forward inserted.
+        /// forward inserted, a jump to no block (the run stops there).
         #[test]
         fn resumed_estimates_equal_whole_runs(
-            edits in proptest::collection::vec((0.0f64..1.0, 0u8..5), 1..4),
+            edits in proptest::collection::vec((0.0f64..1.0, 0u8..6), 1..4),
         ) {
             let mut text = long_program(2500);
             let mut previous = estimate_of(&text, None);
@@ -1128,6 +1134,7 @@ mod tests {
                     (1, Some(at)) => { text.remove(at); }
                     (2, _) => text.insert_str(line_start, "N5 G01 X1 Y1 F2000\n"),
                     (3, _) if line_start > 0 => text.insert_str(line_start, "N6 G73 L1000 Q1\n"),
+                    (4, _) if line_start > 0 => text.insert_str(line_start, "N7 G73 L77777 Q1\n"),
                     _ if line_start > 0 && line_end < text.len() => text.replace_range(line_start..line_end, ""),
                     _ => {}
                 }
