@@ -146,7 +146,12 @@ fn run(state: &Mutex<State>, uri: &Uri, version: i32) -> bool {
     }
     let estimate = Arc::new(input.estimate(previous.as_deref(), STEP_BUDGET));
     drop(input);
-    tracing::debug!("{} v{version}: cycle time estimated in {:?}", uri.as_str(), started.elapsed());
+    let rerun = &estimate.rerun;
+    tracing::debug!(
+        "{} v{version}: cycle time estimated in {:?}, running bytes {rerun:?}",
+        uri.as_str(),
+        started.elapsed()
+    );
     let mut state = lock(state);
     match state.documents.get_mut(uri) {
         Some(document) if document.version == version => {
