@@ -875,7 +875,6 @@ impl<'a> Blocks<'a> {
         let mut opens_with_g79 = false;
         let expected = expected_blocks(&text);
         self.ranges.reserve(expected);
-        self.units.unit_of.reserve(expected);
         self.units.numbers.reserve(expected);
         self.file_starts.push(first);
         let mut reader = BlockReader::new(&text);
@@ -1102,13 +1101,13 @@ impl<'a, 's> Index<'a, 's> {
 struct Units {
     /// Subprogram starts (`G79 L`): the block index, its file and the label.
     starts: Vec<(usize, usize, u32)>,
-    /// The unit of each block (each file's first unit is its main body or
-    /// macrocycle body, then one per subprogram).
-    unit_of: Vec<u32>,
+    /// Where each unit starts, in block order (each file's first unit is
+    /// its main body or macrocycle body, then one per subprogram): the
+    /// units are runs of blocks.
+    unit_starts: Vec<usize>,
     /// Block numbers with their block, sorted; only numbers a jump can
     /// name (`L` is at most 4 digits), in a million-block program's index.
     numbers: Vec<(u32, u32)>,
-    units: u32,
 }
 
 impl Units {
@@ -1117,19 +1116,18 @@ impl Units {
     /// whether the block starts a subprogram.
     fn add(&mut self, index: usize, source: usize, block: &BlockData, opens_file: bool) -> bool {
         if opens_file {
-            self.units += 1;
+            self.unit_starts.push(index);
         }
         // Each `G79` opens a unit: a subprogram, a cycle file's body, or a
         // macrocycle file's body (whose file opened one already).
         if block.has_code(b'G', 79) {
-            self.units += 1;
+            self.unit_starts.push(index);
             let label = match block.word(b'L').and_then(|word| word.value.as_ref()) {
                 Some(Value::Literal(decimal)) => whole_number(decimal),
                 _ => None,
             };
             self.starts.extend(label.map(|label| (index, source, label)));
         }
-        self.unit_of.push(self.units);
         let number = block.number.and_then(|number| u32::try_from(number.value?).ok());
         if let Some((number, index)) = number.zip(u32::try_from(index).ok()) {
             self.numbers.push((number, index));
@@ -1146,15 +1144,20 @@ impl Units {
         self.starts.iter().find(|&&(_, file, l)| file == source && l == label).map(|&(at, _, _)| at + 1)
     }
 
+    /// The unit of block `index`.
+    fn unit_of(&self, index: usize) -> usize {
+        self.unit_starts.partition_point(|&start| start <= index)
+    }
+
     /// The block numbered `label` in the unit of block `from`.
     fn jump_target(&self, from: usize, label: u32) -> Option<usize> {
-        let unit = self.unit_of[from];
+        let unit = self.unit_of(from);
         let first = self.numbers.partition_point(|&(number, _)| number < label);
         self.numbers[first..]
             .iter()
             .take_while(|&&(number, _)| number == label)
             .map(|&(_, at)| at as usize)
-            .find(|&at| self.unit_of[at] == unit)
+            .find(|&at| self.unit_of(at) == unit)
     }
 }
 
@@ -1417,8 +1420,21 @@ impl Runner {
                 _ => self.not_run(&format!("G{number:02}"), code_range),
             }
         }
+        // Technology functions (M, S, T, D) and F keep R383 from merging
+        // the block (04 §1.9.4).
+        let mut technology = false;
+        let mut writes_speed = false;
+        let mut axes: SmallVec<[&Word; 8]> = SmallVec::new();
         for word in &block.words {
-            match self.catalogue.role_of(word.letter) {
+            let role = self.catalogue.role_of(word.letter);
+            technology |= word.letter == b'M'
+                || matches!(
+                    role,
+                    Some(AddressRole::Feed | AddressRole::Speed | AddressRole::Tool | AddressRole::Offset)
+                );
+            writes_speed |= role == Some(AddressRole::Speed);
+            match role {
+                Some(AddressRole::Axis) => axes.push(word),
                 Some(AddressRole::Feed) => self.feed = self.programmed_feed(word),
                 Some(AddressRole::Speed) => match self.count(word) {
                     // `G76 S` limits the speed of constant cutting speed.
@@ -1448,12 +1464,9 @@ impl Runner {
             }
         }
         // When constant cutting speed ends, S keeps the speed it reached.
-        let writes_speed = block.words.iter().any(|w| self.catalogue.role_of(w.letter) == Some(AddressRole::Speed));
         if css_before && !self.feed_mode().css && !writes_speed {
             self.speed = self.speed_reached.take().unwrap_or(self.speed);
         }
-        let mut axes: SmallVec<[&Word; 8]> =
-            block.words.iter().filter(|w| self.catalogue.role_of(w.letter) == Some(AddressRole::Axis)).collect();
         // A block of group 11 names its axes as the function's parameters:
         // it does not move (03 §3).
         if let Some(&(_, code, code_range)) = codes.iter().find(|&&(l, n, _)| l == b'G' && matches!(n, 31 | 34..=39)) {
@@ -1520,13 +1533,6 @@ impl Runner {
         };
         let path = moved.path;
         let m_functions = codes.iter().filter(|&&(letter, code, _)| letter == b'M' && !matches!(code, 0..=2 | 6 | 30));
-        let technology = block.words.iter().any(|word| {
-            word.letter == b'M'
-                || matches!(
-                    self.catalogue.role_of(word.letter),
-                    Some(AddressRole::Feed | AddressRole::Speed | AddressRole::Tool | AddressRole::Offset)
-                )
-        });
         let functions = Functions {
             m_functions: u8::try_from(m_functions.count()).unwrap_or(u8::MAX),
             tool_change: has(b'M', 6),

@@ -110,7 +110,9 @@ impl Decimal {
     pub fn scaled(&self, scale: u32) -> Option<i128> {
         let mantissa = i128::from(self.mantissa?);
         let frac_digits = self.frac_digits();
-        let magnitude = if scale >= frac_digits {
+        let magnitude = if scale == frac_digits {
+            mantissa
+        } else if scale > frac_digits {
             mantissa.checked_mul(10i128.checked_pow(scale - frac_digits)?)?
         } else {
             let divisor = 10i128.checked_pow(frac_digits - scale)?;
