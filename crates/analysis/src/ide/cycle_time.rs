@@ -62,7 +62,7 @@ pub struct Estimate {
 }
 
 /// One block of the file as it ran.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct BlockTime {
     pub range: TextRange,
     /// Seconds since the program's start when its first execution starts
@@ -78,9 +78,17 @@ pub struct BlockTime {
     pub breaks: SmallVec<[BreakAt; 1]>,
 }
 
+/// Every estimate after an edit copies the blocks it keeps: their breaks
+/// as bytes.
+impl Clone for BlockTime {
+    fn clone(&self) -> BlockTime {
+        BlockTime { breaks: SmallVec::from_slice(&self.breaks), ..*self }
+    }
+}
+
 /// The drops of the path speed at a block for one reason, over all its
 /// executions.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BreakAt {
     /// Displayed, the reason in the control's terms; `code()`, its short
     /// name.
@@ -269,14 +277,40 @@ impl<'a> Change<'a> {
             return None;
         }
         let (old, new) = (previous.text.as_bytes(), text.as_bytes());
-        let common = old.iter().zip(new).take_while(|(a, b)| a == b).count();
-        let room = old.len().min(new.len()) - common;
-        let common_end = old.iter().rev().zip(new.iter().rev()).take(room).take_while(|(a, b)| a == b).count();
+        let common = common_prefix(old, new);
+        // After the common start, so that the two do not overlap.
+        let common_end = common_suffix(&old[common..], &new[common..]);
         let offset = |at: usize| TextSize::try_from(at).ok();
         let end = if previous.files == *files { new.len() - common_end } else { new.len() };
         let shift = new.len() as i64 - old.len() as i64;
         Some(Change { previous, start: offset(common)?, end: offset(end)?, shift, budget })
     }
+}
+
+/// Bytes compared a run at a time, with `memcmp`, before byte by byte.
+const COMPARED_RUN: usize = 4096;
+
+/// How many bytes `a` and `b` start with alike.
+fn common_prefix(a: &[u8], b: &[u8]) -> usize {
+    let len = a.len().min(b.len());
+    let mut at = 0;
+    while at + COMPARED_RUN <= len && a[at..at + COMPARED_RUN] == b[at..at + COMPARED_RUN] {
+        at += COMPARED_RUN;
+    }
+    at + a[at..len].iter().zip(&b[at..len]).take_while(|(x, y)| x == y).count()
+}
+
+/// How many bytes `a` and `b` end with alike.
+fn common_suffix(a: &[u8], b: &[u8]) -> usize {
+    let len = a.len().min(b.len());
+    let (a, b) = (&a[a.len() - len..], &b[b.len() - len..]);
+    let mut alike = 0;
+    while alike + COMPARED_RUN <= len
+        && a[len - alike - COMPARED_RUN..len - alike] == b[len - alike - COMPARED_RUN..len - alike]
+    {
+        alike += COMPARED_RUN;
+    }
+    alike + a[..len - alike].iter().rev().zip(b[..len - alike].iter().rev()).take_while(|(x, y)| x == y).count()
 }
 
 /// A checkpoint of the run, the model's state and the charges there.
@@ -1111,6 +1145,24 @@ mod tests {
         // 20 mm more at the last feed, 900 mm/min.
         let longer = resumed.totals.total - first.totals.total;
         assert!((longer - 20.0 / 15.0).abs() < 0.05, "{longer}");
+    }
+
+    proptest::proptest! {
+        /// The run-at-a-time comparisons count what byte by byte does.
+        #[test]
+        fn common_starts_and_ends_are_counted_exactly(
+            shared in proptest::collection::vec(0u8..3, 0..9000),
+            a in proptest::collection::vec(0u8..3, 0..30),
+            b in proptest::collection::vec(0u8..3, 0..30),
+            tail in proptest::collection::vec(0u8..3, 0..9000),
+        ) {
+            let left: Vec<u8> = [&shared[..], &a, &tail].concat();
+            let right: Vec<u8> = [&shared[..], &b, &tail].concat();
+            let prefix = left.iter().zip(&right).take_while(|(x, y)| x == y).count();
+            let suffix = left.iter().rev().zip(right.iter().rev()).take_while(|(x, y)| x == y).count();
+            proptest::prop_assert_eq!(common_prefix(&left, &right), prefix);
+            proptest::prop_assert_eq!(common_suffix(&left, &right), suffix);
+        }
     }
 
     proptest::proptest! {
