@@ -709,8 +709,15 @@ fn exec_benchmark(ncc: &Path, blocks: usize, runs: usize, as_json: bool) -> anyh
     let moves = progen::surfacing(blocks);
     let dir = tempfile::tempdir()?;
     let (cnc, ngc) = (dir.path().join("surface.NCP"), dir.path().join("surface.ngc"));
-    std::fs::write(&cnc, progen::write(&moves, Syntax::Cnc8x6))?;
-    std::fs::write(&ngc, progen::write(&moves, Syntax::Ngc))?;
+    // On disk before the runs, so that writing them back does not run
+    // beside one tool's runs and not the other's.
+    let write_synced = |path: &Path, text: String| -> std::io::Result<()> {
+        let mut file = std::fs::File::create(path)?;
+        std::io::Write::write_all(&mut file, text.as_bytes())?;
+        file.sync_all()
+    };
+    write_synced(&cnc, progen::write(&moves, Syntax::Cnc8x6))?;
+    write_synced(&ngc, progen::write(&moves, Syntax::Ngc))?;
     drop(moves);
     let mut ncc_run = Process::new(ncc);
     ncc_run.arg("run").arg(&cnc).stdout(Stdio::null());
@@ -725,6 +732,9 @@ fn exec_benchmark(ncc: &Path, blocks: usize, runs: usize, as_json: bool) -> anyh
     let rs274_output = rs274_run.output()?;
     anyhow::ensure!(rs274_output.status.success(), "rs274 failed:\n{}", String::from_utf8_lossy(&rs274_output.stderr));
 
+    // Each tool's runs one after the other: on a virtual machine a CPU
+    // that sat idle (the second one, while single-threaded rs274 ran) is
+    // slow to come back, which would fall on ncc's threads alone.
     let timed = |process: &mut Process| -> anyhow::Result<Duration> {
         let mut best = Duration::MAX;
         for _ in 0..runs {
