@@ -724,17 +724,14 @@ fn exec_benchmark(ncc: &Path, blocks: usize, runs: usize, as_json: bool) -> anyh
     let mut rs274_run = Process::new(&rs274);
     rs274_run.arg("-g").arg(&ngc).stdin(Stdio::null()).stdout(Stdio::null());
 
-    // Untimed first runs: both must reach the program end, and they bring
-    // the files into the page cache. What ncc does not run yet it names.
-    let ncc_output = ncc_run.output()?;
-    let ncc_notes = String::from_utf8_lossy(&ncc_output.stderr).replace(&format!("{}/", dir.path().display()), "");
-    anyhow::ensure!(ncc_output.status.success(), "ncc run failed:\n{ncc_notes}");
+    // Each tool's runs one after the other, an untimed one first: on a
+    // virtual machine a CPU that sat idle (the second one, while
+    // single-threaded rs274 ran) is slow to come back, which would fall on
+    // ncc's threads alone. The untimed runs must reach the program end, and
+    // bring the files into the page cache. What ncc does not run yet it
+    // names.
     let rs274_output = rs274_run.output()?;
     anyhow::ensure!(rs274_output.status.success(), "rs274 failed:\n{}", String::from_utf8_lossy(&rs274_output.stderr));
-
-    // Each tool's runs one after the other: on a virtual machine a CPU
-    // that sat idle (the second one, while single-threaded rs274 ran) is
-    // slow to come back, which would fall on ncc's threads alone.
     let timed = |process: &mut Process| -> anyhow::Result<Duration> {
         let mut best = Duration::MAX;
         for _ in 0..runs {
@@ -745,8 +742,11 @@ fn exec_benchmark(ncc: &Path, blocks: usize, runs: usize, as_json: bool) -> anyh
         }
         Ok(best)
     };
-    let ncc_time = timed(&mut ncc_run)?;
     let rs274_time = timed(&mut rs274_run)?;
+    let ncc_output = ncc_run.output()?;
+    let ncc_notes = String::from_utf8_lossy(&ncc_output.stderr).replace(&format!("{}/", dir.path().display()), "");
+    anyhow::ensure!(ncc_output.status.success(), "ncc run failed:\n{ncc_notes}");
+    let ncc_time = timed(&mut ncc_run)?;
     let rate = |time: Duration| blocks as f64 / time.as_secs_f64();
     if as_json {
         let output = json!({
