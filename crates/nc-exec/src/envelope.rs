@@ -22,6 +22,7 @@ use std::collections::VecDeque;
 
 use crate::{
     machine::MachineConfig,
+    run::shift_count,
     velocity::{Dynamics, MIN_CONTINUITY_MS, Profile},
 };
 
@@ -362,9 +363,8 @@ impl Planner {
     /// The planner of a stream with `by` more moves before the ones it
     /// holds.
     pub fn shift_indices(&mut self, by: i64) {
-        let shift = |index: usize| usize::try_from((index as i64 + by).max(0)).unwrap_or(usize::MAX);
-        self.next_index = shift(self.next_index);
-        self.window.iter_mut().for_each(|slot| slot.index = shift(slot.index));
+        self.next_index = shift_count(self.next_index, by);
+        self.window.iter_mut().for_each(|slot| slot.index = shift_count(slot.index, by));
     }
 }
 

@@ -493,6 +493,11 @@ pub fn shift_offset(offset: TextSize, by: i64) -> TextSize {
     TextSize::from(u32::try_from((i64::from(u32::from(offset)) + by).max(0)).unwrap_or(u32::MAX))
 }
 
+/// `range` moved by `by` bytes.
+pub fn shift_range(range: TextRange, by: i64) -> TextRange {
+    TextRange::new(shift_offset(range.start(), by), shift_offset(range.end(), by))
+}
+
 /// `count` moved by `by`, never below zero.
 pub fn shift_count(count: usize, by: i64) -> usize {
     usize::try_from((count as i64 + by).max(0)).unwrap_or(usize::MAX)

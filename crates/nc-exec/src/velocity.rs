@@ -25,12 +25,12 @@
 
 use std::{collections::VecDeque, ops::ControlFlow};
 
-use ncc_syntax::{TextRange, TextSize};
+use ncc_syntax::TextSize;
 
 use crate::{
     envelope::{Envelope, EnvelopeMove, Limit, MoveKind, Planned, Planner},
     machine::MachineConfig,
-    run::{Axes, Checkpoint, Joining, MAX_AXES, Motion, Path, Step, StepSink, Trace, shift_count, shift_offset},
+    run::{Axes, Checkpoint, Joining, MAX_AXES, Motion, Path, Step, StepSink, Trace, shift_count, shift_range},
 };
 
 /// The interpolator tick of the CNC8x6 (000:2749).
@@ -655,9 +655,7 @@ impl TimerState {
     pub fn shifted(&self, text: i64, steps: i64) -> TimerState {
         let mut shifted = self.clone();
         shifted.count = shift_count(self.count, steps);
-        let move_step = |step: &mut Step| {
-            step.range = TextRange::new(shift_offset(step.range.start(), text), shift_offset(step.range.end(), text));
-        };
+        let move_step = |step: &mut Step| step.range = shift_range(step.range, text);
         match &mut shifted.model {
             Model::OneBlock(model) => {
                 if let Some((step, _)) = &mut model.current {

@@ -12,7 +12,7 @@
 use std::{fmt::Write as _, ops::ControlFlow, sync::Arc};
 
 use nc_exec::{
-    run::{Checkpoint, Environment, Motion, Step, Totals, shift_count, shift_offset},
+    run::{Checkpoint, Environment, Motion, Step, Totals, shift_count, shift_offset, shift_range},
     velocity::{self, Break, Dynamics, Reason, Timer, TimerState, TimingSink},
 };
 use ncc_syntax::{TextRange, TextSize, ast::AstNode};
@@ -360,8 +360,12 @@ impl BlockTime {
     /// The block in a text where it starts `shift` bytes later, its runs
     /// `clock` seconds later.
     fn moved(&self, shift: i64, clock: f64) -> BlockTime {
-        let range = TextRange::new(shift_offset(self.range.start(), shift), shift_offset(self.range.end(), shift));
-        BlockTime { range, start: self.start + clock, end: self.end + clock, ..self.clone() }
+        BlockTime {
+            range: shift_range(self.range, shift),
+            start: self.start + clock,
+            end: self.end + clock,
+            ..self.clone()
+        }
     }
 
     /// The block as charged so far, without when it ran.
