@@ -53,6 +53,8 @@ pub struct Estimate {
     /// Where a later estimate may go on from, in text order, and what the
     /// run read.
     checkpoints: Vec<Stored>,
+    /// What `totals` shows, as a later estimate moves it.
+    sums: Sums,
     revisited: Option<TextSize>,
     /// Blocks the run executed, and the most it could.
     blocks_run: usize,
@@ -328,9 +330,40 @@ struct Mark {
     /// steps may wait in the model).
     blocks: usize,
     last: Option<BlockTime>,
+    sums: Sums,
+}
+
+/// What a run adds up to: the executor's totals, the breaks and what they
+/// cost.
+#[derive(Debug, Clone, Copy, Default)]
+struct Sums {
     totals: Totals,
     breaks: usize,
     lost: f64,
+}
+
+impl Sums {
+    /// These sums of a run whose part up to a checkpoint summed to `from`,
+    /// after that part changed to sum to `to`.
+    fn moved(&self, from: &Sums, to: &Sums) -> Sums {
+        Sums {
+            totals: self.totals.moved(&from.totals, &to.totals),
+            breaks: (self.breaks + to.breaks).saturating_sub(from.breaks),
+            lost: self.lost - from.lost + to.lost,
+        }
+    }
+
+    fn cycle_totals(&self) -> CycleTotals {
+        let totals = &self.totals;
+        CycleTotals {
+            total: totals.total_time,
+            cutting: totals.time(Motion::Feed),
+            rapid: totals.time(Motion::Rapid),
+            dwell: totals.time(Motion::Dwell),
+            breaks: self.breaks,
+            lost: self.lost,
+        }
+    }
 }
 
 impl Stored {
@@ -340,17 +373,15 @@ impl Stored {
         let blocks = to.charges.blocks as i64 - from.charges.blocks as i64;
         let steps = to.run.steps() as i64 - from.run.steps() as i64;
         let run_blocks = to.run.block() as i64 - from.run.block() as i64;
-        let clock = to.charges.totals.total_time - from.charges.totals.total_time;
-        let (from, to) = (&from.charges, &to.charges);
+        let (from, to) = (&from.charges.sums, &to.charges.sums);
+        let clock = to.totals.total_time - from.totals.total_time;
         Stored {
             run: self.run.shifted(shift, run_blocks, steps),
             model: self.model.shifted(shift, steps),
             charges: Mark {
                 blocks: shift_count(self.charges.blocks, blocks),
                 last: self.charges.last.as_ref().map(|last| last.moved(shift, clock)),
-                totals: self.charges.totals.moved(&from.totals, &to.totals),
-                breaks: (self.charges.breaks + to.breaks).saturating_sub(from.breaks),
-                lost: self.charges.lost - from.lost + to.lost,
+                sums: self.charges.sums.moved(from, to),
             },
         }
     }
@@ -384,9 +415,7 @@ struct Charges<'a> {
     /// The block of the last step of this file: steps of other files are
     /// its, and a new execution starts when another block's step comes.
     current: Option<usize>,
-    totals: Totals,
-    breaks: usize,
-    lost: f64,
+    sums: Sums,
     checkpoints: Vec<Stored>,
     /// The first block in the text that ran again after other blocks (a
     /// jump back): a checkpoint after its start no longer has the final
@@ -405,9 +434,7 @@ impl<'a> Charges<'a> {
             in_order: true,
             index_of: FxHashMap::default(),
             current: None,
-            totals: Totals::default(),
-            breaks: 0,
-            lost: 0.0,
+            sums: Sums::default(),
             checkpoints: Vec::new(),
             revisited: None,
             change,
@@ -423,9 +450,7 @@ impl<'a> Charges<'a> {
         self.blocks = previous.blocks[..charged].to_vec();
         self.blocks.extend(mark.last.clone());
         self.current = self.blocks.len().checked_sub(1);
-        self.totals = mark.totals;
-        self.breaks = mark.breaks;
-        self.lost = mark.lost;
+        self.sums = mark.sums;
         self.checkpoints = previous.checkpoints[..index].to_vec();
     }
 
@@ -459,8 +484,8 @@ impl<'a> Charges<'a> {
     fn add_block(&mut self, step: &Step) -> usize {
         self.blocks.push(BlockTime {
             range: step.range,
-            start: self.totals.total_time,
-            end: self.totals.total_time,
+            start: self.sums.totals.total_time,
+            end: self.sums.totals.total_time,
             total: 0.0,
             executions: 0,
             profile: velocity::Profile::default(),
@@ -470,13 +495,7 @@ impl<'a> Charges<'a> {
     }
 
     fn mark(&self) -> Mark {
-        Mark {
-            blocks: self.blocks.len(),
-            last: self.blocks.last().cloned(),
-            totals: self.totals,
-            breaks: self.breaks,
-            lost: self.lost,
-        }
+        Mark { blocks: self.blocks.len(), last: self.blocks.last().cloned(), sums: self.sums }
     }
 
     /// The previous estimate's checkpoint at `offset`, when the text after
@@ -496,12 +515,10 @@ impl<'a> Charges<'a> {
         mut self,
         text: &Arc<String>,
         files: &WorkspaceFiles,
-        stopped: Option<String>,
-        (blocks_run, budget): (usize, usize),
+        mut stopped: Option<String>,
+        (mut blocks_run, budget): (usize, usize),
     ) -> Estimate {
-        let mut blocks_run = blocks_run;
-        let mut totals = cycle_totals(&self.totals, self.breaks, self.lost);
-        let mut stopped = stopped;
+        let mut sums = self.sums;
         let mut rerun_end = TextSize::of(text.as_str());
         // The rejoining checkpoint is the run's last.
         let rejoined = self.rejoined.zip(self.checkpoints.last().cloned());
@@ -511,18 +528,14 @@ impl<'a> Charges<'a> {
             let previous = change.previous;
             let (from, to) = (&previous.checkpoints[index], &to);
             rerun_end = to.run.offset();
-            let clock = to.charges.totals.total_time - from.charges.totals.total_time;
+            let clock = to.charges.sums.totals.total_time - from.charges.sums.totals.total_time;
             let kept = to.charges.blocks.saturating_sub(1);
             self.blocks.truncate(kept);
             let first_old = from.charges.blocks.saturating_sub(1);
             self.blocks.extend(previous.blocks[first_old..].iter().map(|block| block.moved(change.shift, clock)));
             let later = previous.checkpoints[index + 1..].iter().map(|stored| stored.moved(from, to, change.shift));
             self.checkpoints.extend(later.collect::<Vec<_>>());
-            let (old, new) = (
-                cycle_totals(&from.charges.totals, from.charges.breaks, from.charges.lost),
-                cycle_totals(&to.charges.totals, to.charges.breaks, to.charges.lost),
-            );
-            totals = previous.totals.moved(&old, &new);
+            sums = previous.sums.moved(&from.charges.sums, &to.charges.sums);
             stopped.clone_from(&previous.stopped);
             blocks_run = previous.blocks_run - from.run.blocks_run() + to.run.blocks_run();
             // The run before the checkpoint went block after block.
@@ -535,7 +548,8 @@ impl<'a> Charges<'a> {
         }
         Estimate {
             blocks: self.blocks,
-            totals,
+            totals: sums.cycle_totals(),
+            sums,
             stopped,
             rerun: TextSize::default()..rerun_end,
             checkpoints: self.checkpoints,
@@ -548,36 +562,10 @@ impl<'a> Charges<'a> {
     }
 }
 
-fn cycle_totals(totals: &Totals, breaks: usize, lost: f64) -> CycleTotals {
-    CycleTotals {
-        total: totals.total_time,
-        cutting: totals.time(Motion::Feed),
-        rapid: totals.time(Motion::Rapid),
-        dwell: totals.time(Motion::Dwell),
-        breaks,
-        lost,
-    }
-}
-
-impl CycleTotals {
-    /// See [`Totals::moved`].
-    fn moved(&self, from: &CycleTotals, to: &CycleTotals) -> CycleTotals {
-        let shift = |value: f64, from: f64, to: f64| value - from + to;
-        CycleTotals {
-            total: shift(self.total, from.total, to.total),
-            cutting: shift(self.cutting, from.cutting, to.cutting),
-            rapid: shift(self.rapid, from.rapid, to.rapid),
-            dwell: shift(self.dwell, from.dwell, to.dwell),
-            breaks: (self.breaks + to.breaks).saturating_sub(from.breaks),
-            lost: shift(self.lost, from.lost, to.lost),
-        }
-    }
-}
-
 impl TimingSink for Charges<'_> {
     fn speed_break(&mut self, step: &Step, speed_break: Break) {
-        self.breaks += 1;
-        self.lost += speed_break.lost;
+        self.sums.breaks += 1;
+        self.sums.lost += speed_break.lost;
         let Some(index) = self.block_of(step) else { return };
         let block = &mut self.blocks[index];
         let code = speed_break.reason.code();
@@ -599,8 +587,8 @@ impl TimingSink for Charges<'_> {
     }
 
     fn timed(&mut self, step: &Step, profile: velocity::Profile) {
-        let start = self.totals.total_time;
-        self.totals.add(step, profile.duration);
+        let start = self.sums.totals.total_time;
+        self.sums.totals.add(step, profile.duration);
         let index = self.block_of(step);
         if step.source == 0
             && let Some(own) = index
