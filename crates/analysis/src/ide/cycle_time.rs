@@ -784,8 +784,9 @@ fn hms(seconds: f64) -> (f64, f64, f64) {
 
 /// `h:mm:ss.sss`, for reports.
 pub fn clock(seconds: f64) -> String {
-    let (hours, minutes, seconds) = hms(seconds);
-    format!("{hours}:{minutes:02}:{seconds:06.3}")
+    // Whole milliseconds first, so that 59.9999 s is `0:01:00.000`.
+    let ms = (seconds.max(0.0) * 1000.0).round() as u64;
+    format!("{}:{:02}:{:02}.{:03}", ms / 3_600_000, ms / 60_000 % 60, ms / 1000 % 60, ms % 1000)
 }
 
 /// A short time for the editor: `0 s`, `0.4 ms`, `420 ms`, `4.25 s`,
@@ -1208,5 +1209,8 @@ mod tests {
         "#]]
         .assert_debug_eq(&shown);
         assert_eq!(clock(3723.4), "1:02:03.400");
+        // Rounded to the millisecond before it is split: never `:60.000`.
+        assert_eq!(clock(119_999.999_9), "33:20:00.000");
+        assert_eq!(clock(59.9996), "0:01:00.000");
     }
 }
