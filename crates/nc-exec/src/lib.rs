@@ -21,6 +21,8 @@
 //!   readers for the control's files.
 //! - [`modes`]: the active code of every G and M group.
 //! - [`run`]: running a program block by block into a [`run::Trace`].
+//! - [`tool_path`]: the moves and positions of the tool centre, which
+//!   radius compensation moves off the programmed contour.
 //! - [`transform`]: the coordinate recalculations G34–G37 and the
 //!   transformations G38/G39/G31, and the frames from program to machine
 //!   coordinates they make.
@@ -35,5 +37,6 @@ pub mod machine;
 pub mod modes;
 pub mod run;
 pub mod tables;
+pub mod tool_path;
 pub mod transform;
 pub mod velocity;

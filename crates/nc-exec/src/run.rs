@@ -393,6 +393,12 @@ pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget:
     std::thread::scope(|scope| run_in(scope, text, files, machine, budget, None, None))
 }
 
+/// The frame of the priority block on `machine`, in which a run starts:
+/// the zero offset G53 of its tables ([`Trace::reset_frame`]).
+pub fn reset_frame(machine: &MachineConfig) -> Frame {
+    Runner::new(std::sync::Arc::new(machine.clone())).frame_in_force()
+}
+
 /// Takes the steps of a run in order, each once no later block can change
 /// it.
 pub trait StepSink {
@@ -402,6 +408,14 @@ pub trait StepSink {
     fn steps(&mut self, steps: &mut Vec<Step>) {
         steps.drain(..).for_each(|step| self.step(step));
     }
+
+    /// Takes, before the steps about to come, what they refer to: the
+    /// run's frames and spans of radius compensation so far (a step's
+    /// [`Step::frame`] indexes `frames`; the last span may grow), and the
+    /// pieces of the tool-centre path that belong to those steps, in path
+    /// order. The trace keeps them all too. A sink on a thread of its own
+    /// ([`run_beside`]) does not take them.
+    fn references(&mut self, _frames: &[Frame], _compensated: &[Compensated], _tool_centre: &[ToolElement]) {}
 
     /// Whether to take a [`Checkpoint`] before block `block`, which starts
     /// at `offset`; asked only where the run can take one.
@@ -1898,7 +1912,15 @@ impl Runner {
             Some(compensator) if !end => compensator.open_block() - self.delivered,
             _ => self.steps.len(),
         };
+        // The pieces of the steps handed on so far come first; the others,
+        // of the steps handed on now and of the open one, in the order
+        // compensation fixed them.
+        let first = self.tool_centre.partition_point(|piece| piece.block < self.delivered);
         self.delivered += open;
+        let fresh = &mut self.tool_centre[first..];
+        fresh.sort_by_key(|piece| piece.block);
+        let fixed = first + fresh.partition_point(|piece| piece.block < self.delivered);
+        sink.references(&self.frames, &self.compensated, &self.tool_centre[first..fixed]);
         if open == self.steps.len() {
             sink.steps(&mut self.steps);
         } else {
