@@ -592,3 +592,117 @@ fn expand_writes_a_program_with_the_same_moves() {
     let report = String::from_utf8(check.stdout).unwrap();
     assert!(!report.contains(": error"), "{report}");
 }
+
+/// A contour under radius compensation (D1 of radius 5 on the left, G41):
+/// the control moves the tool centre on the equidistant and displays it.
+const COMPENSATED: &str = "%1\nN1 G92 D1 R0=5.\nN2 G92 X-100 Y0\nN3 G00 X0 Y-20 D1\nN4 G41 G01 X0 Y0 F600\nN5 X50\nN6 Y50\nN7 G40 X70 Y70\nN8 M30\n";
+
+/// `ncc run --format json` gives the tool centre's positions, in program
+/// and machine coordinates, and under compensation the programmed point
+/// beside them.
+#[test]
+fn run_reports_the_tool_centre_under_radius_compensation() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("CONTOUR.NCP");
+    std::fs::write(&program, COMPENSATED).unwrap();
+    let output = ncc(&["run", program.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    type Point = (f64, f64);
+    let at = |place: &serde_json::Value| (place["X"].as_f64().unwrap(), place["Y"].as_f64().unwrap());
+    let blocks = json["blocks"].as_array().unwrap();
+    let ends: Vec<(u64, Point, Point)> = blocks
+        .iter()
+        .map(|block| (block["line"].as_u64().unwrap(), at(&block["end"]["program"]), at(&block["end"]["machine"])))
+        .collect();
+    // The start move ends on the first line's normal, the inside corner is
+    // where the equidistants meet, and G40 leaves the last one's normal for
+    // the programmed point; G92 X-100 at the machine zero puts the program's
+    // X0 at the machine's X-100.
+    let expected = [
+        (4, (0.0, -20.0), (-100.0, -20.0)),
+        (5, (0.0, 5.0), (-100.0, 5.0)),
+        (6, (45.0, 5.0), (-55.0, 5.0)),
+        (7, (45.0, 50.0), (-55.0, 50.0)),
+        (8, (70.0, 70.0), (-30.0, 70.0)),
+    ];
+    assert_eq!(ends[2..7], expected);
+    let corner = &blocks[4];
+    assert_eq!(at(&corner["start"]["program"]), (0.0, 5.0));
+    assert_eq!(at(&corner["end"]["programmed"]["program"]), (50.0, 0.0));
+    assert_eq!(at(&corner["end"]["programmed"]["machine"]), (-50.0, 0.0));
+    assert_eq!(at(&corner["start"]["programmed"]["program"]), (0.0, 0.0));
+    assert_eq!(corner["length_mm"], 45.0);
+    // Outside compensation the tool centre is the programmed point.
+    assert!(blocks[2]["end"].get("programmed").is_none(), "{}", blocks[2]);
+    assert_eq!(at(&json["end_position"]), (70.0, 70.0));
+    assert!(json.get("programmed_end_position").is_none());
+}
+
+/// `ncc plot` draws the tool centre's moves, and under compensation the
+/// programmed contour as a second layer, thin and dotted, with the same
+/// lines to click.
+#[test]
+fn plot_draws_the_tool_centre_and_the_programmed_contour() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("CONTOUR.NCP");
+    std::fs::write(&program, COMPENSATED).unwrap();
+    let svg = dir.path().join("contour.svg");
+    let output = ncc(&["plot", program.to_str().unwrap(), "-o", svg.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
+    let svg = std::fs::read_to_string(svg).unwrap();
+    let layer = |id: &str| -> Vec<String> {
+        let start = svg.find(&format!("<g id=\"{id}\">")).unwrap_or_else(|| panic!("no layer {id}: {svg}"));
+        let end = start + svg[start..].find("</g>").unwrap();
+        svg[start..end].lines().filter(|line| line.starts_with("<path")).map(str::to_owned).collect()
+    };
+    let (tool, programmed) = (layer("tool-centre"), layer("programmed-contour"));
+    let lines = |paths: &[String]| -> Vec<String> {
+        paths.iter().map(|path| path.split('"').nth(1).unwrap().to_owned()).collect::<Vec<_>>()
+    };
+    assert_eq!(lines(&tool), ["4", "5", "6", "7", "8"], "{svg}");
+    assert_eq!(lines(&programmed), ["5", "6", "7", "8"], "{svg}");
+    assert!(programmed.iter().all(|path| path.contains("stroke-dasharray") && path.contains("programmed contour")));
+    // In program coordinates the rapid starts at X100 (the machine zero),
+    // and the picture spans X 0 to 100, Y -20 to 70: 960 pixels over 100 mm.
+    // The corner block runs from the start move's end (0, 5) to (45, 5),
+    // its programmed line from (0, 0) to (50, 0).
+    let scale = 9.6;
+    let pixel = |x: f64| 20.0 + x * scale;
+    let d = |path: &str| path.split(" d=\"").nth(1).unwrap().split('"').next().unwrap().to_owned();
+    let y = |y: f64| 20.0 + (70.0 - y) * scale;
+    let expected = |(x0, y0): (f64, f64), (x1, y1): (f64, f64)| {
+        format!("M{:.2} {:.2} L{:.2} {:.2}", pixel(x0), y(y0), pixel(x1), y(y1))
+    };
+    assert_eq!(d(&tool[2]), expected((0.0, 5.0), (45.0, 5.0)));
+    assert_eq!(d(&programmed[1]), expected((0.0, 0.0), (50.0, 0.0)));
+    assert!(svg.contains("programmed contour (G41/G42)</text>"), "the legend names the layer: {svg}");
+}
+
+/// Three jump loops nested, each of a thousand runs: a billion blocks,
+/// which only the step budget ends.
+const NESTED_LOOPS: &str =
+    "%1\nN1 G23 G91 G01 X.002 F1\nN2 X.002 G73 L1 Q999\nN3 X.002 G73 L1 Q999\nN4 X.002 G73 L1 Q999\nN5 M30\n";
+
+/// `ncc plot` draws the first moves of a long run only, and says so in the
+/// picture and on stderr; the legend's time is the whole run's.
+#[test]
+fn plot_draws_a_long_run_up_to_a_number_of_moves() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("NESTED.NCP");
+    std::fs::write(&program, NESTED_LOOPS).unwrap();
+    let svg = dir.path().join("nested.svg");
+    let program = program.to_str().unwrap();
+    let output = ncc(&["plot", program, "-o", svg.to_str().unwrap(), "--step-budget", "20000", "--max-moves", "500"]);
+    // The budget stops the run: an error.
+    assert_eq!(output.status.code(), Some(1));
+    let note = "drawn: the first 500 of the run's 20000 moves; the total time and the breaks are the whole run's";
+    let stderr = String::from_utf8(output.stderr).unwrap();
+    assert!(stderr.contains(&format!("note: {note} (--max-moves draws more)\n")), "{stderr}");
+    let svg = std::fs::read_to_string(svg).unwrap();
+    assert_eq!(svg.lines().filter(|line| line.starts_with("<path")).count(), 500);
+    assert!(svg.contains(&format!(">{note}</text>")), "{svg}");
+    // 20,000 moves of 2 µm at 1 mm/min, each 0.12 s.
+    assert!(svg.contains("total time 0:40:00.000"), "{svg}");
+    assert!(svg.len() < 100_000, "{} bytes", svg.len());
+}

@@ -108,6 +108,10 @@ enum Command {
         /// Stop after running this many blocks.
         #[arg(long, default_value_t = nc_exec::run::DEFAULT_STEP_BUDGET)]
         step_budget: usize,
+        /// Draw at most the first this many moves (the time and the breaks
+        /// in the legend stay the whole run's).
+        #[arg(long, default_value_t = plot::DEFAULT_MAX_MOVES)]
+        max_moves: usize,
     },
     /// Write a program as the moves it runs: plain numbered blocks with
     /// calls, jumps, cycles and parameters resolved.
@@ -152,7 +156,7 @@ fn main() -> ExitCode {
         Command::Run { file, format, step_budget } => run::run(&file, format, step_budget),
         Command::Expand { file, output, step_budget } => run::expand(&file, output.as_deref(), step_budget),
         Command::Lower { file } => run::lower(&file),
-        Command::Plot { file, output, step_budget } => run::plot(&file, &output, step_budget),
+        Command::Plot { file, output, step_budget, max_moves } => run::plot(&file, &output, step_budget, max_moves),
         Command::Parse { file } => match check::read_program(&file) {
             Ok(text) => {
                 let parse = ncc_syntax::Parse::new(&text, ncc_syntax::Dialect::Cnc8x6);

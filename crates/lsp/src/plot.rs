@@ -4,14 +4,21 @@
 //! marked; every move and mark carries its source line (`data-line`) and a
 //! tooltip, so that a viewer can jump to the block. A move that a
 //! macrocycle file or the cycle file makes also names that file
-//! (`data-file`): its line is a line of that file. The picture is data
-//! only, without scripts or styles; the editor's toolpath view adds those.
+//! (`data-file`): its line is a line of that file. The moves are the tool
+//! centre's, which the control moves and displays: under radius
+//! compensation G41/G42 the programmed contour is a second layer above
+//! them, thin and dotted. The picture is data only, without scripts or
+//! styles; the editor's toolpath view adds those.
+//!
+//! A long run draws its first moves only ([`Sketch`]): a picture of
+//! millions of moves is of no use to a browser, and would hold them all.
 
 use std::fmt::Write as _;
 
 use nc_exec::{
-    run::{Axes, Motion, Path, Trace},
-    velocity::Timing,
+    run::{Axes, Motion, Path, Step, Trace},
+    tool_path::tool_moves,
+    velocity::{Break, Profile, TimingSink},
 };
 
 /// The picture's width in pixels; the height follows the toolpath.
@@ -20,6 +27,64 @@ const MARGIN: f64 = 20.0;
 const LEGEND_HEIGHT: f64 = 70.0;
 /// Slow to fast.
 const PALETTE: [&str; 5] = ["#3b4cc0", "#6f9bf5", "#a9c66a", "#f4a259", "#d1342f"];
+/// The programmed contour under radius compensation.
+const PROGRAMMED_STYLE: &str = r##"stroke="#111" stroke-width="0.8" stroke-dasharray="1.5 2""##;
+
+/// The moves a picture draws at most unless told otherwise: a browser
+/// still shows this many, each with its tooltip.
+pub(crate) const DEFAULT_MAX_MOVES: usize = 100_000;
+
+/// What the picture keeps of a run as the velocity model times it: the
+/// first moves with their profiles, and the breaks among them; of the
+/// others only what the legend counts.
+pub(crate) struct Sketch {
+    max_moves: usize,
+    pub steps: Vec<Step>,
+    profiles: Vec<Profile>,
+    breaks: Vec<Break>,
+    /// Seconds, of the whole run.
+    pub total_time: f64,
+    /// The run's moves and breaks.
+    pub moves: usize,
+    break_count: usize,
+}
+
+impl Sketch {
+    pub(crate) fn new(max_moves: usize) -> Sketch {
+        Sketch {
+            max_moves,
+            steps: Vec::new(),
+            profiles: Vec::new(),
+            breaks: Vec::new(),
+            total_time: 0.0,
+            moves: 0,
+            break_count: 0,
+        }
+    }
+
+    /// The moves drawn, when not all of the run's.
+    pub(crate) fn capped(&self) -> Option<usize> {
+        (self.moves > self.profiles.len()).then_some(self.profiles.len())
+    }
+}
+
+impl TimingSink for Sketch {
+    fn speed_break(&mut self, _step: &Step, speed_break: Break) {
+        self.break_count += 1;
+        if speed_break.step < self.max_moves {
+            self.breaks.push(speed_break);
+        }
+    }
+
+    fn timed(&mut self, step: &Step, profile: Profile) {
+        self.moves += 1;
+        self.total_time += profile.duration;
+        if self.profiles.len() < self.max_moves {
+            self.steps.push(step.clone());
+            self.profiles.push(profile);
+        }
+    }
+}
 
 /// Where a step's line is, for the marks' `data-line` and `data-file`.
 pub(crate) trait Lines {
@@ -38,15 +103,39 @@ fn source_attributes(lines: &impl Lines, step: usize) -> String {
     }
 }
 
-/// The SVG text of `trace` timed by `timing`, titled `title`.
-pub(crate) fn svg(trace: &Trace, timing: &Timing, lines: &impl Lines, title: &str) -> String {
+/// A step as drawn, in program coordinates of the view plane: the tool
+/// centre's path, and the programmed one where radius compensation moved
+/// the tool off it.
+struct Drawn {
+    tool: Vec<(f64, f64)>,
+    programmed: Option<Vec<(f64, f64)>>,
+}
+
+/// The SVG text of the run `sketch` kept, whose kept steps `trace` holds,
+/// titled `title`.
+pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &str) -> String {
     let (across, up) = view_axes(trace);
     let slot = |letter: u8| trace.axes.iter().position(|&axis| axis == letter);
     let (Some(u), Some(v)) = (slot(across), slot(up)) else { return String::new() };
-    // Every move as a polyline in program coordinates of the view plane.
-    let moves: Vec<Vec<(f64, f64)>> =
-        (0..trace.steps.len()).map(|index| polyline(trace, index, (across, up), (u, v))).collect();
-    let points = moves.iter().flatten();
+    let plane = |values: &Axes| (values[u], values[v]);
+    let drawn: Vec<Drawn> = (0..trace.steps.len())
+        .map(|index| {
+            let step = &trace.steps[index];
+            let centred = trace.centred(index);
+            let start = trace.tool_start_of(index);
+            let mut tool = vec![plane(&start)];
+            let mut from = start;
+            for tool_move in tool_moves(step, &start, centred.as_ref(), &trace.axes) {
+                let piece = polyline(plane(&from), tool_move.path, plane(&tool_move.end), (across, up));
+                tool.extend_from_slice(&piece[1..]);
+                from = tool_move.end;
+            }
+            let programmed =
+                centred.map(|_| polyline(plane(&trace.start_of(index)), step.path, plane(&step.end), (across, up)));
+            Drawn { tool, programmed }
+        })
+        .collect();
+    let points = drawn.iter().flat_map(|drawn| drawn.tool.iter().chain(drawn.programmed.iter().flatten()));
     let (mut min, mut max) = ((f64::INFINITY, f64::INFINITY), (f64::NEG_INFINITY, f64::NEG_INFINITY));
     for &(x, y) in points {
         min = (min.0.min(x), min.1.min(y));
@@ -60,43 +149,69 @@ pub(crate) fn svg(trace: &Trace, timing: &Timing, lines: &impl Lines, title: &st
     let scale = (WIDTH - 2.0 * MARGIN) / span;
     let height = (max.1 - min.1) * scale + 2.0 * MARGIN;
     let pixel = |(x, y): (f64, f64)| (MARGIN + (x - min.0) * scale, MARGIN + (max.1 - y) * scale);
+    let d = |polyline: &[(f64, f64)]| {
+        let mut d = String::new();
+        for (i, &point) in polyline.iter().enumerate() {
+            let (x, y) = pixel(point);
+            let _ = write!(d, "{}{x:.2} {y:.2}", if i == 0 { "M" } else { " L" });
+        }
+        d
+    };
+    let drawable = |index: usize| matches!(trace.steps[index].motion, Motion::Rapid | Motion::Feed);
     // The colours span the feed moves; rapids are drawn apart.
-    let feed_peaks = trace.steps.iter().zip(&timing.profiles).filter(|(step, _)| step.motion == Motion::Feed);
+    let feed_peaks = trace.steps.iter().zip(&sketch.profiles).filter(|(step, _)| step.motion == Motion::Feed);
     let fastest = feed_peaks.map(|(_, profile)| profile.peak).fold(0.0, f64::max).max(1.0);
 
     let mut out = String::new();
-    let total_height = height + LEGEND_HEIGHT;
+    let legend_height = LEGEND_HEIGHT + if sketch.capped().is_some() { 22.0 } else { 0.0 };
+    let total_height = height + legend_height;
     let _ = writeln!(
         out,
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{total_height:.0}" viewBox="0 0 {WIDTH} {total_height:.0}" font-family="sans-serif" font-size="12">"#
     );
     let _ = writeln!(out, "<title>{}</title>", escape(title));
     let _ = writeln!(out, r#"<rect width="100%" height="100%" fill="white"/>"#);
-    for (index, polyline) in moves.iter().enumerate() {
-        let step = &trace.steps[index];
-        if polyline.len() < 2 || !matches!(step.motion, Motion::Rapid | Motion::Feed) {
+    let _ = writeln!(out, r#"<g id="tool-centre">"#);
+    for (index, drawn) in drawn.iter().enumerate() {
+        if drawn.tool.len() < 2 || !drawable(index) {
             continue;
         }
-        let profile = timing.profiles.get(index).copied().unwrap_or_default();
+        let step = &trace.steps[index];
+        let profile = sketch.profiles[index];
         let style = match step.motion {
             Motion::Rapid => r##"stroke="#888" stroke-dasharray="4 3""##.to_owned(),
             _ => format!(r#"stroke="{}""#, colour(profile.peak, fastest)),
         };
-        let mut d = String::new();
-        for (i, &point) in polyline.iter().enumerate() {
-            let (x, y) = pixel(point);
-            let _ = write!(d, "{}{x:.2} {y:.2}", if i == 0 { "M" } else { " L" });
-        }
         let line = lines.line_of(index);
         let source = source_attributes(lines, index);
         let _ = writeln!(
             out,
-            r#"<path{source} d="{d}" fill="none" {style} stroke-width="1.5"><title>line {line}: {:.0} mm/min, {:.3} s</title></path>"#,
-            profile.peak, profile.duration
+            r#"<path{source} d="{}" fill="none" {style} stroke-width="1.5"><title>line {line}: {:.0} mm/min, {:.3} s</title></path>"#,
+            d(&drawn.tool),
+            profile.peak,
+            profile.duration
         );
     }
-    for speed_break in &timing.breaks {
-        let Some(&end) = moves[speed_break.step].last() else { continue };
+    let _ = writeln!(out, "</g>");
+    let mut compensated = false;
+    let _ = writeln!(out, r#"<g id="programmed-contour">"#);
+    for (index, drawn) in drawn.iter().enumerate() {
+        let Some(programmed) = drawn.programmed.as_ref().filter(|polyline| polyline.len() >= 2 && drawable(index))
+        else {
+            continue;
+        };
+        compensated = true;
+        let line = lines.line_of(index);
+        let source = source_attributes(lines, index);
+        let _ = writeln!(
+            out,
+            r#"<path{source} d="{}" fill="none" {PROGRAMMED_STYLE}><title>line {line}: the programmed contour; the tool centre runs beside it (G41/G42)</title></path>"#,
+            d(programmed)
+        );
+    }
+    let _ = writeln!(out, "</g>");
+    for speed_break in &sketch.breaks {
+        let Some(&end) = drawn.get(speed_break.step).and_then(|drawn| drawn.tool.last()) else { continue };
         let (x, y) = pixel(end);
         let fill = if speed_break.at == 0.0 { "#d1342f" } else { "#f4a259" };
         let line = lines.line_of(speed_break.step);
@@ -110,7 +225,7 @@ pub(crate) fn svg(trace: &Trace, timing: &Timing, lines: &impl Lines, title: &st
             speed_break.lost
         );
     }
-    legend(&mut out, height, fastest, timing, (across, up));
+    legend(&mut out, height, fastest, sketch, (across, up), compensated);
     out.push_str("</svg>\n");
     out
 }
@@ -124,13 +239,10 @@ fn view_axes(trace: &Trace) -> (u8, u8) {
     }
 }
 
-/// Step `index` from its start to its end in the view plane; an arc in that
-/// plane as chords of at most 5°.
-fn polyline(trace: &Trace, index: usize, letters: (u8, u8), (u, v): (usize, usize)) -> Vec<(f64, f64)> {
-    let step = &trace.steps[index];
-    let start: Axes = trace.start_of(index);
-    let (from, to) = ((start[u], start[v]), (step.end[u], step.end[v]));
-    let Path::Arc { plane, centre, clockwise } = step.path else { return vec![from, to] };
+/// A move from `from` along `path` to `to` in the view plane of the axes
+/// `letters`; an arc in that plane as chords of at most 5°.
+fn polyline(from: (f64, f64), path: Path, to: (f64, f64), letters: (u8, u8)) -> Vec<(f64, f64)> {
+    let Path::Arc { plane, centre, clockwise } = path else { return vec![from, to] };
     let centre = if plane == letters {
         (centre[0], centre[1])
     } else if plane == (letters.1, letters.0) {
@@ -163,7 +275,7 @@ fn colour(speed: f64, fastest: f64) -> &'static str {
     PALETTE[bucket.min(PALETTE.len() - 1)]
 }
 
-fn legend(out: &mut String, top: f64, fastest: f64, timing: &Timing, (across, up): (u8, u8)) {
+fn legend(out: &mut String, top: f64, fastest: f64, sketch: &Sketch, (across, up): (u8, u8), compensated: bool) {
     let y = top + 20.0;
     let buckets = PALETTE.len() as f64;
     for (i, colour) in PALETTE.iter().enumerate() {
@@ -184,15 +296,34 @@ fn legend(out: &mut String, top: f64, fastest: f64, timing: &Timing, (across, up
     let _ = writeln!(out, r#"<text x="{}" y="{y2}">stop</text>"#, MARGIN + 108.0);
     let _ = writeln!(out, r##"<circle cx="{}" cy="{}" r="3" fill="#f4a259"/>"##, MARGIN + 160.0, y2 - 4.0);
     let _ = writeln!(out, r#"<text x="{}" y="{y2}">slow-down</text>"#, MARGIN + 168.0);
+    let mut x = MARGIN + 260.0;
+    if compensated {
+        let _ = writeln!(out, r#"<line x1="{x}" y1="{0}" x2="{1}" y2="{0}" {PROGRAMMED_STYLE}/>"#, y2 - 4.0, x + 24.0);
+        let _ = writeln!(out, r#"<text x="{}" y="{y2}">programmed contour (G41/G42)</text>"#, x + 30.0);
+        x += 220.0;
+    }
     let _ = writeln!(
         out,
-        r#"<text x="{}" y="{y2}">{}{} plane · total time {} · {} breaks</text>"#,
-        MARGIN + 260.0,
+        r#"<text x="{x}" y="{y2}">{}{} plane · total time {} · {} breaks</text>"#,
         char::from(across),
         char::from(up),
-        ncc_analysis::clock(timing.total_time()),
-        timing.breaks.len()
+        ncc_analysis::clock(sketch.total_time),
+        sketch.break_count
     );
+    if let Some(drawn) = sketch.capped() {
+        let _ = writeln!(
+            out,
+            r##"<text x="{MARGIN}" y="{}" fill="#d1342f" font-weight="bold">{}</text>"##,
+            y2 + 22.0,
+            escape(&capped_note(drawn, sketch.moves))
+        );
+    }
+}
+
+/// What a picture that draws only the first `drawn` of a run's `moves`
+/// says about it.
+pub(crate) fn capped_note(drawn: usize, moves: usize) -> String {
+    format!("drawn: the first {drawn} of the run's {moves} moves; the total time and the breaks are the whole run's")
 }
 
 fn escape(text: &str) -> String {

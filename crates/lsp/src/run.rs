@@ -5,7 +5,8 @@
 //! record per block and every break. `ncc expand`, `ncc plot` and
 //! `ncc lower` share the run, and so does the language server's `ncc.plot`
 //! command, which runs an editor's text ([`Program`]) and draws it with
-//! [`Ran::plot`] as `ncc plot` does.
+//! [`Ran::plotted`] as `ncc plot` does. Positions are the tool centre's,
+//! which radius compensation moves off the programmed contour.
 
 use std::{
     cell::{OnceCell, RefCell},
@@ -19,6 +20,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use line_index::LineIndex;
 use nc_exec::{
     arith::{Message, MessageDisplay},
+    expand::{ExpandError, Expansion},
     lower::BlockData,
     machine::MachineConfig,
     run::{Axes, Called, Environment, Motion, Step, Stop, Totals, Trace, expected_blocks},
@@ -28,7 +30,7 @@ use ncc_analysis::{Config, clock};
 use ncc_syntax::{BlockParser, Dialect, Parse, TextSize, ast::AstNode};
 use serde::Serialize;
 
-use crate::check;
+use crate::{check, plot::Sketch};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum Format {
@@ -56,8 +58,6 @@ pub(crate) struct Ran {
     /// The machine's dynamics, for the velocity model.
     dynamics: Dynamics,
     sources: Vec<Source>,
-    /// The program's number from its `%` header.
-    number: Option<u32>,
 }
 
 impl Program<'_> {
@@ -76,9 +76,15 @@ fn read(path: &Path) -> Result<String, ExitCode> {
     })
 }
 
-/// The program at `path` with the `ncc.toml` found for it.
-fn program_at<'a>(path: &'a Path, text: &'a str, config: Option<&'a Path>) -> Program<'a> {
-    Program { path: Some(path), name: path.display().to_string(), text, config }
+/// Runs `command` on the program at `path` with the `ncc.toml` found for
+/// it; a program that cannot be read is exit status 2.
+fn on_program(path: &Path, command: impl FnOnce(&Program<'_>) -> ExitCode) -> ExitCode {
+    let text = match read(path) {
+        Ok(text) => text,
+        Err(code) => return code,
+    };
+    let config = Config::find_for(path);
+    command(&Program { path: Some(path), name: path.display().to_string(), text: &text, config: config.as_deref() })
 }
 
 /// Prints a configuration error; the exit code says so.
@@ -88,18 +94,6 @@ fn config_error(error: String) -> ExitCode {
 }
 
 impl Ran {
-    /// Runs the program at `path` with the `ncc.toml` found for it, and
-    /// prints the run's findings; the error is the exit code after the
-    /// message is printed.
-    fn new(path: &Path, step_budget: usize) -> Result<Ran, ExitCode> {
-        let text = read(path)?;
-        let config = Config::find_for(path);
-        let program = program_at(path, &text, config.as_deref());
-        let ran = Ran::of(&program, step_budget, Progress::OnTerminal).map_err(config_error)?;
-        ran.print_findings();
-        Ok(ran)
-    }
-
     fn print_findings(&self) {
         for finding in self.findings() {
             eprintln!("{}:{}: {}", finding.file, finding.line, finding.message);
@@ -151,6 +145,32 @@ impl Ran {
         Ok((ran, tally))
     }
 
+    /// Runs `program` through the velocity model as the steps come, keeping
+    /// what the picture draws of the first `max_moves` ([`Sketch`]), and
+    /// draws it: the trace keeps those steps only.
+    pub(crate) fn plotted(
+        program: &Program<'_>,
+        step_budget: usize,
+        max_moves: usize,
+        progress: Progress,
+    ) -> Result<(Ran, Plot), String> {
+        let machine = program.machine()?;
+        let dynamics = Dynamics::of(&machine);
+        let timer = Timer::new(machine.step_axes(), &dynamics, Sketch::new(max_moves));
+        let mut sketched = None;
+        let mut ran = Ran::run(program, &machine, progress, |text, library| {
+            let (trace, timer) = nc_exec::run::run_beside(text, library, &machine, step_budget, timer);
+            sketched = Some(timer.finish());
+            trace
+        });
+        let mut sketch = sketched.unwrap_or_else(|| Sketch::new(max_moves));
+        ran.trace.steps = std::mem::take(&mut sketch.steps);
+        let title = format!("{} · ncc plot", ran.sources[0].name);
+        let svg = crate::plot::svg(&ran.trace, &sketch, &ran, &title);
+        let capped = sketch.capped().map(|drawn| crate::plot::capped_note(drawn, sketch.moves));
+        Ok((ran, Plot { svg, total_time: sketch.total_time, capped }))
+    }
+
     /// Runs `program` with `execute` (which keeps the steps or hands them
     /// on) and the files of its project.
     fn run(
@@ -160,17 +180,13 @@ impl Ran {
         execute: impl FnOnce(&str, &Library) -> Trace,
     ) -> Ran {
         let text = program.text;
-        let number = BlockParser::new(text)
-            .header()
-            .and_then(|header| header.number())
-            .and_then(|n| u32::try_from(n.scaled(0)?).ok());
         let library = Library::for_program(program, progress);
         let trace = execute(text, &library);
         if let Some(bar) = library.progress.get() {
             bar.finish_and_clear();
         }
         let sources = library.sources(&program.name, text, &trace);
-        Ran { trace, dynamics: Dynamics::of(machine), sources, number }
+        Ran { trace, dynamics: Dynamics::of(machine), sources }
     }
 
     /// The run timed with the control's velocity model.
@@ -202,13 +218,11 @@ impl Ran {
     pub(crate) fn stop(&self) -> Option<RunFinding<'_>> {
         self.findings().find(|finding| finding.stopped)
     }
+}
 
-    /// The picture `ncc plot` writes, titled with the program's name.
-    pub(crate) fn plot(&self) -> Plot {
-        let timing = self.timing();
-        let title = format!("{} · ncc plot", self.sources[0].name);
-        Plot { svg: crate::plot::svg(&self.trace, &timing, self, &title), total_time: timing.total_time() }
-    }
+/// The program's number from its `%` header.
+fn program_number(text: &str) -> Option<u32> {
+    BlockParser::new(text).header().and_then(|header| header.number()).and_then(|n| u32::try_from(n.scaled(0)?).ok())
 }
 
 /// What a run found at a place: an instruction it does not run yet, an
@@ -228,6 +242,8 @@ pub(crate) struct Plot {
     pub svg: String,
     /// Seconds, with the velocity model.
     pub total_time: f64,
+    /// What the picture says when it draws only the first moves.
+    pub capped: Option<String>,
 }
 
 /// Whether a long run shows a spinner.
@@ -240,15 +256,13 @@ pub(crate) enum Progress {
 }
 
 pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
-    let text = match read(path) {
-        Ok(text) => text,
-        Err(code) => return code,
-    };
-    let config = Config::find_for(path);
-    let program = program_at(path, &text, config.as_deref());
+    on_program(path, |program| run_program(program, path, format, step_budget))
+}
+
+fn run_program(program: &Program<'_>, path: &Path, format: Format, step_budget: usize) -> ExitCode {
     let (ran, written) = match format {
         Format::Human => {
-            let (ran, tally) = match Ran::tally(&program, step_budget, Progress::OnTerminal) {
+            let (ran, tally) = match Ran::tally(program, step_budget, Progress::OnTerminal) {
                 Ok(ran) => ran,
                 Err(error) => return config_error(error),
             };
@@ -258,7 +272,7 @@ pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
             (ran, written)
         }
         Format::Json => {
-            let ran = match Ran::of(&program, step_budget, Progress::OnTerminal) {
+            let ran = match Ran::of(program, step_budget, Progress::OnTerminal) {
                 Ok(ran) => ran,
                 Err(error) => return config_error(error),
             };
@@ -283,45 +297,74 @@ pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
 }
 
 /// `ncc expand`: the run written back as a program of plain motion blocks,
-/// to `output` or stdout.
+/// to `output` or stdout, each block as its move comes: a run of any length
+/// expands in the same memory. A move the program cannot express stops the
+/// writing; the output file is then removed.
 pub(crate) fn expand(path: &Path, output: Option<&Path>, step_budget: usize) -> ExitCode {
-    let ran = match Ran::new(path, step_budget) {
-        Ok(ran) => ran,
-        Err(code) => return code,
+    on_program(path, |program| expand_program(program, path, output, step_budget))
+}
+
+fn expand_program(program: &Program<'_>, path: &Path, output: Option<&Path>, step_budget: usize) -> ExitCode {
+    let machine = match program.machine() {
+        Ok(machine) => machine,
+        Err(error) => return config_error(error),
+    };
+    let (out, target): (Box<dyn io::Write>, String) = match output {
+        Some(output) => match std::fs::File::create(output) {
+            Ok(file) => (Box::new(file), output.display().to_string()),
+            Err(error) => {
+                eprintln!("error: writing {}: {error}", output.display());
+                return ExitCode::from(2);
+            }
+        },
+        None => (Box::new(io::stdout().lock()), "stdout".to_owned()),
     };
     let name = path.file_name().map_or_else(|| path.display().to_string(), |name| name.to_string_lossy().into_owned());
     let title = format!("EXPANDED FROM {name}");
-    let text = match nc_exec::expand::write(&ran.trace, ran.number.unwrap_or(1), &title) {
-        Ok(text) => text,
-        Err(unwritable) => {
-            let step = &ran.trace.steps[unwritable.step];
-            eprintln!("error: {}: {unwritable}", ran.sources[step.source].place(step.range.start()));
-            return ExitCode::FAILURE;
-        }
+    let number = program_number(program.text).unwrap_or(1);
+    let mut expansion = Expansion::new(io::BufWriter::new(out), &machine, number, &title);
+    let ran = Ran::run(program, &machine, Progress::OnTerminal, |text, library| {
+        nc_exec::run::run_into(text, library, &machine, step_budget, &mut expansion)
+    });
+    ran.print_findings();
+    let failure = match expansion.finish() {
+        Ok(_) => return ran.exit_code(),
+        Err(ExpandError::Io(error)) if error.kind() == io::ErrorKind::BrokenPipe => return ran.exit_code(),
+        Err(failure) => failure,
     };
-    let written = match output {
-        Some(output) => std::fs::write(output, &text).map_err(|error| (output.display().to_string(), error)),
-        None => {
-            let mut out = io::stdout().lock();
-            out.write_all(text.as_bytes()).and_then(|()| out.flush()).map_err(|error| ("stdout".to_owned(), error))
+    let code = match failure {
+        ExpandError::Unwritable(unwritable) => {
+            eprintln!("error: {}: {unwritable}", ran.sources[unwritable.source].place(unwritable.range.start()));
+            ExitCode::FAILURE
         }
-    };
-    match written {
-        Err((target, error)) if error.kind() != io::ErrorKind::BrokenPipe => {
+        ExpandError::Io(error) => {
             eprintln!("error: writing {target}: {error}");
             ExitCode::from(2)
         }
-        _ => ran.exit_code(),
+    };
+    if let Some(output) = output {
+        // A program cut short must not pass for the expansion.
+        let _ = std::fs::remove_file(output);
     }
+    code
 }
 
-/// `ncc plot FILE -o OUT`: the toolpath as an SVG picture.
-pub(crate) fn plot(path: &Path, output: &Path, step_budget: usize) -> ExitCode {
-    let ran = match Ran::new(path, step_budget) {
-        Ok(ran) => ran,
-        Err(code) => return code,
+/// `ncc plot FILE -o OUT`: the toolpath as an SVG picture of the first
+/// `max_moves` moves.
+pub(crate) fn plot(path: &Path, output: &Path, step_budget: usize, max_moves: usize) -> ExitCode {
+    on_program(path, |program| plot_program(program, output, step_budget, max_moves))
+}
+
+fn plot_program(program: &Program<'_>, output: &Path, step_budget: usize, max_moves: usize) -> ExitCode {
+    let (ran, picture) = match Ran::plotted(program, step_budget, max_moves, Progress::OnTerminal) {
+        Ok(plotted) => plotted,
+        Err(error) => return config_error(error),
     };
-    match std::fs::write(output, ran.plot().svg) {
+    ran.print_findings();
+    if let Some(note) = &picture.capped {
+        eprintln!("note: {note} (--max-moves draws more)");
+    }
+    match std::fs::write(output, picture.svg) {
         Ok(()) => ran.exit_code(),
         Err(error) => {
             eprintln!("error: writing {}: {error}", output.display());
@@ -377,7 +420,8 @@ const LISTED_BREAKS: usize = 10;
 #[derive(Default)]
 struct Tally {
     totals: Totals,
-    /// The programmed position at the end.
+    /// The steps timed, and the last one's programmed end.
+    steps: usize,
     end: Axes,
     /// Breaks by kind (in the order first met) and what they cost.
     by_reason: Vec<(&'static str, usize)>,
@@ -501,6 +545,7 @@ impl TimingSink for Tally {
 
     fn timed(&mut self, step: &Step, profile: velocity::Profile) {
         self.totals.add(step, profile.duration);
+        self.steps += 1;
         self.end = step.end;
     }
 }
@@ -534,10 +579,13 @@ fn summary(path: &Path, ran: &Ran, tally: &Tally) -> String {
     let _ = writeln!(out, "  tools        {}", if tools.is_empty() { "none".to_owned() } else { tools.join(" ") });
     // Turners read the diameter axis as a diameter; the trace keeps radii.
     let as_written = |axis: u8, value: f64| if trace.diameter_axis == Some(axis) { 2.0 * value } else { value };
+    // Where the tool centre ended: off the programmed end when the program
+    // ends under radius compensation.
+    let end = tally.steps.checked_sub(1).map_or(tally.end, |last| trace.tool_end(last, &tally.end));
     let position: Vec<String> = trace
         .axes
         .iter()
-        .zip(tally.end)
+        .zip(end)
         .map(|(&axis, value)| format!("{}{:.3}", char::from(axis), as_written(axis, value)))
         .collect();
     let diameter = trace.diameter_axis.map(|axis| format!(" ({} as a diameter)", char::from(axis))).unwrap_or_default();
@@ -583,7 +631,11 @@ struct Report<'a> {
     cutting_length_mm: f64,
     rapid_length_mm: f64,
     tools: &'a [u32],
+    /// Where the tool centre ended, and the programmed end when the last
+    /// block ran under radius compensation.
     end_position: Values<'a>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    programmed_end_position: Option<Values<'a>>,
     blocks: Records<'a>,
     breaks: Vec<BreakRecord<'a>>,
     messages: Vec<MessageRecord<'a>>,
@@ -595,6 +647,7 @@ impl<'a> Report<'a> {
         let (trace, sources) = (&ran.trace, &ran.sources);
         let axes = &trace.axes;
         let totals = trace.totals_with(timing.profiles.iter().map(|profile| profile.duration));
+        let last = trace.steps.len().checked_sub(1);
         Report {
             file: path.display().to_string(),
             total_time_s: totals.total_time,
@@ -605,7 +658,8 @@ impl<'a> Report<'a> {
             cutting_length_mm: totals.length(Motion::Feed),
             rapid_length_mm: totals.length(Motion::Rapid),
             tools: &trace.tools,
-            end_position: Values(trace.end(), axes),
+            end_position: Values(last.map_or(trace.end(), |last| trace.tool_end(last, &trace.end())), axes),
+            programmed_end_position: last.and_then(|last| trace.centred(last)).map(|_| Values(trace.end(), axes)),
             blocks: Records { trace, timing, sources },
             breaks: timing
                 .breaks
@@ -669,8 +723,10 @@ struct Records<'a> {
 impl Serialize for Records<'_> {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         let steps = self.trace.steps.iter().zip(&self.timing.profiles).zip(self.timing.start_times()).enumerate();
+        let (trace, axes) = (self.trace, &self.trace.axes);
         serializer.collect_seq(steps.map(|(index, ((step, profile), start_time))| {
             let source = &self.sources[step.source];
+            let centred = trace.centred(index).is_some();
             BlockRecord {
                 file: &source.name,
                 line: source.line(step.range.start()),
@@ -693,12 +749,20 @@ impl Serialize for Records<'_> {
                 peak_speed_mm_min: profile.peak,
                 exit_speed_mm_min: profile.exit,
                 start: Coordinates {
-                    program: Values(self.trace.start_of(index), &self.trace.axes),
-                    machine: Values(self.trace.machine_start(index), &self.trace.axes),
+                    program: Values(trace.tool_start_of(index), axes),
+                    machine: Values(trace.tool_machine_start(index), axes),
+                    programmed: centred.then(|| Placed {
+                        program: Values(trace.start_of(index), axes),
+                        machine: Values(trace.machine_start(index), axes),
+                    }),
                 },
                 end: Coordinates {
-                    program: Values(step.end, &self.trace.axes),
-                    machine: Values(self.trace.machine_end(index), &self.trace.axes),
+                    program: Values(trace.tool_end(index, &step.end), axes),
+                    machine: Values(trace.tool_machine_end(index), axes),
+                    programmed: centred.then(|| Placed {
+                        program: Values(step.end, axes),
+                        machine: Values(trace.machine_end(index), axes),
+                    }),
                 },
             }
         }))
@@ -724,8 +788,19 @@ struct BlockRecord<'a> {
     end: Coordinates<'a>,
 }
 
+/// Where the tool centre is, in program and machine coordinates, and under
+/// radius compensation where the program put the block.
 #[derive(Serialize)]
 struct Coordinates<'a> {
+    program: Values<'a>,
+    machine: Values<'a>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    programmed: Option<Placed<'a>>,
+}
+
+/// A programmed point in program and machine coordinates.
+#[derive(Serialize)]
+struct Placed<'a> {
     program: Values<'a>,
     machine: Values<'a>,
 }

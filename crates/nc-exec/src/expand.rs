@@ -1,5 +1,5 @@
-//! A run written back as a program (`ncc expand`): every move of the trace
-//! as a plain numbered block, with calls, jumps, cycles, parameters and
+//! A run written back as a program (`ncc expand`) while it runs: every
+//! move as a plain numbered block, with calls, jumps, cycles, parameters and
 //! offsets resolved, that any CNC8x6 accepts and that runs the same moves.
 //!
 //! The program is absolute (G90) with the feed per minute (G94), in radius
@@ -14,92 +14,140 @@
 //! tables, with the zero offsets, length corrections, recalculations
 //! G35–G37 and transformations G38/G39/G31 the run had applied.
 
-use std::fmt::Write as _;
+use std::{
+    collections::VecDeque,
+    fmt,
+    io::{self, Write},
+};
+
+use nalgebra::Point2;
+use ncc_syntax::TextRange;
+use smallvec::SmallVec;
 
 use crate::{
-    compensation::Element,
-    run::{Motion, Path, Position, Stop, Trace, round3, slot},
+    compensation::ToolElement,
+    machine::MachineConfig,
+    run::{Compensated, Motion, Path, Position, Step, StepSink, Stop, reset_frame, round3, slot},
+    tool_path::{Centred, tool_moves},
     transform::{Frame, by_letter, over_axes},
 };
 
 /// The longest line the control reads (000:612).
 const MAX_LINE: usize = 80;
 
-/// A move the written program cannot express.
+/// A move the written program cannot express, at its block.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Unwritable {
-    /// The step of the move.
-    pub step: usize,
+    /// The block's file, as in [`Step::source`], and its range there.
+    pub source: usize,
+    pub range: TextRange,
 }
 
-impl std::fmt::Display for Unwritable {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+impl fmt::Display for Unwritable {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str("an arc turned out of its plane by a transformation (G38/G39/G31) is no arc of any plane")
     }
 }
 
-/// Writes the moves of `trace` over its machine's axes as program
-/// `%number`, with `title` as its header comment.
-pub fn write(trace: &Trace, number: u32, title: &str) -> Result<String, Unwritable> {
-    let mut out = String::new();
-    let title: String = title.chars().filter(|&c| c != '"' && !c.is_control()).collect();
-    let _ = writeln!(out, "%{number} \"{title}\"");
-    let mut writer = Writer { out, number: 0, at: [0.0; 26], feed: None, axes: &trace.axes };
-    let mut header = vec!["G90".to_owned(), "G94".to_owned(), "G53".to_owned()];
-    // The trace keeps radii on a lathe's diameter axis.
-    if trace.diameter_axis.is_some() {
-        header.push("G75".to_owned());
+/// Why an expansion stopped writing.
+#[derive(Debug)]
+pub enum ExpandError {
+    Unwritable(Unwritable),
+    /// The output could not be written.
+    Io(io::Error),
+}
+
+impl From<io::Error> for ExpandError {
+    fn from(error: io::Error) -> ExpandError {
+        ExpandError::Io(error)
     }
-    writer.block(header);
-    let mut tool_centre = trace.tool_centre.iter().peekable();
-    let mut compensated = trace.compensated.iter().peekable();
-    for (index, step) in trace.steps.iter().enumerate() {
-        let frames = Frames { step: &trace.frames[step.frame], written: &trace.reset_frame, axes: &trace.axes };
-        let end = trace.position(&step.end);
-        while compensated.next_if(|span| span.steps.end <= index).is_some() {}
-        let plane = compensated.peek().filter(|span| span.steps.contains(&index)).map(|span| span.plane);
-        // Under radius compensation the tool runs the pieces of the
-        // tool-centre path; the other axes move with the last of them.
-        let moves: Vec<(Path, Position, Option<f64>)> = match plane {
-            None => vec![(step.path, end, step.feed)],
-            Some((a, b)) => {
-                let mut pieces = Vec::new();
-                while let Some(piece) = tool_centre.next_if(|piece| piece.block == index) {
-                    pieces.push(piece);
-                }
-                let last = pieces.len().saturating_sub(1);
-                // Where the written program has the tool, in the step's frame.
-                let at = frames.to_step(&writer.at);
-                let mut moves: Vec<_> = pieces
-                    .iter()
-                    .enumerate()
-                    .map(|(k, piece)| {
-                        let mut to = if k == last { end } else { at };
-                        let point = piece.path.end();
-                        (to[slot(a)], to[slot(b)]) = (point.x, point.y);
-                        let path = match piece.path {
-                            Element::Arc { centre, clockwise, .. } => {
-                                Path::Arc { plane: (a, b), centre: [centre.x, centre.y], clockwise }
-                            }
-                            Element::Line { .. } => Path::Straight,
-                        };
-                        (path, to, step.feed.map(|feed| feed * piece.feed_scale))
-                    })
-                    .collect();
-                if moves.is_empty() {
-                    let mut to = end;
-                    (to[slot(a)], to[slot(b)]) = (at[slot(a)], at[slot(b)]);
-                    moves.push((Path::Straight, to, step.feed));
-                }
-                moves
-            }
+}
+
+/// Writes the moves of a run as program `%number` to `out` while the run
+/// goes: a [`StepSink`] for [`crate::run::run_into`] (a sink on a thread of
+/// its own is not told the frames and the tool-centre path) that writes
+/// the blocks of each step as it comes and keeps nothing of it, so that a
+/// run of any length expands in the same memory.
+#[derive(Debug)]
+pub struct Expansion<W: Write> {
+    writer: Writer<W>,
+    axes: Vec<u8>,
+    /// The frame the written program runs in.
+    written: Frame,
+    /// The run's frames so far.
+    frames: Vec<Frame>,
+    /// The spans of radius compensation the steps to come may be in, and
+    /// the pieces of the tool-centre path of those steps.
+    spans: VecDeque<Compensated>,
+    pieces: VecDeque<ToolElement>,
+    /// The step of the last piece written, and where it ends.
+    path_end: Option<(usize, Point2<f64>)>,
+    /// The index of the step to come.
+    next: usize,
+    /// What stopped the expansion: nothing is written after it.
+    failure: Option<ExpandError>,
+}
+
+impl<W: Write> Expansion<W> {
+    /// Starts program `%number`, with `title` as its header comment, for a
+    /// run on `machine`.
+    pub fn new(out: W, machine: &MachineConfig, number: u32, title: &str) -> Expansion<W> {
+        let writer = Writer { out, number: 0, at: [0.0; 26], feed: None };
+        let mut expansion = Expansion {
+            writer,
+            axes: machine.step_axes().to_vec(),
+            written: reset_frame(machine),
+            frames: Vec::new(),
+            spans: VecDeque::new(),
+            pieces: VecDeque::new(),
+            path_end: None,
+            next: 0,
+            failure: None,
         };
-        let mut blocks: Vec<Vec<String>> = Vec::new();
-        for (path, to, feed) in &moves {
-            let (path, to) = (frames.path(path, to).ok_or(Unwritable { step: index })?, frames.to_written(to));
-            blocks.push(writer.words(step.motion, &path, &to, *feed, step.duration));
+        let title: String = title.chars().filter(|&c| c != '"' && !c.is_control()).collect();
+        let mut header = vec!["G90".to_owned(), "G94".to_owned(), "G53".to_owned()];
+        // The trace keeps radii on a lathe's diameter axis.
+        if machine.diameter_axis.is_some() {
+            header.push("G75".to_owned());
+        }
+        let started =
+            writeln!(expansion.writer.out, "%{number} \"{title}\"").and_then(|()| expansion.writer.block(header));
+        expansion.failure = started.err().map(ExpandError::Io);
+        expansion
+    }
+
+    /// Ends the program after the run, and hands back the output.
+    pub fn finish(mut self) -> Result<W, ExpandError> {
+        if let Some(failure) = self.failure {
+            return Err(failure);
+        }
+        self.writer.block(vec!["M30".to_owned()])?;
+        self.writer.out.write_all(b"*\n")?;
+        self.writer.out.flush()?;
+        Ok(self.writer.out)
+    }
+
+    /// Writes the blocks of `step`, which runs under radius compensation
+    /// when `centred` says so.
+    fn write(&mut self, step: &Step, centred: Option<&Centred<'_>>) -> Result<(), ExpandError> {
+        let axes = &self.axes;
+        let frames = Frames { step: &self.frames[step.frame], written: &self.written, axes };
+        // Where the written program has the tool, in the step's frame: the
+        // start of the pieces of the tool-centre path.
+        let start = match centred {
+            Some(_) => over_axes(&frames.to_step(&self.writer.at), axes),
+            None => step.end,
+        };
+        let moves = tool_moves(step, &start, centred, axes);
+        let mut blocks: SmallVec<[Vec<String>; 2]> = SmallVec::new();
+        for tool_move in &moves {
+            let to = by_letter(&tool_move.end, axes);
+            let unwritable = || ExpandError::Unwritable(Unwritable { source: step.source, range: step.range });
+            let path = frames.path(&tool_move.path, &to).ok_or_else(unwritable)?;
+            let to = frames.to_written(&to);
+            blocks.push(self.writer.words(axes, step.motion, &path, &to, tool_move.feed, step.duration));
             if step.motion != Motion::None && step.motion != Motion::Dwell {
-                writer.at = rounded(&to);
+                self.writer.at = rounded(&to);
             }
         }
         let stop = match step.stop {
@@ -111,12 +159,48 @@ pub fn write(trace: &Trace, number: u32, title: &str) -> Result<String, Unwritab
             last.push(stop);
         }
         for words in blocks.into_iter().filter(|words| !words.is_empty()) {
-            writer.block(words);
+            self.writer.block(words)?;
+        }
+        Ok(())
+    }
+}
+
+impl<W: Write> StepSink for Expansion<W> {
+    fn step(&mut self, step: Step) {
+        let index = self.next;
+        self.next += 1;
+        while self.spans.front().is_some_and(|span| span.steps.end <= index) {
+            self.spans.pop_front();
+        }
+        let mut own: SmallVec<[ToolElement; 2]> = SmallVec::new();
+        while let Some(piece) = self.pieces.front().filter(|piece| piece.block == index) {
+            own.push(*piece);
+            self.pieces.pop_front();
+        }
+        if self.failure.is_some() {
+            return;
+        }
+        let centred = self.spans.front().filter(|span| span.steps.contains(&index)).map(|span| Centred {
+            plane: span.plane,
+            pieces: &own,
+            before: self.path_end.filter(|&(block, _)| block >= span.steps.start).map(|(_, end)| end),
+        });
+        if let Some(last) = own.last() {
+            self.path_end = Some((index, last.path.end()));
+        }
+        if let Err(failure) = self.write(&step, centred.as_ref()) {
+            self.failure = Some(failure);
         }
     }
-    writer.block(vec!["M30".to_owned()]);
-    writer.out.push_str("*\n");
-    Ok(writer.out)
+
+    fn references(&mut self, frames: &[Frame], compensated: &[Compensated], pieces: &[ToolElement]) {
+        self.frames.extend_from_slice(frames.get(self.frames.len()..).unwrap_or_default());
+        // The last span may have grown since.
+        let first = compensated.partition_point(|span| span.steps.end <= self.next);
+        self.spans.clear();
+        self.spans.extend(compensated[first..].iter().cloned());
+        self.pieces.extend(pieces);
+    }
 }
 
 /// From the frame a step ran in to the frame the written program runs in:
@@ -161,23 +245,31 @@ impl Frames<'_> {
     }
 }
 
-struct Writer<'a> {
-    out: String,
+#[derive(Debug)]
+struct Writer<W> {
+    out: W,
     /// The last block number written.
     number: u64,
     /// Where the written program has the tool, rounded as written.
     at: Position,
     /// The F in force in the written program, mm/min.
     feed: Option<i64>,
-    axes: &'a [u8],
 }
 
-impl Writer<'_> {
-    /// The words of one step; none for a step without motion or time.
-    fn words(&mut self, motion: Motion, path: &Path, end: &Position, feed: Option<f64>, duration: f64) -> Vec<String> {
+impl<W: Write> Writer<W> {
+    /// The words of one move over the machine's `axes`; none for a move
+    /// without motion or time.
+    fn words(
+        &mut self,
+        axes: &[u8],
+        motion: Motion,
+        path: &Path,
+        end: &Position,
+        feed: Option<f64>,
+        duration: f64,
+    ) -> Vec<String> {
         let end = rounded(end);
-        let changed: Vec<u8> =
-            self.axes.iter().copied().filter(|&axis| end[slot(axis)] != self.at[slot(axis)]).collect();
+        let changed: Vec<u8> = axes.iter().copied().filter(|&axis| end[slot(axis)] != self.at[slot(axis)]).collect();
         let coordinate = |axis: u8| format!("{}{:.3}", char::from(axis), end[slot(axis)]);
         match (motion, path) {
             (Motion::None, _) => Vec::new(),
@@ -245,18 +337,18 @@ impl Writer<'_> {
     }
 
     /// Writes a block, continuing on further lines past the line length.
-    fn block(&mut self, words: Vec<String>) {
+    fn block(&mut self, words: Vec<String>) -> io::Result<()> {
         self.number += 1;
         let mut line = format!("N{}", self.number);
         for word in words {
             if line.len() + 1 + word.len() > MAX_LINE {
-                let _ = writeln!(self.out, "{line}");
+                writeln!(self.out, "{line}")?;
                 line = String::from(" ");
             }
             line.push(' ');
             line.push_str(&word);
         }
-        let _ = writeln!(self.out, "{line}");
+        writeln!(self.out, "{line}")
     }
 }
 
@@ -268,14 +360,29 @@ fn rounded(position: &Position) -> Position {
 mod tests {
     use expect_test::expect;
 
-    use super::write;
+    use std::{cell::RefCell, io, rc::Rc};
+
+    use super::{ExpandError, Expansion, Unwritable};
     use crate::{
+        compensation::ToolElement,
         machine::MachineConfig,
-        run::{Motion, NoFiles, Trace, run},
+        run::{Compensated, Motion, NoFiles, Step, StepSink, Trace, run, run_into},
+        transform::Frame,
     };
 
     fn run_text(text: &str) -> Trace {
         run(text, &NoFiles, &MachineConfig::default(), 10_000)
+    }
+
+    /// `text` run on `machine` and written as program `%number`.
+    fn expand_on(machine: &MachineConfig, text: &str, number: u32, title: &str) -> Result<String, ExpandError> {
+        let mut expansion = Expansion::new(Vec::new(), machine, number, title);
+        run_into(text, &NoFiles, machine, 10_000, &mut expansion);
+        expansion.finish().map(|written| String::from_utf8(written).unwrap())
+    }
+
+    fn expand(text: &str, number: u32, title: &str) -> String {
+        expand_on(&MachineConfig::default(), text, number, title).unwrap()
     }
 
     /// A program with everything `expand` resolves: a subprogram called
@@ -314,7 +421,7 @@ N102 G90 G70
         let run_on = |text: &str| run(text, &NoFiles, &machine, 1000);
         let original = run_on(text);
         assert!(original.findings.is_empty(), "{:?}", original.findings);
-        let expanded = write(&original, 1, "RESOLVED").unwrap();
+        let expanded = expand_on(&machine, text, 1, "RESOLVED").unwrap();
         let again = run_on(&expanded);
         assert!(again.findings.is_empty(), "{:?}\n{expanded}", again.findings);
         let moves = |trace: &Trace| -> Vec<[i64; 3]> {
@@ -330,8 +437,12 @@ N102 G90 G70
         let text = "%1\nN1 G38 X0 Z0 I30\nN2 G38\nN3\nN4 G02 X10 Y0 I5 J0 F500\nN5 M30\n";
         let trace = run_text(text);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
-        let error = write(&trace, 1, "").unwrap_err();
-        assert_eq!(text[trace.steps[error.step].range].trim_end(), "N4 G02 X10 Y0 I5 J0 F500");
+        let Err(ExpandError::Unwritable(Unwritable { source: 0, range })) =
+            expand_on(&MachineConfig::default(), text, 1, "")
+        else {
+            panic!("the arc turned out of its plane is written");
+        };
+        assert_eq!(text[range].trim_end(), "N4 G02 X10 Y0 I5 J0 F500");
     }
 
     /// Under radius compensation the expansion writes the tool-centre path:
@@ -341,7 +452,7 @@ N102 G90 G70
         let text = "%1\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 X50\nN5 G03 X70 Y20 I0 J20\nN6 G01 Y50\nN7 G40 X90 Y70\nN8 M30\n";
         let original = run_text(text);
         assert!(original.findings.is_empty(), "{:?}", original.findings);
-        let expanded = write(&original, 1, "CENTRE").unwrap();
+        let expanded = expand(text, 1, "CENTRE");
         let again = run_text(&expanded);
         assert!(again.findings.is_empty(), "{:?}\n{expanded}", again.findings);
         let (before, after) = (original.totals().total_time, again.totals().total_time);
@@ -375,7 +486,7 @@ N102 G90 G70
     fn the_expanded_program_runs_the_same_moves() {
         let original = run_text(PROGRAM);
         assert!(original.findings.is_empty(), "{:?}", original.findings);
-        let expanded = write(&original, 7, "DEMO EXPANDED").unwrap();
+        let expanded = expand(PROGRAM, 7, "DEMO EXPANDED");
         let again = run_text(&expanded);
         assert!(again.findings.is_empty(), "{:?}\n{expanded}", again.findings);
         let moves = |trace: &Trace| -> Vec<[i64; 3]> {
@@ -410,5 +521,64 @@ N102 G90 G70
             *
         "#]]
         .assert_eq(&expanded);
+    }
+
+    /// An output the test reads while the expansion writes it.
+    #[derive(Debug, Clone, Default)]
+    struct Shared(Rc<RefCell<Vec<u8>>>);
+
+    impl io::Write for Shared {
+        fn write(&mut self, bytes: &[u8]) -> io::Result<usize> {
+            self.0.borrow_mut().extend_from_slice(bytes);
+            Ok(bytes.len())
+        }
+
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    /// The expansion, and the output's length after each step.
+    struct Watched {
+        expansion: Expansion<Shared>,
+        output: Shared,
+        lengths: Vec<usize>,
+    }
+
+    impl StepSink for Watched {
+        fn step(&mut self, step: Step) {
+            self.expansion.step(step);
+            self.lengths.push(self.output.0.borrow().len());
+        }
+
+        fn references(&mut self, frames: &[Frame], compensated: &[Compensated], tool_centre: &[ToolElement]) {
+            self.expansion.references(frames, compensated, tool_centre);
+        }
+    }
+
+    /// Each step's block is written when the step comes, not at the end of
+    /// the run: a loop of 3,000 moves, longer than a delivery batch.
+    #[test]
+    fn the_blocks_are_written_as_the_steps_come() {
+        let text = "%1\nN1 G91 G01 X1 F600\nN2 X1 G73 L1 Q1499\nN3 M30\n";
+        let output = Shared::default();
+        let machine = MachineConfig::default();
+        let expansion = Expansion::new(output.clone(), &machine, 1, "LOOP");
+        let mut watched = Watched { expansion, output: output.clone(), lengths: Vec::new() };
+        let trace = run_into(text, &NoFiles, &machine, 10_000, &mut watched);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let Watched { expansion, lengths, .. } = watched;
+        let header = "%1 \"LOOP\"\nN1 G90 G94 G53\n".len();
+        // Blocks N2 to N3001, with the X of each: "N2 G01 X1.000 F600".
+        let block = |n: usize| format!("N{n} G01 X{}.000{}\n", n - 1, if n == 2 { " F600" } else { "" }).len();
+        let expected: Vec<usize> = (2..3002)
+            .scan(header, |written, n| {
+                *written += block(n);
+                Some(*written)
+            })
+            .collect();
+        assert_eq!(lengths[..3000], expected[..]);
+        let written = String::from_utf8(expansion.finish().unwrap().0.take()).unwrap();
+        assert!(written.ends_with("N3001 G01 X3000.000\nN3002 M30\n*\n"), "{}", &written[written.len() - 100..]);
     }
 }

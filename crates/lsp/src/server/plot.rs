@@ -17,7 +17,10 @@ use tower_lsp_server::{
 };
 
 use super::{Server, invalid_params};
-use crate::run::{Program, Progress, Ran};
+use crate::{
+    plot::DEFAULT_MAX_MOVES,
+    run::{Program, Progress, Ran},
+};
 
 /// The command's name.
 pub(crate) const COMMAND: &str = "ncc.plot";
@@ -91,10 +94,10 @@ fn plot(job: Job) -> jsonrpc::Result<Value> {
     // The text of our own, so that an edit during the run need not copy it.
     let text = Arc::unwrap_or_clone(job.text);
     let program = Program { path: job.path.as_deref(), name: job.name, text: &text, config: job.config.as_deref() };
-    let ran = Ran::of(&program, nc_exec::run::DEFAULT_STEP_BUDGET, Progress::Hidden).map_err(|error| {
-        jsonrpc::Error { code: ErrorCode::ServerError(REQUEST_FAILED), message: error.into(), data: None }
-    })?;
-    let picture = ran.plot();
+    let (ran, picture) =
+        Ran::plotted(&program, nc_exec::run::DEFAULT_STEP_BUDGET, DEFAULT_MAX_MOVES, Progress::Hidden).map_err(
+            |error| jsonrpc::Error { code: ErrorCode::ServerError(REQUEST_FAILED), message: error.into(), data: None },
+        )?;
     let findings = ran
         .findings()
         .map(|finding| Finding {
