@@ -706,3 +706,25 @@ fn plot_draws_a_long_run_up_to_a_number_of_moves() {
     assert!(svg.contains("total time 0:40:00.000"), "{svg}");
     assert!(svg.len() < 100_000, "{} bytes", svg.len());
 }
+
+/// A move the written program cannot express stops `ncc expand` with the
+/// block's place, and no program cut short is left behind.
+#[test]
+fn expand_stops_at_a_move_it_cannot_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("TURNED.NCP");
+    // A planar transformation of X and Z turns an arc of XY out of its plane.
+    std::fs::write(&program, "%1\nN1 G38 X0 Z0 I30\nN2 G38\nN3\nN4 G01 Z-1 F500\nN5 G02 X10 Y0 I5 J0\nN6 M30\n")
+        .unwrap();
+    let expanded = dir.path().join("EXPANDED.NCP");
+    let output = ncc(&["expand", program.to_str().unwrap(), "-o", expanded.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(1));
+    let stderr = String::from_utf8(output.stderr).unwrap();
+    assert!(
+        stderr.ends_with(
+            "TURNED.NCP:6: an arc turned out of its plane by a transformation (G38/G39/G31) is no arc of any plane\n"
+        ),
+        "{stderr}"
+    );
+    assert!(!expanded.exists());
+}
