@@ -135,6 +135,7 @@ class Server implements vscode.Disposable {
           stdout: () => undefined,
           stderr: (input, output) => stderr.read(input, (line) => output.error(line)),
         },
+        initializationFailedHandler: () => false,
         errorHandler: {
           error: (error, message, count) =>
             started && afterStart
