@@ -310,6 +310,10 @@ function svgMoveLines(frame: Frame): Promise<number[] | undefined> {
     .catch(() => undefined);
 }
 
+// A second session: the workbench now knows the extension's settings from
+// the start, so a setting that a remote window keeps out of the User
+// settings (scope machine or machine-overridable) would never reach the
+// extension here, which would then find no ncc at all.
 describe('a server that exits as it starts', () => {
   const workbench = new Workbench();
 
