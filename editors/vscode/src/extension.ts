@@ -2,12 +2,22 @@
 
 import * as os from 'node:os';
 import * as vscode from 'vscode';
-import { ExecuteCommandRequest, LanguageClient, State } from 'vscode-languageclient/node';
-import { type Environment, type Launch, readSettings, serverLaunch } from './server';
+import {
+  CloseAction,
+  ErrorAction,
+  type ErrorHandler,
+  ExecuteCommandRequest,
+  LanguageClient,
+  State,
+} from 'vscode-languageclient/node';
+import { type Environment, type Launch, readSettings, ServerStderr, serverLaunch, startFailure } from './server';
 import { PLOT_COMMAND } from './toolpath';
 import { ToolpathViews } from './toolpathView';
 
 const LANGUAGE_ID = 'cnc8x6';
+
+/** How long a server that exited at start may take to finish its stderr. */
+const STDERR_WAIT_MS = 2_000;
 
 let server: Server | undefined;
 
@@ -101,6 +111,11 @@ class Server implements vscode.Disposable {
     }
     const { command, args, initializationOptions } = launch.value;
     this.output.info(`Starting ${launch.value.version}: ${command} ${args.join(' ')}`);
+    const stderr = new ServerStderr();
+    // Until the server has answered `initialize`, its failures are this
+    // class's to report (with what it wrote on stderr), not restarted.
+    let started = false;
+    let afterStart: ErrorHandler | undefined;
     const client = new LanguageClient(
       'ncc',
       'ncc',
@@ -115,19 +130,34 @@ class Server implements vscode.Disposable {
         // workspace/didChangeConfiguration.
         synchronize: { configurationSection: 'ncc' },
         outputChannel: this.output,
+        stdioOptions: {
+          // The protocol's stream, which the client reads itself.
+          stdout: () => undefined,
+          stderr: (input, output) => stderr.read(input, (line) => output.error(line)),
+        },
+        initializationFailedHandler: () => false,
+        errorHandler: {
+          error: (error, message, count) =>
+            started && afterStart
+              ? afterStart.error(error, message, count)
+              : { action: ErrorAction.Shutdown, handled: true },
+          closed: () => (started && afterStart ? afterStart.closed() : { action: CloseAction.DoNotRestart, handled: true }),
+        },
       },
     );
+    afterStart = client.createDefaultErrorHandler();
     client.onDidChangeState(({ newState }) => {
       switch (newState) {
         case State.Starting:
           this.show({ state: 'starting' });
           break;
         case State.Running:
+          started = true;
           this.show({ state: 'running', launch: launch.value });
           this.onRunning();
           break;
         case State.Stopped:
-          if (!this.stopping) {
+          if (started && !this.stopping) {
             // The client gave up restarting a server that kept exiting.
             this.fail(`${command} stopped unexpectedly.`);
           }
@@ -141,9 +171,10 @@ class Server implements vscode.Disposable {
     try {
       await client.start();
     } catch (error) {
-      this.fail(`${command} did not start: ${error instanceof Error ? error.message : String(error)}`);
+      const message = startFailure(command, await stderr.lastLines(STDERR_WAIT_MS), error);
+      this.fail(message);
       const log = 'Show Log';
-      void vscode.window.showErrorMessage('The ncc language server did not start.', log).then((choice) => {
+      void vscode.window.showErrorMessage(message, log).then((choice) => {
         if (choice === log) {
           this.output.show(true);
         }

@@ -5,6 +5,8 @@
 import { execFile } from 'node:child_process';
 import { constants, promises as fs } from 'node:fs';
 import * as path from 'node:path';
+import * as readline from 'node:readline';
+import type { Readable } from 'node:stream';
 
 const LOG_LEVELS = ['error', 'warn', 'info', 'debug', 'trace'] as const;
 export type LogLevel = (typeof LOG_LEVELS)[number];
@@ -241,4 +243,53 @@ export async function serverLaunch(settings: Settings, environment: Environment)
       version: version.value,
     },
   };
+}
+
+/** How many of the server's last lines on stderr a failure quotes. */
+const REASON_LINES = 3;
+
+/**
+ * A server's stderr: each line goes on to the log, and the last few are kept
+ * to say why a server that exited as it started did so.
+ */
+export class ServerStderr {
+  private readonly last: string[] = [];
+  private ended: Promise<void> = Promise.resolve();
+
+  /** Reads `input` line by line, handing each line to `log`. */
+  read(input: Readable, log: (line: string) => void): void {
+    const lines = readline.createInterface({ input, crlfDelay: Infinity, terminal: false, historySize: 0 });
+    this.ended = new Promise((resolve) => lines.once('close', resolve));
+    lines.on('line', (line) => {
+      log(line);
+      if (line.trim() !== '') {
+        this.last.push(line.trim());
+        this.last.splice(0, this.last.length - REASON_LINES);
+      }
+    });
+  }
+
+  /**
+   * The last lines the server wrote, once its stderr has ended or `waitMs`
+   * have passed: a process that has died may still have lines on the way.
+   */
+  async lastLines(waitMs: number): Promise<string[]> {
+    let timer: NodeJS.Timeout | undefined;
+    const timeout = new Promise<void>((resolve) => (timer = setTimeout(resolve, waitMs)));
+    await Promise.race([this.ended, timeout]);
+    clearTimeout(timer);
+    return [...this.last];
+  }
+}
+
+/**
+ * What the user is told when the server exited before it answered
+ * `initialize`: what it wrote last on stderr, or the client's error.
+ */
+export function startFailure(command: string, stderr: readonly string[], error: unknown): string {
+  const server = `The ncc language server (${command}) exited as it started`;
+  if (stderr.length > 0) {
+    return `${server}: ${stderr.join(' ')}`;
+  }
+  return `${server} without saying why: ${error instanceof Error ? error.message : String(error)}`;
 }

@@ -1,9 +1,11 @@
 // Server discovery, settings and the command line, on a scratch directory.
 
 import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
 import { promises as fs } from 'node:fs';
 import * as os from 'node:os';
 import * as path from 'node:path';
+import { PassThrough } from 'node:stream';
 import { after, before, describe, test } from 'node:test';
 import {
   type Environment,
@@ -12,8 +14,10 @@ import {
   readSettings,
   resolveSettingPath,
   serverLaunch,
+  ServerStderr,
   serverVersion,
   type Settings,
+  startFailure,
 } from '../src/server';
 
 const posix = process.platform !== 'win32';
@@ -200,5 +204,46 @@ describe('serverLaunch', { skip: !posix }, () => {
     assert.equal(!missing.ok && missing.setting, 'ncc.server.path');
     const outdated = await serverLaunch(settings({ serverPath: old }), environment());
     assert.match(!outdated.ok ? outdated.message : '', /is not an ncc with a language server/);
+  });
+});
+
+describe('a server that exits as it starts', () => {
+  test('is reported with the last lines it wrote on stderr, all of them logged', { skip: !posix }, async () => {
+    const dying = path.join(scratch, 'dying-ncc');
+    await fs.writeFile(
+      dying,
+      '#!/bin/sh\necho "loading ncc.toml" >&2\necho >&2\necho "error: the machine file m.toml:3: unknown key" >&2\nexit 1\n',
+      { mode: 0o755 },
+    );
+    const stderr = new ServerStderr();
+    const logged: string[] = [];
+    const server = spawn(dying, ['lsp']);
+    stderr.read(server.stderr, (line) => logged.push(line));
+    // Asked as soon as the start fails: the lines still come.
+    const lines = await stderr.lastLines(10_000);
+    assert.deepEqual(logged, ['loading ncc.toml', '', 'error: the machine file m.toml:3: unknown key']);
+    assert.equal(
+      startFailure(dying, lines, new Error('write EPIPE')),
+      `The ncc language server (${dying}) exited as it started: loading ncc.toml error: the machine file m.toml:3: unknown key`,
+    );
+  });
+
+  test('keeps the last three lines, and waits for the rest no longer than asked', async () => {
+    const input = new PassThrough();
+    const stderr = new ServerStderr();
+    stderr.read(input, () => undefined);
+    input.write('one\ntwo\nthree\nfour\n');
+    const started = Date.now();
+    // The stream stays open, as that of a server that hangs would.
+    assert.deepEqual(await stderr.lastLines(200), ['two', 'three', 'four']);
+    assert.ok(Date.now() - started < 5_000);
+    input.end();
+  });
+
+  test("without a word on stderr, the client's error says what happened", () => {
+    assert.equal(
+      startFailure('/opt/ncc', [], new Error('spawn /opt/ncc EACCES')),
+      'The ncc language server (/opt/ncc) exited as it started without saying why: spawn /opt/ncc EACCES',
+    );
   });
 });

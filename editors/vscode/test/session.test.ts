@@ -59,8 +59,11 @@ before(async () => {
   // only the initialization option can bring it in.
   await fs.writeFile(path.join(scratch, 'machine', 'ncc.toml'), '[rules]\nspace-after-sign = "warning"\n');
 
+  // NCC_BIN is a path from where the tests run; the setting's relative
+  // paths start at the workspace folder.
+  const bin = process.env['NCC_BIN'];
   const settings = readSettings(
-    (key) => ({ 'server.path': process.env['NCC_BIN'], 'machine.configFile': 'machine/ncc.toml' })[key],
+    (key) => ({ 'server.path': bin && path.resolve(bin), 'machine.configFile': 'machine/ncc.toml' })[key],
   );
   const found = await serverLaunch(settings, {
     base: scratch,

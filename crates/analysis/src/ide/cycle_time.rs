@@ -15,13 +15,14 @@ use nc_exec::{
     run::{Checkpoint, Environment, Motion, Step, Totals, shift_count, shift_offset, shift_range},
     velocity::{self, Break, Dynamics, Reason, Timer, TimerState, TimingSink},
 };
-use ncc_syntax::{TextRange, TextSize, ast::AstNode};
+use ncc_syntax::{BlockParser, SyntaxNode, TextRange, TextSize, ast::AstNode};
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
 use crate::{
     InlayHint, InlayHintKind, MachineConfig,
     db::{Db, Settings, SourceFile},
+    ide::symbols::content_end,
     model::{self, FileKind},
 };
 
@@ -654,15 +655,17 @@ impl Estimate {
         self.blocks[..after].last().filter(|block| block.range.contains_inclusive(offset))
     }
 
-    /// The hints in `range` (everywhere without one), at the end of each
-    /// block's last line in `text`: its time, and a marker per reason the
-    /// speed drops there.
-    pub fn inlay_hints(&self, text: &str, range: Option<TextRange>, mode: CycleTimeHints) -> Vec<InlayHint> {
+    /// The hints in `range` (everywhere without one), at the end of the
+    /// last line of each block that holds program text: its time, and a
+    /// marker per reason the speed drops there. Offsets are in the text
+    /// the estimate ran on.
+    pub fn inlay_hints(&self, range: Option<TextRange>, mode: CycleTimeHints) -> Vec<InlayHint> {
         if mode == CycleTimeHints::Off {
             return Vec::new();
         }
         let first = range.map_or(0, |range| self.blocks.partition_point(|block| block.range.end() < range.start()));
         let mut hints = Vec::new();
+        let mut blocks = BlockParser::new(&self.text);
         for block in &self.blocks[first..] {
             if range.is_some_and(|range| block.range.start() > range.end()) {
                 break;
@@ -670,7 +673,7 @@ impl Estimate {
             if block.total <= 0.0 {
                 continue;
             }
-            let offset = line_end(text, block.range);
+            let offset = hint_offset(&mut blocks, block.range);
             // A block that ends where the range starts has its hints on
             // the line before.
             if range.is_some_and(|range| !range.contains_inclusive(offset)) {
@@ -768,10 +771,13 @@ impl BreakAt {
     }
 }
 
-/// The end of the last line of `range` that holds more than white space.
-fn line_end(text: &str, range: TextRange) -> TextSize {
-    let block = text.get(usize::from(range.start())..usize::from(range.end())).unwrap_or_default();
-    range.start() + TextSize::of(block.trim_end())
+/// Where the hints of the block at `range` go: the end of its last line
+/// that holds program text. A block runs up to the next block number, so
+/// the comment lines after its words are its own; hints after them would
+/// stand lines below the block.
+fn hint_offset(blocks: &mut BlockParser<'_>, range: TextRange) -> TextSize {
+    let block = blocks.block_at(range.start().into());
+    block.map_or(range.end(), |(_, block)| range.start() + content_end(&SyntaxNode::new_root(block)))
 }
 
 /// Hours, minutes and seconds of a non-negative time.
@@ -944,7 +950,7 @@ mod tests {
         let program = "%1\nN10 G23 G01 X10 F600\nN20 Y10 \"SIDE\"\nN30 M30\n*\n";
         let estimate = estimated(program, &[]);
         let hints: Vec<String> = estimate
-            .inlay_hints(program, None, CycleTimeHints::PerBlock)
+            .inlay_hints(None, CycleTimeHints::PerBlock)
             .iter()
             .map(|hint| {
                 format!("{}: {}", &program[..usize::from(hint.offset)].rsplit('\n').next().unwrap(), hint.label)
@@ -960,7 +966,7 @@ mod tests {
         "#]]
         .assert_debug_eq(&hints);
         let cumulative: Vec<String> = estimate
-            .inlay_hints(program, None, CycleTimeHints::Cumulative)
+            .inlay_hints(None, CycleTimeHints::Cumulative)
             .into_iter()
             .filter(|hint| hint.kind == InlayHintKind::BlockTime)
             .map(|hint| hint.label)
@@ -972,12 +978,12 @@ mod tests {
             ]
         "#]]
         .assert_debug_eq(&cumulative);
-        assert!(estimate.inlay_hints(program, None, CycleTimeHints::Off).is_empty());
+        assert!(estimate.inlay_hints(None, CycleTimeHints::Off).is_empty());
         // Only the hints in the range: the line of N20, not N10's before it.
         let n20 = TextSize::from(program.find("N20").unwrap() as u32);
         let line = TextRange::new(n20, TextSize::from(program.find("\nN30").unwrap() as u32));
         let ranged: Vec<String> =
-            estimate.inlay_hints(program, Some(line), CycleTimeHints::PerBlock).into_iter().map(|h| h.label).collect();
+            estimate.inlay_hints(Some(line), CycleTimeHints::PerBlock).into_iter().map(|h| h.label).collect();
         assert_eq!(ranged, ["1.03 s", "▼ non-motion −22 ms"]);
         expect![[r#"
             **Predicted time:** takes 1.03 s, starts at 1.03 s
@@ -987,6 +993,31 @@ mod tests {
             **Speed drops** (non-motion): a block without motion between moves. 600 → 0 mm/min; 22 ms lost against a smooth join."#]].assert_eq(&estimate.hover(n20 + TextSize::from(5)).unwrap());
         expect!["Cycle time 2.07 s · cutting 2.07 s · rapid 0 s · 2 breaks cost 57 ms"].assert_eq(&estimate.headline());
         assert_eq!(estimate.hover(TextSize::from(0)), None, "the header is no block");
+    }
+
+    #[test]
+    fn a_blocks_hints_end_its_last_line_of_program_text_not_the_comment_lines_after_it() {
+        let program = "%1\nN10 R11=5.\nN20 G01 X10\nY10 F600 \"SIDE\"  \n\"NEXT\"\nN30 / G00 ZR11\n\"LIFT\"\n  \"CLEAR\"\n\nN40 M30\n*\n";
+        let estimate = estimated(program, &[]);
+        // Each line with its hints in brackets where they stand.
+        let mut shown = program.to_owned();
+        for hint in estimate.inlay_hints(None, CycleTimeHints::PerBlock).iter().rev() {
+            shown.insert_str(usize::from(hint.offset), &format!("[{}]", hint.label));
+        }
+        expect![[r#"
+            %1
+            N10 R11=5.
+            N20 G01 X10
+            Y10 F600 "SIDE"[1.44 s][▼ rapid −34 ms]  
+            "NEXT"
+            N30 / G00 ZR11[161 ms][▼ rapid −61 ms]
+            "LIFT"
+              "CLEAR"
+
+            N40 M30
+            *
+        "#]]
+        .assert_eq(&shown);
     }
 
     /// A CAM-like program of `blocks` moves: absolute contours with

@@ -179,7 +179,7 @@ fn comment_text(comment: &ast::Comment) -> Option<String> {
 }
 
 /// Where the last line with program text of a block (or header) ends.
-fn content_end(node: &SyntaxNode) -> TextSize {
+pub(crate) fn content_end(node: &SyntaxNode) -> TextSize {
     let mut end = node.text_range().start();
     let mut line_has_text = false;
     for element in node.children_with_tokens() {

@@ -138,7 +138,7 @@ pub(crate) fn inlay_hints(s: &Snapshot, range: lsp::Range) -> Vec<lsp::InlayHint
     let range = s.map.range_offsets(range);
     let mut hints = s.analysis.inlay_hints(s.file, Some(range));
     if let Some(cycle) = &s.cycle {
-        let timed = cycle.estimate.inlay_hints(&s.map.text, Some(range), s.cycle_hints);
+        let timed = cycle.estimate.inlay_hints(Some(range), s.cycle_hints);
         hints.extend(timed.into_iter().filter(|hint| cycle.holds_at(hint.offset)));
         // Parameter values and times can share a line; the client wants
         // them in order.
