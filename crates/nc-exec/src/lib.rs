@@ -20,6 +20,8 @@
 //!   constants), and [`tables`]: its zero offsets and tool corrections with
 //!   readers for the control's files.
 //! - [`modes`]: the active code of every G and M group.
+//! - [`program_flow`]: which block runs after a block (calls, jumps,
+//!   returns), for the runner and the checker's flow walk alike.
 //! - [`run`]: running a program block by block into a [`run::Trace`].
 //! - [`transform`]: the coordinate recalculations G34–G37 and the
 //!   transformations G38/G39/G31, and the frames from program to machine
@@ -33,6 +35,7 @@ pub mod expand;
 pub mod lower;
 pub mod machine;
 pub mod modes;
+pub mod program_flow;
 pub mod run;
 pub mod tables;
 pub mod transform;
