@@ -6,25 +6,34 @@
 //! call walks its subprogram with the caller's state and continues with the
 //! state the subprogram leaves; a G72 call does the same with the workspace's
 //! macrocycle file (or makes everything unknown when the file is missing).
+//! Jumps, returns and repetitions go where the executor goes
+//! ([`program_flow`] decides for both): a block a known jump skips is not
+//! walked, and a loop is walked run by run, up to [`REPEAT_BUDGET`] blocks.
 //! Subprograms nobody calls, macrocycle files and cycle bodies are walked
 //! from an unknown state. Unknown values never produce findings: a rule
-//! reports only what it can prove.
+//! reports only what it can prove. So where a parameter with no known value
+//! decides the way, the walk forgets what it knew where the ways may meet
+//! (flow-not-followed says so).
 //!
-//! Checks are [`FlowCheck`]s that see every block with the state before and
-//! after it.
+//! Checks are [`FlowCheck`]s that see every block each time it runs, with
+//! the state before and after it.
 
 use std::{ops::Range, sync::Arc};
 
-use nc_exec::arith::{self, ArithError, BlockArithmetic, Parameters, Raw, UnknownMachine};
+use nc_exec::{
+    arith::{self, ArithError, BlockArithmetic, Parameters, Raw, UnknownMachine},
+    program_flow::{self, BlockFlow, JumpCounts},
+};
 use ncc_catalog::{AddressRole, Catalogue, Modality};
 use ncc_syntax::{Decimal, Sign, TextRange, TextSize};
 use rustc_hash::FxHashMap;
 
 use crate::{
     Config, Diagnostic,
+    checks::structure::FLOW_NOT_FOLLOWED,
     db::{self, Db, Settings, SourceFile},
     lower::{BlockData, Value, Word},
-    model::{self, FileKind, Program, Transfer},
+    model::{self, FileKind, Program},
 };
 
 /// A value that may not be known statically.
@@ -270,11 +279,19 @@ pub(crate) trait FlowCheck {
     fn end_of_unit(&mut self, _state: &ModalState, _last: Option<(TextSize, &BlockData)>, _out: &mut Vec<Diagnostic>) {}
 }
 
-/// The state before block `index` of `file` each time the walk reaches it (a subprogram called twice is reached twice).
+/// The state before block `index` of `file` each time the walk reaches it
+/// (a subprogram called twice is reached twice); for a block of the main
+/// body, the first time, from the checkpoints.
 pub fn states_before(db: &dyn Db, file: SourceFile, index: usize) -> Vec<(ModalState, ParamState)> {
-    if let Some(state) = crate::states::main_state_before(db, file, index) {
-        return vec![state];
+    match crate::states::main_state_before(db, file, index) {
+        Some(state) => vec![state],
+        None => walked_states(db, file, index),
     }
+}
+
+/// The state before block `index` each time a walk of the whole file
+/// reaches it.
+pub(crate) fn walked_states(db: &dyn Db, file: SourceFile, index: usize) -> Vec<(ModalState, ParamState)> {
     let program = model::program(db, file);
     let Some(block) = program.get_block(index) else { return Vec::new() };
     let seen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
@@ -306,12 +323,11 @@ pub fn flow_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
     let mut walk = Walk::new(db, file, program, crate::checks::flow_checks());
     walk.run();
     let mut out = walk.out;
-    // A subprogram called from several places repeats its findings, with
-    // the first call's related locations kept.
-    out.sort_by(|a, b| {
-        (a.range.start(), a.range.end(), a.code, &a.message).cmp(&(b.range.start(), b.range.end(), b.code, &b.message))
-    });
-    out.dedup_by(|later, first| (later.range, later.code, &later.message) == (first.range, first.code, &first.message));
+    // A block run several times (a subprogram called from several places,
+    // a loop) repeats its findings, maybe with other values: the first
+    // run's is kept (the sort is stable).
+    out.sort_by_key(|d| (d.range.start(), d.range.end(), d.code));
+    out.dedup_by(|later, first| (later.range, later.code) == (first.range, first.code));
     out
 }
 
@@ -367,6 +383,53 @@ pub fn lowered_block(db: &dyn Db, file: SourceFile, index: usize) -> Option<(Tex
 /// business, not the checker's).
 const MAX_CALL_DEPTH: usize = 8;
 
+/// How many blocks a walk runs again for loops and repeated calls, beyond
+/// running each block once: about a fifth of a second, so that a huge
+/// repetition count holds up neither `ncc check` nor the editor.
+const REPEAT_BUDGET: usize = 100_000;
+
+/// What decides which block of a unit the walk runs next, besides the
+/// state.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub(crate) struct Course {
+    /// The jumps taken, counted as the executor counts them.
+    jumps: JumpCounts,
+    /// Blocks ahead that a jump the walk could not decide may reach: there
+    /// the walk forgets the state, which may be another one.
+    merges: Vec<usize>,
+    /// Jump blocks that may or may not have jumped: their count is unknown.
+    unsure: Vec<usize>,
+    /// The walk could not tell which block runs next: it goes through the
+    /// rest of the unit in order, knowing no state, since any of its blocks
+    /// may run next.
+    lost: bool,
+}
+
+impl Course {
+    /// Gives up following the unit.
+    fn lose(&mut self) {
+        *self = Course { lost: true, ..Course::default() };
+    }
+
+    /// Moves the course with the blocks of the main body (`moved` gives a
+    /// block's new index); `false` if a block it holds has none.
+    pub(crate) fn move_blocks(&mut self, moved: impl Fn(usize) -> Option<usize>) -> bool {
+        let mut blocks = self.merges.iter_mut().chain(&mut self.unsure);
+        blocks.all(|block| moved(*block).map(|to| *block = to).is_some()) && self.jumps.move_blocks(moved)
+    }
+}
+
+/// Why the walk cannot decide where a block goes: the word whose parameter
+/// has no known value.
+enum Undecided<'a> {
+    /// Any block of the unit may run next.
+    Course(&'a Word),
+    /// The block jumps to block N`label`, or goes on.
+    Jump(&'a Word, u32),
+    /// The block calls, but what or how often is unknown.
+    Call(&'a Word),
+}
+
 pub(crate) struct Walk<'db> {
     db: &'db dyn Db,
     program: &'db Program,
@@ -378,9 +441,18 @@ pub(crate) struct Walk<'db> {
     /// Subprograms on the call stack (by unit index).
     pub(crate) stack: Vec<usize>,
     called: Vec<bool>,
-    /// The hull of the blocks of the subprograms entered since the last
+    /// The hull of the blocks of the subprograms entered, and of the
+    /// blocks that decided the jumps taken, since the last
     /// [`Walk::take_entered`].
     entered: Option<Range<usize>>,
+    /// Blocks run again so far (see [`REPEAT_BUDGET`]).
+    pub(crate) repeated: usize,
+    /// The program ended (M02/M30, or a jump to no block stopped it).
+    ended: bool,
+    /// The walk started at the program's start; a unit walked from an
+    /// unknown state (a macrocycle file, a subprogram nobody calls) knows
+    /// too little to say where it stops following.
+    from_program_start: bool,
 }
 
 impl<'db> Walk<'db> {
@@ -401,6 +473,9 @@ impl<'db> Walk<'db> {
             stack: Vec::new(),
             called: vec![false; program.units.len()],
             entered: None,
+            repeated: 0,
+            ended: false,
+            from_program_start: false,
         }
     }
 
@@ -408,23 +483,28 @@ impl<'db> Walk<'db> {
         let has_main = self.program.has_main();
         if has_main {
             let (mut state, mut params) = (ModalState::reset(self.catalogue), ParamState::program_start());
+            self.from_program_start = true;
             self.walk_unit(0, &mut state, &mut params);
+            self.from_program_start = false;
         }
         for unit in 0..self.program.units.len() {
             let is_main = has_main && unit == 0;
             let called = self.program.kind == FileKind::Program && self.called[unit];
             if !is_main && !called {
+                self.ended = false;
                 self.walk_unit(unit, &mut ModalState::unknown(), &mut ParamState::unknown());
             }
         }
     }
 
-    /// Walks a unit from `state`, which it leaves as at the unit's end.
+    /// Runs a unit from `state`, which it leaves as at the unit's end.
     fn walk_unit(&mut self, unit: usize, state: &mut ModalState, params: &mut ParamState) {
         self.stack.push(unit);
-        let mut last = None;
-        for index in self.program.units[unit].blocks.clone() {
-            self.step(index, state, params);
+        let blocks = self.program.units[unit].blocks.clone();
+        let mut course = Course::default();
+        let (mut at, mut last) = (Some(blocks.start).filter(|_| !blocks.is_empty()), None);
+        while let Some(index) = at {
+            at = self.step(index, &mut course, state, params);
             last = Some(index);
         }
         let last_block = last.map(|index| self.blocks.get(index));
@@ -435,77 +515,344 @@ impl<'db> Walk<'db> {
     }
 
     /// Runs block `index` (and what it calls) from `state`, which it
-    /// leaves as after the block. In place: a walk without checks then
-    /// copies no state.
-    pub(crate) fn step(&mut self, index: usize, state: &mut ModalState, params: &mut ParamState) {
+    /// leaves as after the block, and tells which block of the unit runs
+    /// next (`None`: the unit's run ends), deciding as the executor does.
+    /// In place: a walk without checks then copies no state.
+    pub(crate) fn step(
+        &mut self,
+        index: usize,
+        course: &mut Course,
+        state: &mut ModalState,
+        params: &mut ParamState,
+    ) -> Option<usize> {
         let (offset, block) = self.blocks.get(index);
-        self.visit(&block, offset, state, params);
-        if let Some((transfer, range)) = self.program.block(index).transfer {
-            self.follow(transfer, range, state, params);
+        let (substitutions, codes) = self.visit(&block, offset, state, params);
+        let unit = *self.stack.last().expect("a block runs in a unit");
+        let blocks = self.program.units[unit].blocks.clone();
+        let next = Some(index + 1).filter(|next| blocks.contains(next));
+        if course.lost {
+            forget(state, params);
+            return next;
+        }
+        let in_subprogram = !(unit == 0 && self.program.has_main());
+        let mut decided = self.block_flow(&block, &substitutions, &codes, params, in_subprogram);
+        // A jump that may have been taken before may have used up its count.
+        if let (Ok(BlockFlow::Jump { label, .. }), Some(word)) = (&decided, block.word(b'L'))
+            && course.unsure.contains(&index)
+        {
+            decided = Err(Undecided::Jump(word, *label));
+        }
+        let flow = match decided {
+            Ok(flow) => flow,
+            Err(Undecided::Jump(word, label)) => {
+                let target = self.program.jump_target(index, label);
+                course.jumps.passed(index);
+                if let Some(target) = target.filter(|&target| target > index) {
+                    let why = unknown_parameter(word, course.unsure.contains(&index));
+                    self.not_followed(word, offset, format!("{why}, so the checker cannot tell whether the program jumps to N{label} here: it checks N{label} knowing no modal state or parameter values"));
+                    for (blocks, block) in [(&mut course.merges, target), (&mut course.unsure, index)] {
+                        if !blocks.contains(&block) {
+                            blocks.push(block);
+                        }
+                    }
+                    return self.arrive(index, next, course, state, params);
+                }
+                // Back: the section may run any number of times more.
+                if target.is_some() {
+                    return self.lose(word, offset, course, state, params, next);
+                }
+                // To no block, which stops the control: going on is the only
+                // way on.
+                return self.arrive(index, next, course, state, params);
+            }
+            Err(Undecided::Course(word)) => return self.lose(word, offset, course, state, params, next),
+            Err(Undecided::Call(word)) => {
+                let why = unknown_parameter(word, false);
+                self.not_followed(word, offset, format!("{why}, so the checker cannot tell what this block calls or how often: it knows no modal state or parameter values after it"));
+                forget(state, params);
+                return self.arrive(index, next, course, state, params);
+            }
+        };
+        let code_range = |code: u32| codes.iter().find(|&&(l, n, _)| l == b'G' && n == code).map(|&(_, _, r)| r);
+        let to = match flow {
+            BlockFlow::Next => {
+                course.jumps.passed(index);
+                course.unsure.retain(|&at| at != index);
+                next
+            }
+            BlockFlow::End => {
+                self.ended = true;
+                None
+            }
+            BlockFlow::Return => next.filter(|_| !in_subprogram),
+            BlockFlow::Call { label, times, macrocycle } => {
+                let range = code_range(if macrocycle { 72 } else { 71 }).unwrap_or(TextRange::empty(offset));
+                self.call(label, times, macrocycle, range, state, params);
+                next.filter(|_| !self.ended)
+            }
+            BlockFlow::Jump { label, times } => {
+                // A jump to no block stops the control (jump-target-not-in-unit).
+                let Some(target) = self.program.jump_target(index, label) else {
+                    self.ended = true;
+                    return None;
+                };
+                if !course.jumps.jumps(index, times) {
+                    course.unsure.retain(|&at| at != index);
+                    return self.arrive(index, next, course, state, params);
+                }
+                let again = (index + 1).saturating_sub(target);
+                if self.repeated + again > REPEAT_BUDGET {
+                    let range = code_range(73).unwrap_or(TextRange::empty(offset));
+                    self.not_followed_at(range, format!("the checker runs loops for at most {REPEAT_BUDGET} blocks, and this jump back to N{label} goes on beyond that: it checks the rest of this program unit without the modal state and parameter values"));
+                    course.lose();
+                    forget(state, params);
+                    return next;
+                }
+                self.repeated += again;
+                // Where the jump goes depends on the block numbers from the
+                // unit's start on.
+                self.enter(blocks.start..index.max(target) + 1);
+                Some(target)
+            }
+        };
+        self.arrive(index, to, course, state, params)
+    }
+
+    /// Gives up following the unit after the block at `offset`, because of
+    /// its word `word`; goes on with `next`.
+    fn lose(
+        &mut self,
+        word: &Word,
+        offset: TextSize,
+        course: &mut Course,
+        state: &mut ModalState,
+        params: &mut ParamState,
+        next: Option<usize>,
+    ) -> Option<usize> {
+        let why = unknown_parameter(word, false);
+        self.not_followed(word, offset, format!("{why}, so the checker cannot tell which block runs after this one: it checks the rest of this program unit without the modal state and parameter values"));
+        course.lose();
+        forget(state, params);
+        next
+    }
+
+    /// The walk goes from block `from` to block `to` (`None`: the unit's
+    /// run ends): where a jump it could not decide may lead as well, it
+    /// forgets the state.
+    fn arrive(
+        &mut self,
+        from: usize,
+        to: Option<usize>,
+        course: &mut Course,
+        state: &mut ModalState,
+        params: &mut ParamState,
+    ) -> Option<usize> {
+        if course.merges.is_empty() {
+            return to;
+        }
+        let Some(to) = to else {
+            // The other way may leave the unit with another state.
+            forget(state, params);
+            return None;
+        };
+        if let Some(&passed) = course.merges.iter().filter(|&&merge| from < merge && merge < to).min() {
+            // A jump past a block the other way reaches: both ways run the
+            // blocks after it.
+            let (offset, block) = self.blocks.get(from);
+            let label = block.word(b'L').map_or(self.program.block(from).head, |word| word.range + offset);
+            self.not_followed_at(label, "this jump passes a block that a jump the checker cannot decide may lead to: it checks the rest of this program unit without the modal state and parameter values".to_owned());
+            course.lose();
+            forget(state, params);
+            return Some(passed);
+        }
+        if let Some(at) = course.merges.iter().position(|&merge| merge == to) {
+            course.merges.swap_remove(at);
+            forget(state, params);
+        }
+        Some(to)
+    }
+
+    /// Where block `block` passes control on (see [`program_flow::block_flow`]):
+    /// its codes as substituted before the block, L and Q as it leaves
+    /// `params`.
+    fn block_flow<'b>(
+        &self,
+        block: &'b BlockData,
+        substitutions: &[Option<Substitution>],
+        codes: &[(u8, u32, TextRange)],
+        params: &ParamState,
+        in_subprogram: bool,
+    ) -> Result<BlockFlow, Undecided<'b>> {
+        let has = |letter: u8, number: u32| codes.iter().any(|&(l, n, _)| l == letter && n == number);
+        let integer = |word: &Word| program_flow::integer(word, &params.values);
+        let unknown = |word: &&Word| match &word.value {
+            Some(value @ Value::Parameter { .. }) => arith::reference(value, &params.values).is_none(),
+            _ => false,
+        };
+        let unknown_code = block.words.iter().zip(substitutions).find(|(word, substitution)| {
+            word.letter == b'G' && matches!(word.value, Some(Value::Parameter { .. })) && substitution.is_none()
+        });
+        let (label, count) = (block.word(b'L'), block.word(b'Q'));
+        if let Some((word, _)) = unknown_code {
+            // In a subprogram the code may be G70; with L, a call or a jump
+            // (G73 to L, G78 going on: 02 §5.6).
+            match label.filter(|label| !unknown(label)).and_then(integer) {
+                _ if in_subprogram => return Err(Undecided::Course(word)),
+                Some(label) if !self.callable(label) => return Err(Undecided::Jump(word, label)),
+                _ if label.is_some() => return Err(Undecided::Course(word)),
+                _ => {}
+            }
+        }
+        let jumps = has(b'G', 73);
+        if jumps || has(b'G', 71) || has(b'G', 72) {
+            if let Some(word) = label.filter(unknown) {
+                return Err(if jumps { Undecided::Course(word) } else { Undecided::Call(word) });
+            }
+            let counted = count.filter(|_| !has(b'G', 4));
+            if let Some(word) = counted.filter(unknown) {
+                return Err(match label.and_then(integer) {
+                    Some(label) if jumps => Undecided::Jump(word, label),
+                    _ => Undecided::Call(word),
+                });
+            }
+        }
+        Ok(program_flow::block_flow(block, has, integer))
+    }
+
+    /// Whether a call of `label` would find a subprogram or a macrocycle.
+    fn callable(&self, label: u32) -> bool {
+        self.program.subprogram(label).is_some() || model::macrocycles(self.db).contains_key(&label)
+    }
+
+    /// Reports that the walk does not follow the program past the word
+    /// `word` of the block at `offset`.
+    fn not_followed(&mut self, word: &Word, offset: TextSize, message: String) {
+        self.not_followed_at(word.range + offset, message);
+    }
+
+    fn not_followed_at(&mut self, range: TextRange, message: String) {
+        // Only a walk that checks reports; the others give the state.
+        if !self.checks.is_empty() && self.from_program_start {
+            self.out.push(Diagnostic::new(&FLOW_NOT_FOLLOWED, range, message));
         }
     }
 
-    /// The hull of the blocks of the subprograms entered since the last
-    /// call (`None`: none).
+    /// Adds `blocks` to the hull [`Walk::take_entered`] gives.
+    fn enter(&mut self, blocks: Range<usize>) {
+        self.entered = Some(match self.entered.take() {
+            Some(hull) => hull.start.min(blocks.start)..hull.end.max(blocks.end),
+            None => blocks,
+        });
+    }
+
+    /// The hull of the blocks of the subprograms entered and the jumps taken
+    /// since the last call (`None`: none).
     pub(crate) fn take_entered(&mut self) -> Option<Range<usize>> {
         self.entered.take()
     }
 
-    /// Follows a call: the callee runs with the caller's state.
-    fn follow(&mut self, transfer: Transfer, call: TextRange, state: &mut ModalState, params: &mut ParamState) {
-        let unknown = |state: &mut ModalState, params: &mut ParamState| {
-            *state = ModalState::unknown();
-            *params = ParamState::unknown();
+    /// Follows a call, `times` runs of the callee with the caller's state.
+    fn call(
+        &mut self,
+        label: u32,
+        times: u32,
+        macrocycle: bool,
+        call: TextRange,
+        state: &mut ModalState,
+        params: &mut ParamState,
+    ) {
+        if self.stack.len() >= MAX_CALL_DEPTH {
+            self.not_followed_at(call, format!("calls nest deeper here than the {MAX_CALL_DEPTH} levels the checker follows: it knows no modal state or parameter values after this block"));
+            return forget(state, params);
+        }
+        if macrocycle {
+            return self.call_macrocycle(label, times, call, state, params);
+        }
+        let Some(unit) = self.program.units.iter().position(|u| u.number == Some(label)) else {
+            // No such subprogram: undefined-subprogram reports the call.
+            return forget(state, params);
         };
-        match transfer {
-            Transfer::Jump(_) => {}
-            Transfer::Subprogram(number) => {
-                let unit = self.program.units.iter().position(|u| u.number == Some(number));
-                match unit {
-                    Some(unit) if self.stack.len() < MAX_CALL_DEPTH && !self.stack.contains(&unit) => {
-                        self.called[unit] = true;
-                        let blocks = &self.program.units[unit].blocks;
-                        self.entered = Some(match self.entered.take() {
-                            Some(hull) => hull.start.min(blocks.start)..hull.end.max(blocks.end),
-                            None => blocks.clone(),
-                        });
-                        self.walk_unit(unit, state, params);
-                    }
-                    _ => unknown(state, params),
-                }
+        if self.stack.contains(&unit) {
+            self.not_followed_at(call, format!("L{label} is running already: the checker does not follow a subprogram into itself, and knows no modal state or parameter values after this block"));
+            return forget(state, params);
+        }
+        self.called[unit] = true;
+        let blocks = self.program.units[unit].blocks.clone();
+        self.enter(blocks.clone());
+        for run in 0..times {
+            if run > 0 && !self.repeat(blocks.len(), call, state, params) {
+                return;
             }
-            Transfer::Macrocycle(number) => {
-                let file = model::macrocycles(self.db).get(&number).and_then(|files| files.first().copied());
-                match file {
-                    Some(file) if self.stack.len() < MAX_CALL_DEPTH => {
-                        // The macrocycle's own findings belong to its file;
-                        // here only the state it leaves matters.
-                        let program = model::program(self.db, file);
-                        let mut inner = Walk::new(self.db, file, program, Vec::new());
-                        inner.stack = vec![usize::MAX; self.stack.len()];
-                        if program.units.is_empty() {
-                            return unknown(state, params);
-                        }
-                        let origins_before = params.origins.clone();
-                        let settings_before = state.clone();
-                        inner.walk_unit(0, state, params);
-                        state.point_settings_at(&settings_before, call);
-                        // Ranges in the macrocycle's file mean nothing here:
-                        // what it assigned comes from the call.
-                        for (origin, before) in params.origins.iter_mut().zip(origins_before) {
-                            if *origin != before {
-                                *origin = origin.map(|_| Origin { range: call, point: false, computed: true });
-                            }
-                        }
-                    }
-                    _ => unknown(state, params),
-                }
+            self.walk_unit(unit, state, params);
+            if self.ended {
+                return;
             }
         }
     }
 
-    /// Takes the state over one block, and runs the checks on it.
-    fn visit(&mut self, block: &BlockData, offset: TextSize, state: &mut ModalState, params: &mut ParamState) {
+    /// Follows a macrocycle call: its file's findings belong to that file;
+    /// here only the state it leaves matters.
+    fn call_macrocycle(
+        &mut self,
+        label: u32,
+        times: u32,
+        call: TextRange,
+        state: &mut ModalState,
+        params: &mut ParamState,
+    ) {
+        let Some(file) = model::macrocycles(self.db).get(&label).and_then(|files| files.first().copied()) else {
+            // No such file: undefined-macrocycle reports the call.
+            return forget(state, params);
+        };
+        let program = model::program(self.db, file);
+        if program.units.is_empty() {
+            return forget(state, params);
+        }
+        let mut inner = Walk::new(self.db, file, program, Vec::new());
+        inner.stack = vec![usize::MAX; self.stack.len()];
+        let origins_before = params.origins.clone();
+        let settings_before = state.clone();
+        for run in 0..times {
+            if run > 0 && !self.repeat(program.units[0].blocks.len(), call, state, params) {
+                return;
+            }
+            inner.walk_unit(0, state, params);
+            if inner.ended {
+                self.ended = true;
+                return;
+            }
+        }
+        state.point_settings_at(&settings_before, call);
+        // Ranges in the macrocycle's file mean nothing here: what it
+        // assigned comes from the call.
+        for (origin, before) in params.origins.iter_mut().zip(origins_before) {
+            if *origin != before {
+                *origin = origin.map(|_| Origin { range: call, point: false, computed: true });
+            }
+        }
+    }
+
+    /// Whether the budget allows running `blocks` blocks of a call once
+    /// more; if not, says so and forgets the state.
+    fn repeat(&mut self, blocks: usize, call: TextRange, state: &mut ModalState, params: &mut ParamState) -> bool {
+        if self.repeated + blocks > REPEAT_BUDGET {
+            self.not_followed_at(call, format!("the checker runs repeated calls for at most {REPEAT_BUDGET} blocks, and this one goes on beyond that: it knows no modal state or parameter values after this block"));
+            forget(state, params);
+            return false;
+        }
+        self.repeated += blocks;
+        true
+    }
+
+    /// Takes the state over one block, and runs the checks on it; gives
+    /// the block's substitutions and codes.
+    fn visit(
+        &mut self,
+        block: &BlockData,
+        offset: TextSize,
+        state: &mut ModalState,
+        params: &mut ParamState,
+    ) -> (Vec<Option<Substitution>>, Codes) {
         let substitutions: Vec<Option<Substitution>> = block.words.iter().map(|w| substitute(w, params)).collect();
         let codes = codes(block, &substitutions, offset);
         let before = (!self.checks.is_empty()).then(|| (state.clone(), params.clone()));
@@ -516,7 +863,7 @@ impl<'db> Walk<'db> {
             state.position = [Known::Unknown; 26];
         }
         let arithmetic_error = self.assign(block, offset, params);
-        let Some((before, params_before)) = before else { return };
+        let Some((before, params_before)) = before else { return (substitutions, codes) };
         let visit = Visit {
             block,
             offset,
@@ -533,6 +880,7 @@ impl<'db> Walk<'db> {
         for check in &mut self.checks {
             check.block(&visit, &mut self.out);
         }
+        (substitutions, codes)
     }
 
     /// Takes the modal state over a block.
@@ -681,6 +1029,25 @@ impl<'db> Walk<'db> {
     }
 }
 
+/// Forgets everything the walk knew: what runs next is unknown.
+fn forget(state: &mut ModalState, params: &mut ParamState) {
+    *state = ModalState::unknown();
+    *params = ParamState::unknown();
+}
+
+/// Why the walk cannot read `word`: a parameter with no known value, or
+/// (`unsure`) a jump that may have been taken already.
+fn unknown_parameter(word: &Word, unsure: bool) -> String {
+    match word.value {
+        _ if unsure => "whether this jump was taken before is unknown, and with it whether it is taken now".to_owned(),
+        Some(Value::Parameter { index: Some(index), negative, .. }) => {
+            let sign = if negative { "-" } else { "" };
+            format!("`{}{sign}R{index}`: R{index} has no known value here", char::from(word.letter))
+        }
+        _ => format!("`{}` has no readable value", char::from(word.letter)),
+    }
+}
+
 /// The value a parameter reference substitutes, if known.
 fn substitute(word: &Word, params: &ParamState) -> Option<Substitution> {
     let Some(Value::Parameter { negative, index: Some(index), .. }) = word.value else { return None };
@@ -704,8 +1071,11 @@ pub(crate) fn thousandths(word: &Word, substitution: Option<Substitution>) -> Op
     }
 }
 
+/// A block's G and M codes (letter, number, file range).
+type Codes = Vec<(u8, u32, TextRange)>;
+
 /// The block's G and M codes: literal, or substituted with a known value.
-fn codes(block: &BlockData, substitutions: &[Option<Substitution>], offset: TextSize) -> Vec<(u8, u32, TextRange)> {
+fn codes(block: &BlockData, substitutions: &[Option<Substitution>], offset: TextSize) -> Codes {
     let mut codes = Vec::new();
     for (word, substitution) in block.words.iter().zip(substitutions) {
         if !matches!(word.letter, b'G' | b'M') {

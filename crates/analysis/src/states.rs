@@ -32,7 +32,7 @@ use rustc_hash::FxHashMap;
 use crate::{
     Config,
     db::{Db, Settings, SourceFile},
-    flow::{Known, ModalState, ParamState, Walk},
+    flow::{Course, Known, ModalState, ParamState, Walk},
     model::{self, Program},
 };
 
@@ -113,11 +113,22 @@ impl Context {
     }
 }
 
+/// What the walk of the main body carries from block to block.
+#[derive(Clone, PartialEq, Eq)]
+struct Carried {
+    state: (ModalState, ParamState),
+    course: Course,
+    /// Blocks run again so far, against the walk's budget.
+    repeated: usize,
+}
+
 struct Checkpoint {
-    /// The state is the one before this block.
+    /// The state is the one before this block, which the walk reaches here
+    /// the first time, having run no block after it yet: so the first time
+    /// it reaches any later block is after this checkpoint.
     index: usize,
     /// Boxed, so that inserting a checkpoint moves little.
-    state: Box<(ModalState, ParamState)>,
+    state: Box<Carried>,
     /// Where the last text range in `state` ends: an edit after it moves
     /// none of them.
     reach: TextSize,
@@ -130,7 +141,7 @@ struct Checkpoint {
 }
 
 impl Checkpoint {
-    fn new(index: usize, state: (ModalState, ParamState), entered: Option<Range<usize>>) -> Checkpoint {
+    fn new(index: usize, state: Carried, entered: Option<Range<usize>>) -> Checkpoint {
         let mut point = Checkpoint { index, state: Box::new(state), reach: TextSize::from(0), entered, linked: true };
         point.reach = point.ranges().map(|range| range.end()).max().unwrap_or_default();
         point
@@ -138,7 +149,7 @@ impl Checkpoint {
 
     /// The text ranges in the state.
     fn ranges(&mut self) -> impl Iterator<Item = &mut TextRange> {
-        let (state, params) = &mut *self.state;
+        let (state, params) = &mut self.state.state;
         let settings = state.settings_mut().into_iter().filter_map(|setting| match setting {
             Known::Is(Some(setting)) => Some(&mut setting.range),
             _ => None,
@@ -146,9 +157,12 @@ impl Checkpoint {
         settings.chain(params.origins.iter_mut().flatten().map(|origin| &mut origin.range))
     }
 
-    /// Moves the state's text ranges with the text; `false` if one lies in
-    /// the changed text.
+    /// Moves the state's text ranges with the text and its jump counts
+    /// with their blocks; `false` if one lies in the change.
     fn move_ranges(&mut self, changed: &Changed) -> bool {
+        if !self.state.course.move_blocks(|block| changed.blocks(&(block..block + 1)).map(|moved| moved.start)) {
+            return false;
+        }
         if self.reach <= changed.old_text.start() {
             return true;
         }
@@ -324,8 +338,9 @@ impl Checkpoints {
         });
     }
 
-    /// The state before block `index` of the main body, and how many blocks
-    /// the walk to it took.
+    /// The state before block `index` of the main body, the first time the
+    /// walk reaches it (`None`: it does not before it has run a block after
+    /// it), and how many blocks the walk to it took.
     fn state_before(
         &mut self,
         db: &dyn Db,
@@ -333,16 +348,20 @@ impl Checkpoints {
         program: &Program,
         index: usize,
         waiting: Option<&AtomicUsize>,
-    ) -> ((ModalState, ParamState), usize) {
+    ) -> (Option<(ModalState, ParamState)>, usize) {
         let points = &mut self.points;
         // Start at the last checkpoint before the question that only linked
         // ones precede.
         let trusted = points.iter().position(|p| !p.linked).unwrap_or(points.len());
         // `at`: the first checkpoint after `block`.
         let mut at = points[..trusted].partition_point(|p| p.index <= index);
-        let (mut block, mut state) = match at.checked_sub(1) {
+        let (mut block, mut carried) = match at.checked_sub(1) {
             Some(start) => (points[start].index, (*points[start].state).clone()),
-            None => (0, (ModalState::reset(Settings::get(db).dialect(db).catalogue()), ParamState::program_start())),
+            None => {
+                let catalogue = Settings::get(db).dialect(db).catalogue();
+                let state = (ModalState::reset(catalogue), ParamState::program_start());
+                (0, Carried { state, course: Course::default(), repeated: 0 })
+            }
         };
         // An unlinked checkpoint just after the question is checked as well:
         // the edit the question follows left it there, and unchecked ones
@@ -354,17 +373,31 @@ impl Checkpoints {
             .map_or(index, |p| p.index);
         let mut walk = Walk::new(db, file, program, Vec::new());
         walk.stack.push(0);
-        let (mut last, mut walked, mut answer) = (block, 0, None);
+        walk.repeated = carried.repeated;
+        // `unrun`: the first block after every block run so far. Loops run
+        // blocks before it again; a block at or after it runs the first time.
+        let (mut unrun, mut last, mut walked, mut answer) = (block, block, 0, None);
         loop {
-            if points.get(at).is_some_and(|p| p.index == block) {
+            let first_time = block >= unrun;
+            if first_time {
+                // Checkpoints the walk passed without reaching them are no
+                // longer on its way.
+                while points.get(at).is_some_and(|p| p.index < block) {
+                    points.remove(at);
+                    if let Some(next) = points.get_mut(at) {
+                        next.linked = false;
+                    }
+                }
+            }
+            if first_time && points.get(at).is_some_and(|p| p.index == block) {
                 let entered = walk.take_entered();
                 let point = &mut points[at];
                 if !point.linked {
-                    if *point.state == state {
+                    if *point.state == carried {
                         point.linked = true;
                         point.entered = entered;
                     } else {
-                        *point = Checkpoint::new(block, state.clone(), entered);
+                        *point = Checkpoint::new(block, carried.clone(), entered);
                         // The ones linked to it followed the old state.
                         if let Some(next) = points.get_mut(at + 1) {
                             next.linked = false;
@@ -377,24 +410,38 @@ impl Checkpoints {
                 let jump = at + points[at..run].partition_point(|p| p.index <= index).saturating_sub(1);
                 if jump > at {
                     block = points[jump].index;
-                    state = (*points[jump].state).clone();
+                    carried = (*points[jump].state).clone();
+                    walk.repeated = carried.repeated;
+                    unrun = block;
                 }
                 at = jump + 1;
                 last = block;
             }
-            if block == index && end > index {
-                answer = Some(state.clone());
+            if first_time && block == index {
+                answer = Some(carried.state.clone());
             }
-            if block == end {
-                return (answer.unwrap_or(state), walked);
+            // The walk reached the last block it had to, or passed it: a
+            // block it passed is reached later, if at all, by a loop.
+            if first_time && block >= end {
+                if block > end && points.get(at.wrapping_sub(1)).is_none_or(|p| p.index != block) {
+                    points.insert(at, Checkpoint::new(block, carried, walk.take_entered()));
+                }
+                return (answer, walked);
             }
-            walk.step(block, &mut state.0, &mut state.1);
-            block += 1;
+            let Some(next) = walk.step(block, &mut carried.course, &mut carried.state.0, &mut carried.state.1) else {
+                return (answer, walked);
+            };
+            carried.repeated = walk.repeated;
+            unrun = unrun.max(block + 1);
+            block = next;
             walked += 1;
+            if block < unrun {
+                continue;
+            }
             // A new checkpoint every STRIDE blocks, but not right before one.
             let following = points.get(at).map_or(usize::MAX, |p| p.index);
-            if block - last >= STRIDE && following - block >= STRIDE / 2 {
-                points.insert(at, Checkpoint::new(block, state.clone(), walk.take_entered()));
+            if block - last >= STRIDE && following.saturating_sub(block) >= STRIDE / 2 {
+                points.insert(at, Checkpoint::new(block, carried.clone(), walk.take_entered()));
                 at += 1;
                 last = block;
             }
@@ -402,9 +449,9 @@ impl Checkpoints {
             // checkpoint here and let go.
             if waiting.is_some_and(|waiting| waiting.load(Ordering::Relaxed) > 0) && block < end {
                 if following != block && last != block {
-                    points.insert(at, Checkpoint::new(block, state.clone(), walk.take_entered()));
+                    points.insert(at, Checkpoint::new(block, carried, walk.take_entered()));
                 }
-                return (state, walked);
+                return (None, walked);
             }
         }
     }
@@ -425,37 +472,46 @@ pub(crate) fn prepare(db: &dyn Db, file: SourceFile) {
     };
     // The first step carries the checkpoints over to the current tree.
     walk_to(db, file, 0, Asker::Preparation);
+    let mut progress = None;
     loop {
-        let target = {
+        let (target, now) = {
             let files = db.state_cache().files.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
             let points = files.get(&file).map_or(&[][..], |checkpoints| checkpoints.points.as_slice());
-            match points.iter().find(|point| !point.linked) {
-                Some(unlinked) => unlinked.index,
-                None => {
-                    let from = points.last().map_or(0, |point| point.index);
-                    if from + STRIDE > last {
-                        return;
-                    }
-                    (from + SLICE).min(last)
-                }
+            let unlinked = points.iter().find(|point| !point.linked).map(|point| point.index);
+            let from = points.last().map_or(0, |point| point.index);
+            // Where the checkpoints stand: a step that changed nothing (the
+            // program ended before the target, or a question came inside
+            // a loop, where no checkpoint goes) ends the preparation.
+            let now = Some((unlinked, from, points.len()));
+            match unlinked {
+                Some(unlinked) => (unlinked, now),
+                None if from + STRIDE > last => return,
+                None => ((from + SLICE).min(last), now),
             }
         };
+        if now == progress {
+            return;
+        }
+        progress = now;
         walk_to(db, file, target, Asker::Preparation);
     }
 }
 
 /// The state before block `index` when it belongs to the main body
 /// (`None` otherwise: other blocks are reached from several places).
+/// (`None` also when the walk does not reach it before it has run a block
+/// after it: a jump passed it, and a loop may come back to it).
 pub(crate) fn main_state_before(db: &dyn Db, file: SourceFile, index: usize) -> Option<(ModalState, ParamState)> {
-    main_state_and_walk(db, file, index).map(|(state, _)| state)
+    main_state_and_walk(db, file, index).and_then(|(state, _)| state)
 }
 
-/// [`main_state_before`], and how many blocks it walked.
+/// [`main_state_before`], and how many blocks it walked (`None`: not in
+/// the main body).
 pub(crate) fn main_state_and_walk(
     db: &dyn Db,
     file: SourceFile,
     index: usize,
-) -> Option<((ModalState, ParamState), usize)> {
+) -> Option<(Option<(ModalState, ParamState)>, usize)> {
     walk_to(db, file, index, Asker::Question)
 }
 
@@ -475,7 +531,12 @@ impl Drop for Waiting<'_> {
     }
 }
 
-fn walk_to(db: &dyn Db, file: SourceFile, index: usize, asker: Asker) -> Option<((ModalState, ParamState), usize)> {
+fn walk_to(
+    db: &dyn Db,
+    file: SourceFile,
+    index: usize,
+    asker: Asker,
+) -> Option<(Option<(ModalState, ParamState)>, usize)> {
     let program = model::program(db, file);
     if !program.has_main() || !program.units[0].blocks.contains(&index) {
         return None;
@@ -505,7 +566,7 @@ mod tests {
     use ncc_syntax::{Dialect, Parse, ast::AstNode};
 
     use super::{STRIDE, changed_blocks, main_state_and_walk, main_state_before};
-    use crate::{AnalysisHost, Config, TextEdit, TextRange, TextSize};
+    use crate::{AnalysisHost, Config, TextEdit, TextRange, TextSize, flow::walked_states};
 
     /// What [`changed_blocks`] promises, whatever the tree's shape: the
     /// blocks before and after the change are the same nodes, the text
@@ -598,6 +659,58 @@ mod tests {
 
         let mut fresh = AnalysisHost::new(Config::default());
         let fresh_file = fresh.add_file("main.NCP", text.as_str());
-        assert_eq!(Some(state), main_state_before(fresh.db(), fresh_file, far));
+        assert_eq!(state, main_state_before(fresh.db(), fresh_file, far));
+    }
+
+    /// With jumps and loops the checkpoints still give the state the
+    /// checker's walk reaches a main-body block in the first time, before
+    /// and after edits that move the jumps' counts; a block the walk passes
+    /// without running it is left to the whole walk.
+    #[test]
+    fn checkpoints_follow_jumps_as_the_walk_does() {
+        let mut text = String::from("%1 \"JUMPS\"\nN1 G90 G01 F100 R1=0 R2=0\n");
+        for n in 2..=700 {
+            let extra = match n % 150 {
+                // Forward over four blocks, once: the count stays until the
+                // loop below comes back to it.
+                10 => format!(" G73 L{}", n + 5),
+                12 => " R2=7.".to_owned(),
+                // R1 counts the runs of a loop back over the jump.
+                40 => " G26 R5=-41010001".to_owned(),
+                60 => format!(" G73 L{} Q2", n - 55),
+                // A jump whose condition (R3) is unknown.
+                90 => format!(" GR3 L{}", n + 20),
+                100 => " R4=1.".to_owned(),
+                _ => String::new(),
+            };
+            text.push_str(&format!("N{n} X{n}. YR2{extra}\n"));
+        }
+        text.push_str("N9999 M30\n*\n");
+        let mut host = AnalysisHost::new(Config::default());
+        let file = host.add_file("main.NCP", text.as_str());
+        let edits = [("N7 X7.", "N7 X7.\nN8000 X1."), ("N160 X160. YR2 G73 L165", "N160 X160. YR2 G73 L164")];
+        for edit in [None].into_iter().chain(edits.map(Some)) {
+            if let Some((find, replace)) = edit {
+                let at = TextSize::from(text.find(find).unwrap() as u32);
+                let edit = TextEdit::replace(TextRange::at(at, TextSize::of(find)), replace);
+                host.apply_edit(file, &edit);
+                edit.apply(&mut text);
+            }
+            host.analysis().prepare_states(file);
+            let db = host.db();
+            let blocks = crate::model::program(db, file).units[0].blocks.clone();
+            let (mut passed, mut counted) = (0, false);
+            for index in blocks.step_by(13) {
+                let walked = walked_states(db, file, index);
+                match main_state_before(db, file, index) {
+                    Some(state) => {
+                        counted |= state.1.values.get(1).is_some_and(|runs| runs > 1);
+                        assert_eq!(Some(&state), walked.first(), "block {index} after {edit:?}");
+                    }
+                    None => passed += 1,
+                }
+            }
+            assert!(passed > 0 && counted, "{passed} blocks passed; the loop counted: {counted}");
+        }
     }
 }

@@ -156,6 +156,15 @@ fn hover_in_a_subprogram_shows_the_value_of_each_call() {
 }
 
 #[test]
+fn hover_after_a_loop_shows_the_value_the_loop_left() {
+    // N20 runs 123 times, counting R10 up by one each time.
+    let text = "%1\nN10 R10=0\nN20 G26 R5=-41100010\nN30 G73 L20 Q122\nN40 GR$010\nN50 M30\n*\n";
+    let (host, file, offset, _) = setup(&[("main.NCP", text)]);
+    let hover = host.analysis().hover(file, offset).unwrap();
+    assert!(hover.markdown.contains("**Value before this block:** `0.123` (123 thousandths)"), "{}", hover.markdown);
+}
+
+#[test]
 fn hover_on_a_call_says_where_it_goes() {
     let (host, file, offset, _) = setup(&[("main.NCP", &at(PROGRAM, "L100 Q2"))]);
     let hover = host.analysis().hover(file, offset).unwrap();

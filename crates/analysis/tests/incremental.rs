@@ -320,9 +320,14 @@ fn an_edited_subprogram_reaches_the_checkpoints_after_its_calls() {
     for number in [2820, 900, 60] {
         state_at(&host, file, &text, number);
     }
-    // A G70 after its last one makes L5 end there, with the G19 before it:
-    // the edit is not in L5's blocks, but L5 changed.
+    // A G70 after its last one makes L5 end there: the edit is not in L5's
+    // blocks, but L5 changed. A call still returns at the first G70 it
+    // reaches, as the control does...
     replace(&mut host, file, &mut text, "N9997 X5.", "N9997 G70");
+    let (state, _) = state_at(&host, file, &text, 900);
+    assert!(plane(&state, 18), "{state:?}");
+    // ...and runs the G19 after it only when a jump leads there.
+    replace(&mut host, file, &mut text, "N9994 G18", "N9994 G18 G73 L9996");
     let (state, _) = state_at(&host, file, &text, 900);
     assert!(plane(&state, 19), "{state:?}");
 }
@@ -332,7 +337,20 @@ fn an_edited_subprogram_reaches_the_checkpoints_after_its_calls() {
 /// every answer equals a fresh walk.
 #[test]
 fn random_edits_keep_the_states_equal_to_a_fresh_walk() {
-    let mut text = stateful_program(1500, true);
+    random_edits_in(stateful_program(1500, true), 120);
+}
+
+/// The same with jumps: one over a few blocks, and a loop back over it,
+/// which the edits move, break and mend.
+#[test]
+fn random_edits_around_jumps_keep_the_states_equal_to_a_fresh_walk() {
+    let text = stateful_program(1500, true)
+        .replace("N300 G01 X300. YR1", "N300 G01 X300. YR1 G73 L305")
+        .replace("N700 G01 X700. YR1", "N700 G01 X700. YR1 G73 L290 Q2");
+    random_edits_in(text, 60);
+}
+
+fn random_edits_in(mut text: String, rounds: usize) {
     let mut host = AnalysisHost::new(Config::default());
     let file = host.add_file("main.NCP", text.as_str());
     let mut seed = 0x9E37_79B9_7F4A_7C15_u64;
@@ -340,7 +358,7 @@ fn random_edits_keep_the_states_equal_to_a_fresh_walk() {
         seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
         (seed >> 33) as usize % bound
     };
-    for round in 0..120 {
+    for round in 0..rounds {
         let lines: Vec<usize> = std::iter::once(0).chain(text.match_indices('\n').map(|(at, _)| at + 1)).collect();
         // Any line but the header and the end.
         let line = 1 + below(lines.len() - 3);

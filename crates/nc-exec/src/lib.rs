@@ -20,6 +20,8 @@
 //!   constants), and [`tables`]: its zero offsets and tool corrections with
 //!   readers for the control's files.
 //! - [`modes`]: the active code of every G and M group.
+//! - [`program_flow`]: which block runs after a block (calls, jumps,
+//!   returns), for the runner and the checker's flow walk alike.
 //! - [`run`]: running a program block by block into a [`run::Trace`].
 //! - [`tool_path`]: the moves and positions of the tool centre, which
 //!   radius compensation moves off the programmed contour.
@@ -35,6 +37,7 @@ pub mod expand;
 pub mod lower;
 pub mod machine;
 pub mod modes;
+pub mod program_flow;
 pub mod run;
 pub mod tables;
 pub mod tool_path;

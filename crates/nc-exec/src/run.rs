@@ -55,6 +55,7 @@ use crate::{
     lower::{BlockData, BlockReader, PlainReader, Value, Word},
     machine::MachineConfig,
     modes::{Group, Modes},
+    program_flow::{self, BlockFlow, JumpCounts, block_flow, whole_number},
     tables::{OffsetTable, ToolEntry, ToolTable},
     transform::{self, Frame, Kind, Recalculation, Refused, Transformation, Transformations},
 };
@@ -646,8 +647,7 @@ fn run_in<'a, 's>(
     // Calls being run: where to return, how many runs remain, where the
     // subprogram starts.
     let mut calls: Vec<Call> = Vec::new();
-    // Jumps taken so far from each jump block, until its count runs out.
-    let mut jumps: std::collections::HashMap<usize, u32> = Default::default();
+    let mut jumps = JumpCounts::default();
     // The rest of a block whose cycle of the cycle file has just run.
     let mut resume: Option<Flow> = None;
     let mut data = BlockData::default();
@@ -695,11 +695,7 @@ fn run_in<'a, 's>(
         at = match flow {
             Flow::End => break,
             Flow::Next => {
-                // A jump block passed without jumping (`GRxx` read as G78)
-                // starts its count again next time.
-                if !jumps.is_empty() {
-                    jumps.remove(&at);
-                }
+                jumps.passed(at);
                 next
             }
             Flow::Return => match calls.last_mut() {
@@ -790,17 +786,8 @@ fn run_in<'a, 's>(
                 }
             }
             Flow::Jump { label, times } => match index.complete().units.jump_target(at, label) {
-                Some(target) => {
-                    let taken = jumps.entry(at).or_default();
-                    if *taken < times {
-                        *taken += 1;
-                        target
-                    } else {
-                        // The count starts again when the section is reached anew.
-                        jumps.remove(&at);
-                        next
-                    }
-                }
+                Some(target) if jumps.jumps(at, times) => target,
+                Some(_) => next,
                 None => {
                     runner.finding(range, &format!("no block N{label} in this program unit to jump to"), true);
                     break;
@@ -1207,6 +1194,18 @@ enum Flow {
     },
 }
 
+impl From<BlockFlow> for Flow {
+    fn from(flow: BlockFlow) -> Flow {
+        match flow {
+            BlockFlow::Next => Flow::Next,
+            BlockFlow::End => Flow::End,
+            BlockFlow::Return => Flow::Return,
+            BlockFlow::Call { label, times, macrocycle } => Flow::Call { label, times, macrocycle },
+            BlockFlow::Jump { label, times } => Flow::Jump { label, times },
+        }
+    }
+}
+
 /// The control's state while a program runs.
 #[derive(Clone)]
 struct Runner {
@@ -1607,23 +1606,9 @@ impl Runner {
         self.flow_of(block, has)
     }
 
-    /// What follows the block once its work is done: M02/M30 end the
-    /// program; otherwise its call or jump runs, at the end of the block
-    /// (with G04, Q is the dwell and a call runs once, 01 §4.8).
+    /// What follows the block once its work is done ([`block_flow`]).
     fn flow_of(&self, block: &BlockData, has: impl Fn(u8, u32) -> bool) -> Flow {
-        if has(b'M', 2) || has(b'M', 30) {
-            return Flow::End;
-        }
-        let label = block.word(b'L').and_then(|word| self.integer(word));
-        let count = block.word(b'Q').filter(|_| !has(b'G', 4)).and_then(|word| self.integer(word));
-        match label {
-            Some(label) if has(b'G', 71) || has(b'G', 72) => {
-                Flow::Call { label, times: count.unwrap_or(1).max(1), macrocycle: has(b'G', 72) }
-            }
-            Some(label) if has(b'G', 73) => Flow::Jump { label, times: count.unwrap_or(1) },
-            _ if has(b'G', 70) => Flow::Return,
-            _ => Flow::Next,
-        }
+        block_flow(block, has, |word| self.integer(word)).into()
     }
 
     /// Runs a block of group 11 with its axis words `axes`; the error says
@@ -2254,10 +2239,7 @@ impl Runner {
     /// A dimensionless word's whole number (codes, T): the literal, or a
     /// parameter's raw digits.
     fn integer(&self, word: &Word) -> Option<u32> {
-        match word.value.as_ref()? {
-            Value::Literal(decimal) => whole_number(decimal),
-            value => u32::try_from(self.raw(value)?).ok(),
-        }
+        program_flow::integer(word, &self.params)
     }
 
     /// The raw value a parameter reference reads, sign applied.
@@ -2541,11 +2523,6 @@ fn plane(one: u8, other: u8) -> (u8, u8) {
         (b'Y', b'X') => (b'X', b'Y'),
         pair => pair,
     }
-}
-
-/// A dimensionless literal (a code, L, Q, T): written without a point.
-fn whole_number(decimal: &ncc_syntax::Decimal) -> Option<u32> {
-    if decimal.has_point() { None } else { u32::try_from(decimal.scaled(0)?).ok() }
 }
 
 /// A length on the control's µm grid.

@@ -137,8 +137,8 @@ fn check_feed_range(visit: &Visit<'_>, out: &mut Vec<Diagnostic>) {
     let Known::Is(Some(feed)) = visit.after.feed else { return };
     let Some(per_minute) = feed_value(&feed) else { return };
     let origin = substitution.and_then(|s| s.origin);
-    // A parameter written with a point is already reported with its value
-    // in mm/min (feed-parameter-in-metres).
+    // A parameter written with a point has its own rule, which tells the
+    // unit it was read in (feed-parameter-in-metres).
     if origin.is_some_and(|o| o.point && !o.computed) {
         return;
     }

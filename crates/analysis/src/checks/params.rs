@@ -15,7 +15,7 @@ declare_rules! {
     PARAMETER_DIGIT_OVERFLOW = "R301", "parameter-digit-overflow", Error, "A parameter whose value has more digits than the address it is substituted into.";
     SUBSTITUTED_VALUE_OUT_OF_RANGE = "R302", "substituted-value-out-of-range", Error, "A parameter whose value is outside the range of the address it is substituted into.";
     PARAMETER_IN_THOUSANDTHS = "R303", "parameter-in-thousandths", Warning, "A length taken from a parameter written without a decimal point (read in thousandths).";
-    FEED_PARAMETER_IN_METRES = "R304", "feed-parameter-in-metres", Warning, "A feed per minute taken from a parameter written with a decimal point (read in m/min).";
+    FEED_PARAMETER_IN_METRES = "R304", "feed-parameter-in-metres", Error, "A feed per minute from a parameter written with a decimal point, which F reads in m/min, above the machine's feed limit.";
     RESERVED_PARAMETER = "R305", "reserved-parameter", Error, "R95, the control's own parameter, written by the program.";
     NOT_RECOMMENDED_PARAMETER = "R306", "not-recommended-parameter", Warning, "R90 to R94, reserved for future control parameters.";
     PARAMETER_NUMBER_OUT_OF_RANGE = "R307", "parameter-number-out-of-range", Error, "A parameter number above 95.";
@@ -154,10 +154,14 @@ pub(crate) fn check_substitution(
                 format!("the parameter holds {} (read as `&{raw}`): each `&` digit must be 0, 1 or 2", show(raw)),
             )));
         }
-        // Only per minute does the point mean metres; per revolution (and for
-        // a thread lead) it means mm/rev, the natural unit.
+        // Per minute the point means metres, which the manual recommends
+        // (`R10=0.100` is 100 mm/min, 02 §3.5): only a value above the limit
+        // is a mistake, mostly mm/min written with a point (`R10=100.`).
+        // Per revolution (and for a thread lead) it means mm/rev.
+        let limit = i64::from(visit.config.machine.feed_limit);
         if address.role == AddressRole::Feed
             && !thread
+            && raw > limit
             && substitution.origin.is_some_and(|o| o.point && !o.computed)
             && let Some(mode) = feed::feed_mode(visit.after, visit.config).filter(|mode| !mode.per_revolution)
         {
@@ -165,7 +169,7 @@ pub(crate) fn check_substitution(
                 &FEED_PARAMETER_IN_METRES,
                 range,
                 format!(
-                    "under G{} the parameter was written with a decimal point, so `{letter}` reads {} m/min ({raw} mm/min); write it without the point for mm/min",
+                    "under G{} the parameter was written with a decimal point, so `{letter}` reads {} m/min ({raw} mm/min), above this machine's maximum feed of {limit} mm/min (`feed-limit` in ncc.toml); for mm/min write the value without the point",
                     mode.code,
                     show(raw)
                 ),

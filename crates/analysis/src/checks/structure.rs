@@ -30,6 +30,7 @@ declare_rules! {
     JUMP_TARGET_NOT_IN_UNIT = "P118", "jump-target-not-in-unit", Error, "G73 jumps to a block outside its program unit, or to none.";
     NESTED_SUBPROGRAM_CALL = "P119", "nested-subprogram-call", Info, "G71 inside a subprogram, which the manual does not describe.";
     CYCLE_NUMBER_UNREACHABLE = "P120", "cycle-number-unreachable", Warning, "A fixed-cycle body with a number outside 81 to 89.", unnecessary;
+    FLOW_NOT_FOLLOWED = "P121", "flow-not-followed", Info, "A block after which the checker cannot follow the program: a jump or call from a parameter with no known value, or a loop longer than it runs.";
 }
 
 pub(crate) fn check(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
