@@ -51,6 +51,12 @@ impl Modes {
         self.active[group.0]
     }
 
+    /// The group a modal code puts itself in force in; `None` for
+    /// block-only codes and codes outside the groups.
+    pub fn modal_group_of(&self, letter: u8, number: u32) -> Option<Group> {
+        self.catalogue.modal_group_index(char::from(letter), number).map(Group)
+    }
+
     /// Puts a modal code in force in its group; block-only codes and codes
     /// outside the groups change nothing.
     pub fn set(&mut self, letter: u8, number: u32) {

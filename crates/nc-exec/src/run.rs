@@ -52,6 +52,7 @@ use crate::{
     arith::{self, BlockArithmetic, Machine, Message, Parameters, Raw},
     compensation::{CompensationError, Compensator, Element, Settings, Side, ToolElement},
     cycles::{self, CycleError, CycleInput, CycleKind, CycleStep, Spindle},
+    formats,
     lower::{BlockData, BlockReader, PlainReader, Value, Word},
     machine::MachineConfig,
     modes::{Group, Modes},
@@ -1394,6 +1395,10 @@ impl Runner {
             .filter_map(|word| Some((word.letter, self.integer(word)?, at(word.range))))
             .collect();
         let has = |letter: u8, number: u32| codes.iter().any(|&(l, n, _)| l == letter && n == number);
+        if let Some((refused, message)) = self.refused_value(block, &codes) {
+            self.finding(at(refused), &message, true);
+            return Flow::End;
+        }
         for word in &block.words {
             if let Some(Value::Parameter { index: Some(index), .. }) = word.value
                 && (index as usize) < arith::PARAMETER_COUNT
@@ -1591,6 +1596,40 @@ impl Runner {
             }
         }
         self.flow_of(block, has)
+    }
+
+    /// The first value of the block the control refuses, with its range in
+    /// the block: a literal or an assignment outside its address's format,
+    /// or a parameter whose value the address cannot take (02 §3.6: the
+    /// control checks them only as the block runs). `codes` are the
+    /// block's G and M codes.
+    fn refused_value(&self, block: &BlockData, codes: &[(u8, u32, TextRange)]) -> Option<(TextRange, String)> {
+        let motion = codes
+            .iter()
+            .rev()
+            .find(|&&(letter, number, _)| self.modes.modal_group_of(letter, number) == Some(self.groups.motion))
+            .map_or(self.modes.active(self.groups.motion), |&(_, number, _)| Some(number));
+        let thread = motion == Some(33);
+        let machine = &*self.machine;
+        for word in &block.words {
+            let Some(address) = self.catalogue.address_of(word.letter) else { continue };
+            let fault = match word.value.as_ref() {
+                Some(Value::Literal(decimal)) => formats::literal_fault(address, decimal, machine),
+                Some(value) => {
+                    self.raw(value).and_then(|raw| formats::substitution_fault(address, raw, thread, machine))
+                }
+                None => None,
+            };
+            if let Some(fault) = fault {
+                return Some((word.value_range.unwrap_or(word.range), fault.message));
+            }
+        }
+        block.assignments.iter().find_map(|assignment| {
+            let Some(Value::Literal(value)) = &assignment.value else { return None };
+            let letter = self.catalogue.letter_with_role(AddressRole::Parameter)?;
+            let fault = formats::assignment_fault(self.catalogue.address_of(letter)?, value)?;
+            Some((assignment.value_range.unwrap_or(assignment.range), fault.message))
+        })
     }
 
     /// What follows the block once its work is done: M02/M30 end the
@@ -2929,7 +2968,7 @@ mod tests {
         close6(trace.steps[2].length, PI * 5.0);
         // Compensation G41 on the mirrored contour runs on the right: the
         // tool-centre path is the mirror image, with the same lengths.
-        let text = "%1\nN0 G35 X0\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 X50\nN5 Y50\nN6 G40 X70 Y70\nN7 M30\n";
+        let text = "%1\nN10 G35 X0\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 X50\nN5 Y50\nN6 G40 X70 Y70\nN7 M30\n";
         let trace = run_text(text);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
         assert_eq!(lengths(&trace)[1..7], [0.0, 20.0, 25.0, 45.0, 45.0, 32.016]);
@@ -3101,6 +3140,48 @@ mod tests {
             ]
         );
         assert!(trace.steps[..3].iter().all(|step| step.duration == 0.0));
+    }
+
+    /// The fatal findings of a run: where (the text) and what.
+    fn stops<'t>(text: &'t str, trace: &'t Trace) -> Vec<(&'t str, &'t str)> {
+        trace.findings.iter().filter(|f| f.fatal).map(|f| (&text[f.range], f.message.as_str())).collect()
+    }
+
+    #[test]
+    fn a_value_the_control_refuses_stops_the_run_in_the_checkers_words() {
+        let overflow = "the parameter holds 0.123 (123 as digits, 3 decades) but `{}` takes at most 2: the control stops with \"an R of more than 2 decades cannot be substituted\"";
+        // The manual's example: three decades into G's two.
+        let text = "%1\nN10 R10=123\nN20 GR10\nN30 G00 X10\nN40 M30\n";
+        let trace = run_text(text);
+        assert_eq!(stops(text, &trace), [("R10", overflow.replace("{}", "G").as_str())]);
+        assert_eq!(trace.findings.len(), 1, "{:?}", trace.findings);
+        assert_eq!(lines_run(text, &trace), ["N10 R10=123"]);
+        // In a subprogram.
+        let text = "%1\nN10 R10=123\nN20 G71 L5\nN30 M30\nN40 G79 L5\nN50 MR10\nN60 G70\n";
+        let trace = run_text(text);
+        assert_eq!(stops(text, &trace), [("R10", overflow.replace("{}", "M").as_str())]);
+        for (text, at, message) in [
+            ("%1\nN1 G01 X10 F-100\nN2 M30\n", "-100", "`F` takes only unsigned values; remove the sign"),
+            (
+                "%1\nN1 G26 R5=99010203\nN2 M30\n",
+                "99010203",
+                "`99010203` is outside the parameter range -69999.999 to 69999.999",
+            ),
+            (
+                "%1\nN1 R10=-100\nN2 G01 X10 FR10\nN3 M30\n",
+                "R10",
+                "the parameter holds -0.100, but `F` takes only unsigned values",
+            ),
+            (
+                "%1\nN10 G1 X99999999999999999999 F100\nN20 M30\n",
+                "99999999999999999999",
+                "`X99999999999999999999` has 20 digits before the point; the format of `X` allows 5",
+            ),
+        ] {
+            let trace = run_text(text);
+            assert_eq!(stops(text, &trace), [(at, message)], "{text}");
+            assert!(trace.steps.iter().all(|step| step.motion == Motion::None), "{text}");
+        }
     }
 
     #[test]
