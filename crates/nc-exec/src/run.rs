@@ -1261,9 +1261,6 @@ struct Runner {
     reported: Vec<String>,
 }
 
-/// Tolerance of the arc end point's distance from the centre (1 µm, 01 §6.4).
-const ARC_TOLERANCE: f64 = 0.001;
-
 impl Runner {
     fn new(machine: std::sync::Arc<MachineConfig>) -> Self {
         // The priority block: G01 G17 G90 G94 F0 S0 M05 ….
@@ -1532,7 +1529,10 @@ impl Runner {
                 }
             }
             self.position = end;
-            self.moved(&Move { block, range, axes: &axes, start, end })
+            let Some(moved) = self.moved(&Move { block, range, axes: &axes, start, end }) else {
+                return Flow::End;
+            };
+            moved
         };
         let stop = if has(b'M', 0) {
             Some(Stop::Program)
@@ -2068,19 +2068,21 @@ impl Runner {
         self.findings.push(Finding { source: self.source, range, message: message.to_owned(), fatal });
     }
 
-    /// Length, duration and feed of a block's move.
-    fn moved(&mut self, step: &Move<'_>) -> Moved {
+    /// Length, duration and feed of a block's move; `None` after
+    /// reporting an error the control stops on.
+    fn moved(&mut self, step: &Move<'_>) -> Option<Moved> {
         let (range, start, end) = (step.range, step.start, step.end);
         let straight = distance(&start, &end);
         let motion = self.modes.active(self.groups.motion);
-        let moved = |motion, length, duration, feed, path| Moved { motion, length, duration, feed, path };
+        let moved = |motion, length, duration, feed, path| Some(Moved { motion, length, duration, feed, path });
         if motion == Some(0) {
             return moved(Motion::Rapid, straight, self.rapid_seconds(&start, &end), None, Path::Straight);
         }
         let arc = match motion {
             Some(2 | 3) => match self.arc(step, motion == Some(3)) {
-                Some(arc) => Some(arc),
-                None => return moved(Motion::Feed, straight, 0.0, None, Path::Straight),
+                Ok(Some(arc)) => Some(arc),
+                Ok(None) => return moved(Motion::Feed, straight, 0.0, None, Path::Straight),
+                Err(()) => return None,
             },
             _ => None,
         };
@@ -2192,15 +2194,16 @@ impl Runner {
     }
 
     /// The arc of a G02/G03 block, or `None` after reporting why the block
-    /// is not one.
-    fn arc(&mut self, step: &Move<'_>, counter_clockwise: bool) -> Option<Arc> {
+    /// is not one; the error after reporting an end point the control
+    /// stops on.
+    fn arc(&mut self, step: &Move<'_>, counter_clockwise: bool) -> Result<Option<Arc>, ()> {
         let Move { block, range, axes, start, end } = *step;
         let mut letters: Vec<u8> = axes.iter().map(|word| word.letter).collect();
         letters.dedup();
         if letters.len() < 2 {
             let message = "an arc needs both coordinates of its plane, even when the end point equals the start";
             self.finding(range, message, false);
-            return None;
+            return Ok(None);
         }
         // The plane's first axis is the one I measures along: X of XY, Y of
         // YZ, Z of ZX (01 §6.4).
@@ -2217,14 +2220,15 @@ impl Runner {
         let to = Vector2::new(end[a], end[b]);
         let centre = from + Vector2::new(centre_offset(b'I', first), centre_offset(b'J', second));
         let (radius, end_radius) = ((from - centre).norm(), (to - centre).norm());
-        if (radius - end_radius).abs() > ARC_TOLERANCE {
+        let tolerance = self.machine.arc_tolerance();
+        if (radius - end_radius).abs() > tolerance {
             let message = format!(
-                "the end point does not lie on the circle: {} mm from the centre, the start {} mm (error 7.56)",
+                "the end point does not lie on the circle: {} mm from the centre, the start {} mm, more than the tolerance {tolerance} mm apart: the control stops with error 7.56",
                 round3(end_radius),
                 round3(radius)
             );
-            self.finding(range, &message, false);
-            return None;
+            self.finding(range, &message, true);
+            return Err(());
         }
         let angle_of = |point: Vector2<f64>| (point.y - centre.y).atan2(point.x - centre.x);
         let start_angle = angle_of(from);
@@ -2237,7 +2241,7 @@ impl Runner {
         // A third axis written in the block moves along with the arc.
         let lead: f64 =
             letters[2..].iter().map(|&l| (end[usize::from(l - b'A')] - start[usize::from(l - b'A')]).powi(2)).sum();
-        Some(Arc { plane: (a, b), centre, radius, start_angle, sweep, lead: lead.sqrt() })
+        Ok(Some(Arc { plane: (a, b), centre, radius, start_angle, sweep, lead: lead.sqrt() }))
     }
 
     /// F as written: a literal, or a parameter's raw value read as digits
@@ -3127,19 +3131,41 @@ mod tests {
 
     #[test]
     fn bad_arcs_and_missing_feed_are_reported_where_they_are() {
-        let text = "%1\nN1 G01 X10\nN2 G02 X20 Y0 I3 F100\nN3 G02 X5\nN4 M30\n";
+        let text = "%1\nN1 G01 X10\nN2 G02 X5\nN3 G02 X20 Y0 I3 F100\nN4 M30\n";
         let trace = run_text(text);
-        let found: Vec<(&str, &str)> =
-            trace.findings.iter().map(|f| (&text[f.range], f.message.split(':').next().unwrap_or(""))).collect();
+        let found: Vec<(&str, &str, bool)> = trace
+            .findings
+            .iter()
+            .map(|f| (&text[f.range], f.message.split(':').next().unwrap_or(""), f.fatal))
+            .collect();
         assert_eq!(
             found,
             [
-                ("N1 G01 X10\n", "no feed F programmed before this motion"),
-                ("N2 G02 X20 Y0 I3 F100\n", "the end point does not lie on the circle"),
-                ("N3 G02 X5\n", "an arc needs both coordinates of its plane, even when the end point equals the start"),
+                ("N1 G01 X10\n", "no feed F programmed before this motion", false),
+                (
+                    "N2 G02 X5\n",
+                    "an arc needs both coordinates of its plane, even when the end point equals the start",
+                    false
+                ),
+                ("N3 G02 X20 Y0 I3 F100\n", "the end point does not lie on the circle", true),
             ]
         );
-        assert!(trace.steps[..3].iter().all(|step| step.duration == 0.0));
+        // The control stops with error 7.56 before the arc runs.
+        assert_eq!(lines_run(text, &trace), ["N1 G01 X10", "N2 G02 X5"]);
+        assert!(trace.steps.iter().all(|step| step.duration == 0.0));
+    }
+
+    #[test]
+    fn machine_constant_55_widens_the_arc_end_tolerance() {
+        // The end point lies 3 µm outside the circle of radius 10.
+        let text = "%1\nN1 G00 X10 Y0\nN2 G02 X-10.003 Y0 I-10 F100\nN3 M30\n";
+        let stopped = run_text(text);
+        assert_eq!(stopped.findings.iter().filter(|f| f.fatal).count(), 1, "{:?}", stopped.findings);
+        assert_eq!(stopped.steps.len(), 1);
+        let machine = MachineConfig { constants: [(55, 5)].into(), ..MachineConfig::default() };
+        let trace = run(text, &NoFiles, &machine, 100);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        assert_eq!(trace.steps.len(), 3);
     }
 
     /// The fatal findings of a run: where (the text) and what.
