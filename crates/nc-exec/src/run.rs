@@ -1532,6 +1532,10 @@ impl Runner {
             let Some(moved) = self.moved(&Move { block, range, axes: &axes, start, end }) else {
                 return Flow::End;
             };
+            if let Some(message) = self.unreachable(&self.position) {
+                self.finding(range, &message, true);
+                return Flow::End;
+            }
             moved
         };
         let stop = if has(b'M', 0) {
@@ -1900,6 +1904,10 @@ impl Runner {
         let Functions { m_functions, tool_change, mergeable } = functions;
         let Moved { motion, length, duration, feed, path } = moved;
         let (source, end, frame) = (self.source, self.machine_axes(end), self.frames.len() - 1);
+        debug_assert!(
+            [length, duration, feed.unwrap_or(0.0)].iter().chain(&end).all(|value| value.is_finite()),
+            "no NaN or infinity leaves the executor: {end:?} {length} {duration} {feed:?}"
+        );
         let joining = match self.modes.active(self.groups.joining) {
             Some(23) => Joining::Continuous,
             Some(24) => Joining::Tight,
@@ -1958,8 +1966,8 @@ impl Runner {
     /// Runs a built-in cycle; `false` after reporting why it cannot run.
     fn built_in_cycle_or_stop(&mut self, number: u32, range: TextRange) -> bool {
         let result = self.built_in_cycle(number, range);
-        if let Err(error) = &result {
-            self.finding(range, &format!("the fixed cycle G{number} cannot run: {error}"), true);
+        if let Err(message) = &result {
+            self.finding(range, message, true);
         }
         result.is_ok()
     }
@@ -1972,8 +1980,9 @@ impl Runner {
 
     /// Runs one pass of a built-in fixed cycle from where the block ended
     /// and times its moves as steps of the block. Its F, S and spindle
-    /// changes stay inside it (03 §1.4 I6).
-    fn built_in_cycle(&mut self, number: u32, range: TextRange) -> Result<(), CycleError> {
+    /// changes stay inside it (03 §1.4 I6). The error says why the
+    /// control stops.
+    fn built_in_cycle(&mut self, number: u32, range: TextRange) -> Result<(), String> {
         let spindle = match self.modes.active(self.groups.spindle) {
             Some(3) => Spindle::Clockwise,
             Some(4) => Spindle::CounterClockwise,
@@ -2000,11 +2009,15 @@ impl Runner {
             spindle,
             diameter: self.diameter,
         };
-        let cycle = cycles::expand(&input)?;
+        let cycle = cycles::expand(&input)
+            .map_err(|error: CycleError| format!("the fixed cycle G{number} cannot run: {error}"))?;
         let physical = |position: &Position| scaled(position, |value, factor| value / factor);
         let mut at = physical(&cycle.start);
         for step in &cycle.steps {
             let to = step.to().map_or(at, physical);
+            if let Some(message) = self.unreachable(&to) {
+                return Err(format!("the fixed cycle G{number}: {message}"));
+            }
             let length = distance(&at, &to);
             let (motion, duration, feed, path) = match *step {
                 CycleStep::Rapid { .. } => (Motion::Rapid, self.rapid_seconds(&at, &to), None, Path::Straight),
@@ -2143,6 +2156,39 @@ impl Runner {
             Some(97) => FeedMode { per_revolution: !swapped, css: true },
             _ => FeedMode { per_revolution: false, css: false },
         }
+    }
+
+    /// Why the control cannot move to `position` (program coordinates in
+    /// the frame in force): an axis beyond what its address holds, or
+    /// beyond its travel limits in machine coordinates, where the
+    /// software limit switches work (03 §3.2).
+    fn unreachable(&self, position: &Position) -> Option<String> {
+        let axes = &self.machine.axes;
+        let machine = self.frame().to_machine(&self.machine_axes(position), axes);
+        for (&axis, &real) in axes.iter().zip(&machine) {
+            let letter = char::from(axis);
+            // On a diameter axis the program holds the diameter.
+            let written = position[slot(axis)] * self.written_per_unit(axis);
+            if let Some((min, max)) = self.catalogue.address_of(axis).and_then(|address| address.bounds)
+                && !(min..=max).contains(&round3(written))
+            {
+                return Some(format!(
+                    "{letter} would reach {written:.3}, outside the range of `{letter}`: {min:.3} to {max:.3}: the control stops"
+                ));
+            }
+            let limits = self.machine.limits.get(&axis).copied().unwrap_or_default();
+            let beyond = |limit: Option<i32>, beyond: fn(f64, f64) -> bool| {
+                limit.map(|limit| f64::from(limit) / 1000.0).filter(|&limit| beyond(round3(real), limit))
+            };
+            if let Some(limit) =
+                beyond(limits.min, |value, min| value < min).or(beyond(limits.max, |value, max| value > max))
+            {
+                return Some(format!(
+                    "{letter} would reach {real:.3} in machine coordinates, beyond its travel limit {limit:.3} (`limits` of the machine): the control stops at the software limit switch"
+                ));
+            }
+        }
+        None
     }
 
     fn incremental(&self) -> bool {
@@ -2586,7 +2632,10 @@ mod tests {
         Axes, Called, Checkpoint, DELIVERY_BATCH, Environment, Motion, NoFiles, Path, Step, StepSink, Stop, Trace,
         resume_into, round3, run, run_into,
     };
-    use crate::machine::MachineConfig;
+    use crate::{
+        machine::{MachineConfig, TravelLimits},
+        tables::OffsetTable,
+    };
 
     impl StepSink for Vec<Step> {
         fn step(&mut self, step: Step) {
@@ -2908,7 +2957,6 @@ mod tests {
 
     #[test]
     fn zero_offsets_move_the_program_zero() {
-        use crate::tables::OffsetTable;
         // G54 is X+100: the same programmed X10 is 100 mm further.
         let mut machine = MachineConfig::default();
         (machine.offsets, _) = OffsetTable::parse("$POS\nG54: X=100.0\n", &machine.axes);
@@ -3208,6 +3256,36 @@ mod tests {
             assert_eq!(stops(text, &trace), [(at, message)], "{text}");
             assert!(trace.steps.iter().all(|step| step.motion == Motion::None), "{text}");
         }
+    }
+
+    #[test]
+    fn a_move_beyond_the_axis_range_or_the_travel_limits_stops_the_run() {
+        // G91 X1000 repeated: the 70th would reach X70000.
+        let text = "%1\nN1 G91 G00 X1000\nN2 G73 L1 Q999\nN3 M30\n";
+        let trace = run(text, &NoFiles, &MachineConfig::default(), 10_000);
+        let message = "X would reach 70000.000, outside the range of `X`: -69999.999 to 69999.999: the control stops";
+        assert_eq!(stops(text, &trace), [("N1 G91 G00 X1000\n", message)]);
+        assert_eq!(trace.steps.len(), 2 * 69);
+        assert_eq!(trace.axis(&trace.end(), b'X'), 69_000.0);
+        // Travel limits are machine coordinates: G54 puts X250 at 450.
+        let mut machine = MachineConfig {
+            limits: [
+                (b'X', TravelLimits { min: None, max: Some(500_000) }),
+                (b'Z', TravelLimits { min: Some(-5_000), max: None }),
+            ]
+            .into(),
+            ..MachineConfig::default()
+        };
+        (machine.offsets, _) = OffsetTable::parse("$POS\nG54: X=200.0\n", &machine.axes);
+        let text = "%1\nN1 G54 G00 X250\nN2 X300\nN3 X350\nN4 M30\n";
+        let trace = run(text, &NoFiles, &machine, 100);
+        let message = "X would reach 550.000 in machine coordinates, beyond its travel limit 500.000 (`limits` of the machine): the control stops at the software limit switch";
+        assert_eq!(stops(text, &trace), [("N3 X350\n", message)]);
+        assert_eq!(trace.steps.len(), 2);
+        // A built-in cycle's moves too: G81 drills to Z-10.
+        let trace = run(DRILLING, &NoFiles, &machine, 100);
+        let message = "the fixed cycle G81: Z would reach -10.000 in machine coordinates, beyond its travel limit -5.000 (`limits` of the machine): the control stops at the software limit switch";
+        assert_eq!(stops(DRILLING, &trace), [("N3 G81 X20\n", message)]);
     }
 
     #[test]
