@@ -1507,15 +1507,22 @@ impl Runner {
         self.shift_frame(shifts_length);
         let start = self.position;
         let writes_table = has(b'G', 92) || has(b'G', 93);
-        let moved = if writes_table {
+        // G04 Q dwells in 10 ms steps (02 §2.1), after the block's motion:
+        // the cycles' `G01 ZR31 G04 QR29` drill, then dwell (03 §1).
+        let dwell = has(b'G', 4).then(|| Moved {
+            motion: Motion::Dwell,
+            length: 0.0,
+            duration: block.word(b'Q').and_then(|q| self.count(q)).unwrap_or(0.0) * 0.01,
+            feed: None,
+            path: Path::Straight,
+        });
+        let still = Moved { motion: Motion::None, length: 0.0, duration: 0.0, feed: None, path: Path::Straight };
+        let (moved, dwell) = if writes_table {
             // G92/G93 write the table and move nothing (01 §5.6, §5.7).
             self.write_table(block, has(b'G', 93));
-            Moved { motion: Motion::None, length: 0.0, duration: 0.0, feed: None, path: Path::Straight }
-        } else if has(b'G', 4) {
-            let dwell = block.word(b'Q').and_then(|q| self.count(q)).unwrap_or(0.0) * 0.01;
-            Moved { motion: Motion::Dwell, length: 0.0, duration: dwell, feed: None, path: Path::Straight }
+            (still, None)
         } else if axes.is_empty() {
-            Moved { motion: Motion::None, length: 0.0, duration: 0.0, feed: None, path: Path::Straight }
+            (dwell.unwrap_or(still), None)
         } else {
             let mut end = self.position;
             for word in &axes {
@@ -1536,7 +1543,7 @@ impl Runner {
                 self.finding(range, &message, true);
                 return Flow::End;
             }
-            moved
+            (moved, dwell)
         };
         let stop = if has(b'M', 0) {
             Some(Stop::Program)
@@ -1552,11 +1559,15 @@ impl Runner {
             tool_change: has(b'M', 6),
             mergeable: moved.motion == Motion::Feed && motion == Some(1) && !technology && !self.incremental(),
         };
-        self.record(range, &self.position.clone(), moved, stop, functions);
+        let end = self.position;
+        self.record(range, &end, moved, stop.filter(|_| dwell.is_none()), functions);
         if let Err(error) = self.compensate(start, path) {
             let range = self.step_mut(error.block()).range;
             self.finding(range, &format!("radius compensation: {error}"), true);
             return Flow::End;
+        }
+        if let Some(dwell) = dwell {
+            self.record(range, &end, dwell, stop, Functions::default());
         }
         // Assignments and arithmetic take effect after the block's motion.
         arith::assign(block, &mut self.params);
@@ -3214,6 +3225,44 @@ mod tests {
         let trace = run(text, &NoFiles, &machine, 100);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
         assert_eq!(trace.steps.len(), 3);
+    }
+
+    #[test]
+    fn a_block_with_motion_and_g04_moves_then_dwells() {
+        // 15 mm at F100 take 9 s, then 300 × 10 ms.
+        let text = "%1\nN1 G00 X0 Y0 Z5\nN2 G01 Z-10 F100 G04 Q300\nN3 G00 Z5\nN4 M30\n";
+        let trace = run_text(text);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let motions: Vec<(String, Motion)> =
+            trace.steps.iter().map(|step| (text[step.range].trim_end().to_owned(), step.motion)).collect();
+        let n2 = "N2 G01 Z-10 F100 G04 Q300".to_owned();
+        assert_eq!(motions[1..3], [(n2.clone(), Motion::Feed), (n2, Motion::Dwell)]);
+        assert_eq!(timing(&trace)[1..4], [(9.0, 15.0), (3.0, 0.0), (0.09, 15.0)]);
+        assert_eq!(trace.axis(&trace.steps[2].end, b'Z'), -10.0);
+        // The manual's G82 of the cycle file drills, then dwells at the
+        // bottom (R29 = 250: 2.5 s).
+        let body = "\"$PC\nN1 G79 L82\nN2 G00 G90 ZR30 FR26 SR27\nN3 G01 ZR31 G04 QR29\nN4 G00 ZR32\nN5 G70\n*\n";
+        let machine = MachineConfig { cycle_file: Some("PC.NCP".to_owned()), ..MachineConfig::default() };
+        let text =
+            "%1\nN1 R26=100 R27=1000 R29=250 R30=2. R31=-10. R32=5. M03\nN2 G00 X10 Y10 Z5\nN3 G82 X20\nN4 G80 M30\n";
+        let trace = run(text, &Library(body), &machine, 1000);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let body_steps: Vec<(Motion, f64, f64)> = trace
+            .steps
+            .iter()
+            .filter(|step| step.source == 1)
+            .map(|step| (step.motion, round3(step.duration), trace.axis(&step.end, b'Z')))
+            .collect();
+        assert_eq!(
+            body_steps,
+            [
+                (Motion::Rapid, 0.018, 2.0),
+                (Motion::Feed, 7.2, -10.0),
+                (Motion::Dwell, 2.5, -10.0),
+                (Motion::Rapid, 0.09, 5.0),
+                (Motion::None, 0.0, 5.0),
+            ]
+        );
     }
 
     /// The fatal findings of a run: where (the text) and what.
