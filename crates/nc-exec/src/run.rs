@@ -1229,6 +1229,9 @@ struct Runner {
     corrections: ToolTable,
     /// The envelope velocity's dynamic set, `G23 I1` … `I4`.
     dynamic_set: u8,
+    /// The zero offset the block writes, which holds in it alone when it
+    /// is G58 or G59.
+    block_offset: Option<u8>,
     /// The correction entry D and the length-compensation digits `&`.
     correction: u8,
     length_digits: u32,
@@ -1285,6 +1288,7 @@ impl Runner {
             offsets: machine.offsets.clone(),
             corrections: machine.tools.clone(),
             dynamic_set: 1,
+            block_offset: None,
             correction: 0,
             length_digits: 0,
             length_shift: [0.0; 26],
@@ -1337,6 +1341,8 @@ impl Runner {
             offsets,
             corrections,
             dynamic_set,
+            // Set anew by every block before it is read.
+            block_offset: _,
             correction,
             length_digits,
             length_shift,
@@ -1485,6 +1491,11 @@ impl Runner {
             }
             axes.clear();
         }
+        // G58 and G59 hold in their own block only (01 §5.5).
+        self.block_offset = codes
+            .iter()
+            .find(|&&(letter, number, _)| self.modes.group_of(letter, number) == Some(self.groups.zero_offset))
+            .and_then(|&(_, number, _)| u8::try_from(number).ok());
         // A new zero offset holds from this block; a new length correction
         // from its first block of linear or rapid motion (02 §1.18.2).
         let motion = self.modes.active(self.groups.motion);
@@ -1969,9 +1980,12 @@ impl Runner {
         transform::over_axes(position, &self.machine.axes)
     }
 
-    /// The row of the zero-offset table in force (G53–G59).
+    /// The row of the zero-offset table in force (G53–G59): the block's
+    /// own, else the modal one.
     fn zero_offset_row(&self) -> u8 {
-        self.modes.active(self.groups.zero_offset).and_then(|code| u8::try_from(code).ok()).unwrap_or(53)
+        self.block_offset
+            .or_else(|| self.modes.active(self.groups.zero_offset).and_then(|code| u8::try_from(code).ok()))
+            .unwrap_or(53)
     }
 
     /// Runs a built-in cycle; `false` after reporting why it cannot run.
@@ -3263,6 +3277,15 @@ mod tests {
                 (Motion::None, 0.0, 5.0),
             ]
         );
+    }
+
+    #[test]
+    fn g58_and_g59_hold_in_their_own_block_and_g92_writes_their_row() {
+        let text = "%1\nN1 G55 G92 X10.\nN2 G58 G92 X100.\nN3 G59 G92 X200.\nN4 G00 X0\nN5 G58 X0\nN6 X0\nN7 G59 X0\nN8 X0\nN9 M30\n";
+        let trace = run_text(text);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let machine_x: Vec<f64> = (3..8).map(|step| trace.axis(&trace.machine_end(step), b'X')).collect();
+        assert_eq!(machine_x, [10.0, 100.0, 10.0, 200.0, 10.0]);
     }
 
     /// The fatal findings of a run: where (the text) and what.
