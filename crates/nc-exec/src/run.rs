@@ -1232,6 +1232,8 @@ struct Runner {
     /// The zero offset the block writes, which holds in it alone when it
     /// is G58 or G59.
     block_offset: Option<u8>,
+    /// The helix's axis and its travel per turn in mm, from G10.
+    helix_lead: Option<(u8, f64)>,
     /// The correction entry D and the length-compensation digits `&`.
     correction: u8,
     length_digits: u32,
@@ -1289,6 +1291,7 @@ impl Runner {
             corrections: machine.tools.clone(),
             dynamic_set: 1,
             block_offset: None,
+            helix_lead: None,
             correction: 0,
             length_digits: 0,
             length_shift: [0.0; 26],
@@ -1343,6 +1346,7 @@ impl Runner {
             dynamic_set,
             // Set anew by every block before it is read.
             block_offset: _,
+            helix_lead,
             correction,
             length_digits,
             length_shift,
@@ -1372,6 +1376,7 @@ impl Runner {
             && *offsets == other.offsets
             && *corrections == other.corrections
             && *dynamic_set == other.dynamic_set
+            && *helix_lead == other.helix_lead
             && *correction == other.correction
             && *length_digits == other.length_digits
             && *length_shift == other.length_shift
@@ -1424,6 +1429,8 @@ impl Runner {
                 // Program flow, which the caller follows, and the
                 // arithmetic, which runs after the motion.
                 (b'G', 26..=29 | 70..=73 | 79) => {}
+                // The helix G09 and its lead G10, which the motion reads.
+                (b'G', 9 | 10) => {}
                 // Transformations, which the block is about.
                 (b'G', 31 | 34..=39) => {}
                 // Group G10 also holds the block's own G04/G92/G93, so the
@@ -1488,6 +1495,14 @@ impl Runner {
                 if fatal {
                     return Flow::End;
                 }
+            }
+            axes.clear();
+        }
+        // The helix lead block `N10 Z1.05 G10` names the axis the helix
+        // drives and its travel per turn: it does not move (02 §4).
+        if has(b'G', 10) {
+            if let Some(word) = axes.first() {
+                self.helix_lead = self.number(word).map(|lead| (word.letter, lead));
             }
             axes.clear();
         }
@@ -2266,10 +2281,16 @@ impl Runner {
 
     /// The arc of a G02/G03 block, or `None` after reporting why the block
     /// is not one; the error after reporting an end point the control
-    /// stops on.
+    /// stops on. Under a helix the axis of its lead turns with the arc.
     fn arc(&mut self, step: &Move<'_>, counter_clockwise: bool) -> Result<Option<Arc>, ()> {
         let Move { block, range, axes, start, end } = *step;
-        let mut letters: Vec<u8> = axes.iter().map(|word| word.letter).collect();
+        let helix = self.helix_lead.filter(|_| self.modes.active(self.groups.joining) == Some(9));
+        // Under a helix a word for its axis is not a coordinate of the arc.
+        let mut letters: Vec<u8> = axes
+            .iter()
+            .map(|word| word.letter)
+            .filter(|&letter| helix.is_none_or(|(axis, _)| axis != letter))
+            .collect();
         letters.dedup();
         if letters.len() < 2 {
             let message = "an arc needs both coordinates of its plane, even when the end point equals the start";
@@ -2309,9 +2330,16 @@ impl Runner {
         } else if !counter_clockwise && sweep >= 0.0 {
             sweep -= std::f64::consts::TAU;
         }
-        // A third axis written in the block moves along with the arc.
-        let lead: f64 =
+        // A third axis written in the block moves along with the arc; the
+        // helix's axis travels its lead per full turn, whichever way the
+        // arc turns (02 §4).
+        let mut lead: f64 =
             letters[2..].iter().map(|&l| (end[usize::from(l - b'A')] - start[usize::from(l - b'A')]).powi(2)).sum();
+        if let Some((axis, per_turn)) = helix.filter(|&(axis, _)| axis != first && axis != second) {
+            let travel = per_turn * sweep.abs() / std::f64::consts::TAU;
+            self.position[slot(axis)] = round3(start[slot(axis)] + travel);
+            lead += (self.position[slot(axis)] - start[slot(axis)]).powi(2);
+        }
         Ok(Some(Arc { plane: (a, b), centre, radius, start_angle, sweep, lead: lead.sqrt() }))
     }
 
@@ -3286,6 +3314,30 @@ mod tests {
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
         let machine_x: Vec<f64> = (3..8).map(|step| trace.axis(&trace.machine_end(step), b'X')).collect();
         assert_eq!(machine_x, [10.0, 100.0, 10.0, 200.0, 10.0]);
+    }
+
+    #[test]
+    fn a_helix_drives_its_lead_axis_by_the_turns_of_the_arc() {
+        use std::f64::consts::TAU;
+        // The manual's helix: lead 1.05 mm on Z, a full circle of radius
+        // 100 run 21 times (Q20), then a half circle; after G98 an arc
+        // leaves Z alone.
+        let text = "%1\nN5 X0 Y0 Z0 G00\nN10 Z1.05 G10\nN50 G09 G02 X0 Y0 I100 G73 L50 Q20 F1000\nN60 X200. Y0 I100\nN70 G98\nN75 G02 X200 Y0 I-100\nN80 M30\n";
+        let trace = run_text(text);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let z: Vec<f64> = trace.steps.iter().map(|step| trace.axis(&step.end, b'Z')).collect();
+        // The lead block does not move.
+        assert_eq!(z[..3], [0.0, 0.0, 1.05]);
+        assert_eq!(z[21..], [21.0, 22.05, 22.575, 22.575, 22.575, 22.575]);
+        let turn = (TAU * 100.0).hypot(1.05);
+        let half = (TAU / 2.0 * 100.0).hypot(0.525);
+        close6(trace.steps[2].length, turn);
+        close6(trace.steps[23].length, half);
+        close6(trace.steps[25].length, TAU * 100.0);
+        let length = 21.0 * turn + half + TAU * 100.0;
+        close6(trace.totals().length(Motion::Feed), length);
+        close6(trace.totals().time(Motion::Feed), length / 1000.0 * 60.0);
+        assert_eq!(trace.axis(&trace.steps[23].end, b'X'), 200.0);
     }
 
     /// The fatal findings of a run: where (the text) and what.
