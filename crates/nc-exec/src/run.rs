@@ -2062,7 +2062,7 @@ impl Runner {
             let (motion, duration, feed, path) = match *step {
                 CycleStep::Rapid { .. } => (Motion::Rapid, self.rapid_seconds(&at, &to), None, Path::Straight),
                 CycleStep::Feed { .. } => {
-                    let rate = step.feed_rate().filter(|&rate| rate > 0.0);
+                    let rate = step.feed_rate().map(|rate| rate * self.feed_factor()).filter(|&rate| rate > 0.0);
                     (Motion::Feed, rate.map_or(0.0, |rate| length / rate * 60.0), rate, Path::Straight)
                 }
                 CycleStep::Thread { thread, .. } => {
@@ -2141,7 +2141,11 @@ impl Runner {
         };
         let length = arc.as_ref().map_or(straight, Arc::length);
         let mode = self.feed_mode();
-        let feed = self.feed.map(|feed| feed.value(mode.per_revolution || motion == Some(33)));
+        // A thread's F is its lead, which M37 leaves alone.
+        let feed = match motion {
+            Some(33) => self.feed.map(|feed| feed.value(true)),
+            _ => self.feed.map(|feed| feed.value(mode.per_revolution) * self.feed_factor()),
+        };
         // Minutes, and the path feed in mm/min (the average where it varies).
         let timed = |minutes: f64| (minutes, length / minutes);
         let minutes = match (feed.filter(|&feed| feed > 0.0), mode) {
@@ -2196,6 +2200,12 @@ impl Runner {
             Some(97) => FeedMode { per_revolution: !swapped, css: true },
             _ => FeedMode { per_revolution: false, css: false },
         }
+    }
+
+    /// What the feed is multiplied by: M37 reduces it 1 : 100, M36 (the
+    /// reset state) runs it as programmed (01 §6.6).
+    fn feed_factor(&self) -> f64 {
+        if self.modes.active(self.groups.feed_reduction) == Some(37) { 0.01 } else { 1.0 }
     }
 
     /// Why the control cannot move to `position` (program coordinates in
@@ -2533,6 +2543,7 @@ struct Groups {
     zero_offset: Group,
     plane: Group,
     compensation: Group,
+    feed_reduction: Group,
 }
 
 impl Groups {
@@ -2547,6 +2558,7 @@ impl Groups {
             zero_offset: modes.group("G5"),
             plane: modes.group("G1"),
             compensation: modes.group("G3"),
+            feed_reduction: modes.group("M4"),
         }
     }
 }
@@ -3338,6 +3350,24 @@ mod tests {
         close6(trace.totals().length(Motion::Feed), length);
         close6(trace.totals().time(Motion::Feed), length / 1000.0 * 60.0);
         assert_eq!(trace.axis(&trace.steps[23].end, b'X'), 200.0);
+    }
+
+    #[test]
+    fn m37_runs_the_feed_at_a_hundredth_until_m36() {
+        let text = "%1\nN1 G01 X100 F1000\nN2 M37\nN3 X200\nN4 G00 X0\nN5 G95 S500 G01 X10 F200\nN6 M36\nN7 G94 X110 F1000\nN8 M37 S500 G33 Z-15. F1.5\nN9 M30\n";
+        let trace = run_text(text);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        // 100 mm at 10 mm/min; the rapid is not a feed; 200 µm/rev at S500
+        // is 100 mm/min, 1 mm/min under M37; after M36 the feed is F again.
+        let feeds: Vec<Option<f64>> = trace.steps.iter().map(|step| step.feed).collect();
+        assert_eq!(feeds[..7], [Some(1000.0), None, Some(10.0), None, Some(1.0), None, Some(1000.0)]);
+        let times: Vec<f64> = timing(&trace).iter().map(|&(duration, _)| duration).collect();
+        assert_eq!(times[..7], [6.0, 0.0, 600.0, 1.2, 600.0, 0.0, 6.0]);
+        // A thread's F is its lead: 15 mm at 1.5 mm/rev and S500.
+        close6(trace.steps[7].duration, (0.02 + 0.001) * 60.0);
+        // The built-in cycles feed under it too: 12 mm at F100 / 100.
+        let trace = run_text(&DRILLING.replace("M03", "M03 M37"));
+        close(trace.totals().time(Motion::Feed), 2.0 * 12.0 / 1.0 * 60.0);
     }
 
     /// The fatal findings of a run: where (the text) and what.
