@@ -3325,6 +3325,22 @@ mod tests {
                 (Motion::None, 0.0, 5.0),
             ]
         );
+        // The manual's G86 pecks R28 deeper each time and dwells there.
+        let body = "\"$PC\nN1 G79 L86\nN3 FR26 SR27\n   G27 R5=07280028\n       R6=16313034\nN4 GR34 L100\nN10 G00 G90 ZR30\n    G26 R5=00300024\nN20 G27 R5=02242824\n        R6=15312423\nN30 GR23 L60\nN40 G01  ZR24 G04 QR29\nN50 G73 L20 Q9998\nN60 ZR31\nN70 G70 G00 ZR32\n*\n";
+        let text = "%1\nN1 R26=100 R27=1000 R28=3. R29=50 R30=2. R31=-10. R32=5. M03\nN2 G00 X10 Y10 Z5\nN3 G86 X20\nN4 G80 M30\n";
+        let trace = run(text, &Library(body), &machine, 1000);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let pecks: Vec<(Motion, f64)> = trace
+            .steps
+            .iter()
+            .filter(|step| matches!(step.motion, Motion::Feed | Motion::Dwell))
+            .map(|step| (step.motion, trace.axis(&step.end, b'Z')))
+            .collect();
+        let (feed, dwell) = (Motion::Feed, Motion::Dwell);
+        let expected = [(feed, -1.0), (dwell, -1.0), (feed, -4.0), (dwell, -4.0), (feed, -7.0), (dwell, -7.0)];
+        // The last peck reaches R31, where N60's feed ends too.
+        assert_eq!(pecks[..6], expected);
+        assert_eq!(pecks[6..], [(feed, -10.0), (dwell, -10.0), (feed, -10.0)]);
     }
 
     #[test]
