@@ -45,7 +45,8 @@ pub fn literal_fault(address: &Address, value: &Decimal, machine: &MachineConfig
     if let Some(message) = digit_overflow(address, value) {
         return Some(Fault::new(Refusal::Digits, message));
     }
-    outside_range(address, value.to_f64(), machine).then(|| {
+    let outside = !surely_within(address, value) && outside_range(address, value.to_f64(), machine);
+    outside.then(|| {
         Fault::new(
             Refusal::Range,
             format!(
@@ -81,7 +82,6 @@ pub fn digit_overflow(address: &Address, value: &Decimal) -> Option<String> {
     let int_limit =
         if value.has_point() { address.int_digits? } else { address.int_digits_without_point.or(address.int_digits)? };
     let int = value.significant_int_digits();
-    let frac = value.significant_frac_digits();
     let letter = &address.letter;
     if int > u32::from(int_limit) {
         let form = if address.int_digits_without_point.is_some() {
@@ -93,8 +93,12 @@ pub fn digit_overflow(address: &Address, value: &Decimal) -> Option<String> {
             "`{letter}{value}` has {int} digits before the point; the format of `{letter}` allows {int_limit}{form}"
         ));
     }
-    let frac_limit = address.frac_digits.unwrap_or(0);
-    if value.has_point() && frac > u32::from(frac_limit) && frac_limit > 0 {
+    let frac_limit = u32::from(address.frac_digits.unwrap_or(0));
+    // Trailing zeros are counted only when there are more decimals than
+    // the limit: every word of a program comes here.
+    let frac = || value.significant_frac_digits();
+    if value.has_point() && frac_limit > 0 && value.frac_digits() > frac_limit && frac() > frac_limit {
+        let frac = frac();
         return Some(format!(
             "`{letter}{value}` has {frac} decimals; `{letter}` takes at most {frac_limit} (the control's resolution)"
         ));
@@ -153,6 +157,20 @@ pub fn substitution_fault(address: &Address, raw: Raw, thread: bool, machine: &M
             ),
         )
     })
+}
+
+/// Whether the digits of `value` before its point put it within the
+/// range of `address` whatever they are: `X12.345` lies between 10 and
+/// 100. Every word of a program comes here, and most are decided so,
+/// without converting the number.
+fn surely_within(address: &Address, value: &Decimal) -> bool {
+    const POWERS: [f64; 10] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
+    let digits = value.significant_int_digits() as usize;
+    let (Some((min, max)), Some(&above)) = (address.bounds, POWERS.get(digits)) else { return false };
+    // At least 10^(digits - 1) (or 0), below 10^digits.
+    let at_least = if digits == 0 { 0.0 } else { POWERS[digits - 1] };
+    let (low, high) = if value.is_negative() { (-above, -at_least) } else { (at_least, above) };
+    min <= low && high <= max
 }
 
 /// Whether `value` lies outside the range of `address`. `D0` is not: it

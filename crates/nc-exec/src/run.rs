@@ -1232,6 +1232,9 @@ struct Runner {
     css_setting: u8,
     /// Machine constant 329 decade 7: the length-compensation mode (0 = A).
     length_setting: u8,
+    /// What the address of each machine axis holds (±69999.999), in the
+    /// order of the axes; read once, as every move asks.
+    axis_ranges: [Option<(f64, f64)>; MAX_AXES],
     /// The zero-offset and correction tables, as the program changes them.
     offsets: OffsetTable,
     corrections: ToolTable,
@@ -1290,6 +1293,10 @@ impl Runner {
             in_cycle: false,
             css_setting: machine.decade(329, 3),
             length_setting: machine.decade(329, 7),
+            axis_ranges: std::array::from_fn(|index| {
+                let axis = *machine.axes.get(index)?;
+                Dialect::Cnc8x6.catalogue().address_of(axis)?.bounds
+            }),
             compensator: None,
             compensation: Settings::of(&machine),
             tool_centre: Vec::new(),
@@ -1349,6 +1356,7 @@ impl Runner {
             compensated: _,
             css_setting: _,
             length_setting: _,
+            axis_ranges: _,
             offsets,
             corrections,
             dynamic_set,
@@ -2221,19 +2229,28 @@ impl Runner {
     /// beyond its travel limits in machine coordinates, where the
     /// software limit switches work (03 §3.2).
     fn unreachable(&self, position: &Position) -> Option<String> {
+        // Positions lie on the µm grid; half of one keeps float noise off
+        // the bounds.
+        const HALF_MICROMETRE: f64 = 0.0005;
         let axes = &self.machine.axes;
-        let machine = self.frame().to_machine(&self.machine_axes(position), axes);
-        for (&axis, &real) in axes.iter().zip(&machine) {
+        for (&axis, &range) in axes.iter().zip(&self.axis_ranges) {
             let letter = char::from(axis);
             // On a diameter axis the program holds the diameter.
             let written = position[slot(axis)] * self.written_per_unit(axis);
-            if let Some((min, max)) = self.catalogue.address_of(axis).and_then(|address| address.bounds)
-                && !(min..=max).contains(&round3(written))
+            if let Some((min, max)) = range
+                && !(min - HALF_MICROMETRE..=max + HALF_MICROMETRE).contains(&written)
             {
                 return Some(format!(
                     "{letter} would reach {written:.3}, outside the range of `{letter}`: {min:.3} to {max:.3}: the control stops"
                 ));
             }
+        }
+        if self.machine.limits.is_empty() {
+            return None;
+        }
+        let machine = self.frame().to_machine(&self.machine_axes(position), axes);
+        for (&axis, &real) in axes.iter().zip(&machine) {
+            let letter = char::from(axis);
             let limits = self.machine.limits.get(&axis).copied().unwrap_or_default();
             let beyond = |limit: Option<i32>, beyond: fn(f64, f64) -> bool| {
                 limit.map(|limit| f64::from(limit) / 1000.0).filter(|&limit| beyond(round3(real), limit))
