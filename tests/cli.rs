@@ -520,6 +520,65 @@ fn run_stops_on_a_call_to_nothing() {
     assert!(stderr.ends_with("CALL.NCP:3: there is no subprogram L9 (G79 L9) in this file\n"), "{stderr}");
 }
 
+/// Where the control stops, `ncc run`, `ncc expand` and `ncc plot` stop:
+/// the located message, exit status 1, and no infinity or NaN in what
+/// they write.
+#[test]
+fn run_expand_and_plot_stop_where_the_control_stops() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            "OVERFLOW.NCP",
+            "%1\nN10 R10=123\nN20 GR10\nN30 G00 X10\nN40 M30\n",
+            3,
+            "the parameter holds 0.123 (123 as digits, 3 decades) but `G` takes at most 2: the control stops with \"an R of more than 2 decades cannot be substituted\"",
+        ),
+        ("SIGN.NCP", "%1\nN1 G01 X10 F-100\nN2 M30\n", 2, "`F` takes only unsigned values; remove the sign"),
+        (
+            "HUGE.NCP",
+            "%1\nN10 G1 X99999999999999999999 F100\nN20 M30\n",
+            2,
+            "`X99999999999999999999` has 20 digits before the point; the format of `X` allows 5",
+        ),
+        (
+            "REPEAT.NCP",
+            "%1\nN1 G91 G00 X1000\nN2 G73 L1 Q999\nN3 M30\n",
+            2,
+            "X would reach 70000.000, outside the range of `X`: -69999.999 to 69999.999: the control stops",
+        ),
+        (
+            "ARC.NCP",
+            "%1\nN1 G00 X10 Y0\nN2 G02 X20 Y0 I3 F100\nN3 M30\n",
+            3,
+            "the end point does not lie on the circle: 7 mm from the centre, the start 3 mm, more than the tolerance 0.001 mm apart: the control stops with error 7.56",
+        ),
+    ];
+    let svg = dir.path().join("PLOT.svg");
+    for (name, text, line, message) in cases {
+        let program = dir.path().join(name);
+        std::fs::write(&program, text).unwrap();
+        let program = program.to_str().unwrap();
+        for args in [
+            vec!["run", program],
+            vec!["run", program, "--format", "json"],
+            vec!["expand", program],
+            vec!["plot", program, "-o", svg.to_str().unwrap()],
+        ] {
+            let _ = std::fs::remove_file(&svg);
+            let output = ncc(&args);
+            assert_eq!(output.status.code(), Some(1), "{args:?}");
+            let stderr = String::from_utf8(output.stderr.clone()).unwrap();
+            assert!(stderr.ends_with(&format!("{name}:{line}: {message}\n")), "{args:?}: {stderr}");
+            let written = stdout(&output) + &std::fs::read_to_string(&svg).unwrap_or_default();
+            let words = written.split(|c: char| !c.is_ascii_alphanumeric()).map(str::to_ascii_lowercase);
+            assert!(
+                words.clone().all(|word| word != "inf" && word != "nan" && word != "infinity"),
+                "{args:?}: {written}"
+            );
+        }
+    }
+}
+
 /// `G72 L9001` runs the macrocycle file `L9001` of the program's project
 /// (the directory of its ncc.toml); its blocks and findings name that file.
 #[test]

@@ -128,6 +128,8 @@ pub struct Catalogue {
     pub cycles: Vec<Cycle>,
     codes_by_number: HashMap<(char, u32), usize>,
     roles: [Option<AddressRole>; 128],
+    /// The index in `addresses` of each address byte, either case.
+    address_index: [Option<u8>; 128],
     /// [`Catalogue::modal_group_index`] of G and M codes below
     /// [`DENSE_CODES`], which every block asks for.
     modal_groups: [[Option<u8>; DENSE_CODES as usize]; 2],
@@ -152,10 +154,13 @@ impl Catalogue {
         let codes_by_number =
             codes.codes.iter().enumerate().filter_map(|(i, code)| Some((split_code(&code.code)?, i))).collect();
         let mut roles = [None; 128];
-        for address in &addresses.addresses {
+        let mut address_index = [None; 128];
+        for (index, address) in addresses.addresses.iter().enumerate() {
             for byte in address.letter.bytes().filter(u8::is_ascii) {
-                roles[usize::from(byte.to_ascii_uppercase())] = Some(address.role);
-                roles[usize::from(byte.to_ascii_lowercase())] = Some(address.role);
+                for case in [byte.to_ascii_uppercase(), byte.to_ascii_lowercase()] {
+                    roles[usize::from(case)] = Some(address.role);
+                    address_index[usize::from(case)] = u8::try_from(index).ok();
+                }
             }
         }
         let mut catalogue = Catalogue {
@@ -169,6 +174,7 @@ impl Catalogue {
             cycles: cycles.cycles,
             codes_by_number,
             roles,
+            address_index,
             modal_groups: [[None; DENSE_CODES as usize]; 2],
         };
         for (table, letter) in [(0, 'G'), (1, 'M')] {
@@ -230,6 +236,13 @@ impl Catalogue {
 
     pub fn address(&self, letter: &str) -> Option<&Address> {
         self.addresses.iter().find(|a| a.letter.eq_ignore_ascii_case(letter))
+    }
+
+    /// The address of a byte, case-insensitively; a table lookup, for the
+    /// executor's every word.
+    pub fn address_of(&self, byte: u8) -> Option<&Address> {
+        let index = self.address_index.get(usize::from(byte)).copied().flatten()?;
+        self.addresses.get(usize::from(index))
     }
 
     /// The role of an address byte, case-insensitively; a table lookup, for

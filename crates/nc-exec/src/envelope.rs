@@ -976,7 +976,7 @@ mod tests {
         // The CNC8x6 model stops at every 10 ms block (60 ms is its shortest).
         let program: String = (1..=100).map(|x| format!("N{x} X{x}\n")).collect();
         let machine = MachineConfig::default();
-        let trace = run(&format!("%1\nN0 G23 G01 F6000\n{program}M30\n"), &NoFiles, &machine, 1000);
+        let trace = run(&format!("%1\nN101 G23 G01 F6000\n{program}M30\n"), &NoFiles, &machine, 1000);
         let cnc8x6 = time(&trace, &Dynamics::of(&machine)).total_time();
         assert!(cnc8x6 > 3.0 * total(&planned), "{cnc8x6}");
         // Parabolic: the sections' ramps over several blocks come within 2%

@@ -14,6 +14,8 @@
 //! - [`envelope`]: the CNC8x9 envelope velocity, a streaming look-ahead
 //!   planner of up to 500 blocks with linear or jerk-limited ramps.
 //! - [`expand`]: a run written back as a program of plain motion blocks.
+//! - [`formats`]: what the control refuses in a value, by its address's
+//!   format; the checker words its findings with it too.
 //! - [`lower`]: blocks as plain data (words, parameter assignments,
 //!   comments), read from the syntax tree; the analysis uses it too.
 //! - [`machine`]: the machine a program runs on (axes, rates, limits,
@@ -34,6 +36,7 @@ pub mod compensation;
 pub mod cycles;
 pub mod envelope;
 pub mod expand;
+pub mod formats;
 pub mod lower;
 pub mod machine;
 pub mod modes;

@@ -147,6 +147,13 @@ impl MachineConfig {
         self.rapid_rates.get(&letter).copied().unwrap_or(self.rapid_rate)
     }
 
+    /// How far an arc's end point may lie from its circle, in mm: machine
+    /// constant 55 in µm, at least the 1 µm the control computes in (01
+    /// §6.4).
+    pub fn arc_tolerance(&self) -> f64 {
+        self.constant(55).max(1) as f64 / 1000.0
+    }
+
     /// Whether `letter` names a configured axis.
     pub fn is_axis(&self, letter: u8) -> bool {
         self.axes.contains(&letter.to_ascii_uppercase())

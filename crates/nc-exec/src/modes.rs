@@ -51,6 +51,18 @@ impl Modes {
         self.active[group.0]
     }
 
+    /// The group a modal code puts itself in force in; `None` for
+    /// block-only codes and codes outside the groups.
+    pub fn modal_group_of(&self, letter: u8, number: u32) -> Option<Group> {
+        self.catalogue.modal_group_index(char::from(letter), number).map(Group)
+    }
+
+    /// The group of a code, modal or block-only.
+    pub fn group_of(&self, letter: u8, number: u32) -> Option<Group> {
+        let group = self.catalogue.group_of(char::from(letter), number)?;
+        self.catalogue.groups.iter().position(|g| std::ptr::eq(g, group)).map(Group)
+    }
+
     /// Puts a modal code in force in its group; block-only codes and codes
     /// outside the groups change nothing.
     pub fn set(&mut self, letter: u8, number: u32) {

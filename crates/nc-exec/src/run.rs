@@ -8,10 +8,12 @@
 //!   taking Q from a call in its block, M00/M01 stops, M02/M30, and a step
 //!   budget against endless loops.
 //! - Motion: G00, G01, arcs and helices G02/G03 (the centre from I/J/K, the
-//!   plane from the two axes written, 01 §6.4), threads G33, G90/G91.
+//!   plane from the two axes written, 01 §6.4; the helix's lead from G10
+//!   under G09, 02 §4), threads G33, G90/G91.
 //! - Feed and spindle: the modal machine of every group ([`Modes`]), F
-//!   with its decimal-point rules per minute or per revolution, S, constant
-//!   cutting speed G96/G97 with the G76 limit, dwell (G04 Q, in 10 ms).
+//!   with its decimal-point rules per minute or per revolution and M37's
+//!   1 : 100, S, constant cutting speed G96/G97 with the G76 limit, dwell
+//!   (G04 Q, in 10 ms, after the block's motion).
 //! - Parameters: assignments and arithmetic G26–G29 take effect after the
 //!   block's motion, which reads the values from before them.
 //! - Fixed cycles G81–G89 after the block's motion until G80: the bodies of
@@ -24,6 +26,12 @@
 //! - Coordinates: diameter programming G74/G75 on the machine's diameter
 //!   axis (positions are radii), the recalculations G34–G37 and the
 //!   transformations G38/G39/G31 ([`crate::transform`]).
+//!
+//! Where the control stops on an error, the run stops with a fatal
+//! [`Finding`]: a value its address cannot take ([`crate::formats`]), a
+//! position beyond an axis's range or the machine's travel limits, an arc
+//! end point off its circle, a call, jump, cycle or arithmetic that cannot
+//! run.
 //!
 //! A block's time is its path length over its feed (G00: the slowest axis
 //! at its own rapid rate), plus dwells; ramps and block joining are the
@@ -52,6 +60,7 @@ use crate::{
     arith::{self, BlockArithmetic, Machine, Message, Parameters, Raw},
     compensation::{CompensationError, Compensator, Element, Settings, Side, ToolElement},
     cycles::{self, CycleError, CycleInput, CycleKind, CycleStep, Spindle},
+    formats,
     lower::{BlockData, BlockReader, PlainReader, Value, Word},
     machine::MachineConfig,
     modes::{Group, Modes},
@@ -1236,11 +1245,19 @@ struct Runner {
     css_setting: u8,
     /// Machine constant 329 decade 7: the length-compensation mode (0 = A).
     length_setting: u8,
+    /// What the address of each machine axis holds (±69999.999), in the
+    /// order of the axes; read once, as every move asks.
+    axis_ranges: [Option<(f64, f64)>; MAX_AXES],
     /// The zero-offset and correction tables, as the program changes them.
     offsets: OffsetTable,
     corrections: ToolTable,
     /// The envelope velocity's dynamic set, `G23 I1` … `I4`.
     dynamic_set: u8,
+    /// The zero offset the block writes, which holds in it alone when it
+    /// is G58 or G59.
+    block_offset: Option<u8>,
+    /// The helix's axis and its travel per turn in mm, from G10.
+    helix_lead: Option<(u8, f64)>,
     /// The correction entry D and the length-compensation digits `&`.
     correction: u8,
     length_digits: u32,
@@ -1273,9 +1290,6 @@ struct Runner {
     reported: Vec<String>,
 }
 
-/// Tolerance of the arc end point's distance from the centre (1 µm, 01 §6.4).
-const ARC_TOLERANCE: f64 = 0.001;
-
 impl Runner {
     fn new(machine: std::sync::Arc<MachineConfig>) -> Self {
         // The priority block: G01 G17 G90 G94 F0 S0 M05 ….
@@ -1292,6 +1306,10 @@ impl Runner {
             in_cycle: false,
             css_setting: machine.decade(329, 3),
             length_setting: machine.decade(329, 7),
+            axis_ranges: std::array::from_fn(|index| {
+                let axis = *machine.axes.get(index)?;
+                Dialect::Cnc8x6.catalogue().address_of(axis)?.bounds
+            }),
             compensator: None,
             compensation: Settings::of(&machine),
             tool_centre: Vec::new(),
@@ -1300,6 +1318,8 @@ impl Runner {
             offsets: machine.offsets.clone(),
             corrections: machine.tools.clone(),
             dynamic_set: 1,
+            block_offset: None,
+            helix_lead: None,
             correction: 0,
             length_digits: 0,
             length_shift: [0.0; 26],
@@ -1349,9 +1369,13 @@ impl Runner {
             compensated: _,
             css_setting: _,
             length_setting: _,
+            axis_ranges: _,
             offsets,
             corrections,
             dynamic_set,
+            // Set anew by every block before it is read.
+            block_offset: _,
+            helix_lead,
             correction,
             length_digits,
             length_shift,
@@ -1381,6 +1405,7 @@ impl Runner {
             && *offsets == other.offsets
             && *corrections == other.corrections
             && *dynamic_set == other.dynamic_set
+            && *helix_lead == other.helix_lead
             && *correction == other.correction
             && *length_digits == other.length_digits
             && *length_shift == other.length_shift
@@ -1407,6 +1432,10 @@ impl Runner {
             .filter_map(|word| Some((word.letter, self.integer(word)?, at(word.range))))
             .collect();
         let has = |letter: u8, number: u32| codes.iter().any(|&(l, n, _)| l == letter && n == number);
+        if let Some((refused, message)) = self.refused_value(block, &codes) {
+            self.finding(at(refused), &message, true);
+            return Flow::End;
+        }
         for word in &block.words {
             if let Some(Value::Parameter { index: Some(index), .. }) = word.value
                 && (index as usize) < arith::PARAMETER_COUNT
@@ -1429,6 +1458,8 @@ impl Runner {
                 // Program flow, which the caller follows, and the
                 // arithmetic, which runs after the motion.
                 (b'G', 26..=29 | 70..=73 | 79) => {}
+                // The helix G09 and its lead G10, which the motion reads.
+                (b'G', 9 | 10) => {}
                 // Transformations, which the block is about.
                 (b'G', 31 | 34..=39) => {}
                 // Group G10 also holds the block's own G04/G92/G93, so the
@@ -1496,6 +1527,19 @@ impl Runner {
             }
             axes.clear();
         }
+        // The helix lead block `N10 Z1.05 G10` names the axis the helix
+        // drives and its travel per turn: it does not move (02 §4).
+        if has(b'G', 10) {
+            if let Some(word) = axes.first() {
+                self.helix_lead = self.number(word).map(|lead| (word.letter, lead));
+            }
+            axes.clear();
+        }
+        // G58 and G59 hold in their own block only (01 §5.5).
+        self.block_offset = codes
+            .iter()
+            .find(|&&(letter, number, _)| self.modes.group_of(letter, number) == Some(self.groups.zero_offset))
+            .and_then(|&(_, number, _)| u8::try_from(number).ok());
         // A new zero offset holds from this block; a new length correction
         // from its first block of linear or rapid motion (02 §1.18.2).
         let motion = self.modes.active(self.groups.motion);
@@ -1518,15 +1562,22 @@ impl Runner {
         self.shift_frame(shifts_length);
         let start = self.position;
         let writes_table = has(b'G', 92) || has(b'G', 93);
-        let moved = if writes_table {
+        // G04 Q dwells in 10 ms steps (02 §2.1), after the block's motion:
+        // the cycles' `G01 ZR31 G04 QR29` drill, then dwell (03 §1).
+        let dwell = has(b'G', 4).then(|| Moved {
+            motion: Motion::Dwell,
+            length: 0.0,
+            duration: block.word(b'Q').and_then(|q| self.count(q)).unwrap_or(0.0) * 0.01,
+            feed: None,
+            path: Path::Straight,
+        });
+        let still = Moved { motion: Motion::None, length: 0.0, duration: 0.0, feed: None, path: Path::Straight };
+        let (moved, dwell) = if writes_table {
             // G92/G93 write the table and move nothing (01 §5.6, §5.7).
             self.write_table(block, has(b'G', 93));
-            Moved { motion: Motion::None, length: 0.0, duration: 0.0, feed: None, path: Path::Straight }
-        } else if has(b'G', 4) {
-            let dwell = block.word(b'Q').and_then(|q| self.count(q)).unwrap_or(0.0) * 0.01;
-            Moved { motion: Motion::Dwell, length: 0.0, duration: dwell, feed: None, path: Path::Straight }
+            (still, None)
         } else if axes.is_empty() {
-            Moved { motion: Motion::None, length: 0.0, duration: 0.0, feed: None, path: Path::Straight }
+            (dwell.unwrap_or(still), None)
         } else {
             let mut end = self.position;
             for word in &axes {
@@ -1540,7 +1591,14 @@ impl Runner {
                 }
             }
             self.position = end;
-            self.moved(&Move { block, range, axes: &axes, start, end })
+            let Some(moved) = self.moved(&Move { block, range, axes: &axes, start, end }) else {
+                return Flow::End;
+            };
+            if let Some(message) = self.unreachable(&self.position) {
+                self.finding(range, &message, true);
+                return Flow::End;
+            }
+            (moved, dwell)
         };
         let stop = if has(b'M', 0) {
             Some(Stop::Program)
@@ -1556,11 +1614,15 @@ impl Runner {
             tool_change: has(b'M', 6),
             mergeable: moved.motion == Motion::Feed && motion == Some(1) && !technology && !self.incremental(),
         };
-        self.record(range, &self.position.clone(), moved, stop, functions);
+        let end = self.position;
+        self.record(range, &end, moved, stop.filter(|_| dwell.is_none()), functions);
         if let Err(error) = self.compensate(start, path) {
             let range = self.step_mut(error.block()).range;
             self.finding(range, &format!("radius compensation: {error}"), true);
             return Flow::End;
+        }
+        if let Some(dwell) = dwell {
+            self.record(range, &end, dwell, stop, Functions::default());
         }
         // Assignments and arithmetic take effect after the block's motion.
         arith::assign(block, &mut self.params);
@@ -1604,6 +1666,40 @@ impl Runner {
             }
         }
         self.flow_of(block, has)
+    }
+
+    /// The first value of the block the control refuses, with its range in
+    /// the block: a literal or an assignment outside its address's format,
+    /// or a parameter whose value the address cannot take (02 §3.6: the
+    /// control checks them only as the block runs). `codes` are the
+    /// block's G and M codes.
+    fn refused_value(&self, block: &BlockData, codes: &[(u8, u32, TextRange)]) -> Option<(TextRange, String)> {
+        let motion = codes
+            .iter()
+            .rev()
+            .find(|&&(letter, number, _)| self.modes.modal_group_of(letter, number) == Some(self.groups.motion))
+            .map_or(self.modes.active(self.groups.motion), |&(_, number, _)| Some(number));
+        let thread = motion == Some(33);
+        let machine = &*self.machine;
+        for word in &block.words {
+            let Some(address) = self.catalogue.address_of(word.letter) else { continue };
+            let fault = match word.value.as_ref() {
+                Some(Value::Literal(decimal)) => formats::literal_fault(address, decimal, machine),
+                Some(value) => {
+                    self.raw(value).and_then(|raw| formats::substitution_fault(address, raw, thread, machine))
+                }
+                None => None,
+            };
+            if let Some(fault) = fault {
+                return Some((word.value_range.unwrap_or(word.range), fault.message));
+            }
+        }
+        block.assignments.iter().find_map(|assignment| {
+            let Some(Value::Literal(value)) = &assignment.value else { return None };
+            let letter = self.catalogue.letter_with_role(AddressRole::Parameter)?;
+            let fault = formats::assignment_fault(self.catalogue.address_of(letter)?, value)?;
+            Some((assignment.value_range.unwrap_or(assignment.range), fault.message))
+        })
     }
 
     /// What follows the block once its work is done ([`block_flow`]).
@@ -1860,6 +1956,10 @@ impl Runner {
         let Functions { m_functions, tool_change, mergeable } = functions;
         let Moved { motion, length, duration, feed, path } = moved;
         let (source, end, frame) = (self.source, self.machine_axes(end), self.frames.len() - 1);
+        debug_assert!(
+            [length, duration, feed.unwrap_or(0.0)].iter().chain(&end).all(|value| value.is_finite()),
+            "no NaN or infinity leaves the executor: {end:?} {length} {duration} {feed:?}"
+        );
         let joining = match self.modes.active(self.groups.joining) {
             Some(23) => Joining::Continuous,
             Some(24) => Joining::Tight,
@@ -1918,16 +2018,19 @@ impl Runner {
         transform::over_axes(position, &self.machine.axes)
     }
 
-    /// The row of the zero-offset table in force (G53–G59).
+    /// The row of the zero-offset table in force (G53–G59): the block's
+    /// own, else the modal one.
     fn zero_offset_row(&self) -> u8 {
-        self.modes.active(self.groups.zero_offset).and_then(|code| u8::try_from(code).ok()).unwrap_or(53)
+        self.block_offset
+            .or_else(|| self.modes.active(self.groups.zero_offset).and_then(|code| u8::try_from(code).ok()))
+            .unwrap_or(53)
     }
 
     /// Runs a built-in cycle; `false` after reporting why it cannot run.
     fn built_in_cycle_or_stop(&mut self, number: u32, range: TextRange) -> bool {
         let result = self.built_in_cycle(number, range);
-        if let Err(error) = &result {
-            self.finding(range, &format!("the fixed cycle G{number} cannot run: {error}"), true);
+        if let Err(message) = &result {
+            self.finding(range, message, true);
         }
         result.is_ok()
     }
@@ -1940,8 +2043,9 @@ impl Runner {
 
     /// Runs one pass of a built-in fixed cycle from where the block ended
     /// and times its moves as steps of the block. Its F, S and spindle
-    /// changes stay inside it (03 §1.4 I6).
-    fn built_in_cycle(&mut self, number: u32, range: TextRange) -> Result<(), CycleError> {
+    /// changes stay inside it (03 §1.4 I6). The error says why the
+    /// control stops.
+    fn built_in_cycle(&mut self, number: u32, range: TextRange) -> Result<(), String> {
         let spindle = match self.modes.active(self.groups.spindle) {
             Some(3) => Spindle::Clockwise,
             Some(4) => Spindle::CounterClockwise,
@@ -1968,16 +2072,20 @@ impl Runner {
             spindle,
             diameter: self.diameter,
         };
-        let cycle = cycles::expand(&input)?;
+        let cycle = cycles::expand(&input)
+            .map_err(|error: CycleError| format!("the fixed cycle G{number} cannot run: {error}"))?;
         let physical = |position: &Position| scaled(position, |value, factor| value / factor);
         let mut at = physical(&cycle.start);
         for step in &cycle.steps {
             let to = step.to().map_or(at, physical);
+            if let Some(message) = self.unreachable(&to) {
+                return Err(format!("the fixed cycle G{number}: {message}"));
+            }
             let length = distance(&at, &to);
             let (motion, duration, feed, path) = match *step {
                 CycleStep::Rapid { .. } => (Motion::Rapid, self.rapid_seconds(&at, &to), None, Path::Straight),
                 CycleStep::Feed { .. } => {
-                    let rate = step.feed_rate().filter(|&rate| rate > 0.0);
+                    let rate = step.feed_rate().map(|rate| rate * self.feed_factor()).filter(|&rate| rate > 0.0);
                     (Motion::Feed, rate.map_or(0.0, |rate| length / rate * 60.0), rate, Path::Straight)
                 }
                 CycleStep::Thread { thread, .. } => {
@@ -2036,25 +2144,31 @@ impl Runner {
         self.findings.push(Finding { source: self.source, range, message: message.to_owned(), fatal });
     }
 
-    /// Length, duration and feed of a block's move.
-    fn moved(&mut self, step: &Move<'_>) -> Moved {
+    /// Length, duration and feed of a block's move; `None` after
+    /// reporting an error the control stops on.
+    fn moved(&mut self, step: &Move<'_>) -> Option<Moved> {
         let (range, start, end) = (step.range, step.start, step.end);
         let straight = distance(&start, &end);
         let motion = self.modes.active(self.groups.motion);
-        let moved = |motion, length, duration, feed, path| Moved { motion, length, duration, feed, path };
+        let moved = |motion, length, duration, feed, path| Some(Moved { motion, length, duration, feed, path });
         if motion == Some(0) {
             return moved(Motion::Rapid, straight, self.rapid_seconds(&start, &end), None, Path::Straight);
         }
         let arc = match motion {
             Some(2 | 3) => match self.arc(step, motion == Some(3)) {
-                Some(arc) => Some(arc),
-                None => return moved(Motion::Feed, straight, 0.0, None, Path::Straight),
+                Ok(Some(arc)) => Some(arc),
+                Ok(None) => return moved(Motion::Feed, straight, 0.0, None, Path::Straight),
+                Err(()) => return None,
             },
             _ => None,
         };
         let length = arc.as_ref().map_or(straight, Arc::length);
         let mode = self.feed_mode();
-        let feed = self.feed.map(|feed| feed.value(mode.per_revolution || motion == Some(33)));
+        // A thread's F is its lead, which M37 leaves alone.
+        let feed = match motion {
+            Some(33) => self.feed.map(|feed| feed.value(true)),
+            _ => self.feed.map(|feed| feed.value(mode.per_revolution) * self.feed_factor()),
+        };
         // Minutes, and the path feed in mm/min (the average where it varies).
         let timed = |minutes: f64| (minutes, length / minutes);
         let minutes = match (feed.filter(|&feed| feed > 0.0), mode) {
@@ -2111,6 +2225,54 @@ impl Runner {
         }
     }
 
+    /// What the feed is multiplied by: M37 reduces it 1 : 100, M36 (the
+    /// reset state) runs it as programmed (01 §6.6).
+    fn feed_factor(&self) -> f64 {
+        if self.modes.active(self.groups.feed_reduction) == Some(37) { 0.01 } else { 1.0 }
+    }
+
+    /// Why the control cannot move to `position` (program coordinates in
+    /// the frame in force): an axis beyond what its address holds, or
+    /// beyond its travel limits in machine coordinates, where the
+    /// software limit switches work (03 §3.2).
+    fn unreachable(&self, position: &Position) -> Option<String> {
+        // Positions lie on the µm grid; half of one keeps float noise off
+        // the bounds.
+        const HALF_MICROMETRE: f64 = 0.0005;
+        let axes = &self.machine.axes;
+        for (&axis, &range) in axes.iter().zip(&self.axis_ranges) {
+            let letter = char::from(axis);
+            // On a diameter axis the program holds the diameter.
+            let written = position[slot(axis)] * self.written_per_unit(axis);
+            if let Some((min, max)) = range
+                && !(min - HALF_MICROMETRE..=max + HALF_MICROMETRE).contains(&written)
+            {
+                return Some(format!(
+                    "{letter} would reach {written:.3}, outside the range of `{letter}`: {min:.3} to {max:.3}: the control stops"
+                ));
+            }
+        }
+        if self.machine.limits.is_empty() {
+            return None;
+        }
+        let machine = self.frame().to_machine(&self.machine_axes(position), axes);
+        for (&axis, &real) in axes.iter().zip(&machine) {
+            let letter = char::from(axis);
+            let limits = self.machine.limits.get(&axis).copied().unwrap_or_default();
+            let beyond = |limit: Option<i32>, beyond: fn(f64, f64) -> bool| {
+                limit.map(|limit| f64::from(limit) / 1000.0).filter(|&limit| beyond(round3(real), limit))
+            };
+            if let Some(limit) =
+                beyond(limits.min, |value, min| value < min).or(beyond(limits.max, |value, max| value > max))
+            {
+                return Some(format!(
+                    "{letter} would reach {real:.3} in machine coordinates, beyond its travel limit {limit:.3} (`limits` of the machine): the control stops at the software limit switch"
+                ));
+            }
+        }
+        None
+    }
+
     fn incremental(&self) -> bool {
         self.modes.active(self.groups.dimensions) == Some(91)
     }
@@ -2160,15 +2322,22 @@ impl Runner {
     }
 
     /// The arc of a G02/G03 block, or `None` after reporting why the block
-    /// is not one.
-    fn arc(&mut self, step: &Move<'_>, counter_clockwise: bool) -> Option<Arc> {
+    /// is not one; the error after reporting an end point the control
+    /// stops on. Under a helix the axis of its lead turns with the arc.
+    fn arc(&mut self, step: &Move<'_>, counter_clockwise: bool) -> Result<Option<Arc>, ()> {
         let Move { block, range, axes, start, end } = *step;
-        let mut letters: Vec<u8> = axes.iter().map(|word| word.letter).collect();
+        let helix = self.helix_lead.filter(|_| self.modes.active(self.groups.joining) == Some(9));
+        // Under a helix a word for its axis is not a coordinate of the arc.
+        let mut letters: Vec<u8> = axes
+            .iter()
+            .map(|word| word.letter)
+            .filter(|&letter| helix.is_none_or(|(axis, _)| axis != letter))
+            .collect();
         letters.dedup();
         if letters.len() < 2 {
             let message = "an arc needs both coordinates of its plane, even when the end point equals the start";
             self.finding(range, message, false);
-            return None;
+            return Ok(None);
         }
         // The plane's first axis is the one I measures along: X of XY, Y of
         // YZ, Z of ZX (01 §6.4).
@@ -2185,14 +2354,15 @@ impl Runner {
         let to = Vector2::new(end[a], end[b]);
         let centre = from + Vector2::new(centre_offset(b'I', first), centre_offset(b'J', second));
         let (radius, end_radius) = ((from - centre).norm(), (to - centre).norm());
-        if (radius - end_radius).abs() > ARC_TOLERANCE {
+        let tolerance = self.machine.arc_tolerance();
+        if (radius - end_radius).abs() > tolerance {
             let message = format!(
-                "the end point does not lie on the circle: {} mm from the centre, the start {} mm (error 7.56)",
+                "the end point does not lie on the circle: {} mm from the centre, the start {} mm, more than the tolerance {tolerance} mm apart: the control stops with error 7.56",
                 round3(end_radius),
                 round3(radius)
             );
-            self.finding(range, &message, false);
-            return None;
+            self.finding(range, &message, true);
+            return Err(());
         }
         let angle_of = |point: Vector2<f64>| (point.y - centre.y).atan2(point.x - centre.x);
         let start_angle = angle_of(from);
@@ -2202,10 +2372,17 @@ impl Runner {
         } else if !counter_clockwise && sweep >= 0.0 {
             sweep -= std::f64::consts::TAU;
         }
-        // A third axis written in the block moves along with the arc.
-        let lead: f64 =
+        // A third axis written in the block moves along with the arc; the
+        // helix's axis travels its lead per full turn, whichever way the
+        // arc turns (02 §4).
+        let mut lead: f64 =
             letters[2..].iter().map(|&l| (end[usize::from(l - b'A')] - start[usize::from(l - b'A')]).powi(2)).sum();
-        Some(Arc { plane: (a, b), centre, radius, start_angle, sweep, lead: lead.sqrt() })
+        if let Some((axis, per_turn)) = helix.filter(|&(axis, _)| axis != first && axis != second) {
+            let travel = per_turn * sweep.abs() / std::f64::consts::TAU;
+            self.position[slot(axis)] = round3(start[slot(axis)] + travel);
+            lead += (self.position[slot(axis)] - start[slot(axis)]).powi(2);
+        }
+        Ok(Some(Arc { plane: (a, b), centre, radius, start_angle, sweep, lead: lead.sqrt() }))
     }
 
     /// F as written: a literal, or a parameter's raw value read as digits
@@ -2395,6 +2572,7 @@ struct Groups {
     zero_offset: Group,
     plane: Group,
     compensation: Group,
+    feed_reduction: Group,
 }
 
 impl Groups {
@@ -2409,6 +2587,7 @@ impl Groups {
             zero_offset: modes.group("G5"),
             plane: modes.group("G1"),
             compensation: modes.group("G3"),
+            feed_reduction: modes.group("M4"),
         }
     }
 }
@@ -2542,7 +2721,10 @@ mod tests {
         Axes, Called, Checkpoint, DELIVERY_BATCH, Environment, Motion, NoFiles, Path, Step, StepSink, Stop, Trace,
         resume_into, round3, run, run_into,
     };
-    use crate::machine::MachineConfig;
+    use crate::{
+        machine::{MachineConfig, TravelLimits},
+        tables::OffsetTable,
+    };
 
     impl StepSink for Vec<Step> {
         fn step(&mut self, step: Step) {
@@ -2864,7 +3046,6 @@ mod tests {
 
     #[test]
     fn zero_offsets_move_the_program_zero() {
-        use crate::tables::OffsetTable;
         // G54 is X+100: the same programmed X10 is 100 mm further.
         let mut machine = MachineConfig::default();
         (machine.offsets, _) = OffsetTable::parse("$POS\nG54: X=100.0\n", &machine.axes);
@@ -2928,7 +3109,7 @@ mod tests {
         close6(trace.steps[2].length, PI * 5.0);
         // Compensation G41 on the mirrored contour runs on the right: the
         // tool-centre path is the mirror image, with the same lengths.
-        let text = "%1\nN0 G35 X0\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 X50\nN5 Y50\nN6 G40 X70 Y70\nN7 M30\n";
+        let text = "%1\nN10 G35 X0\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 X50\nN5 Y50\nN6 G40 X70 Y70\nN7 M30\n";
         let trace = run_text(text);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
         assert_eq!(lengths(&trace)[1..7], [0.0, 20.0, 25.0, 45.0, 45.0, 32.016]);
@@ -3087,19 +3268,218 @@ mod tests {
 
     #[test]
     fn bad_arcs_and_missing_feed_are_reported_where_they_are() {
-        let text = "%1\nN1 G01 X10\nN2 G02 X20 Y0 I3 F100\nN3 G02 X5\nN4 M30\n";
+        let text = "%1\nN1 G01 X10\nN2 G02 X5\nN3 G02 X20 Y0 I3 F100\nN4 M30\n";
         let trace = run_text(text);
-        let found: Vec<(&str, &str)> =
-            trace.findings.iter().map(|f| (&text[f.range], f.message.split(':').next().unwrap_or(""))).collect();
+        let found: Vec<(&str, &str, bool)> = trace
+            .findings
+            .iter()
+            .map(|f| (&text[f.range], f.message.split(':').next().unwrap_or(""), f.fatal))
+            .collect();
         assert_eq!(
             found,
             [
-                ("N1 G01 X10\n", "no feed F programmed before this motion"),
-                ("N2 G02 X20 Y0 I3 F100\n", "the end point does not lie on the circle"),
-                ("N3 G02 X5\n", "an arc needs both coordinates of its plane, even when the end point equals the start"),
+                ("N1 G01 X10\n", "no feed F programmed before this motion", false),
+                (
+                    "N2 G02 X5\n",
+                    "an arc needs both coordinates of its plane, even when the end point equals the start",
+                    false
+                ),
+                ("N3 G02 X20 Y0 I3 F100\n", "the end point does not lie on the circle", true),
             ]
         );
-        assert!(trace.steps[..3].iter().all(|step| step.duration == 0.0));
+        // The control stops with error 7.56 before the arc runs.
+        assert_eq!(lines_run(text, &trace), ["N1 G01 X10", "N2 G02 X5"]);
+        assert!(trace.steps.iter().all(|step| step.duration == 0.0));
+    }
+
+    #[test]
+    fn machine_constant_55_widens_the_arc_end_tolerance() {
+        // The end point lies 3 µm outside the circle of radius 10.
+        let text = "%1\nN1 G00 X10 Y0\nN2 G02 X-10.003 Y0 I-10 F100\nN3 M30\n";
+        let stopped = run_text(text);
+        assert_eq!(stopped.findings.iter().filter(|f| f.fatal).count(), 1, "{:?}", stopped.findings);
+        assert_eq!(stopped.steps.len(), 1);
+        let machine = MachineConfig { constants: [(55, 5)].into(), ..MachineConfig::default() };
+        let trace = run(text, &NoFiles, &machine, 100);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        assert_eq!(trace.steps.len(), 3);
+    }
+
+    #[test]
+    fn a_block_with_motion_and_g04_moves_then_dwells() {
+        // 15 mm at F100 take 9 s, then 300 × 10 ms.
+        let text = "%1\nN1 G00 X0 Y0 Z5\nN2 G01 Z-10 F100 G04 Q300\nN3 G00 Z5\nN4 M30\n";
+        let trace = run_text(text);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let motions: Vec<(String, Motion)> =
+            trace.steps.iter().map(|step| (text[step.range].trim_end().to_owned(), step.motion)).collect();
+        let n2 = "N2 G01 Z-10 F100 G04 Q300".to_owned();
+        assert_eq!(motions[1..3], [(n2.clone(), Motion::Feed), (n2, Motion::Dwell)]);
+        assert_eq!(timing(&trace)[1..4], [(9.0, 15.0), (3.0, 0.0), (0.09, 15.0)]);
+        assert_eq!(trace.axis(&trace.steps[2].end, b'Z'), -10.0);
+        // The manual's G82 of the cycle file drills, then dwells at the
+        // bottom (R29 = 250: 2.5 s).
+        let body = "\"$PC\nN1 G79 L82\nN2 G00 G90 ZR30 FR26 SR27\nN3 G01 ZR31 G04 QR29\nN4 G00 ZR32\nN5 G70\n*\n";
+        let machine = MachineConfig { cycle_file: Some("PC.NCP".to_owned()), ..MachineConfig::default() };
+        let text =
+            "%1\nN1 R26=100 R27=1000 R29=250 R30=2. R31=-10. R32=5. M03\nN2 G00 X10 Y10 Z5\nN3 G82 X20\nN4 G80 M30\n";
+        let trace = run(text, &Library(body), &machine, 1000);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let body_steps: Vec<(Motion, f64, f64)> = trace
+            .steps
+            .iter()
+            .filter(|step| step.source == 1)
+            .map(|step| (step.motion, round3(step.duration), trace.axis(&step.end, b'Z')))
+            .collect();
+        assert_eq!(
+            body_steps,
+            [
+                (Motion::Rapid, 0.018, 2.0),
+                (Motion::Feed, 7.2, -10.0),
+                (Motion::Dwell, 2.5, -10.0),
+                (Motion::Rapid, 0.09, 5.0),
+                (Motion::None, 0.0, 5.0),
+            ]
+        );
+        // The manual's G86 pecks R28 deeper each time and dwells there.
+        let body = "\"$PC\nN1 G79 L86\nN3 FR26 SR27\n   G27 R5=07280028\n       R6=16313034\nN4 GR34 L100\nN10 G00 G90 ZR30\n    G26 R5=00300024\nN20 G27 R5=02242824\n        R6=15312423\nN30 GR23 L60\nN40 G01  ZR24 G04 QR29\nN50 G73 L20 Q9998\nN60 ZR31\nN70 G70 G00 ZR32\n*\n";
+        let text = "%1\nN1 R26=100 R27=1000 R28=3. R29=50 R30=2. R31=-10. R32=5. M03\nN2 G00 X10 Y10 Z5\nN3 G86 X20\nN4 G80 M30\n";
+        let trace = run(text, &Library(body), &machine, 1000);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let pecks: Vec<(Motion, f64)> = trace
+            .steps
+            .iter()
+            .filter(|step| matches!(step.motion, Motion::Feed | Motion::Dwell))
+            .map(|step| (step.motion, trace.axis(&step.end, b'Z')))
+            .collect();
+        let (feed, dwell) = (Motion::Feed, Motion::Dwell);
+        let expected = [(feed, -1.0), (dwell, -1.0), (feed, -4.0), (dwell, -4.0), (feed, -7.0), (dwell, -7.0)];
+        // The last peck reaches R31, where N60's feed ends too.
+        assert_eq!(pecks[..6], expected);
+        assert_eq!(pecks[6..], [(feed, -10.0), (dwell, -10.0), (feed, -10.0)]);
+    }
+
+    #[test]
+    fn g58_and_g59_hold_in_their_own_block_and_g92_writes_their_row() {
+        let text = "%1\nN1 G55 G92 X10.\nN2 G58 G92 X100.\nN3 G59 G92 X200.\nN4 G00 X0\nN5 G58 X0\nN6 X0\nN7 G59 X0\nN8 X0\nN9 M30\n";
+        let trace = run_text(text);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let machine_x: Vec<f64> = (3..8).map(|step| trace.axis(&trace.machine_end(step), b'X')).collect();
+        assert_eq!(machine_x, [10.0, 100.0, 10.0, 200.0, 10.0]);
+    }
+
+    #[test]
+    fn a_helix_drives_its_lead_axis_by_the_turns_of_the_arc() {
+        use std::f64::consts::TAU;
+        // The manual's helix: lead 1.05 mm on Z, a full circle of radius
+        // 100 run 21 times (Q20), then a half circle; after G98 an arc
+        // leaves Z alone.
+        let text = "%1\nN5 X0 Y0 Z0 G00\nN10 Z1.05 G10\nN50 G09 G02 X0 Y0 I100 G73 L50 Q20 F1000\nN60 X200. Y0 I100\nN70 G98\nN75 G02 X200 Y0 I-100\nN80 M30\n";
+        let trace = run_text(text);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        let z: Vec<f64> = trace.steps.iter().map(|step| trace.axis(&step.end, b'Z')).collect();
+        // The lead block does not move.
+        assert_eq!(z[..3], [0.0, 0.0, 1.05]);
+        assert_eq!(z[21..], [21.0, 22.05, 22.575, 22.575, 22.575, 22.575]);
+        let turn = (TAU * 100.0).hypot(1.05);
+        let half = (TAU / 2.0 * 100.0).hypot(0.525);
+        close6(trace.steps[2].length, turn);
+        close6(trace.steps[23].length, half);
+        close6(trace.steps[25].length, TAU * 100.0);
+        let length = 21.0 * turn + half + TAU * 100.0;
+        close6(trace.totals().length(Motion::Feed), length);
+        close6(trace.totals().time(Motion::Feed), length / 1000.0 * 60.0);
+        assert_eq!(trace.axis(&trace.steps[23].end, b'X'), 200.0);
+    }
+
+    #[test]
+    fn m37_runs_the_feed_at_a_hundredth_until_m36() {
+        let text = "%1\nN1 G01 X100 F1000\nN2 M37\nN3 X200\nN4 G00 X0\nN5 G95 S500 G01 X10 F200\nN6 M36\nN7 G94 X110 F1000\nN8 M37 S500 G33 Z-15. F1.5\nN9 M30\n";
+        let trace = run_text(text);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        // 100 mm at 10 mm/min; the rapid is not a feed; 200 µm/rev at S500
+        // is 100 mm/min, 1 mm/min under M37; after M36 the feed is F again.
+        let feeds: Vec<Option<f64>> = trace.steps.iter().map(|step| step.feed).collect();
+        assert_eq!(feeds[..7], [Some(1000.0), None, Some(10.0), None, Some(1.0), None, Some(1000.0)]);
+        let times: Vec<f64> = timing(&trace).iter().map(|&(duration, _)| duration).collect();
+        assert_eq!(times[..7], [6.0, 0.0, 600.0, 1.2, 600.0, 0.0, 6.0]);
+        // A thread's F is its lead: 15 mm at 1.5 mm/rev and S500.
+        close6(trace.steps[7].duration, (0.02 + 0.001) * 60.0);
+        // The built-in cycles feed under it too: 12 mm at F100 / 100.
+        let trace = run_text(&DRILLING.replace("M03", "M03 M37"));
+        close(trace.totals().time(Motion::Feed), 2.0 * 12.0 / 1.0 * 60.0);
+    }
+
+    /// The fatal findings of a run: where (the text) and what.
+    fn stops<'t>(text: &'t str, trace: &'t Trace) -> Vec<(&'t str, &'t str)> {
+        trace.findings.iter().filter(|f| f.fatal).map(|f| (&text[f.range], f.message.as_str())).collect()
+    }
+
+    #[test]
+    fn a_value_the_control_refuses_stops_the_run_in_the_checkers_words() {
+        let overflow = "the parameter holds 0.123 (123 as digits, 3 decades) but `{}` takes at most 2: the control stops with \"an R of more than 2 decades cannot be substituted\"";
+        // The manual's example: three decades into G's two.
+        let text = "%1\nN10 R10=123\nN20 GR10\nN30 G00 X10\nN40 M30\n";
+        let trace = run_text(text);
+        assert_eq!(stops(text, &trace), [("R10", overflow.replace("{}", "G").as_str())]);
+        assert_eq!(trace.findings.len(), 1, "{:?}", trace.findings);
+        assert_eq!(lines_run(text, &trace), ["N10 R10=123"]);
+        // In a subprogram.
+        let text = "%1\nN10 R10=123\nN20 G71 L5\nN30 M30\nN40 G79 L5\nN50 MR10\nN60 G70\n";
+        let trace = run_text(text);
+        assert_eq!(stops(text, &trace), [("R10", overflow.replace("{}", "M").as_str())]);
+        for (text, at, message) in [
+            ("%1\nN1 G01 X10 F-100\nN2 M30\n", "-100", "`F` takes only unsigned values; remove the sign"),
+            (
+                "%1\nN1 G26 R5=99010203\nN2 M30\n",
+                "99010203",
+                "`99010203` is outside the parameter range -69999.999 to 69999.999",
+            ),
+            (
+                "%1\nN1 R10=-100\nN2 G01 X10 FR10\nN3 M30\n",
+                "R10",
+                "the parameter holds -0.100, but `F` takes only unsigned values",
+            ),
+            (
+                "%1\nN10 G1 X99999999999999999999 F100\nN20 M30\n",
+                "99999999999999999999",
+                "`X99999999999999999999` has 20 digits before the point; the format of `X` allows 5",
+            ),
+        ] {
+            let trace = run_text(text);
+            assert_eq!(stops(text, &trace), [(at, message)], "{text}");
+            assert!(trace.steps.iter().all(|step| step.motion == Motion::None), "{text}");
+        }
+    }
+
+    #[test]
+    fn a_move_beyond_the_axis_range_or_the_travel_limits_stops_the_run() {
+        // G91 X1000 repeated: the 70th would reach X70000.
+        let text = "%1\nN1 G91 G00 X1000\nN2 G73 L1 Q999\nN3 M30\n";
+        let trace = run(text, &NoFiles, &MachineConfig::default(), 10_000);
+        let message = "X would reach 70000.000, outside the range of `X`: -69999.999 to 69999.999: the control stops";
+        assert_eq!(stops(text, &trace), [("N1 G91 G00 X1000\n", message)]);
+        assert_eq!(trace.steps.len(), 2 * 69);
+        assert_eq!(trace.axis(&trace.end(), b'X'), 69_000.0);
+        // Travel limits are machine coordinates: G54 puts X250 at 450.
+        let mut machine = MachineConfig {
+            limits: [
+                (b'X', TravelLimits { min: None, max: Some(500_000) }),
+                (b'Z', TravelLimits { min: Some(-5_000), max: None }),
+            ]
+            .into(),
+            ..MachineConfig::default()
+        };
+        (machine.offsets, _) = OffsetTable::parse("$POS\nG54: X=200.0\n", &machine.axes);
+        let text = "%1\nN1 G54 G00 X250\nN2 X300\nN3 X350\nN4 M30\n";
+        let trace = run(text, &NoFiles, &machine, 100);
+        let message = "X would reach 550.000 in machine coordinates, beyond its travel limit 500.000 (`limits` of the machine): the control stops at the software limit switch";
+        assert_eq!(stops(text, &trace), [("N3 X350\n", message)]);
+        assert_eq!(trace.steps.len(), 2);
+        // A built-in cycle's moves too: G81 drills to Z-10.
+        let trace = run(DRILLING, &NoFiles, &machine, 100);
+        let message = "the fixed cycle G81: Z would reach -10.000 in machine coordinates, beyond its travel limit -5.000 (`limits` of the machine): the control stops at the software limit switch";
+        assert_eq!(stops(DRILLING, &trace), [("N3 G81 X20\n", message)]);
     }
 
     #[test]

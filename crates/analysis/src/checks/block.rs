@@ -4,9 +4,10 @@ use ncc_catalog::{Address, AddressRole, Catalogue, Dialect};
 use ncc_syntax::{Decimal, TextRange};
 use rustc_hash::FxHashMap;
 
+use nc_exec::formats::{self, Fault, Refusal};
+
 use crate::{
     Config, Diagnostic,
-    checks::motion,
     diagnostic::declare_rules,
     lower::{BlockData, Value, Word},
 };
@@ -143,17 +144,17 @@ fn check_literal(
 ) {
     let range = word.value_range.unwrap_or(word.range);
     let letter = &address.letter;
-    if value.sign().is_some() && !address.signed {
-        out.push(Diagnostic::new(
-            &UNEXPECTED_SIGN,
-            range,
-            format!("`{letter}` takes only unsigned values; remove the sign"),
-        ));
-        return;
-    }
-    if let Some(message) = digit_overflow(address, value) {
-        out.push(Diagnostic::new(&TOO_MANY_DIGITS, range, message));
-        return;
+    let fault = formats::literal_fault(address, value, &config.machine);
+    match fault {
+        Some(Fault { refusal: Refusal::Sign, message }) => {
+            out.push(Diagnostic::new(&UNEXPECTED_SIGN, range, message));
+            return;
+        }
+        Some(Fault { refusal: Refusal::Digits, message }) => {
+            out.push(Diagnostic::new(&TOO_MANY_DIGITS, range, message));
+            return;
+        }
+        _ => {}
     }
     if value.has_point() && address.frac_digits == Some(0) {
         out.push(Diagnostic::new(
@@ -177,53 +178,18 @@ fn check_literal(
             return;
         }
     }
-    if let Some((min, max)) = address.bounds {
-        let number = value.to_f64();
-        if (number < min || number > max) && !motion::cancels_length_compensation(word.letter, number, config) {
-            let d0 = if word.letter == b'D' && number == 0.0 {
-                "; `D0` cancels the length corrections only in length-compensation mode B (machine constant 329 decade 7 = 1 in ncc.toml)"
-            } else {
-                ""
-            };
-            out.push(Diagnostic::new(
-                &VALUE_OUT_OF_RANGE,
-                range,
-                format!(
-                    "`{letter}{value}` is outside the range of `{letter}`: {} to {}{d0}",
-                    address.min.as_deref().unwrap_or_default(),
-                    address.max.as_deref().unwrap_or_default()
-                ),
-            ));
-        }
-    }
-}
-
-/// The format's digit limits: significant digits before the point (leading
-/// zeros may always be written) and digits after it (trailing zeros may be).
-pub(crate) fn digit_overflow(address: &Address, value: &Decimal) -> Option<String> {
-    let int_limit =
-        if value.has_point() { address.int_digits? } else { address.int_digits_without_point.or(address.int_digits)? };
-    let int = value.significant_int_digits();
-    let frac = value.significant_frac_digits();
-    let letter = &address.letter;
-    if int > u32::from(int_limit) {
-        let form = if address.int_digits_without_point.is_some() {
-            if value.has_point() { " with a decimal point" } else { " without a decimal point" }
+    if let Some(Fault { refusal: Refusal::Range, message }) = fault {
+        let d0 = if word.letter == b'D' && value.to_f64() == 0.0 {
+            "; `D0` cancels the length corrections only in length-compensation mode B (machine constant 329 decade 7 = 1 in ncc.toml)"
         } else {
             ""
         };
-        return Some(format!(
-            "`{letter}{value}` has {int} digits before the point; the format of `{letter}` allows {int_limit}{form}"
-        ));
+        out.push(Diagnostic::new(&VALUE_OUT_OF_RANGE, range, format!("{message}{d0}")));
     }
-    let frac_limit = address.frac_digits.unwrap_or(0);
-    if value.has_point() && frac > u32::from(frac_limit) && frac_limit > 0 {
-        return Some(format!(
-            "`{letter}{value}` has {frac} decimals; `{letter}` takes at most {frac_limit} (the control's resolution)"
-        ));
-    }
-    None
 }
+
+/// The format's digit limits of a value, shared with the executor.
+pub(crate) use nc_exec::formats::digit_overflow;
 
 fn check_code(word: &Word, value: &Decimal, catalogue: &Catalogue, out: &mut Vec<Diagnostic>) {
     let Some(number) = value.scaled(0).and_then(|v| u32::try_from(v).ok()) else { return };
@@ -325,14 +291,9 @@ fn check_assignments(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Dia
         match &assignment.value {
             Some(Value::Literal(value)) => {
                 let range = assignment.value_range.unwrap_or(assignment.range);
-                if let Some(message) = digit_overflow(r, value) {
-                    out.push(Diagnostic::new(&TOO_MANY_DIGITS, range, message));
-                } else if parameter_raw(value).is_none_or(|raw| raw.abs() > 69_999_999) {
-                    out.push(Diagnostic::new(
-                        &VALUE_OUT_OF_RANGE,
-                        range,
-                        format!("`{value}` is outside the parameter range -69999.999 to 69999.999"),
-                    ));
+                if let Some(Fault { refusal, message }) = formats::assignment_fault(r, value) {
+                    let rule = if refusal == Refusal::Digits { &TOO_MANY_DIGITS } else { &VALUE_OUT_OF_RANGE };
+                    out.push(Diagnostic::new(rule, range, message));
                 }
             }
             Some(Value::Parameter { .. }) => out.push(Diagnostic::new(

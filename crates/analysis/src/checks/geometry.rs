@@ -276,8 +276,8 @@ fn end_off_circle(visit: &Visit<'_>, arc: &Arc<'_>, refinement: Refinement) -> O
         let e = [along(0, end[0] as f64, position), along(1, end[1] as f64, position)];
         (c[0].hypot(c[1]), (s[0] + c[0] - e[0]).hypot(s[1] + c[1] - e[1]))
     };
-    // Machine constant 55 as written in TAB0.REK, in mm (raw: µm).
-    let tolerance = visit.config.machine.constant(55).max(1) as f64;
+    // In µm, as the positions.
+    let tolerance = visit.config.machine.arc_tolerance() * 1000.0;
     if readings.iter().map(radii).any(|(from_start, from_end)| (from_start - from_end).abs() <= tolerance + ROUNDING) {
         return None;
     }

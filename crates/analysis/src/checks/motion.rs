@@ -287,11 +287,6 @@ enum LengthMode {
     C,
 }
 
-/// `D0` cancels the length corrections in mode B, beside the entries 1–99.
-pub(crate) fn cancels_length_compensation(letter: u8, value: f64, config: &Config) -> bool {
-    letter == b'D' && value == 0.0 && length_mode(config) == Some(LengthMode::B)
-}
-
 fn length_mode(config: &Config) -> Option<LengthMode> {
     match config.machine.decade(329, 7) {
         0 => Some(LengthMode::A),

@@ -1,11 +1,11 @@
 //! Parameters: substitution into addresses, and parameter arithmetic.
 
+use nc_exec::formats::{self, Fault, Refusal};
 use ncc_catalog::{AddressRole, Dialect};
-use ncc_syntax::Decimal;
 
 use crate::{
     Diagnostic,
-    checks::{feed, motion},
+    checks::feed,
     diagnostic::declare_rules,
     flow::{FlowCheck, Substitution, Visit},
     lower::Value,
@@ -99,52 +99,18 @@ pub(crate) fn check_substitution(
     };
     let raw = substitution.raw;
     let letter = &address.letter;
-    let dimensionless = address.frac_digits == Some(0) || address.role == AddressRole::Feed;
     // In a thread block F is the lead, read in µm/rev like a feed per revolution.
     let thread = visit.after.g(0) == Some(Some(33));
-    if dimensionless {
+    if formats::takes_digits(address) {
         // The address takes the raw digits: `R10=123` → `G123`.
-        let digits = raw.unsigned_abs().to_string();
-        let limit = match address.role {
-            // Leads above 99.99 mm are what a parameter is for: `R10=250.0` then `FR10` cuts a 250 mm lead.
-            AddressRole::Feed if thread => None,
-            AddressRole::Feed => address.int_digits_without_point,
-            _ => address.int_digits,
-        };
-        if let Some(limit) = limit.filter(|&l| digits.len() > usize::from(l)) {
-            out.push(related(Diagnostic::new(
-                &PARAMETER_DIGIT_OVERFLOW,
-                range,
-                format!(
-                    "the parameter holds {} ({digits} as digits, {} decades) but `{letter}` takes at most {limit}: the control stops with \"an R of more than {limit} decades cannot be substituted\"",
-                    show(raw),
-                    digits.len()
-                ),
-            )));
-            return;
-        }
-        if raw < 0 && !address.signed {
-            out.push(related(Diagnostic::new(
-                &SUBSTITUTED_VALUE_OUT_OF_RANGE,
-                range,
-                format!("the parameter holds {}, but `{letter}` takes only unsigned values", show(raw)),
-            )));
-            return;
-        }
-        if let Some((min, max)) = address.bounds.filter(|_| address.role != AddressRole::Feed) {
-            let value = raw as f64;
-            if (value < min || value > max) && !motion::cancels_length_compensation(word.letter, value, visit.config) {
-                out.push(related(Diagnostic::new(
-                    &SUBSTITUTED_VALUE_OUT_OF_RANGE,
-                    range,
-                    format!(
-                        "the parameter holds {} (read as `{letter}{}`), outside `{letter}`'s range {} to {}",
-                        show(raw),
-                        raw,
-                        address.min.as_deref().unwrap_or_default(),
-                        address.max.as_deref().unwrap_or_default()
-                    ),
-                )));
+        if let Some(Fault { refusal, message }) =
+            formats::substitution_fault(address, raw, thread, &visit.config.machine)
+        {
+            let rule =
+                if refusal == Refusal::Digits { &PARAMETER_DIGIT_OVERFLOW } else { &SUBSTITUTED_VALUE_OUT_OF_RANGE };
+            out.push(related(Diagnostic::new(rule, range, message)));
+            if refusal != Refusal::Range {
+                return;
             }
         }
         if address.role == AddressRole::LengthCompensation && digits_outside(&raw.unsigned_abs().to_string(), b'2') {
@@ -195,8 +161,4 @@ fn digits_outside(digits: &str, max: u8) -> bool {
 }
 
 /// A raw value as the real number the parameter holds (`864` → `0.864`).
-pub(crate) fn show(raw: i64) -> String {
-    let value = Decimal::parse(None, &raw.unsigned_abs().to_string()).map_or(0.0, |d| d.to_f64()) / 1000.0;
-    let sign = if raw < 0 { "-" } else { "" };
-    format!("{sign}{value:.3}")
-}
+pub(crate) use nc_exec::formats::show;

@@ -1,0 +1,258 @@
+//! The catalogue's address formats applied to values: what the control
+//! refuses in a value written in a block or substituted from a parameter,
+//! worded once for the checker, which finds it before the program runs,
+//! and the executor, which stops there as the control does.
+
+use ncc_catalog::{Address, AddressRole};
+use ncc_syntax::Decimal;
+
+use crate::{
+    arith::{MAX_RAW, Raw, literal_raw},
+    machine::MachineConfig,
+};
+
+/// Why the control refuses a value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Refusal {
+    /// A sign on an address that takes only unsigned values.
+    Sign,
+    /// More digits than the address's format has.
+    Digits,
+    /// Outside the address's range.
+    Range,
+}
+
+/// A value the control refuses, and what to tell the programmer.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Fault {
+    pub refusal: Refusal,
+    pub message: String,
+}
+
+impl Fault {
+    fn new(refusal: Refusal, message: String) -> Fault {
+        Fault { refusal, message }
+    }
+}
+
+/// A literal written at `address` on `machine`: a sign it does not take,
+/// more digits than its format has, or a value outside its range.
+pub fn literal_fault(address: &Address, value: &Decimal, machine: &MachineConfig) -> Option<Fault> {
+    let letter = &address.letter;
+    if value.sign().is_some() && !address.signed {
+        return Some(Fault::new(Refusal::Sign, format!("`{letter}` takes only unsigned values; remove the sign")));
+    }
+    if let Some(message) = digit_overflow(address, value) {
+        return Some(Fault::new(Refusal::Digits, message));
+    }
+    let outside = !surely_within(address, value) && outside_range(address, value.to_f64(), machine);
+    outside.then(|| {
+        Fault::new(
+            Refusal::Range,
+            format!(
+                "`{letter}{value}` is outside the range of `{letter}`: {} to {}",
+                address.min.as_deref().unwrap_or_default(),
+                address.max.as_deref().unwrap_or_default()
+            ),
+        )
+    })
+}
+
+/// A literal assigned to a parameter (`R5=…`, `parameter` the address of
+/// R): more digits than its format has, or a value outside ±69999.999.
+pub fn assignment_fault(parameter: &Address, value: &Decimal) -> Option<Fault> {
+    if let Some(message) = digit_overflow(parameter, value) {
+        return Some(Fault::new(Refusal::Digits, message));
+    }
+    literal_raw(value).is_none_or(|raw| raw.abs() > MAX_RAW).then(|| {
+        Fault::new(
+            Refusal::Range,
+            format!(
+                "`{value}` is outside the parameter range {} to {}",
+                parameter.min.as_deref().unwrap_or_default(),
+                parameter.max.as_deref().unwrap_or_default()
+            ),
+        )
+    })
+}
+
+/// The format's digit limits: significant digits before the point (leading
+/// zeros may always be written) and digits after it (trailing zeros may be).
+pub fn digit_overflow(address: &Address, value: &Decimal) -> Option<String> {
+    let int_limit =
+        if value.has_point() { address.int_digits? } else { address.int_digits_without_point.or(address.int_digits)? };
+    let int = value.significant_int_digits();
+    let letter = &address.letter;
+    if int > u32::from(int_limit) {
+        let form = if address.int_digits_without_point.is_some() {
+            if value.has_point() { " with a decimal point" } else { " without a decimal point" }
+        } else {
+            ""
+        };
+        return Some(format!(
+            "`{letter}{value}` has {int} digits before the point; the format of `{letter}` allows {int_limit}{form}"
+        ));
+    }
+    let frac_limit = u32::from(address.frac_digits.unwrap_or(0));
+    // Trailing zeros are counted only when there are more decimals than
+    // the limit: every word of a program comes here.
+    let frac = || value.significant_frac_digits();
+    if value.has_point() && frac_limit > 0 && value.frac_digits() > frac_limit && frac() > frac_limit {
+        let frac = frac();
+        return Some(format!(
+            "`{letter}{value}` has {frac} decimals; `{letter}` takes at most {frac_limit} (the control's resolution)"
+        ));
+    }
+    None
+}
+
+/// Whether `address` takes a parameter's raw digits (`R10=123` → `G123`)
+/// rather than its value in mm: codes, counts, numbers and the feed.
+pub fn takes_digits(address: &Address) -> bool {
+    address.frac_digits == Some(0) || address.role == AddressRole::Feed
+}
+
+/// A parameter's raw value substituted into `address` on `machine`, when
+/// the address takes its digits: more of them than it takes (the control
+/// stops with "an R of more than 2 decades cannot be substituted", 02 §3.6),
+/// a sign it does not take, or a value outside its range. `thread`: F is a
+/// thread's lead, which a parameter gives beyond 99.99 mm (01 §6.8.5).
+pub fn substitution_fault(address: &Address, raw: Raw, thread: bool, machine: &MachineConfig) -> Option<Fault> {
+    if !takes_digits(address) {
+        return None;
+    }
+    let letter = &address.letter;
+    let digits = raw.unsigned_abs().to_string();
+    let limit = match address.role {
+        AddressRole::Feed if thread => None,
+        AddressRole::Feed => address.int_digits_without_point,
+        _ => address.int_digits,
+    };
+    if let Some(limit) = limit.filter(|&limit| digits.len() > usize::from(limit)) {
+        return Some(Fault::new(
+            Refusal::Digits,
+            format!(
+                "the parameter holds {} ({digits} as digits, {} decades) but `{letter}` takes at most {limit}: the control stops with \"an R of more than {limit} decades cannot be substituted\"",
+                show(raw),
+                digits.len()
+            ),
+        ));
+    }
+    if raw < 0 && !address.signed {
+        return Some(Fault::new(
+            Refusal::Sign,
+            format!("the parameter holds {}, but `{letter}` takes only unsigned values", show(raw)),
+        ));
+    }
+    // A feed's range depends on its unit, which the feed checks know.
+    let ranged = address.role != AddressRole::Feed && outside_range(address, raw as f64, machine);
+    ranged.then(|| {
+        Fault::new(
+            Refusal::Range,
+            format!(
+                "the parameter holds {} (read as `{letter}{raw}`), outside `{letter}`'s range {} to {}",
+                show(raw),
+                address.min.as_deref().unwrap_or_default(),
+                address.max.as_deref().unwrap_or_default()
+            ),
+        )
+    })
+}
+
+/// Whether the digits of `value` before its point put it within the
+/// range of `address` whatever they are: `X12.345` lies between 10 and
+/// 100. Every word of a program comes here, and most are decided so,
+/// without converting the number.
+fn surely_within(address: &Address, value: &Decimal) -> bool {
+    const POWERS: [f64; 10] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
+    let digits = value.significant_int_digits() as usize;
+    let (Some((min, max)), Some(&above)) = (address.bounds, POWERS.get(digits)) else { return false };
+    // At least 10^(digits - 1) (or 0), below 10^digits.
+    let at_least = if digits == 0 { 0.0 } else { POWERS[digits - 1] };
+    let (low, high) = if value.is_negative() { (-above, -at_least) } else { (at_least, above) };
+    min <= low && high <= max
+}
+
+/// Whether `value` lies outside the range of `address`. `D0` is not: it
+/// cancels the length corrections in length-compensation mode B (machine
+/// constant 329 decade 7 = 1, 02 §1.18.1).
+fn outside_range(address: &Address, value: f64, machine: &MachineConfig) -> bool {
+    let cancels_length = address.role == AddressRole::Offset && value == 0.0 && machine.decade(329, 7) == 1;
+    address.bounds.is_some_and(|(min, max)| !(min..=max).contains(&value)) && !cancels_length
+}
+
+/// A raw value as the real number the parameter holds (`864` → `0.864`).
+pub fn show(raw: Raw) -> String {
+    let sign = if raw < 0 { "-" } else { "" };
+    let magnitude = raw.unsigned_abs();
+    format!("{sign}{}.{:03}", magnitude / 1000, magnitude % 1000)
+}
+
+#[cfg(test)]
+mod tests {
+    use ncc_catalog::Dialect;
+    use ncc_syntax::{Decimal, Sign};
+
+    use super::{Refusal, assignment_fault, literal_fault, show, substitution_fault};
+    use crate::machine::MachineConfig;
+
+    fn decimal(text: &str) -> Decimal {
+        let (sign, digits) = match text.strip_prefix('-') {
+            Some(digits) => (Some(Sign::Minus), digits),
+            None => (None, text),
+        };
+        Decimal::parse(sign, digits).expect("a number")
+    }
+
+    fn refusal_of_literal(letter: u8, text: &str, machine: &MachineConfig) -> Option<Refusal> {
+        let address = Dialect::Cnc8x6.catalogue().address_of(letter).expect("an address");
+        literal_fault(address, &decimal(text), machine).map(|fault| fault.refusal)
+    }
+
+    #[test]
+    fn literals_are_held_to_their_address_format() {
+        let machine = MachineConfig::default();
+        let refused = |letter, text| refusal_of_literal(letter, text, &machine);
+        assert_eq!(refused(b'F', "-100"), Some(Refusal::Sign));
+        assert_eq!(refused(b'X', "99999999999999999999"), Some(Refusal::Digits));
+        assert_eq!(refused(b'X', "1.2345"), Some(Refusal::Digits));
+        assert_eq!(refused(b'X', "99999.999"), Some(Refusal::Range));
+        assert_eq!(refused(b'X', "-69999.999"), None);
+        assert_eq!(refused(b'F', "24000"), None);
+        assert_eq!(refused(b'D', "0"), Some(Refusal::Range));
+        // D0 cancels the length corrections in mode B.
+        let mode_b = MachineConfig { constants: [(329, 1_000_000)].into(), ..MachineConfig::default() };
+        assert_eq!(refusal_of_literal(b'D', "0", &mode_b), None);
+    }
+
+    #[test]
+    fn assignments_stay_within_the_parameter_range() {
+        let r = Dialect::Cnc8x6.catalogue().address_of(b'R').expect("R");
+        let fault = assignment_fault(r, &decimal("99010203")).expect("out of range");
+        assert_eq!(fault.message, "`99010203` is outside the parameter range -69999.999 to 69999.999");
+        assert_eq!(assignment_fault(r, &decimal("69999999")), None);
+        assert_eq!(assignment_fault(r, &decimal("123456.")).map(|fault| fault.refusal), Some(Refusal::Digits));
+    }
+
+    #[test]
+    fn a_substituted_value_has_the_digits_its_address_takes() {
+        let catalogue = Dialect::Cnc8x6.catalogue();
+        let machine = MachineConfig::default();
+        let fault = |letter, raw, thread| {
+            substitution_fault(catalogue.address_of(letter).expect("an address"), raw, thread, &machine)
+        };
+        let overflow = fault(b'G', 123, false).expect("three digits into two");
+        assert_eq!(
+            overflow.message,
+            "the parameter holds 0.123 (123 as digits, 3 decades) but `G` takes at most 2: the control stops with \"an R of more than 2 decades cannot be substituted\""
+        );
+        assert_eq!(fault(b'M', 99, false), None);
+        assert_eq!(fault(b'F', 250_000, true), None);
+        assert_eq!(fault(b'F', 250_000, false).map(|fault| fault.refusal), Some(Refusal::Digits));
+        assert_eq!(fault(b'F', -100, false).map(|fault| fault.refusal), Some(Refusal::Sign));
+        assert_eq!(fault(b'Q', 0, false).map(|fault| fault.refusal), Some(Refusal::Range));
+        // Lengths take the value in mm, not digits.
+        assert_eq!(fault(b'X', 99_999_999, false), None);
+        assert_eq!([show(864), show(-864), show(100_000)], ["0.864", "-0.864", "100.000"]);
+    }
+}
