@@ -92,6 +92,7 @@ syntax_error_kinds! {
     ParameterWithoutAssignment = "S017", "parameter-without-assignment", Error, "A parameter `R12` on its own: neither assigned (`R12=5.`) nor used after an address (`XR12`).";
     MissingParameterNumber = "S018", "missing-parameter-number", Error, "`R` without the parameter number.";
     MisplacedEquals = "S019", "misplaced-equals", Error, "An `=` that does not follow a parameter.";
+    ByteOrderMark = "S020", "byte-order-mark", Warning, "A file saved as Unicode text with a byte-order mark, which the control does not read.";
 }
 
 /// One syntax diagnostic.

@@ -17,6 +17,7 @@ mod error;
 mod green;
 mod runs;
 mod syntax_kind;
+pub mod visible;
 
 use std::sync::Arc;
 

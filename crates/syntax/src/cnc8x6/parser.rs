@@ -30,8 +30,10 @@ use super::{
 use crate::{
     SyntaxError, SyntaxErrorKind as E,
     SyntaxKind::{self, *},
+    encoding::BYTE_ORDER_MARK,
     green::{self, GreenElement, GreenFactory},
     runs::RunBuilder,
+    visible,
 };
 
 /// The control's limit on characters per line.
@@ -117,16 +119,33 @@ struct Outline {
 fn outline(text: &str) -> Outline {
     let mut front: Vec<GreenElement> = Vec::new();
     let mut errors = Vec::new();
-    let header = find_outside_comments(text, 0, b'%');
+    // An editor's mark of Unicode text is not part of the program (01 §1.2:
+    // the control reads plain text).
+    let mark = if text.starts_with(BYTE_ORDER_MARK) {
+        let mark = BYTE_ORDER_MARK.len_utf8();
+        front.push(NodeOrToken::Node(green::node(
+            ERROR,
+            [rowan::GreenToken::new(ERROR_TOKEN.into(), &text[..mark]).into()],
+        )));
+        errors.push(SyntaxError::new(
+            E::ByteOrderMark,
+            range(0..mark),
+            "the file starts with a byte-order mark: it was saved as Unicode text (UTF-8, UTF-16 or UTF-32 with a mark), but the control reads plain text, one byte a character (ASCII, Kamenický in comments); save it as plain text",
+        ));
+        mark
+    } else {
+        0
+    };
+    let header = find_outside_comments(text, mark, b'%');
     let body_start = match header {
         Some(at) => {
-            if at > 0 {
-                let preamble = &text[..at];
+            if at > mark {
+                let preamble = &text[mark..at];
                 front.push(NodeOrToken::Token(rowan::GreenToken::new(PREAMBLE.into(), preamble)));
                 if !preamble.trim().is_empty() {
                     errors.push(SyntaxError::new(
                         E::IgnoredPreamble,
-                        range(0..at),
+                        range(mark..at),
                         "text before the program header `%` is skipped by the control",
                     ));
                 }
@@ -136,7 +155,7 @@ fn outline(text: &str) -> Outline {
             errors.append(&mut parser.errors);
             parser.pos
         }
-        None => 0,
+        None => mark,
     };
     let end = find_outside_comments(text, body_start, b'*').unwrap_or(text.len());
     Outline { front, errors, header, body: body_start..end }
@@ -487,7 +506,10 @@ impl<'a> Parser<'a> {
                     self.error(
                         E::UnexpectedCharacter,
                         item_start..self.pos,
-                        format!("unexpected text `{text}`: an address letter must be followed by its value; text belongs in a comment `\"…\"`"),
+                        format!(
+                            "unexpected text `{}`: an address letter must be followed by its value; text belongs in a comment `\"…\"`",
+                            visible::quoted(text)
+                        ),
                     );
                     NodeOrToken::Node(green::node(ERROR, [self.green.token(ERROR_TOKEN, text)]))
                 }
@@ -505,7 +527,7 @@ impl<'a> Parser<'a> {
                             E::NumberWithoutAddress,
                             format!(
                                 "number `{}` without an address letter",
-                                &self.text[self.pos..self.pos + token.len]
+                                visible::quoted(&self.text[self.pos..self.pos + token.len])
                             ),
                             item_start,
                         ),
@@ -532,7 +554,8 @@ impl<'a> Parser<'a> {
                         "unexpected `,`: the decimal separator is `.`".to_owned()
                     } else {
                         format!(
-                            "unexpected `{text}`: outside comments only addresses, numbers, signs, `=`, `/`, `&` and spaces are allowed"
+                            "unexpected `{}`: outside comments only addresses, numbers, signs, `=`, `/`, `&` and spaces are allowed",
+                            visible::quoted(text)
                         )
                     };
                     self.error_token(E::UnexpectedCharacter, message)
@@ -600,7 +623,7 @@ impl<'a> Parser<'a> {
         if self.at_value(value_at) {
             self.value(&mut children);
             if self.letters.is_parameter(self.byte_at(start)) {
-                let written = self.text[start..self.pos].to_owned();
+                let written = visible::quoted(&self.text[start..self.pos]);
                 self.error(
                     E::ParameterWithoutAssignment,
                     start..self.pos,
