@@ -592,3 +592,59 @@ fn expand_writes_a_program_with_the_same_moves() {
     let report = String::from_utf8(check.stdout).unwrap();
     assert!(!report.contains(": error"), "{report}");
 }
+
+/// A megabyte of random text on one line has hundreds of thousands of
+/// findings; every format shows ten of the line and counts the rest in one
+/// finding as severe as the worst of them.
+#[test]
+fn a_line_of_random_text_reports_ten_findings_and_counts_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("RANDOM.NCP");
+    std::fs::write(&path, ncc_bench::progen::random_line(1 << 20, 7)).unwrap();
+    let path = path.to_str().unwrap();
+
+    let output = ncc(&["check", "--format", "short", path]);
+    assert_eq!(output.status.code(), Some(1));
+    let report = stdout(&output);
+    let lines: Vec<&str> = report.lines().collect();
+    assert_eq!(lines.len(), 11, "{report}");
+    let rest = lines.iter().find(|line| line.contains("[Z001]")).unwrap();
+    let counted: u64 = rest.split("[Z001]: ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    assert!(counted > 100_000, "{rest}");
+    assert!(rest.contains(": error[Z001]: "), "as severe as the worst it counts: {rest}");
+
+    let output = ncc(&["check", "--format", "json", path]);
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(json.as_array().unwrap().len(), 11);
+}
+
+/// A file shows its first 1000 findings (or what `ncc.toml` says) and
+/// counts the rest in one finding where the first one left out is.
+#[test]
+fn a_file_reports_its_first_findings_and_counts_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("MANY.NCP");
+    let program: String = (0..300).map(|block| format!("N{block} X1 Y Y Y Y\n")).collect();
+    std::fs::write(&path, format!("%1\n{program}")).unwrap();
+    let path = path.to_str().unwrap();
+    let findings = |max: usize| -> Vec<serde_json::Value> {
+        std::fs::write(dir.path().join("ncc.toml"), format!("[report]\nmax-findings = {max}\n")).unwrap();
+        let output = ncc(&["check", "--format", "json", path]);
+        serde_json::from_slice::<serde_json::Value>(&output.stdout).unwrap().as_array().unwrap().clone()
+    };
+    let all = findings(100_000);
+    assert!(all.len() > 2000 && all.iter().all(|d| d["code"] != "Z002"), "{}", all.len());
+    let position = |d: &serde_json::Value| (d["line"].as_u64(), d["column"].as_u64());
+    for max in [5, 1000] {
+        let shown = findings(max);
+        assert_eq!(shown.len(), max + 1);
+        let rest = shown.iter().find(|d| d["code"] == "Z002").unwrap();
+        let more = format!("{} more findings in this file not shown", all.len() - max);
+        assert!(rest["message"].as_str().unwrap().starts_with(&more), "{rest}");
+        assert_eq!(position(rest), position(&all[max]), "at the first one left out");
+    }
+    std::fs::remove_file(dir.path().join("ncc.toml")).unwrap();
+    let output = ncc(&["check", "--format", "json", path]);
+    let default: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(default.as_array().unwrap().len(), 1001, "1000 by default, and the rest");
+}

@@ -23,6 +23,7 @@ use rustc_hash::FxHashMap;
 use crate::{
     Config, Diagnostic,
     db::{self, Db, Settings, SourceFile},
+    findings::Findings,
     lower::{BlockData, Value, Word},
     model::{self, FileKind, Program, Transfer},
 };
@@ -299,9 +300,9 @@ impl FlowCheck for Probe {
     }
 }
 
-/// Diagnostics of the rules that follow the program's flow.
+/// Diagnostics of the rules that follow the program's flow, limited per line.
 #[salsa::tracked(returns(ref))]
-pub fn flow_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
+pub fn flow_diagnostics(db: &dyn Db, file: SourceFile) -> Findings {
     let program = model::program(db, file);
     let mut walk = Walk::new(db, file, program, crate::checks::flow_checks());
     walk.run();
@@ -312,7 +313,7 @@ pub fn flow_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
         (a.range.start(), a.range.end(), a.code, &a.message).cmp(&(b.range.start(), b.range.end(), b.code, &b.message))
     });
     out.dedup_by(|later, first| (later.range, later.code, &later.message) == (first.range, first.code, &first.message));
-    out
+    Findings::of(file.text(db), out, Vec::new())
 }
 
 /// The lowered blocks of a file, each lowered when a walk first reaches it

@@ -9,7 +9,7 @@ use ncc_syntax::{
     encoding::{self, Encoding},
 };
 use proptest::prelude::*;
-use strategies::{block_program, program_text};
+use strategies::{block_program, crowded_lines, program_text};
 
 fn char_boundary(text: &str, at: usize) -> usize {
     (0..=at.min(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap()
@@ -61,7 +61,7 @@ proptest! {
     }
 
     #[test]
-    fn program_like_text_round_trips(text in program_text()) {
+    fn program_like_text_round_trips(text in prop_oneof![program_text(), crowded_lines()]) {
         assert_well_formed(&text, &Parse::new(&text, Dialect::Cnc8x6));
     }
 
@@ -85,7 +85,7 @@ proptest! {
 
     #[test]
     fn reparse_equals_full_parse(
-        text in prop_oneof![program_text(), block_program()],
+        text in prop_oneof![program_text(), block_program(), crowded_lines()],
         start in 0usize..2000,
         len in 0usize..12,
         insert in program_text().prop_map(|t| t.chars().take(6).collect::<String>()),
