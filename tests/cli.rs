@@ -75,6 +75,23 @@ fn human_report_shows_code_message_and_line() {
     assert!(report.ends_with("Found 2 errors, 0 warnings, 0 infos and 0 hints in 1 file.\n"), "{report}");
 }
 
+/// Lines end at a lone `\r` too, as the parser reads them: old files from
+/// the control's editor end their lines so.
+#[test]
+fn positions_count_lines_ended_by_a_carriage_return() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("CR.NCP");
+    std::fs::write(&path, "%1\rN10 G00 X1\rN20 Y\rN30 M30\r*\r").unwrap();
+    let path = path.to_str().unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&ncc(&["check", "--format", "json", path]).stdout).unwrap();
+    assert_eq!(
+        (json[0]["code"].as_str(), json[0]["line"].as_u64(), json[0]["column"].as_u64()),
+        (Some("S004"), Some(3), Some(5))
+    );
+    let human = stdout(&ncc(&["check", path]));
+    assert!(human.contains(&format!("{path}:3:5")), "{human}");
+}
+
 #[test]
 fn files_in_the_controls_code_page_are_read_losslessly() {
     let output = ncc(&["check", "--format", "json", "tests/fixtures/kamenicky.NCP"]);

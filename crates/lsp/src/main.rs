@@ -3,6 +3,7 @@
 mod check;
 mod explain;
 mod plot;
+mod positions;
 mod report;
 mod rules;
 mod run;

@@ -6,29 +6,26 @@ use std::{
 };
 
 use ariadne::{Color, FnCache, IndexType, Label, Report, ReportKind};
-use line_index::{LineIndex, WideEncoding};
 use ncc_analysis::{Diagnostic, Severity, TextRange, TextSize};
 use serde::Serialize;
 
-use crate::check::Checked;
+use crate::{
+    check::Checked,
+    positions::{Columns, TextIndex},
+};
 
 /// Line and column of offsets in one file: 1-based, columns counting
 /// characters (Unicode scalar values), as editors and people count them.
-pub(crate) struct Positions(LineIndex);
+pub(crate) struct Positions(TextIndex);
 
 impl Positions {
     pub fn new(text: &str) -> Positions {
-        Positions(LineIndex::new(text))
+        Positions(TextIndex::new(text))
     }
 
     pub fn at(&self, offset: TextSize) -> (u32, u32) {
-        let line_col = self.0.line_col(offset);
-        // Offsets of diagnostics are always inside their file's text.
-        let wide = self
-            .0
-            .to_wide(WideEncoding::Utf32, line_col)
-            .unwrap_or(line_index::WideLineCol { line: line_col.line, col: line_col.col });
-        (wide.line + 1, wide.col + 1)
+        let (line, col) = self.0.line_col(offset, Columns::Characters);
+        (line + 1, col + 1)
     }
 }
 

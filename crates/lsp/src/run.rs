@@ -16,7 +16,6 @@ use std::{
 };
 
 use indicatif::{ProgressBar, ProgressStyle};
-use line_index::LineIndex;
 use nc_exec::{
     arith::{Message, MessageDisplay},
     lower::BlockData,
@@ -28,7 +27,10 @@ use ncc_analysis::{Config, clock};
 use ncc_syntax::{BlockParser, Dialect, Parse, TextSize, ast::AstNode};
 use serde::Serialize;
 
-use crate::check;
+use crate::{
+    check,
+    positions::{Columns, TextIndex},
+};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum Format {
@@ -352,10 +354,10 @@ pub(crate) fn lower(path: &Path) -> ExitCode {
         }
     };
     let parse = Parse::new(&text, Dialect::Cnc8x6);
-    let lines = LineIndex::new(&text);
+    let lines = TextIndex::new(&text);
     let mut out = String::new();
     for block in parse.tree().blocks() {
-        let line = lines.line_col(block.syntax().text_range().start()).line + 1;
+        let line = lines.line_col(block.syntax().text_range().start(), Columns::Characters).0 + 1;
         let _ = writeln!(out, "{line:>6}  {}", BlockData::lower(block.syntax().green()));
     }
     let mut stdout = io::stdout().lock();
@@ -813,7 +815,7 @@ impl Library {
     /// The program and the files the run read, in the trace's source order.
     fn sources(&self, name: &str, text: &str, trace: &Trace) -> Vec<Source> {
         let read = self.read.take();
-        let source = |name: String, text: &str| Source { name, lines: LineIndex::new(text) };
+        let source = |name: String, text: &str| Source { name, lines: TextIndex::new(text) };
         let files = trace.files.iter().filter_map(|called| read.iter().find(|(c, _, _)| c == called));
         let files = files.map(|(_, path, text)| source(path.display().to_string(), text));
         std::iter::once(source(name.to_owned(), text)).chain(files).collect()
@@ -849,12 +851,12 @@ impl Environment for Library {
 /// A file a run read, for locating its blocks.
 struct Source {
     name: String,
-    lines: LineIndex,
+    lines: TextIndex,
 }
 
 impl Source {
     fn line(&self, offset: TextSize) -> u32 {
-        self.lines.line_col(offset).line + 1
+        self.lines.line_col(offset, Columns::Characters).0 + 1
     }
 
     /// `path:line`.
