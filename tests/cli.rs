@@ -633,6 +633,46 @@ fn a_line_of_random_text_reports_ten_findings_and_counts_the_rest() {
     let output = ncc(&["check", "--format", "json", path]);
     let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
     assert_eq!(json.as_array().unwrap().len(), 11);
+
+    // Each report shows the line cut to windows around its marks.
+    let human = stdout(&ncc(&["check", path]));
+    assert_eq!(human.matches("╭─[").count(), 11, "{human}");
+    assert!(human.len() < 20_000, "{} bytes", human.len());
+}
+
+/// A mark far into a long line: the report shows a window of the line
+/// around it, and the place above it counts the columns of the whole line.
+#[test]
+fn a_report_shows_a_long_line_around_its_mark_at_its_real_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("LONG.NCP");
+    std::fs::write(&path, format!("%1\nN10 G01 X1 F100{}Y\nN20 M30\n*\n", " ".repeat(5000))).unwrap();
+    let path = path.to_str().unwrap();
+    let human = stdout(&ncc(&["check", path]));
+    assert!(human.contains("[S004 missing-value] Error: address `Y` has no value"), "{human}");
+    assert!(human.contains(&format!("{path}:2:5016 ]")), "{human}");
+    assert!(human.contains(&format!("{path}:2:81 ]")), "line-too-long: {human}");
+    let widest = human.lines().map(|line| line.chars().count()).max().unwrap();
+    assert!(widest < 300, "a line of {widest} characters: {human}");
+}
+
+/// Control characters from a file are drawn or escaped in every report
+/// for people, never written raw: a terminal would act on them.
+#[test]
+fn control_characters_of_a_file_are_never_printed_raw() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("CONTROL.NCP");
+    std::fs::write(&path, "%1\nN10 G01 X1 F100 \u{0}\u{1b}[2J Y2 \"\u{1b}]0;title\u{7}\"\u{c}\nN20 M30\n*\n").unwrap();
+    let path = path.to_str().unwrap();
+    for format in ["human", "short"] {
+        let output = ncc(&["check", "--format", format, path]);
+        assert_eq!(output.status.code(), Some(1));
+        let report = stdout(&output);
+        assert!(report.contains("unexpected `\\u{0}\\u{1b}[`"), "{format}: {report}");
+        let raw: Vec<char> = report.chars().filter(|&c| c.is_control() && c != '\n').collect();
+        assert!(raw.is_empty(), "{format} prints {raw:?}: {report}");
+    }
+    assert!(stdout(&ncc(&["check", path])).contains("F100 ␀␛[2J Y2 \"␛]0;title␇\"␌"));
 }
 
 /// A file shows its first 1000 findings (or what `ncc.toml` says) and
@@ -664,4 +704,19 @@ fn a_file_reports_its_first_findings_and_counts_the_rest() {
     let output = ncc(&["check", "--format", "json", path]);
     let default: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
     assert_eq!(default.as_array().unwrap().len(), 1001, "1000 by default, and the rest");
+}
+
+/// `ncc run` names a program in what it prints: a control character in the
+/// file's name is escaped there too.
+#[test]
+fn run_escapes_control_characters_in_what_it_prints() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("A\u{1b}[2J.NCP");
+    std::fs::write(&path, "%1\nN10 G72 L9002\nN20 M30\n").unwrap();
+    let output = ncc(&["run", path.to_str().unwrap()]);
+    let (out, err) = (stdout(&output), String::from_utf8(output.stderr).unwrap());
+    assert!(err.contains("A\\u{1b}[2J.NCP:2: there is no macrocycle file L9002 to call"), "{err}");
+    for printed in [&out, &err] {
+        assert!(!printed.contains('\u{1b}'), "{printed}");
+    }
 }

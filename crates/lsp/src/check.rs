@@ -10,7 +10,7 @@ use std::{
 
 use indicatif::{ParallelProgressIterator, ProgressBar, ProgressStyle};
 use ncc_analysis::{AnalysisHost, Config, Diagnostic, Severity};
-use ncc_syntax::encoding;
+use ncc_syntax::{encoding, visible};
 use rayon::prelude::*;
 
 use crate::{report, sarif};
@@ -25,6 +25,11 @@ pub(crate) enum Format {
     Json,
     /// SARIF 2.1.0, for code-scanning services.
     Sarif,
+}
+
+/// A path as people are shown it: control characters escaped.
+pub(crate) fn shown_path(path: &Path) -> String {
+    visible::escaped(&path.display().to_string()).into_owned()
 }
 
 /// Reads a program file; bytes that are not UTF-8 are read as Kamenický, so
@@ -136,7 +141,7 @@ pub(crate) fn run(paths: &[PathBuf], format: Format) -> ExitCode {
         return ExitCode::from(2);
     }
     for failure in &failures {
-        eprintln!("error: {failure}");
+        eprintln!("error: {}", visible::escaped(failure));
     }
     exit_code(&checked, &failures)
 }

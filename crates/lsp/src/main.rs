@@ -1,6 +1,7 @@
 //! `ncc`: the command line of the CNC partprogram toolchain.
 
 mod check;
+mod excerpt;
 mod explain;
 mod plot;
 mod positions;

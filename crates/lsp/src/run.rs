@@ -24,11 +24,11 @@ use nc_exec::{
     velocity::{self, Dynamics, Timer, Timing, TimingSink},
 };
 use ncc_analysis::{Config, clock};
-use ncc_syntax::{BlockParser, Dialect, Parse, TextSize, ast::AstNode};
+use ncc_syntax::{BlockParser, Dialect, Parse, TextSize, ast::AstNode, visible};
 use serde::Serialize;
 
 use crate::{
-    check,
+    check::{self, shown_path},
     positions::{Columns, TextIndex},
 };
 
@@ -73,7 +73,7 @@ impl Program<'_> {
 /// message is printed.
 fn read(path: &Path) -> Result<String, ExitCode> {
     check::read_program(path).map_err(|error| {
-        eprintln!("error: {}: {error}", path.display());
+        eprintln!("error: {}: {error}", shown_path(path));
         ExitCode::from(2)
     })
 }
@@ -104,7 +104,7 @@ impl Ran {
 
     fn print_findings(&self) {
         for finding in self.findings() {
-            eprintln!("{}:{}: {}", finding.file, finding.line, finding.message);
+            eprintln!("{}:{}: {}", visible::escaped(finding.file), finding.line, visible::escaped(finding.message));
         }
     }
 
@@ -297,7 +297,8 @@ pub(crate) fn expand(path: &Path, output: Option<&Path>, step_budget: usize) -> 
         Ok(text) => text,
         Err(unwritable) => {
             let step = &ran.trace.steps[unwritable.step];
-            eprintln!("error: {}: {unwritable}", ran.sources[step.source].place(step.range.start()));
+            let message = visible::escaped(&unwritable.to_string()).into_owned();
+            eprintln!("error: {}: {message}", ran.sources[step.source].place(step.range.start()));
             return ExitCode::FAILURE;
         }
     };
@@ -349,7 +350,7 @@ pub(crate) fn lower(path: &Path) -> ExitCode {
     let text = match check::read_program(path) {
         Ok(text) => text,
         Err(error) => {
-            eprintln!("error: {}: {error}", path.display());
+            eprintln!("error: {}: {error}", shown_path(path));
             return ExitCode::from(2);
         }
     };
@@ -512,7 +513,7 @@ fn summary(path: &Path, ran: &Ran, tally: &Tally) -> String {
     let mut out = String::new();
     let (feed, rapid) = (Motion::Feed, Motion::Rapid);
     let totals = &tally.totals;
-    let _ = writeln!(out, "{}", path.display());
+    let _ = writeln!(out, "{}", shown_path(path));
     let (total, at_feed) = (clock(totals.total_time), clock(totals.programmed_time));
     let _ = writeln!(out, "  total time   {total}  ({at_feed} at the programmed feeds)");
     let _ = writeln!(out, "    cutting    {}  {:>12.3} mm", clock(totals.time(feed)), totals.length(feed));
@@ -859,8 +860,8 @@ impl Source {
         self.lines.line_col(offset, Columns::Characters).0 + 1
     }
 
-    /// `path:line`.
+    /// `path:line`, for people.
     fn place(&self, offset: TextSize) -> String {
-        format!("{}:{}", self.name, self.line(offset))
+        format!("{}:{}", visible::escaped(&self.name), self.line(offset))
     }
 }
