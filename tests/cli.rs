@@ -316,7 +316,55 @@ fn clean_file_gives_an_empty_json_array() {
 fn missing_path_is_a_usage_error() {
     let output = ncc(&["check", "no/such/program.NCP"]);
     assert_eq!(output.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&output.stderr).contains("no/such/program.NCP: no such file or directory"));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("no/such/program.NCP: No such file or directory (os error 2)"), "{stderr}");
+}
+
+/// `ncc` with a timeout: a command that waits forever fails the test
+/// instead of hanging it.
+fn ncc_within(args: &[&str], limit: std::time::Duration) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ncc"))
+        .args(args)
+        .current_dir(workspace())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if started.elapsed() > limit {
+            child.kill().unwrap();
+            panic!("`ncc {}` still runs after {limit:?}", args.join(" "));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// A path that is no regular file is reported with what it is, by `check`
+/// and `run` alike; a named pipe without a writer is not waited for.
+#[cfg(unix)]
+#[test]
+fn paths_that_are_no_regular_files_are_reported_as_what_they_are() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("PIPE.NCP");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let (loop_a, loop_b) = (dir.path().join("A.NCP"), dir.path().join("B.NCP"));
+    std::os::unix::fs::symlink(&loop_b, &loop_a).unwrap();
+    std::os::unix::fs::symlink(&loop_a, &loop_b).unwrap();
+    let cases = [
+        ("/dev/null".into(), "a character device, not a regular file"),
+        (fifo.display().to_string(), "a named pipe (FIFO), not a regular file"),
+        (loop_a.display().to_string(), "Too many levels of symbolic links"),
+    ];
+    for (path, cause) in &cases {
+        for command in ["check", "run"] {
+            let output = ncc_within(&[command, path], std::time::Duration::from_secs(20));
+            assert_eq!(output.status.code(), Some(2), "{command} {path}");
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            assert!(stderr.contains(&format!("{path}: {cause}")), "{command} {path}: {stderr}");
+        }
+    }
 }
 
 #[test]
