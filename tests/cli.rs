@@ -106,6 +106,29 @@ fn files_in_the_controls_code_page_are_read_losslessly() {
     assert!(tree.contains(r#"COMMENT@3..14 "\"ŘEZÁNÍ\"""#), "{tree}");
 }
 
+/// A program saved as UTF-16 or UTF-32 text (with the byte-order mark
+/// editors write) is checked as written; the encoding is one finding.
+#[test]
+fn unicode_files_are_checked_as_written_with_one_finding_for_the_encoding() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = "\u{FEFF}%1 \"ŘEZ\"\r\nN10 G00 X0 Y0\r\nN20 M30\r\n*\r\n";
+    let utf16: Vec<u8> = program.encode_utf16().flat_map(u16::to_le_bytes).collect();
+    let utf32: Vec<u8> = program.chars().flat_map(|c| u32::from(c).to_be_bytes()).collect();
+    for (name, bytes) in [("UTF16.NCP", utf16), ("UTF32.NCP", utf32)] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let path = path.to_str().unwrap();
+        let output = ncc(&["check", "--format", "json", path]);
+        let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+        let codes: Vec<&str> = json.as_array().unwrap().iter().map(|d| d["code"].as_str().unwrap()).collect();
+        assert_eq!(codes, ["S020"], "{name}: {json}");
+        assert_eq!((json[0]["line"].as_u64(), json[0]["column"].as_u64()), (Some(1), Some(1)));
+        let human = stdout(&ncc(&["check", path]));
+        assert!(human.contains("[S020 byte-order-mark] Warning: the file starts with a byte-order mark"), "{human}");
+        assert!(!human.contains('\0'), "{human}");
+    }
+}
+
 #[test]
 fn warnings_fail_and_infos_do_not() {
     let dir = tempfile::tempdir().unwrap();

@@ -124,10 +124,8 @@ fn outline(text: &str) -> Outline {
     // the control reads plain text).
     let mark = if text.starts_with(BYTE_ORDER_MARK) {
         let mark = BYTE_ORDER_MARK.len_utf8();
-        front.push(NodeOrToken::Node(green::node(
-            ERROR,
-            [rowan::GreenToken::new(ERROR_TOKEN.into(), &text[..mark]).into()],
-        )));
+        // A token, not a node: the header stays the file's first node.
+        front.push(NodeOrToken::Token(rowan::GreenToken::new(ERROR_TOKEN.into(), &text[..mark])));
         errors.kept.push(SyntaxError::new(
             E::ByteOrderMark,
             range(0..mark),
