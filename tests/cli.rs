@@ -75,6 +75,23 @@ fn human_report_shows_code_message_and_line() {
     assert!(report.ends_with("Found 2 errors, 0 warnings, 0 infos and 0 hints in 1 file.\n"), "{report}");
 }
 
+/// Lines end at a lone `\r` too, as the parser reads them: old files from
+/// the control's editor end their lines so.
+#[test]
+fn positions_count_lines_ended_by_a_carriage_return() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("CR.NCP");
+    std::fs::write(&path, "%1\rN10 G00 X1\rN20 Y\rN30 M30\r*\r").unwrap();
+    let path = path.to_str().unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&ncc(&["check", "--format", "json", path]).stdout).unwrap();
+    assert_eq!(
+        (json[0]["code"].as_str(), json[0]["line"].as_u64(), json[0]["column"].as_u64()),
+        (Some("S004"), Some(3), Some(5))
+    );
+    let human = stdout(&ncc(&["check", path]));
+    assert!(human.contains(&format!("{path}:3:5")), "{human}");
+}
+
 #[test]
 fn files_in_the_controls_code_page_are_read_losslessly() {
     let output = ncc(&["check", "--format", "json", "tests/fixtures/kamenicky.NCP"]);
@@ -87,6 +104,29 @@ fn files_in_the_controls_code_page_are_read_losslessly() {
 
     let tree = stdout(&ncc(&["parse", "tests/fixtures/kamenicky.NCP"]));
     assert!(tree.contains(r#"COMMENT@3..14 "\"ŘEZÁNÍ\"""#), "{tree}");
+}
+
+/// A program saved as UTF-16 or UTF-32 text (with the byte-order mark
+/// editors write) is checked as written; the encoding is one finding.
+#[test]
+fn unicode_files_are_checked_as_written_with_one_finding_for_the_encoding() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = "\u{FEFF}%1 \"ŘEZ\"\r\nN10 G00 X0 Y0\r\nN20 M30\r\n*\r\n";
+    let utf16: Vec<u8> = program.encode_utf16().flat_map(u16::to_le_bytes).collect();
+    let utf32: Vec<u8> = program.chars().flat_map(|c| u32::from(c).to_be_bytes()).collect();
+    for (name, bytes) in [("UTF16.NCP", utf16), ("UTF32.NCP", utf32)] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let path = path.to_str().unwrap();
+        let output = ncc(&["check", "--format", "json", path]);
+        let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+        let codes: Vec<&str> = json.as_array().unwrap().iter().map(|d| d["code"].as_str().unwrap()).collect();
+        assert_eq!(codes, ["S020"], "{name}: {json}");
+        assert_eq!((json[0]["line"].as_u64(), json[0]["column"].as_u64()), (Some(1), Some(1)));
+        let human = stdout(&ncc(&["check", path]));
+        assert!(human.contains("[S020 byte-order-mark] Warning: the file starts with a byte-order mark"), "{human}");
+        assert!(!human.contains('\0'), "{human}");
+    }
 }
 
 #[test]
@@ -299,7 +339,55 @@ fn clean_file_gives_an_empty_json_array() {
 fn missing_path_is_a_usage_error() {
     let output = ncc(&["check", "no/such/program.NCP"]);
     assert_eq!(output.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&output.stderr).contains("no/such/program.NCP: no such file or directory"));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("no/such/program.NCP: No such file or directory (os error 2)"), "{stderr}");
+}
+
+/// `ncc` with a timeout: a command that waits forever fails the test
+/// instead of hanging it.
+fn ncc_within(args: &[&str], limit: std::time::Duration) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ncc"))
+        .args(args)
+        .current_dir(workspace())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if started.elapsed() > limit {
+            child.kill().unwrap();
+            panic!("`ncc {}` still runs after {limit:?}", args.join(" "));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// A path that is no regular file is reported with what it is, by `check`
+/// and `run` alike; a named pipe without a writer is not waited for.
+#[cfg(unix)]
+#[test]
+fn paths_that_are_no_regular_files_are_reported_as_what_they_are() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("PIPE.NCP");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let (loop_a, loop_b) = (dir.path().join("A.NCP"), dir.path().join("B.NCP"));
+    std::os::unix::fs::symlink(&loop_b, &loop_a).unwrap();
+    std::os::unix::fs::symlink(&loop_a, &loop_b).unwrap();
+    let cases = [
+        ("/dev/null".into(), "a character device, not a regular file"),
+        (fifo.display().to_string(), "a named pipe (FIFO), not a regular file"),
+        (loop_a.display().to_string(), "Too many levels of symbolic links"),
+    ];
+    for (path, cause) in &cases {
+        for command in ["check", "run"] {
+            let output = ncc_within(&[command, path], std::time::Duration::from_secs(20));
+            assert_eq!(output.status.code(), Some(2), "{command} {path}");
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            assert!(stderr.contains(&format!("{path}: {cause}")), "{command} {path}: {stderr}");
+        }
+    }
 }
 
 #[test]
@@ -786,4 +874,115 @@ fn expand_stops_at_a_move_it_cannot_write() {
         "{stderr}"
     );
     assert!(!expanded.exists());
+}
+
+/// A megabyte of random text on one line has hundreds of thousands of
+/// findings; every format shows ten of the line and counts the rest in one
+/// finding as severe as the worst of them.
+#[test]
+fn a_line_of_random_text_reports_ten_findings_and_counts_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("RANDOM.NCP");
+    std::fs::write(&path, ncc_bench::progen::random_line(1 << 20, 7)).unwrap();
+    let path = path.to_str().unwrap();
+
+    let output = ncc(&["check", "--format", "short", path]);
+    assert_eq!(output.status.code(), Some(1));
+    let report = stdout(&output);
+    let lines: Vec<&str> = report.lines().collect();
+    assert_eq!(lines.len(), 11, "{report}");
+    let rest = lines.iter().find(|line| line.contains("[Z001]")).unwrap();
+    let counted: u64 = rest.split("[Z001]: ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    assert!(counted > 100_000, "{rest}");
+    assert!(rest.contains(": error[Z001]: "), "as severe as the worst it counts: {rest}");
+
+    let output = ncc(&["check", "--format", "json", path]);
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(json.as_array().unwrap().len(), 11);
+
+    // Each report shows the line cut to windows around its marks.
+    let human = stdout(&ncc(&["check", path]));
+    assert_eq!(human.matches("╭─[").count(), 11, "{human}");
+    assert!(human.len() < 20_000, "{} bytes", human.len());
+}
+
+/// A mark far into a long line: the report shows a window of the line
+/// around it, and the place above it counts the columns of the whole line.
+#[test]
+fn a_report_shows_a_long_line_around_its_mark_at_its_real_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("LONG.NCP");
+    std::fs::write(&path, format!("%1\nN10 G01 X1 F100{}Y\nN20 M30\n*\n", " ".repeat(5000))).unwrap();
+    let path = path.to_str().unwrap();
+    let human = stdout(&ncc(&["check", path]));
+    assert!(human.contains("[S004 missing-value] Error: address `Y` has no value"), "{human}");
+    assert!(human.contains(&format!("{path}:2:5016 ]")), "{human}");
+    assert!(human.contains(&format!("{path}:2:81 ]")), "line-too-long: {human}");
+    let widest = human.lines().map(|line| line.chars().count()).max().unwrap();
+    assert!(widest < 300, "a line of {widest} characters: {human}");
+}
+
+/// Control characters from a file are drawn or escaped in every report
+/// for people, never written raw: a terminal would act on them.
+#[test]
+fn control_characters_of_a_file_are_never_printed_raw() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("CONTROL.NCP");
+    std::fs::write(&path, "%1\nN10 G01 X1 F100 \u{0}\u{1b}[2J Y2 \"\u{1b}]0;title\u{7}\"\u{c}\nN20 M30\n*\n").unwrap();
+    let path = path.to_str().unwrap();
+    for format in ["human", "short"] {
+        let output = ncc(&["check", "--format", format, path]);
+        assert_eq!(output.status.code(), Some(1));
+        let report = stdout(&output);
+        assert!(report.contains("unexpected `\\u{0}\\u{1b}[`"), "{format}: {report}");
+        let raw: Vec<char> = report.chars().filter(|&c| c.is_control() && c != '\n').collect();
+        assert!(raw.is_empty(), "{format} prints {raw:?}: {report}");
+    }
+    assert!(stdout(&ncc(&["check", path])).contains("F100 ␀␛[2J Y2 \"␛]0;title␇\"␌"));
+}
+
+/// A file shows its first 1000 findings (or what `ncc.toml` says) and
+/// counts the rest in one finding where the first one left out is.
+#[test]
+fn a_file_reports_its_first_findings_and_counts_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("MANY.NCP");
+    let program: String = (0..300).map(|block| format!("N{block} X1 Y Y Y Y\n")).collect();
+    std::fs::write(&path, format!("%1\n{program}")).unwrap();
+    let path = path.to_str().unwrap();
+    let findings = |max: usize| -> Vec<serde_json::Value> {
+        std::fs::write(dir.path().join("ncc.toml"), format!("[report]\nmax-findings = {max}\n")).unwrap();
+        let output = ncc(&["check", "--format", "json", path]);
+        serde_json::from_slice::<serde_json::Value>(&output.stdout).unwrap().as_array().unwrap().clone()
+    };
+    let all = findings(100_000);
+    assert!(all.len() > 2000 && all.iter().all(|d| d["code"] != "Z002"), "{}", all.len());
+    let position = |d: &serde_json::Value| (d["line"].as_u64(), d["column"].as_u64());
+    for max in [5, 1000] {
+        let shown = findings(max);
+        assert_eq!(shown.len(), max + 1);
+        let rest = shown.iter().find(|d| d["code"] == "Z002").unwrap();
+        let more = format!("{} more findings in this file not shown", all.len() - max);
+        assert!(rest["message"].as_str().unwrap().starts_with(&more), "{rest}");
+        assert_eq!(position(rest), position(&all[max]), "at the first one left out");
+    }
+    std::fs::remove_file(dir.path().join("ncc.toml")).unwrap();
+    let output = ncc(&["check", "--format", "json", path]);
+    let default: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(default.as_array().unwrap().len(), 1001, "1000 by default, and the rest");
+}
+
+/// `ncc run` names a program in what it prints: a control character in the
+/// file's name is escaped there too.
+#[test]
+fn run_escapes_control_characters_in_what_it_prints() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("A\u{1b}[2J.NCP");
+    std::fs::write(&path, "%1\nN10 G72 L9002\nN20 M30\n").unwrap();
+    let output = ncc(&["run", path.to_str().unwrap()]);
+    let (out, err) = (stdout(&output), String::from_utf8(output.stderr).unwrap());
+    assert!(err.contains("A\\u{1b}[2J.NCP:2: there is no macrocycle file L9002 to call"), "{err}");
+    for printed in [&out, &err] {
+        assert!(!printed.contains('\u{1b}'), "{printed}");
+    }
 }

@@ -264,6 +264,23 @@ fn a_very_large_document_does_not_stop_the_server() {
     assert_eq!(published.params()["diagnostics"], json!([]), "a generated program is clean");
 }
 
+/// A megabyte of random text on one line, hundreds of thousands of
+/// findings: the server publishes ten and counts the rest, and goes on
+/// answering.
+#[test]
+fn a_megabyte_line_of_random_text_gets_ten_findings_and_a_count() {
+    let (mut client, dir) = session();
+    client.timeout = Duration::from_secs(120);
+    let doc = document(&dir, "random.NCP", &progen::random_line(1 << 20, 7));
+    client.notify("textDocument/didOpen", doc.did_open()).unwrap();
+    let settled = settled_diagnostics(&mut client, &doc);
+    let diagnostics = settled.params()["diagnostics"].as_array().unwrap();
+    assert_eq!(diagnostics.len(), 11, "{}", settled.json);
+    let rest = diagnostics.iter().find(|d| d["code"] == "Z001").unwrap();
+    assert_eq!(rest["severity"], 1, "an error among them: {rest}");
+    assert_serving(&mut client, &dir);
+}
+
 #[test]
 fn rapid_edits_end_in_the_diagnostics_of_the_final_text_without_growing() {
     let (mut client, dir) = session();

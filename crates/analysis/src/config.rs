@@ -6,6 +6,9 @@
 //! S009 = "off"
 //! non-canonical-word-order = "info"   # opt-in rules are off until named
 //!
+//! [report]
+//! max-findings = 1000          # a file's findings shown at most
+//!
 //! [machine]
 //! file = "machines/mill.toml"             # a machine file; the keys below override it
 //! axes = ["X", "Y", "Z", "U", "V", "C"]   # letters of axes 1-6
@@ -80,7 +83,22 @@ impl Level {
 pub struct Config {
     /// Severity overrides by rule code or name.
     pub rules: BTreeMap<String, Level>,
+    pub report: ReportConfig,
     pub machine: MachineConfig,
+}
+
+/// The `[report]` section of `ncc.toml`: how much a report shows.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "kebab-case", default)]
+pub struct ReportConfig {
+    /// The most findings shown of a file; one more finding counts the rest.
+    pub max_findings: usize,
+}
+
+impl Default for ReportConfig {
+    fn default() -> Self {
+        ReportConfig { max_findings: 1000 }
+    }
 }
 
 #[derive(Deserialize)]
@@ -88,6 +106,8 @@ pub struct Config {
 struct ConfigFile {
     #[serde(default)]
     rules: BTreeMap<String, Level>,
+    #[serde(default)]
+    report: ReportConfig,
     #[serde(default)]
     machine: Option<MachineFile>,
 }
@@ -303,7 +323,7 @@ impl Config {
     pub fn from_toml(text: &str, path: &Path, read: impl Fn(&Path) -> io::Result<String>) -> Result<Config, String> {
         let origin = path.display().to_string();
         let file: ConfigFile = toml::from_str(text).map_err(|e| format!("{origin}: {e}"))?;
-        let mut config = Config { rules: file.rules, machine: MachineConfig::default() };
+        let mut config = Config { rules: file.rules, report: file.report, machine: MachineConfig::default() };
         if let Some(unknown) = config.rules.keys().find(|key| crate::Rule::find(key).is_none()) {
             return Err(format!("{origin}: [rules] names no rule `{unknown}` (see `ncc rules`)"));
         }
@@ -344,14 +364,16 @@ impl Config {
     /// Applies the severity overrides; `None` when the rule is turned off,
     /// or is an opt-in rule the configuration does not name.
     pub(crate) fn adjust(&self, mut diagnostic: Diagnostic) -> Option<Diagnostic> {
-        let level = self.rules.get(diagnostic.code).or_else(|| self.rules.get(diagnostic.name));
-        match level {
-            None if crate::Rule::find(diagnostic.code).is_some_and(|rule| rule.opt_in) => None,
-            None => Some(diagnostic),
-            Some(level) => {
-                diagnostic.severity = level.severity()?;
-                Some(diagnostic)
-            }
+        diagnostic.severity = self.severity(diagnostic.code, diagnostic.name, diagnostic.severity)?;
+        Some(diagnostic)
+    }
+
+    /// What a finding of rule `code` (`name`) found at `severity` becomes.
+    pub(crate) fn severity(&self, code: &str, name: &str, severity: Severity) -> Option<Severity> {
+        match self.rules.get(code).or_else(|| self.rules.get(name)) {
+            None if crate::Rule::find(code).is_some_and(|rule| rule.opt_in) => None,
+            None => Some(severity),
+            Some(level) => level.severity(),
         }
     }
 }

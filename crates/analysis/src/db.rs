@@ -11,11 +11,12 @@ use std::{
     sync::{Arc, Mutex},
 };
 
-use ncc_syntax::{Dialect, Parse, SyntaxKind, TextSize};
+use ncc_syntax::{Dialect, Parse, SyntaxKind, TextSize, limit::LineLimiter};
 use rowan::GreenNode;
 
 use crate::{
     Config, Diagnostic,
+    findings::{self, Findings},
     lower::BlockData,
     model::{BlockSummary, ChunkSummary},
     states::StateCache,
@@ -157,15 +158,21 @@ pub fn lower_chunk<'a>(db: &'a dyn Db, chunk: BlockChunk<'a>) -> impl Iterator<I
 }
 
 /// The findings about the blocks of a chunk that need nothing but each
-/// block and the configuration; ranges relative to the chunk's start.
+/// block and the configuration, limited per line of the chunk; ranges
+/// relative to the chunk's start.
 #[salsa::tracked(returns(ref))]
-pub fn chunk_diagnostics<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<Diagnostic> {
+pub fn chunk_diagnostics<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Findings {
     let config = Settings::get(db).config(db);
-    lower_chunk(db, chunk)
-        .flat_map(|(offset, data)| {
-            crate::checks::block::check(&data, config).into_iter().map(move |d| d.shifted(offset))
-        })
-        .collect()
+    let text = chunk.green(db).0.to_string();
+    let mut limiter = LineLimiter::new(&text);
+    let mut diagnostics = Vec::new();
+    for (offset, data) in lower_chunk(db, chunk) {
+        let mut block: Vec<Diagnostic> =
+            crate::checks::block::check(&data, config).into_iter().map(|d| d.shifted(offset)).collect();
+        findings::sort_diagnostics(&mut block);
+        diagnostics.extend(block.into_iter().filter(|d| limiter.keep(d.range.start(), findings::key(d))));
+    }
+    Findings { diagnostics, omitted: limiter.finish() }
 }
 
 /// What the program model needs of each block of a chunk; ranges relative

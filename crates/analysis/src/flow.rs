@@ -32,6 +32,7 @@ use crate::{
     Config, Diagnostic,
     checks::structure::FLOW_NOT_FOLLOWED,
     db::{self, Db, Settings, SourceFile},
+    findings::Findings,
     lower::{BlockData, Value, Word},
     model::{self, FileKind, Program},
 };
@@ -316,9 +317,9 @@ impl FlowCheck for Probe {
     }
 }
 
-/// Diagnostics of the rules that follow the program's flow.
+/// Diagnostics of the rules that follow the program's flow, limited per line.
 #[salsa::tracked(returns(ref))]
-pub fn flow_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
+pub fn flow_diagnostics(db: &dyn Db, file: SourceFile) -> Findings {
     let program = model::program(db, file);
     let mut walk = Walk::new(db, file, program, crate::checks::flow_checks());
     walk.run();
@@ -328,7 +329,7 @@ pub fn flow_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
     // run's is kept (the sort is stable).
     out.sort_by_key(|d| (d.range.start(), d.range.end(), d.code));
     out.dedup_by(|later, first| (later.range, later.code) == (first.range, first.code));
-    out
+    Findings::of(file.text(db), out, Vec::new())
 }
 
 /// The lowered blocks of a file, each lowered when a walk first reaches it

@@ -11,6 +11,7 @@ mod checks;
 mod config;
 mod db;
 mod diagnostic;
+mod findings;
 pub mod flow;
 mod ide;
 pub mod model;
@@ -40,9 +41,10 @@ pub use crate::ide::{
     symbols::{DocumentSymbol, SymbolKind},
 };
 pub use crate::{
-    config::{CONFIG_FILE, Config, Level, MachineConfig, parse_constant},
+    config::{CONFIG_FILE, Config, Level, MachineConfig, ReportConfig, parse_constant},
     db::{RootDatabase, SourceFile},
     diagnostic::{Diagnostic, Fix, Related, Rule},
+    findings::{Findings, OmittedFindings},
     ide::{HoverResult, NavigationTarget},
 };
 
@@ -161,23 +163,31 @@ impl Analysis {
     /// Every diagnostic of a file after configuration and suppression
     /// comments, sorted by position.
     pub fn diagnostics(&self, file: FileId) -> Vec<Diagnostic> {
-        let mut all = local_diagnostics(&self.db, file).clone();
-        all.extend(self.flow_diagnostics(file));
-        sort_diagnostics(&mut all);
-        all
+        let mut all = self.local_findings(file);
+        all.append(self.flow_findings(file));
+        self.limit(file, all)
     }
 
-    /// The diagnostics that need no flow walk (syntax, blocks, program
+    /// The findings that need no flow walk (syntax, blocks, program
     /// structure): after an edit these cost only the edited chunk, so an
     /// editor can show them at once and the flow findings when they come.
-    pub fn local_diagnostics(&self, file: FileId) -> Vec<Diagnostic> {
-        local_diagnostics(&self.db, file).clone()
+    /// Unlimited: [`Analysis::limit`] makes them a report.
+    pub fn local_findings(&self, file: FileId) -> Findings {
+        local_findings(&self.db, file).clone()
     }
 
-    /// The diagnostics of the rules that follow the program's flow,
-    /// configured and sorted.
-    pub fn flow_diagnostics(&self, file: FileId) -> Vec<Diagnostic> {
-        configured_flow_diagnostics(&self.db, file).clone()
+    /// The findings of the rules that follow the program's flow,
+    /// configured; unlimited.
+    pub fn flow_findings(&self, file: FileId) -> Findings {
+        configured_flow_findings(&self.db, file).clone()
+    }
+
+    /// The diagnostics every report of `file` shows: at most
+    /// `ncc_syntax::limit::PER_LINE` a line and the configured number a
+    /// file, sorted, with one finding each that counts what was left out.
+    pub fn limit(&self, file: FileId, findings: Findings) -> Vec<Diagnostic> {
+        let max_per_file = Settings::get(&self.db).config(&self.db).report.max_findings;
+        findings::limit(file.text(&self.db), findings, max_per_file)
     }
 
     /// What the thing at `offset` is: a code's or an address's
@@ -273,35 +283,51 @@ impl Analysis {
     }
 }
 
-/// Syntax, block and program-structure diagnostics of a file, configured.
+/// Syntax, block and program-structure findings of a file, configured.
 #[salsa::tracked(returns(ref))]
-fn local_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
+fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
     let parse = file.parse(db);
-    let mut all: Vec<Diagnostic> = parse.errors().iter().map(Diagnostic::from_syntax).collect();
+    let mut all = Findings {
+        diagnostics: parse.errors().iter().map(Diagnostic::from_syntax).collect(),
+        omitted: parse.omitted().iter().map(|o| o.map(|kind| (kind.code(), kind.severity()))).collect(),
+    };
     for chunk in db::file_chunks(db, file) {
-        all.extend(db::chunk_diagnostics(db, chunk.chunk).iter().map(|d| d.clone().shifted(chunk.offset)));
+        all.append(db::chunk_diagnostics(db, chunk.chunk).clone().shifted(chunk.offset));
     }
-    all.extend(checks::structure::check(db, file));
-    all.extend(checks::cycles::check_file(db, file));
+    all.diagnostics.extend(checks::structure::check(db, file));
+    all.diagnostics.extend(checks::cycles::check_file(db, file));
     configure(db, file, all)
 }
 
-/// The flow walk's diagnostics of a file, configured.
+/// The flow walk's findings of a file, configured.
 #[salsa::tracked(returns(ref))]
-fn configured_flow_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
+fn configured_flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
     configure(db, file, flow::flow_diagnostics(db, file).clone())
 }
 
-/// Applies suppression comments and the configured levels, and sorts.
-fn configure(db: &dyn Db, file: SourceFile, all: Vec<Diagnostic>) -> Vec<Diagnostic> {
+/// Applies suppression comments and the configured levels, and limits
+/// per line.
+fn configure(db: &dyn Db, file: SourceFile, all: Findings) -> Findings {
     let config = Settings::get(db).config(db);
     let suppressions = suppress::Suppressions::of(file.text(db), file.parse(db));
-    let mut diagnostics: Vec<Diagnostic> =
-        all.into_iter().filter(|d| !suppressions.silences(d)).filter_map(|d| config.adjust(d)).collect();
-    sort_diagnostics(&mut diagnostics);
-    diagnostics
-}
-
-fn sort_diagnostics(diagnostics: &mut [Diagnostic]) {
-    diagnostics.sort_by(|a, b| (a.range.start(), a.range.end(), a.code).cmp(&(b.range.start(), b.range.end(), b.code)));
+    let diagnostics = all
+        .diagnostics
+        .into_iter()
+        .filter(|d| !suppressions.silences(d.range.start(), d.code, d.name))
+        .filter_map(|d| config.adjust(d))
+        .collect();
+    let omitted = all
+        .omitted
+        .into_iter()
+        .filter_map(|o| {
+            let (code, severity) = o.kind;
+            let name = Rule::find(code).map_or(code, |rule| rule.name);
+            if suppressions.silences(o.at, code, name) {
+                return None;
+            }
+            let severity = config.severity(code, name, severity)?;
+            Some(o.map(|_| (code, severity)))
+        })
+        .collect();
+    Findings::of(file.text(db), diagnostics, omitted)
 }

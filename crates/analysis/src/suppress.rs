@@ -13,9 +13,7 @@
 
 use std::ops::Range;
 
-use ncc_syntax::{Parse, SyntaxKind, ast::Comment};
-
-use crate::Diagnostic;
+use ncc_syntax::{Parse, SyntaxKind, TextSize, ast::Comment};
 
 const MARKER: &str = "ncc:ignore";
 
@@ -51,14 +49,17 @@ impl Suppressions {
             let target = if alone { line_around(text, (line.end + 1).min(text.len())) } else { line };
             lines.push((target, rules));
         }
+        lines.sort_by_key(|(line, _)| line.start);
         Suppressions { lines }
     }
 
-    pub(crate) fn silences(&self, diagnostic: &Diagnostic) -> bool {
-        let at = usize::from(diagnostic.range.start());
-        self.lines.iter().any(|(line, rules)| {
-            line.contains(&at) || (line.is_empty() && line.start == at)
-        } && (rules.is_empty() || rules.iter().any(|r| r == diagnostic.code || r == diagnostic.name)))
+    /// Whether findings of rule `code` (`name`) starting at `at` are
+    /// silenced. A binary search: a file can have a comment on every line.
+    pub(crate) fn silences(&self, at: TextSize, code: &str, name: &str) -> bool {
+        let at = usize::from(at);
+        let candidates = &self.lines[..self.lines.partition_point(|(line, _)| line.start <= at)];
+        let on_line = candidates.iter().rev().take_while(|(line, _)| line.contains(&at) || line.start == at);
+        on_line.into_iter().any(|(_, rules)| rules.is_empty() || rules.iter().any(|r| r == code || r == name))
     }
 }
 

@@ -10,7 +10,7 @@ use ncc_analysis::{
     TextSize,
 };
 use proptest::prelude::*;
-use strategies::{block_program, program_text};
+use strategies::{block_program, crowded_lines, program_text};
 
 /// A partprogram with subprograms, jumps, parameters and Czech comments.
 const PROGRAM: &str = "%100 \"DÍL – ČEP Ø20\"
@@ -488,7 +488,7 @@ fn odd_input_gives_well_formed_answers() {
 
 /// Program text, sometimes a fixed-cycle file's (`$PC` before the blocks).
 fn any_program() -> impl Strategy<Value = String> {
-    let text = prop_oneof![program_text(), block_program()];
+    let text = prop_oneof![program_text(), block_program(), crowded_lines()];
     (text, prop::bool::ANY).prop_map(|(text, cycles)| if cycles { format!("\"  $PC \"\n{text}") } else { text })
 }
 
@@ -503,6 +503,29 @@ proptest! {
         len in 0usize..100,
     ) {
         check_highlight_ranges(path, &text, start, start + len);
+    }
+
+    /// Diagnostics after an edit equal a fresh analysis's, on lines with
+    /// more findings than a report shows too.
+    #[test]
+    fn edited_diagnostics_equal_a_fresh_analysis(
+        text in any_program(),
+        start in 0usize..400,
+        len in 0usize..12,
+        insert in prop_oneof![Just(""), Just("X "), Just("\n"), Just("N7 "), Just("1 2 3"), Just("\"")],
+    ) {
+        let boundary = |at: usize| (0..=at.min(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap_or(0);
+        let (start, end) = (boundary(start), boundary(start + len));
+        let edit = TextEdit::replace(TextRange::new(TextSize::try_from(start).unwrap(), TextSize::try_from(end).unwrap()), insert);
+        let mut host = AnalysisHost::default();
+        let file = host.add_file("P.NCP", text.as_str());
+        host.analysis().diagnostics(file);
+        host.apply_edit(file, &edit);
+        let mut edited = text.clone();
+        edit.apply(&mut edited);
+        let mut fresh = AnalysisHost::default();
+        let fresh_file = fresh.add_file("P.NCP", edited.as_str());
+        prop_assert_eq!(host.analysis().diagnostics(file), fresh.analysis().diagnostics(fresh_file));
     }
 
     #[test]

@@ -176,6 +176,14 @@ pub fn block_count(moves: &[Move]) -> usize {
     moves.iter().filter(|m| !matches!(m, Move::Comment(_))).count()
 }
 
+/// Hostile input: `len` random letters and digits on one line, seeded. The
+/// parser and the checks find something every few characters.
+pub fn random_line(len: usize, seed: u64) -> String {
+    const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
+    let mut rng = crate::edits::Lcg::new(seed);
+    (0..len).map(|_| char::from(ALPHABET[rng.below(ALPHABET.len())])).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

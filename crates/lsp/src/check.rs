@@ -10,7 +10,7 @@ use std::{
 
 use indicatif::{ParallelProgressIterator, ProgressBar, ProgressStyle};
 use ncc_analysis::{AnalysisHost, Config, Diagnostic, Severity};
-use ncc_syntax::encoding;
+use ncc_syntax::{encoding, visible};
 use rayon::prelude::*;
 
 use crate::{report, sarif};
@@ -27,10 +27,48 @@ pub(crate) enum Format {
     Sarif,
 }
 
+/// A path as people are shown it: control characters escaped.
+pub(crate) fn shown_path(path: &Path) -> String {
+    visible::escaped(&path.display().to_string()).into_owned()
+}
+
 /// Reads a program file; bytes that are not UTF-8 are read as Kamenický, so
 /// every file can be read (see `ncc_syntax::encoding`).
 pub(crate) fn read_program(path: &Path) -> io::Result<String> {
-    Ok(encoding::decode(std::fs::read(path)?).0)
+    Ok(encoding::decode(read_file(path)?).0)
+}
+
+/// Reads a regular file (through symbolic links). Anything else is refused
+/// with what it is: a named pipe would wait for a writer forever, and a
+/// device may never end.
+fn read_file(path: &Path) -> io::Result<Vec<u8>> {
+    let kind = std::fs::metadata(path)?.file_type();
+    if kind.is_dir() {
+        return Err(io::Error::new(io::ErrorKind::IsADirectory, "a directory, not a file"));
+    }
+    if !kind.is_file() {
+        return Err(io::Error::new(io::ErrorKind::InvalidInput, format!("{}, not a regular file", special_kind(kind))));
+    }
+    std::fs::read(path)
+}
+
+/// What a file that is neither a regular file nor a directory is.
+fn special_kind(kind: std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            return "a named pipe (FIFO)";
+        } else if kind.is_char_device() {
+            return "a character device";
+        } else if kind.is_block_device() {
+            return "a block device";
+        } else if kind.is_socket() {
+            return "a socket";
+        }
+    }
+    let _ = kind;
+    "a special file"
 }
 
 pub(crate) struct CheckedFile {
@@ -59,7 +97,8 @@ const PROGRESS_BAR_MIN_FILES: usize = 200;
 /// Reads an `ncc.toml` and the machine and table files it names; the error
 /// names the file.
 pub(crate) fn load_config(path: &Path) -> Result<Config, String> {
-    std::fs::read_to_string(path)
+    read_file(path)
+        .and_then(|bytes| String::from_utf8(bytes).map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e)))
         .map_err(|e| format!("{}: {e}", path.display()))
         .and_then(|text| Config::from_toml(&text, path, read_program))
 }
@@ -136,7 +175,7 @@ pub(crate) fn run(paths: &[PathBuf], format: Format) -> ExitCode {
         return ExitCode::from(2);
     }
     for failure in &failures {
-        eprintln!("error: {failure}");
+        eprintln!("error: {}", visible::escaped(failure));
     }
     exit_code(&checked, &failures)
 }
@@ -194,14 +233,23 @@ pub(crate) fn macrocycles_beside(programs: &[(PathBuf, String)]) -> Vec<(PathBuf
 }
 
 /// The files to check: explicit files as given, partprograms found in
-/// directories. Returns them sorted, and the paths that do not exist.
+/// directories. Returns them sorted, and why the paths that cannot be
+/// looked at cannot (reading a file that is not a regular one fails later,
+/// saying what it is).
 pub(crate) fn collect_files(paths: &[PathBuf]) -> (Vec<PathBuf>, Vec<String>) {
     let mut files = Vec::new();
     let mut failures = Vec::new();
     for path in paths {
-        if path.is_file() {
+        let metadata = match std::fs::metadata(path) {
+            Ok(metadata) => metadata,
+            Err(error) => {
+                failures.push(format!("{}: {error}", path.display()));
+                continue;
+            }
+        };
+        if !metadata.is_dir() {
             files.push(path.clone());
-        } else if path.is_dir() {
+        } else {
             for entry in ignore::WalkBuilder::new(path).build() {
                 match entry {
                     Ok(entry) if entry.file_type().is_some_and(|t| t.is_file()) && is_partprogram(entry.path()) => {
@@ -211,8 +259,6 @@ pub(crate) fn collect_files(paths: &[PathBuf]) -> (Vec<PathBuf>, Vec<String>) {
                     Err(error) => failures.push(error.to_string()),
                 }
             }
-        } else {
-            failures.push(format!("{}: no such file or directory", path.display()));
         }
     }
     files.sort();

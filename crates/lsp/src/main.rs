@@ -1,8 +1,10 @@
 //! `ncc`: the command line of the CNC partprogram toolchain.
 
 mod check;
+mod excerpt;
 mod explain;
 mod plot;
+mod positions;
 mod report;
 mod rules;
 mod run;

@@ -1,81 +1,83 @@
 //! The text and JSON reports of `ncc check`.
 
 use std::{
+    collections::HashMap,
     io::{self, Write},
-    ops::Range,
 };
 
-use ariadne::{Color, FnCache, IndexType, Label, Report, ReportKind};
-use line_index::{LineIndex, WideEncoding};
+use ariadne::{Color, IndexType, Label, Report, ReportKind};
 use ncc_analysis::{Diagnostic, Severity, TextRange, TextSize};
+use ncc_syntax::visible;
 use serde::Serialize;
 
-use crate::check::Checked;
+use crate::{
+    check::Checked,
+    excerpt::{MarkedFile, Shown},
+    positions::{Columns, TextIndex},
+};
 
 /// Line and column of offsets in one file: 1-based, columns counting
 /// characters (Unicode scalar values), as editors and people count them.
-pub(crate) struct Positions(LineIndex);
+pub(crate) struct Positions(TextIndex);
 
 impl Positions {
     pub fn new(text: &str) -> Positions {
-        Positions(LineIndex::new(text))
+        Positions(TextIndex::new(text))
     }
 
     pub fn at(&self, offset: TextSize) -> (u32, u32) {
-        let line_col = self.0.line_col(offset);
-        // Offsets of diagnostics are always inside their file's text.
-        let wide = self
-            .0
-            .to_wide(WideEncoding::Utf32, line_col)
-            .unwrap_or(line_index::WideLineCol { line: line_col.line, col: line_col.col });
-        (wide.line + 1, wide.col + 1)
+        let (line, col) = self.0.line_col(offset, Columns::Characters);
+        (line + 1, col + 1)
     }
 }
 
 pub(crate) fn write_human(out: &mut impl Write, checked: &Checked, color: bool) -> io::Result<()> {
-    let config = ariadne::Config::default().with_index_type(IndexType::Byte).with_color(color);
-    // Each file's text is indexed once, however many reports point into it.
-    let mut cache = FnCache::new(|name: &String| checked.sources.get(name).map(|text| text.as_str()).ok_or("not read"));
+    let config = ariadne::Config::default().with_index_type(IndexType::Char).with_color(color);
+    let mut shown = Shown::new(marked_files(checked));
     let mut counts = [0usize; 4];
+    let mut rendered = Vec::new();
     for file in &checked.files {
         let name = file.path.display().to_string();
+        let Some(key) = shown.key(&name) else { continue };
         for diagnostic in &file.diagnostics {
             counts[diagnostic.severity as usize] += 1;
-            let range: Range<usize> = diagnostic.range.into();
             let (kind, label_color) = match diagnostic.severity {
                 Severity::Error => (ReportKind::Error, Color::Red),
                 Severity::Warning => (ReportKind::Warning, Color::Yellow),
                 Severity::Info => (ReportKind::Custom("info", Color::Blue), Color::Blue),
                 Severity::Hint => (ReportKind::Custom("hint", Color::Cyan), Color::Cyan),
             };
-            let mut report = Report::build(kind, (name.clone(), range.clone()))
+            let span = shown.span(key, diagnostic.range);
+            let mut report = Report::build(kind, span.clone())
                 .with_config(config)
                 .with_code(format!("{} {}", diagnostic.code, diagnostic.name))
-                .with_message(&diagnostic.message)
+                .with_message(visible::escaped(&diagnostic.message))
                 .with_label(
-                    Label::new((name.clone(), range))
+                    Label::new(span)
                         .with_message(diagnostic.name.replace('-', " "))
                         .with_color(label_color)
                         .with_order(0),
                 );
             for related in &diagnostic.related {
                 let other = related.file.as_ref().unwrap_or(&name);
-                if checked.source(other).is_some() {
-                    report.add_label(
-                        Label::new((other.clone(), related.range.into()))
-                            .with_message(&related.message)
+                match shown.key(other) {
+                    Some(other) => report.add_label(
+                        Label::new(shown.span(other, related.range))
+                            .with_message(visible::escaped(&related.message))
                             .with_color(Color::Cyan)
                             .with_order(1),
-                    );
-                } else {
-                    report.add_note(format!("{other}: {}", related.message));
+                    ),
+                    None => report.add_note(visible::escaped(&format!("{other}: {}", related.message))),
                 }
             }
             for fix in &diagnostic.fixes {
-                report.add_help(&fix.title);
+                report.add_help(visible::escaped(&fix.title));
             }
-            report.finish().write(&mut cache, &mut *out)?;
+            rendered.clear();
+            report.finish().write(&mut shown, &mut rendered)?;
+            out.write_all(shown.restore_places(&String::from_utf8_lossy(&rendered)).as_bytes())?;
         }
+        shown.forget(key);
     }
     let [hints, infos, warnings, errors] = counts;
     let plural = |n: usize, word: &str| format!("{n} {word}{}", if n == 1 { "" } else { "s" });
@@ -94,23 +96,42 @@ pub(crate) fn write_human(out: &mut impl Write, checked: &Checked, color: bool) 
     }
 }
 
+/// The files the findings point into, with the places they mark.
+fn marked_files(checked: &Checked) -> Vec<MarkedFile<'_>> {
+    let mut marks: HashMap<&str, Vec<usize>> = HashMap::new();
+    for file in &checked.files {
+        for diagnostic in &file.diagnostics {
+            let own =
+                checked.sources.get_key_value(file.path.display().to_string().as_str()).map(|(name, _)| name.as_str());
+            let places = own.map(|name| (name, diagnostic.range)).into_iter().chain(
+                diagnostic.related.iter().filter_map(|related| {
+                    let name = related.file.as_deref().or(own)?;
+                    Some((checked.sources.get_key_value(name)?.0.as_str(), related.range))
+                }),
+            );
+            for (name, range) in places {
+                marks.entry(name).or_default().extend([usize::from(range.start()), usize::from(range.end())]);
+            }
+        }
+    }
+    marks
+        .into_iter()
+        .filter_map(|(name, marks)| Some(MarkedFile { name, text: checked.source(name)?, marks }))
+        .collect()
+}
+
 /// `file:line:col: severity[code]: message`, one line each, like compilers
 /// print for editors and grep.
 pub(crate) fn write_short(out: &mut impl Write, checked: &Checked) -> io::Result<()> {
     for file in &checked.files {
         let positions = Positions::new(&file.text);
+        let name = file.path.display().to_string();
+        let name = visible::escaped(&name);
         for diagnostic in &file.diagnostics {
             let (line, column) = positions.at(diagnostic.range.start());
-            // A message is one line; keep the report one line per finding
-            // even if a future message is not.
-            let message = diagnostic.message.replace('\n', " ");
-            writeln!(
-                out,
-                "{}:{line}:{column}: {}[{}]: {message}",
-                file.path.display(),
-                diagnostic.severity,
-                diagnostic.code
-            )?;
+            // One line per finding, whatever a message or a file name holds.
+            let message = visible::escaped(&diagnostic.message);
+            writeln!(out, "{name}:{line}:{column}: {}[{}]: {message}", diagnostic.severity, diagnostic.code)?;
         }
     }
     Ok(())

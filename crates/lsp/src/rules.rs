@@ -56,6 +56,7 @@ const KINDS: &[(char, &str)] = &[
     ('C', "Fixed cycles"),
     ('X', "Transformations"),
     ('D', "Dynamics and continuity"),
+    ('Z', "Report limits"),
 ];
 
 /// The rules as Markdown tables, one section per kind.

@@ -17,7 +17,6 @@ use std::{
 };
 
 use indicatif::{ProgressBar, ProgressStyle};
-use line_index::LineIndex;
 use nc_exec::{
     arith::{Message, MessageDisplay},
     expand::{ExpandError, Expansion},
@@ -27,10 +26,14 @@ use nc_exec::{
     velocity::{self, Dynamics, Timer, Timing, TimingSink},
 };
 use ncc_analysis::{Config, clock};
-use ncc_syntax::{BlockParser, Dialect, Parse, TextSize, ast::AstNode};
+use ncc_syntax::{BlockParser, Dialect, Parse, TextSize, ast::AstNode, visible};
 use serde::Serialize;
 
-use crate::{check, plot::Sketch};
+use crate::{
+    check::{self, shown_path},
+    plot::Sketch,
+    positions::{Columns, TextIndex},
+};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum Format {
@@ -71,7 +74,7 @@ impl Program<'_> {
 /// message is printed.
 fn read(path: &Path) -> Result<String, ExitCode> {
     check::read_program(path).map_err(|error| {
-        eprintln!("error: {}: {error}", path.display());
+        eprintln!("error: {}: {error}", shown_path(path));
         ExitCode::from(2)
     })
 }
@@ -96,7 +99,7 @@ fn config_error(error: String) -> ExitCode {
 impl Ran {
     fn print_findings(&self) {
         for finding in self.findings() {
-            eprintln!("{}:{}: {}", finding.file, finding.line, finding.message);
+            eprintln!("{}:{}: {}", visible::escaped(finding.file), finding.line, visible::escaped(finding.message));
         }
     }
 
@@ -334,7 +337,8 @@ fn expand_program(program: &Program<'_>, path: &Path, output: Option<&Path>, ste
     };
     let code = match failure {
         ExpandError::Unwritable(unwritable) => {
-            eprintln!("error: {}: {unwritable}", ran.sources[unwritable.source].place(unwritable.range.start()));
+            let message = visible::escaped(&unwritable.to_string()).into_owned();
+            eprintln!("error: {}: {message}", ran.sources[unwritable.source].place(unwritable.range.start()));
             ExitCode::FAILURE
         }
         ExpandError::Io(error) => {
@@ -390,15 +394,15 @@ pub(crate) fn lower(path: &Path) -> ExitCode {
     let text = match check::read_program(path) {
         Ok(text) => text,
         Err(error) => {
-            eprintln!("error: {}: {error}", path.display());
+            eprintln!("error: {}: {error}", shown_path(path));
             return ExitCode::from(2);
         }
     };
     let parse = Parse::new(&text, Dialect::Cnc8x6);
-    let lines = LineIndex::new(&text);
+    let lines = TextIndex::new(&text);
     let mut out = String::new();
     for block in parse.tree().blocks() {
-        let line = lines.line_col(block.syntax().text_range().start()).line + 1;
+        let line = lines.line_col(block.syntax().text_range().start(), Columns::Characters).0 + 1;
         let _ = writeln!(out, "{line:>6}  {}", BlockData::lower(block.syntax().green()));
     }
     let mut stdout = io::stdout().lock();
@@ -555,7 +559,7 @@ fn summary(path: &Path, ran: &Ran, tally: &Tally) -> String {
     let mut out = String::new();
     let (feed, rapid) = (Motion::Feed, Motion::Rapid);
     let totals = &tally.totals;
-    let _ = writeln!(out, "{}", path.display());
+    let _ = writeln!(out, "{}", shown_path(path));
     let (total, at_feed) = (clock(totals.total_time), clock(totals.programmed_time));
     let _ = writeln!(out, "  total time   {total}  ({at_feed} at the programmed feeds)");
     let _ = writeln!(out, "    cutting    {}  {:>12.3} mm", clock(totals.time(feed)), totals.length(feed));
@@ -888,7 +892,7 @@ impl Library {
     /// The program and the files the run read, in the trace's source order.
     fn sources(&self, name: &str, text: &str, trace: &Trace) -> Vec<Source> {
         let read = self.read.take();
-        let source = |name: String, text: &str| Source { name, lines: LineIndex::new(text) };
+        let source = |name: String, text: &str| Source { name, lines: TextIndex::new(text) };
         let files = trace.files.iter().filter_map(|called| read.iter().find(|(c, _, _)| c == called));
         let files = files.map(|(_, path, text)| source(path.display().to_string(), text));
         std::iter::once(source(name.to_owned(), text)).chain(files).collect()
@@ -924,16 +928,16 @@ impl Environment for Library {
 /// A file a run read, for locating its blocks.
 struct Source {
     name: String,
-    lines: LineIndex,
+    lines: TextIndex,
 }
 
 impl Source {
     fn line(&self, offset: TextSize) -> u32 {
-        self.lines.line_col(offset).line + 1
+        self.lines.line_col(offset, Columns::Characters).0 + 1
     }
 
-    /// `path:line`.
+    /// `path:line`, for people.
     fn place(&self, offset: TextSize) -> String {
-        format!("{}:{}", self.name, self.line(offset))
+        format!("{}:{}", visible::escaped(&self.name), self.line(offset))
     }
 }

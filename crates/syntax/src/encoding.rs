@@ -6,19 +6,62 @@
 //! 256 byte values to a different character, so *any* byte sequence decodes
 //! and encodes back to exactly the same bytes: files from the control keep
 //! their Czech comments, and even binary garbage round-trips.
+//!
+//! A file that starts with the byte-order mark of UTF-16 or UTF-32 (an
+//! editor's "Unicode" text) is read in that encoding when all of it decodes,
+//! the mark kept as the text's first character (U+FEFF), so that the
+//! parser reports the encoding once and checks the program as written.
 
 /// How the bytes of a file were turned into text.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Encoding {
     Utf8,
     Kamenicky,
+    Utf16 { big_endian: bool },
+    Utf32 { big_endian: bool },
 }
+
+/// The byte-order mark, as the text's first character.
+pub const BYTE_ORDER_MARK: char = '\u{FEFF}';
 
 /// Decodes a program file. Never fails; UTF-8 input is not copied.
 pub fn decode(bytes: Vec<u8>) -> (String, Encoding) {
+    if let Some(decoded) = decode_wide(&bytes) {
+        return decoded;
+    }
     match String::from_utf8(bytes) {
         Ok(text) => (text, Encoding::Utf8),
         Err(error) => (error.into_bytes().into_iter().map(kamenicky_char).collect(), Encoding::Kamenicky),
+    }
+}
+
+/// UTF-32 or UTF-16 text behind its byte-order mark; `None` without a mark
+/// or when any unit does not decode. UTF-32 is tried first: its
+/// little-endian mark starts like UTF-16's.
+fn decode_wide(bytes: &[u8]) -> Option<(String, Encoding)> {
+    let utf32 = |big_endian: bool| -> Option<(String, Encoding)> {
+        let units = bytes.chunks(4).map(|unit| {
+            let unit: [u8; 4] = unit.try_into().ok()?;
+            char::from_u32(if big_endian { u32::from_be_bytes(unit) } else { u32::from_le_bytes(unit) })
+        });
+        Some((units.collect::<Option<String>>()?, Encoding::Utf32 { big_endian }))
+    };
+    let utf16 = |big_endian: bool| -> Option<(String, Encoding)> {
+        if !bytes.len().is_multiple_of(2) {
+            return None;
+        }
+        let units = bytes.chunks_exact(2).map(|unit| {
+            let unit = [unit[0], unit[1]];
+            if big_endian { u16::from_be_bytes(unit) } else { u16::from_le_bytes(unit) }
+        });
+        Some((char::decode_utf16(units).collect::<Result<String, _>>().ok()?, Encoding::Utf16 { big_endian }))
+    };
+    match bytes {
+        [0xFF, 0xFE, 0, 0, ..] => utf32(false).or_else(|| utf16(false)),
+        [0, 0, 0xFE, 0xFF, ..] => utf32(true),
+        [0xFF, 0xFE, ..] => utf16(false),
+        [0xFE, 0xFF, ..] => utf16(true),
+        _ => None,
     }
 }
 
@@ -29,6 +72,14 @@ pub fn encode(text: &str, encoding: Encoding) -> Vec<u8> {
     match encoding {
         Encoding::Utf8 => text.as_bytes().to_vec(),
         Encoding::Kamenicky => text.chars().map(|c| kamenicky_byte(c).unwrap_or(b'?')).collect(),
+        Encoding::Utf16 { big_endian } => text
+            .encode_utf16()
+            .flat_map(|unit| if big_endian { unit.to_be_bytes() } else { unit.to_le_bytes() })
+            .collect(),
+        Encoding::Utf32 { big_endian } => text
+            .chars()
+            .flat_map(|c| if big_endian { u32::from(c).to_be_bytes() } else { u32::from(c).to_le_bytes() })
+            .collect(),
     }
 }
 
@@ -79,6 +130,28 @@ mod tests {
         let (text, encoding) = decode(bytes.clone());
         assert_eq!(encoding, Encoding::Kamenicky);
         assert_eq!(encode(&text, encoding), bytes);
+    }
+
+    #[test]
+    fn unicode_text_with_a_byte_order_mark_is_decoded() {
+        let text = "\u{FEFF}%1\r\nN10 X1 \"ŘEZ 🙂\"\r\n";
+        for encoding in [false, true]
+            .into_iter()
+            .flat_map(|big_endian| [Encoding::Utf16 { big_endian }, Encoding::Utf32 { big_endian }])
+        {
+            let bytes = encode(text, encoding);
+            assert_eq!(decode(bytes.clone()), (text.to_owned(), encoding));
+            assert_eq!(encode(text, encoding), bytes);
+        }
+        // An odd length or a lone surrogate is not UTF-16: read byte by byte.
+        assert_eq!(decode(vec![0xFF, 0xFE, b'N']).1, Encoding::Kamenicky);
+        assert_eq!(decode(vec![0xFF, 0xFE, 0x00, 0xD8, b'N', 0]).1, Encoding::Kamenicky);
+        // A UTF-16 mark followed by U+0000 reads as UTF-32 when it is; the
+        // bytes come back either way.
+        let odd = vec![0xFF, 0xFE, 0, 0, b'N', 0];
+        let (text, encoding) = decode(odd.clone());
+        assert_eq!((text.as_str(), encoding), ("\u{FEFF}\0N", Encoding::Utf16 { big_endian: false }));
+        assert_eq!(encode(&text, encoding), odd);
     }
 
     #[test]

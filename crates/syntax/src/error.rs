@@ -4,6 +4,8 @@ use std::fmt;
 
 use rowan::TextRange;
 
+use crate::limit::{Omitted, keep_per_line};
+
 /// How serious a finding is. Ordered from least to most severe.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Severity {
@@ -92,6 +94,7 @@ syntax_error_kinds! {
     ParameterWithoutAssignment = "S017", "parameter-without-assignment", Error, "A parameter `R12` on its own: neither assigned (`R12=5.`) nor used after an address (`XR12`).";
     MissingParameterNumber = "S018", "missing-parameter-number", Error, "`R` without the parameter number.";
     MisplacedEquals = "S019", "misplaced-equals", Error, "An `=` that does not follow a parameter.";
+    ByteOrderMark = "S020", "byte-order-mark", Warning, "A file saved as Unicode text with a byte-order mark, which the control does not read.";
 }
 
 /// One syntax diagnostic.
@@ -109,6 +112,31 @@ impl SyntaxError {
 
     pub fn severity(&self) -> Severity {
         self.kind.severity()
+    }
+}
+
+/// Errors as the parser collects them: the first ones of each kind on each
+/// line, and counts of the others (see `limit`).
+#[derive(Debug, Default)]
+pub(crate) struct Errors {
+    pub(crate) kept: Vec<SyntaxError>,
+    pub(crate) omitted: Vec<Omitted<SyntaxErrorKind>>,
+}
+
+impl Errors {
+    pub(crate) fn append(&mut self, mut other: Errors) {
+        self.kept.append(&mut other.kept);
+        self.omitted.append(&mut other.omitted);
+    }
+
+    /// The errors in canonical order, limited over whole lines, and the
+    /// counts of those left out: equal for equal texts however the text was
+    /// split into parts.
+    pub(crate) fn finish(self, text: &str) -> (Vec<SyntaxError>, Vec<Omitted<SyntaxErrorKind>>) {
+        let Errors { mut kept, mut omitted } = self;
+        sort_errors(&mut kept);
+        let kept = keep_per_line(text, kept, &mut omitted, |e| e.range.start(), |e| e.kind);
+        (kept, omitted)
     }
 }
 

@@ -15,8 +15,10 @@ mod decimal;
 pub mod encoding;
 mod error;
 mod green;
+pub mod limit;
 mod runs;
 mod syntax_kind;
+pub mod visible;
 
 use std::sync::Arc;
 
@@ -29,6 +31,7 @@ pub use crate::{
     cnc8x6::{BlockParser, MAX_LINE_CHARS},
     decimal::{Decimal, Sign},
     error::{Severity, SyntaxError, SyntaxErrorKind},
+    limit::Omitted,
     syntax_kind::{NcLanguage, SyntaxElement, SyntaxKind, SyntaxNode, SyntaxToken},
 };
 
@@ -58,6 +61,7 @@ impl TextEdit {
 pub struct Parse {
     green: GreenNode,
     errors: Arc<[SyntaxError]>,
+    omitted: Arc<[Omitted<SyntaxErrorKind>]>,
     dialect: Dialect,
 }
 
@@ -66,8 +70,8 @@ impl Parse {
     pub fn new(text: &str, dialect: Dialect) -> Parse {
         match dialect {
             Dialect::Cnc8x6 => {
-                let (green, errors) = cnc8x6::parse_source_file(text);
-                Parse { green, errors: errors.into(), dialect }
+                let (green, errors, omitted) = cnc8x6::parse_source_file(text);
+                Parse { green, errors: errors.into(), omitted: omitted.into(), dialect }
             }
         }
     }
@@ -99,9 +103,16 @@ impl Parse {
         <ast::SourceFile as ast::AstNode>::cast(self.syntax_node()).expect("the root is a SOURCE_FILE")
     }
 
-    /// Syntax errors sorted by position.
+    /// Syntax errors sorted by position: on a line, the first
+    /// [`limit::PER_LINE`] of each kind.
     pub fn errors(&self) -> &[SyntaxError] {
         &self.errors
+    }
+
+    /// The syntax errors left out of [`Parse::errors`], counted per line
+    /// and kind.
+    pub fn omitted(&self) -> &[Omitted<SyntaxErrorKind>] {
+        &self.omitted
     }
 
     /// The tree and the errors as text, for tests and `ncc parse`.
@@ -109,6 +120,10 @@ impl Parse {
         let mut dump = format!("{:#?}", self.syntax_node());
         for error in self.errors.iter() {
             dump.push_str(&format!("{error}\n"));
+        }
+        for omitted in self.omitted.iter() {
+            let Omitted { kind, at, count, .. } = omitted;
+            dump.push_str(&format!("{count} more {}[{}] from {at:?} on its line\n", kind.severity(), kind.code()));
         }
         dump
     }

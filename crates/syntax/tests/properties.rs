@@ -3,9 +3,13 @@
 
 mod strategies;
 
-use ncc_syntax::{BlockParser, Dialect, Parse, TextEdit, TextRange, TextSize, ast::AstNode};
+use ncc_syntax::{
+    BlockParser, Dialect, Parse, TextEdit, TextRange, TextSize,
+    ast::AstNode,
+    encoding::{self, Encoding},
+};
 use proptest::prelude::*;
-use strategies::{block_program, program_text};
+use strategies::{block_program, crowded_lines, program_text};
 
 fn char_boundary(text: &str, at: usize) -> usize {
     (0..=at.min(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap()
@@ -28,8 +32,36 @@ proptest! {
         assert_well_formed(&text, &Parse::new(&text, Dialect::Cnc8x6));
     }
 
+    /// The file boundary is lossless, byte-order marks or not.
     #[test]
-    fn program_like_text_round_trips(text in program_text()) {
+    fn any_bytes_round_trip(
+        mark in prop_oneof![
+            Just(vec![]), Just(vec![0xFF, 0xFE]), Just(vec![0xFE, 0xFF]), Just(vec![0xFF, 0xFE, 0, 0]), Just(vec![0, 0, 0xFE, 0xFF]),
+        ],
+        rest in any::<Vec<u8>>(),
+    ) {
+        let bytes = [mark, rest].concat();
+        let (text, encoding) = encoding::decode(bytes.clone());
+        prop_assert_eq!(encoding::encode(&text, encoding), bytes);
+    }
+
+    /// Text saved as UTF-16 or UTF-32 with its mark reads back as itself
+    /// (unless it is UTF-16 that also reads as UTF-32: it starts with
+    /// U+0000).
+    #[test]
+    fn unicode_files_read_as_their_text(text in any::<String>(), big_endian in any::<bool>(), wide in any::<bool>()) {
+        let text = format!("{}{text}", encoding::BYTE_ORDER_MARK);
+        let written = if wide { Encoding::Utf32 { big_endian } } else { Encoding::Utf16 { big_endian } };
+        let bytes = encoding::encode(&text, written);
+        let (read, encoding) = encoding::decode(bytes.clone());
+        prop_assert_eq!(encoding::encode(&read, encoding), bytes);
+        if !text[3..].starts_with('\0') {
+            prop_assert_eq!((read, encoding), (text, written));
+        }
+    }
+
+    #[test]
+    fn program_like_text_round_trips(text in prop_oneof![program_text(), crowded_lines()]) {
         assert_well_formed(&text, &Parse::new(&text, Dialect::Cnc8x6));
     }
 
@@ -53,7 +85,7 @@ proptest! {
 
     #[test]
     fn reparse_equals_full_parse(
-        text in prop_oneof![program_text(), block_program()],
+        text in prop_oneof![program_text(), block_program(), crowded_lines()],
         start in 0usize..2000,
         len in 0usize..12,
         insert in program_text().prop_map(|t| t.chars().take(6).collect::<String>()),

@@ -27,6 +27,7 @@ pub(crate) static RULES: &[&[&crate::Rule]] = &[
     transform::RULES,
     cycles::RULES,
     dynamics::RULES,
+    crate::findings::RULES,
 ];
 
 /// The checks that follow the program's flow, fresh for one walk.

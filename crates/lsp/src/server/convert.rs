@@ -3,32 +3,28 @@
 
 use std::sync::Arc;
 
-use line_index::{LineIndex, WideEncoding, WideLineCol};
 use ncc_analysis::{Diagnostic, Severity, TextEdit, TextRange, TextSize};
 use tower_lsp_server::ls_types::{self as lsp, Uri};
+
+use crate::positions::{Columns, TextIndex};
 
 /// A document's text with its line index.
 #[derive(Debug, Clone)]
 pub(crate) struct LineMap {
     pub text: Arc<String>,
-    index: Arc<LineIndex>,
+    index: Arc<TextIndex>,
 }
 
 /// Byte offsets to protocol positions: the line index without the text, for
 /// work that may outlive the next edit (a holder of the text makes the edit
 /// copy it instead of changing it in place).
 #[derive(Debug, Clone)]
-pub(crate) struct Positions(Arc<LineIndex>);
+pub(crate) struct Positions(Arc<TextIndex>);
 
 impl Positions {
     pub fn position(&self, offset: TextSize) -> lsp::Position {
-        let offset = offset.min(self.0.len());
-        let line_col = self.0.line_col(offset);
-        let wide = self
-            .0
-            .to_wide(WideEncoding::Utf16, line_col)
-            .unwrap_or(WideLineCol { line: line_col.line, col: line_col.col });
-        lsp::Position::new(wide.line, wide.col)
+        let (line, character) = self.0.line_col(offset, Columns::Utf16);
+        lsp::Position::new(line, character)
     }
 
     pub fn range(&self, range: TextRange) -> lsp::Range {
@@ -38,7 +34,7 @@ impl Positions {
 
 impl LineMap {
     pub fn new(text: Arc<String>) -> LineMap {
-        let index = Arc::new(LineIndex::new(&text));
+        let index = Arc::new(TextIndex::new(&text));
         LineMap { text, index }
     }
 
@@ -47,24 +43,16 @@ impl LineMap {
     }
 
     /// The byte offset of a position; positions past a line's end or past
-    /// the last line are clamped to the end, as editors expect.
+    /// the last line are clamped to the end, as editors expect, and one
+    /// between the halves of a surrogate pair moves to the character's start.
     pub fn offset(&self, position: lsp::Position) -> TextSize {
         let len = self.index.len();
-        let Some(line) = self.index.line(position.line) else { return len };
-        let line_text = &self.text[line];
-        let line_text = line_text.strip_suffix('\n').map_or(line_text, |t| t.strip_suffix('\r').unwrap_or(t));
-        let wide = WideLineCol { line: position.line, col: position.character };
-        let col = match self.index.to_utf8(WideEncoding::Utf16, wide) {
-            Some(utf8) => utf8.col.min(line_text.len() as u32),
-            None => line_text.len() as u32,
-        };
-        // A column inside a character (between the halves of a surrogate
-        // pair) moves to the character's start.
-        let mut col = col as usize;
-        while !line_text.is_char_boundary(col) {
-            col -= 1;
-        }
-        line.start() + TextSize::from(col as u32)
+        let Some(start) = self.index.line_start(position.line) else { return len };
+        let next = self.index.line_start(position.line + 1).unwrap_or(len);
+        let line = &self.text[usize::from(start)..usize::from(next)];
+        let content = ["\r\n", "\n", "\r"].iter().find_map(|end| line.strip_suffix(end)).unwrap_or(line);
+        let end = start + TextSize::of(content);
+        self.index.offset_in_line(start, end, position.character)
     }
 
     pub fn range_offsets(&self, range: lsp::Range) -> TextRange {
@@ -150,6 +138,14 @@ mod tests {
         assert_eq!(at(9, 0), 19, "past the last line: the end");
         assert_eq!(map.position(TextSize::from(10)), lsp::Position::new(0, 7));
         assert_eq!(map.position(TextSize::from(99)), lsp::Position::new(2, 0));
+    }
+
+    #[test]
+    fn a_lone_carriage_return_ends_a_line_as_the_protocol_says() {
+        let map = LineMap::new(Arc::new("%1\rN10 X1\rN20 Y\r".to_owned()));
+        assert_eq!(map.position(TextSize::from(14)), lsp::Position::new(2, 4));
+        assert_eq!(u32::from(map.offset(lsp::Position::new(2, 4))), 14);
+        assert_eq!(u32::from(map.offset(lsp::Position::new(1, 99))), 9, "before the line's `\\r`");
     }
 
     #[test]

@@ -33,7 +33,7 @@ use std::{
     },
 };
 
-use ncc_analysis::{Analysis, Cancelled, CycleTimeHints, Diagnostic, FileId, TextRange, TextSize};
+use ncc_analysis::{Analysis, Cancelled, CycleTimeHints, Diagnostic, FileId, Findings, TextRange, TextSize};
 use tokio::sync::mpsc;
 use tower_lsp_server::{
     Client, LanguageServer, LspService,
@@ -115,7 +115,7 @@ struct Document {
     map: LineMap,
     /// The flow findings last computed, moved along with later edits until
     /// they are computed again.
-    flow: Vec<Diagnostic>,
+    flow: Findings,
     cycle: cycle_time::Cycle,
 }
 
@@ -268,18 +268,27 @@ impl Server {
                         tracing::error!("cannot start a thread preparing states: {error}");
                     }
                 }
-                Cancelled::catch(|| analysis.local_diagnostics(file))
+                Cancelled::catch(|| {
+                    let local = analysis.local_findings(file);
+                    let mut first = local.clone();
+                    first.append(carried);
+                    (analysis.limit(file, first), local)
+                })
             });
-            let Ok(local) = local else { return };
+            let Ok((first, local)) = local else { return };
             tracing::debug!("{} v{version}: local diagnostics in {:?}", uri.as_str(), started.elapsed());
-            let mut first = local.clone();
-            first.extend(carried);
             send(first);
             background_priority();
             if !opened {
                 prepare(&analysis);
             }
-            let Ok(flow) = Cancelled::catch(|| analysis.flow_diagnostics(file)) else {
+            let all = Cancelled::catch(|| {
+                let flow = analysis.flow_findings(file);
+                let mut all = local;
+                all.append(flow.clone());
+                (analysis.limit(file, all), flow)
+            });
+            let Ok((all, flow)) = all else {
                 tracing::debug!("{} v{version}: flow walk cancelled by an edit", uri.as_str());
                 return;
             };
@@ -288,12 +297,10 @@ impl Server {
             {
                 let mut state = lock(&state);
                 match state.documents.get_mut(&uri) {
-                    Some(document) if document.version == version => document.flow = flow.clone(),
+                    Some(document) if document.version == version => document.flow = flow,
                     _ => return,
                 }
             }
-            let mut all = local;
-            all.extend(flow);
             send(all);
         });
         if let Err(error) = spawned {
@@ -437,10 +444,7 @@ impl LanguageServer for Server {
                 document.map = LineMap::new(Arc::default());
                 host.apply_edit(document.file, &edit);
                 document.map = LineMap::new(host.analysis().text(document.file));
-                document.flow = std::mem::take(&mut document.flow)
-                    .into_iter()
-                    .filter_map(|diagnostic| diagnostic.moved_through(&edit))
-                    .collect();
+                document.flow = std::mem::take(&mut document.flow).moved_through(&edit);
                 document.cycle.edited(TextRange::at(edit.delete.start(), TextSize::of(&edit.insert)));
             }
             document.version = params.text_document.version;

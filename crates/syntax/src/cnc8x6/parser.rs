@@ -30,8 +30,12 @@ use super::{
 use crate::{
     SyntaxError, SyntaxErrorKind as E,
     SyntaxKind::{self, *},
+    encoding::BYTE_ORDER_MARK,
+    error::Errors,
     green::{self, GreenElement, GreenFactory},
+    limit::{LineLimiter, Omitted},
     runs::RunBuilder,
+    visible,
 };
 
 /// The control's limit on characters per line.
@@ -40,11 +44,11 @@ pub const MAX_LINE_CHARS: usize = 80;
 /// Bodies larger than this are split at block boundaries and parsed in parallel.
 const PARALLEL_THRESHOLD: usize = 1 << 20;
 
-pub(crate) fn parse_source_file(text: &str) -> (GreenNode, Vec<SyntaxError>) {
+pub(crate) fn parse_source_file(text: &str) -> (GreenNode, Vec<SyntaxError>, Vec<Omitted<E>>) {
     parse_source_file_with(text, PARALLEL_THRESHOLD)
 }
 
-fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, Vec<SyntaxError>) {
+fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, Vec<SyntaxError>, Vec<Omitted<E>>) {
     let Outline { mut front, mut errors, header, body } = outline(text);
     let (body_start, end) = (body.start, body.end);
 
@@ -58,8 +62,7 @@ fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, 
         }
     }
     let blocks_start = parser.pos;
-    errors.append(&mut parser.errors);
-    drop(parser);
+    errors.append(parser.into_errors());
 
     // The blocks, in parts that start at block boundaries. Each part also
     // checks the length of the lines that start inside it.
@@ -70,10 +73,10 @@ fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, 
         split_at_blocks(text, blocks_start..end, rayon::current_num_threads() * 4)
     };
     let line_starts: Vec<usize> = bounds.iter().map(|&at| line_start_at_or_after(text, at, lines_from, end)).collect();
-    errors.extend(long_lines(text, lines_from..line_starts[0]));
+    errors.kept.extend(long_lines(text, lines_from..line_starts[0]));
     let parse_part = |i: usize| {
         let (blocks, mut part_errors) = parse_blocks(text, bounds[i]..bounds[i + 1]);
-        part_errors.extend(long_lines(text, line_starts[i]..line_starts[i + 1]));
+        part_errors.kept.extend(long_lines(text, line_starts[i]..line_starts[i + 1]));
         (blocks, part_errors)
     };
     let parts: Vec<_> = if bounds.len() > 2 {
@@ -87,28 +90,28 @@ fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, 
     if end < text.len() {
         let mut parser = Parser::new(text, end, text.len());
         back = Some(NodeOrToken::Node(parser.end()));
-        errors.append(&mut parser.errors);
+        errors.append(parser.into_errors());
     }
     // Runs are formed in one pass over all parts: where a run ends must not
     // depend on how the text was split for parallel parsing.
     let mut runs = RunBuilder::new(text, blocks_start);
-    for (blocks, mut part_errors) in parts {
+    for (blocks, part_errors) in parts {
         for block in blocks {
             runs.push(block);
         }
-        errors.append(&mut part_errors);
+        errors.append(part_errors);
     }
-    crate::error::sort_errors(&mut errors);
+    let (errors, omitted) = errors.finish(text);
 
     let children: Vec<GreenElement> = front.into_iter().chain(runs.finish()).chain(back).collect();
-    (green::node(SOURCE_FILE, children), errors)
+    (green::node(SOURCE_FILE, children), errors, omitted)
 }
 
 /// What surrounds a program's blocks: the preamble and the header, and the
 /// body, which runs from the header to the physical end `*`.
 struct Outline {
     front: Vec<GreenElement>,
-    errors: Vec<SyntaxError>,
+    errors: Errors,
     /// Where the header's `%` is.
     header: Option<usize>,
     body: Range<usize>,
@@ -116,27 +119,43 @@ struct Outline {
 
 fn outline(text: &str) -> Outline {
     let mut front: Vec<GreenElement> = Vec::new();
-    let mut errors = Vec::new();
-    let header = find_outside_comments(text, 0, b'%');
+    let mut errors = Errors::default();
+    // An editor's mark of Unicode text is not part of the program (01 §1.2:
+    // the control reads plain text).
+    let mark = if text.starts_with(BYTE_ORDER_MARK) {
+        let mark = BYTE_ORDER_MARK.len_utf8();
+        // A token, not a node: the header stays the file's first node.
+        front.push(NodeOrToken::Token(rowan::GreenToken::new(ERROR_TOKEN.into(), &text[..mark])));
+        errors.kept.push(SyntaxError::new(
+            E::ByteOrderMark,
+            range(0..mark),
+            "the file starts with a byte-order mark: it was saved as Unicode text (UTF-8, UTF-16 or UTF-32 with a mark), but the control reads plain text, one byte a character (ASCII, Kamenický in comments); save it as plain text",
+        ));
+        mark
+    } else {
+        0
+    };
+    let header = find_outside_comments(text, mark, b'%');
     let body_start = match header {
         Some(at) => {
-            if at > 0 {
-                let preamble = &text[..at];
+            if at > mark {
+                let preamble = &text[mark..at];
                 front.push(NodeOrToken::Token(rowan::GreenToken::new(PREAMBLE.into(), preamble)));
                 if !preamble.trim().is_empty() {
-                    errors.push(SyntaxError::new(
+                    errors.kept.push(SyntaxError::new(
                         E::IgnoredPreamble,
-                        range(0..at),
+                        range(mark..at),
                         "text before the program header `%` is skipped by the control",
                     ));
                 }
             }
             let mut parser = Parser::new(text, at, text.len());
             front.push(NodeOrToken::Node(parser.header()));
-            errors.append(&mut parser.errors);
-            parser.pos
+            let pos = parser.pos;
+            errors.append(parser.into_errors());
+            pos
         }
-        None => 0,
+        None => mark,
     };
     let end = find_outside_comments(text, body_start, b'*').unwrap_or(text.len());
     Outline { front, errors, header, body: body_start..end }
@@ -225,7 +244,7 @@ fn line_start_at_or_after(text: &str, at: usize, lines_from: usize, limit: usize
 
 /// Parses the blocks in `region`, which starts at a block's `N` and ends at
 /// a block start, at `*` or at the end of the text.
-pub(crate) fn parse_blocks(text: &str, region: Range<usize>) -> (Vec<GreenElement>, Vec<SyntaxError>) {
+pub(crate) fn parse_blocks(text: &str, region: Range<usize>) -> (Vec<GreenElement>, Errors) {
     let (blocks, errors, _) = parse_blocks_until(text, region, |_| false);
     (blocks, errors)
 }
@@ -236,7 +255,7 @@ pub(crate) fn parse_blocks_until(
     text: &str,
     region: Range<usize>,
     stop_at: impl Fn(usize) -> bool,
-) -> (Vec<GreenElement>, Vec<SyntaxError>, usize) {
+) -> (Vec<GreenElement>, Errors, usize) {
     let mut parser = Parser::new(text, region.start, region.end);
     let mut blocks = Vec::new();
     while parser.pos < region.end {
@@ -246,7 +265,8 @@ pub(crate) fn parse_blocks_until(
             break;
         }
     }
-    (blocks, parser.errors, parser.pos)
+    let pos = parser.pos;
+    (blocks, parser.into_errors(), pos)
 }
 
 /// The first block start at or after the line holding `from`.
@@ -335,6 +355,8 @@ struct Parser<'a> {
     pos: usize,
     end: usize,
     errors: Vec<SyntaxError>,
+    /// Keeps `errors` short on lines with thousands of them.
+    limiter: LineLimiter<'a, E>,
     green: GreenFactory<'a>,
     /// The number that ended the last word or assignment, while only
     /// spaces follow it: a number after those spaces is a split number.
@@ -352,6 +374,7 @@ impl<'a> Parser<'a> {
             pos,
             end,
             errors: Vec::new(),
+            limiter: LineLimiter::new(text),
             green: GreenFactory::new(),
             last_number: None,
             block_children: Vec::with_capacity(32),
@@ -390,7 +413,14 @@ impl<'a> Parser<'a> {
     }
 
     fn error(&mut self, kind: E, r: Range<usize>, message: impl Into<String>) {
-        self.errors.push(SyntaxError::new(kind, range(r), message));
+        let r = range(r);
+        if self.limiter.keep(r.start(), kind) {
+            self.errors.push(SyntaxError::new(kind, r, message));
+        }
+    }
+
+    fn into_errors(self) -> Errors {
+        Errors { kept: self.errors, omitted: self.limiter.finish() }
     }
 
     /// Consumes the next token as a green token.
@@ -487,7 +517,10 @@ impl<'a> Parser<'a> {
                     self.error(
                         E::UnexpectedCharacter,
                         item_start..self.pos,
-                        format!("unexpected text `{text}`: an address letter must be followed by its value; text belongs in a comment `\"…\"`"),
+                        format!(
+                            "unexpected text `{}`: an address letter must be followed by its value; text belongs in a comment `\"…\"`",
+                            visible::quoted(text)
+                        ),
                     );
                     NodeOrToken::Node(green::node(ERROR, [self.green.token(ERROR_TOKEN, text)]))
                 }
@@ -505,7 +538,7 @@ impl<'a> Parser<'a> {
                             E::NumberWithoutAddress,
                             format!(
                                 "number `{}` without an address letter",
-                                &self.text[self.pos..self.pos + token.len]
+                                visible::quoted(&self.text[self.pos..self.pos + token.len])
                             ),
                             item_start,
                         ),
@@ -532,7 +565,8 @@ impl<'a> Parser<'a> {
                         "unexpected `,`: the decimal separator is `.`".to_owned()
                     } else {
                         format!(
-                            "unexpected `{text}`: outside comments only addresses, numbers, signs, `=`, `/`, `&` and spaces are allowed"
+                            "unexpected `{}`: outside comments only addresses, numbers, signs, `=`, `/`, `&` and spaces are allowed",
+                            visible::quoted(text)
                         )
                     };
                     self.error_token(E::UnexpectedCharacter, message)
@@ -600,7 +634,7 @@ impl<'a> Parser<'a> {
         if self.at_value(value_at) {
             self.value(&mut children);
             if self.letters.is_parameter(self.byte_at(start)) {
-                let written = self.text[start..self.pos].to_owned();
+                let written = visible::quoted(&self.text[start..self.pos]);
                 self.error(
                     E::ParameterWithoutAssignment,
                     start..self.pos,
@@ -832,12 +866,17 @@ mod tests {
             "N3 X36.  12 / Y 4.\r\n",
             "N4 X1 N5 Y2 # 7\n\n",
             "n6 comment text\n",
+            // More errors of one kind than a line keeps, on lines that the
+            // split into parts cuts.
+            "N7 X X X X X X X X X X X X X 1 2 3 4 5 6 7 8 9 1 2 3 4\n",
+            "N8 X N9 X N10 X N11 X N12 X N13 X N14 X N15 X N16 X N17 X N18 X N19 X\n",
         ];
         for i in 0..2000 {
             text.push_str(pieces[i % pieces.len()]);
         }
         text.push_str("* \"end\"\nN99\n");
         let sequential = parse_source_file_with(&text, usize::MAX);
+        assert!(!sequential.2.is_empty(), "no line had errors left out");
         let parallel = parse_source_file_with(&text, 0);
         assert_eq!(sequential, parallel);
         assert_eq!(rowan::SyntaxNode::<crate::NcLanguage>::new_root(parallel.0).to_string(), text);

@@ -14,7 +14,11 @@ use rowan::{NodeOrToken, TextRange, TextSize};
 
 use super::{is_block_letter, lexer::TYPOGRAPHIC_QUOTES, parser};
 use crate::{
-    Parse, SyntaxErrorKind, SyntaxKind, SyntaxNode, TextEdit, error::sort_errors, green::GreenElement, runs::RunBuilder,
+    Parse, SyntaxError, SyntaxErrorKind, SyntaxKind, SyntaxNode, TextEdit,
+    error::sort_errors,
+    green::GreenElement,
+    limit::{Omitted, keep_per_line},
+    runs::RunBuilder,
 };
 
 pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Option<Parse> {
@@ -81,6 +85,16 @@ pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Op
     let line_hi = line_end(new_text, stop, limit);
     let old_line_hi = unshift(line_hi);
     let line_lo_size = TextSize::from(line_lo as u32);
+    // A line that had errors left out needs them back when the edit removes
+    // some of its kept ones: only a full parse has them.
+    let touched =
+        |o: &Omitted<SyntaxErrorKind>| o.line <= old_line_hi && (o.line >= line_lo_size || o.at >= line_lo_size);
+    if old.omitted().iter().any(touched) {
+        return None;
+    }
+    let move_after_stop = |range: TextRange| {
+        if range.start() >= old_stop { TextRange::new(shift(range.start()), shift(range.end())) } else { range }
+    };
     let mut errors: Vec<_> = old
         .errors()
         .iter()
@@ -90,18 +104,26 @@ pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Op
             let in_blocks = at >= region_start && at < old_stop;
             !(in_blocks || (error.kind == SyntaxErrorKind::LineTooLong && in_lines))
         })
-        .map(|error| {
-            let mut error = error.clone();
-            if error.range.start() >= old_stop {
-                error.range = TextRange::new(shift(error.range.start()), shift(error.range.end()));
-            }
-            error
-        })
+        .map(|error| SyntaxError { range: move_after_stop(error.range), ..error.clone() })
         .collect();
-    errors.extend(block_errors);
+    errors.extend(block_errors.kept);
     errors.extend(parser::long_lines(new_text, line_lo..line_hi));
     sort_errors(&mut errors);
-    Some(Parse { green, errors: errors.into(), dialect: old.dialect })
+    // Only the touched lines can have more errors of a kind than they keep.
+    let new_line_hi = TextSize::from(line_hi as u32);
+    let touched_from = errors.partition_point(|e| e.range.start() < line_lo_size);
+    let touched_to = errors.partition_point(|e| e.range.start() <= new_line_hi);
+    let after = errors.split_off(touched_to);
+    let touched_errors = errors.split_off(touched_from);
+    let mut omitted = block_errors.omitted;
+    errors.extend(keep_per_line(new_text, touched_errors, &mut omitted, |e| e.range.start(), |e| e.kind));
+    errors.extend(after);
+    omitted.extend(old.omitted().iter().map(|o| {
+        let moved = move_after_stop(TextRange::new(o.line, o.at));
+        Omitted { line: moved.start(), at: moved.end(), ..*o }
+    }));
+    omitted.sort_by_key(|o| (o.at, o.kind));
+    Some(Parse { green, errors: errors.into(), omitted: omitted.into(), dialect: old.dialect })
 }
 
 /// The root with the blocks from `first` up to `stop` (or to the end of the

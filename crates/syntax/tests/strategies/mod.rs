@@ -46,3 +46,13 @@ pub fn block_program() -> impl Strategy<Value = String> {
     (prop::collection::vec(block, 1..12), prop::bool::ANY)
         .prop_map(|(blocks, star)| format!("%1 \"T\"\n{}{}", blocks.concat(), if star { "*\n" } else { "" }))
 }
+
+/// Blocks on lines crowded with errors of a few kinds, more than a line
+/// keeps, sometimes many blocks to a line, so that edits meet lines whose
+/// errors were counted rather than kept.
+pub fn crowded_lines() -> impl Strategy<Value = String> {
+    let item = prop_oneof![Just("X "), Just("1 "), Just("="), Just("x1 "), Just("N1 X "), Just("G1 ")];
+    let line = (prop::collection::vec(item, 0..40), prop_oneof![Just("\n"), Just("\r\n"), Just("\r")])
+        .prop_map(|(items, end)| format!("N5 {}{end}", items.concat()));
+    prop::collection::vec(line, 1..6).prop_map(|lines| format!("%1\n{}", lines.concat()))
+}
