@@ -6,7 +6,7 @@ mod strategies;
 use expect_test::{Expect, expect};
 use ncc_analysis::{AnalysisHost, CompletionItem, CompletionKind, Config, TextRange, TextSize};
 use proptest::prelude::*;
-use strategies::{block_program, crowded_lines, program_text};
+use strategies::{block_program, crowded_lines, overlong_lines, program_text};
 
 const PROGRAM: &str = "%1 \"ZKOUŠKA – doplňování\"
 N10 G90 G17 R12=12.5 R13=864 \"Čerpání\"
@@ -299,7 +299,7 @@ proptest! {
 
     /// Any text, any cursor: answers that stay inside the text, no panic.
     #[test]
-    fn completions_and_hints_anywhere(text in prop_oneof![program_text(), block_program(), crowded_lines()], at in 0usize..2000) {
+    fn completions_and_hints_anywhere(text in prop_oneof![program_text(), block_program(), crowded_lines(), overlong_lines()], at in 0usize..2000) {
         let mut host = AnalysisHost::default();
         let file = host.add_file("main.NCP", text.as_str());
         let analysis = host.analysis();

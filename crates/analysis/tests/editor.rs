@@ -10,7 +10,7 @@ use ncc_analysis::{
     TextSize,
 };
 use proptest::prelude::*;
-use strategies::{block_program, crowded_lines, program_text};
+use strategies::{block_program, crowded_lines, overlong_lines, program_text};
 
 /// A partprogram with subprograms, jumps, parameters and Czech comments.
 const PROGRAM: &str = "%100 \"DÍL – ČEP Ø20\"
@@ -488,7 +488,7 @@ fn odd_input_gives_well_formed_answers() {
 
 /// Program text, sometimes a fixed-cycle file's (`$PC` before the blocks).
 fn any_program() -> impl Strategy<Value = String> {
-    let text = prop_oneof![program_text(), block_program(), crowded_lines()];
+    let text = prop_oneof![program_text(), block_program(), crowded_lines(), overlong_lines()];
     (text, prop::bool::ANY).prop_map(|(text, cycles)| if cycles { format!("\"  $PC \"\n{text}") } else { text })
 }
 

@@ -10,7 +10,7 @@ use ncc_analysis::{AnalysisHost, Dialect, TextEdit};
 use ncc_syntax::{Parse, SyntaxErrorKind, SyntaxKind, SyntaxNode};
 use proptest::prelude::*;
 use rowan::NodeOrToken;
-use strategies::{block_program, crowded_lines, program_text};
+use strategies::{block_program, crowded_lines, overlong_lines, program_text};
 
 /// The edits that format `text`.
 fn format_edits(text: &str) -> Vec<TextEdit> {
@@ -206,7 +206,7 @@ proptest! {
 
     #[test]
     fn formatting_keeps_the_tree_and_is_idempotent(
-        text in prop_oneof![program_text(), block_program(), spaced_program(), crowded_lines(), any::<String>()],
+        text in prop_oneof![program_text(), block_program(), spaced_program(), crowded_lines(), overlong_lines(), any::<String>()],
     ) {
         check_format_properties(&text)?;
     }

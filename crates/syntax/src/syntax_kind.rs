@@ -16,6 +16,10 @@ pub enum SyntaxKind {
     PREAMBLE,
     /// Text after the physical end `*`, which the control never reads.
     TRAILER,
+    /// The rest of a line past the bytes ncc reads of it
+    /// (`MAX_READ_LINE`): only a line far longer than the control's limit
+    /// has it.
+    UNREAD,
 
     // Tokens with meaning.
     /// One address letter (`X`, `G`, `N`, …) in any case.
@@ -77,6 +81,7 @@ impl SyntaxKind {
                 | SyntaxKind::COMMENT
                 | SyntaxKind::PREAMBLE
                 | SyntaxKind::TRAILER
+                | SyntaxKind::UNREAD
         )
     }
 
@@ -99,6 +104,7 @@ const ALL_KINDS: [SyntaxKind; SyntaxKind::LAST as usize + 1] = {
         COMMENT,
         PREAMBLE,
         TRAILER,
+        UNREAD,
         LETTER,
         NUMBER,
         PLUS,

@@ -9,7 +9,7 @@ use ncc_syntax::{
     encoding::{self, Encoding},
 };
 use proptest::prelude::*;
-use strategies::{block_program, crowded_lines, program_text};
+use strategies::{block_program, crowded_lines, overlong_lines, program_text};
 
 fn char_boundary(text: &str, at: usize) -> usize {
     (0..=at.min(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap()
@@ -61,12 +61,12 @@ proptest! {
     }
 
     #[test]
-    fn program_like_text_round_trips(text in prop_oneof![program_text(), crowded_lines()]) {
+    fn program_like_text_round_trips(text in prop_oneof![program_text(), crowded_lines(), overlong_lines()]) {
         assert_well_formed(&text, &Parse::new(&text, Dialect::Cnc8x6));
     }
 
     #[test]
-    fn blocks_parsed_one_by_one_are_the_tree_blocks(text in prop_oneof![program_text(), block_program()]) {
+    fn blocks_parsed_one_by_one_are_the_tree_blocks(text in prop_oneof![program_text(), block_program(), overlong_lines()]) {
         let parse = Parse::new(&text, Dialect::Cnc8x6);
         let tree = parse.tree();
         let expected: Vec<_> =
@@ -85,7 +85,7 @@ proptest! {
 
     #[test]
     fn reparse_equals_full_parse(
-        text in prop_oneof![program_text(), block_program(), crowded_lines()],
+        text in prop_oneof![program_text(), block_program(), crowded_lines(), overlong_lines()],
         start in 0usize..2000,
         len in 0usize..12,
         insert in program_text().prop_map(|t| t.chars().take(6).collect::<String>()),

@@ -134,7 +134,9 @@ impl Formatter<'_> {
             }
             _ => {
                 let place = match kind {
-                    SyntaxKind::PREAMBLE | SyntaxKind::TRAILER | SyntaxKind::ERROR_TOKEN => Place::Verbatim,
+                    SyntaxKind::PREAMBLE | SyntaxKind::TRAILER | SyntaxKind::UNREAD | SyntaxKind::ERROR_TOKEN => {
+                        Place::Verbatim
+                    }
                     _ => place,
                 };
                 let head = std::mem::take(&mut self.block_head);

@@ -376,7 +376,7 @@ impl Walk {
 fn token_kind_of(token: SyntaxKind) -> Option<HighlightKind> {
     Some(match token {
         SyntaxKind::WHITESPACE | SyntaxKind::NEWLINE => return None,
-        SyntaxKind::COMMENT | SyntaxKind::PREAMBLE | SyntaxKind::TRAILER => HighlightKind::Comment,
+        SyntaxKind::COMMENT | SyntaxKind::PREAMBLE | SyntaxKind::TRAILER | SyntaxKind::UNREAD => HighlightKind::Comment,
         SyntaxKind::NUMBER | SyntaxKind::PLUS | SyntaxKind::MINUS => HighlightKind::Number,
         SyntaxKind::PERCENT | SyntaxKind::STAR | SyntaxKind::SLASH => HighlightKind::Keyword,
         SyntaxKind::EQ => HighlightKind::Operator,

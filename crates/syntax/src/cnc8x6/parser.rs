@@ -41,6 +41,30 @@ use crate::{
 /// The control's limit on characters per line.
 pub const MAX_LINE_CHARS: usize = 80;
 
+/// How many bytes of a line ncc reads; the rest is one `UNREAD` token.
+/// Far beyond the control's 80 characters, so nothing a person or a CAM
+/// system writes is cut, but bounded: a line of megabytes of random text
+/// would otherwise become millions of words, each a node of the tree.
+pub const MAX_READ_LINE: usize = 1024;
+
+/// Where the read part of the line that starts at `line_start` ends (it
+/// may end earlier, at its line break), at most `limit`.
+fn read_end(text: &str, line_start: usize, limit: usize) -> usize {
+    let mut end = line_start + MAX_READ_LINE;
+    while end < limit && !text.is_char_boundary(end) {
+        end += 1;
+    }
+    end.min(limit)
+}
+
+pub(crate) fn line_start(text: &str, at: usize) -> usize {
+    memchr::memrchr2(b'\n', b'\r', &text.as_bytes()[..at]).map_or(0, |i| i + 1)
+}
+
+pub(crate) fn line_end(text: &str, at: usize, limit: usize) -> usize {
+    memchr::memchr2(b'\n', b'\r', &text.as_bytes()[at..limit]).map_or(limit, |i| at + i)
+}
+
 /// Bodies larger than this are split at block boundaries and parsed in parallel.
 const PARALLEL_THRESHOLD: usize = 1 << 20;
 
@@ -56,7 +80,7 @@ fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, 
     let mut parser = Parser::new(text, body_start, end);
     while let Some(token) = parser.peek() {
         match token.kind {
-            WHITESPACE | NEWLINE | COMMENT => front.push(parser.bump_trivia(token)),
+            WHITESPACE | NEWLINE | COMMENT | UNREAD => front.push(parser.bump_trivia(token)),
             LETTER if parser.at_block_start() => break,
             _ => front.push(NodeOrToken::Node(parser.block())),
         }
@@ -182,8 +206,8 @@ impl<'a> BlockParser<'a> {
         let header = header.and_then(|_| front.into_iter().find_map(NodeOrToken::into_node));
         let mut parser = Parser::new(text, body.start, body.end);
         // File-level trivia before the first block belongs to no block.
-        while let Some(Token { kind: WHITESPACE | NEWLINE | COMMENT, len }) = parser.peek() {
-            parser.pos += len;
+        while let Some(Token { kind: WHITESPACE | NEWLINE | COMMENT | UNREAD, len }) = parser.peek() {
+            parser.move_to(parser.pos + len);
         }
         let body = parser.pos..body.end;
         BlockParser { parser, header, body }
@@ -205,7 +229,7 @@ impl<'a> BlockParser<'a> {
     /// The block that starts at `at` with its range; `None` at the end of
     /// the body.
     pub fn block_at(&mut self, at: usize) -> Option<(TextRange, GreenNode)> {
-        self.parser.pos = at;
+        self.parser.move_to(at);
         self.parser.peek()?;
         let block = self.parser.block();
         self.parser.errors.clear();
@@ -276,12 +300,22 @@ fn next_block_start(text: &str, from: usize, limit: usize) -> usize {
         Some(i) => from + i,
         None => return limit,
     };
+    // Past the read part of a line no block starts.
+    let mut unread_from = limit;
     while pos < limit {
+        if pos >= unread_from {
+            pos = line_end(text, pos, limit);
+            unread_from = limit;
+            continue;
+        }
         let token = lexer::token_at(text, pos);
         if token.kind == LETTER && is_block_letter(bytes[pos]) {
             return pos;
         }
         pos += token.len;
+        if token.kind == NEWLINE {
+            unread_from = read_end(text, pos, limit);
+        }
     }
     limit
 }
@@ -329,11 +363,16 @@ pub(crate) fn long_lines(text: &str, region: Range<usize>) -> Vec<SyntaxError> {
             let chars = line.chars().count();
             if chars > MAX_LINE_CHARS {
                 let excess = line.char_indices().nth(MAX_LINE_CHARS).map_or(0, |(i, _)| i);
+                let unread = if line.len() > MAX_READ_LINE {
+                    format!("; ncc reads only its first {MAX_READ_LINE} bytes")
+                } else {
+                    String::new()
+                };
                 errors.push(SyntaxError::new(
                     E::LineTooLong,
                     range(line_start + excess..line_end),
                     format!(
-                        "line is {chars} characters long; the control accepts at most {MAX_LINE_CHARS} per line (a block may continue on the next line)"
+                        "line is {chars} characters long; the control accepts at most {MAX_LINE_CHARS} per line (a block may continue on the next line){unread}"
                     ),
                 ));
             }
@@ -353,7 +392,10 @@ fn range(r: Range<usize>) -> TextRange {
 struct Parser<'a> {
     text: &'a str,
     pos: usize,
+    /// Where reading stops: `region_end`, or before it where the read part
+    /// of the current line ends (`MAX_READ_LINE`).
     end: usize,
+    region_end: usize,
     errors: Vec<SyntaxError>,
     /// Keeps `errors` short on lines with thousands of them.
     limiter: LineLimiter<'a, E>,
@@ -369,24 +411,48 @@ struct Parser<'a> {
 
 impl<'a> Parser<'a> {
     fn new(text: &'a str, pos: usize, end: usize) -> Self {
-        Parser {
+        let mut parser = Parser {
             text,
             pos,
             end,
+            region_end: end,
             errors: Vec::new(),
             limiter: LineLimiter::new(text),
             green: GreenFactory::new(),
             last_number: None,
             block_children: Vec::with_capacity(32),
             letters: grammar_letters(),
-        }
+        };
+        parser.move_to(pos);
+        parser
+    }
+
+    /// Continues at `pos`, which may be on another line.
+    fn move_to(&mut self, pos: usize) {
+        self.pos = pos;
+        let line_start = line_start(self.text, pos);
+        self.end = read_end(self.text, line_start, self.region_end);
+    }
+
+    /// Reads the line that starts at the parser's position.
+    fn new_line(&mut self) {
+        self.end = read_end(self.text, self.pos, self.region_end);
     }
 
     fn token_at(&self, pos: usize) -> Option<Token> {
-        (pos < self.end).then(|| {
-            let token = lexer::token_at(self.text, pos);
-            Token { kind: token.kind, len: token.len.min(self.end - pos) }
-        })
+        if pos >= self.region_end {
+            return None;
+        }
+        if pos >= self.end {
+            let unread = line_end(self.text, pos, self.region_end) - pos;
+            if unread > 0 {
+                return Some(Token { kind: UNREAD, len: unread });
+            }
+        }
+        let token = lexer::token_at(self.text, pos);
+        // A line break is whole even where reading the line stops at it.
+        let end = if token.kind == NEWLINE { self.region_end } else { self.end };
+        Some(Token { kind: token.kind, len: token.len.min(end - pos) })
     }
 
     fn peek(&self) -> Option<Token> {
@@ -428,6 +494,10 @@ impl<'a> Parser<'a> {
         let token = self.peek().expect("bump past the end");
         let text = &self.text[self.pos..self.pos + token.len];
         self.pos += token.len;
+        if matches!(token.kind, NEWLINE | UNREAD) {
+            // After the unread part comes the line break, read as usual.
+            self.new_line();
+        }
         self.green.token(token.kind, text)
     }
 
@@ -478,7 +548,8 @@ impl<'a> Parser<'a> {
             // Fast paths for what CAM output is made of; each builds exactly
             // the tree the general path below would.
             match self.text.as_bytes()[..self.end].get(self.pos) {
-                None => break,
+                // The end, or where reading the line stops: the general path.
+                None => {}
                 Some(b' ') if !matches!(self.text.as_bytes()[..self.end].get(self.pos + 1), Some(b' ' | b'\t')) => {
                     children.push(self.green.space());
                     self.pos += 1;
@@ -487,6 +558,7 @@ impl<'a> Parser<'a> {
                 Some(b'\n') => {
                     children.push(self.green.newline());
                     self.pos += 1;
+                    self.new_line();
                     self.last_number = None;
                     continue;
                 }
@@ -506,7 +578,7 @@ impl<'a> Parser<'a> {
                     self.last_number = number_before;
                     self.bump()
                 }
-                NEWLINE | COMMENT => self.bump_trivia(token),
+                NEWLINE | COMMENT | UNREAD => self.bump_trivia(token),
                 LETTER if self.letters.is_block(self.byte_at(self.pos)) => break,
                 STAR => break,
                 LETTER if self.at_parameter_assignment(self.pos) => self.parameter_assignment(),
@@ -829,10 +901,9 @@ impl<'a> Parser<'a> {
                 WHITESPACE | NEWLINE | COMMENT => children.push(self.bump()),
                 _ => {
                     let start = self.pos;
-                    let line_end = memchr::memchr2(b'\n', b'\r', &self.text.as_bytes()[start..])
-                        .map_or(self.text.len(), |i| start + i);
+                    let line_end = line_end(self.text, start, self.text.len());
                     children.push(self.green.token(TRAILER, &self.text[start..line_end]));
-                    self.pos = line_end;
+                    self.move_to(line_end);
                     let first = ignored.map_or(start, |r| r.start);
                     ignored = Some(first..line_end);
                 }
@@ -870,9 +941,12 @@ mod tests {
             // split into parts cuts.
             "N7 X X X X X X X X X X X X X 1 2 3 4 5 6 7 8 9 1 2 3 4\n",
             "N8 X N9 X N10 X N11 X N12 X N13 X N14 X N15 X N16 X N17 X N18 X N19 X\n",
+            // Block numbers past the read part of a line start no block.
+            &"N20 X1 Y2 ".repeat(150),
+            "\n",
         ];
         for i in 0..2000 {
-            text.push_str(pieces[i % pieces.len()]);
+            text.push_str(&pieces[i % pieces.len()]);
         }
         text.push_str("* \"end\"\nN99\n");
         let sequential = parse_source_file_with(&text, usize::MAX);
@@ -880,5 +954,27 @@ mod tests {
         let parallel = parse_source_file_with(&text, 0);
         assert_eq!(sequential, parallel);
         assert_eq!(rowan::SyntaxNode::<crate::NcLanguage>::new_root(parallel.0).to_string(), text);
+    }
+
+    /// A line of megabytes is read up to `MAX_READ_LINE` bytes and the rest
+    /// kept as one token: its tree does not grow with its length.
+    #[test]
+    fn a_long_line_is_read_up_to_the_limit() {
+        let line: String = (0..1_000_000u32).map(|i| b"N1X.5G=Y-2"[(i * 7 % 10) as usize] as char).collect();
+        for text in [format!("%1\n{line}\nN2 X1\n"), format!("%1 \"{line}\nN2 X1\n"), format!("{line}\r\nN2 X1")] {
+            let (green, errors, _) = parse_source_file(&text);
+            let root = crate::SyntaxNode::new_root(green);
+            assert_eq!(root.to_string(), text);
+            assert!(root.descendants_with_tokens().count() < 2_000, "{}", root.descendants_with_tokens().count());
+            let unread: Vec<_> = root.descendants_with_tokens().filter(|e| e.kind() == UNREAD).collect();
+            assert_eq!(unread.len(), 1);
+            let line_start = text.find(&line[..20]).unwrap_or(0);
+            let unread_start = usize::from(unread[0].text_range().start());
+            assert!(unread_start >= line_start + MAX_READ_LINE - 4 && unread_start <= line_start + MAX_READ_LINE);
+            // The block after the long line is read.
+            let last = root.descendants().filter(|n| n.kind() == BLOCK).last().unwrap();
+            assert!(last.to_string().starts_with("N2 X1"), "{last}");
+            assert!(errors.iter().any(|e| e.message.contains("ncc reads only its first 1024 bytes")));
+        }
     }
 }

@@ -12,7 +12,11 @@
 
 use rowan::{NodeOrToken, TextRange, TextSize};
 
-use super::{is_block_letter, lexer::TYPOGRAPHIC_QUOTES, parser};
+use super::{
+    is_block_letter,
+    lexer::TYPOGRAPHIC_QUOTES,
+    parser::{self, line_end, line_start},
+};
 use crate::{
     Parse, SyntaxError, SyntaxErrorKind, SyntaxKind, SyntaxNode, TextEdit,
     error::sort_errors,
@@ -42,6 +46,15 @@ pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Op
         if new_text[lines].contains(global) {
             return None;
         }
+    }
+
+    // Where reading a long line stops depends on where the line starts,
+    // which an edit on it moves for the blocks after the edit.
+    let edit_start = usize::from(edit.delete.start());
+    let edited_lines =
+        line_end(new_text, edit_start + edit.insert.len(), new_text.len()) - line_start(new_text, edit_start);
+    if edited_lines.max(edited_lines + usize::from(edit.delete.len()) - edit.insert.len()) > parser::MAX_READ_LINE {
+        return None;
     }
 
     let layout = Layout::of(&root);
@@ -236,14 +249,6 @@ fn block_at(root: &SyntaxNode, offset: TextSize) -> Option<SyntaxNode> {
 
 fn old_block_starts_at(root: &SyntaxNode, offset: TextSize, body_end: TextSize) -> bool {
     offset < body_end && block_at(root, offset).is_some_and(|block| block.text_range().start() == offset)
-}
-
-fn line_start(text: &str, at: usize) -> usize {
-    memchr::memrchr2(b'\n', b'\r', &text.as_bytes()[..at]).map_or(0, |i| i + 1)
-}
-
-fn line_end(text: &str, at: usize, limit: usize) -> usize {
-    memchr::memchr2(b'\n', b'\r', &text.as_bytes()[at..limit]).map_or(limit, |i| at + i)
 }
 
 #[cfg(test)]

@@ -56,3 +56,13 @@ pub fn crowded_lines() -> impl Strategy<Value = String> {
         .prop_map(|(items, end)| format!("N5 {}{end}", items.concat()));
     prop::collection::vec(line, 1..6).prop_map(|lines| format!("%1\n{}", lines.concat()))
 }
+
+/// Lines around the length past which ncc leaves a line unread (1024
+/// bytes), with block numbers, comments and two-byte characters where
+/// reading stops, so that edits meet text read and unread.
+pub fn overlong_lines() -> impl Strategy<Value = String> {
+    let item = prop_oneof![Just("N1 "), Just("X1.5 "), Just("\"note "), Just("Ř"), Just("G1"), Just(" "), Just("*")];
+    let line = (prop::collection::vec(item, 150..400), prop_oneof![Just("\n"), Just("\r\n"), Just("\r")])
+        .prop_map(|(items, end)| format!("{}{end}", items.concat()));
+    prop::collection::vec(line, 1..4).prop_map(|lines| format!("%1\n{}", lines.concat()))
+}
