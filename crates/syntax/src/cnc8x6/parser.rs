@@ -946,7 +946,7 @@ mod tests {
             "\n",
         ];
         for i in 0..2000 {
-            text.push_str(&pieces[i % pieces.len()]);
+            text.push_str(pieces[i % pieces.len()]);
         }
         text.push_str("* \"end\"\nN99\n");
         let sequential = parse_source_file_with(&text, usize::MAX);
