@@ -7,7 +7,7 @@ mod strategies;
 use nc_exec::lower::{BlockData, BlockReader};
 use ncc_syntax::{Dialect, Parse, TextRange, ast::AstNode};
 use proptest::prelude::*;
-use strategies::{block_program, crowded_lines, program_text};
+use strategies::{block_program, crowded_lines, overlong_lines, program_text};
 
 /// Each block's range, lowering, and whether it was read from its text.
 fn read(text: &str) -> Vec<(TextRange, BlockData, bool)> {
@@ -49,7 +49,7 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(3000))]
 
     #[test]
-    fn blocks_read_as_their_tree_lowers(text in prop_oneof![near_plain_text(), block_program(), program_text(), crowded_lines()]) {
+    fn blocks_read_as_their_tree_lowers(text in prop_oneof![near_plain_text(), block_program(), program_text(), crowded_lines(), overlong_lines()]) {
         let read: Vec<_> = read(&text).into_iter().map(|(range, data, _)| (range, data)).collect();
         prop_assert_eq!(read, from_tree(&text));
     }
