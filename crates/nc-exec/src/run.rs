@@ -815,6 +815,7 @@ fn run_in<'a, 's>(
             runner.deliver(sink, false);
         }
     }
+    runner.finish_compensation();
     if let Some(sink) = sink {
         runner.deliver(sink, true);
     }
@@ -1912,9 +1913,11 @@ impl Runner {
                     }
                     _ => Element::Line { from, to },
                 };
-                let pieces = if moves_in_plane { compensator.push(index, element)? } else { Vec::new() };
+                let pushed = if moves_in_plane { compensator.push(index, element) } else { Ok(Vec::new()) };
+                // Kept on an error too, so that the run's end fixes the
+                // element before the block the control stops at.
                 self.compensator = Some(compensator);
-                pieces
+                pushed?
             }
             (None, _) => return Ok(()),
         };
@@ -1922,6 +1925,25 @@ impl Runner {
         if let Some(compensated) = self.compensated.last_mut() {
             compensated.steps.end = index + 1;
         }
+        self.charge(pieces);
+        Ok(())
+    }
+
+    /// Ends radius compensation still in force where the run ends: the
+    /// tool centre stays on the normal at the last programmed point
+    /// ([`Compensator::finish`]), and the last element's length and time
+    /// are those of its path there.
+    fn finish_compensation(&mut self) {
+        if let Some(compensator) = self.compensator.take() {
+            self.charge(vec![compensator.finish()]);
+        }
+    }
+
+    /// Puts the length and time of the tool-centre path's `pieces` on the
+    /// steps they belong to, in place of the programmed ones.
+    fn charge(&mut self, pieces: Vec<ToolElement>) {
+        let Some(&Compensated { plane, .. }) = self.compensated.last() else { return };
+        let (a, b) = (slot(plane.0), slot(plane.1));
         let mut charged: Vec<usize> = Vec::new();
         for piece in &pieces {
             let length = piece.path.length();
@@ -1946,7 +1968,6 @@ impl Runner {
             step.duration += duration;
         }
         self.tool_centre.extend(pieces);
-        Ok(())
     }
 
     /// Adds a step of the block at `range` that ends at `end`. Its start
