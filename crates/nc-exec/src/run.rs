@@ -1944,8 +1944,7 @@ impl Runner {
     fn charge(&mut self, pieces: Vec<ToolElement>) {
         let Some(&Compensated { plane, .. }) = self.compensated.last() else { return };
         let (a, b) = (slot(plane.0), slot(plane.1));
-        let mut charged: Vec<usize> = Vec::new();
-        for piece in &pieces {
+        for piece in pieces {
             let length = piece.path.length();
             let step = self.step_mut(piece.block);
             let duration = match (step.motion, step.feed) {
@@ -1959,15 +1958,18 @@ impl Runner {
                     self.rapid_seconds(&in_plane(piece.path.start()), &in_plane(piece.path.end()))
                 }
             };
+            // Pieces come in the order of their blocks, a block's over
+            // one or two calls (its corner, then its contour): its first
+            // one replaces the programmed length and time.
+            let first = self.tool_centre.last().is_none_or(|last| last.block != piece.block);
             let step = self.step_mut(piece.block);
-            if !charged.contains(&piece.block) {
-                charged.push(piece.block);
+            if first {
                 (step.length, step.duration) = (0.0, 0.0);
             }
             step.length += length;
             step.duration += duration;
+            self.tool_centre.push(piece);
         }
-        self.tool_centre.extend(pieces);
     }
 
     /// Adds a step of the block at `range` that ends at `end`. Its start

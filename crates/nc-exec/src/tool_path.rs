@@ -216,6 +216,11 @@ mod tests {
         assert_eq!(moves[0].path, Path::Arc { plane: (b'X', b'Y'), centre: [50.0, 0.0], clockwise: false });
         assert_eq!((moves[0].feed, moves[1].feed), (Some(600.0), Some(600.0)));
         assert_eq!(centre_ends(&trace)[3], (50.0, -5.0));
+        // Its length and time are both: the quarter circle of radius 5 and
+        // the 50 mm line.
+        let length = std::f64::consts::FRAC_PI_2 * 5.0 + 50.0;
+        assert!((trace.steps[4].length - length).abs() < 1e-9, "{} mm", trace.steps[4].length);
+        assert!((trace.steps[4].duration - length / 10.0).abs() < 1e-9, "{} s", trace.steps[4].duration);
     }
 
     /// A run that ends with compensation in force fixes its last element
