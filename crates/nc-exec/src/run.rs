@@ -3506,6 +3506,12 @@ mod tests {
         assert_eq!(stops(text, &trace), [("N1 G91 G00 X1000\n", message)]);
         assert_eq!(trace.steps.len(), 2 * 69);
         assert_eq!(trace.axis(&trace.end(), b'X'), 69_000.0);
+        // Under diameter programming the range holds the diameter.
+        let lathe = MachineConfig { diameter_axis: Some(b'X'), ..MachineConfig::default() };
+        let text = "%1\nN1 G74 G91 G00 X1000\nN2 G73 L1 Q999\nN3 M30\n";
+        let trace = run(text, &NoFiles, &lathe, 10_000);
+        assert_eq!(stops(text, &trace), [("N1 G74 G91 G00 X1000\n", message)]);
+        assert_eq!(trace.axis(&trace.end(), b'X'), 34_500.0);
         // Travel limits are machine coordinates: G54 puts X250 at 450.
         let mut machine = MachineConfig {
             limits: [
