@@ -826,6 +826,48 @@ fn plot_draws_the_tool_centre_and_the_programmed_contour() {
     assert!(svg.contains("programmed contour (G41/G42)</text>"), "the legend names the layer: {svg}");
 }
 
+/// A program that ends (M30) with compensation still in force: the control
+/// leaves the tool centre on the normal at the last programmed point, as
+/// before a G40 block, and every report says so alike: the run's end, the
+/// last block's end and length, the expanded program and the picture.
+#[test]
+fn a_program_ending_under_compensation_ends_on_the_last_normal() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("OPEN.NCP");
+    std::fs::write(&program, "%1\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 X50\nN5 Y50\nN6 M30\n")
+        .unwrap();
+    let program = program.to_str().unwrap();
+    let at = |place: &serde_json::Value| (place["X"].as_f64().unwrap(), place["Y"].as_f64().unwrap());
+    let output = ncc(&["run", program, "--format", "json"]);
+    assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    // The last line Y50 runs on its equidistant X45 from the corner (45, 5).
+    assert_eq!(at(&json["end_position"]), (45.0, 50.0));
+    let last = json["blocks"].as_array().unwrap().iter().rfind(|block| block["motion"] == "feed").unwrap();
+    assert_eq!((last["line"].as_u64(), at(&last["end"]["program"])), (Some(6), (45.0, 50.0)));
+    assert_eq!(last["length_mm"], 45.0);
+    // 25 onto the first normal, then 45 and 45 on the equidistants.
+    assert_eq!(json["cutting_length_mm"], 115.0);
+    let summary = String::from_utf8(ncc(&["run", program]).stdout).unwrap();
+    assert!(summary.contains("end position X45.000 Y50.000 "), "{summary}");
+    // The expanded program makes the same last move.
+    let expanded = dir.path().join("EXPANDED.NCP");
+    let output = ncc(&["expand", program, "-o", expanded.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
+    let expanded = std::fs::read_to_string(expanded).unwrap();
+    assert!(expanded.contains(" G01 Y50.000\n"), "{expanded}");
+    // The picture's last tool-centre move runs from (45, 5) to (45, 50):
+    // X 0 to 50 and Y -20 to 50 over 960 pixels make 13.71 pixels a mm.
+    let svg = dir.path().join("open.svg");
+    let output = ncc(&["plot", program, "-o", svg.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
+    let svg = std::fs::read_to_string(svg).unwrap();
+    let scale = 960.0 / 70.0;
+    let last_move = svg.lines().find(|line| line.starts_with("<path data-line=\"6\"")).unwrap();
+    let (x, y0, y1) = (20.0 + 45.0 * scale, 20.0 + 45.0 * scale, 20.0);
+    assert!(last_move.contains(&format!(" d=\"M{x:.2} {y0:.2} L{x:.2} {y1:.2}\"")), "{svg}");
+}
+
 /// Three jump loops nested, each of a thousand runs: a billion blocks,
 /// which only the step budget ends.
 const NESTED_LOOPS: &str =

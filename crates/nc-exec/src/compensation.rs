@@ -24,7 +24,8 @@
 //!    ending on the normal at its programmed end, and the move from there to
 //!    the G40 block's end (02 §1.9). With machine constant 339 decade 7 = 1
 //!    the runner calls it at the first block after G40 that moves in the
-//!    plane.
+//!    plane. A program that ends with compensation in force ends it with
+//!    [`Compensator::finish`]: the last element, without a move after it.
 //!
 //! Each [`ToolElement`] names the block it belongs to, so that the runner
 //! charges its time there. [`Settings::of`] reads the machine constants.
@@ -326,15 +327,19 @@ impl Compensator {
     /// (02 §1.9). Without an element since the start, both blocks run as
     /// programmed.
     pub fn cancel(self, block: usize, to: Point2<f64>) -> Vec<ToolElement> {
+        let last = self.finish();
+        vec![last, line(block, Piece::Cancel, last.path.end(), to)]
+    }
+
+    /// The tool path still open where compensation ends: the last element
+    /// up to the normal at its programmed end, where the tool centre stays
+    /// when the program ends with compensation in force, as before a G40
+    /// block (02 §1.9); the start block as programmed when no element
+    /// followed it.
+    pub fn finish(self) -> ToolElement {
         match self.pending {
-            Some(pending) => {
-                let end = self.normal_point(&pending.element, pending.element.end());
-                vec![self.contour(pending, end), line(block, Piece::Cancel, end, to)]
-            }
-            None => vec![
-                line(self.start_block, Piece::Start, self.start_from, self.start_to),
-                line(block, Piece::Cancel, self.start_to, to),
-            ],
+            Some(pending) => self.contour(pending, self.normal_point(&pending.element, pending.element.end())),
+            None => line(self.start_block, Piece::Start, self.start_from, self.start_to),
         }
     }
 

@@ -45,7 +45,9 @@ pub fn literal_fault(address: &Address, value: &Decimal, machine: &MachineConfig
     if let Some(message) = digit_overflow(address, value) {
         return Some(Fault::new(Refusal::Digits, message));
     }
-    let outside = !surely_within(address, value) && outside_range(address, value.to_f64(), machine);
+    let digits = value.significant_int_digits();
+    let outside =
+        !surely_within(address.bounds, digits, value.is_negative()) && outside_range(address, value.to_f64(), machine);
     outside.then(|| {
         Fault::new(
             Refusal::Range,
@@ -79,8 +81,7 @@ pub fn assignment_fault(parameter: &Address, value: &Decimal) -> Option<Fault> {
 /// The format's digit limits: significant digits before the point (leading
 /// zeros may always be written) and digits after it (trailing zeros may be).
 pub fn digit_overflow(address: &Address, value: &Decimal) -> Option<String> {
-    let int_limit =
-        if value.has_point() { address.int_digits? } else { address.int_digits_without_point.or(address.int_digits)? };
+    let int_limit = int_limit(address, value.has_point())?;
     let int = value.significant_int_digits();
     let letter = &address.letter;
     if int > u32::from(int_limit) {
@@ -104,6 +105,62 @@ pub fn digit_overflow(address: &Address, value: &Decimal) -> Option<String> {
         ));
     }
     None
+}
+
+/// The significant digits before the point the format of `address` allows
+/// in a value written with or without a point; `None`: its digits are not
+/// limited.
+fn int_limit(address: &Address, point: bool) -> Option<u8> {
+    if point { address.int_digits } else { address.int_digits_without_point.or(address.int_digits) }
+}
+
+/// The literals an address plainly takes, worked out once from its format:
+/// the run checks every word it runs, and nearly all are plainly right.
+/// What [`PlainLiterals::take`] does not take, [`literal_fault`] looks at.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct PlainLiterals {
+    signed: bool,
+    /// The digits before the point allowed without and with a point
+    /// (`u8::MAX`: not limited).
+    int_digits: [u8; 2],
+    /// The decimals allowed (0: not limited).
+    frac_digits: u8,
+    /// For values not negative and negative: bit `d` is set when any `d`
+    /// significant digits before the point keep a value within the range
+    /// (all bits without a range).
+    within: [u16; 2],
+}
+
+impl PlainLiterals {
+    /// What `address` plainly takes; none of it when there is no address.
+    pub fn of(address: Option<&Address>) -> PlainLiterals {
+        let Some(address) = address else { return PlainLiterals::default() };
+        // Without a range no value is outside it.
+        let within = |negative| match address.bounds {
+            None => u16::MAX,
+            bounds => (0..POWERS.len() as u32)
+                .filter(|&digits| surely_within(bounds, digits, negative))
+                .fold(0, |mask, digits| mask | 1 << digits),
+        };
+        PlainLiterals {
+            signed: address.signed,
+            int_digits: [false, true].map(|point| int_limit(address, point).unwrap_or(u8::MAX)),
+            // Without a limit before the point, digit_overflow counts no decimals.
+            frac_digits: address.int_digits.and(address.frac_digits).unwrap_or(0),
+            within: [within(false), within(true)],
+        }
+    }
+
+    /// Whether `value` is plainly taken: then [`literal_fault`] finds no
+    /// fault in it.
+    pub fn take(&self, value: &Decimal) -> bool {
+        let digits = value.significant_int_digits();
+        let point = value.has_point();
+        (self.signed || value.sign().is_none())
+            && digits <= u32::from(self.int_digits[usize::from(point)])
+            && !(point && self.frac_digits > 0 && value.frac_digits() > u32::from(self.frac_digits))
+            && self.within[usize::from(value.is_negative())].checked_shr(digits).is_some_and(|bits| bits & 1 == 1)
+    }
 }
 
 /// Whether `address` takes a parameter's raw digits (`R10=123` → `G123`)
@@ -159,17 +216,18 @@ pub fn substitution_fault(address: &Address, raw: Raw, thread: bool, machine: &M
     })
 }
 
-/// Whether the digits of `value` before its point put it within the
-/// range of `address` whatever they are: `X12.345` lies between 10 and
-/// 100. Every word of a program comes here, and most are decided so,
-/// without converting the number.
-fn surely_within(address: &Address, value: &Decimal) -> bool {
-    const POWERS: [f64; 10] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
-    let digits = value.significant_int_digits() as usize;
-    let (Some((min, max)), Some(&above)) = (address.bounds, POWERS.get(digits)) else { return false };
+const POWERS: [f64; 10] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
+
+/// Whether `digits` significant digits before the point put a value (a
+/// `negative` one) within the range `bounds` whatever they are: `X12.345`
+/// lies between 10 and 100. Most words are decided so, without converting
+/// the number.
+fn surely_within(bounds: Option<(f64, f64)>, digits: u32, negative: bool) -> bool {
+    let digits = digits as usize;
+    let (Some((min, max)), Some(&above)) = (bounds, POWERS.get(digits)) else { return false };
     // At least 10^(digits - 1) (or 0), below 10^digits.
     let at_least = if digits == 0 { 0.0 } else { POWERS[digits - 1] };
-    let (low, high) = if value.is_negative() { (-above, -at_least) } else { (at_least, above) };
+    let (low, high) = if negative { (-above, -at_least) } else { (at_least, above) };
     min <= low && high <= max
 }
 
@@ -193,7 +251,7 @@ mod tests {
     use ncc_catalog::Dialect;
     use ncc_syntax::{Decimal, Sign};
 
-    use super::{Refusal, assignment_fault, literal_fault, show, substitution_fault};
+    use super::{PlainLiterals, Refusal, assignment_fault, literal_fault, show, substitution_fault};
     use crate::machine::MachineConfig;
 
     fn decimal(text: &str) -> Decimal {
@@ -223,6 +281,50 @@ mod tests {
         // D0 cancels the length corrections in mode B.
         let mode_b = MachineConfig { constants: [(329, 1_000_000)].into(), ..MachineConfig::default() };
         assert_eq!(refusal_of_literal(b'D', "0", &mode_b), None);
+    }
+
+    /// The words of CAM output are plainly taken; what is not is refused
+    /// or needs a closer look.
+    #[test]
+    fn plain_words_are_taken_at_a_glance() {
+        let plain = |letter: u8, text: &str| {
+            PlainLiterals::of(Dialect::Cnc8x6.catalogue().address_of(letter)).take(&decimal(text))
+        };
+        for (letter, text) in
+            [(b'X', "12.345"), (b'Y', "-1.5"), (b'Z', "0"), (b'G', "1"), (b'F', "2400"), (b'N', "123")]
+        {
+            assert!(plain(letter, text), "{}{text}", char::from(letter));
+        }
+        for (letter, text) in [(b'X', "99999.999"), (b'X', "1.2345"), (b'F', "-100"), (b'D', "0")] {
+            assert!(!plain(letter, text), "{}{text}", char::from(letter));
+        }
+        assert!(!PlainLiterals::of(None).take(&decimal("1")));
+    }
+
+    proptest::proptest! {
+        /// What an address plainly takes, it takes: the glance agrees with
+        /// the close look, on every address and in both length modes.
+        #[test]
+        fn a_plainly_taken_literal_has_no_fault(
+            letter in 0u8..26,
+            negative: bool,
+            int in "[0-9]{0,12}",
+            frac in proptest::option::of("[0-9]{0,6}"),
+            mode_b: bool,
+        ) {
+            let text = match &frac {
+                Some(frac) => format!("{}{int}.{frac}", if negative { "-" } else { "" }),
+                None => format!("{}{int}", if negative { "-" } else { "" }),
+            };
+            proptest::prop_assume!(!int.is_empty() || frac.as_deref().is_some_and(|frac| !frac.is_empty()));
+            let value = decimal(&text);
+            let address = Dialect::Cnc8x6.catalogue().address_of(b'A' + letter);
+            let machine = MachineConfig { constants: [(329, if mode_b { 1_000_000 } else { 0 })].into(), ..MachineConfig::default() };
+            if PlainLiterals::of(address).take(&value) {
+                let fault = address.and_then(|address| literal_fault(address, &value, &machine));
+                proptest::prop_assert_eq!(fault, None, "{}{}", char::from(b'A' + letter), text);
+            }
+        }
     }
 
     #[test]

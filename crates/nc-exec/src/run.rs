@@ -60,7 +60,7 @@ use crate::{
     arith::{self, BlockArithmetic, Machine, Message, Parameters, Raw},
     compensation::{CompensationError, Compensator, Element, Settings, Side, ToolElement},
     cycles::{self, CycleError, CycleInput, CycleKind, CycleStep, Spindle},
-    formats,
+    formats::{self, PlainLiterals},
     lower::{BlockData, BlockReader, PlainReader, Value, Word},
     machine::MachineConfig,
     modes::{Group, Modes},
@@ -815,6 +815,7 @@ fn run_in<'a, 's>(
             runner.deliver(sink, false);
         }
     }
+    runner.finish_compensation();
     if let Some(sink) = sink {
         runner.deliver(sink, true);
     }
@@ -1246,8 +1247,12 @@ struct Runner {
     /// Machine constant 329 decade 7: the length-compensation mode (0 = A).
     length_setting: u8,
     /// What the address of each machine axis holds (±69999.999), in the
-    /// order of the axes; read once, as every move asks.
-    axis_ranges: [Option<(f64, f64)>; MAX_AXES],
+    /// order of the axes, as bounds of the positions (radii on a diameter
+    /// axis) with half a µm to spare, outside and under diameter
+    /// programming G74; worked out once, as every move asks.
+    axis_bounds: [[(f64, f64); MAX_AXES]; 2],
+    /// The literals each address A–Z plainly takes, as every word asks.
+    plain_literals: [PlainLiterals; 26],
     /// The zero-offset and correction tables, as the program changes them.
     offsets: OffsetTable,
     corrections: ToolTable,
@@ -1306,9 +1311,19 @@ impl Runner {
             in_cycle: false,
             css_setting: machine.decade(329, 3),
             length_setting: machine.decade(329, 7),
-            axis_ranges: std::array::from_fn(|index| {
-                let axis = *machine.axes.get(index)?;
-                Dialect::Cnc8x6.catalogue().address_of(axis)?.bounds
+            axis_bounds: [false, true].map(|diameter| {
+                std::array::from_fn(|index| {
+                    let Some(&axis) = machine.axes.get(index) else { return (f64::NEG_INFINITY, f64::INFINITY) };
+                    let per_unit = if diameter && machine.diameter_axis == Some(axis) { 2.0 } else { 1.0 };
+                    match Dialect::Cnc8x6.catalogue().address_of(axis).and_then(|address| address.bounds) {
+                        // Exact: halving and doubling lose no bits.
+                        Some((min, max)) => ((min - HALF_MICROMETRE) / per_unit, (max + HALF_MICROMETRE) / per_unit),
+                        None => (f64::NEG_INFINITY, f64::INFINITY),
+                    }
+                })
+            }),
+            plain_literals: std::array::from_fn(|index| {
+                PlainLiterals::of(Dialect::Cnc8x6.catalogue().address_of(b'A' + index as u8))
             }),
             compensator: None,
             compensation: Settings::of(&machine),
@@ -1369,7 +1384,8 @@ impl Runner {
             compensated: _,
             css_setting: _,
             length_setting: _,
-            axis_ranges: _,
+            axis_bounds: _,
+            plain_literals: _,
             offsets,
             corrections,
             dynamic_set,
@@ -1682,6 +1698,12 @@ impl Runner {
         let thread = motion == Some(33);
         let machine = &*self.machine;
         for word in &block.words {
+            if let Some(Value::Literal(decimal)) = &word.value
+                && let Some(plain) = self.plain_literals.get(usize::from(word.letter.wrapping_sub(b'A')))
+                && plain.take(decimal)
+            {
+                continue;
+            }
             let Some(address) = self.catalogue.address_of(word.letter) else { continue };
             let fault = match word.value.as_ref() {
                 Some(Value::Literal(decimal)) => formats::literal_fault(address, decimal, machine),
@@ -1912,9 +1934,11 @@ impl Runner {
                     }
                     _ => Element::Line { from, to },
                 };
-                let pieces = if moves_in_plane { compensator.push(index, element)? } else { Vec::new() };
+                let pushed = if moves_in_plane { compensator.push(index, element) } else { Ok(Vec::new()) };
+                // Kept on an error too, so that the run's end fixes the
+                // element before the block the control stops at.
                 self.compensator = Some(compensator);
-                pieces
+                pushed?
             }
             (None, _) => return Ok(()),
         };
@@ -1922,8 +1946,26 @@ impl Runner {
         if let Some(compensated) = self.compensated.last_mut() {
             compensated.steps.end = index + 1;
         }
-        let mut charged: Vec<usize> = Vec::new();
-        for piece in &pieces {
+        self.charge(pieces);
+        Ok(())
+    }
+
+    /// Ends radius compensation still in force where the run ends: the
+    /// tool centre stays on the normal at the last programmed point
+    /// ([`Compensator::finish`]), and the last element's length and time
+    /// are those of its path there.
+    fn finish_compensation(&mut self) {
+        if let Some(compensator) = self.compensator.take() {
+            self.charge(vec![compensator.finish()]);
+        }
+    }
+
+    /// Puts the length and time of the tool-centre path's `pieces` on the
+    /// steps they belong to, in place of the programmed ones.
+    fn charge(&mut self, pieces: Vec<ToolElement>) {
+        let Some(&Compensated { plane, .. }) = self.compensated.last() else { return };
+        let (a, b) = (slot(plane.0), slot(plane.1));
+        for piece in pieces {
             let length = piece.path.length();
             let step = self.step_mut(piece.block);
             let duration = match (step.motion, step.feed) {
@@ -1937,16 +1979,18 @@ impl Runner {
                     self.rapid_seconds(&in_plane(piece.path.start()), &in_plane(piece.path.end()))
                 }
             };
+            // Pieces come in the order of their blocks, a block's over
+            // one or two calls (its corner, then its contour): its first
+            // one replaces the programmed length and time.
+            let first = self.tool_centre.last().is_none_or(|last| last.block != piece.block);
             let step = self.step_mut(piece.block);
-            if !charged.contains(&piece.block) {
-                charged.push(piece.block);
+            if first {
                 (step.length, step.duration) = (0.0, 0.0);
             }
             step.length += length;
             step.duration += duration;
+            self.tool_centre.push(piece);
         }
-        self.tool_centre.extend(pieces);
-        Ok(())
     }
 
     /// Adds a step of the block at `range` that ends at `end`. Its start
@@ -2236,21 +2280,18 @@ impl Runner {
     /// beyond its travel limits in machine coordinates, where the
     /// software limit switches work (03 §3.2).
     fn unreachable(&self, position: &Position) -> Option<String> {
-        // Positions lie on the µm grid; half of one keeps float noise off
-        // the bounds.
-        const HALF_MICROMETRE: f64 = 0.0005;
         let axes = &self.machine.axes;
-        for (&axis, &range) in axes.iter().zip(&self.axis_ranges) {
+        let bounds = &self.axis_bounds[usize::from(self.diameter)];
+        let beyond =
+            axes.iter().zip(bounds).find(|&(&axis, &(low, high))| !(low..=high).contains(&position[slot(axis)]));
+        if let Some((&axis, _)) = beyond {
             let letter = char::from(axis);
             // On a diameter axis the program holds the diameter.
             let written = position[slot(axis)] * self.written_per_unit(axis);
-            if let Some((min, max)) = range
-                && !(min - HALF_MICROMETRE..=max + HALF_MICROMETRE).contains(&written)
-            {
-                return Some(format!(
-                    "{letter} would reach {written:.3}, outside the range of `{letter}`: {min:.3} to {max:.3}: the control stops"
-                ));
-            }
+            let (min, max) = self.catalogue.address_of(axis).and_then(|address| address.bounds).unwrap_or_default();
+            return Some(format!(
+                "{letter} would reach {written:.3}, outside the range of `{letter}`: {min:.3} to {max:.3}: the control stops"
+            ));
         }
         if self.machine.limits.is_empty() {
             return None;
@@ -2705,6 +2746,10 @@ fn plane(one: u8, other: u8) -> (u8, u8) {
 }
 
 /// A length on the control's µm grid.
+/// Positions lie on the µm grid; half of one keeps float noise off the
+/// bounds of the axes' ranges.
+const HALF_MICROMETRE: f64 = 0.0005;
+
 pub(crate) fn round3(value: f64) -> f64 {
     (value * 1000.0).round() / 1000.0
 }
@@ -3461,6 +3506,12 @@ mod tests {
         assert_eq!(stops(text, &trace), [("N1 G91 G00 X1000\n", message)]);
         assert_eq!(trace.steps.len(), 2 * 69);
         assert_eq!(trace.axis(&trace.end(), b'X'), 69_000.0);
+        // Under diameter programming the range holds the diameter.
+        let lathe = MachineConfig { diameter_axis: Some(b'X'), ..MachineConfig::default() };
+        let text = "%1\nN1 G74 G91 G00 X1000\nN2 G73 L1 Q999\nN3 M30\n";
+        let trace = run(text, &NoFiles, &lathe, 10_000);
+        assert_eq!(stops(text, &trace), [("N1 G74 G91 G00 X1000\n", message)]);
+        assert_eq!(trace.axis(&trace.end(), b'X'), 34_500.0);
         // Travel limits are machine coordinates: G54 puts X250 at 450.
         let mut machine = MachineConfig {
             limits: [

@@ -38,9 +38,10 @@ pub struct ToolMove {
 
 /// Where the tool centre is at the end of a step that ends at `end` (its
 /// programmed end over the machine's `axes`): `end`, but under radius
-/// compensation, in the plane, where the tool-centre path ends so far; a
-/// step compensation has fixed no path for yet (the run ended first) keeps
-/// its programmed point.
+/// compensation, in the plane, where the tool-centre path ends so far (the
+/// run's end fixes the last element, [`crate::compensation::Compensator::finish`]);
+/// a compensated step with no path of its own or before it keeps its
+/// programmed point.
 pub fn tool_end(end: &Axes, centred: Option<&Centred<'_>>, axes: &[u8]) -> Axes {
     let Some(centred) = centred else { return *end };
     let point = centred.pieces.last().map(|piece| piece.path.end()).or(centred.before);
@@ -215,6 +216,32 @@ mod tests {
         assert_eq!(moves[0].path, Path::Arc { plane: (b'X', b'Y'), centre: [50.0, 0.0], clockwise: false });
         assert_eq!((moves[0].feed, moves[1].feed), (Some(600.0), Some(600.0)));
         assert_eq!(centre_ends(&trace)[3], (50.0, -5.0));
+        // Its length and time are both: the quarter circle of radius 5 and
+        // the 50 mm line.
+        let length = std::f64::consts::FRAC_PI_2 * 5.0 + 50.0;
+        assert!((trace.steps[4].length - length).abs() < 1e-9, "{} mm", trace.steps[4].length);
+        assert!((trace.steps[4].duration - length / 10.0).abs() < 1e-9, "{} s", trace.steps[4].duration);
+    }
+
+    /// A run that ends with compensation in force fixes its last element
+    /// as a G40 block would: the tool centre stays on the normal at the
+    /// last programmed point, and the step's length is its path there;
+    /// so at the end of the file, and before a block the control refuses.
+    #[test]
+    fn a_run_ending_under_compensation_ends_on_the_last_normal() {
+        let contour = "%1\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 X50\nN5 Y50\n";
+        let trace = run(contour, &NoFiles, &MachineConfig::default(), 10_000);
+        assert!(trace.findings.iter().all(|finding| !finding.fatal), "{:?}", trace.findings);
+        assert_eq!(centre_ends(&trace).last(), Some(&(45.0, 50.0)));
+        assert_eq!(trace.steps.last().map(|step| step.length), Some(45.0));
+        // An arc too small for the tool on its inside stops the run.
+        let refused = format!("{contour}N6 G03 X50 Y56 I0 J3\nN7 M30\n");
+        let trace = run(&refused, &NoFiles, &MachineConfig::default(), 10_000);
+        let fatal: Vec<&str> = trace.findings.iter().filter(|f| f.fatal).map(|f| refused[f.range].trim_end()).collect();
+        assert_eq!(fatal, ["N6 G03 X50 Y56 I0 J3"]);
+        let line = trace.steps.iter().rposition(|step| refused[step.range].starts_with("N5")).expect("N5 ran");
+        assert_eq!(centre_ends(&trace)[line], (45.0, 50.0));
+        assert_eq!(trace.steps[line].length, 45.0);
     }
 
     /// What a streaming sink is told besides the steps.
