@@ -700,14 +700,14 @@ fn run_in<'a, 's>(
                 runner.block(&data, range)
             }
         };
-        let passes_on = flow == Flow::Next;
+        let passes_on = flow == Flow::Block(BlockFlow::Next);
         at = match flow {
-            Flow::End => break,
-            Flow::Next => {
+            Flow::Block(BlockFlow::End) => break,
+            Flow::Block(BlockFlow::Next) => {
                 jumps.passed(at);
                 next
             }
-            Flow::Return => match calls.last_mut() {
+            Flow::Block(BlockFlow::Return) => match calls.last_mut() {
                 Some(call) if call.remaining > 1 => {
                     call.remaining -= 1;
                     call.start
@@ -715,7 +715,7 @@ fn run_in<'a, 's>(
                 Some(_) => calls.pop().map_or(next, |call| {
                     if let Some((snapshot, then)) = call.cycle {
                         runner.restore(*snapshot);
-                        resume = Some(then);
+                        resume = Some(Flow::Block(then));
                     }
                     call.back
                 }),
@@ -733,7 +733,7 @@ fn run_in<'a, 's>(
                 match source.and_then(|source| program.units.subprogram(source, number)) {
                     Some(start) => {
                         // Back to the calling block, to go on with its flow.
-                        let cycle = Some((Box::new(runner.snapshot()), *then));
+                        let cycle = Some((Box::new(runner.snapshot()), then));
                         runner.in_cycle = true;
                         calls.push(Call { back: at, remaining: 1, start, cycle });
                         start
@@ -747,12 +747,12 @@ fn run_in<'a, 's>(
                         if !runner.built_in_cycle_or_stop(number, range) {
                             break;
                         }
-                        resume = Some(*then);
+                        resume = Some(Flow::Block(then));
                         at
                     }
                 }
             }
-            Flow::Call { label, times, macrocycle: is_macrocycle } => {
+            Flow::Block(BlockFlow::Call { label, times, macrocycle: is_macrocycle }) => {
                 let program = index.complete();
                 let start = if is_macrocycle {
                     let known = loaded.iter().find(|&&(number, _)| number == label).map(|&(_, start)| start);
@@ -794,7 +794,7 @@ fn run_in<'a, 's>(
                     }
                 }
             }
-            Flow::Jump { label, times } => match index.complete().units.jump_target(at, label) {
+            Flow::Block(BlockFlow::Jump { label, times }) => match index.complete().units.jump_target(at, label) {
                 Some(target) if jumps.jumps(at, times) => target,
                 Some(_) => next,
                 None => {
@@ -847,7 +847,7 @@ struct Call {
     start: usize,
     /// A fixed cycle of the cycle file: the state to restore on return, and
     /// the flow of its block, which goes on then.
-    cycle: Option<(Box<Snapshot>, Flow)>,
+    cycle: Option<(Box<Snapshot>, BlockFlow)>,
 }
 
 /// The blocks of the program and the macrocycle files loaded so far, one
@@ -1177,43 +1177,16 @@ impl Units {
     }
 }
 
-/// What runs after a block.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// What runs after a block: its own flow, or first a fixed cycle's body.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Flow {
-    Next,
-    End,
-    /// `G70`: back from a subprogram.
-    Return,
-    /// `G71 L` (or `G72 L`, a macrocycle file): run subprogram `label`
-    /// `times` times.
-    Call {
-        label: u32,
-        times: u32,
-        macrocycle: bool,
-    },
+    Block(BlockFlow),
     /// A fixed cycle's body in the cycle file, after the block's motion;
     /// then the block's own flow.
     Cycle {
         number: u32,
-        then: Box<Flow>,
+        then: BlockFlow,
     },
-    /// `G73 L Q`: jump to block N`label`, `times` times in all.
-    Jump {
-        label: u32,
-        times: u32,
-    },
-}
-
-impl From<BlockFlow> for Flow {
-    fn from(flow: BlockFlow) -> Flow {
-        match flow {
-            BlockFlow::Next => Flow::Next,
-            BlockFlow::End => Flow::End,
-            BlockFlow::Return => Flow::Return,
-            BlockFlow::Call { label, times, macrocycle } => Flow::Call { label, times, macrocycle },
-            BlockFlow::Jump { label, times } => Flow::Jump { label, times },
-        }
-    }
 }
 
 /// The control's state while a program runs.
@@ -1450,7 +1423,7 @@ impl Runner {
         let has = |letter: u8, number: u32| codes.iter().any(|&(l, n, _)| l == letter && n == number);
         if let Some((refused, message)) = self.refused_value(block, &codes) {
             self.finding(at(refused), &message, true);
-            return Flow::End;
+            return Flow::Block(BlockFlow::End);
         }
         for word in &block.words {
             if let Some(Value::Parameter { index: Some(index), .. }) = word.value
@@ -1538,7 +1511,7 @@ impl Runner {
             if let Err((message, fatal)) = self.transform(code, &axes, block) {
                 self.finding(code_range, &message, fatal);
                 if fatal {
-                    return Flow::End;
+                    return Flow::Block(BlockFlow::End);
                 }
             }
             axes.clear();
@@ -1608,11 +1581,11 @@ impl Runner {
             }
             self.position = end;
             let Some(moved) = self.moved(&Move { block, range, axes: &axes, start, end }) else {
-                return Flow::End;
+                return Flow::Block(BlockFlow::End);
             };
             if let Some(message) = self.unreachable(&self.position) {
                 self.finding(range, &message, true);
-                return Flow::End;
+                return Flow::Block(BlockFlow::End);
             }
             (moved, dwell)
         };
@@ -1635,7 +1608,7 @@ impl Runner {
         if let Err(error) = self.compensate(start, path) {
             let range = self.step_mut(error.block()).range;
             self.finding(range, &format!("radius compensation: {error}"), true);
-            return Flow::End;
+            return Flow::Block(BlockFlow::End);
         }
         if let Some(dwell) = dwell {
             self.record(range, &end, dwell, stop, Functions::default());
@@ -1663,11 +1636,11 @@ impl Runner {
                 let message =
                     "a control word in R5–R8 has no value: it was computed from a value the executor does not know";
                 self.finding(range, message, true);
-                return Flow::End;
+                return Flow::Block(BlockFlow::End);
             }
             BlockArithmetic::Ran { function, result: Err(error), .. } => {
                 self.finding(at(function), &format!("parameter arithmetic failed: {error}"), true);
-                return Flow::End;
+                return Flow::Block(BlockFlow::End);
             }
         }
         // The active fixed cycle runs after the block's motion, in every
@@ -1675,13 +1648,13 @@ impl Runner {
         let cycle = self.modes.active(self.groups.cycle).filter(|&number| (81..=89).contains(&number));
         if let Some(number) = cycle.filter(|_| !self.in_cycle) {
             if self.machine.cycle_file.is_some() {
-                return Flow::Cycle { number, then: Box::new(self.flow_of(block, has)) };
+                return Flow::Cycle { number, then: self.flow_of(block, has) };
             }
             if !self.built_in_cycle_or_stop(number, range) {
-                return Flow::End;
+                return Flow::Block(BlockFlow::End);
             }
         }
-        self.flow_of(block, has)
+        Flow::Block(self.flow_of(block, has))
     }
 
     /// The first value of the block the control refuses, with its range in
@@ -1725,8 +1698,8 @@ impl Runner {
     }
 
     /// What follows the block once its work is done ([`block_flow`]).
-    fn flow_of(&self, block: &BlockData, has: impl Fn(u8, u32) -> bool) -> Flow {
-        block_flow(block, has, |word| self.integer(word)).into()
+    fn flow_of(&self, block: &BlockData, has: impl Fn(u8, u32) -> bool) -> BlockFlow {
+        block_flow(block, has, |word| self.integer(word))
     }
 
     /// Runs a block of group 11 with its axis words `axes`; the error says
