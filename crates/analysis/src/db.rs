@@ -2,9 +2,9 @@
 //!
 //! Inputs are the files (text and parse, kept in step by the host) and the
 //! settings (configuration and the workspace's file list). Block work is
-//! keyed by chunks of blocks interned by the blocks' identities: after an
-//! edit, the incremental reparse keeps every untouched block's node, so only
-//! the chunk the edit touched is lowered and checked again.
+//! keyed by chunks of blocks identified by their nodes: after an edit, the
+//! incremental reparse keeps every untouched block's node, so only the
+//! chunk the edit touched is lowered and checked again.
 
 use std::{
     hash::{Hash, Hasher},
@@ -54,8 +54,8 @@ pub struct Settings {
 }
 
 /// A green node compared and hashed by identity: nodes the reparse kept are
-/// the same node, and the interned chunk keeps the node alive, so an
-/// address is never reused while it is a key.
+/// the same node, and the chunk keeps the node alive, so an address is
+/// never reused while it is a key.
 #[derive(Debug, Clone)]
 pub struct BlockGreen(pub GreenNode);
 
@@ -80,7 +80,12 @@ impl Hash for BlockGreen {
 /// compact summary, full block data is rebuilt when needed). The reparse
 /// rebuilds only the runs an edit touches, so the other chunks, and their
 /// results, stay as they were.
-#[salsa::interned(debug)]
+///
+/// [`file_chunks`] creates the chunks of a file's tree, so a chunk whose
+/// node the tree no longer has goes with its results when `file_chunks`
+/// runs again. (Interned, replaced chunks stayed until salsa happened to
+/// reuse their slots: ever more of them over a long session.)
+#[salsa::tracked(debug)]
 pub struct BlockChunk<'db> {
     #[returns(ref)]
     pub green: BlockGreen,
@@ -219,5 +224,42 @@ impl salsa::Database for RootDatabase {}
 impl Db for RootDatabase {
     fn state_cache(&self) -> &StateCache {
         &self.states
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::file_chunks;
+    use crate::{AnalysisHost, TextEdit, TextRange, TextSize};
+
+    /// An edit replaces the chunk it touched: the database keeps the chunks
+    /// of the current tree and their results, not those of every chunk an
+    /// edit of a long session replaced.
+    #[test]
+    fn replaced_chunks_go_with_their_results() {
+        let blocks = 3000;
+        let mut text = String::from("%1 \"CHUNKS\"\n");
+        for n in 1..=blocks {
+            text.push_str(&format!("N{n} G01 X{n}. Y-{n}.\n"));
+        }
+        text.push_str("N9999 M30\n*\n");
+        let mut host = AnalysisHost::default();
+        let file = host.add_file("main.NCP", text.as_str());
+        for n in (7..blocks).step_by(11) {
+            let at = text.find(&format!("N{n} G01 X")).unwrap() + format!("N{n} G01 X").len();
+            let edit = TextEdit::replace(TextRange::empty(TextSize::from(at as u32)), "1");
+            host.apply_edit(file, &edit);
+            edit.apply(&mut text);
+            assert!(host.analysis().local_diagnostics(file).is_empty());
+        }
+        let chunks = file_chunks(host.db(), file).len();
+        assert!(chunks > 5, "{chunks} chunks");
+        let db: &mut dyn salsa::Database = &mut host.db;
+        let usage = db.memory_usage();
+        let kept = usage.structs.iter().find(|s| s.debug_name() == "BlockChunk").map(|s| s.count());
+        assert_eq!(kept, Some(chunks), "chunks kept, {chunks} in the tree");
+        for query in ["chunk_diagnostics", "chunk_summaries"] {
+            assert_eq!(usage.queries.get(query).map(|q| q.count()), Some(chunks), "results of {query}");
+        }
     }
 }
