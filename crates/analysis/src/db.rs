@@ -6,10 +6,7 @@
 //! incremental reparse keeps every untouched block's node, so only the
 //! chunk the edit touched is lowered and checked again.
 
-use std::{
-    hash::{Hash, Hasher},
-    sync::{Arc, Mutex},
-};
+use std::sync::{Arc, Mutex};
 
 use ncc_syntax::{Dialect, Parse, SyntaxKind, TextSize};
 use rowan::GreenNode;
@@ -53,9 +50,8 @@ pub struct Settings {
     pub files: Vec<SourceFile>,
 }
 
-/// A green node compared and hashed by identity: nodes the reparse kept are
-/// the same node, and the chunk keeps the node alive, so an address is
-/// never reused while it is a key.
+/// A chunk's node, compared by identity: nodes the reparse kept are the
+/// same node.
 #[derive(Debug, Clone)]
 pub struct BlockGreen(pub GreenNode);
 
@@ -67,12 +63,6 @@ impl PartialEq for BlockGreen {
 
 impl Eq for BlockGreen {}
 
-impl Hash for BlockGreen {
-    fn hash<H: Hasher>(&self, state: &mut H) {
-        std::ptr::hash::<rowan::GreenNodeData, H>(&*self.0, state);
-    }
-}
-
 /// The unit of incremental work: a run of blocks (`BLOCK_RUN`), or one
 /// block outside any run (words before the first numbered block). Chunks
 /// keep every query small (salsa's bookkeeping gets slow for queries with
@@ -81,17 +71,30 @@ impl Hash for BlockGreen {
 /// rebuilds only the runs an edit touches, so the other chunks, and their
 /// results, stay as they were.
 ///
-/// [`file_chunks`] creates the chunks of a file's tree, so a chunk whose
-/// node the tree no longer has goes with its results when `file_chunks`
-/// runs again. (Interned, replaced chunks stayed until salsa happened to
-/// reuse their slots: ever more of them over a long session.)
+/// [`file_chunks`] creates the chunks of a file's tree and gives each its
+/// node, so a chunk whose node the tree no longer has goes, with its node
+/// and its results, when `file_chunks` runs again. (Interned, replaced
+/// chunks stayed until salsa happened to reuse their slots, ever more over
+/// a long session; and a field of a tracked struct stays in its slot after
+/// the struct goes, until the slot is reused.)
 #[salsa::tracked(debug)]
 pub struct BlockChunk<'db> {
-    #[returns(ref)]
-    pub green: BlockGreen,
+    /// Where the chunk's node is: it identifies the chunk among those
+    /// `file_chunks` created before, whose nodes live while they do.
+    address: usize,
+}
+
+/// The node of a chunk, which `file_chunks` gives every chunk it creates.
+#[salsa::tracked(returns(ref), specify)]
+fn chunk_green<'db>(_db: &'db dyn Db, _chunk: BlockChunk<'db>) -> BlockGreen {
+    unreachable!("file_chunks gives every chunk it creates its node")
 }
 
 impl<'db> BlockChunk<'db> {
+    fn green(self, db: &'db dyn Db) -> &'db BlockGreen {
+        chunk_green(db, self)
+    }
+
     /// The chunk's run node, when it is a run rather than a lone block.
     fn run(self, db: &'db dyn Db) -> Option<&'db rowan::GreenNodeData> {
         let node: &'db rowan::GreenNodeData = &self.green(db).0;
@@ -140,7 +143,8 @@ pub fn file_chunks(db: &dyn Db, file: SourceFile) -> Vec<FileChunk<'_>> {
         if let rowan::NodeOrToken::Node(node) = child
             && (node.kind() == SyntaxKind::BLOCK.into() || node.kind() == SyntaxKind::BLOCK_RUN.into())
         {
-            let chunk = BlockChunk::new(db, BlockGreen(node.to_owned()));
+            let chunk = BlockChunk::new(db, std::ptr::from_ref(node).addr());
+            chunk_green::specify(db, chunk, BlockGreen(node.to_owned()));
             chunks.push(FileChunk { chunk, offset, first });
             first += chunk.len(db);
         }
