@@ -73,6 +73,23 @@ pub fn run(server: &Path, options: &Options) -> anyhow::Result<()> {
     client.initialize(dir.path(), None)?;
     let rss = |client: &Client| client.memory().map(|m| m.rss).context("the server's memory is unknown (no /proc)");
     let before_open = rss(&client)?;
+    let mb = |bytes: u64| bytes as f64 / 1e6;
+    // The curve as it comes: a run takes minutes.
+    let show = |sample: &Sample| {
+        if !as_json {
+            println!("  {:>8}  {:>9.1}  {:>9.1}", sample.edits, mb(sample.rss), sample.elapsed.as_secs_f64());
+        }
+    };
+    if !as_json {
+        println!(
+            "lsp-memory benchmark: {blocks} blocks ({:.1} MB), {edits} single-character edits, a pause after every \
+             {pause_every}th, {}",
+            bytes as f64 / 1e6,
+            server.display()
+        );
+        println!("  {:>8}  {:>9}  {:>9}", "edits", "RSS MB", "time s");
+        println!("  {:>8}  {:>9.1}", "unopened", mb(before_open));
+    }
 
     let mut doc = Document::new(lsp_client::file_uri(&path), text);
     let started = Instant::now();
@@ -80,6 +97,7 @@ pub fn run(server: &Path, options: &Options) -> anyhow::Result<()> {
     client.diagnostics(&doc.uri, doc.version)?;
     pause(&mut client, &doc, 0)?;
     let mut samples = vec![Sample { edits: 0, rss: rss(&client)?, elapsed: started.elapsed() }];
+    show(&samples[0]);
 
     let mut rng = Lcg::new(SEED);
     let mut missing_refreshes = 0;
@@ -97,6 +115,7 @@ pub fn run(server: &Path, options: &Options) -> anyhow::Result<()> {
         }
         if sample {
             samples.push(Sample { edits: done, rss: rss(&client)?, elapsed: started.elapsed() });
+            show(&samples[samples.len() - 1]);
         }
     }
 
@@ -114,7 +133,6 @@ pub fn run(server: &Path, options: &Options) -> anyhow::Result<()> {
     let first = at(sample_every.min(edits)).context("no sample")?;
     let last = samples.last().context("no sample")?.rss;
     let growth = last as f64 / first as f64;
-    let mb = |bytes: u64| bytes as f64 / 1e6;
     if as_json {
         let curve: Vec<Value> = samples
             .iter()
@@ -133,17 +151,6 @@ pub fn run(server: &Path, options: &Options) -> anyhow::Result<()> {
         });
         println!("{output:#}");
     } else {
-        println!(
-            "lsp-memory benchmark: {blocks} blocks ({:.1} MB), {edits} single-character edits, a pause after every \
-             {pause_every}th, {}",
-            bytes as f64 / 1e6,
-            server.display()
-        );
-        println!("  {:>8}  {:>9}  {:>9}", "edits", "RSS MB", "time s");
-        println!("  {:>8}  {:>9.1}", "unopened", mb(before_open));
-        for sample in &samples {
-            println!("  {:>8}  {:>9.1}  {:>9.1}", sample.edits, mb(sample.rss), sample.elapsed.as_secs_f64());
-        }
         println!("  {:>8}  {:>9.1}", "closed", mb(after_close));
         let verdict = if growth <= GROWTH_GOAL { "met" } else { "NOT met" };
         println!("  RSS({edits})/RSS({}) = {growth:.3}   goal <= {GROWTH_GOAL}: {verdict}", sample_every.min(edits));
@@ -160,9 +167,9 @@ pub fn run(server: &Path, options: &Options) -> anyhow::Result<()> {
 }
 
 /// Waits until the server is done with the current version, whose first
-/// diagnostics have come: its complete diagnostics, then the cycle-time estimate's refresh, after which the
-/// client asks for the inlay hints of the lines around `at`. Returns
-/// whether the refresh came.
+/// diagnostics have come: its complete diagnostics, then the cycle-time
+/// estimate's refresh, after which the client asks for the inlay hints of
+/// the lines around `at`. Returns whether the refresh came.
 fn pause(client: &mut Client, doc: &Document, at: usize) -> anyhow::Result<bool> {
     client.diagnostics(&doc.uri, doc.version)?;
     let refreshed = client
