@@ -295,6 +295,8 @@ impl Server {
             let mut all = local;
             all.extend(flow);
             send(all);
+            // The version's work is done: typing paused.
+            crate::return_free_memory();
         });
         if let Err(error) = spawned {
             tracing::error!("cannot start a diagnostics thread: {error}");
@@ -467,6 +469,7 @@ impl LanguageServer for Server {
             }
         }
         self.timer.forget(&uri);
+        crate::return_free_memory();
         self.client.publish_diagnostics(uri, Vec::new(), None).await;
     }
 
