@@ -2,14 +2,11 @@
 //!
 //! Inputs are the files (text and parse, kept in step by the host) and the
 //! settings (configuration and the workspace's file list). Block work is
-//! keyed by chunks of blocks interned by the blocks' identities: after an
-//! edit, the incremental reparse keeps every untouched block's node, so only
-//! the chunk the edit touched is lowered and checked again.
+//! keyed by chunks of blocks identified by their nodes: after an edit, the
+//! incremental reparse keeps every untouched block's node, so only the
+//! chunk the edit touched is lowered and checked again.
 
-use std::{
-    hash::{Hash, Hasher},
-    sync::{Arc, Mutex},
-};
+use std::sync::{Arc, Mutex};
 
 use ncc_syntax::{Dialect, Parse, SyntaxKind, TextSize, limit::LineLimiter};
 use rowan::GreenNode;
@@ -54,9 +51,8 @@ pub struct Settings {
     pub files: Vec<SourceFile>,
 }
 
-/// A green node compared and hashed by identity: nodes the reparse kept are
-/// the same node, and the interned chunk keeps the node alive, so an
-/// address is never reused while it is a key.
+/// A chunk's node, compared by identity: nodes the reparse kept are the
+/// same node.
 #[derive(Debug, Clone)]
 pub struct BlockGreen(pub GreenNode);
 
@@ -68,12 +64,6 @@ impl PartialEq for BlockGreen {
 
 impl Eq for BlockGreen {}
 
-impl Hash for BlockGreen {
-    fn hash<H: Hasher>(&self, state: &mut H) {
-        std::ptr::hash::<rowan::GreenNodeData, H>(&*self.0, state);
-    }
-}
-
 /// The unit of incremental work: a run of blocks (`BLOCK_RUN`), or one
 /// block outside any run (words before the first numbered block). Chunks
 /// keep every query small (salsa's bookkeeping gets slow for queries with
@@ -81,13 +71,31 @@ impl Hash for BlockGreen {
 /// compact summary, full block data is rebuilt when needed). The reparse
 /// rebuilds only the runs an edit touches, so the other chunks, and their
 /// results, stay as they were.
-#[salsa::interned(debug)]
+///
+/// [`file_chunks`] creates the chunks of a file's tree and gives each its
+/// node, so a chunk whose node the tree no longer has goes, with its node
+/// and its results, when `file_chunks` runs again. (Interned, replaced
+/// chunks stayed until salsa happened to reuse their slots, ever more over
+/// a long session; and a field of a tracked struct stays in its slot after
+/// the struct goes, until the slot is reused.)
+#[salsa::tracked(debug)]
 pub struct BlockChunk<'db> {
-    #[returns(ref)]
-    pub green: BlockGreen,
+    /// Where the chunk's node is: it identifies the chunk among those
+    /// `file_chunks` created before, whose nodes live while they do.
+    address: usize,
+}
+
+/// The node of a chunk, which `file_chunks` gives every chunk it creates.
+#[salsa::tracked(returns(ref), specify)]
+fn chunk_green<'db>(_db: &'db dyn Db, _chunk: BlockChunk<'db>) -> BlockGreen {
+    unreachable!("file_chunks gives every chunk it creates its node")
 }
 
 impl<'db> BlockChunk<'db> {
+    fn green(self, db: &'db dyn Db) -> &'db BlockGreen {
+        chunk_green(db, self)
+    }
+
     /// The chunk's run node, when it is a run rather than a lone block.
     fn run(self, db: &'db dyn Db) -> Option<&'db rowan::GreenNodeData> {
         let node: &'db rowan::GreenNodeData = &self.green(db).0;
@@ -136,7 +144,8 @@ pub fn file_chunks(db: &dyn Db, file: SourceFile) -> Vec<FileChunk<'_>> {
         if let rowan::NodeOrToken::Node(node) = child
             && (node.kind() == SyntaxKind::BLOCK.into() || node.kind() == SyntaxKind::BLOCK_RUN.into())
         {
-            let chunk = BlockChunk::new(db, BlockGreen(node.to_owned()));
+            let chunk = BlockChunk::new(db, std::ptr::from_ref(node).addr());
+            chunk_green::specify(db, chunk, BlockGreen(node.to_owned()));
             chunks.push(FileChunk { chunk, offset, first });
             first += chunk.len(db);
         }
@@ -226,5 +235,42 @@ impl salsa::Database for RootDatabase {}
 impl Db for RootDatabase {
     fn state_cache(&self) -> &StateCache {
         &self.states
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::file_chunks;
+    use crate::{AnalysisHost, TextEdit, TextRange, TextSize};
+
+    /// An edit replaces the chunk it touched: the database keeps the chunks
+    /// of the current tree and their results, not those of every chunk an
+    /// edit of a long session replaced.
+    #[test]
+    fn replaced_chunks_go_with_their_results() {
+        let blocks = 3000;
+        let mut text = String::from("%1 \"CHUNKS\"\n");
+        for n in 1..=blocks {
+            text.push_str(&format!("N{n} G01 X{n}. Y-{n}.\n"));
+        }
+        text.push_str("N9999 M30\n*\n");
+        let mut host = AnalysisHost::default();
+        let file = host.add_file("main.NCP", text.as_str());
+        for n in (7..blocks).step_by(11) {
+            let at = text.find(&format!("N{n} G01 X")).unwrap() + format!("N{n} G01 X").len();
+            let edit = TextEdit::replace(TextRange::empty(TextSize::from(at as u32)), "1");
+            host.apply_edit(file, &edit);
+            edit.apply(&mut text);
+            assert!(host.analysis().local_findings(file).diagnostics.is_empty());
+        }
+        let chunks = file_chunks(host.db(), file).len();
+        assert!(chunks > 5, "{chunks} chunks");
+        let db: &mut dyn salsa::Database = &mut host.db;
+        let usage = db.memory_usage();
+        let kept = usage.structs.iter().find(|s| s.debug_name() == "BlockChunk").map(|s| s.count());
+        assert_eq!(kept, Some(chunks), "chunks kept, {chunks} in the tree");
+        for query in ["chunk_diagnostics", "chunk_summaries"] {
+            assert_eq!(usage.queries.get(query).map(|q| q.count()), Some(chunks), "results of {query}");
+        }
     }
 }

@@ -85,20 +85,38 @@ impl AnalysisHost {
         file
     }
 
-    /// Removes a file from the workspace (its handle must not be used again).
+    /// Removes a file from the workspace, and everything computed from it
+    /// (its handle must not be used again).
     pub fn remove_file(&mut self, file: FileId) {
+        self.release(file);
         let settings = Settings::get(&self.db);
         let files: Vec<SourceFile> = settings.files(&self.db).iter().copied().filter(|&f| f != file).collect();
+        // A new revision: salsa frees the results `release` replaced.
         settings.set_files(&mut self.db).to(files);
-        self.db.state_cache().forget(file);
     }
 
-    /// Replaces a file's text.
+    /// Replaces a file's text; what was computed from the old one goes at
+    /// once, not when the file is next analysed (a document that closes
+    /// may never be).
     pub fn set_text(&mut self, file: FileId, text: impl Into<String>) {
+        self.release(file);
         let text = Arc::new(text.into());
         let parse = Parse::new(&text, self.dialect());
         file.set_text(&mut self.db).to(text);
         file.set_parse(&mut self.db).to(parse);
+    }
+
+    /// Lets go of everything computed from a file's text. Salsa keeps a
+    /// query's result until the query runs again, and an input for good;
+    /// so the file's queries run once on an empty text, which leaves next
+    /// to nothing, and the chunks of its old tree go with their results.
+    /// The results replaced are freed at the next revision.
+    fn release(&mut self, file: FileId) {
+        self.db.state_cache().forget(file);
+        let empty = Parse::new("", self.dialect());
+        file.set_text(&mut self.db).to(Arc::default());
+        file.set_parse(&mut self.db).to(empty);
+        self.analysis().diagnostics(file);
     }
 
     /// Applies an edit, reparsing only the blocks it touches.

@@ -445,10 +445,12 @@ impl Checkpoints {
                 at += 1;
                 last = block;
             }
-            // Preparing for questions must not keep one waiting: leave a
-            // checkpoint here and let go.
+            // Preparing for questions must not keep one waiting: let go,
+            // leaving a checkpoint here to go on from, unless it would crowd
+            // those around it (over a session of edits and questions they
+            // would pile up); the next step then walks from the last one.
             if waiting.is_some_and(|waiting| waiting.load(Ordering::Relaxed) > 0) && block < end {
-                if following != block && last != block {
+                if block - last >= STRIDE / 2 && following - block >= STRIDE / 2 {
                     points.insert(at, Checkpoint::new(block, carried, walk.take_entered()));
                 }
                 return (None, walked);
@@ -565,8 +567,10 @@ fn walk_to(
 mod tests {
     use ncc_syntax::{Dialect, Parse, ast::AstNode};
 
-    use super::{STRIDE, changed_blocks, main_state_and_walk, main_state_before};
-    use crate::{AnalysisHost, Config, TextEdit, TextRange, TextSize, flow::walked_states};
+    use std::sync::atomic::Ordering;
+
+    use super::{Asker, STRIDE, changed_blocks, main_state_and_walk, main_state_before, walk_to};
+    use crate::{AnalysisHost, Config, TextEdit, TextRange, TextSize, db::Db, flow::walked_states};
 
     /// What [`changed_blocks`] promises, whatever the tree's shape: the
     /// blocks before and after the change are the same nodes, the text
@@ -712,5 +716,43 @@ mod tests {
             }
             assert!(passed > 0 && counted, "{passed} blocks passed; the loop counted: {counted}");
         }
+    }
+
+    /// A preparation that gives way to a question again and again, after
+    /// every edit of a long session, leaves no more checkpoints than its
+    /// stride allows: they would pile up over the session otherwise.
+    #[test]
+    fn preparations_giving_way_to_questions_keep_their_checkpoints_apart() {
+        let blocks = 3000;
+        let mut text = String::from("%1 \"YIELD\"\nN1 G90 F100\n");
+        for n in 2..=blocks {
+            text.push_str(&format!("N{n} G01 X{n}. Y-{n}.\n"));
+        }
+        text.push_str("N9999 M30\n*\n");
+        let mut host = AnalysisHost::new(Config::default());
+        let file = host.add_file("main.NCP", text.as_str());
+        host.analysis().prepare_states(file);
+        let points = |host: &AnalysisHost| -> Vec<usize> {
+            let files = host.db().state_cache().files.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+            files[&file].points.iter().map(|point| point.index).collect()
+        };
+        let regular = points(&host).len();
+        for n in (7..blocks).step_by(37) {
+            let at = text.find(&format!("N{n} G01 X")).unwrap() + format!("N{n} G01 X").len();
+            let edit = TextEdit::replace(TextRange::empty(TextSize::from(at as u32)), "1");
+            host.apply_edit(file, &edit);
+            edit.apply(&mut text);
+            // A question waits all along: each step walks a block and lets go.
+            let waiting = &host.db().state_cache().waiting;
+            waiting.fetch_add(1, Ordering::Relaxed);
+            for _ in 0..20 {
+                walk_to(host.db(), file, blocks - 1, Asker::Preparation);
+            }
+            waiting.fetch_sub(1, Ordering::Relaxed);
+            host.analysis().prepare_states(file);
+        }
+        let after = points(&host);
+        assert!(after.windows(2).all(|pair| pair[1] - pair[0] >= STRIDE / 2), "{after:?}");
+        assert!(after.len() <= 2 * regular, "{} checkpoints, {regular} after the first preparation", after.len());
     }
 }

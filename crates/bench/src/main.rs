@@ -4,9 +4,12 @@
 //! cargo run --release -p ncc-bench -- parse [--blocks 1000000] [--runs 3]
 //! cargo run --release -p ncc-bench -- generate --blocks 1000000 --syntax cnc8x6 -o big.NCP
 //! cargo build --release -p ncc -p ncc-bench && target/release/ncc-bench lsp [--json]
+//! cargo build --release -p ncc -p ncc-bench && target/release/ncc-bench lsp-memory [--edits 30000] [--json]
 //! cargo build --release -p ncc -p ncc-bench && target/release/ncc-bench exec [--blocks 1000000] [--runs 3] [--json]
 //! ```
 #![allow(unsafe_code)] // The counting allocator below; nothing else.
+
+mod lsp_memory;
 
 use std::{
     alloc::{GlobalAlloc, Layout},
@@ -110,6 +113,27 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Drive the language server (`ncc lsp`) through a long editing session
+    /// on a generated program at an editor's pace, and print its resident
+    /// memory every `--sample-every` edits and after the document closes.
+    LspMemory {
+        /// The `ncc` binary [default: the one beside ncc-bench].
+        #[arg(long)]
+        server: Option<PathBuf>,
+        #[arg(long, default_value_t = 100_000)]
+        blocks: usize,
+        #[arg(long, default_value_t = 30_000)]
+        edits: usize,
+        #[arg(long, default_value_t = 1_000)]
+        sample_every: usize,
+        /// Every this many edits, wait until the server has finished its
+        /// background work (complete diagnostics, cycle-time estimate).
+        #[arg(long, default_value_t = 100)]
+        pause_every: usize,
+        /// Print the results as one JSON object.
+        #[arg(long)]
+        json: bool,
+    },
     /// Run a generated surfacing program with `ncc run` and the same
     /// toolpath in NGC syntax with LinuxCNC's `rs274 -g`, each a process
     /// whose output is discarded.
@@ -161,6 +185,10 @@ fn main() -> anyhow::Result<()> {
         Command::Lsp { server, blocks, edits, json } => {
             lsp_benchmark(&server.map_or_else(ncc_beside_bench, Ok)?, blocks, edits, json)
         }
+        Command::LspMemory { server, blocks, edits, sample_every, pause_every, json } => lsp_memory::run(
+            &server.map_or_else(ncc_beside_bench, Ok)?,
+            &lsp_memory::Options { blocks, edits, sample_every, pause_every, json },
+        ),
         Command::Exec { ncc, blocks, runs, json } => {
             exec_benchmark(&ncc.map_or_else(ncc_beside_bench, Ok)?, blocks, runs.max(1), json)
         }

@@ -103,6 +103,11 @@ impl Timer {
                     Ok(false) => {}
                     Err(_) => tracing::error!("{} v{version}: estimating the cycle time failed", uri.as_str()),
                 }
+                let (lock, _) = &*jobs;
+                if lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).pending.is_empty() {
+                    // Nothing more to estimate: typing paused.
+                    crate::return_free_memory();
+                }
             }
         });
         if let Err(error) = spawned {

@@ -302,6 +302,8 @@ impl Server {
                 }
             }
             send(all);
+            // The version's work is done: typing paused.
+            crate::return_free_memory();
         });
         if let Err(error) = spawned {
             tracing::error!("cannot start a diagnostics thread: {error}");
@@ -471,6 +473,7 @@ impl LanguageServer for Server {
             }
         }
         self.timer.forget(&uri);
+        crate::return_free_memory();
         self.client.publish_diagnostics(uri, Vec::new(), None).await;
     }
 
