@@ -13,15 +13,13 @@
 
 use std::{
     path::Path,
-    process::Command,
     time::{Duration, Instant},
 };
 
 use anyhow::Context;
 use ncc_bench::{
     edits::{self, Lcg},
-    lsp_client::{self, Client, Document},
-    progen::{self, Syntax},
+    lsp_client::{Client, Document},
 };
 use serde_json::{Value, json};
 
@@ -58,19 +56,8 @@ struct Sample {
 pub fn run(server: &Path, options: &Options) -> anyhow::Result<()> {
     let Options { blocks, edits, sample_every, pause_every, json: as_json } = *options;
     anyhow::ensure!(edits > 0 && sample_every > 0 && pause_every > 0, "counts must be at least 1");
-    let text = progen::write(&progen::surfacing(blocks), Syntax::Cnc8x6);
-    let bytes = text.len();
-    // The program is a file of the workspace, as in an editor: closing it
-    // leaves the text on disk in the workspace.
-    let dir = tempfile::tempdir()?;
-    let path = dir.path().join("surface.NCP");
-    std::fs::write(&path, &text)?;
-
-    let mut process = Command::new(server);
-    process.arg("lsp");
-    let mut client = Client::spawn(process)?;
-    client.timeout = Duration::from_secs(120);
-    client.initialize(dir.path(), None)?;
+    let (mut client, _workspace, mut doc) = crate::serve_generated_program(server, blocks)?;
+    let bytes = doc.text().len();
     let rss = |client: &Client| client.memory().map(|m| m.rss).context("the server's memory is unknown (no /proc)");
     let before_open = rss(&client)?;
     let mb = |bytes: u64| bytes as f64 / 1e6;
@@ -91,7 +78,6 @@ pub fn run(server: &Path, options: &Options) -> anyhow::Result<()> {
         println!("  {:>8}  {:>9.1}", "unopened", mb(before_open));
     }
 
-    let mut doc = Document::new(lsp_client::file_uri(&path), text);
     let started = Instant::now();
     client.notify("textDocument/didOpen", doc.did_open())?;
     client.diagnostics(&doc.uri, doc.version)?;

@@ -490,22 +490,32 @@ fn wake_ups(count: usize) -> Latencies {
     latencies
 }
 
-fn lsp_benchmark(server: &Path, blocks: usize, edits: usize, as_json: bool) -> anyhow::Result<()> {
-    anyhow::ensure!(edits > 0, "--edits must be at least 1");
+/// The server at `server` started on a workspace that holds a generated
+/// program of `blocks` blocks, and that program as a document not yet
+/// opened; the workspace lasts as long as the returned directory.
+pub(crate) fn serve_generated_program(
+    server: &Path,
+    blocks: usize,
+) -> anyhow::Result<(Client, tempfile::TempDir, Document)> {
     let text = progen::write(&progen::surfacing(blocks), Syntax::Cnc8x6);
-    let bytes = text.len();
-    // Editors open files that exist; the server may look beside them.
+    // Editors open files that exist: the server may look beside them, and
+    // a closed document stays in the workspace as its file.
     let dir = tempfile::tempdir()?;
     let path = dir.path().join("surface.NCP");
     std::fs::write(&path, &text)?;
-
     let mut process = Process::new(server);
     process.arg("lsp");
     let mut client = Client::spawn(process)?;
     // A slow answer is measured, only a missing one fails the run.
     client.timeout = Duration::from_secs(120);
     client.initialize(dir.path(), None)?;
-    let mut doc = Document::new(lsp_client::file_uri(&path), text);
+    Ok((client, dir, Document::new(lsp_client::file_uri(&path), text)))
+}
+
+fn lsp_benchmark(server: &Path, blocks: usize, edits: usize, as_json: bool) -> anyhow::Result<()> {
+    anyhow::ensure!(edits > 0, "--edits must be at least 1");
+    let (mut client, _workspace, mut doc) = serve_generated_program(server, blocks)?;
+    let bytes = doc.text().len();
     let cpu_before = CpuTimes::now();
     let opened = client.notify("textDocument/didOpen", doc.did_open())?;
     let open = client.diagnostics(&doc.uri, doc.version)?.received - opened;
