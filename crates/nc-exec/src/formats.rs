@@ -49,14 +49,7 @@ pub fn literal_fault(address: &Address, value: &Decimal, machine: &MachineConfig
     let outside =
         !surely_within(address.bounds, digits, value.is_negative()) && outside_range(address, value.to_f64(), machine);
     outside.then(|| {
-        Fault::new(
-            Refusal::Range,
-            format!(
-                "`{letter}{value}` is outside the range of `{letter}`: {} to {}",
-                address.min.as_deref().unwrap_or_default(),
-                address.max.as_deref().unwrap_or_default()
-            ),
-        )
+        Fault::new(Refusal::Range, format!("`{letter}{value}` is outside the range of `{letter}`: {}", range(address)))
     })
 }
 
@@ -66,16 +59,14 @@ pub fn assignment_fault(parameter: &Address, value: &Decimal) -> Option<Fault> {
     if let Some(message) = digit_overflow(parameter, value) {
         return Some(Fault::new(Refusal::Digits, message));
     }
-    literal_raw(value).is_none_or(|raw| raw.abs() > MAX_RAW).then(|| {
-        Fault::new(
-            Refusal::Range,
-            format!(
-                "`{value}` is outside the parameter range {} to {}",
-                parameter.min.as_deref().unwrap_or_default(),
-                parameter.max.as_deref().unwrap_or_default()
-            ),
-        )
-    })
+    literal_raw(value)
+        .is_none_or(|raw| raw.abs() > MAX_RAW)
+        .then(|| Fault::new(Refusal::Range, format!("`{value}` is outside the parameter range {}", range(parameter))))
+}
+
+/// An address's range as messages write it: `min to max`.
+fn range(address: &Address) -> String {
+    format!("{} to {}", address.min.as_deref().unwrap_or_default(), address.max.as_deref().unwrap_or_default())
 }
 
 /// The format's digit limits: significant digits before the point (leading
@@ -207,10 +198,9 @@ pub fn substitution_fault(address: &Address, raw: Raw, thread: bool, machine: &M
         Fault::new(
             Refusal::Range,
             format!(
-                "the parameter holds {} (read as `{letter}{raw}`), outside `{letter}`'s range {} to {}",
+                "the parameter holds {} (read as `{letter}{raw}`), outside `{letter}`'s range {}",
                 show(raw),
-                address.min.as_deref().unwrap_or_default(),
-                address.max.as_deref().unwrap_or_default()
+                range(address)
             ),
         )
     })
