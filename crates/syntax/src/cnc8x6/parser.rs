@@ -206,8 +206,8 @@ impl<'a> BlockParser<'a> {
         let header = header.and_then(|_| front.into_iter().find_map(NodeOrToken::into_node));
         let mut parser = Parser::new(text, body.start, body.end);
         // File-level trivia before the first block belongs to no block.
-        while let Some(Token { kind: WHITESPACE | NEWLINE | COMMENT | UNREAD, len }) = parser.peek() {
-            parser.move_to(parser.pos + len);
+        while let Some(token @ Token { kind: WHITESPACE | NEWLINE | COMMENT | UNREAD, .. }) = parser.peek() {
+            parser.advance(token);
         }
         let body = parser.pos..body.end;
         BlockParser { parser, header, body }
@@ -439,6 +439,16 @@ impl<'a> Parser<'a> {
         self.end = read_end(self.text, self.pos, self.region_end);
     }
 
+    /// Steps over `token`. After a line break a new line starts; after the
+    /// rest of a line that is not read (unread, or after `*`) comes its line
+    /// break, read as usual.
+    fn advance(&mut self, token: Token) {
+        self.pos += token.len;
+        if matches!(token.kind, NEWLINE | UNREAD | TRAILER) {
+            self.new_line();
+        }
+    }
+
     fn token_at(&self, pos: usize) -> Option<Token> {
         if pos >= self.region_end {
             return None;
@@ -493,11 +503,7 @@ impl<'a> Parser<'a> {
     fn bump(&mut self) -> GreenElement {
         let token = self.peek().expect("bump past the end");
         let text = &self.text[self.pos..self.pos + token.len];
-        self.pos += token.len;
-        if matches!(token.kind, NEWLINE | UNREAD) {
-            // After the unread part comes the line break, read as usual.
-            self.new_line();
-        }
+        self.advance(token);
         self.green.token(token.kind, text)
     }
 
@@ -903,7 +909,7 @@ impl<'a> Parser<'a> {
                     let start = self.pos;
                     let line_end = line_end(self.text, start, self.text.len());
                     children.push(self.green.token(TRAILER, &self.text[start..line_end]));
-                    self.move_to(line_end);
+                    self.advance(Token { kind: TRAILER, len: line_end - start });
                     let first = ignored.map_or(start, |r| r.start);
                     ignored = Some(first..line_end);
                 }
