@@ -332,6 +332,11 @@ describe('a server that exits as it starts', () => {
     await workbench.screenshot('5-start-failure');
     assert.match(toast, /exited as it started/);
     assert.match(toast, /Show Log/);
+    // The client's own notification would cover this one and its button.
+    const toasts = await workbench.page.evaluate(() =>
+      [...document.querySelectorAll<HTMLElement>('.notification-toast')].map((t) => t.innerText),
+    );
+    assert.deepEqual(toasts, [toast], 'one notification reports the failed start');
     const status = await workbench.page.evaluate(() => document.querySelector<HTMLElement>('.part.statusbar')?.innerText ?? '');
     assert.match(status, /\bncc\b/);
     const [showLog] = await workbench.page.$$('xpath/.//*[contains(@class, "notification-toast")]//*[contains(@class, "monaco-button") and normalize-space(.)="Show Log"]');

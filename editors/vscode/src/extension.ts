@@ -8,6 +8,8 @@ import {
   type ErrorHandler,
   ExecuteCommandRequest,
   LanguageClient,
+  type LanguageClientOptions,
+  type ServerOptions,
   State,
 } from 'vscode-languageclient/node';
 import { type Environment, type Launch, readSettings, ServerStderr, serverLaunch, startFailure } from './server';
@@ -116,9 +118,8 @@ class Server implements vscode.Disposable {
     // class's to report (with what it wrote on stderr), not restarted.
     let started = false;
     let afterStart: ErrorHandler | undefined;
-    const client = new LanguageClient(
-      'ncc',
-      'ncc',
+    const client = new StartReportingClient(
+      () => started,
       { command, args },
       {
         documentSelector: [
@@ -267,6 +268,27 @@ class Server implements vscode.Disposable {
     }
     tooltip.appendMarkdown('\n\n[Restart](command:ncc.restartServer) · [Show log](command:ncc.showOutput)');
     this.item.tooltip = tooltip;
+  }
+}
+
+/**
+ * A language client that, until its server has answered `initialize`, logs
+ * its errors without a notification of its own: the extension reports a
+ * failed start itself, with the server's reason and a button to the log, and
+ * a second notification (the client's "couldn't create connection") would
+ * cover it.
+ */
+class StartReportingClient extends LanguageClient {
+  constructor(
+    private readonly started: () => boolean,
+    server: ServerOptions,
+    options: LanguageClientOptions,
+  ) {
+    super('ncc', 'ncc', server, options);
+  }
+
+  override error(message: string, data?: unknown, showNotification: boolean | 'force' = true): void {
+    super.error(message, data, this.started() ? showNotification : false);
   }
 }
 
