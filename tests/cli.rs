@@ -873,6 +873,29 @@ fn a_program_ending_under_compensation_ends_on_the_last_normal() {
 const NESTED_LOOPS: &str =
     "%1\nN1 G23 G91 G01 X.002 F1\nN2 X.002 G73 L1 Q999\nN3 X.002 G73 L1 Q999\nN4 X.002 G73 L1 Q999\nN5 M30\n";
 
+/// `ncc expand | head`: once the reader has gone, the run ends quietly
+/// instead of running on to its step budget.
+#[test]
+fn expand_ends_when_its_reader_goes() {
+    use std::io::BufRead;
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("NESTED.NCP");
+    std::fs::write(&program, NESTED_LOOPS).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ncc"))
+        .args(["expand", program.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    std::io::BufReader::new(child.stdout.take().unwrap()).read_line(&mut first).unwrap();
+    assert_eq!(first, "%1 \"EXPANDED FROM NESTED.NCP\"\n");
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8(output.stderr).unwrap();
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    assert!(!stderr.contains("stopped after"), "{stderr}");
+}
+
 /// `ncc plot` draws the first moves of a long run only, and says so in the
 /// picture and on stderr; the legend's time is the whole run's.
 #[test]

@@ -201,6 +201,11 @@ impl<W: Write> StepSink for Expansion<W> {
         self.spans.extend(compensated[first..].iter().cloned());
         self.pieces.extend(pieces);
     }
+
+    /// Nothing more is written after a failure, so the run need not go on.
+    fn closed(&self) -> bool {
+        self.failure.is_some()
+    }
 }
 
 /// From the frame a step ran in to the frame the written program runs in:

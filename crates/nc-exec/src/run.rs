@@ -438,6 +438,12 @@ pub trait StepSink {
     fn checkpoint(&mut self, _checkpoint: Checkpoint) -> ControlFlow<()> {
         ControlFlow::Continue(())
     }
+
+    /// Whether the sink takes no more steps (where it writes has closed):
+    /// the run then ends after the batch it has just taken.
+    fn closed(&self) -> bool {
+        false
+    }
 }
 
 /// The run between two blocks of the program's main body while it goes
@@ -813,6 +819,9 @@ fn run_in<'a, 's>(
             && runner.steps.len() >= DELIVERY_BATCH
         {
             runner.deliver(sink, false);
+            if sink.closed() {
+                break;
+            }
         }
     }
     runner.finish_compensation();
@@ -2748,6 +2757,33 @@ mod tests {
         fn step(&mut self, step: Step) {
             self.push(step);
         }
+    }
+
+    /// Takes steps until it has `room` of them, then is closed.
+    struct Closing {
+        taken: usize,
+        room: usize,
+    }
+
+    impl StepSink for Closing {
+        fn step(&mut self, _step: Step) {
+            self.taken += 1;
+        }
+
+        fn closed(&self) -> bool {
+            self.taken >= self.room
+        }
+    }
+
+    #[test]
+    fn a_streamed_run_ends_soon_after_its_sink_closes() {
+        // Two nested loops: a million moves.
+        let text = "%1\nN1 G91 G01 X1 F1000\nN2 X-1 G73 L1 Q999\nN3 Y.001 G73 L1 Q999\nN4 M30\n";
+        let mut sink = Closing { taken: 0, room: 1 };
+        let trace = run_into(text, &NoFiles, &MachineConfig::default(), 1_000_000, &mut sink);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        assert!(sink.taken <= 2 * DELIVERY_BATCH, "{} steps after the sink closed", sink.taken);
+        assert!(trace.blocks_run <= 4 * DELIVERY_BATCH, "{} blocks run", trace.blocks_run);
     }
 
     #[test]
