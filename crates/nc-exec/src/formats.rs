@@ -20,6 +20,9 @@ pub enum Refusal {
     Digits,
     /// Outside the address's range.
     Range,
+    /// An `&` digit other than 0 (off), 1 (add) or 2 (subtract): each
+    /// switches one axis's length correction (02 §1.18).
+    Decade,
 }
 
 /// A value the control refuses, and what to tell the programmer.
@@ -44,6 +47,14 @@ pub fn literal_fault(address: &Address, value: &Decimal, machine: &MachineConfig
     }
     if let Some(message) = digit_overflow(address, value) {
         return Some(Fault::new(Refusal::Digits, message));
+    }
+    if switches_lengths_outside_decades(address, &value.to_string()) {
+        return Some(Fault::new(
+            Refusal::Decade,
+            format!(
+                "`{letter}{value}`: each digit assigns one axis's length correction and must be 0 (off), 1 (add) or 2 (subtract)"
+            ),
+        ));
     }
     let digits = value.significant_int_digits();
     let outside =
@@ -125,7 +136,10 @@ pub struct PlainLiterals {
 impl PlainLiterals {
     /// What `address` plainly takes; none of it when there is no address.
     pub fn of(address: Option<&Address>) -> PlainLiterals {
-        let Some(address) = address else { return PlainLiterals::default() };
+        // `&` is read digit by digit, not by its range.
+        let Some(address) = address.filter(|address| address.role != AddressRole::LengthCompensation) else {
+            return PlainLiterals::default();
+        };
         // Without a range no value is outside it.
         let within = |negative| match address.bounds {
             None => u16::MAX,
@@ -152,6 +166,12 @@ impl PlainLiterals {
             && !(point && self.frac_digits > 0 && value.frac_digits() > u32::from(self.frac_digits))
             && self.within[usize::from(value.is_negative())].checked_shr(digits).is_some_and(|bits| bits & 1 == 1)
     }
+}
+
+/// Whether `address` switches length corrections (`&`) and `digits` has a
+/// digit other than 0, 1 or 2.
+fn switches_lengths_outside_decades(address: &Address, digits: &str) -> bool {
+    address.role == AddressRole::LengthCompensation && digits.bytes().any(|b| matches!(b, b'3'..=b'9'))
 }
 
 /// Whether `address` takes a parameter's raw digits (`R10=123` → `G123`)
@@ -190,6 +210,15 @@ pub fn substitution_fault(address: &Address, raw: Raw, thread: bool, machine: &M
         return Some(Fault::new(
             Refusal::Sign,
             format!("the parameter holds {}, but `{letter}` takes only unsigned values", show(raw)),
+        ));
+    }
+    if switches_lengths_outside_decades(address, &digits) {
+        return Some(Fault::new(
+            Refusal::Decade,
+            format!(
+                "the parameter holds {} (read as `{letter}{raw}`): each `{letter}` digit must be 0, 1 or 2",
+                show(raw)
+            ),
         ));
     }
     // A feed's range depends on its unit, which the feed checks know.

@@ -3499,6 +3499,16 @@ mod tests {
                 "99999999999999999999",
                 "`X99999999999999999999` has 20 digits before the point; the format of `X` allows 5",
             ),
+            (
+                "%1\nN1 G92 D1 R0=5.\nN2 &0031 D1\nN3 M30\n",
+                "0031",
+                "`&0031`: each digit assigns one axis's length correction and must be 0 (off), 1 (add) or 2 (subtract)",
+            ),
+            (
+                "%1\nN1 G92 D1 R0=5.\nN2 R10=13\nN3 &R10 D1\nN4 M30\n",
+                "R10",
+                "the parameter holds 0.013 (read as `&13`): each `&` digit must be 0, 1 or 2",
+            ),
         ] {
             let trace = run_text(text);
             assert_eq!(stops(text, &trace), [(at, message)], "{text}");

@@ -167,16 +167,9 @@ fn check_literal(
         check_code(word, value, catalogue, out);
         return;
     }
-    if address.role == AddressRole::LengthCompensation {
-        let digits = value.to_string();
-        if digits.bytes().any(|b| !matches!(b, b'0'..=b'2' | b'.' | b'-' | b'+')) {
-            out.push(Diagnostic::new(
-                &LENGTH_COMPENSATION_DIGITS,
-                range,
-                format!("`&{digits}`: each digit assigns one axis's length correction and must be 0 (off), 1 (add) or 2 (subtract)"),
-            ));
-            return;
-        }
+    if let Some(Fault { refusal: Refusal::Decade, message }) = &fault {
+        out.push(Diagnostic::new(&LENGTH_COMPENSATION_DIGITS, range, message));
+        return;
     }
     if let Some(Fault { refusal: Refusal::Range, message }) = fault {
         let d0 = if word.letter == b'D' && value.to_f64() == 0.0 {

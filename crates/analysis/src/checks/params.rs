@@ -113,13 +113,6 @@ pub(crate) fn check_substitution(
                 return;
             }
         }
-        if address.role == AddressRole::LengthCompensation && digits_outside(&raw.unsigned_abs().to_string(), b'2') {
-            out.push(related(Diagnostic::new(
-                &SUBSTITUTED_VALUE_OUT_OF_RANGE,
-                range,
-                format!("the parameter holds {} (read as `&{raw}`): each `&` digit must be 0, 1 or 2", show(raw)),
-            )));
-        }
         // Per minute the point means metres, which the manual recommends
         // (`R10=0.100` is 100 mm/min, 02 §3.5): only a value above the limit
         // is a mistake, mostly mm/min written with a point (`R10=100.`).
@@ -154,10 +147,6 @@ pub(crate) fn check_substitution(
             ),
         )));
     }
-}
-
-fn digits_outside(digits: &str, max: u8) -> bool {
-    digits.bytes().any(|b| b > max)
 }
 
 /// A raw value as the real number the parameter holds (`864` → `0.864`).
