@@ -75,6 +75,16 @@ pub fn assignment_fault(parameter: &Address, value: &Decimal) -> Option<Fault> {
         .then(|| Fault::new(Refusal::Range, format!("`{value}` is outside the parameter range {}", range(parameter))))
 }
 
+/// A parameter number the control does not have.
+pub fn parameter_number_fault(index: u32) -> Option<Fault> {
+    (index as usize >= crate::arith::PARAMETER_COUNT).then(|| {
+        Fault::new(
+            Refusal::Range,
+            format!("R{index}: the control has parameters R0 to R{}", crate::arith::PARAMETER_COUNT - 1),
+        )
+    })
+}
+
 /// An address's range as messages write it: `min to max`.
 fn range(address: &Address) -> String {
     format!("{} to {}", address.min.as_deref().unwrap_or_default(), address.max.as_deref().unwrap_or_default())

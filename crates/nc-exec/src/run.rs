@@ -1686,6 +1686,11 @@ impl Runner {
             {
                 continue;
             }
+            if let Some(Value::Parameter { index: Some(index), index_range, .. }) = &word.value
+                && let Some(fault) = formats::parameter_number_fault(*index)
+            {
+                return Some((*index_range, fault.message));
+            }
             let Some(address) = self.catalogue.address_of(word.letter) else { continue };
             let fault = match word.value.as_ref() {
                 Some(Value::Literal(decimal)) => formats::literal_fault(address, decimal, machine),
@@ -1699,6 +1704,9 @@ impl Runner {
             }
         }
         block.assignments.iter().find_map(|assignment| {
+            if let Some(fault) = assignment.index.and_then(formats::parameter_number_fault) {
+                return Some((assignment.index_range, fault.message));
+            }
             let Some(Value::Literal(value)) = &assignment.value else { return None };
             let letter = self.catalogue.letter_with_role(AddressRole::Parameter)?;
             let fault = formats::assignment_fault(self.catalogue.address_of(letter)?, value)?;
@@ -3499,6 +3507,8 @@ mod tests {
                 "99999999999999999999",
                 "`X99999999999999999999` has 20 digits before the point; the format of `X` allows 5",
             ),
+            ("%1\nN1 R96=5\nN2 M30\n", "96", "R96: the control has parameters R0 to R95"),
+            ("%1\nN1 G01 XR100 F100\nN2 M30\n", "100", "R100: the control has parameters R0 to R95"),
             (
                 "%1\nN1 G92 D1 R0=5.\nN2 &0031 D1\nN3 M30\n",
                 "0031",

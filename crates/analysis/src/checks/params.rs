@@ -67,12 +67,8 @@ impl FlowCheck for Parameters {
 }
 
 fn check_number(index: u32, range: ncc_syntax::TextRange, out: &mut Vec<Diagnostic>) {
-    if index > 95 {
-        out.push(Diagnostic::new(
-            &PARAMETER_NUMBER_OUT_OF_RANGE,
-            range,
-            format!("R{index}: the control has parameters R0 to R95"),
-        ));
+    if let Some(fault) = formats::parameter_number_fault(index) {
+        out.push(Diagnostic::new(&PARAMETER_NUMBER_OUT_OF_RANGE, range, fault.message));
     } else if (90..=94).contains(&index) {
         out.push(Diagnostic::new(
             &NOT_RECOMMENDED_PARAMETER,
