@@ -2196,6 +2196,11 @@ impl Runner {
             },
             _ => None,
         };
+        // The arc's sides may reach beyond a limit its ends keep within.
+        if let Some(message) = arc.iter().flat_map(|arc| arc.sides(&end)).find_map(|side| self.unreachable(&side)) {
+            self.finding(range, &format!("the arc's side: {message}"), true);
+            return None;
+        }
         let length = arc.as_ref().map_or(straight, Arc::length);
         let mode = self.feed_mode();
         // A thread's F is its lead, which M37 leaves alone.
@@ -2701,6 +2706,21 @@ struct Arc {
 impl Arc {
     fn length(&self) -> f64 {
         (self.radius * self.sweep).hypot(self.lead)
+    }
+
+    /// The points where the arc runs furthest along its plane's axes (at
+    /// 0°, 90°, 180° and 270°) between its ends, the other axes at `end`.
+    fn sides<'a>(&'a self, end: &'a Position) -> impl Iterator<Item = Position> + 'a {
+        (0..4).filter_map(move |quarter| {
+            let angle = f64::from(quarter) * std::f64::consts::FRAC_PI_2;
+            let turned = if self.sweep > 0.0 { angle - self.start_angle } else { self.start_angle - angle };
+            (turned.rem_euclid(std::f64::consts::TAU) < self.sweep.abs()).then(|| {
+                let mut side = *end;
+                side[self.plane.0] = round3(self.centre.x + self.radius * angle.cos());
+                side[self.plane.1] = round3(self.centre.y + self.radius * angle.sin());
+                side
+            })
+        })
     }
 
     /// The coordinate of slot `slot` at fraction `t` of the arc, when the
@@ -3556,6 +3576,15 @@ mod tests {
         let message = "X would reach 550.000 in machine coordinates, beyond its travel limit 500.000 (`limits` of the machine): the control stops at the software limit switch";
         assert_eq!(stops(text, &trace), [("N3 X350\n", message)]);
         assert_eq!(trace.steps.len(), 2);
+        // An arc's side: G03 from X290 (490 on the machine) about I0 J10
+        // reaches 500; G02 between the same ends reaches 480.
+        machine.limits.insert(b'X', TravelLimits { min: None, max: Some(495_000) });
+        let text = "%1\nN1 G54 G00 X290 Y0\nN2 G03 X290 Y20 I0 J10 F100\nN3 M30\n";
+        let trace = run(text, &NoFiles, &machine, 100);
+        let message = "the arc's side: X would reach 500.000 in machine coordinates, beyond its travel limit 495.000 (`limits` of the machine): the control stops at the software limit switch";
+        assert_eq!(stops(text, &trace), [("N2 G03 X290 Y20 I0 J10 F100\n", message)]);
+        let trace = run(&text.replace("G03", "G02"), &NoFiles, &machine, 100);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
         // A built-in cycle's moves too: G81 drills to Z-10.
         let trace = run(DRILLING, &NoFiles, &machine, 100);
         let message = "the fixed cycle G81: Z would reach -10.000 in machine coordinates, beyond its travel limit -5.000 (`limits` of the machine): the control stops at the software limit switch";
