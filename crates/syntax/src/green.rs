@@ -8,7 +8,9 @@
 //! every user of the tree. Each parser (and so each thread of a parallel
 //! parse) has its own set: threads never contend for one reference count.
 
-use rowan::{GreenNode, GreenToken, NodeOrToken};
+use std::borrow::Cow;
+
+use rowan::{GreenNode, GreenNodeData, GreenToken, NodeOrToken};
 use rustc_hash::FxHashMap;
 
 use crate::SyntaxKind::{self, *};
@@ -38,7 +40,8 @@ pub(crate) struct GreenFactory<'a> {
     /// Simple words of up to eight bytes, keyed by their bytes packed into
     /// an integer: hashing and comparing them is a multiply and a compare.
     short_words: FxHashMap<u64, GreenNode>,
-    long_words: FxHashMap<&'a str, GreenNode>,
+    /// Keyed by the text parsed, or by a copy for a word of another tree.
+    long_words: FxHashMap<Cow<'a, str>, GreenNode>,
 }
 
 impl<'a> GreenFactory<'a> {
@@ -102,15 +105,12 @@ impl<'a> GreenFactory<'a> {
     /// The `WORD` node of `text` = upper-case letter, optional sign of
     /// `sign_len` bytes, number.
     pub(crate) fn simple_word(&mut self, text: &'a str, sign_len: usize) -> GreenElement {
-        let word = if text.len() <= 8 {
-            // Simple words hold no zero byte, so the padding cannot collide.
-            let mut key = [0u8; 8];
-            key[..text.len()].copy_from_slice(text.as_bytes());
-            match self.short_words.get(&u64::from_le_bytes(key)) {
+        let word = if let Some(key) = short_key(text) {
+            match self.short_words.get(&key) {
                 Some(word) => word.clone(),
                 None => {
                     let word = self.build_simple_word(text, sign_len);
-                    self.short_words.insert(u64::from_le_bytes(key), word.clone());
+                    self.short_words.insert(key, word.clone());
                     word
                 }
             }
@@ -119,12 +119,32 @@ impl<'a> GreenFactory<'a> {
                 Some(word) => word.clone(),
                 None => {
                     let word = self.build_simple_word(text, sign_len);
-                    self.long_words.insert(text, word.clone());
+                    self.long_words.insert(Cow::Borrowed(text), word.clone());
                     word
                 }
             }
         };
         NodeOrToken::Node(word)
+    }
+
+    /// Shares the simple words of `tree` (a block of the tree a reparse
+    /// replaces) with the nodes built from now on. A reparsed block would
+    /// otherwise get its own copy of every word, which a full parse shares
+    /// with the other blocks: over a long session the tree would grow
+    /// towards a copy per block.
+    pub(crate) fn share_words_of(&mut self, tree: &GreenNodeData) {
+        for child in tree.children() {
+            let NodeOrToken::Node(node) = child else { continue };
+            if node.kind() != WORD.into() {
+                self.share_words_of(node);
+                continue;
+            }
+            let Some(text) = simple_word_text(node) else { continue };
+            match short_key(&text) {
+                Some(key) => self.short_words.entry(key).or_insert_with(|| node.to_owned()),
+                None => self.long_words.entry(Cow::Owned(text)).or_insert_with(|| node.to_owned()),
+            };
+        }
     }
 
     fn build_simple_word(&self, text: &str, sign_len: usize) -> GreenNode {
@@ -140,4 +160,32 @@ impl<'a> GreenFactory<'a> {
             }
         }
     }
+}
+
+/// The key of a simple word of up to eight bytes: its bytes packed into an
+/// integer (simple words hold no zero byte, so the padding cannot collide).
+fn short_key(text: &str) -> Option<u64> {
+    let mut key = [0u8; 8];
+    key.get_mut(..text.len())?.copy_from_slice(text.as_bytes());
+    Some(u64::from_le_bytes(key))
+}
+
+/// The text of `word` when it is a simple word as [`GreenFactory::simple_word`]
+/// builds it: an upper-case letter, an optional sign, a number.
+fn simple_word_text(word: &GreenNodeData) -> Option<String> {
+    let mut tokens = word.children().map(NodeOrToken::into_token);
+    let letter = tokens.next()??;
+    let mut next = tokens.next()??;
+    let sign = if matches!(next.kind(), k if k == PLUS.into() || k == MINUS.into()) {
+        let sign = next;
+        next = tokens.next()??;
+        Some(sign)
+    } else {
+        None
+    };
+    let simple = letter.kind() == LETTER.into()
+        && letter.text().bytes().all(|b| b.is_ascii_uppercase())
+        && next.kind() == NUMBER.into()
+        && tokens.next().is_none();
+    simple.then(|| [Some(letter), sign, Some(next)].into_iter().flatten().map(|token| token.text()).collect())
 }

@@ -269,7 +269,7 @@ fn line_start_at_or_after(text: &str, at: usize, lines_from: usize, limit: usize
 /// Parses the blocks in `region`, which starts at a block's `N` and ends at
 /// a block start, at `*` or at the end of the text.
 pub(crate) fn parse_blocks(text: &str, region: Range<usize>) -> (Vec<GreenElement>, Errors) {
-    let (blocks, errors, _) = parse_blocks_until(text, region, |_| false);
+    let (blocks, errors, _) = parse_blocks_until(text, region, |_| false, &[]);
     (blocks, errors)
 }
 
@@ -279,8 +279,12 @@ pub(crate) fn parse_blocks_until(
     text: &str,
     region: Range<usize>,
     stop_at: impl Fn(usize) -> bool,
+    replaced: &[&rowan::GreenNodeData],
 ) -> (Vec<GreenElement>, Errors, usize) {
     let mut parser = Parser::new(text, region.start, region.end);
+    for block in replaced {
+        parser.green.share_words_of(block);
+    }
     let mut blocks = Vec::new();
     while parser.pos < region.end {
         let before = parser.pos;

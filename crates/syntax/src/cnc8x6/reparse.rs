@@ -84,9 +84,15 @@ pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Op
 
     // Reparse until a block start that was a block start before the edit.
     let min_end = usize::from(shift(old_region_end));
-    let (blocks, block_errors, stop) = parser::parse_blocks_until(new_text, start..limit, |at| {
-        at >= min_end && old_block_starts_at(&root, unshift(at), body_end)
-    });
+    // The new blocks share the words of the old ones, as a full parse would.
+    let replaced = [first.green(), last.green()];
+    let replaced: Vec<&rowan::GreenNodeData> = replaced.iter().map(|green| &**green).collect();
+    let (blocks, block_errors, stop) = parser::parse_blocks_until(
+        new_text,
+        start..limit,
+        |at| at >= min_end && old_block_starts_at(&root, unshift(at), body_end),
+        &replaced,
+    );
 
     let stop_block = if stop >= limit { None } else { Some(block_at(&root, unshift(stop))?) };
     let green = regroup(&root, &first, blocks, stop_block.as_ref(), new_text, layout.end_index);
@@ -276,5 +282,34 @@ mod tests {
             assert_eq!(old_blocks[i], new_blocks[i], "node {i} was rebuilt");
         }
         assert_ne!(old_blocks[2], new_blocks[2]);
+    }
+
+    #[test]
+    fn a_reparsed_block_shares_its_unchanged_words_as_a_full_parse_does() {
+        // `G01` and `Y-2.` are one node each in a full parse: the edit to
+        // N20's X leaves them shared, however long the session.
+        let text = "%1\nN10 G01 X1. Y-2.\nN20 G01 X3. Y-2.\nN30 G01 X5. Y-2.\n*\n";
+        let mut parse = Parse::new(text, Dialect::Cnc8x6);
+        let mut text = text.to_owned();
+        for digit in ["7", "8", "9"] {
+            let at = TextSize::from(text.find("N20 G01 X").unwrap() as u32 + 9);
+            let edit = TextEdit::replace(TextRange::new(at, at + TextSize::from(1)), digit);
+            edit.apply(&mut text);
+            parse = parse.reparse(&edit, &text);
+        }
+        assert_eq!(parse, Parse::new(&text, Dialect::Cnc8x6));
+        let words = |word: &str| -> Vec<*const rowan::GreenNodeData> {
+            parse
+                .syntax_node()
+                .descendants()
+                .filter(|node| node.text() == word)
+                .map(|node| std::ptr::from_ref::<rowan::GreenNodeData>(node.green()))
+                .collect()
+        };
+        for word in ["G01", "Y-2."] {
+            let nodes = words(word);
+            assert_eq!(nodes.len(), 3, "{word}");
+            assert!(nodes.iter().all(|&node| node == nodes[0]), "{word} is not shared: {nodes:?}");
+        }
     }
 }
