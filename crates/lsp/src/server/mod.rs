@@ -73,6 +73,7 @@ pub(crate) fn run(log_level: LogLevel) -> ExitCode {
         .with(tracing_subscriber::fmt::layer().with_writer(std::io::stderr).with_ansi(false))
         .with(filter)
         .init();
+    without_huge_pages();
     let runtime = match tokio::runtime::Builder::new_multi_thread().enable_all().build() {
         Ok(runtime) => runtime,
         Err(error) => {
@@ -323,6 +324,16 @@ fn background_priority() {
     // leaves the thread as it was.
     #[cfg(target_os = "linux")]
     let _ = rustix::process::setpriority_process(None, 10);
+}
+
+/// Transparent huge pages off for the server's process. mimalloc asks for
+/// them on its arenas, and the kernel then keeps 2 MB for a page the
+/// allocator holds a few small blocks in: a long session's resident memory
+/// grows with the scatter of what it keeps, not with what it keeps.
+fn without_huge_pages() {
+    // Failing leaves the process as it was.
+    #[cfg(target_os = "linux")]
+    let _ = rustix::thread::disable_transparent_huge_pages(true);
 }
 
 /// A panic while holding the lock leaves consistent data (edits are
