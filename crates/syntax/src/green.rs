@@ -176,7 +176,7 @@ fn simple_word_text(word: &GreenNodeData) -> Option<String> {
     let mut tokens = word.children().map(NodeOrToken::into_token);
     let letter = tokens.next()??;
     let mut next = tokens.next()??;
-    let sign = if matches!(next.kind(), k if k == PLUS.into() || k == MINUS.into()) {
+    let sign = if next.kind() == PLUS.into() || next.kind() == MINUS.into() {
         let sign = next;
         next = tokens.next()??;
         Some(sign)

@@ -85,13 +85,11 @@ pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Op
     // Reparse until a block start that was a block start before the edit.
     let min_end = usize::from(shift(old_region_end));
     // The new blocks share the words of the old ones, as a full parse would.
-    let replaced = [first.green(), last.green()];
-    let replaced: Vec<&rowan::GreenNodeData> = replaced.iter().map(|green| &**green).collect();
     let (blocks, block_errors, stop) = parser::parse_blocks_until(
         new_text,
         start..limit,
         |at| at >= min_end && old_block_starts_at(&root, unshift(at), body_end),
-        &replaced,
+        &[first.green(), last.green()],
     );
 
     let stop_block = if stop >= limit { None } else { Some(block_at(&root, unshift(stop))?) };
