@@ -1051,3 +1051,85 @@ fn run_escapes_control_characters_in_what_it_prints() {
         assert!(!printed.contains('\u{1b}'), "{printed}");
     }
 }
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8(output.stderr.clone()).unwrap()
+}
+
+#[test]
+fn an_unknown_dialect_is_a_usage_error_that_lists_the_known_ones() {
+    for args in [&["check", "--dialect", "fanuc", "examples"][..], &["--dialect", "fanuc", "run", "x.NCP"]] {
+        let output = ncc(args);
+        assert_eq!(output.status.code(), Some(2));
+        let message = stderr(&output);
+        assert!(message.contains("unknown dialect `fanuc` (known: cnc8x6, haas-lathe, sinumerik)"), "{message}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("ncc.toml"), "dialect = \"fanuc\"\n").unwrap();
+    std::fs::write(dir.path().join("a.NCP"), "%1\nN10 M30\n").unwrap();
+    let output = ncc(&["check", dir.path().to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert!(message.contains("ncc.toml: TOML parse error at line 1, column 11"), "{message}");
+    assert!(message.contains("unknown dialect `fanuc` (known: cnc8x6, haas-lathe, sinumerik)"), "{message}");
+}
+
+#[test]
+fn a_named_dialect_this_version_does_not_read_exits_with_2() {
+    let output = ncc(&["check", "--dialect", "sinumerik", "examples"]);
+    assert_eq!(output.status.code(), Some(2));
+    assert_eq!(stderr(&output), "error: ncc does not read Siemens Sinumerik programs yet (dialect `sinumerik`)\n");
+    let dir = tempfile::tempdir().unwrap();
+    let lathe = dir.path().join("O1000.nc");
+    std::fs::write(&lathe, "%\nO1000\nG28\nM30\n%\n").unwrap();
+    for command in ["check", "run", "expand", "lower", "parse"] {
+        let output = ncc(&[command, lathe.to_str().unwrap()]);
+        assert_eq!(output.status.code(), Some(2), "{command}");
+        assert!(
+            stderr(&output).ends_with("O1000.nc: ncc does not read Haas lathe programs yet (dialect `haas-lathe`)\n")
+        );
+    }
+    // `--dialect` reads it as the named dialect, whatever its name says.
+    assert_eq!(ncc(&["check", "--dialect", "cnc8x6", lathe.to_str().unwrap()]).status.code(), Some(1));
+    assert_eq!(ncc(&["explain", "--dialect", "cnc8x6", "G40"]).status.code(), Some(0));
+}
+
+#[test]
+fn directories_are_searched_by_extension_per_dialect_and_ncc_toml_maps_more() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).unwrap();
+    write("a.NCP", "%1\nN10 M30\n*\n");
+    write("b.PRG", "%2\nN10 M30\n*\n");
+    write("MAIN.MPF", "G0 X0\nM30\n");
+    write("SUB.SPF", "PROC SUB\nRET\n");
+    write("O1000.nc", "%\nO1000\nM30\n%\n");
+    write("notes.txt", "N10 X\n");
+    let checked = |dir: &Path| {
+        let output = ncc(&["check", dir.to_str().unwrap()]);
+        (output.status.code(), stdout(&output), stderr(&output))
+    };
+    let (code, out, err) = checked(dir.path());
+    assert_eq!(code, Some(0), "{out}{err}");
+    assert_eq!(out, "All checks passed (1 file checked).\n");
+    assert_eq!(
+        err,
+        "note: 1 file skipped: ncc does not read Haas lathe programs yet (dialect `haas-lathe`)\n\
+         note: 2 files skipped: ncc does not read Siemens Sinumerik programs yet (dialect `sinumerik`)\n"
+    );
+    // The project maps an extension of its own, and takes `.nc` files for
+    // CNC8x6 programs.
+    write("ncc.toml", "[extensions]\nPRG = \"cnc8x6\"\n\".nc\" = \"cnc8x6\"\n");
+    let (code, out, _) = checked(dir.path());
+    assert_eq!(code, Some(1), "{out}");
+    assert!(out.ends_with("in 3 files.\n") && out.contains("O1000.nc"), "{out}");
+    assert!(!out.contains("b.PRG"), "a clean file has no findings: {out}");
+    // A project of one dialect: every program is read as it.
+    write("ncc.toml", "dialect = \"sinumerik\"\n");
+    let (code, out, err) = checked(dir.path());
+    assert_eq!((code, out.as_str()), (Some(0), "All checks passed (0 files checked).\n"));
+    assert!(err.contains("note: 4 files skipped: ncc does not read Siemens Sinumerik programs yet"), "{err}");
+    write("ncc.toml", "[extensions]\n\"a/b\" = \"cnc8x6\"\n");
+    let (code, _, err) = checked(dir.path());
+    assert_eq!(code, Some(2));
+    assert!(err.contains("ncc.toml: [extensions] key `a/b` is not a file extension like `NCP`"), "{err}");
+}

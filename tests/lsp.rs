@@ -587,3 +587,18 @@ fn hover_on_a_block_adds_its_speed_profile() {
     // Anywhere else in the block: the time alone.
     assert_eq!(hover(&mut client, "SIDE"), N20_HOVER);
 }
+
+#[test]
+fn a_document_of_a_dialect_this_version_does_not_read_gets_one_finding_saying_so() {
+    let (mut client, dir) = session();
+    let doc = document(&dir, "MAIN.MPF", "DEF REAL X0=1\nG0 X=X0\nM30\n");
+    let published = open(&mut client, &doc);
+    let diagnostics = published.params()["diagnostics"].as_array().unwrap();
+    assert_eq!(diagnostics.len(), 1, "{}", published.json);
+    assert_eq!(diagnostics[0]["message"], "ncc does not read Siemens Sinumerik programs yet (dialect `sinumerik`)");
+    assert_eq!(diagnostics[0]["severity"], 3);
+    // Nothing else is answered for it, and the server goes on serving.
+    let hover = client.call("textDocument/hover", doc.at(doc.position(0))).unwrap();
+    assert!(hover.result().is_none_or(Value::is_null), "{}", hover.json);
+    assert_serving(&mut client, &dir);
+}

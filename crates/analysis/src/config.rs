@@ -1,6 +1,12 @@
 //! The project configuration, `ncc.toml`: rule severities and the machine.
 //!
 //! ```toml
+//! dialect = "cnc8x6"           # every program here is in this dialect
+//!
+//! [extensions]                 # else a file's extension names its dialect
+//! PRG = "cnc8x6"               # (defaults: NCP and L<n> cnc8x6, MPF and SPF
+//!                              #  sinumerik, nc and tap haas-lathe)
+//!
 //! [rules]
 //! missing-feed = "warning"     # by name or by code
 //! S009 = "off"
@@ -47,6 +53,7 @@ use std::{
 
 pub use nc_exec::machine::{MachineConfig, TravelLimits, parse_constant};
 use nc_exec::tables::{self, Finding, OffsetTable, ToolTable};
+use ncc_catalog::DialectId;
 use ncc_syntax::Severity;
 use serde::Deserialize;
 
@@ -81,10 +88,48 @@ impl Level {
 /// Everything configurable about an analysis.
 #[derive(Debug, Clone, PartialEq, Eq, Hash, Default)]
 pub struct Config {
+    pub dialects: Dialects,
     /// Severity overrides by rule code or name.
     pub rules: BTreeMap<String, Level>,
     pub report: ReportConfig,
     pub machine: MachineConfig,
+}
+
+/// Which dialect a program is in: `dialect` and `[extensions]` in
+/// `ncc.toml`.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Default)]
+pub struct Dialects {
+    /// The dialect of every program, when the project names one.
+    pub dialect: Option<DialectId>,
+    /// Dialects by file extension (without the dot, any case), before the
+    /// defaults.
+    pub extensions: BTreeMap<String, DialectId>,
+}
+
+impl Dialects {
+    /// The dialect the name of the file at `path` gives: its extension as
+    /// `[extensions]` maps it, else by default; `None` for a file that is
+    /// no program by its name.
+    pub fn by_name(&self, path: &Path) -> Option<DialectId> {
+        let mapped = || {
+            let extension = path.extension()?.to_str()?;
+            self.extensions.iter().find(|(known, _)| known.eq_ignore_ascii_case(extension)).map(|(_, &dialect)| dialect)
+        };
+        mapped().or_else(|| DialectId::by_default_for(path))
+    }
+
+    /// The dialect of a file found in a directory, `None` when it is no
+    /// program by its name: `forced` (`--dialect`), else the project's,
+    /// else the one its name gives.
+    pub fn of_found(&self, path: &Path, forced: Option<DialectId>) -> Option<DialectId> {
+        self.by_name(path).map(|by_name| forced.or(self.dialect).unwrap_or(by_name))
+    }
+
+    /// The dialect of a program given by name: as a found one's, and
+    /// CNC8x6 for a name that says nothing.
+    pub fn of_given(&self, path: &Path, forced: Option<DialectId>) -> DialectId {
+        forced.or(self.dialect).or_else(|| self.by_name(path)).unwrap_or(DialectId::Cnc8x6)
+    }
 }
 
 /// The `[report]` section of `ncc.toml`: how much a report shows.
@@ -104,6 +149,9 @@ impl Default for ReportConfig {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields, rename_all = "kebab-case")]
 struct ConfigFile {
+    dialect: Option<DialectId>,
+    #[serde(default)]
+    extensions: BTreeMap<String, DialectId>,
     #[serde(default)]
     rules: BTreeMap<String, Level>,
     #[serde(default)]
@@ -323,7 +371,20 @@ impl Config {
     pub fn from_toml(text: &str, path: &Path, read: impl Fn(&Path) -> io::Result<String>) -> Result<Config, String> {
         let origin = path.display().to_string();
         let file: ConfigFile = toml::from_str(text).map_err(|e| format!("{origin}: {e}"))?;
-        let mut config = Config { rules: file.rules, report: file.report, machine: MachineConfig::default() };
+        let mut extensions = BTreeMap::new();
+        for (extension, dialect) in file.extensions {
+            let bare = extension.strip_prefix('.').unwrap_or(&extension);
+            if bare.is_empty() || bare.contains(['.', '/', '\\']) {
+                return Err(format!("{origin}: [extensions] key `{extension}` is not a file extension like `NCP`"));
+            }
+            extensions.insert(bare.to_owned(), dialect);
+        }
+        let mut config = Config {
+            dialects: Dialects { dialect: file.dialect, extensions },
+            rules: file.rules,
+            report: file.report,
+            machine: MachineConfig::default(),
+        };
         if let Some(unknown) = config.rules.keys().find(|key| crate::Rule::find(key).is_none()) {
             return Err(format!("{origin}: [rules] names no rule `{unknown}` (see `ncc rules`)"));
         }

@@ -22,6 +22,7 @@ use std::sync::Arc;
 
 /// Blocks as plain data, lowered the same way for the executor.
 pub use nc_exec::lower;
+pub use ncc_catalog::DialectId;
 use ncc_syntax::Parse;
 pub use ncc_syntax::{Dialect, Severity, TextEdit, TextRange, TextSize};
 pub use salsa::Cancelled;
@@ -41,7 +42,7 @@ pub use crate::ide::{
     symbols::{DocumentSymbol, SymbolKind},
 };
 pub use crate::{
-    config::{CONFIG_FILE, Config, Level, MachineConfig, ReportConfig, parse_constant},
+    config::{CONFIG_FILE, Config, Dialects, Level, MachineConfig, ReportConfig, parse_constant},
     db::{RootDatabase, SourceFile},
     diagnostic::{Diagnostic, Fix, Related, Rule},
     findings::{Findings, OmittedFindings},

@@ -7,6 +7,7 @@
 //! under `data/<dialect>/`, compiled into the binary and parsed once on first
 //! use; tests validate them against the manual's tables.
 
+mod dialect_id;
 mod explain;
 mod render;
 pub mod schema;
@@ -14,6 +15,7 @@ pub mod schema;
 use std::{collections::HashMap, sync::OnceLock};
 
 pub use crate::{
+    dialect_id::{DialectId, UnknownDialect, macrocycle_number},
     explain::{Item, NotFound},
     schema::*,
 };

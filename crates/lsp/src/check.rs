@@ -9,7 +9,8 @@ use std::{
 };
 
 use indicatif::{ParallelProgressIterator, ProgressBar, ProgressStyle};
-use ncc_analysis::{AnalysisHost, Config, Diagnostic, Severity};
+use ncc_analysis::{AnalysisHost, Config, Diagnostic, Dialect, DialectId, Dialects, Severity};
+pub(crate) use ncc_catalog::macrocycle_number;
 use ncc_syntax::{encoding, visible};
 use rayon::prelude::*;
 
@@ -103,8 +104,58 @@ pub(crate) fn load_config(path: &Path) -> Result<Config, String> {
         .and_then(|text| Config::from_toml(&text, path, read_program))
 }
 
-pub(crate) fn run(paths: &[PathBuf], format: Format) -> ExitCode {
-    let (files, mut failures) = collect_files(paths);
+/// The projects met: for each directory the `ncc.toml` that applies, and
+/// each such file's configuration (or why it cannot be read), loaded once.
+#[derive(Default)]
+pub(crate) struct Projects {
+    /// The configuration file that applies to every file, when one is named.
+    forced_config: Option<PathBuf>,
+    config_of_directory: HashMap<PathBuf, Option<PathBuf>>,
+    configs: HashMap<Option<PathBuf>, Result<Config, String>>,
+}
+
+impl Projects {
+    /// Projects that all have the configuration in `forced_config`, when
+    /// one is named.
+    pub fn with_config(forced_config: Option<PathBuf>) -> Projects {
+        Projects { forced_config, ..Projects::default() }
+    }
+
+    /// The `ncc.toml` that applies to the file at `path`.
+    pub fn config_path(&mut self, path: &Path) -> Option<PathBuf> {
+        if self.forced_config.is_some() {
+            return self.forced_config.clone();
+        }
+        let directory = path.parent().unwrap_or(Path::new("")).to_path_buf();
+        self.config_of_directory.entry(directory).or_insert_with(|| Config::find_for(path)).clone()
+    }
+
+    /// The configuration in `config_path`, the defaults for `None`.
+    pub fn config(&mut self, config_path: Option<&Path>) -> &Result<Config, String> {
+        self.configs
+            .entry(config_path.map(Path::to_path_buf))
+            .or_insert_with(|| config_path.map_or_else(|| Ok(Config::default()), load_config))
+    }
+
+    /// What the project of the file at `path` says of dialects; a project
+    /// whose configuration cannot be read says nothing (reading it reports
+    /// the error).
+    pub fn dialects(&mut self, path: &Path) -> Dialects {
+        let config_path = self.config_path(path);
+        self.config(config_path.as_deref()).as_ref().map(|config| config.dialects.clone()).unwrap_or_default()
+    }
+}
+
+/// The implementation of the dialect of a program given by name (see
+/// [`Dialects::of_given`]), or why there is none.
+pub(crate) fn dialect_for(path: &Path, forced: Option<DialectId>) -> Result<Dialect, String> {
+    let dialect = Projects::default().dialects(path).of_given(path, forced);
+    dialect.implementation().ok_or_else(|| format!("{}: {}", shown_path(path), dialect.not_read()))
+}
+
+pub(crate) fn run(paths: &[PathBuf], format: Format, forced: Option<DialectId>) -> ExitCode {
+    let mut projects = Projects::default();
+    let Found { files, mut failures, not_read } = collect_files(paths, &mut projects, forced);
     let progress = progress_bar(files.len());
     let read: Vec<Result<(PathBuf, String), String>> = files
         .par_iter()
@@ -115,22 +166,19 @@ pub(crate) fn run(paths: &[PathBuf], format: Format) -> ExitCode {
     let mut workspaces: BTreeMap<Option<PathBuf>, Vec<(PathBuf, String)>> = BTreeMap::new();
     for result in read {
         match result {
-            Ok((path, text)) => workspaces.entry(Config::find_for(&path)).or_default().push((path, text)),
+            Ok((path, text)) => workspaces.entry(projects.config_path(&path)).or_default().push((path, text)),
             Err(message) => failures.push(message),
         }
     }
     let mut checked = Vec::new();
     let mut sources = HashMap::new();
     for (config_path, programs) in workspaces {
-        let config = match &config_path {
-            Some(path) => match load_config(path) {
-                Ok(config) => config,
-                Err(message) => {
-                    failures.push(message);
-                    continue;
-                }
-            },
-            None => Config::default(),
+        let config = match projects.config(config_path.as_deref()) {
+            Ok(config) => config.clone(),
+            Err(message) => {
+                failures.push(message.clone());
+                continue;
+            }
         };
         let mut host = AnalysisHost::new(config);
         // Macrocycle files beside the checked programs are what their G72
@@ -176,6 +224,10 @@ pub(crate) fn run(paths: &[PathBuf], format: Format) -> ExitCode {
     }
     for failure in &failures {
         eprintln!("error: {}", visible::escaped(failure));
+    }
+    for (dialect, count) in not_read {
+        let files = if count == 1 { "file" } else { "files" };
+        eprintln!("note: {count} {files} skipped: {}", dialect.not_read());
     }
     exit_code(&checked, &failures)
 }
@@ -232,69 +284,60 @@ pub(crate) fn macrocycles_beside(programs: &[(PathBuf, String)]) -> Vec<(PathBuf
     found
 }
 
-/// The files to check: explicit files as given, partprograms found in
-/// directories. Returns them sorted, and why the paths that cannot be
-/// looked at cannot (reading a file that is not a regular one fails later,
-/// saying what it is).
-pub(crate) fn collect_files(paths: &[PathBuf]) -> (Vec<PathBuf>, Vec<String>) {
-    let mut files = Vec::new();
-    let mut failures = Vec::new();
+/// What [`collect_files`] found.
+pub(crate) struct Found {
+    /// The programs to read, sorted.
+    pub files: Vec<PathBuf>,
+    /// Why paths cannot be looked at.
+    pub failures: Vec<String>,
+    /// Programs found in directories whose dialect this build does not
+    /// read, counted by dialect.
+    pub not_read: BTreeMap<DialectId, usize>,
+}
+
+/// The programs to check: explicit files as given, and in directories the
+/// files that are programs of a dialect by their project's configuration or
+/// their name. An explicit file of a dialect this build does not read is a
+/// failure; found ones are counted. Reading a file that is not a regular
+/// one fails later, saying what it is.
+pub(crate) fn collect_files(paths: &[PathBuf], projects: &mut Projects, forced: Option<DialectId>) -> Found {
+    let mut found = Found { files: Vec::new(), failures: Vec::new(), not_read: BTreeMap::new() };
     for path in paths {
         let metadata = match std::fs::metadata(path) {
             Ok(metadata) => metadata,
             Err(error) => {
-                failures.push(format!("{}: {error}", path.display()));
+                found.failures.push(format!("{}: {error}", path.display()));
                 continue;
             }
         };
         if !metadata.is_dir() {
-            files.push(path.clone());
-        } else {
-            for entry in ignore::WalkBuilder::new(path).build() {
-                match entry {
-                    Ok(entry) if entry.file_type().is_some_and(|t| t.is_file()) && is_partprogram(entry.path()) => {
-                        files.push(entry.into_path());
+            let dialect = projects.dialects(path).of_given(path, forced);
+            match dialect.implementation() {
+                Some(_) => found.files.push(path.clone()),
+                None => found.failures.push(format!("{}: {}", path.display(), dialect.not_read())),
+            }
+            continue;
+        }
+        for entry in ignore::WalkBuilder::new(path).build() {
+            match entry {
+                Ok(entry) if entry.file_type().is_some_and(|t| t.is_file()) => {
+                    match projects.dialects(entry.path()).of_found(entry.path(), forced) {
+                        Some(dialect) if dialect.implementation().is_some() => found.files.push(entry.into_path()),
+                        Some(dialect) => *found.not_read.entry(dialect).or_default() += 1,
+                        None => {}
                     }
-                    Ok(_) => {}
-                    Err(error) => failures.push(error.to_string()),
                 }
+                Ok(_) => {}
+                Err(error) => found.failures.push(error.to_string()),
             }
         }
     }
-    files.sort();
-    files.dedup();
-    (files, failures)
-}
-
-/// Partprograms (`*.NCP`, any case) and macrocycle files (`L<number>`, with
-/// or without an extension).
-fn is_partprogram(path: &Path) -> bool {
-    path.extension().is_some_and(|ext| ext.eq_ignore_ascii_case("ncp")) || is_macrocycle(path)
+    found.files.sort();
+    found.files.dedup();
+    found
 }
 
 /// Macrocycle files: `L<number>`, with or without an extension.
 fn is_macrocycle(path: &Path) -> bool {
     macrocycle_number(path).is_some()
-}
-
-/// The number of a macrocycle file `L<number>`.
-pub(crate) fn macrocycle_number(path: &Path) -> Option<u32> {
-    let stem = path.file_stem()?.to_str()?;
-    let digits = stem.strip_prefix(['L', 'l']).filter(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()))?;
-    digits.parse().ok()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn recognises_partprogram_file_names() {
-        for name in ["a.NCP", "b.ncp", "L9001", "L12.NCP", "dir/L7"] {
-            assert!(is_partprogram(Path::new(name)), "{name}");
-        }
-        for name in ["README.md", "L", "Lx1", "a.txt", "NCP"] {
-            assert!(!is_partprogram(Path::new(name)), "{name}");
-        }
-    }
 }

@@ -2,10 +2,13 @@
 
 use std::process::ExitCode;
 
-use ncc_catalog::{Catalogue, Dialect};
+use ncc_catalog::{Catalogue, Dialect, DialectId};
 
-pub(crate) fn run(query: Option<&str>, list: bool) -> ExitCode {
-    let catalogue = Dialect::Cnc8x6.catalogue();
+/// Explains `query` in `dialect`'s catalogue (CNC8x6's when none is named;
+/// the command line has refused one this version does not read).
+pub(crate) fn run(query: Option<&str>, list: bool, dialect: Option<DialectId>) -> ExitCode {
+    let dialect = dialect.and_then(DialectId::implementation).unwrap_or(Dialect::Cnc8x6);
+    let catalogue = dialect.catalogue();
     if list {
         print!("{}", listing(catalogue));
         return ExitCode::SUCCESS;
@@ -19,8 +22,9 @@ pub(crate) fn run(query: Option<&str>, list: bool) -> ExitCode {
         }
         Err(not_found) => {
             eprintln!(
-                "error: `{}` is not a code, address, parameter, machine constant or operation of CNC8x6",
-                not_found.query
+                "error: `{}` is not a code, address, parameter, machine constant or operation of {}",
+                not_found.query,
+                DialectId::from(dialect).title()
             );
             if !not_found.suggestions.is_empty() {
                 eprintln!("help: did you mean {}?", not_found.suggestions.join(", "));

@@ -14,6 +14,7 @@ mod server;
 use std::{path::PathBuf, process::ExitCode};
 
 use clap::{Parser, Subcommand};
+use ncc_analysis::DialectId;
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
@@ -30,8 +31,21 @@ pub(crate) fn return_free_memory() {
 }
 
 #[derive(Parser)]
-#[command(name = "ncc", version, about = "Checker and toolchain for MEFI CNC8x6 partprograms")]
+#[command(
+    name = "ncc",
+    version,
+    about = "Checker, language server and toolchain for CNC partprograms",
+    long_about = "Checker, language server and toolchain for CNC partprograms.\n\n\
+        A program's dialect is `--dialect`, else `dialect` in its project's ncc.toml, else what its \
+        extension maps to ([extensions] in ncc.toml; by default *.NCP and macrocycle files L<n> are \
+        cnc8x6 (MEFI CNC8x6), *.MPF and *.SPF sinumerik, *.nc and *.tap haas-lathe). This version \
+        reads cnc8x6 programs."
+)]
 struct Cli {
+    /// The dialect of every program read, whatever its name and project
+    /// say: cnc8x6, haas-lathe or sinumerik.
+    #[arg(long, global = true, value_name = "NAME")]
+    dialect: Option<DialectId>,
     #[command(subcommand)]
     command: Command,
 }
@@ -40,10 +54,12 @@ struct Cli {
 enum Command {
     /// Check partprograms and report every problem found.
     ///
-    /// Directories are searched for partprograms (`*.NCP` and macrocycle
-    /// files `L<number>`), honouring `.gitignore`. Exit status: 0 when no
-    /// error or warning was found, 1 when one was, 2 when a path or an
-    /// `ncc.toml` could not be read.
+    /// Directories are searched for partprograms (by default `*.NCP` and
+    /// macrocycle files `L<number>`, `*.MPF`, `*.SPF`, `*.nc` and `*.tap`;
+    /// see `[extensions]` in ncc.toml), honouring `.gitignore`. Exit status:
+    /// 0 when no error or warning was found, 1 when one was, 2 when a path
+    /// or an `ncc.toml` could not be read or a program named on the command
+    /// line is in a dialect this version does not read.
     Check {
         /// Files or directories to check.
         #[arg(default_value = ".")]
@@ -157,29 +173,26 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    match Cli::parse().command {
-        Command::Check { paths, format } => check::run(&paths, format),
-        Command::Explain { query, list } => explain::run(query.as_deref(), list),
+    let Cli { dialect, command } = Cli::parse();
+    if let Some(unread) = dialect.filter(|dialect| dialect.implementation().is_none()) {
+        eprintln!("error: {}", unread.not_read());
+        return ExitCode::from(2);
+    }
+    match command {
+        Command::Check { paths, format } => check::run(&paths, format, dialect),
+        Command::Explain { query, list } => explain::run(query.as_deref(), list, dialect),
         Command::Rules { query, markdown } => rules::run(query.as_deref(), markdown),
         Command::Lsp { version: true, .. } => {
             println!("ncc {}", env!("CARGO_PKG_VERSION"));
             ExitCode::SUCCESS
         }
-        Command::Lsp { log_level, .. } => server::run(log_level),
-        Command::Run { file, format, step_budget } => run::run(&file, format, step_budget),
-        Command::Expand { file, output, step_budget } => run::expand(&file, output.as_deref(), step_budget),
-        Command::Lower { file } => run::lower(&file),
-        Command::Plot { file, output, step_budget, max_moves } => run::plot(&file, &output, step_budget, max_moves),
-        Command::Parse { file } => match check::read_program(&file) {
-            Ok(text) => {
-                let parse = ncc_syntax::Parse::new(&text, ncc_syntax::Dialect::Cnc8x6);
-                print!("{}", parse.debug_dump());
-                ExitCode::SUCCESS
-            }
-            Err(error) => {
-                eprintln!("error: {}: {error}", file.display());
-                ExitCode::from(2)
-            }
-        },
+        Command::Lsp { log_level, .. } => server::run(log_level, dialect),
+        Command::Run { file, format, step_budget } => run::run(&file, dialect, format, step_budget),
+        Command::Expand { file, output, step_budget } => run::expand(&file, dialect, output.as_deref(), step_budget),
+        Command::Lower { file } => run::lower(&file, dialect),
+        Command::Plot { file, output, step_budget, max_moves } => {
+            run::plot(&file, dialect, &output, step_budget, max_moves)
+        }
+        Command::Parse { file } => run::parse(&file, dialect),
     }
 }

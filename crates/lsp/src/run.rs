@@ -25,8 +25,8 @@ use nc_exec::{
     run::{Axes, Called, Environment, Motion, Step, Stop, Totals, Trace, expected_blocks},
     velocity::{self, Dynamics, Timer, Timing, TimingSink},
 };
-use ncc_analysis::{Config, clock};
-use ncc_syntax::{BlockParser, Dialect, Parse, TextSize, ast::AstNode, visible};
+use ncc_analysis::{Config, DialectId, clock};
+use ncc_syntax::{BlockParser, Parse, TextSize, ast::AstNode, visible};
 use serde::Serialize;
 
 use crate::{
@@ -80,8 +80,12 @@ fn read(path: &Path) -> Result<String, ExitCode> {
 }
 
 /// Runs `command` on the program at `path` with the `ncc.toml` found for
-/// it; a program that cannot be read is exit status 2.
-fn on_program(path: &Path, command: impl FnOnce(&Program<'_>) -> ExitCode) -> ExitCode {
+/// it; a program that cannot be read, or is in a dialect this version does
+/// not read, is exit status 2.
+fn on_program(path: &Path, dialect: Option<DialectId>, command: impl FnOnce(&Program<'_>) -> ExitCode) -> ExitCode {
+    if let Err(error) = check::dialect_for(path, dialect) {
+        return config_error(error);
+    }
     let text = match read(path) {
         Ok(text) => text,
         Err(code) => return code,
@@ -258,8 +262,8 @@ pub(crate) enum Progress {
     Hidden,
 }
 
-pub(crate) fn run(path: &Path, format: Format, step_budget: usize) -> ExitCode {
-    on_program(path, |program| run_program(program, path, format, step_budget))
+pub(crate) fn run(path: &Path, dialect: Option<DialectId>, format: Format, step_budget: usize) -> ExitCode {
+    on_program(path, dialect, |program| run_program(program, path, format, step_budget))
 }
 
 fn run_program(program: &Program<'_>, path: &Path, format: Format, step_budget: usize) -> ExitCode {
@@ -303,8 +307,8 @@ fn run_program(program: &Program<'_>, path: &Path, format: Format, step_budget: 
 /// to `output` or stdout, each block as its move comes: a run of any length
 /// expands in the same memory. A move the program cannot express stops the
 /// writing; the output file is then removed.
-pub(crate) fn expand(path: &Path, output: Option<&Path>, step_budget: usize) -> ExitCode {
-    on_program(path, |program| expand_program(program, path, output, step_budget))
+pub(crate) fn expand(path: &Path, dialect: Option<DialectId>, output: Option<&Path>, step_budget: usize) -> ExitCode {
+    on_program(path, dialect, |program| expand_program(program, path, output, step_budget))
 }
 
 fn expand_program(program: &Program<'_>, path: &Path, output: Option<&Path>, step_budget: usize) -> ExitCode {
@@ -355,8 +359,14 @@ fn expand_program(program: &Program<'_>, path: &Path, output: Option<&Path>, ste
 
 /// `ncc plot FILE -o OUT`: the toolpath as an SVG picture of the first
 /// `max_moves` moves.
-pub(crate) fn plot(path: &Path, output: &Path, step_budget: usize, max_moves: usize) -> ExitCode {
-    on_program(path, |program| plot_program(program, output, step_budget, max_moves))
+pub(crate) fn plot(
+    path: &Path,
+    dialect: Option<DialectId>,
+    output: &Path,
+    step_budget: usize,
+    max_moves: usize,
+) -> ExitCode {
+    on_program(path, dialect, |program| plot_program(program, output, step_budget, max_moves))
 }
 
 fn plot_program(program: &Program<'_>, output: &Path, step_budget: usize, max_moves: usize) -> ExitCode {
@@ -389,16 +399,32 @@ impl crate::plot::Lines for Ran {
     }
 }
 
-/// `ncc lower FILE`: each block as the executor reads it, after its line.
-pub(crate) fn lower(path: &Path) -> ExitCode {
-    let text = match check::read_program(path) {
-        Ok(text) => text,
-        Err(error) => {
-            eprintln!("error: {}: {error}", shown_path(path));
-            return ExitCode::from(2);
+/// The program at `path` parsed in its dialect; the error is the exit code
+/// after the message is printed.
+fn parsed(path: &Path, dialect: Option<DialectId>) -> Result<(String, Parse), ExitCode> {
+    let dialect = check::dialect_for(path, dialect).map_err(config_error)?;
+    let text = read(path)?;
+    let parse = Parse::new(&text, dialect);
+    Ok((text, parse))
+}
+
+/// `ncc parse FILE`: the lossless syntax tree.
+pub(crate) fn parse(path: &Path, dialect: Option<DialectId>) -> ExitCode {
+    match parsed(path, dialect) {
+        Ok((_, parse)) => {
+            print!("{}", parse.debug_dump());
+            ExitCode::SUCCESS
         }
+        Err(code) => code,
+    }
+}
+
+/// `ncc lower FILE`: each block as the executor reads it, after its line.
+pub(crate) fn lower(path: &Path, dialect: Option<DialectId>) -> ExitCode {
+    let (text, parse) = match parsed(path, dialect) {
+        Ok(parsed) => parsed,
+        Err(code) => return code,
     };
-    let parse = Parse::new(&text, Dialect::Cnc8x6);
     let lines = TextIndex::new(&text);
     let mut out = String::new();
     for block in parse.tree().blocks() {
@@ -870,7 +896,9 @@ impl Library {
                 let directory = path.parent().filter(|dir| !dir.as_os_str().is_empty()).unwrap_or(Path::new("."));
                 let beside = std::fs::read_dir(directory).into_iter().flatten().flatten().map(|entry| entry.path());
                 let project = program.config.and_then(Path::parent).map(Path::to_path_buf);
-                let in_project = project.map(|root| check::collect_files(&[root]).0).unwrap_or_default();
+                let in_project = project
+                    .map(|root| check::collect_files(&[root], &mut check::Projects::default(), None).files)
+                    .unwrap_or_default();
                 beside.chain(in_project).filter(|path| path.is_file()).collect()
             }
             None => Vec::new(),

@@ -33,7 +33,7 @@ use std::{
     },
 };
 
-use ncc_analysis::{Analysis, Cancelled, CycleTimeHints, Diagnostic, FileId, Findings, TextRange, TextSize};
+use ncc_analysis::{Analysis, Cancelled, CycleTimeHints, Diagnostic, DialectId, FileId, Findings, TextRange, TextSize};
 use tokio::sync::mpsc;
 use tower_lsp_server::{
     Client, LanguageServer, LspService,
@@ -43,7 +43,10 @@ use tower_lsp_server::{
 
 use tracing_subscriber::{filter::Targets, layer::SubscriberExt, util::SubscriberInitExt};
 
-use self::{convert::LineMap, workspace::Workspaces};
+use self::{
+    convert::LineMap,
+    workspace::{Opened, Workspaces},
+};
 
 /// How much the server logs to stderr.
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -55,7 +58,8 @@ pub(crate) enum LogLevel {
     Trace,
 }
 
-pub(crate) fn run(log_level: LogLevel) -> ExitCode {
+/// Serves the protocol; `dialect`, when given, is every document's.
+pub(crate) fn run(log_level: LogLevel, dialect: Option<DialectId>) -> ExitCode {
     let level = match log_level {
         LogLevel::Error => tracing::Level::ERROR,
         LogLevel::Warn => tracing::Level::WARN,
@@ -84,7 +88,7 @@ pub(crate) fn run(log_level: LogLevel) -> ExitCode {
     let shut_down = Arc::new(AtomicBool::new(false));
     let flag = shut_down.clone();
     runtime.block_on(async move {
-        let (service, socket) = LspService::new(move |client| Server::new(client, flag));
+        let (service, socket) = LspService::new(move |client| Server::new(client, flag, dialect));
         // The protocol layer talks to in-memory pipes; the frames guard sits
         // between them and stdio.
         let (server_input, guarded_input) = tokio::io::duplex(1 << 16);
@@ -170,10 +174,10 @@ struct Snapshot {
 }
 
 impl Server {
-    fn new(client: Client, shut_down: Arc<AtomicBool>) -> Server {
+    fn new(client: Client, shut_down: Arc<AtomicBool>, dialect: Option<DialectId>) -> Server {
         let (publisher, publications) = mpsc::unbounded_channel();
         tokio::spawn(publish(client.clone(), publications));
-        let state: Arc<Mutex<State>> = Arc::default();
+        let state = Arc::new(Mutex::new(State { workspaces: Workspaces::new(dialect), ..State::default() }));
         let (refresh, refreshes) = mpsc::unbounded_channel();
         tokio::spawn(cycle_time::refresh(client.clone(), state.clone(), refreshes));
         let timer = cycle_time::Timer::start(state.clone(), refresh.clone());
@@ -425,7 +429,21 @@ impl LanguageServer for Server {
         let document = params.text_document;
         let errors = {
             let mut state = self.state();
-            let (workspace, file, errors) = state.workspaces.open(&document.uri, document.text);
+            let (workspace, file, errors) = match state.workspaces.open(&document.uri, document.text) {
+                Opened::Analysed { index, file, errors } => (index, file, errors),
+                Opened::NotRead(dialect) => {
+                    drop(state);
+                    // One finding at the start says why nothing else is said.
+                    let diagnostic = lsp::Diagnostic {
+                        severity: Some(lsp::DiagnosticSeverity::INFORMATION),
+                        source: Some("ncc".to_owned()),
+                        message: dialect.not_read(),
+                        ..lsp::Diagnostic::default()
+                    };
+                    let _ = self.publisher.send((document.uri, vec![diagnostic], document.version));
+                    return;
+                }
+            };
             let map = LineMap::new(state.workspaces.get(workspace).analysis().text(file));
             let (flow, cycle) = Default::default();
             let version = document.version;

@@ -7,7 +7,7 @@ use std::{
     path::{Path, PathBuf},
 };
 
-use ncc_analysis::{AnalysisHost, Config, FileId, NavigationTarget};
+use ncc_analysis::{AnalysisHost, Config, DialectId, Dialects, FileId, NavigationTarget};
 use tower_lsp_server::ls_types::{self as lsp, Uri};
 
 use super::convert::LineMap;
@@ -17,12 +17,16 @@ use crate::check;
 pub(crate) struct Workspaces {
     /// The configuration file the client named for every document.
     forced_config: Option<PathBuf>,
+    /// The dialect of every document, when the server was started with one.
+    forced_dialect: Option<DialectId>,
     list: Vec<Workspace>,
 }
 
 #[derive(Debug)]
 struct Workspace {
     config_path: Option<PathBuf>,
+    /// What its configuration says of dialects.
+    dialects: Dialects,
     host: AnalysisHost,
     /// Files by the path the analysis knows them by.
     files: HashMap<String, FileId>,
@@ -39,7 +43,20 @@ fn document_path(uri: &Uri) -> (String, Option<PathBuf>) {
     }
 }
 
+/// What opening a document gave.
+pub(crate) enum Opened {
+    /// The document is analysed as `file` of workspace `index`; `errors`
+    /// are about files read on the way.
+    Analysed { index: usize, file: FileId, errors: Vec<String> },
+    /// The document is in a dialect this version does not read.
+    NotRead(DialectId),
+}
+
 impl Workspaces {
+    pub fn new(forced_dialect: Option<DialectId>) -> Workspaces {
+        Workspaces { forced_dialect, ..Workspaces::default() }
+    }
+
     pub fn configure(&mut self, config_file: Option<PathBuf>) {
         self.forced_config = config_file;
     }
@@ -71,8 +88,10 @@ impl Workspaces {
             }),
             None => Config::default(),
         };
+        let dialects = config.dialects.clone();
         self.list.push(Workspace {
             config_path,
+            dialects,
             host: AnalysisHost::new(config),
             files: HashMap::new(),
             uris: HashMap::new(),
@@ -103,25 +122,32 @@ impl Workspaces {
     /// Indexes the partprograms and macrocycle files under the workspace
     /// folders, so that calls resolve across files.
     pub fn load_roots(&mut self, roots: &[PathBuf]) -> Vec<String> {
-        let (files, mut errors) = check::collect_files(roots);
+        let mut projects = check::Projects::with_config(self.forced_config.clone());
+        let check::Found { files, mut failures, .. } = check::collect_files(roots, &mut projects, self.forced_dialect);
         for path in files {
-            self.add_from_disk(&path, &mut errors);
+            self.add_from_disk(&path, &mut failures);
         }
-        errors
+        failures
     }
 
     /// Opens a document: its text replaces what was read from disk.
     /// Macrocycle files beside it join the workspace.
-    pub fn open(&mut self, uri: &Uri, text: String) -> (usize, FileId, Vec<String>) {
+    pub fn open(&mut self, uri: &Uri, text: String) -> Opened {
         let (name, path) = document_path(uri);
         let mut errors = Vec::new();
+        let index = self.workspace_for(path.as_deref(), &mut errors);
+        let dialects = &self.list[index].dialects;
+        // A document that is no file (`untitled:`) has the default dialect.
+        let dialect = dialects.of_given(path.as_deref().unwrap_or(Path::new("")), self.forced_dialect);
+        if dialect.implementation().is_none() {
+            return Opened::NotRead(dialect);
+        }
         if let Some(path) = &path {
             let beside = check::macrocycles_beside(&[(path.clone(), String::new())]);
             for (macrocycle, _) in beside {
                 self.add_from_disk(&macrocycle, &mut errors);
             }
         }
-        let index = self.workspace_for(path.as_deref(), &mut errors);
         let workspace = &mut self.list[index];
         let file = match workspace.files.get(&name) {
             Some(&file) => {
@@ -135,7 +161,7 @@ impl Workspaces {
             }
         };
         workspace.uris.insert(file, uri.clone());
-        (index, file, errors)
+        Opened::Analysed { index, file, errors }
     }
 
     /// Closes a document: the file on disk takes its place again, or the
