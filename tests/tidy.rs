@@ -52,17 +52,10 @@ const DIALECT_DEBT: &[(&str, usize)] = &[
     ("crates/lsp/src/run.rs", 2),
     ("crates/lsp/src/server/handlers.rs", 1),
     ("crates/lsp/src/server/semantic.rs", 1),
-    ("crates/nc-exec/src/arith.rs", 1),
-    ("crates/nc-exec/src/cycles.rs", 3),
-    ("crates/nc-exec/src/expand.rs", 13),
-    ("crates/nc-exec/src/lower.rs", 2),
     ("crates/nc-exec/src/machine.rs", 1),
-    ("crates/nc-exec/src/modes.rs", 1),
-    ("crates/nc-exec/src/program_flow.rs", 8),
     ("crates/nc-exec/src/run/index.rs", 2),
     ("crates/nc-exec/src/run/runner.rs", 25),
     ("crates/nc-exec/src/run/support.rs", 12),
-    ("crates/nc-exec/src/tables.rs", 2),
     ("crates/syntax/src/lib.rs", 2),
 ];
 
@@ -71,7 +64,7 @@ const DIALECT_DEBT: &[(&str, usize)] = &[
 const CYCLE_DEBT: &[&str] = &[
     "analysis: checks → db → diagnostic → findings → flow → model → states",
     "lsp: check → report → sarif",
-    "nc-exec: arith → compensation → cycles → formats → machine → program_flow → run → transform",
+    "nc-exec: cnc8x6 → compensation → machine → run → tool_path → transform",
     "nc-exec: envelope → velocity",
     "syntax: ast → cnc8x6",
 ];

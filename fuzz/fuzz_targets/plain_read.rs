@@ -4,7 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use nc_exec::lower::{BlockData, BlockReader};
+use nc_exec::cnc8x6::lower::{BlockData, BlockReader};
 use ncc_syntax::{Dialect, Parse, ast::AstNode};
 
 fuzz_target!(|data: &[u8]| {

@@ -42,7 +42,7 @@
 //! `ncc.toml` replace the machine file's, and within `rapid-rates`,
 //! `limits` and `constants` key by key. Every mistake is an error that names
 //! the file, and the key or the line and column of a table file
-//! (`nc_exec::tables` has their formats); `docs/machine.md` documents every
+//! (`nc_exec::cnc8x6::tables` has their formats); `docs/machine.md` documents every
 //! key.
 
 use std::{
@@ -51,8 +51,8 @@ use std::{
     path::{Path, PathBuf},
 };
 
+use nc_exec::cnc8x6::tables::{self, Finding, OffsetTable, ToolTable};
 pub use nc_exec::machine::{MachineConfig, TravelLimits, parse_constant};
-use nc_exec::tables::{self, Finding, OffsetTable, ToolTable};
 use ncc_catalog::DialectId;
 use ncc_syntax::Severity;
 use serde::Deserialize;

@@ -21,8 +21,8 @@
 use std::{ops::Range, sync::Arc};
 
 use nc_exec::{
-    arith::{self, ArithError, BlockArithmetic, Parameters, Raw, UnknownMachine},
-    program_flow::{self, BlockFlow, JumpCounts},
+    cnc8x6::arith::{self, ArithError, BlockArithmetic, Parameters, Raw, UnknownMachine},
+    cnc8x6::program_flow::{self, BlockFlow, JumpCounts},
 };
 use ncc_catalog::{AddressRole, Catalogue, Modality};
 use ncc_syntax::{Decimal, Sign, TextRange, TextSize};

@@ -21,7 +21,7 @@ mod suppress;
 use std::sync::Arc;
 
 /// Blocks as plain data, lowered the same way for the executor.
-pub use nc_exec::lower;
+pub use nc_exec::cnc8x6::lower;
 pub use ncc_catalog::DialectId;
 use ncc_syntax::Parse;
 pub use ncc_syntax::{Dialect, Severity, TextEdit, TextRange, TextSize};

@@ -18,9 +18,9 @@ use std::{
 
 use indicatif::{ProgressBar, ProgressStyle};
 use nc_exec::{
-    arith::{Message, MessageDisplay},
-    expand::{ExpandError, Expansion},
-    lower::BlockData,
+    cnc8x6::arith::{Message, MessageDisplay},
+    cnc8x6::expand::{ExpandError, Expansion},
+    cnc8x6::lower::BlockData,
     machine::MachineConfig,
     run::{Axes, Called, Environment, Motion, Step, Stop, Totals, Trace, expected_blocks},
     velocity::{self, Dynamics, Timer, Timing, TimingSink},

@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 
 use ncc_catalog::Dialect;
 
-use crate::tables::{self, OffsetTable, ToolTable};
+use crate::cnc8x6::tables::{self, OffsetTable, ToolTable};
 
 /// The machine the programs run on.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]

@@ -10,7 +10,7 @@
 //! - Motion: G00, G01, arcs and helices G02/G03 (the centre from I/J/K, the
 //!   plane from the two axes written, 01 §6.4; the helix's lead from G10
 //!   under G09, 02 §4), threads G33, G90/G91.
-//! - Feed and spindle: the modal machine of every group ([`Modes`]), F
+//! - Feed and spindle: the modal machine of every group ([`Modes`](crate::cnc8x6::modes::Modes)), F
 //!   with its decimal-point rules per minute or per revolution and M37's
 //!   1 : 100, S, constant cutting speed G96/G97 with the G76 limit, dwell
 //!   (G04 Q, in 10 ms, after the block's motion).
@@ -18,7 +18,7 @@
 //!   block's motion, which reads the values from before them.
 //! - Fixed cycles G81–G89 after the block's motion until G80: the bodies of
 //!   the machine's cycle file with the state restored afterwards, or the
-//!   built-in cycles ([`crate::cycles`]).
+//!   built-in cycles ([`crate::cnc8x6::cycles`]).
 //!
 //! - Offsets: zero offsets G53–G59 with G92/G93, length corrections D/&,
 //!   and radius compensation G41/G42 ([`crate::compensation`]).
@@ -28,7 +28,7 @@
 //!   transformations G38/G39/G31 ([`crate::transform`]).
 //!
 //! Where the control stops on an error, the run stops with a fatal
-//! [`Finding`]: a value its address cannot take ([`crate::formats`]), a
+//! [`Finding`]: a value its address cannot take ([`crate::cnc8x6::formats`]), a
 //! position beyond an axis's range or the machine's travel limits, an arc
 //! end point off its circle, a call, jump, cycle or arithmetic that cannot
 //! run.

@@ -4,7 +4,7 @@
 #[path = "../../syntax/tests/strategies/mod.rs"]
 mod strategies;
 
-use nc_exec::lower::{BlockData, BlockReader};
+use nc_exec::cnc8x6::lower::{BlockData, BlockReader};
 use ncc_syntax::{Dialect, Parse, TextRange, ast::AstNode};
 use proptest::prelude::*;
 use strategies::{block_program, crowded_lines, overlong_lines, program_text};

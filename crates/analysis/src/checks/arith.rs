@@ -9,7 +9,7 @@
 //! Failures of the values (division by zero, overflow, …) are
 //! `arithmetic-error`'s.
 
-use nc_exec::arith::{self, ArithConfig, ArithError, ControlWord, Parameters, Raw, UnknownMachine};
+use nc_exec::cnc8x6::arith::{self, ArithConfig, ArithError, ControlWord, Parameters, Raw, UnknownMachine};
 use ncc_catalog::{AddressRole, Dialect};
 use ncc_syntax::{Severity, TextEdit, TextRange};
 use rustc_hash::FxHashSet;

@@ -4,7 +4,7 @@ use ncc_catalog::{Address, AddressRole, Catalogue, Dialect};
 use ncc_syntax::{Decimal, TextRange};
 use rustc_hash::FxHashMap;
 
-use nc_exec::formats::{self, Fault, Refusal};
+use nc_exec::cnc8x6::formats::{self, Fault, Refusal};
 
 use crate::{
     Config, Diagnostic,
@@ -182,7 +182,7 @@ fn check_literal(
 }
 
 /// The format's digit limits of a value, shared with the executor.
-pub(crate) use nc_exec::formats::digit_overflow;
+pub(crate) use nc_exec::cnc8x6::formats::digit_overflow;
 
 fn check_code(word: &Word, value: &Decimal, catalogue: &Catalogue, out: &mut Vec<Diagnostic>) {
     let Some(number) = value.scaled(0).and_then(|v| u32::try_from(v).ok()) else { return };
@@ -308,7 +308,7 @@ fn check_assignments(block: &BlockData, catalogue: &Catalogue, out: &mut Vec<Dia
 
 /// The raw value a parameter stores: thousandths (`R1=864` → 864,
 /// `R1=864.` → 864000).
-pub(crate) use nc_exec::arith::literal_raw as parameter_raw;
+pub(crate) use nc_exec::cnc8x6::arith::literal_raw as parameter_raw;
 
 fn check_skip(block: &BlockData, out: &mut Vec<Diagnostic>) {
     for digit in &block.skip_digits {

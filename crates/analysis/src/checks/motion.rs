@@ -3,7 +3,7 @@
 //! the control's 200-block look-ahead); length compensation `&`/D and the
 //! correction-table write `G92 D`.
 
-use nc_exec::arith::MAX_RAW;
+use nc_exec::cnc8x6::arith::MAX_RAW;
 use ncc_catalog::{AddressRole, Dialect};
 use ncc_syntax::{Severity, TextEdit, TextRange};
 

@@ -1,6 +1,6 @@
 //! Parameters: substitution into addresses, and parameter arithmetic.
 
-use nc_exec::formats::{self, Fault, Refusal};
+use nc_exec::cnc8x6::formats::{self, Fault, Refusal};
 use ncc_catalog::{AddressRole, Dialect};
 
 use crate::{
@@ -146,4 +146,4 @@ pub(crate) fn check_substitution(
 }
 
 /// A raw value as the real number the parameter holds (`864` → `0.864`).
-pub(crate) use nc_exec::formats::show;
+pub(crate) use nc_exec::cnc8x6::formats::show;

@@ -11,10 +11,10 @@ use std::{
 use ncc_syntax::{TextRange, TextSize};
 
 use crate::{
+    cnc8x6::lower::BlockData,
+    cnc8x6::program_flow::{BlockFlow, JumpCounts},
     compensation::ToolElement,
-    lower::BlockData,
     machine::MachineConfig,
-    program_flow::{BlockFlow, JumpCounts},
     transform::Frame,
 };
 

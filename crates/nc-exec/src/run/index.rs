@@ -15,8 +15,8 @@ use ncc_syntax::{TextRange, TextSize};
 use rowan::GreenNode;
 
 use crate::{
-    lower::{BlockData, BlockReader, PlainReader, Value},
-    program_flow::{BlockFlow, whole_number},
+    cnc8x6::lower::{BlockData, BlockReader, PlainReader, Value},
+    cnc8x6::program_flow::{BlockFlow, whole_number},
 };
 
 use super::support::*;

@@ -6,15 +6,15 @@ use ncc_syntax::TextRange;
 use smallvec::SmallVec;
 
 use crate::{
-    arith::{self, BlockArithmetic, Parameters, Raw},
+    cnc8x6::arith::{self, BlockArithmetic, Parameters, Raw},
+    cnc8x6::cycles::{self, CycleError, CycleInput, CycleKind, CycleStep, Spindle},
+    cnc8x6::formats::{self, PlainLiterals},
+    cnc8x6::lower::{BlockData, Value, Word},
+    cnc8x6::modes::Modes,
+    cnc8x6::program_flow::{self, BlockFlow, block_flow},
+    cnc8x6::tables::{OffsetTable, ToolTable},
     compensation::{CompensationError, Compensator, Element, Settings, Side, ToolElement},
-    cycles::{self, CycleError, CycleInput, CycleKind, CycleStep, Spindle},
-    formats::{self, PlainLiterals},
-    lower::{BlockData, Value, Word},
     machine::MachineConfig,
-    modes::Modes,
-    program_flow::{self, BlockFlow, block_flow},
-    tables::{OffsetTable, ToolTable},
     transform::{self, Frame, Kind, Recalculation, Refused, Transformation, Transformations},
 };
 

@@ -5,11 +5,11 @@ use nalgebra::Vector2;
 use ncc_syntax::TextRange;
 
 use crate::{
-    arith::{Machine, Message, Parameters, Raw},
-    lower::{BlockData, Word},
+    cnc8x6::arith::{Machine, Message, Parameters, Raw},
+    cnc8x6::lower::{BlockData, Word},
+    cnc8x6::modes::{Group, Modes},
+    cnc8x6::tables::{OffsetTable, ToolEntry, ToolTable},
     machine::MachineConfig,
-    modes::{Group, Modes},
-    tables::{OffsetTable, ToolEntry, ToolTable},
     transform::{self, Frame},
 };
 

@@ -9,8 +9,8 @@ use super::{
     resume_into, round3, run, run_into,
 };
 use crate::{
+    cnc8x6::tables::OffsetTable,
     machine::{MachineConfig, TravelLimits},
-    tables::OffsetTable,
 };
 
 impl StepSink for Vec<Step> {
@@ -497,7 +497,7 @@ fn the_spatial_transformation_and_what_the_control_refuses() {
 
 #[test]
 fn operation_51_messages_are_kept_with_their_block() {
-    use crate::arith::{Message, MessageDisplay};
+    use crate::cnc8x6::arith::{Message, MessageDisplay};
     let trace = run_text("%1\nN1 G00 X10\nN2 R30=12.5 R5=51073053 G26\nN3 R5=51073050 G26\nN4 M30\n");
     assert!(trace.findings.is_empty(), "{:?}", trace.findings);
     let shown: Vec<(usize, Message)> = trace.messages.iter().map(|m| (m.step, m.message)).collect();

@@ -5,7 +5,7 @@ use std::ops::Range;
 use ncc_syntax::TextRange;
 
 use crate::{
-    arith::Message,
+    cnc8x6::arith::Message,
     compensation::ToolElement,
     transform::{self, Frame},
 };

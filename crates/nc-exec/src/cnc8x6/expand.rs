@@ -418,7 +418,7 @@ N102 G90 G70
     /// expansion runs in G53 the machine positions the original ran.
     #[test]
     fn offsets_and_transformations_are_written_as_machine_positions() {
-        use crate::tables::{OffsetTable, ToolTable};
+        use crate::cnc8x6::tables::{OffsetTable, ToolTable};
         let mut machine = MachineConfig::default();
         (machine.offsets, _) = OffsetTable::parse("$POS\nG53: X=1.0\nG54: X=100.0 Y=-50.0\n", &machine.axes);
         (machine.tools, _) = ToolTable::parse("$KOR\n01: R=0 X=0 Y=0 Z=25.0\n", &machine.axes);

@@ -55,7 +55,7 @@
 use std::fmt;
 
 use crate::{
-    arith::{MAX_RAW, Parameters, Raw},
+    cnc8x6::arith::{MAX_RAW, Parameters, Raw},
     run::Position,
 };
 

@@ -7,7 +7,7 @@ use ncc_catalog::{Address, AddressRole};
 use ncc_syntax::Decimal;
 
 use crate::{
-    arith::{MAX_RAW, Raw, literal_raw},
+    cnc8x6::arith::{MAX_RAW, Raw, literal_raw},
     machine::MachineConfig,
 };
 
@@ -77,10 +77,10 @@ pub fn assignment_fault(parameter: &Address, value: &Decimal) -> Option<Fault> {
 
 /// A parameter number the control does not have.
 pub fn parameter_number_fault(index: u32) -> Option<Fault> {
-    (index as usize >= crate::arith::PARAMETER_COUNT).then(|| {
+    (index as usize >= crate::cnc8x6::arith::PARAMETER_COUNT).then(|| {
         Fault::new(
             Refusal::Range,
-            format!("R{index}: the control has parameters R0 to R{}", crate::arith::PARAMETER_COUNT - 1),
+            format!("R{index}: the control has parameters R0 to R{}", crate::cnc8x6::arith::PARAMETER_COUNT - 1),
         )
     })
 }

@@ -66,7 +66,7 @@ use std::fmt;
 use ncc_syntax::TextRange;
 
 use crate::{
-    lower::{BlockData, Value},
+    cnc8x6::lower::{BlockData, Value},
     machine::MachineConfig,
 };
 

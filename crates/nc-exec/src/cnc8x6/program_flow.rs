@@ -7,8 +7,8 @@ use std::collections::BTreeMap;
 use ncc_syntax::Decimal;
 
 use crate::{
-    arith::{self, Parameters},
-    lower::{BlockData, Value, Word},
+    cnc8x6::arith::{self, Parameters},
+    cnc8x6::lower::{BlockData, Value, Word},
 };
 
 /// How a block passes control on once its work is done.

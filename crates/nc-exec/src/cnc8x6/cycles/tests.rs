@@ -2,7 +2,7 @@ use expect_test::{Expect, expect};
 use ncc_syntax::{Decimal, Sign};
 
 use super::*;
-use crate::arith::literal_raw;
+use crate::cnc8x6::arith::literal_raw;
 
 /// Parameters from their values as a program writes them.
 fn params(values: &[(usize, &str)]) -> Parameters {

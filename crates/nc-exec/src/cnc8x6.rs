@@ -1,0 +1,12 @@
+//! The CNC8x6 dialect's part of the executor: its block IR and lowering,
+//! value formats, modal groups, parameter arithmetic, program flow, fixed
+//! cycles, table files and the writer of expanded programs.
+
+pub mod arith;
+pub mod cycles;
+pub mod expand;
+pub mod formats;
+pub mod lower;
+pub mod modes;
+pub mod program_flow;
+pub mod tables;
