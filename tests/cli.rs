@@ -561,7 +561,7 @@ fn run_prints_the_time_and_a_record_per_block() {
     "#]]
     .assert_eq(&summary);
     let warnings = String::from_utf8(output.stderr).unwrap().replace(program, "DEMO.NCP");
-    assert_eq!(warnings, "DEMO.NCP:6: the executor does not run G08 yet: the time leaves them out\n");
+    assert_eq!(warnings, "DEMO.NCP:6: info[E020]: the executor does not run G08 yet: the time leaves them out\n");
 
     let output = ncc(&["run", program, "--format", "json"]);
     let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
@@ -605,7 +605,7 @@ fn run_stops_on_a_call_to_nothing() {
     let output = ncc(&["run", program.to_str().unwrap(), "--step-budget", "100"]);
     assert_eq!(output.status.code(), Some(1));
     let stderr = String::from_utf8(output.stderr).unwrap();
-    assert!(stderr.ends_with("CALL.NCP:3: there is no subprogram L9 (G79 L9) in this file\n"), "{stderr}");
+    assert!(stderr.ends_with("CALL.NCP:3: error[E007]: there is no subprogram L9 (G79 L9) in this file\n"), "{stderr}");
 }
 
 /// Where the control stops, `ncc run`, `ncc expand` and `ncc plot` stop:
@@ -656,7 +656,9 @@ fn run_expand_and_plot_stop_where_the_control_stops() {
             let output = ncc(&args);
             assert_eq!(output.status.code(), Some(1), "{args:?}");
             let stderr = String::from_utf8(output.stderr.clone()).unwrap();
-            assert!(stderr.ends_with(&format!("{name}:{line}: {message}\n")), "{args:?}: {stderr}");
+            let (place, said) = stderr.trim_end().split_once(": error[E").unwrap_or_default();
+            assert!(place.ends_with(&format!("{name}:{line}")), "{args:?}: {stderr}");
+            assert!(said.split_once("]: ").is_some_and(|(_, said)| said == message), "{args:?}: {stderr}");
             let written = stdout(&output) + &std::fs::read_to_string(&svg).unwrap_or_default();
             let words = written.split(|c: char| !c.is_ascii_alphanumeric()).map(str::to_ascii_lowercase);
             assert!(
@@ -1046,7 +1048,7 @@ fn run_escapes_control_characters_in_what_it_prints() {
     std::fs::write(&path, "%1\nN10 G72 L9002\nN20 M30\n").unwrap();
     let output = ncc(&["run", path.to_str().unwrap()]);
     let (out, err) = (stdout(&output), String::from_utf8(output.stderr).unwrap());
-    assert!(err.contains("A\\u{1b}[2J.NCP:2: there is no macrocycle file L9002 to call"), "{err}");
+    assert!(err.contains("A\\u{1b}[2J.NCP:2: error[E007]: there is no macrocycle file L9002 to call"), "{err}");
     for printed in [&out, &err] {
         assert!(!printed.contains('\u{1b}'), "{printed}");
     }
@@ -1132,4 +1134,46 @@ fn directories_are_searched_by_extension_per_dialect_and_ncc_toml_maps_more() {
     let (code, _, err) = checked(dir.path());
     assert_eq!(code, Some(2));
     assert!(err.contains("ncc.toml: [extensions] key `a/b` is not a file extension like `NCP`"), "{err}");
+}
+
+/// The executor's findings are rules: `ncc.toml` turns them off or changes
+/// their level, `ncc:ignore` comments silence them, and the JSON output
+/// names them; a finding the run stops on is shown whatever its level.
+#[test]
+fn run_findings_are_rules_that_ncc_toml_configures() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("RULES.NCP");
+    let text = "%1\nN10 G01 X1 F100\nN20 G30\nN30 G23 I7\nN35 G23 I9 \"ncc:ignore E015\nN40 G72 L9001\nN50 M30\n";
+    std::fs::write(&program, text).unwrap();
+    let program = program.to_str().unwrap();
+    let findings = |config: &str| {
+        std::fs::write(dir.path().join("ncc.toml"), config).unwrap();
+        let output = ncc(&["run", program]);
+        assert_eq!(output.status.code(), Some(1));
+        String::from_utf8(output.stderr).unwrap().replace(program, "RULES.NCP")
+    };
+    assert_eq!(
+        findings(""),
+        "RULES.NCP:3: info[E020]: the executor does not run G30 yet: the time leaves them out\n\
+         RULES.NCP:4: warning[E015]: G23 I7: the dynamic sets are I1 to I4: the set in force stays\n\
+         RULES.NCP:6: error[E007]: there is no macrocycle file L9001 to call\n"
+    );
+    let configured = "[rules]\nnot-run-yet = \"off\"\nE015 = \"error\"\ncall-target-missing = \"off\"\n";
+    assert_eq!(
+        findings(configured),
+        "RULES.NCP:4: error[E015]: G23 I7: the dynamic sets are I1 to I4: the set in force stays\n\
+         RULES.NCP:6: error[E007]: there is no macrocycle file L9001 to call\n"
+    );
+    let output = ncc(&["run", program, "--format", "json"]);
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let records: Vec<String> = json["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| format!("{} {} {} {} {}", f["code"], f["name"], f["severity"], f["line"], f["stopped"]))
+        .collect();
+    assert_eq!(
+        records,
+        [r#""E015" "dynamic-set-out-of-range" "error" 4 false"#, r#""E007" "call-target-missing" "error" 6 true"#]
+    );
 }

@@ -429,6 +429,11 @@ impl Config {
         Some(diagnostic)
     }
 
+    /// What a finding of `rule` becomes: `None` when it is off.
+    pub fn level_of(&self, rule: &crate::Rule) -> Option<Severity> {
+        self.severity(rule.code, rule.name, rule.severity)
+    }
+
     /// What a finding of rule `code` (`name`) found at `severity` becomes.
     pub(crate) fn severity(&self, code: &str, name: &str, severity: Severity) -> Option<Severity> {
         match self.rules.get(code).or_else(|| self.rules.get(name)) {

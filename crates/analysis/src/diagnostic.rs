@@ -1,6 +1,7 @@
 //! What the analysis reports: diagnostics with ranges, related locations and
 //! quick fixes, and the registry of rules with their stable codes.
 
+use nc_exec::run::RunRule;
 use ncc_syntax::{Severity, SyntaxError, SyntaxErrorKind, TextEdit, TextRange};
 
 /// A finding in one file.
@@ -138,6 +139,22 @@ static SYNTAX_RULES: std::sync::LazyLock<Vec<Rule>> = std::sync::LazyLock::new(|
         .collect()
 });
 
+/// The executor's findings as rules: `ncc run` reports them, and
+/// configuration and listings treat them like every other rule.
+static RUN_RULES: std::sync::LazyLock<Vec<Rule>> = std::sync::LazyLock::new(|| {
+    RunRule::ALL
+        .iter()
+        .map(|rule| Rule {
+            code: rule.code(),
+            name: rule.name(),
+            severity: rule.severity(),
+            summary: rule.summary(),
+            opt_in: false,
+            unnecessary: false,
+        })
+        .collect()
+});
+
 /// A rule: what a diagnostic is about. Codes and names are stable:
 /// configuration and suppression comments refer to them.
 #[derive(Debug, PartialEq, Eq, Hash)]
@@ -156,9 +173,17 @@ pub struct Rule {
 }
 
 impl Rule {
-    /// Every rule: the parser's syntax diagnostics, then every check module's.
+    /// Every rule: the parser's syntax diagnostics, every check module's,
+    /// then the executor's.
     pub fn all() -> impl Iterator<Item = &'static Rule> {
-        SYNTAX_RULES.iter().chain(crate::checks::RULES.iter().flat_map(|rules| rules.iter().copied()))
+        let checks = crate::checks::RULES.iter().flat_map(|rules| rules.iter().copied());
+        SYNTAX_RULES.iter().chain(checks).chain(RUN_RULES.iter())
+    }
+
+    /// The rule of an executor's finding.
+    pub fn of_run(rule: RunRule) -> &'static Rule {
+        // `RunRule::ALL` lists the rules in their declaration order.
+        &RUN_RULES[rule as usize]
     }
 
     /// The rule with this code or name.

@@ -47,6 +47,7 @@ pub use crate::{
     diagnostic::{Diagnostic, Fix, Related, Rule},
     findings::{Findings, OmittedFindings},
     ide::{HoverResult, NavigationTarget},
+    suppress::Suppressions,
 };
 
 /// A file of the analysis.
@@ -328,7 +329,7 @@ fn configured_flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
 /// per line.
 fn configure(db: &dyn Db, file: SourceFile, all: Findings) -> Findings {
     let config = Settings::get(db).config(db);
-    let suppressions = suppress::Suppressions::of(file.text(db), file.parse(db));
+    let suppressions = Suppressions::of(file.text(db), file.parse(db));
     let diagnostics = all
         .diagnostics
         .into_iter()

@@ -13,16 +13,26 @@
 
 use std::ops::Range;
 
-use ncc_syntax::{Parse, SyntaxKind, TextSize, ast::Comment};
+use ncc_syntax::{Dialect, Parse, SyntaxKind, TextSize, ast::Comment};
 
 const MARKER: &str = "ncc:ignore";
 
-pub(crate) struct Suppressions {
+#[derive(Debug)]
+pub struct Suppressions {
     /// Byte ranges of silenced lines, with the rules silenced (empty = all).
     lines: Vec<(Range<usize>, Vec<String>)>,
 }
 
 impl Suppressions {
+    /// The suppressions of a text outside the database (a file the
+    /// executor runs); it is parsed only when it holds a marker.
+    pub fn of_text(text: &str, dialect: Dialect) -> Suppressions {
+        if !text.contains(MARKER) {
+            return Suppressions { lines: Vec::new() };
+        }
+        Suppressions::of(text, &Parse::new(text, dialect))
+    }
+
     pub(crate) fn of(text: &str, parse: &Parse) -> Suppressions {
         let mut lines = Vec::new();
         // Most files have none; finding that out needs no tree walk.
@@ -55,7 +65,7 @@ impl Suppressions {
 
     /// Whether findings of rule `code` (`name`) starting at `at` are
     /// silenced. A binary search: a file can have a comment on every line.
-    pub(crate) fn silences(&self, at: TextSize, code: &str, name: &str) -> bool {
+    pub fn silences(&self, at: TextSize, code: &str, name: &str) -> bool {
         let at = usize::from(at);
         let candidates = &self.lines[..self.lines.partition_point(|(line, _)| line.start <= at)];
         let on_line = candidates.iter().rev().take_while(|(line, _)| line.contains(&at) || line.start == at);

@@ -14,10 +14,14 @@
 //! diagnostic of that rule starts somewhere on the line above (for ranges
 //! that start in the first column). A `name.toml` beside a fixture is used
 //! as its `ncc.toml`. Files without annotations must have no diagnostics.
+//!
+//! The fixtures in `test_data/run_rules` are run on the executor instead,
+//! and its findings are compared with their annotations the same way.
 
 use std::{fmt::Write, fs, path::PathBuf};
 
-use ncc_analysis::{AnalysisHost, Config, Diagnostic, Rule};
+use nc_exec::run::{Called, Environment};
+use ncc_analysis::{AnalysisHost, Config, Diagnostic, Rule, TextRange};
 
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
 struct Expected {
@@ -53,13 +57,17 @@ fn annotations(text: &str) -> Vec<Expected> {
 }
 
 fn actual(text: &str, diagnostic: &Diagnostic) -> Expected {
-    let start = usize::from(diagnostic.range.start());
-    let end = usize::from(diagnostic.range.end());
+    actual_at(text, diagnostic.range, diagnostic.name)
+}
+
+fn actual_at(text: &str, range: TextRange, name: &str) -> Expected {
+    let start = usize::from(range.start());
+    let end = usize::from(range.end());
     let line = text[..start].matches('\n').count();
     let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
     let column = |at: usize| text[line_start..at].chars().count();
     let end_column = if text[start..end].contains('\n') { column(start) + 1 } else { column(end) };
-    Expected { line, columns: Some((column(start), end_column)), name: diagnostic.name.to_owned() }
+    Expected { line, columns: Some((column(start), end_column)), name: name.to_owned() }
 }
 
 fn matches(expected: &Expected, actual: &Expected) -> bool {
@@ -70,8 +78,8 @@ fn matches(expected: &Expected, actual: &Expected) -> bool {
 
 /// Single-file fixtures (`*.ncp`) and workspace fixtures (directories whose
 /// files are analysed together, e.g. a program and its macrocycle files).
-fn fixtures() -> Vec<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("test_data/rules");
+fn fixtures(directory: &str) -> Vec<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("test_data").join(directory);
     let mut entries: Vec<PathBuf> = fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -81,7 +89,8 @@ fn fixtures() -> Vec<PathBuf> {
     entries
 }
 
-fn check(fixture: &PathBuf) -> Result<Vec<Diagnostic>, String> {
+/// A fixture's files with their text, and its configuration.
+fn inputs(fixture: &PathBuf) -> Result<(Vec<(PathBuf, String)>, Config), String> {
     let (files, config_path) = if fixture.is_dir() {
         let mut files: Vec<PathBuf> = fs::read_dir(fixture)
             .unwrap()
@@ -98,20 +107,23 @@ fn check(fixture: &PathBuf) -> Result<Vec<Diagnostic>, String> {
     } else {
         Config::default()
     };
+    Ok((files.into_iter().map(|path| (path.clone(), fs::read_to_string(path).unwrap())).collect(), config))
+}
+
+fn check(fixture: &PathBuf) -> Result<Vec<Diagnostic>, String> {
+    let (files, config) = inputs(fixture)?;
     let mut host = AnalysisHost::new(config);
     let ids: Vec<_> = files
-        .iter()
-        .map(|path| {
-            let text = fs::read_to_string(path).unwrap();
-            (host.add_file(path.display().to_string(), text.as_str()), path, text)
-        })
+        .into_iter()
+        .map(|(path, text)| (host.add_file(path.display().to_string(), text.as_str()), path, text))
         .collect();
     let analysis = host.analysis();
     let mut all = Vec::new();
     let mut report = String::new();
     for (file, path, text) in ids {
         let diagnostics = analysis.diagnostics(file);
-        if let Err(mismatch) = compare(path, &text, &diagnostics) {
+        let found = diagnostics.iter().map(|d| (actual(&text, d), d.message.clone())).collect();
+        if let Err(mismatch) = compare(&path, &text, found) {
             report.push_str(&mismatch);
         }
         all.extend(diagnostics);
@@ -119,16 +131,75 @@ fn check(fixture: &PathBuf) -> Result<Vec<Diagnostic>, String> {
     if report.is_empty() { Ok(all) } else { Err(report) }
 }
 
-fn compare(path: &std::path::Path, text: &str, diagnostics: &[Diagnostic]) -> Result<(), String> {
+/// The files of a run fixture besides its program: macrocycle files by
+/// number, the cycle file by name.
+struct FixtureFiles<'a>(&'a [(PathBuf, String)]);
+
+impl FixtureFiles<'_> {
+    fn named(&self, name: &str) -> Option<&(PathBuf, String)> {
+        self.0.iter().find(|(path, _)| path.file_name().is_some_and(|file| file.eq_ignore_ascii_case(name)))
+    }
+}
+
+impl Environment for FixtureFiles<'_> {
+    fn macrocycle(&self, number: u32) -> Option<String> {
+        self.named(&format!("L{number}")).map(|(_, text)| text.clone())
+    }
+
+    fn cycle_file(&self, name: &str) -> Option<String> {
+        self.named(name).map(|(_, text)| text.clone())
+    }
+}
+
+/// Blocks a run fixture may run: enough for each, few enough for a loop
+/// that never ends.
+const RUN_FIXTURE_BUDGET: usize = 1000;
+
+/// Runs a fixture's program (its `.ncp` file) and compares the findings
+/// in each of its files with their annotations; returns the rules found.
+fn run_check(fixture: &PathBuf) -> Result<Vec<&'static str>, String> {
+    let (files, config) = inputs(fixture)?;
+    let program = files.iter().position(|(path, _)| path.extension().is_some_and(|e| e == "ncp")).unwrap();
+    let trace = nc_exec::run::run(&files[program].1, &FixtureFiles(&files), &config.machine, RUN_FIXTURE_BUDGET);
+    let file_of = |source: usize| match source.checked_sub(1).map(|called| &trace.files[called]) {
+        None => program,
+        Some(Called::Macrocycle(number)) => {
+            files.iter().position(|(path, _)| path.ends_with(format!("L{number}"))).unwrap()
+        }
+        Some(Called::CycleFile) => {
+            let name = config.machine.cycle_file.as_deref().unwrap_or_default();
+            files.iter().position(|(path, _)| path.ends_with(name)).unwrap()
+        }
+    };
+    let mut report = String::new();
+    for (index, (path, text)) in
+        files.iter().enumerate().filter(|(_, (path, _))| path.extension().is_none_or(|e| e != "KOR"))
+    {
+        let found = trace
+            .findings
+            .iter()
+            .filter(|finding| file_of(finding.source) == index)
+            .map(|finding| (actual_at(text, finding.range, finding.rule.name()), finding.message.clone()))
+            .collect();
+        if let Err(mismatch) = compare(path, text, found) {
+            report.push_str(&mismatch);
+        }
+    }
+    let rules = trace.findings.iter().map(|finding| finding.rule.name()).collect();
+    if report.is_empty() { Ok(rules) } else { Err(report) }
+}
+
+/// Compares what was found in a file, each with its message, with the
+/// file's annotations.
+fn compare(path: &std::path::Path, text: &str, found: Vec<(Expected, String)>) -> Result<(), String> {
     let mut expected = annotations(text);
     let mut unexpected = Vec::new();
-    for diagnostic in diagnostics {
-        let found = actual(text, diagnostic);
+    for (found, message) in found {
         match expected.iter().position(|e| matches(e, &found)) {
             Some(i) => {
                 expected.remove(i);
             }
-            None => unexpected.push((found, diagnostic)),
+            None => unexpected.push((found, message)),
         }
     }
     if expected.is_empty() && unexpected.is_empty() {
@@ -139,17 +210,9 @@ fn compare(path: &std::path::Path, text: &str, diagnostics: &[Diagnostic]) -> Re
         let at = e.columns.map_or(String::new(), |(s, end)| format!(":{}-{}", s + 1, end + 1));
         let _ = writeln!(report, "  missing    {}{at} {}", e.line + 1, e.name);
     }
-    for (found, diagnostic) in &unexpected {
+    for (found, message) in &unexpected {
         let (s, end) = found.columns.unwrap();
-        let _ = writeln!(
-            report,
-            "  unexpected {}:{}-{} {}: {}",
-            found.line + 1,
-            s + 1,
-            end + 1,
-            found.name,
-            diagnostic.message
-        );
+        let _ = writeln!(report, "  unexpected {}:{}-{} {}: {message}", found.line + 1, s + 1, end + 1, found.name);
     }
     Err(report)
 }
@@ -158,9 +221,15 @@ fn compare(path: &std::path::Path, text: &str, diagnostics: &[Diagnostic]) -> Re
 fn fixtures_have_exactly_the_annotated_diagnostics() {
     let mut failures = String::new();
     let mut covered = std::collections::BTreeSet::new();
-    for path in fixtures() {
+    for path in fixtures("rules") {
         match check(&path) {
             Ok(diagnostics) => covered.extend(diagnostics.iter().map(|d| d.name)),
+            Err(report) => failures.push_str(&report),
+        }
+    }
+    for path in fixtures("run_rules") {
+        match run_check(&path) {
+            Ok(rules) => covered.extend(rules),
             Err(report) => failures.push_str(&report),
         }
     }

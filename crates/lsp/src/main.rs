@@ -81,7 +81,8 @@ enum Command {
         #[arg(long, conflicts_with = "query")]
         list: bool,
     },
-    /// List the rules `ncc check` applies: code, default severity, name.
+    /// List the rules of `ncc check` and of the executor: code, default
+    /// severity, name.
     ///
     /// Names and codes are what `ncc.toml` and `ncc:ignore` comments use.
     Rules {

@@ -21,11 +21,10 @@ use nc_exec::{
     cnc8x6::arith::{Message, MessageDisplay},
     cnc8x6::expand::{ExpandError, Expansion},
     cnc8x6::lower::BlockData,
-    machine::MachineConfig,
     run::{Axes, Called, Environment, Motion, Step, Stop, Totals, Trace, expected_blocks},
     velocity::{self, Dynamics, Timer, Timing, TimingSink},
 };
-use ncc_analysis::{Config, DialectId, clock};
+use ncc_analysis::{Config, Dialect, DialectId, Rule, Severity, Suppressions, clock};
 use ncc_syntax::{BlockParser, Parse, TextSize, ast::AstNode, visible};
 use serde::Serialize;
 
@@ -51,6 +50,8 @@ pub(crate) struct Program<'a> {
     pub name: String,
     /// The text to run: an editor's may differ from the file's.
     pub text: &'a str,
+    /// The dialect it is read in.
+    pub dialect: Dialect,
     /// The `ncc.toml` that applies, whose directory is the project.
     pub config: Option<&'a Path>,
 }
@@ -58,15 +59,17 @@ pub(crate) struct Program<'a> {
 /// A program run on the machine of its project.
 pub(crate) struct Ran {
     trace: Trace,
+    /// The levels of the run's rules.
+    config: Config,
     /// The machine's dynamics, for the velocity model.
     dynamics: Dynamics,
     sources: Vec<Source>,
 }
 
 impl Program<'_> {
-    /// The machine its configuration describes.
-    fn machine(&self) -> Result<MachineConfig, String> {
-        Ok(self.config.map(check::load_config).transpose()?.unwrap_or_default().machine)
+    /// Its configuration: the machine, and the levels of the run's rules.
+    fn config(&self) -> Result<Config, String> {
+        Ok(self.config.map(check::load_config).transpose()?.unwrap_or_default())
     }
 }
 
@@ -83,15 +86,22 @@ fn read(path: &Path) -> Result<String, ExitCode> {
 /// it; a program that cannot be read, or is in a dialect this version does
 /// not read, is exit status 2.
 fn on_program(path: &Path, dialect: Option<DialectId>, command: impl FnOnce(&Program<'_>) -> ExitCode) -> ExitCode {
-    if let Err(error) = check::dialect_for(path, dialect) {
-        return config_error(error);
-    }
+    let dialect = match check::dialect_for(path, dialect) {
+        Ok(dialect) => dialect,
+        Err(error) => return config_error(error),
+    };
     let text = match read(path) {
         Ok(text) => text,
         Err(code) => return code,
     };
     let config = Config::find_for(path);
-    command(&Program { path: Some(path), name: path.display().to_string(), text: &text, config: config.as_deref() })
+    command(&Program {
+        path: Some(path),
+        name: path.display().to_string(),
+        text: &text,
+        dialect,
+        config: config.as_deref(),
+    })
 }
 
 /// Prints a configuration error; the exit code says so.
@@ -101,9 +111,12 @@ fn config_error(error: String) -> ExitCode {
 }
 
 impl Ran {
+    /// On stderr, one line each, as `ncc check --format short` writes them.
     fn print_findings(&self) {
         for finding in self.findings() {
-            eprintln!("{}:{}: {}", visible::escaped(finding.file), finding.line, visible::escaped(finding.message));
+            let (file, line, message) =
+                (visible::escaped(finding.file), finding.line, visible::escaped(finding.message));
+            eprintln!("{file}:{line}: {}[{}]: {message}", finding.severity.as_str(), finding.rule.code);
         }
     }
 
@@ -111,23 +124,24 @@ impl Ran {
     /// error is a configuration that cannot be read; a program that stops
     /// on an error has its run up to there (see [`Ran::stop`]).
     pub(crate) fn of(program: &Program<'_>, step_budget: usize, progress: Progress) -> Result<Ran, String> {
-        let machine = program.machine()?;
-        Ok(Ran::run(program, &machine, progress, |text, library| {
-            nc_exec::run::run(text, library, &machine, step_budget)
+        let config = program.config()?;
+        Ok(Ran::run(program, &config, progress, |text, library| {
+            nc_exec::run::run(text, library, &config.machine, step_budget)
         }))
     }
 
     /// Like [`Ran::of`], through the velocity model as the steps come,
     /// keeping only what the summary shows: the trace keeps no steps.
     fn tally(program: &Program<'_>, step_budget: usize, progress: Progress) -> Result<(Ran, Tally), String> {
-        let machine = program.machine()?;
-        let dynamics = Dynamics::of(&machine);
+        let config = program.config()?;
+        let machine = &config.machine;
+        let dynamics = Dynamics::of(machine);
         let tally_with = |places: Places| {
             let timer = Timer::new(machine.step_axes(), &dynamics, Tally { places, ..Tally::default() });
             let mut timed = None;
-            let ran = Ran::run(program, &machine, progress, |text, library| {
+            let ran = Ran::run(program, &config, progress, |text, library| {
                 // The model runs beside the executor, on the other core.
-                let (trace, timer) = nc_exec::run::run_beside(text, library, &machine, step_budget, timer);
+                let (trace, timer) = nc_exec::run::run_beside(text, library, machine, step_budget, timer);
                 timed = Some(timer.finish());
                 trace
             });
@@ -161,12 +175,13 @@ impl Ran {
         max_moves: usize,
         progress: Progress,
     ) -> Result<(Ran, Plot), String> {
-        let machine = program.machine()?;
-        let dynamics = Dynamics::of(&machine);
+        let config = program.config()?;
+        let machine = &config.machine;
+        let dynamics = Dynamics::of(machine);
         let timer = Timer::new(machine.step_axes(), &dynamics, Sketch::new(max_moves));
         let mut sketched = None;
-        let mut ran = Ran::run(program, &machine, progress, |text, library| {
-            let (trace, timer) = nc_exec::run::run_beside(text, library, &machine, step_budget, timer);
+        let mut ran = Ran::run(program, &config, progress, |text, library| {
+            let (trace, timer) = nc_exec::run::run_beside(text, library, machine, step_budget, timer);
             sketched = Some(timer.finish());
             trace
         });
@@ -182,7 +197,7 @@ impl Ran {
     /// on) and the files of its project.
     fn run(
         program: &Program<'_>,
-        machine: &MachineConfig,
+        config: &Config,
         progress: Progress,
         execute: impl FnOnce(&str, &Library) -> Trace,
     ) -> Ran {
@@ -192,8 +207,8 @@ impl Ran {
         if let Some(bar) = library.progress.get() {
             bar.finish_and_clear();
         }
-        let sources = library.sources(&program.name, text, &trace);
-        Ran { trace, dynamics: Dynamics::of(machine), sources }
+        let sources = library.sources(&program.name, text, program.dialect, &trace);
+        Ran { trace, config: config.clone(), dynamics: Dynamics::of(&config.machine), sources }
     }
 
     /// The run timed with the control's velocity model.
@@ -207,17 +222,25 @@ impl Ran {
 
     /// The run's findings in the order they came, each with its file (the
     /// program's name for the program), its line and whether the run
-    /// stopped there.
+    /// stopped there, at the level the configuration gives its rule; those
+    /// of rules turned off or silenced by an `ncc:ignore` comment are left
+    /// out, unless the run stopped there.
     pub(crate) fn findings(&self) -> impl Iterator<Item = RunFinding<'_>> {
-        self.trace.findings.iter().map(|finding| {
+        self.trace.findings.iter().filter_map(|finding| {
             let source = &self.sources[finding.source];
-            RunFinding {
+            let rule = Rule::of_run(finding.rule);
+            let silenced = source.suppressions.silences(finding.range.start(), rule.code, rule.name);
+            let level = self.config.level_of(rule).filter(|_| !silenced);
+            let severity = if finding.stops() { level.unwrap_or(rule.severity) } else { level? };
+            Some(RunFinding {
+                rule,
+                severity,
                 file: &source.name,
                 in_program: finding.source == 0,
                 line: source.line(finding.range.start()),
                 message: &finding.message,
-                stopped: finding.fatal,
-            }
+                stopped: finding.stops(),
+            })
         })
     }
 
@@ -235,6 +258,8 @@ fn program_number(text: &str) -> Option<u32> {
 /// What a run found at a place: an instruction it does not run yet, an
 /// error the control stops on.
 pub(crate) struct RunFinding<'a> {
+    pub rule: &'static Rule,
+    pub severity: Severity,
     pub file: &'a str,
     /// In the program itself, not in a file it called.
     pub in_program: bool,
@@ -312,10 +337,11 @@ pub(crate) fn expand(path: &Path, dialect: Option<DialectId>, output: Option<&Pa
 }
 
 fn expand_program(program: &Program<'_>, path: &Path, output: Option<&Path>, step_budget: usize) -> ExitCode {
-    let machine = match program.machine() {
-        Ok(machine) => machine,
+    let config = match program.config() {
+        Ok(config) => config,
         Err(error) => return config_error(error),
     };
+    let machine = &config.machine;
     let (out, target): (Box<dyn io::Write>, String) = match output {
         Some(output) => match std::fs::File::create(output) {
             Ok(file) => (Box::new(file), output.display().to_string()),
@@ -329,9 +355,9 @@ fn expand_program(program: &Program<'_>, path: &Path, output: Option<&Path>, ste
     let name = path.file_name().map_or_else(|| path.display().to_string(), |name| name.to_string_lossy().into_owned());
     let title = format!("EXPANDED FROM {name}");
     let number = program_number(program.text).unwrap_or(1);
-    let mut expansion = Expansion::new(io::BufWriter::new(out), &machine, number, &title);
-    let ran = Ran::run(program, &machine, Progress::OnTerminal, |text, library| {
-        nc_exec::run::run_into(text, library, &machine, step_budget, &mut expansion)
+    let mut expansion = Expansion::new(io::BufWriter::new(out), machine, number, &title);
+    let ran = Ran::run(program, &config, Progress::OnTerminal, |text, library| {
+        nc_exec::run::run_into(text, library, machine, step_budget, &mut expansion)
     });
     ran.print_findings();
     let failure = match expansion.finish() {
@@ -729,14 +755,16 @@ impl<'a> Report<'a> {
                     }
                 })
                 .collect(),
-            findings: trace
-                .findings
-                .iter()
+            findings: ran
+                .findings()
                 .map(|finding| FindingRecord {
-                    file: &sources[finding.source].name,
-                    line: sources[finding.source].line(finding.range.start()),
-                    message: &finding.message,
-                    stopped: finding.fatal,
+                    code: finding.rule.code,
+                    name: finding.rule.name,
+                    severity: finding.severity.as_str(),
+                    file: finding.file,
+                    line: finding.line,
+                    message: finding.message,
+                    stopped: finding.stopped,
                 })
                 .collect(),
         }
@@ -860,6 +888,9 @@ struct BreakRecord<'a> {
 
 #[derive(Serialize)]
 struct FindingRecord<'a> {
+    code: &'static str,
+    name: &'static str,
+    severity: &'static str,
     file: &'a str,
     line: u32,
     message: &'a str,
@@ -918,9 +949,13 @@ impl Library {
     }
 
     /// The program and the files the run read, in the trace's source order.
-    fn sources(&self, name: &str, text: &str, trace: &Trace) -> Vec<Source> {
+    fn sources(&self, name: &str, text: &str, dialect: Dialect, trace: &Trace) -> Vec<Source> {
         let read = self.read.take();
-        let source = |name: String, text: &str| Source { name, lines: TextIndex::new(text) };
+        let source = |name: String, text: &str| Source {
+            name,
+            lines: TextIndex::new(text),
+            suppressions: Suppressions::of_text(text, dialect),
+        };
         let files = trace.files.iter().filter_map(|called| read.iter().find(|(c, _, _)| c == called));
         let files = files.map(|(_, path, text)| source(path.display().to_string(), text));
         std::iter::once(source(name.to_owned(), text)).chain(files).collect()
@@ -957,6 +992,8 @@ impl Environment for Library {
 struct Source {
     name: String,
     lines: TextIndex,
+    /// Its `ncc:ignore` comments.
+    suppressions: Suppressions,
 }
 
 impl Source {

@@ -42,12 +42,13 @@
 
 mod driver;
 mod index;
+mod rules;
 mod runner;
 mod support;
 mod trace;
 
 pub(crate) use self::support::{round3, slot};
-pub use self::{driver::*, index::expected_blocks, trace::*};
+pub use self::{driver::*, index::expected_blocks, rules::RunRule, trace::*};
 
 #[cfg(test)]
 mod tests;

@@ -231,13 +231,14 @@ mod tests {
     fn a_run_ending_under_compensation_ends_on_the_last_normal() {
         let contour = "%1\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 X50\nN5 Y50\n";
         let trace = run(contour, &NoFiles, &MachineConfig::default(), 10_000);
-        assert!(trace.findings.iter().all(|finding| !finding.fatal), "{:?}", trace.findings);
+        assert!(trace.findings.iter().all(|finding| !finding.stops()), "{:?}", trace.findings);
         assert_eq!(centre_ends(&trace).last(), Some(&(45.0, 50.0)));
         assert_eq!(trace.steps.last().map(|step| step.length), Some(45.0));
         // An arc too small for the tool on its inside stops the run.
         let refused = format!("{contour}N6 G03 X50 Y56 I0 J3\nN7 M30\n");
         let trace = run(&refused, &NoFiles, &MachineConfig::default(), 10_000);
-        let fatal: Vec<&str> = trace.findings.iter().filter(|f| f.fatal).map(|f| refused[f.range].trim_end()).collect();
+        let fatal: Vec<&str> =
+            trace.findings.iter().filter(|f| f.stops()).map(|f| refused[f.range].trim_end()).collect();
         assert_eq!(fatal, ["N6 G03 X50 Y56 I0 J3"]);
         let line = trace.steps.iter().rposition(|step| refused[step.range].starts_with("N5")).expect("N5 ran");
         assert_eq!(centre_ends(&trace)[line], (45.0, 50.0));

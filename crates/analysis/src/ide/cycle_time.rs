@@ -245,7 +245,7 @@ pub fn estimate(
             trace
         }
     };
-    let stopped = trace.findings.iter().find(|finding| finding.fatal).map(|finding| finding.message.clone());
+    let stopped = trace.findings.iter().find(|finding| finding.stops()).map(|finding| finding.message.clone());
     let mut estimate = charges.into_estimate(text, files, stopped, (trace.blocks_run, budget));
     estimate.rerun.start = rerun_from;
     estimate

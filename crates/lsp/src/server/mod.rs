@@ -33,7 +33,9 @@ use std::{
     },
 };
 
-use ncc_analysis::{Analysis, Cancelled, CycleTimeHints, Diagnostic, DialectId, FileId, Findings, TextRange, TextSize};
+use ncc_analysis::{
+    Analysis, Cancelled, CycleTimeHints, Diagnostic, Dialect, DialectId, FileId, Findings, TextRange, TextSize,
+};
 use tokio::sync::mpsc;
 use tower_lsp_server::{
     Client, LanguageServer, LspService,
@@ -115,6 +117,8 @@ pub(crate) fn run(log_level: LogLevel, dialect: Option<DialectId>) -> ExitCode {
 #[derive(Debug)]
 struct Document {
     workspace: usize,
+    /// The dialect it is read in.
+    dialect: Dialect,
     file: FileId,
     version: i32,
     map: LineMap,
@@ -429,8 +433,8 @@ impl LanguageServer for Server {
         let document = params.text_document;
         let errors = {
             let mut state = self.state();
-            let (workspace, file, errors) = match state.workspaces.open(&document.uri, document.text) {
-                Opened::Analysed { index, file, errors } => (index, file, errors),
+            let (workspace, dialect, file, errors) = match state.workspaces.open(&document.uri, document.text) {
+                Opened::Analysed { index, dialect, file, errors } => (index, dialect, file, errors),
                 Opened::NotRead(dialect) => {
                     drop(state);
                     // One finding at the start says why nothing else is said.
@@ -447,7 +451,9 @@ impl LanguageServer for Server {
             let map = LineMap::new(state.workspaces.get(workspace).analysis().text(file));
             let (flow, cycle) = Default::default();
             let version = document.version;
-            state.documents.insert(document.uri.clone(), Document { workspace, file, version, map, flow, cycle });
+            state
+                .documents
+                .insert(document.uri.clone(), Document { workspace, dialect, file, version, map, flow, cycle });
             errors
         };
         self.timer.request(document.uri.clone(), document.version);

@@ -9,6 +9,7 @@
 
 use std::{path::PathBuf, sync::Arc};
 
+use ncc_analysis::Dialect;
 use serde::Serialize;
 use serde_json::Value;
 use tower_lsp_server::{
@@ -56,6 +57,7 @@ struct Job {
     text: Arc<String>,
     path: Option<PathBuf>,
     name: String,
+    dialect: Dialect,
     config: Option<PathBuf>,
 }
 
@@ -76,7 +78,7 @@ pub(crate) async fn execute(server: &Server, arguments: Vec<Value>) -> jsonrpc::
         let path = uri.to_file_path().map(|path| path.into_owned());
         let name = path.as_ref().map_or_else(|| uri.as_str().to_owned(), |path| path.display().to_string());
         let config = state.workspaces.config_path(document.workspace).map(PathBuf::from);
-        Job { text: document.map.text.clone(), path, name, config }
+        Job { text: document.map.text.clone(), path, name, dialect: document.dialect, config }
     };
     // A run takes as long as the program's blocks; the blocking pool keeps
     // it off the threads that answer the other requests.
@@ -93,7 +95,13 @@ pub(crate) async fn execute(server: &Server, arguments: Vec<Value>) -> jsonrpc::
 fn plot(job: Job) -> jsonrpc::Result<Value> {
     // The text of our own, so that an edit during the run need not copy it.
     let text = Arc::unwrap_or_clone(job.text);
-    let program = Program { path: job.path.as_deref(), name: job.name, text: &text, config: job.config.as_deref() };
+    let program = Program {
+        path: job.path.as_deref(),
+        name: job.name,
+        text: &text,
+        dialect: job.dialect,
+        config: job.config.as_deref(),
+    };
     let (ran, picture) =
         Ran::plotted(&program, nc_exec::run::DEFAULT_STEP_BUDGET, DEFAULT_MAX_MOVES, Progress::Hidden).map_err(
             |error| jsonrpc::Error { code: ErrorCode::ServerError(REQUEST_FAILED), message: error.into(), data: None },

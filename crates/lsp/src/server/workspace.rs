@@ -7,7 +7,7 @@ use std::{
     path::{Path, PathBuf},
 };
 
-use ncc_analysis::{AnalysisHost, Config, DialectId, Dialects, FileId, NavigationTarget};
+use ncc_analysis::{AnalysisHost, Config, Dialect, DialectId, Dialects, FileId, NavigationTarget};
 use tower_lsp_server::ls_types::{self as lsp, Uri};
 
 use super::convert::LineMap;
@@ -45,9 +45,9 @@ fn document_path(uri: &Uri) -> (String, Option<PathBuf>) {
 
 /// What opening a document gave.
 pub(crate) enum Opened {
-    /// The document is analysed as `file` of workspace `index`; `errors`
-    /// are about files read on the way.
-    Analysed { index: usize, file: FileId, errors: Vec<String> },
+    /// The document is analysed in `dialect` as `file` of workspace
+    /// `index`; `errors` are about files read on the way.
+    Analysed { index: usize, dialect: Dialect, file: FileId, errors: Vec<String> },
     /// The document is in a dialect this version does not read.
     NotRead(DialectId),
 }
@@ -139,9 +139,9 @@ impl Workspaces {
         let dialects = &self.list[index].dialects;
         // A document that is no file (`untitled:`) has the default dialect.
         let dialect = dialects.of_given(path.as_deref().unwrap_or(Path::new("")), self.forced_dialect);
-        if dialect.implementation().is_none() {
+        let Some(implementation) = dialect.implementation() else {
             return Opened::NotRead(dialect);
-        }
+        };
         if let Some(path) = &path {
             let beside = check::macrocycles_beside(&[(path.clone(), String::new())]);
             for (macrocycle, _) in beside {
@@ -161,7 +161,7 @@ impl Workspaces {
             }
         };
         workspace.uris.insert(file, uri.clone());
-        Opened::Analysed { index, file, errors }
+        Opened::Analysed { index, dialect: implementation, file, errors }
     }
 
     /// Closes a document: the file on disk takes its place again, or the

@@ -18,7 +18,7 @@ use crate::{
     transform::Frame,
 };
 
-use super::{index::*, runner::*, trace::*};
+use super::{index::*, rules::RunRule, runner::*, trace::*};
 
 /// How many blocks a run executes at most before it stops: a jump loop
 /// that never ends or runaway recursion stops here with a finding.
@@ -348,7 +348,11 @@ pub(super) fn run_in<'a, 's>(
         }
         runner.source = source;
         if resume.is_none() && calls.is_empty() && index.starts_subprogram(at) {
-            runner.finding(range, "the main body runs into a subprogram: it has no M02 or M30 before it", false);
+            runner.finding(
+                RunRule::RunsIntoSubprogram,
+                range,
+                "the main body runs into a subprogram: it has no M02 or M30 before it",
+            );
             break;
         }
         executed += usize::from(resume.is_none());
@@ -357,7 +361,7 @@ pub(super) fn run_in<'a, 's>(
         }
         if executed > budget {
             let message = format!("stopped after {budget} blocks: a jump loop that never ends or runaway calls?");
-            runner.finding(range, &message, true);
+            runner.finding(RunRule::StepBudget, range, &message);
             break;
         }
         let next = at + 1;
@@ -411,7 +415,12 @@ pub(super) fn run_in<'a, 's>(
                             None => format!("the cycle file {name} the machine names is not in the project"),
                             Some(_) => format!("the cycle file {name} has no body G79 L{number}"),
                         };
-                        runner.report_once(&why, range, &format!("{why}: the built-in cycle runs instead"));
+                        runner.report_once(
+                            RunRule::CycleFileMissing,
+                            &why,
+                            range,
+                            &format!("{why}: the built-in cycle runs instead"),
+                        );
                         if !runner.built_in_cycle_or_stop(number, range) {
                             break;
                         }
@@ -441,23 +450,18 @@ pub(super) fn run_in<'a, 's>(
                         start
                     }
                     Some(_) => {
-                        runner.finding(
-                            range,
-                            &format!("calls nest deeper than {MAX_CALL_DEPTH}: runaway recursion?"),
-                            true,
-                        );
+                        let message = format!("calls nest deeper than {MAX_CALL_DEPTH}: runaway recursion?");
+                        runner.finding(RunRule::CallDepth, range, &message);
                         break;
                     }
                     None if is_macrocycle => {
-                        runner.finding(range, &format!("there is no macrocycle file L{label} to call"), true);
+                        let message = format!("there is no macrocycle file L{label} to call");
+                        runner.finding(RunRule::CallTargetMissing, range, &message);
                         break;
                     }
                     None => {
-                        runner.finding(
-                            range,
-                            &format!("there is no subprogram L{label} (G79 L{label}) in this file"),
-                            true,
-                        );
+                        let message = format!("there is no subprogram L{label} (G79 L{label}) in this file");
+                        runner.finding(RunRule::CallTargetMissing, range, &message);
                         break;
                     }
                 }
@@ -466,7 +470,8 @@ pub(super) fn run_in<'a, 's>(
                 Some(target) if jumps.jumps(at, times) => target,
                 Some(_) => next,
                 None => {
-                    runner.finding(range, &format!("no block N{label} in this program unit to jump to"), true);
+                    let message = format!("no block N{label} in this program unit to jump to");
+                    runner.finding(RunRule::CallTargetMissing, range, &message);
                     break;
                 }
             },
@@ -474,7 +479,7 @@ pub(super) fn run_in<'a, 's>(
         // Only another file's blocks can end without a way back.
         let leaves_file = |index: &mut Index<'_, '_>| index.complete().block(at).is_none_or(|(_, file)| file != source);
         if source != 0 && passes_on && leaves_file(&mut index) {
-            runner.finding(range, "the macrocycle file ends without G70", true);
+            runner.finding(RunRule::MacrocycleWithoutReturn, range, "the macrocycle file ends without G70");
             break;
         }
         if let Some(sink) = sink.as_deref_mut()

@@ -18,7 +18,7 @@ use crate::{
     transform::{self, Frame, Kind, Recalculation, Refused, Transformation, Transformations},
 };
 
-use super::{driver::*, support::*, trace::*};
+use super::{driver::*, rules::RunRule, support::*, trace::*};
 
 /// What runs after a block: its own flow, or first a fixed cycle's body.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -265,7 +265,7 @@ impl Runner {
             .collect();
         let has = |letter: u8, number: u32| codes.iter().any(|&(l, n, _)| l == letter && n == number);
         if let Some((refused, message)) = self.refused_value(block, &codes) {
-            self.finding(at(refused), &message, true);
+            self.finding(RunRule::ValueRefused, at(refused), &message);
             return Flow::Block(BlockFlow::End);
         }
         for word in &block.words {
@@ -276,7 +276,7 @@ impl Runner {
                 let message = format!(
                     "R{index} holds a value the executor does not know (read from a table or register it does not model yet): words that use it are left out"
                 );
-                self.report_once(&format!("R{index}"), at(word.range), &message);
+                self.report_once(RunRule::ParameterUnknown, &format!("R{index}"), at(word.range), &message);
             }
         }
         let css_before = self.feed_mode().css;
@@ -352,7 +352,8 @@ impl Runner {
         // it does not move (03 §3).
         if let Some(&(_, code, code_range)) = codes.iter().find(|&&(l, n, _)| l == b'G' && matches!(n, 31 | 34..=39)) {
             if let Err((message, fatal)) = self.transform(code, &axes, block) {
-                self.finding(code_range, &message, fatal);
+                let rule = if fatal { RunRule::TransformationRefused } else { RunRule::TransformationIgnored };
+                self.finding(rule, code_range, &message);
                 if fatal {
                     return Flow::Block(BlockFlow::End);
                 }
@@ -384,9 +385,9 @@ impl Runner {
             match u8::try_from(set) {
                 Ok(set @ 1..=4) => self.dynamic_set = set,
                 _ => self.finding(
+                    RunRule::DynamicSetOutOfRange,
                     at(word.range),
                     &format!("G23 I{set}: the dynamic sets are I1 to I4: the set in force stays"),
-                    false,
                 ),
             }
         }
@@ -427,7 +428,7 @@ impl Runner {
                 return Flow::Block(BlockFlow::End);
             };
             if let Some(message) = self.unreachable(&self.position) {
-                self.finding(range, &message, true);
+                self.finding(RunRule::BeyondAxisRange, range, &message);
                 return Flow::Block(BlockFlow::End);
             }
             (moved, dwell)
@@ -450,7 +451,7 @@ impl Runner {
         self.record(range, &end, moved, stop.filter(|_| dwell.is_none()), functions);
         if let Err(error) = self.compensate(start, path) {
             let range = self.step_mut(error.block()).range;
-            self.finding(range, &format!("radius compensation: {error}"), true);
+            self.finding(RunRule::CompensationFailed, range, &format!("radius compensation: {error}"));
             return Flow::Block(BlockFlow::End);
         }
         if let Some(dwell) = dwell {
@@ -478,11 +479,11 @@ impl Runner {
             BlockArithmetic::UnknownWord => {
                 let message =
                     "a control word in R5–R8 has no value: it was computed from a value the executor does not know";
-                self.finding(range, message, true);
+                self.finding(RunRule::ControlWordUnknown, range, message);
                 return Flow::Block(BlockFlow::End);
             }
             BlockArithmetic::Ran { function, result: Err(error), .. } => {
-                self.finding(at(function), &format!("parameter arithmetic failed: {error}"), true);
+                self.finding(RunRule::ArithmeticFailed, at(function), &format!("parameter arithmetic failed: {error}"));
                 return Flow::Block(BlockFlow::End);
             }
         }
@@ -909,7 +910,7 @@ impl Runner {
     pub(super) fn built_in_cycle_or_stop(&mut self, number: u32, range: TextRange) -> bool {
         let result = self.built_in_cycle(number, range);
         if let Err(message) = &result {
-            self.finding(range, message, true);
+            self.finding(RunRule::CycleFailed, range, message);
         }
         result.is_ok()
     }
@@ -1019,8 +1020,8 @@ impl Runner {
         self.in_cycle = false;
     }
 
-    pub(super) fn finding(&mut self, range: TextRange, message: &str, fatal: bool) {
-        self.findings.push(Finding { source: self.source, range, message: message.to_owned(), fatal });
+    pub(super) fn finding(&mut self, rule: RunRule, range: TextRange, message: &str) {
+        self.findings.push(Finding { rule, source: self.source, range, message: message.to_owned() });
     }
 
     /// Length, duration and feed of a block's move; `None` after
@@ -1043,7 +1044,7 @@ impl Runner {
         };
         // The arc's sides may reach beyond a limit its ends keep within.
         if let Some(message) = arc.iter().flat_map(|arc| arc.sides(&end)).find_map(|side| self.unreachable(&side)) {
-            self.finding(range, &format!("the arc's side: {message}"), true);
+            self.finding(RunRule::BeyondAxisRange, range, &format!("the arc's side: {message}"));
             return None;
         }
         let length = arc.as_ref().map_or(straight, Arc::length);
@@ -1091,7 +1092,7 @@ impl Runner {
                     }
                     _ => "feed per revolution (G95) with spindle speed S0: the axes cannot move",
                 };
-                self.finding(range, why, false);
+                self.finding(RunRule::MotionWithoutFeed, range, why);
                 moved(Motion::Feed, length, 0.0, None, path)
             }
         }
@@ -1217,7 +1218,7 @@ impl Runner {
         letters.dedup();
         if letters.len() < 2 {
             let message = "an arc needs both coordinates of its plane, even when the end point equals the start";
-            self.finding(range, message, false);
+            self.finding(RunRule::ArcPlaneIncomplete, range, message);
             return Ok(None);
         }
         // The plane's first axis is the one I measures along: X of XY, Y of
@@ -1242,7 +1243,7 @@ impl Runner {
                 round3(end_radius),
                 round3(radius)
             );
-            self.finding(range, &message, true);
+            self.finding(RunRule::ArcOffCircle, range, &message);
             return Err(());
         }
         let angle_of = |point: Vector2<f64>| (point.y - centre.y).atan2(point.x - centre.x);
@@ -1306,14 +1307,15 @@ impl Runner {
     }
 
     pub(super) fn not_run(&mut self, what: &str, range: TextRange) {
-        self.report_once(what, range, &format!("the executor does not run {what} yet: the time leaves them out"));
+        let message = format!("the executor does not run {what} yet: the time leaves them out");
+        self.report_once(RunRule::NotRunYet, what, range, &message);
     }
 
     /// Reports a problem of kind `key` at its first place only.
-    pub(super) fn report_once(&mut self, key: &str, range: TextRange, message: &str) {
+    pub(super) fn report_once(&mut self, rule: RunRule, key: &str, range: TextRange, message: &str) {
         if !self.reported.iter().any(|done| done == key) {
             self.reported.push(key.to_owned());
-            self.finding(range, message, false);
+            self.finding(rule, range, message);
         }
     }
 }

@@ -403,7 +403,7 @@ fn radius_compensation_runs_the_tool_centre_path() {
     // An arc too small for the tool on its inside stops the run there.
     let text = "%1\nN1 G92 D1 R0=5.\nN2 G00 X0 Y-20 D1\nN3 G41 G01 X0 Y0 F600\nN4 G03 X0 Y6 I0 J3\nN5 G40 G01 X0 Y20\nN6 M30\n";
     let trace = run_text(text);
-    let fatal: Vec<&str> = trace.findings.iter().filter(|f| f.fatal).map(|f| text[f.range].trim_end()).collect();
+    let fatal: Vec<&str> = trace.findings.iter().filter(|f| f.stops()).map(|f| text[f.range].trim_end()).collect();
     assert_eq!(fatal, ["N4 G03 X0 Y6 I0 J3"]);
 }
 
@@ -436,7 +436,7 @@ fn scale_multiplies_the_programmed_lengths() {
     // A scale of 0 stops the run at its G36.
     let text = "%1\nN1 G36 X1 Y0\nN2 G01 X10 F600\nN3 M30\n";
     let trace = run_text(text);
-    let fatal: Vec<&str> = trace.findings.iter().filter(|f| f.fatal).map(|f| &text[f.range]).collect();
+    let fatal: Vec<&str> = trace.findings.iter().filter(|f| f.stops()).map(|f| &text[f.range]).collect();
     assert_eq!(fatal, ["G36"]);
     assert_eq!(trace.steps.len(), 0);
 }
@@ -489,7 +489,7 @@ fn the_spatial_transformation_and_what_the_control_refuses() {
     // while active stops the run.
     let text = "%1\nN1 G39\nN2 G39 X0 Y0 I30\nN3 G39\nN4 G39 X1 Y1 I30\nN5 M30\n";
     let trace = run_text(text);
-    let findings: Vec<(&str, bool)> = trace.findings.iter().map(|f| (text[f.range].trim_end(), f.fatal)).collect();
+    let findings: Vec<(&str, bool)> = trace.findings.iter().map(|f| (text[f.range].trim_end(), f.stops())).collect();
     assert_eq!(findings, [("G39", false), ("G39", true)]);
     assert_eq!(&text[trace.findings[1].range.start().into()..][..2], "G3");
     assert!(trace.findings[1].message.contains("cannot change while it is active"));
@@ -576,7 +576,7 @@ fn bad_arcs_and_missing_feed_are_reported_where_they_are() {
     let text = "%1\nN1 G01 X10\nN2 G02 X5\nN3 G02 X20 Y0 I3 F100\nN4 M30\n";
     let trace = run_text(text);
     let found: Vec<(&str, &str, bool)> =
-        trace.findings.iter().map(|f| (&text[f.range], f.message.split(':').next().unwrap_or(""), f.fatal)).collect();
+        trace.findings.iter().map(|f| (&text[f.range], f.message.split(':').next().unwrap_or(""), f.stops())).collect();
     assert_eq!(
         found,
         [
@@ -599,7 +599,7 @@ fn machine_constant_55_widens_the_arc_end_tolerance() {
     // The end point lies 3 µm outside the circle of radius 10.
     let text = "%1\nN1 G00 X10 Y0\nN2 G02 X-10.003 Y0 I-10 F100\nN3 M30\n";
     let stopped = run_text(text);
-    assert_eq!(stopped.findings.iter().filter(|f| f.fatal).count(), 1, "{:?}", stopped.findings);
+    assert_eq!(stopped.findings.iter().filter(|f| f.stops()).count(), 1, "{:?}", stopped.findings);
     assert_eq!(stopped.steps.len(), 1);
     let machine = MachineConfig { constants: [(55, 5)].into(), ..MachineConfig::default() };
     let trace = run(text, &NoFiles, &machine, 100);
@@ -715,7 +715,7 @@ fn m37_runs_the_feed_at_a_hundredth_until_m36() {
 
 /// The fatal findings of a run: where (the text) and what.
 fn stops<'t>(text: &'t str, trace: &'t Trace) -> Vec<(&'t str, &'t str)> {
-    trace.findings.iter().filter(|f| f.fatal).map(|f| (&text[f.range], f.message.as_str())).collect()
+    trace.findings.iter().filter(|f| f.stops()).map(|f| (&text[f.range], f.message.as_str())).collect()
 }
 
 #[test]
@@ -921,7 +921,7 @@ fn endless_loops_and_missing_targets_stop_the_run_where_they_are() {
     let text = "%1\nN1 G71 L1\nN2 M30\nN3 G79 L1\nN4 G71 L1\nN5 G70\n";
     let trace = run_text(text);
     let fatal: Vec<(&str, &str)> =
-        trace.findings.iter().filter(|f| f.fatal).map(|f| (text[f.range].trim_end(), f.message.as_str())).collect();
+        trace.findings.iter().filter(|f| f.stops()).map(|f| (text[f.range].trim_end(), f.message.as_str())).collect();
     assert_eq!(fatal, [("N4 G71 L1", "calls nest deeper than 64: runaway recursion?")]);
 
     let text = "%1\nN1 G73 L1 Q9999\nN2 M30\n";
@@ -958,7 +958,7 @@ fn arithmetic_runs_after_the_motion_and_conditional_codes_jump_on_73() {
     // model: the word that uses the value is named and left out.
     let text = "%1\nN1 R5=49410110 G26\nN2 G01 XR10 F100\nN3 M30\n";
     let trace = run_text(text);
-    let found: Vec<(&str, bool)> = trace.findings.iter().map(|f| (&text[f.range], f.fatal)).collect();
+    let found: Vec<(&str, bool)> = trace.findings.iter().map(|f| (&text[f.range], f.stops())).collect();
     assert_eq!(found, [("XR10", false)]);
     assert!(trace.findings[0].message.starts_with("R10 holds a value the executor does not know"));
 }
@@ -969,7 +969,7 @@ fn an_arithmetic_error_stops_the_run_at_its_function() {
     let text = "%1\nN1 R1=1. R2=0 R5=4010203 G26\nN2 G00 X1\nN3 M30\n";
     let trace = run_text(text);
     let found: Vec<(&str, &str, bool)> =
-        trace.findings.iter().map(|f| (&text[f.range], f.message.as_str(), f.fatal)).collect();
+        trace.findings.iter().map(|f| (&text[f.range], f.message.as_str(), f.stops())).collect();
     assert_eq!(found, [("G26", "parameter arithmetic failed: division by zero", true)]);
     assert_eq!(trace.steps.len(), 1);
 }

@@ -4,6 +4,8 @@ use std::ops::Range;
 
 use ncc_syntax::TextRange;
 
+use super::rules::RunRule;
+
 use crate::{
     cnc8x6::arith::Message,
     compensation::ToolElement,
@@ -196,12 +198,18 @@ pub enum Stop {
 /// A problem found while running, at a text range.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Finding {
+    pub rule: RunRule,
     /// The file, as in [`Step::source`].
     pub source: usize,
     pub range: TextRange,
     pub message: String,
+}
+
+impl Finding {
     /// The run stopped here (an error the control stops on).
-    pub fatal: bool,
+    pub fn stops(&self) -> bool {
+        self.rule.stops()
+    }
 }
 
 /// A whole run.
