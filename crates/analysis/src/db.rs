@@ -13,10 +13,10 @@ use rowan::GreenNode;
 
 use crate::{
     Config, Diagnostic,
+    cnc8x6::model::{BlockSummary, ChunkSummary},
+    cnc8x6::states::StateCache,
     findings::{self, Findings},
     lower::BlockData,
-    model::{BlockSummary, ChunkSummary},
-    states::StateCache,
 };
 
 #[salsa::db]
@@ -177,7 +177,7 @@ pub fn chunk_diagnostics<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Findin
     let mut diagnostics = Vec::new();
     for (offset, data) in lower_chunk(db, chunk) {
         let mut block: Vec<Diagnostic> =
-            crate::checks::block::check(&data, config).into_iter().map(|d| d.shifted(offset)).collect();
+            crate::cnc8x6::checks::block::check(&data, config).into_iter().map(|d| d.shifted(offset)).collect();
         findings::sort_diagnostics(&mut block);
         diagnostics.extend(block.into_iter().filter(|d| limiter.keep(d.range.start(), findings::key(d))));
     }

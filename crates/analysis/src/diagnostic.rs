@@ -176,7 +176,7 @@ impl Rule {
     /// Every rule: the parser's syntax diagnostics, every check module's,
     /// then the executor's.
     pub fn all() -> impl Iterator<Item = &'static Rule> {
-        let checks = crate::checks::RULES.iter().flat_map(|rules| rules.iter().copied());
+        let checks = crate::cnc8x6::checks::RULES.iter().flat_map(|rules| rules.iter().copied());
         SYNTAX_RULES.iter().chain(checks).chain(RUN_RULES.iter())
     }
 

@@ -7,21 +7,18 @@
 //! answer is plain Rust data with text ranges; line/column conversion, LSP
 //! and terminal output are the caller's business.
 
-mod checks;
+pub mod cnc8x6;
 mod config;
 mod db;
 mod diagnostic;
 mod findings;
-pub mod flow;
 mod ide;
-pub mod model;
-mod states;
 mod suppress;
 
 use std::sync::Arc;
 
 /// Blocks as plain data, lowered the same way for the executor.
-pub use nc_exec::cnc8x6::lower;
+pub(crate) use nc_exec::cnc8x6::lower;
 pub use ncc_catalog::DialectId;
 use ncc_syntax::Parse;
 pub use ncc_syntax::{Dialect, Severity, TextEdit, TextRange, TextSize};
@@ -225,7 +222,11 @@ impl Analysis {
 
     /// The modal state and parameters before the block at `offset`, each
     /// time the program reaches it.
-    pub fn states_at(&self, file: FileId, offset: TextSize) -> Vec<(flow::ModalState, flow::ParamState)> {
+    pub fn states_at(
+        &self,
+        file: FileId,
+        offset: TextSize,
+    ) -> Vec<(cnc8x6::flow::ModalState, cnc8x6::flow::ParamState)> {
         ide::states_at(&self.db, file, offset)
     }
 
@@ -234,7 +235,7 @@ impl Analysis {
     /// checkpoints. Long, but a question meanwhile waits a millisecond at
     /// most; meant for idle time.
     pub fn prepare_states(&self, file: FileId) {
-        states::prepare(&self.db, file);
+        cnc8x6::states::prepare(&self.db, file);
     }
 
     /// The outline: program units, and the blocks jumps go to in each.
@@ -314,15 +315,15 @@ fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
     for chunk in db::file_chunks(db, file) {
         all.append(db::chunk_diagnostics(db, chunk.chunk).clone().shifted(chunk.offset));
     }
-    all.diagnostics.extend(checks::structure::check(db, file));
-    all.diagnostics.extend(checks::cycles::check_file(db, file));
+    all.diagnostics.extend(cnc8x6::checks::structure::check(db, file));
+    all.diagnostics.extend(cnc8x6::checks::cycles::check_file(db, file));
     configure(db, file, all)
 }
 
 /// The flow walk's findings of a file, configured.
 #[salsa::tracked(returns(ref))]
 fn configured_flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
-    configure(db, file, flow::flow_diagnostics(db, file).clone())
+    configure(db, file, cnc8x6::flow::flow_diagnostics(db, file).clone())
 }
 
 /// Applies suppression comments and the configured levels, and limits

@@ -3,7 +3,7 @@
 
 use ncc_analysis::{
     AnalysisHost, Config, FileId, RootDatabase, TextEdit, TextRange, TextSize,
-    flow::{Known, ModalState, ParamState},
+    cnc8x6::flow::{Known, ModalState, ParamState},
 };
 
 fn program(blocks: usize) -> String {

@@ -3,10 +3,10 @@
 //! cycles, table files and the writer of expanded programs.
 
 pub mod arith;
-pub mod cycles;
+pub(crate) mod cycles;
 pub mod expand;
 pub mod formats;
 pub mod lower;
-pub mod modes;
+pub(crate) mod modes;
 pub mod program_flow;
 pub mod tables;

@@ -527,7 +527,8 @@ impl Planner {
     }
 
     /// How many moves the planner holds (never more than the depth).
-    pub fn held(&self) -> usize {
+    #[cfg(test)]
+    fn held(&self) -> usize {
         self.window.len()
     }
 

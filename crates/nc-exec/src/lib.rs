@@ -30,10 +30,10 @@
 //!   coordinates they make.
 
 pub mod cnc8x6;
-pub mod compensation;
-pub mod envelope;
+pub(crate) mod compensation;
+pub(crate) mod envelope;
 pub mod machine;
 pub mod run;
 pub mod tool_path;
-pub mod transform;
+pub(crate) mod transform;
 pub mod velocity;

@@ -103,14 +103,6 @@ impl Kind {
         }
     }
 
-    pub fn code(self) -> u32 {
-        match self {
-            Kind::FirstPlanar => 38,
-            Kind::SecondPlanar => 39,
-            Kind::Spatial => 31,
-        }
-    }
-
     /// How many axes its parameter block names.
     pub fn axis_count(self) -> usize {
         match self {
@@ -273,10 +265,6 @@ impl Transformations {
 
     pub fn deactivate(&mut self, kind: Kind) {
         self.active[kind.index()] = false;
-    }
-
-    pub fn is_active(&self, kind: Kind) -> bool {
-        self.active[kind.index()]
     }
 
     fn in_force(&self) -> impl Iterator<Item = &Transformation> {

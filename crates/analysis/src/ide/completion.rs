@@ -25,11 +25,11 @@ use ncc_syntax::{TextRange, TextSize};
 
 use crate::{
     Config,
-    checks::motion::{PLANE_CODES, interpolation_planes, plane_axes},
+    cnc8x6::checks::motion::{PLANE_CODES, interpolation_planes, plane_axes},
+    cnc8x6::flow::{self, show_thousandths},
+    cnc8x6::model,
     db::{Db, Settings, SourceFile},
-    flow::{self, show_thousandths},
     lower::{BlockData, Value, Word},
-    model,
 };
 
 /// One thing that may be written at the cursor.

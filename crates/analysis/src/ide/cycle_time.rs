@@ -21,9 +21,9 @@ use smallvec::SmallVec;
 
 use crate::{
     InlayHint, InlayHintKind, MachineConfig,
+    cnc8x6::model::{self, FileKind},
     db::{Db, Settings, SourceFile},
     ide::symbols::content_end,
-    model::{self, FileKind},
 };
 
 /// What the cycle-time inlay hints show.

@@ -11,8 +11,8 @@ use rowan::{GreenNodeData, NodeOrToken};
 use rustc_hash::FxHashMap;
 
 use crate::{
+    cnc8x6::model::FileKind,
     db::{Db, Settings, SourceFile},
-    model::FileKind,
 };
 
 /// A classified piece of text. A file's ranges are sorted, never overlap,

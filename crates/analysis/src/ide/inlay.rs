@@ -15,9 +15,9 @@ use ncc_catalog::AddressRole;
 use ncc_syntax::{TextRange, TextSize};
 
 use crate::{
-    checks::block::parameter_raw,
+    cnc8x6::checks::block::parameter_raw,
+    cnc8x6::flow::show_thousandths,
     db::{self, Db, Settings, SourceFile},
-    flow::show_thousandths,
     lower::Value,
 };
 

@@ -19,10 +19,10 @@ use ncc_catalog::Item;
 use ncc_syntax::{TextRange, TextSize};
 
 use crate::{
+    cnc8x6::flow::{self, Known, ModalState, ParamState, show_thousandths},
+    cnc8x6::model::{self, Transfer},
     db::{Db, Settings, SourceFile},
-    flow::{self, Known, ModalState, ParamState, show_thousandths},
     lower::{BlockData, Value, Word},
-    model::{self, Transfer},
 };
 
 /// Text to show for the thing under the cursor.

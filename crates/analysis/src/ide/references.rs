@@ -11,9 +11,9 @@ use ncc_syntax::{TextRange, TextSize};
 
 use super::{Target, block_at, symbols::Outline, target_at};
 use crate::{
+    cnc8x6::model::{self, FileKind, Program, Transfer},
     db::{self, BlockChunk, Db, Settings, SourceFile},
     lower::{BlockData, Value},
-    model::{self, FileKind, Program, Transfer},
 };
 
 /// A place where the thing is defined or used.

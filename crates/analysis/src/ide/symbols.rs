@@ -11,9 +11,9 @@ use ncc_syntax::{
 use rustc_hash::FxHashMap;
 
 use crate::{
+    cnc8x6::model::{self, FileKind, Program, Transfer, Unit},
     db::{Db, SourceFile},
     lower::BlockData,
-    model::{self, FileKind, Program, Transfer, Unit},
 };
 
 /// An entry of the outline.

@@ -70,12 +70,6 @@ impl Modes {
             self.active[index] = Some(number);
         }
     }
-
-    /// Puts the reset code of `group` in force (M00/M01 do so for a while,
-    /// M02/M30 for good).
-    pub fn reset_group(&mut self, group: Group) {
-        self.active[group.0] = default_code(self.catalogue.groups[group.0].default.as_deref());
-    }
 }
 
 fn default_code(default: Option<&str>) -> Option<u32> {
@@ -98,7 +92,5 @@ mod tests {
         modes.set(b'M', 0);
         assert_eq!([modes.active(motion), modes.active(units), modes.active(spindle)], [Some(0), Some(97), Some(3)]);
         assert_eq!(modes.active(flow), None);
-        modes.reset_group(spindle);
-        assert_eq!(modes.active(spindle), Some(5));
     }
 }

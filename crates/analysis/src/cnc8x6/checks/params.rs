@@ -5,9 +5,9 @@ use ncc_catalog::{AddressRole, Dialect};
 
 use crate::{
     Diagnostic,
-    checks::feed,
+    cnc8x6::checks::feed,
+    cnc8x6::flow::{FlowCheck, Substitution, Visit},
     diagnostic::declare_rules,
-    flow::{FlowCheck, Substitution, Visit},
     lower::Value,
 };
 

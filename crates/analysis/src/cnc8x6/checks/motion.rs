@@ -9,9 +9,9 @@ use ncc_syntax::{Severity, TextEdit, TextRange};
 
 use crate::{
     Config, Diagnostic, MachineConfig,
-    checks::block::{assigns_corrections, parameter_raw},
+    cnc8x6::checks::block::{assigns_corrections, parameter_raw},
+    cnc8x6::flow::{FlowCheck, Known, ModalState, Visit},
     diagnostic::declare_rules,
-    flow::{FlowCheck, Known, ModalState, Visit},
     lower::{BlockData, Value, Word},
 };
 

@@ -11,11 +11,11 @@ use ncc_syntax::{Severity, TextEdit, TextRange, TextSize};
 
 use crate::{
     Config, Diagnostic,
-    checks::{motion, params::show, structure},
+    cnc8x6::checks::{motion, params::show, structure},
+    cnc8x6::flow::{FlowCheck, ModalState, Origin, Visit},
+    cnc8x6::model::{self, FileKind},
     db::{Db, SourceFile},
     diagnostic::declare_rules,
-    flow::{FlowCheck, ModalState, Origin, Visit},
-    model::{self, FileKind},
 };
 
 declare_rules! {

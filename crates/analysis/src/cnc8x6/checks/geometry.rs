@@ -10,9 +10,9 @@ use ncc_syntax::{TextEdit, TextRange};
 
 use crate::{
     Diagnostic,
-    checks::motion::{self, plane_axes},
+    cnc8x6::checks::motion::{self, plane_axes},
+    cnc8x6::flow::{FlowCheck, Known, Visit, thousandths},
     diagnostic::declare_rules,
-    flow::{FlowCheck, Known, Visit, thousandths},
     lower::Word,
 };
 

@@ -16,12 +16,12 @@ use rustc_hash::FxHashSet;
 
 use crate::{
     Diagnostic, Rule,
-    checks::{
+    cnc8x6::checks::{
         block::{self, parameter_raw},
         params,
     },
+    cnc8x6::flow::{FlowCheck, Origin, Visit},
     diagnostic::declare_rules,
-    flow::{FlowCheck, Origin, Visit},
     lower::{Value, Word},
 };
 

@@ -18,9 +18,9 @@ use ncc_syntax::{Decimal, TextRange, TextSize};
 
 use crate::{
     Config, Diagnostic,
-    checks::motion,
+    cnc8x6::checks::motion,
+    cnc8x6::flow::{FlowCheck, Known, ModalState, Visit},
     diagnostic::declare_rules,
-    flow::{FlowCheck, Known, ModalState, Visit},
     lower::{BlockData, Value, Word},
 };
 

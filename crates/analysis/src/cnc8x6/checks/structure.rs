@@ -5,9 +5,9 @@ use rustc_hash::FxHashMap;
 
 use crate::{
     Diagnostic,
+    cnc8x6::model::{self, FileKind, Program, Transfer, Unit},
     db::{Db, SourceFile},
     diagnostic::declare_rules,
-    model::{self, FileKind, Program, Transfer, Unit},
 };
 
 declare_rules! {

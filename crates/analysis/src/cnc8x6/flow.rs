@@ -30,11 +30,11 @@ use rustc_hash::FxHashMap;
 
 use crate::{
     Config, Diagnostic,
-    checks::structure::FLOW_NOT_FOLLOWED,
+    cnc8x6::checks::structure::FLOW_NOT_FOLLOWED,
+    cnc8x6::model::{self, FileKind, Program},
     db::{self, Db, Settings, SourceFile},
     findings::Findings,
     lower::{BlockData, Value, Word},
-    model::{self, FileKind, Program},
 };
 
 /// A value that may not be known statically.
@@ -284,7 +284,7 @@ pub(crate) trait FlowCheck {
 /// (a subprogram called twice is reached twice); for a block of the main
 /// body, the first time, from the checkpoints.
 pub fn states_before(db: &dyn Db, file: SourceFile, index: usize) -> Vec<(ModalState, ParamState)> {
-    match crate::states::main_state_before(db, file, index) {
+    match crate::cnc8x6::states::main_state_before(db, file, index) {
         Some(state) => vec![state],
         None => walked_states(db, file, index),
     }
@@ -321,7 +321,7 @@ impl FlowCheck for Probe {
 #[salsa::tracked(returns(ref))]
 pub fn flow_diagnostics(db: &dyn Db, file: SourceFile) -> Findings {
     let program = model::program(db, file);
-    let mut walk = Walk::new(db, file, program, crate::checks::flow_checks());
+    let mut walk = Walk::new(db, file, program, crate::cnc8x6::checks::flow_checks());
     walk.run();
     let mut out = walk.out;
     // A block run several times (a subprogram called from several places,

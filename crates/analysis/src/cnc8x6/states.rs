@@ -31,9 +31,9 @@ use rustc_hash::FxHashMap;
 
 use crate::{
     Config,
+    cnc8x6::flow::{Course, Known, ModalState, ParamState, Walk},
+    cnc8x6::model::{self, Program},
     db::{Db, Settings, SourceFile},
-    flow::{Course, Known, ModalState, ParamState, Walk},
-    model::{self, Program},
 };
 
 /// Blocks between checkpoints: walking this many costs well under a
@@ -570,7 +570,7 @@ mod tests {
     use std::sync::atomic::Ordering;
 
     use super::{Asker, STRIDE, changed_blocks, main_state_and_walk, main_state_before, walk_to};
-    use crate::{AnalysisHost, Config, TextEdit, TextRange, TextSize, db::Db, flow::walked_states};
+    use crate::{AnalysisHost, Config, TextEdit, TextRange, TextSize, cnc8x6::flow::walked_states, db::Db};
 
     /// What [`changed_blocks`] promises, whatever the tree's shape: the
     /// blocks before and after the change are the same nodes, the text
@@ -702,7 +702,7 @@ mod tests {
             }
             host.analysis().prepare_states(file);
             let db = host.db();
-            let blocks = crate::model::program(db, file).units[0].blocks.clone();
+            let blocks = crate::cnc8x6::model::program(db, file).units[0].blocks.clone();
             let (mut passed, mut counted) = (0, false);
             for index in blocks.step_by(13) {
                 let walked = walked_states(db, file, index);

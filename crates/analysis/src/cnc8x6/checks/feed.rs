@@ -6,12 +6,12 @@ use ncc_syntax::{TextEdit, TextRange, TextSize};
 
 use crate::{
     Config, Diagnostic,
-    checks::{
+    cnc8x6::checks::{
         block::{digit_overflow, parameter_raw},
         motion,
     },
+    cnc8x6::flow::{FlowCheck, Known, ModalState, Setting, Substitution, Visit, show_thousandths},
     diagnostic::declare_rules,
-    flow::{FlowCheck, Known, ModalState, Setting, Substitution, Visit, show_thousandths},
     lower::{BlockData, Value, Word},
 };
 

@@ -5,8 +5,8 @@ use ncc_catalog::{AddressRole, Dialect};
 
 use crate::{
     Diagnostic,
+    cnc8x6::flow::{FlowCheck, Known, ModalState, Visit},
     diagnostic::declare_rules,
-    flow::{FlowCheck, Known, ModalState, Visit},
     lower::{BlockData, Value},
 };
 

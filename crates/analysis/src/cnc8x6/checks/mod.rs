@@ -12,7 +12,7 @@ pub(crate) mod structure;
 pub(crate) mod threads;
 pub(crate) mod transform;
 
-use crate::flow::FlowCheck;
+use crate::cnc8x6::flow::FlowCheck;
 
 /// The rules of every check module.
 pub(crate) static RULES: &[&[&crate::Rule]] = &[

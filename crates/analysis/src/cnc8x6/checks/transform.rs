@@ -14,9 +14,9 @@ use ncc_syntax::TextRange;
 
 use crate::{
     Diagnostic,
-    checks::{block, motion},
+    cnc8x6::checks::{block, motion},
+    cnc8x6::flow::{FlowCheck, Visit},
     diagnostic::declare_rules,
-    flow::{FlowCheck, Visit},
     lower::{Value, Word},
 };
 
