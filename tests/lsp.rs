@@ -602,3 +602,24 @@ fn a_document_of_a_dialect_this_version_does_not_read_gets_one_finding_saying_so
     assert!(hover.result().is_none_or(Value::is_null), "{}", hover.json);
     assert_serving(&mut client, &dir);
 }
+
+#[test]
+fn the_project_decides_a_documents_dialect() {
+    let (mut client, dir) = session();
+    std::fs::create_dir(dir.path().join("siemens")).unwrap();
+    std::fs::write(dir.path().join("siemens/ncc.toml"), "dialect = \"sinumerik\"\n").unwrap();
+    std::fs::write(dir.path().join("ncc.toml"), "[extensions]\nPRG = \"cnc8x6\"\n").unwrap();
+    // Named CNC8x6 by its extension, but in a Sinumerik project.
+    let siemens = document(&dir, "siemens/A.NCP", "%1\nN10 G01 X1\n");
+    let published = open(&mut client, &siemens);
+    let message = "ncc does not read Siemens Sinumerik programs yet (dialect `sinumerik`)";
+    assert_eq!(published.params()["diagnostics"][0]["message"], message);
+    // An extension of the project's own: analysed as CNC8x6.
+    let mapped = document(&dir, "B.PRG", "%1\nN10 G01 X1\nN20 M30\n*\n");
+    client.notify("textDocument/didOpen", mapped.did_open()).unwrap();
+    let published = settled_diagnostics(&mut client, &mapped);
+    let codes: Vec<&str> =
+        published.params()["diagnostics"].as_array().unwrap().iter().filter_map(|d| d["code"].as_str()).collect();
+    assert_eq!(codes, ["M401"], "{}", published.json);
+    assert_serving(&mut client, &dir);
+}

@@ -62,13 +62,20 @@ impl Default for AnalysisHost {
 }
 
 impl AnalysisHost {
+    /// A host whose files are in the default dialect.
     pub fn new(config: Config) -> AnalysisHost {
-        AnalysisHost::with_database(RootDatabase::default(), config)
+        AnalysisHost::in_dialect(Dialect::default(), config)
+    }
+
+    /// A host whose files are in `dialect`: a workspace is one project in
+    /// one dialect (a program calls only programs of its own dialect).
+    pub fn in_dialect(dialect: Dialect, config: Config) -> AnalysisHost {
+        AnalysisHost::with_database(RootDatabase::default(), dialect, config)
     }
 
     /// A host over `db` (e.g. one that logs executions).
-    pub fn with_database(db: RootDatabase, config: Config) -> AnalysisHost {
-        Settings::new(&db, Dialect::default(), config, Vec::new());
+    pub fn with_database(db: RootDatabase, dialect: Dialect, config: Config) -> AnalysisHost {
+        Settings::new(&db, dialect, config, Vec::new());
         AnalysisHost { db }
     }
 

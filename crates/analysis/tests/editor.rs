@@ -430,7 +430,7 @@ fn highlighting_computes_nothing_and_references_relower_one_chunk_after_an_edit(
         text.push_str(&format!("N{n} G01 X{n}. ZR12\n"));
     }
     text.push_str("N5000 M30\n*\n");
-    let mut host = AnalysisHost::with_database(RootDatabase::with_execution_log(), Config::default());
+    let mut host = AnalysisHost::with_database(RootDatabase::with_execution_log(), Dialect::Cnc8x6, Config::default());
     let file = host.add_file("main.NCP", text.as_str());
     host.analysis().highlight(file);
     assert_eq!(host.db().take_executions(), Vec::<String>::new(), "highlighting reads the tree only");

@@ -2,7 +2,7 @@
 //! (a run of blocks) is lowered and checked again, no other.
 
 use ncc_analysis::{
-    AnalysisHost, Config, FileId, RootDatabase, TextEdit, TextRange, TextSize,
+    AnalysisHost, Config, Dialect, FileId, RootDatabase, TextEdit, TextRange, TextSize,
     cnc8x6::flow::{Known, ModalState, ParamState},
 };
 
@@ -22,7 +22,7 @@ fn count(executions: &[String], query: &str) -> usize {
 #[test]
 fn an_edit_relowers_and_rechecks_only_the_touched_chunk() {
     let text = program(5000);
-    let mut host = AnalysisHost::with_database(RootDatabase::with_execution_log(), Config::default());
+    let mut host = AnalysisHost::with_database(RootDatabase::with_execution_log(), Dialect::Cnc8x6, Config::default());
     let file = host.add_file("main.NCP", text.as_str());
     assert!(host.analysis().diagnostics(file).is_empty());
     let first = host.db().take_executions();

@@ -92,6 +92,9 @@ impl Checked {
     }
 }
 
+/// A workspace: the `ncc.toml` of a project, and a dialect.
+type Workspace = (Option<PathBuf>, DialectId);
+
 /// Below this many files a run is quick enough not to need a progress bar.
 const PROGRESS_BAR_MIN_FILES: usize = 200;
 
@@ -157,22 +160,30 @@ pub(crate) fn run(paths: &[PathBuf], format: Format, forced: Option<DialectId>) 
     let mut projects = Projects::default();
     let Found { files, mut failures, not_read } = collect_files(paths, &mut projects, forced);
     let progress = progress_bar(files.len());
-    let read: Vec<Result<(PathBuf, String), String>> = files
+    let read: Vec<Result<(PathBuf, DialectId, String), String>> = files
         .par_iter()
-        .map(|path| read_program(path).map(|text| (path.clone(), text)).map_err(|e| format!("{}: {e}", path.display())))
+        .map(|(path, dialect)| {
+            read_program(path)
+                .map(|text| (path.clone(), *dialect, text))
+                .map_err(|e| format!("{}: {e}", path.display()))
+        })
         .collect();
 
-    // Files under the same `ncc.toml` form one workspace.
-    let mut workspaces: BTreeMap<Option<PathBuf>, Vec<(PathBuf, String)>> = BTreeMap::new();
+    // The files of one dialect under the same `ncc.toml` form one workspace.
+    let mut workspaces: BTreeMap<Workspace, Vec<(PathBuf, String)>> = BTreeMap::new();
     for result in read {
         match result {
-            Ok((path, text)) => workspaces.entry(projects.config_path(&path)).or_default().push((path, text)),
+            Ok((path, dialect, text)) => {
+                workspaces.entry((projects.config_path(&path), dialect)).or_default().push((path, text))
+            }
             Err(message) => failures.push(message),
         }
     }
     let mut checked = Vec::new();
     let mut sources = HashMap::new();
-    for (config_path, programs) in workspaces {
+    for ((config_path, dialect), programs) in workspaces {
+        // Only dialects with an implementation are collected.
+        let Some(dialect) = dialect.implementation() else { continue };
         let config = match projects.config(config_path.as_deref()) {
             Ok(config) => config.clone(),
             Err(message) => {
@@ -180,7 +191,7 @@ pub(crate) fn run(paths: &[PathBuf], format: Format, forced: Option<DialectId>) 
                 continue;
             }
         };
-        let mut host = AnalysisHost::new(config);
+        let mut host = AnalysisHost::in_dialect(dialect, config);
         // Macrocycle files beside the checked programs are what their G72
         // calls run, so they are part of the workspace even when they are
         // not checked themselves.
@@ -286,8 +297,8 @@ pub(crate) fn macrocycles_beside(programs: &[(PathBuf, String)]) -> Vec<(PathBuf
 
 /// What [`collect_files`] found.
 pub(crate) struct Found {
-    /// The programs to read, sorted.
-    pub files: Vec<PathBuf>,
+    /// The programs to read, sorted, with their dialect.
+    pub files: Vec<(PathBuf, DialectId)>,
     /// Why paths cannot be looked at.
     pub failures: Vec<String>,
     /// Programs found in directories whose dialect this build does not
@@ -313,7 +324,7 @@ pub(crate) fn collect_files(paths: &[PathBuf], projects: &mut Projects, forced: 
         if !metadata.is_dir() {
             let dialect = projects.dialects(path).of_given(path, forced);
             match dialect.implementation() {
-                Some(_) => found.files.push(path.clone()),
+                Some(_) => found.files.push((path.clone(), dialect)),
                 None => found.failures.push(format!("{}: {}", path.display(), dialect.not_read())),
             }
             continue;
@@ -322,7 +333,9 @@ pub(crate) fn collect_files(paths: &[PathBuf], projects: &mut Projects, forced: 
             match entry {
                 Ok(entry) if entry.file_type().is_some_and(|t| t.is_file()) => {
                     match projects.dialects(entry.path()).of_found(entry.path(), forced) {
-                        Some(dialect) if dialect.implementation().is_some() => found.files.push(entry.into_path()),
+                        Some(dialect) if dialect.implementation().is_some() => {
+                            found.files.push((entry.into_path(), dialect))
+                        }
                         Some(dialect) => *found.not_read.entry(dialect).or_default() += 1,
                         None => {}
                     }
@@ -333,7 +346,7 @@ pub(crate) fn collect_files(paths: &[PathBuf], projects: &mut Projects, forced: 
         }
     }
     found.files.sort();
-    found.files.dedup();
+    found.files.dedup_by(|(a, _), (b, _)| a == b);
     found
 }
 

@@ -928,8 +928,9 @@ impl Library {
                 let beside = std::fs::read_dir(directory).into_iter().flatten().flatten().map(|entry| entry.path());
                 let project = program.config.and_then(Path::parent).map(Path::to_path_buf);
                 let in_project = project
-                    .map(|root| check::collect_files(&[root], &mut check::Projects::default(), None).files)
-                    .unwrap_or_default();
+                    .into_iter()
+                    .flat_map(|root| check::collect_files(&[root], &mut check::Projects::default(), None).files)
+                    .map(|(path, _)| path);
                 beside.chain(in_project).filter(|path| path.is_file()).collect()
             }
             None => Vec::new(),

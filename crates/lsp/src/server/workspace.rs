@@ -7,7 +7,7 @@ use std::{
     path::{Path, PathBuf},
 };
 
-use ncc_analysis::{AnalysisHost, Config, Dialect, DialectId, Dialects, FileId, NavigationTarget};
+use ncc_analysis::{AnalysisHost, Config, Dialect, DialectId, FileId, NavigationTarget};
 use tower_lsp_server::ls_types::{self as lsp, Uri};
 
 use super::convert::LineMap;
@@ -19,14 +19,16 @@ pub(crate) struct Workspaces {
     forced_config: Option<PathBuf>,
     /// The dialect of every document, when the server was started with one.
     forced_dialect: Option<DialectId>,
+    /// Each project's configuration, by its `ncc.toml`, read once.
+    configs: HashMap<Option<PathBuf>, Config>,
     list: Vec<Workspace>,
 }
 
+/// The files of one dialect in one project.
 #[derive(Debug)]
 struct Workspace {
     config_path: Option<PathBuf>,
-    /// What its configuration says of dialects.
-    dialects: Dialects,
+    dialect: Dialect,
     host: AnalysisHost,
     /// Files by the path the analysis knows them by.
     files: HashMap<String, FileId>,
@@ -74,34 +76,45 @@ impl Workspaces {
         self.list[index].config_path.as_deref()
     }
 
-    /// The workspace whose configuration applies to `path`; errors reading
-    /// a configuration file are returned, and its defaults used.
-    fn workspace_for(&mut self, path: Option<&Path>, errors: &mut Vec<String>) -> usize {
+    /// The `ncc.toml` that applies to the program at `path` and its
+    /// dialect (a document that is no file, `untitled:`, has the default
+    /// one); errors reading a configuration file are returned, and its
+    /// defaults used.
+    fn project_of(&mut self, path: Option<&Path>, errors: &mut Vec<String>) -> (Option<PathBuf>, DialectId) {
         let config_path = self.forced_config.clone().or_else(|| path.and_then(Config::find_for));
-        if let Some(index) = self.list.iter().position(|w| w.config_path == config_path) {
-            return index;
-        }
-        let config = match &config_path {
+        let config = self.configs.entry(config_path.clone()).or_insert_with(|| match &config_path {
             Some(path) => check::load_config(path).unwrap_or_else(|error| {
                 errors.push(error);
                 Config::default()
             }),
             None => Config::default(),
-        };
-        let dialects = config.dialects.clone();
+        });
+        let dialect = config.dialects.of_given(path.unwrap_or(Path::new("")), self.forced_dialect);
+        (config_path, dialect)
+    }
+
+    /// The workspace of `dialect` in the project of `config_path`.
+    fn workspace_for(&mut self, config_path: Option<PathBuf>, dialect: Dialect) -> usize {
+        if let Some(index) = self.list.iter().position(|w| w.config_path == config_path && w.dialect == dialect) {
+            return index;
+        }
+        let config = self.configs.get(&config_path).cloned().unwrap_or_default();
         self.list.push(Workspace {
             config_path,
-            dialects,
-            host: AnalysisHost::new(config),
+            dialect,
+            host: AnalysisHost::in_dialect(dialect, config),
             files: HashMap::new(),
             uris: HashMap::new(),
         });
         self.list.len() - 1
     }
 
-    /// Adds a file read from disk unless the workspace has it.
+    /// Adds a file read from disk unless its workspace has it, or its
+    /// dialect is one this version does not read.
     fn add_from_disk(&mut self, path: &Path, errors: &mut Vec<String>) {
-        let index = self.workspace_for(Some(path), errors);
+        let (config_path, dialect) = self.project_of(Some(path), errors);
+        let Some(dialect) = dialect.implementation() else { return };
+        let index = self.workspace_for(config_path, dialect);
         let workspace = &mut self.list[index];
         let name = path.display().to_string();
         if workspace.files.contains_key(&name) {
@@ -124,7 +137,7 @@ impl Workspaces {
     pub fn load_roots(&mut self, roots: &[PathBuf]) -> Vec<String> {
         let mut projects = check::Projects::with_config(self.forced_config.clone());
         let check::Found { files, mut failures, .. } = check::collect_files(roots, &mut projects, self.forced_dialect);
-        for path in files {
+        for (path, _) in files {
             self.add_from_disk(&path, &mut failures);
         }
         failures
@@ -135,13 +148,11 @@ impl Workspaces {
     pub fn open(&mut self, uri: &Uri, text: String) -> Opened {
         let (name, path) = document_path(uri);
         let mut errors = Vec::new();
-        let index = self.workspace_for(path.as_deref(), &mut errors);
-        let dialects = &self.list[index].dialects;
-        // A document that is no file (`untitled:`) has the default dialect.
-        let dialect = dialects.of_given(path.as_deref().unwrap_or(Path::new("")), self.forced_dialect);
+        let (config_path, dialect) = self.project_of(path.as_deref(), &mut errors);
         let Some(implementation) = dialect.implementation() else {
             return Opened::NotRead(dialect);
         };
+        let index = self.workspace_for(config_path, implementation);
         if let Some(path) = &path {
             let beside = check::macrocycles_beside(&[(path.clone(), String::new())]);
             for (macrocycle, _) in beside {
