@@ -52,8 +52,7 @@ const DIALECT_DEBT: &[(&str, usize)] = &[
 const CYCLE_DEBT: &[&str] = &[
     "analysis: cnc8x6 → db → diagnostic → findings",
     "lsp: check → report → sarif",
-    "nc-exec: cnc8x6 → compensation → machine → run → tool_path → transform",
-    "nc-exec: envelope → velocity",
+    "nc-exec: cnc8x6 → compensation → envelope → machine → run → tool_path → transform → velocity",
     "syntax: ast → cnc8x6",
 ];
 

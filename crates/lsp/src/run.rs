@@ -19,6 +19,7 @@ use std::{
 use indicatif::{ProgressBar, ProgressStyle};
 use nc_exec::{
     cnc8x6::arith::{Message, MessageDisplay},
+    cnc8x6::dynamics,
     cnc8x6::expand::{ExpandError, Expansion},
     cnc8x6::lower::BlockData,
     run::{Axes, Called, Environment, Motion, Step, Stop, Totals, Trace, expected_blocks},
@@ -135,7 +136,7 @@ impl Ran {
     fn tally(program: &Program<'_>, step_budget: usize, progress: Progress) -> Result<(Ran, Tally), String> {
         let config = program.config()?;
         let machine = &config.machine;
-        let dynamics = Dynamics::of(machine);
+        let dynamics = dynamics::dynamics(machine);
         let tally_with = |places: Places| {
             let timer = Timer::new(machine.step_axes(), &dynamics, Tally { places, ..Tally::default() });
             let mut timed = None;
@@ -177,7 +178,7 @@ impl Ran {
     ) -> Result<(Ran, Plot), String> {
         let config = program.config()?;
         let machine = &config.machine;
-        let dynamics = Dynamics::of(machine);
+        let dynamics = dynamics::dynamics(machine);
         let timer = Timer::new(machine.step_axes(), &dynamics, Sketch::new(max_moves));
         let mut sketched = None;
         let mut ran = Ran::run(program, &config, progress, |text, library| {
@@ -208,7 +209,7 @@ impl Ran {
             bar.finish_and_clear();
         }
         let sources = library.sources(&program.name, text, program.dialect, &trace);
-        Ran { trace, config: config.clone(), dynamics: Dynamics::of(&config.machine), sources }
+        Ran { trace, config: config.clone(), dynamics: dynamics::dynamics(&config.machine), sources }
     }
 
     /// The run timed with the control's velocity model.

@@ -4,6 +4,7 @@
 
 pub mod arith;
 pub(crate) mod cycles;
+pub mod dynamics;
 pub mod expand;
 pub mod formats;
 pub mod lower;

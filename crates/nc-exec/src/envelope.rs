@@ -20,11 +20,7 @@
 
 use std::collections::VecDeque;
 
-use crate::{
-    machine::MachineConfig,
-    run::shift_count,
-    velocity::{Dynamics, MIN_CONTINUITY_MS, Profile},
-};
+use crate::{run::shift_count, velocity::Profile};
 
 /// The control plans at most this many blocks ahead (04 §1.9).
 pub const MAX_DEPTH: usize = 500;
@@ -36,14 +32,7 @@ const SPEED_RANGE: (f64, f64) = (1e-6, 1e9);
 /// The parabolic ramp P as a jerk: J = P / 32.768 mm/s³ reproduces both of
 /// the manual's A7.1 formulas, T = 1.478·sqrt(F/P) and A < sqrt(Fmax·P/1966)
 /// (04 §1.10).
-const P_PER_JERK: f64 = 32.768;
-
-/// What the planner assumes for the constants the manual gives no value
-/// for, until the configuration sets them: its examples, R384 and R409 =
-/// 8 µm, R385 and R410 = 10000 mm/s², R383 = 0.005 mm, P (R407) = 50000
-/// and A (R408) = 600 mm/s² (04 §1.9 A6.2, §2.2).
-const ASSUMED: [(u32, i64); 7] =
-    [(384, 8), (385, 10_000), (383, 5), (407, 50_000), (408, 600), (409, 8), (410, 10_000)];
+pub(crate) const P_PER_JERK: f64 = 32.768;
 
 /// How speed changes: linearly (R338 decade 2 = 1) or parabolically, with
 /// limited jerk (decade 2 = 2).
@@ -99,112 +88,6 @@ pub struct Envelope {
     pub rapid: Ramp,
     /// Ramps of feed moves outside continuity: R52.
     pub basic: Ramp,
-}
-
-impl Envelope {
-    /// The machine's envelope velocity, or `None` when machine constant R338
-    /// decade 2 does not switch it on (then the CNC8x6 model applies).
-    pub fn of(machine: &MachineConfig) -> Option<Envelope> {
-        let profile = match machine.known_decade(338, 2) {
-            Some(1) => ProfileKind::Linear,
-            Some(2) => ProfileKind::Parabolic,
-            _ => return None,
-        };
-        let dynamics = Dynamics::cnc8x6(machine);
-        let raw = |number: u32| {
-            let assumed = ASSUMED.iter().find(|&&(n, _)| n == number).map(|&(_, value)| value);
-            machine.known_constant(number).or(assumed).unwrap_or(0)
-        };
-        let digits = |value: i64, decades: u32| (value.unsigned_abs() % 10u64.pow(decades)) as f64;
-        // P in decades 1–7; decade 8 scales it down for very flat parabolas.
-        let jerk_of = |value: i64| {
-            let scale = match value.unsigned_abs() / 10_000_000 % 10 {
-                2 => 100.0,
-                3 => 1000.0,
-                _ => 1.0,
-            };
-            match profile {
-                ProfileKind::Linear => f64::INFINITY,
-                ProfileKind::Parabolic => digits(value, 7) / scale / P_PER_JERK,
-            }
-        };
-        let jerk = jerk_of(raw(407));
-        // A minus sign blocks the length limits; their point is mm.
-        let length = |number| (raw(number).max(0) as f64) / 1000.0;
-        let mut set = DynamicSet {
-            ramp: Ramp { acceleration: dynamics.continuity_acceleration, jerk },
-            accuracy: digits(raw(384), 4) / 1000.0,
-            overload: digits(raw(385), 7),
-            centrifugal: 0.0,
-        };
-        let mut rapid = Ramp { acceleration: dynamics.rapid_acceleration, jerk };
-        let mut sets = [set; 4];
-        // The sets govern the parabolic profile when R406 decade 1 is 1;
-        // then R236, R384 and R385 have no effect (04 §2.2).
-        if profile == ProfileKind::Parabolic && machine.decade(406, 1) == 1 {
-            // A set's value, when the set is on, holds it directly (not a
-            // program parameter's number) and is not zero.
-            let value = |set: u32, offset: u32| {
-                let base = 406 + 6 * set;
-                let on = set == 0 || machine.decade(base, 1) == 1;
-                let direct = machine.decade(base, offset + 1) == 0;
-                let value = if set == 0 { raw(base + offset) } else { machine.constant(base + offset) };
-                (on && direct && value != 0).then_some(value)
-            };
-            let centrifugal = |value: i64| {
-                let new_method = value.unsigned_abs() / 10_000_000 % 10 == 1;
-                if new_method { digits(value, 7) / 10.0 } else { 0.0 }
-            };
-            // Set 1's unknown values (in program parameters) keep what the
-            // control uses without the sets.
-            set = DynamicSet {
-                ramp: Ramp {
-                    acceleration: value(0, 2).map_or(set.ramp.acceleration, |a| digits(a, 8)),
-                    jerk: value(0, 1).map_or(set.ramp.jerk, jerk_of),
-                },
-                accuracy: value(0, 3).map_or(set.accuracy, |v| digits(v, 4) / 1000.0),
-                overload: value(0, 4).map_or(set.overload, |v| digits(v, 7)),
-                centrifugal: value(0, 5).map_or(0.0, centrifugal),
-            };
-            for (n, slot) in sets.iter_mut().enumerate() {
-                let n = n as u32;
-                *slot = DynamicSet {
-                    ramp: Ramp {
-                        acceleration: value(n, 2).map_or(set.ramp.acceleration, |a| digits(a, 8)),
-                        jerk: value(n, 1).map_or(set.ramp.jerk, jerk_of),
-                    },
-                    accuracy: value(n, 3).map_or(set.accuracy, |v| digits(v, 4) / 1000.0),
-                    overload: value(n, 4).map_or(set.overload, |v| digits(v, 7)),
-                    centrifugal: value(n, 5).map_or(set.centrifugal, centrifugal),
-                };
-            }
-            // R430–R432 for G00, falling back to set 1 (04 §2.2).
-            let own = |number: u32| {
-                (machine.decade(430, 1) == 1).then(|| machine.constant(number)).filter(|&value| value != 0)
-            };
-            rapid = Ramp {
-                acceleration: own(432).map_or(set.ramp.acceleration, |a| digits(a, 8)),
-                jerk: own(431).map_or(set.ramp.jerk, jerk_of),
-            };
-        }
-        let hold = match raw(395) {
-            // 0 is the basic setting of 0.5 s (04 §1.9.3).
-            0 => 0.5,
-            ms => ms.unsigned_abs() as f64 / 1000.0,
-        };
-        Some(Envelope {
-            profile,
-            depth: (machine.look_ahead_blocks as usize).clamp(1, MAX_DEPTH),
-            tick: f64::from(machine.envelope_tick_us.max(1)) / 1e6,
-            min_duration: MIN_CONTINUITY_MS.1 / 1000.0,
-            short_block: length(382),
-            merge_below: length(383),
-            hold_time: hold,
-            sets,
-            rapid,
-            basic: Ramp { acceleration: dynamics.feed_acceleration, jerk: set.ramp.jerk },
-        })
-    }
 }
 
 /// What a move is to the planner.
@@ -844,9 +727,10 @@ mod tests {
 
     use super::{Envelope, EnvelopeMove, Limit, MoveKind, Planned, Planner, ProfileKind, corner_cap};
     use crate::{
+        cnc8x6::dynamics,
         machine::MachineConfig,
         run::{NoFiles, run},
-        velocity::{Dynamics, time},
+        velocity::time,
     };
 
     /// A machine with these constants (raw values) besides the defaults:
@@ -858,11 +742,11 @@ mod tests {
     }
 
     fn linear() -> Envelope {
-        Envelope::of(&machine(&[(338, 10)])).unwrap()
+        dynamics::envelope(&machine(&[(338, 10)])).unwrap()
     }
 
     fn parabolic() -> Envelope {
-        Envelope::of(&machine(&[(338, 20)])).unwrap()
+        dynamics::envelope(&machine(&[(338, 20)])).unwrap()
     }
 
     const X: [f64; 3] = [1.0, 0.0, 0.0];
@@ -902,7 +786,7 @@ mod tests {
 
     #[test]
     fn the_envelope_follows_r338_and_reads_the_sets() {
-        assert_eq!(Envelope::of(&MachineConfig::default()), None);
+        assert_eq!(dynamics::envelope(&MachineConfig::default()), None);
         let envelope = linear();
         assert_eq!((envelope.profile, envelope.depth, envelope.tick), (ProfileKind::Linear, 500, 0.002));
         let set = envelope.sets[0];
@@ -912,7 +796,7 @@ mod tests {
         // set 1 for P; rapid moves take R430–R432. R411 with decade 8 = 1
         // is the centrifugal acceleration ×10.
         let sets = [(338, 20), (406, 1), (407, 10_000), (408, 800), (411, 10_004_000), (412, 1), (414, 300)];
-        let envelope = Envelope::of(&machine(&[&sets[..], &[(430, 1), (432, 2000)]].concat())).unwrap();
+        let envelope = dynamics::envelope(&machine(&[&sets[..], &[(430, 1), (432, 2000)]].concat())).unwrap();
         let jerk = 10_000.0 / 32.768;
         assert_eq!((envelope.sets[0].ramp.acceleration, envelope.sets[0].ramp.jerk), (800.0, jerk));
         assert_eq!((envelope.sets[1].ramp.acceleration, envelope.sets[1].ramp.jerk), (300.0, jerk));
@@ -978,7 +862,7 @@ mod tests {
         let program: String = (1..=100).map(|x| format!("N{x} X{x}\n")).collect();
         let machine = MachineConfig::default();
         let trace = run(&format!("%1\nN101 G23 G01 F6000\n{program}M30\n"), &NoFiles, &machine, 1000);
-        let cnc8x6 = time(&trace, &Dynamics::of(&machine)).total_time();
+        let cnc8x6 = time(&trace, &dynamics::dynamics(&machine)).total_time();
         assert!(cnc8x6 > 3.0 * total(&planned), "{cnc8x6}");
         // Parabolic: the sections' ramps over several blocks come within 2%
         // of one 100 mm S-curve (1.5% faster: a section's ramp is not

@@ -29,7 +29,6 @@ use ncc_syntax::TextSize;
 
 use crate::{
     envelope::{Envelope, EnvelopeMove, Limit, MoveKind, Planned, Planner},
-    machine::MachineConfig,
     run::{Axes, Checkpoint, Joining, MAX_AXES, Motion, Path, Step, StepSink, Trace, shift_count, shift_range},
 };
 
@@ -37,28 +36,11 @@ use crate::{
 const TICK: f64 = 0.01;
 /// The largest distance of a chord from its circle the control allows (000:2747).
 const CHORD_ERROR: f64 = 0.001;
-/// Moves shorter in time (ms) than these at their programmed speed cannot
-/// be joined smoothly (G23) or tightly (G24), on a CNC8x6 and on a CNC8x9
-/// (000:7006, 000:6965).
-pub const MIN_CONTINUITY_MS: (f64, f64) = (60.0, 4.0);
-pub const MIN_TIGHT_JOINING_MS: (f64, f64) = (30.0, 2.0);
-
 /// The spatial angle in degrees between the motion directions (unit
 /// vectors over the first three axes) at a junction, which the control
 /// compares with R39.
 pub fn junction_angle(before: [f64; 3], after: [f64; 3]) -> f64 {
     before.iter().zip(after).map(|(a, b)| a * b).sum::<f64>().clamp(-1.0, 1.0).acos().to_degrees()
-}
-
-/// Machine constant R39 in degrees (thousandths, the decimal point valid).
-pub fn tolerance_angle(machine: &MachineConfig) -> f64 {
-    machine.constant(39) as f64 / 1000.0
-}
-
-/// The CNC8x6 or CNC8x9 value of a limit: envelope velocity (R338 decade
-/// 2) exists only on CNC8x9; otherwise the control is the CNC8x6.
-pub fn for_control(machine: &MachineConfig, (cnc8x6, cnc8x9): (f64, f64)) -> f64 {
-    if matches!(machine.known_decade(338, 2), Some(1 | 2)) { cnc8x9 } else { cnc8x6 }
 }
 
 /// What the model reads from the machine.
@@ -69,7 +51,7 @@ pub struct Dynamics {
     pub continuity: u8,
     /// R39 in degrees, and its cosine, which junctions compare with.
     pub tolerance_angle: f64,
-    tolerance_cosine: f64,
+    pub(crate) tolerance_cosine: f64,
     /// R52, R236 (R52 when 0) and R237 in mm/s².
     pub feed_acceleration: f64,
     pub continuity_acceleration: f64,
@@ -87,47 +69,6 @@ pub struct Dynamics {
     /// The CNC8x9 envelope velocity, when machine constant R338 switches it
     /// on: it plans the moves instead of the one-block look-ahead.
     pub envelope: Option<Envelope>,
-}
-
-/// What the model assumes for machine constants the manual gives no value
-/// for, until the machine's configuration sets them: automatic continuity,
-/// R52 and R237 of 1000 mm/s², and the manual's example of 400 mm/s² for
-/// R236. The checker assumes nothing: its continuity rules wait for R97.
-const ASSUMED_CONTINUITY: u8 = 2;
-const ASSUMED_ACCELERATIONS: [(u32, i64); 3] = [(52, 1000), (236, 400), (237, 1000)];
-
-impl Dynamics {
-    pub fn of(machine: &MachineConfig) -> Dynamics {
-        Dynamics { envelope: Envelope::of(machine), ..Dynamics::cnc8x6(machine) }
-    }
-
-    /// The CNC8x6 model's constants, which the envelope builds on.
-    pub(crate) fn cnc8x6(machine: &MachineConfig) -> Dynamics {
-        let acceleration = |number| {
-            let assumed = ASSUMED_ACCELERATIONS.iter().find(|&&(n, _)| n == number).map(|&(_, value)| value);
-            machine.known_constant(number).or(assumed).unwrap_or(0).unsigned_abs() as f64
-        };
-        let feed_acceleration = acceleration(52);
-        let continuity_acceleration = match acceleration(236) {
-            0.0 => feed_acceleration,
-            value => value,
-        };
-        Dynamics {
-            continuity: machine.known_decade(97, 1).unwrap_or(ASSUMED_CONTINUITY),
-            tolerance_angle: tolerance_angle(machine),
-            tolerance_cosine: tolerance_angle(machine).to_radians().cos(),
-            feed_acceleration,
-            continuity_acceleration,
-            rapid_acceleration: acceleration(237),
-            block_pause: f64::from(machine.block_pause_ms) / 1000.0,
-            settle_time: f64::from(machine.settle_time_ms) / 1000.0,
-            min_continuity: for_control(machine, MIN_CONTINUITY_MS) / 1000.0,
-            min_tight_joining: for_control(machine, MIN_TIGHT_JOINING_MS) / 1000.0,
-            m_function_time: f64::from(machine.m_function_ms) / 1000.0,
-            tool_change_time: f64::from(machine.tool_change_ms) / 1000.0,
-            envelope: None,
-        }
-    }
 }
 
 /// A move's speed through it, in mm/min: at its start, its highest, and at
@@ -946,8 +887,9 @@ fn lost_time(this: &Move, next: &Move, entry: f64, exit: f64, smooth: f64, after
 
 #[cfg(test)]
 mod tests {
-    use super::{Dynamics, Reason, Timing, time};
+    use super::{Reason, Timing, time};
     use crate::{
+        cnc8x6::dynamics,
         machine::MachineConfig,
         run::{NoFiles, run},
     };
@@ -958,7 +900,7 @@ mod tests {
         let machine = MachineConfig::default();
         let trace = run(text, &NoFiles, &machine, 1000);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
-        time(&trace, &Dynamics::of(&machine))
+        time(&trace, &dynamics::dynamics(&machine))
     }
 
     fn close(actual: f64, expected: f64) {
@@ -972,7 +914,7 @@ mod tests {
 
     #[test]
     fn unset_constants_take_the_models_assumptions() {
-        let dynamics = Dynamics::of(&MachineConfig::default());
+        let dynamics = dynamics::dynamics(&MachineConfig::default());
         assert_eq!((dynamics.continuity, dynamics.tolerance_angle), (2, 60.0));
         let accelerations = (dynamics.feed_acceleration, dynamics.continuity_acceleration, dynamics.rapid_acceleration);
         assert_eq!(accelerations, (1000.0, 400.0, 1000.0));
@@ -1079,7 +1021,7 @@ mod tests {
     /// decade 2 = 1).
     fn enveloped(text: &str) -> Timing {
         let machine = MachineConfig { constants: [(338, 10)].into(), ..MachineConfig::default() };
-        let dynamics = Dynamics::of(&machine);
+        let dynamics = dynamics::dynamics(&machine);
         assert!(dynamics.envelope.is_some());
         let trace = run(text, &NoFiles, &machine, 1000);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
@@ -1122,7 +1064,7 @@ mod tests {
         // A minus sign blocks R383.
         let machine = MachineConfig { constants: [(338, 10), (383, -5)].into(), ..MachineConfig::default() };
         let trace = run(&program("X50.003"), &NoFiles, &machine, 1000);
-        let blocked = time(&trace, &Dynamics::of(&machine)).total_time();
+        let blocked = time(&trace, &dynamics::dynamics(&machine)).total_time();
         assert!(blocked > merged + 0.9 * ramps, "{blocked} vs {merged}");
     }
 
@@ -1136,7 +1078,7 @@ mod tests {
             let text = format!("%1\nN1 G23 I{set} G01 X100 F6000\nN2 M30\n");
             let trace = run(&text, &NoFiles, &machine, 1000);
             assert!(trace.findings.is_empty(), "{:?}", trace.findings);
-            time(&trace, &Dynamics::of(&machine)).total_time()
+            time(&trace, &dynamics::dynamics(&machine)).total_time()
         };
         let (first, second) = (timed(1), timed(2));
         // J = P / 32.768. Set 2 reaches A: v/A + A/J + L/v (04 §2.2); set 1
@@ -1199,7 +1141,7 @@ mod tests {
         let machine = MachineConfig { m_function_ms: 200, tool_change_ms: 6000, ..MachineConfig::default() };
         // M06 is the tool change; M03 and M08 two M functions; M30 ends.
         let trace = run("%1\nN1 T1 M06\nN2 M03 M08 S1000\nN3 M30\n", &NoFiles, &machine, 100);
-        let timing = time(&trace, &Dynamics::of(&machine));
+        let timing = time(&trace, &dynamics::dynamics(&machine));
         let durations: Vec<f64> = timing.profiles.iter().map(|profile| profile.duration).collect();
         assert_eq!(durations, [6.0, 0.4, 0.0]);
     }

@@ -12,8 +12,9 @@
 use std::{fmt::Write as _, ops::ControlFlow, sync::Arc};
 
 use nc_exec::{
+    cnc8x6::dynamics,
     run::{Checkpoint, Environment, Motion, Step, Totals, shift_count, shift_offset, shift_range},
-    velocity::{self, Break, Dynamics, Reason, Timer, TimerState, TimingSink},
+    velocity::{self, Break, Reason, Timer, TimerState, TimingSink},
 };
 use ncc_syntax::{BlockParser, SyntaxNode, TextRange, TextSize, ast::AstNode};
 use rustc_hash::FxHashMap;
@@ -215,7 +216,7 @@ pub fn estimate(
     machine: &MachineConfig,
     budget: usize,
 ) -> Estimate {
-    let dynamics = Dynamics::of(machine);
+    let dynamics = dynamics::dynamics(machine);
     let axes = machine.step_axes();
     let change = previous.and_then(|previous| Change::between(previous, text, files, machine, budget));
     let resumed = change.as_ref().and_then(|change| {
@@ -884,7 +885,7 @@ mod tests {
     fn model_total(program: &str) -> f64 {
         let machine = MachineConfig::default();
         let trace = nc_exec::run::run(program, &nc_exec::run::NoFiles, &machine, 1000);
-        velocity::time(&trace, &Dynamics::of(&machine)).total_time()
+        velocity::time(&trace, &dynamics::dynamics(&machine)).total_time()
     }
 
     #[test]

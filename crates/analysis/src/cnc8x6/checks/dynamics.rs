@@ -12,7 +12,10 @@
 
 use std::f64::consts::TAU;
 
-use nc_exec::velocity::{MIN_CONTINUITY_MS, MIN_TIGHT_JOINING_MS, for_control, junction_angle, tolerance_angle};
+use nc_exec::{
+    cnc8x6::dynamics::{MIN_CONTINUITY_MS, MIN_TIGHT_JOINING_MS, for_control, tolerance_angle},
+    velocity::junction_angle,
+};
 use ncc_catalog::{AddressRole, Dialect};
 use ncc_syntax::{Decimal, TextRange, TextSize};
 
