@@ -623,3 +623,27 @@ fn the_project_decides_a_documents_dialect() {
     assert_eq!(codes, ["M401"], "{}", published.json);
     assert_serving(&mut client, &dir);
 }
+
+/// `ncc.plot` runs the called files as the editor has them, as the inline
+/// times do: an unsaved edit of a macrocycle file changes the picture.
+#[test]
+fn the_plot_command_runs_called_files_as_edited() {
+    let (mut client, dir) = session();
+    let macro_path = dir.path().join("L9001");
+    std::fs::write(&macro_path, "N1 G79 L9001\nN2 G91 G01 X10 F600\nN3 G90 G70\n*\n").unwrap();
+    let program = document(&dir, "MAIN.NCP", "%1\nN10 G00 X0 Y0\nN20 G72 L9001\nN30 M30\n*\n");
+    open(&mut client, &program);
+    let total = |client: &mut Client| {
+        let answer = plot(client, json!([program.uri]));
+        answer.result().unwrap_or_else(|| panic!("{}", answer.json))["totalTimeS"].as_f64().unwrap()
+    };
+    let on_disk = total(&mut client);
+    let mut macrocycle = Document::new(file_uri(&macro_path), std::fs::read_to_string(&macro_path).unwrap());
+    open(&mut client, &macrocycle);
+    assert_eq!(total(&mut client), on_disk);
+    // Three times the way, not saved: 20 mm more at 10 mm/s.
+    let x = macrocycle.text().find("X10").unwrap();
+    client.notify("textDocument/didChange", macrocycle.change(x + 1..x + 3, "30")).unwrap();
+    let edited = total(&mut client);
+    assert!((edited - on_disk - 2.0).abs() < 0.01, "{on_disk} s before the edit, {edited} s after");
+}

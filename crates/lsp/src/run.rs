@@ -25,7 +25,7 @@ use nc_exec::{
     run::{Axes, Called, Environment, Motion, Step, Stop, Totals, Trace, expected_blocks},
     velocity::{self, Dynamics, Timer, Timing, TimingSink},
 };
-use ncc_analysis::{Config, Dialect, DialectId, Rule, Severity, Suppressions, clock};
+use ncc_analysis::{Config, Dialect, DialectId, Rule, Severity, Suppressions, WorkspaceFiles, clock};
 use ncc_syntax::{BlockParser, Parse, TextSize, ast::AstNode, visible};
 use serde::Serialize;
 
@@ -55,6 +55,9 @@ pub(crate) struct Program<'a> {
     pub dialect: Dialect,
     /// The `ncc.toml` that applies, whose directory is the project.
     pub config: Option<&'a Path>,
+    /// The files it calls as an editor has them; `None` reads them from
+    /// disk.
+    pub files: Option<&'a WorkspaceFiles>,
 }
 
 /// A program run on the machine of its project.
@@ -102,6 +105,7 @@ fn on_program(path: &Path, dialect: Option<DialectId>, command: impl FnOnce(&Pro
         text: &text,
         dialect,
         config: config.as_deref(),
+        files: None,
     })
 }
 
@@ -914,6 +918,8 @@ impl Serialize for Values<'_> {
 /// then anywhere in its project, the directory of its `ncc.toml`.
 struct Library {
     candidates: Vec<PathBuf>,
+    /// The editor's files, which take the place of the candidates.
+    snapshot: Option<WorkspaceFiles>,
     /// The files read, with their text.
     read: RefCell<Vec<(Called, PathBuf, String)>>,
     /// A spinner on stderr once a run is long enough to wait for, when a
@@ -924,7 +930,7 @@ struct Library {
 impl Library {
     fn for_program(program: &Program<'_>, progress: Progress) -> Library {
         let candidates = match program.path {
-            Some(path) => {
+            Some(path) if program.files.is_none() => {
                 let directory = path.parent().filter(|dir| !dir.as_os_str().is_empty()).unwrap_or(Path::new("."));
                 let beside = std::fs::read_dir(directory).into_iter().flatten().flatten().map(|entry| entry.path());
                 let project = program.config.and_then(Path::parent).map(Path::to_path_buf);
@@ -934,19 +940,31 @@ impl Library {
                     .map(|(path, _)| path);
                 beside.chain(in_project).filter(|path| path.is_file()).collect()
             }
-            None => Vec::new(),
+            _ => Vec::new(),
         };
         let progress = match progress {
             Progress::OnTerminal => OnceCell::new(),
             Progress::Hidden => OnceCell::from(ProgressBar::hidden()),
         };
-        Library { candidates, read: RefCell::default(), progress }
+        Library { candidates, snapshot: program.files.cloned(), read: RefCell::default(), progress }
     }
 
-    fn read(&self, called: Called, matches: impl Fn(&Path) -> bool) -> Option<String> {
-        let path = self.candidates.iter().find(|path| matches(path))?;
-        let text = check::read_program(path).ok()?;
-        self.read.borrow_mut().push((called, path.clone(), text.clone()));
+    /// The file `called`: from the editor's snapshot when there is one
+    /// (`in_snapshot` finds it), else the first candidate that `matches`.
+    fn read(
+        &self,
+        called: Called,
+        matches: impl Fn(&Path) -> bool,
+        in_snapshot: impl FnOnce(&WorkspaceFiles) -> Option<(&str, &str)>,
+    ) -> Option<String> {
+        let (path, text) = match &self.snapshot {
+            Some(files) => in_snapshot(files).map(|(path, text)| (PathBuf::from(path), text.to_owned()))?,
+            None => {
+                let path = self.candidates.iter().find(|path| matches(path))?;
+                (path.clone(), check::read_program(path).ok()?)
+            }
+        };
+        self.read.borrow_mut().push((called, path, text.clone()));
         Some(text)
     }
 
@@ -966,13 +984,14 @@ impl Library {
 
 impl Environment for Library {
     fn macrocycle(&self, number: u32) -> Option<String> {
-        self.read(Called::Macrocycle(number), |path| check::macrocycle_number(path) == Some(number))
+        let named = |path: &Path| check::macrocycle_number(path) == Some(number);
+        self.read(Called::Macrocycle(number), named, |files| files.macrocycle_file(number))
     }
 
     fn cycle_file(&self, name: &str) -> Option<String> {
         let named =
             |path: &Path| path.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.eq_ignore_ascii_case(name));
-        self.read(Called::CycleFile, named)
+        self.read(Called::CycleFile, named, |files| files.cycle_file_named(name))
     }
 
     fn progress(&self, blocks_run: usize) {

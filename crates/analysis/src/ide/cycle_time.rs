@@ -125,23 +125,39 @@ pub struct RunInput {
     pub files: WorkspaceFiles,
 }
 
-/// The macrocycle files and possible cycle files of a workspace.
+/// The macrocycle files and possible cycle files of a workspace, as the
+/// editor has them (unsaved edits too): what the inline times and the
+/// plot of an open program run with.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct WorkspaceFiles {
-    macrocycles: FxHashMap<u32, Arc<String>>,
+    /// Path and text by number.
+    macrocycles: FxHashMap<u32, (String, Arc<String>)>,
     /// The files named as the machine's cycle file, by their name without
-    /// directory and extension.
-    by_stem: Vec<(String, Arc<String>)>,
+    /// directory and extension, with their path.
+    by_stem: Vec<(String, String, Arc<String>)>,
+}
+
+impl WorkspaceFiles {
+    /// The path and text of the macrocycle file `L<number>`.
+    pub fn macrocycle_file(&self, number: u32) -> Option<(&str, &str)> {
+        self.macrocycles.get(&number).map(|(path, text)| (path.as_str(), text.as_str()))
+    }
+
+    /// The path and text of the cycle file the machine names `name`.
+    pub fn cycle_file_named(&self, name: &str) -> Option<(&str, &str)> {
+        let stem = model::file_stem(name);
+        let found = self.by_stem.iter().find(|(s, _, _)| s.eq_ignore_ascii_case(stem));
+        found.map(|(_, path, text)| (path.as_str(), text.as_str()))
+    }
 }
 
 impl Environment for WorkspaceFiles {
     fn macrocycle(&self, number: u32) -> Option<String> {
-        self.macrocycles.get(&number).map(|text| String::clone(text))
+        self.macrocycle_file(number).map(|(_, text)| text.to_owned())
     }
 
     fn cycle_file(&self, name: &str) -> Option<String> {
-        let stem = model::file_stem(name);
-        self.by_stem.iter().find(|(s, _)| s.eq_ignore_ascii_case(stem)).map(|(_, text)| String::clone(text))
+        self.cycle_file_named(name).map(|(_, text)| text.to_owned())
     }
 }
 
@@ -155,7 +171,7 @@ pub(crate) fn run_input(db: &dyn Db, file: SourceFile) -> Option<RunInput> {
     let mut files = WorkspaceFiles::default();
     for (&number, found) in model::macrocycles(db) {
         if let Some(first) = found.first() {
-            files.macrocycles.insert(number, first.text(db).clone());
+            files.macrocycles.insert(number, (first.path(db).clone(), first.text(db).clone()));
         }
     }
     let machine = &settings.config(db).machine;
@@ -165,7 +181,7 @@ pub(crate) fn run_input(db: &dyn Db, file: SourceFile) -> Option<RunInput> {
         for &other in settings.files(db) {
             let stem = model::file_stem(other.path(db));
             if other != file && stem.eq_ignore_ascii_case(cycle_file) {
-                files.by_stem.push((stem.to_owned(), other.text(db).clone()));
+                files.by_stem.push((stem.to_owned(), other.path(db).clone(), other.text(db).clone()));
             }
         }
     }
@@ -1153,9 +1169,12 @@ mod tests {
     fn a_changed_macrocycle_file_reruns_from_the_last_checkpoint() {
         let text = long_program(2500).replace("N99999 G00 Z5 M30", "N99998 G72 L9001\nN99999 G00 Z5 M30");
         let files = |x: &str| WorkspaceFiles {
-            macrocycles: [(9001, Arc::new(format!("N1 G79 L9001\nN2 G91 G01 X{x}\nN3 G90 G70\n*\n")))]
-                .into_iter()
-                .collect(),
+            macrocycles: [(
+                9001,
+                ("L9001".to_owned(), Arc::new(format!("N1 G79 L9001\nN2 G91 G01 X{x}\nN3 G90 G70\n*\n"))),
+            )]
+            .into_iter()
+            .collect(),
             by_stem: Vec::new(),
         };
         let machine = MachineConfig::default();

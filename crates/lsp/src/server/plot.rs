@@ -9,7 +9,7 @@
 
 use std::{path::PathBuf, sync::Arc};
 
-use ncc_analysis::Dialect;
+use ncc_analysis::{Dialect, WorkspaceFiles};
 use serde::Serialize;
 use serde_json::Value;
 use tower_lsp_server::{
@@ -55,6 +55,8 @@ struct Finding {
 /// What the run needs from the server's state, taken under its lock.
 struct Job {
     text: Arc<String>,
+    /// The called files as the editor has them.
+    files: Option<WorkspaceFiles>,
     path: Option<PathBuf>,
     name: String,
     dialect: Dialect,
@@ -78,7 +80,9 @@ pub(crate) async fn execute(server: &Server, arguments: Vec<Value>) -> jsonrpc::
         let path = uri.to_file_path().map(|path| path.into_owned());
         let name = path.as_ref().map_or_else(|| uri.as_str().to_owned(), |path| path.display().to_string());
         let config = state.workspaces.config_path(document.workspace).map(PathBuf::from);
-        Job { text: document.map.text.clone(), path, name, dialect: document.dialect, config }
+        let files =
+            state.workspaces.get(document.workspace).analysis().run_input(document.file).map(|input| input.files);
+        Job { text: document.map.text.clone(), files, path, name, dialect: document.dialect, config }
     };
     // A run takes as long as the program's blocks; the blocking pool keeps
     // it off the threads that answer the other requests.
@@ -101,6 +105,7 @@ fn plot(job: Job) -> jsonrpc::Result<Value> {
         text: &text,
         dialect: job.dialect,
         config: job.config.as_deref(),
+        files: job.files.as_ref(),
     };
     let (ran, picture) =
         Ran::plotted(&program, nc_exec::run::DEFAULT_STEP_BUDGET, DEFAULT_MAX_MOVES, Progress::Hidden).map_err(
