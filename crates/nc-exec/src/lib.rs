@@ -3,6 +3,8 @@
 //! analysis calls into it (the arithmetic, the lowering), never the other
 //! way round.
 //!
+//! - [`arc`]: circular arcs from their ends and centre, for the runner and
+//!   the checker alike.
 //! - [`cnc8x6`]: what belongs to the CNC8x6 dialect, to become its own
 //!   crate: [`cnc8x6::lower`] (blocks as plain data, read from the syntax
 //!   tree; the analysis uses it too), [`cnc8x6::arith`] (the
@@ -29,6 +31,7 @@
 //!   transformations G38/G39/G31, and the frames from program to machine
 //!   coordinates they make.
 
+pub mod arc;
 pub mod cnc8x6;
 pub(crate) mod compensation;
 pub(crate) mod envelope;

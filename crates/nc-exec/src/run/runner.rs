@@ -6,6 +6,7 @@ use ncc_syntax::TextRange;
 use smallvec::SmallVec;
 
 use crate::{
+    arc::{OffCircle, circle_through},
     cnc8x6::arith::{self, BlockArithmetic, Parameters, Raw},
     cnc8x6::cycles::{self, CycleError, CycleInput, CycleKind, CycleStep, Spindle},
     cnc8x6::formats::{self, PlainLiterals},
@@ -1232,28 +1233,22 @@ impl Runner {
             self.recalculation.apply(axis, value)
         };
         let counter_clockwise = counter_clockwise != self.recalculation.flips((first, second));
-        let from = Vector2::new(start[a], start[b]);
-        let to = Vector2::new(end[a], end[b]);
-        let centre = from + Vector2::new(centre_offset(b'I', first), centre_offset(b'J', second));
-        let (radius, end_radius) = ((from - centre).norm(), (to - centre).norm());
+        let (from, to) = ([start[a], start[b]], [end[a], end[b]]);
+        let centre = [from[0] + centre_offset(b'I', first), from[1] + centre_offset(b'J', second)];
         let tolerance = self.machine.arc_tolerance();
-        if (radius - end_radius).abs() > tolerance {
-            let message = format!(
-                "the end point does not lie on the circle: {} mm from the centre, the start {} mm, more than the tolerance {tolerance} mm apart: the control stops with error 7.56",
-                round3(end_radius),
-                round3(radius)
-            );
-            self.finding(RunRule::ArcOffCircle, range, &message);
-            return Err(());
-        }
-        let angle_of = |point: Vector2<f64>| (point.y - centre.y).atan2(point.x - centre.x);
-        let start_angle = angle_of(from);
-        let mut sweep = angle_of(to) - start_angle;
-        if counter_clockwise && sweep <= 0.0 {
-            sweep += std::f64::consts::TAU;
-        } else if !counter_clockwise && sweep >= 0.0 {
-            sweep -= std::f64::consts::TAU;
-        }
+        let circle = match circle_through(from, to, centre, counter_clockwise, tolerance) {
+            Ok(circle) => circle,
+            Err(OffCircle { start_radius, end_radius }) => {
+                let message = format!(
+                    "the end point does not lie on the circle: {} mm from the centre, the start {} mm, more than the tolerance {tolerance} mm apart: the control stops with error 7.56",
+                    round3(end_radius),
+                    round3(start_radius)
+                );
+                self.finding(RunRule::ArcOffCircle, range, &message);
+                return Err(());
+            }
+        };
+        let sweep = circle.sweep;
         // A third axis written in the block moves along with the arc; the
         // helix's axis travels its lead per full turn, whichever way the
         // arc turns (02 §4).
@@ -1264,6 +1259,7 @@ impl Runner {
             self.position[slot(axis)] = round3(start[slot(axis)] + travel);
             lead += (self.position[slot(axis)] - start[slot(axis)]).powi(2);
         }
+        let (centre, radius, start_angle) = (Vector2::from(circle.centre), circle.radius, circle.start_angle);
         Ok(Some(Arc { plane: (a, b), centre, radius, start_angle, sweep, lead: lead.sqrt() }))
     }
 

@@ -10,9 +10,8 @@
 //! the known end positions; [`Arc`] gives the length and tangents of a
 //! G02/G03 block.
 
-use std::f64::consts::TAU;
-
 use nc_exec::{
+    arc::circle_through,
     cnc8x6::dynamics::{MIN_CONTINUITY_MS, MIN_TIGHT_JOINING_MS, for_control, tolerance_angle},
     velocity::junction_angle,
 };
@@ -53,9 +52,6 @@ const ROTARY_AXES: [u8; 3] = [b'A', b'B', b'C'];
 /// Arc planes by the two axes written in the block, first axis (I) first:
 /// X–Y, Y–Z and Z–X (I along Z, J along X).
 const ARC_PLANES: [[u8; 2]; 3] = [[b'X', b'Y'], [b'Y', b'Z'], [b'Z', b'X']];
-/// How far (mm) an arc's end may lie off its circle for its length to be
-/// taken; a larger error is the circle rules' business.
-const ARC_END_TOLERANCE: f64 = 0.01;
 
 /// How the control joins blocks under G23: machine constant R97 decade 1.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -131,26 +127,16 @@ pub(crate) struct Arc {
 impl Arc {
     /// The arc of a G02 (`clockwise`) or G03 block from `start` to `end`,
     /// with the centre `offset` from the start (I, J are always
-    /// incremental); `None` when the end does not lie on the circle.
-    pub fn through(start: [f64; 2], end: [f64; 2], offset: [f64; 2], clockwise: bool) -> Option<Arc> {
+    /// incremental); `None` when the end lies farther than `tolerance` (the
+    /// machine's, R55) off the circle, which the control stops on.
+    pub fn through(start: [f64; 2], end: [f64; 2], offset: [f64; 2], clockwise: bool, tolerance: f64) -> Option<Arc> {
         let centre = [start[0] + offset[0], start[1] + offset[1]];
-        let radius = offset[0].hypot(offset[1]);
-        let end_radius = (end[0] - centre[0]).hypot(end[1] - centre[1]);
-        if radius == 0.0 || (end_radius - radius).abs() > ARC_END_TOLERANCE {
-            return None;
-        }
-        let start_angle = (start[1] - centre[1]).atan2(start[0] - centre[0]);
-        let end_angle = (end[1] - centre[1]).atan2(end[0] - centre[0]);
-        let mut counter_clockwise = (end_angle - start_angle).rem_euclid(TAU);
-        if start == end {
-            counter_clockwise = TAU;
-        }
-        let sweep = match (clockwise, counter_clockwise) {
-            (false, ccw) => ccw,
-            (true, ccw) if ccw == TAU => -TAU,
-            (true, ccw) => ccw - TAU,
-        };
-        Some(Arc { radius, start_angle, sweep })
+        let circle = circle_through(start, end, centre, !clockwise, tolerance).ok()?;
+        (circle.radius > 0.0).then_some(Arc {
+            radius: circle.radius,
+            start_angle: circle.start_angle,
+            sweep: circle.sweep,
+        })
     }
 
     pub fn length(&self) -> f64 {
@@ -261,7 +247,8 @@ fn arc_path(visit: &Visit<'_>, scale: f64, clockwise: bool) -> Option<Path> {
         Some(point)
     };
     let offset = [centre_offset(visit, b'I')?, centre_offset(visit, b'J')?];
-    let arc = Arc::through(point(visit.before)?, point(visit.after)?, offset, clockwise)?;
+    let tolerance = visit.config.machine.arc_tolerance();
+    let arc = Arc::through(point(visit.before)?, point(visit.after)?, offset, clockwise, tolerance)?;
     let in_space = |tangent: [f64; 2]| -> Option<Vector> {
         let mut vector = [0.0; 3];
         for (slot, &letter) in plane.iter().enumerate() {
@@ -797,19 +784,19 @@ mod tests {
     #[test]
     fn arc_length_follows_the_direction() {
         // From (0,0) around (10,0) to (20,0): half a circle either way.
-        let ccw = Arc::through([0.0, 0.0], [20.0, 0.0], [10.0, 0.0], false).unwrap();
+        let ccw = Arc::through([0.0, 0.0], [20.0, 0.0], [10.0, 0.0], false, 0.001).unwrap();
         assert!(close(ccw.length(), 10.0 * PI));
         // A quarter one way is three quarters the other.
-        let quarter = Arc::through([10.0, 0.0], [0.0, 10.0], [-10.0, 0.0], false).unwrap();
+        let quarter = Arc::through([10.0, 0.0], [0.0, 10.0], [-10.0, 0.0], false, 0.001).unwrap();
         assert!(close(quarter.length(), 5.0 * PI));
-        let three_quarters = Arc::through([10.0, 0.0], [0.0, 10.0], [-10.0, 0.0], true).unwrap();
+        let three_quarters = Arc::through([10.0, 0.0], [0.0, 10.0], [-10.0, 0.0], true, 0.001).unwrap();
         assert!(close(three_quarters.length(), 15.0 * PI));
     }
 
     #[test]
     fn arc_to_its_start_is_a_full_circle() {
         for clockwise in [false, true] {
-            let full = Arc::through([5.0, 0.0], [5.0, 0.0], [-5.0, 0.0], clockwise).unwrap();
+            let full = Arc::through([5.0, 0.0], [5.0, 0.0], [-5.0, 0.0], clockwise, 0.001).unwrap();
             assert!(close(full.length(), 10.0 * PI));
         }
     }
@@ -817,20 +804,20 @@ mod tests {
     #[test]
     fn arc_tangents_point_along_the_motion() {
         // Counter-clockwise from below the centre: leaves along +X, ends along +Y.
-        let arc = Arc::through([0.0, 0.0], [10.0, 10.0], [0.0, 10.0], false).unwrap();
+        let arc = Arc::through([0.0, 0.0], [10.0, 10.0], [0.0, 10.0], false, 0.001).unwrap();
         let [sx, sy] = arc.start_tangent();
         let [ex, ey] = arc.end_tangent();
         assert!(close(sx, 1.0) && close(sy, 0.0));
         assert!(close(ex, 0.0) && close(ey, 1.0));
         // Clockwise from above the centre: leaves along +X, ends along -Y.
-        let arc = Arc::through([0.0, 10.0], [10.0, 0.0], [0.0, -10.0], true).unwrap();
+        let arc = Arc::through([0.0, 10.0], [10.0, 0.0], [0.0, -10.0], true, 0.001).unwrap();
         let [ex, ey] = arc.end_tangent();
         assert!(close(arc.start_tangent()[0], 1.0) && close(ex, 0.0) && close(ey, -1.0));
     }
 
     #[test]
     fn end_off_the_circle_has_no_arc() {
-        assert!(Arc::through([0.0, 0.0], [25.0, 0.0], [10.0, 0.0], false).is_none());
-        assert!(Arc::through([0.0, 0.0], [0.0, 0.0], [0.0, 0.0], false).is_none());
+        assert!(Arc::through([0.0, 0.0], [25.0, 0.0], [10.0, 0.0], false, 0.001).is_none());
+        assert!(Arc::through([0.0, 0.0], [0.0, 0.0], [0.0, 0.0], false, 0.001).is_none());
     }
 }

@@ -6,6 +6,7 @@
 //! choose only the radius-compensation plane); I is the centre offset along
 //! the plane's first axis and J along the second, both from the start point.
 
+use nc_exec::arc::{OffCircle, circle_through};
 use ncc_syntax::{TextEdit, TextRange};
 
 use crate::{
@@ -269,19 +270,20 @@ fn end_off_circle(visit: &Visit<'_>, arc: &Arc<'_>, refinement: Refinement) -> O
         (_, Some(Some(74))) => &[(0.5, 1.0), (0.5, 0.5)],
         _ => &[(1.0, 1.0), (0.5, 1.0), (0.5, 0.5)],
     };
-    let radii = |&(position, offset): &(f64, f64)| {
+    // In µm, as the positions.
+    let tolerance = visit.config.machine.arc_tolerance() * 1000.0;
+    let circle = |&(position, offset): &(f64, f64)| {
         let along = |axis: usize, value: f64, factor: f64| if Some(axis) == x { value * factor } else { value };
         let c = [along(0, centre[0], offset), along(1, centre[1], offset)];
         let s = [along(0, start[0] as f64, position), along(1, start[1] as f64, position)];
         let e = [along(0, end[0] as f64, position), along(1, end[1] as f64, position)];
-        (c[0].hypot(c[1]), (s[0] + c[0] - e[0]).hypot(s[1] + c[1] - e[1]))
+        // The direction does not matter to whether the end is on the circle.
+        circle_through(s, e, [s[0] + c[0], s[1] + c[1]], true, tolerance + ROUNDING)
     };
-    // In µm, as the positions.
-    let tolerance = visit.config.machine.arc_tolerance() * 1000.0;
-    if readings.iter().map(radii).any(|(from_start, from_end)| (from_start - from_end).abs() <= tolerance + ROUNDING) {
+    if readings.iter().map(circle).any(|circle| circle.is_ok()) {
         return None;
     }
-    let (from_start, from_end) = radii(&readings[0]);
+    let OffCircle { start_radius: from_start, end_radius: from_end } = circle(&readings[0]).err()?;
     Some(Diagnostic::new(
         &ARC_END_NOT_ON_CIRCLE,
         arc.range(visit)?,
