@@ -51,9 +51,7 @@ const DIALECT_DEBT: &[(&str, usize)] = &[
 /// modules in order.
 const CYCLE_DEBT: &[&str] = &[
     "analysis: cnc8x6 → db → diagnostic → findings",
-    "lsp: check → report → sarif",
     "nc-exec: cnc8x6 → compensation → envelope → machine → run → tool_path → transform → velocity",
-    "syntax: ast → cnc8x6",
 ];
 
 /// Lines a file may have without saying why in its header.

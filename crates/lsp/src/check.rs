@@ -5,16 +5,18 @@ use std::{
     io::{self, IsTerminal, Write},
     path::{Path, PathBuf},
     process::ExitCode,
-    sync::Arc,
 };
 
 use indicatif::{ParallelProgressIterator, ProgressBar, ProgressStyle};
-use ncc_analysis::{AnalysisHost, Config, Diagnostic, Dialect, DialectId, Dialects, Severity};
+use ncc_analysis::{AnalysisHost, Config, Dialect, DialectId, Dialects, Severity};
 pub(crate) use ncc_catalog::macrocycle_number;
 use ncc_syntax::{encoding, visible};
 use rayon::prelude::*;
 
-use crate::{report, sarif};
+use crate::{
+    report::{self, Checked, CheckedFile},
+    sarif,
+};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum Format {
@@ -70,26 +72,6 @@ fn special_kind(kind: std::fs::FileType) -> &'static str {
     }
     let _ = kind;
     "a special file"
-}
-
-pub(crate) struct CheckedFile {
-    pub path: PathBuf,
-    pub text: Arc<String>,
-    pub diagnostics: Vec<Diagnostic>,
-}
-
-/// What a report shows: the checked files, and the text of every file a
-/// diagnostic points into (macrocycle files that were not checked too).
-pub(crate) struct Checked {
-    pub files: Vec<CheckedFile>,
-    pub sources: HashMap<String, Arc<String>>,
-}
-
-impl Checked {
-    /// The text of a file named in a related location.
-    pub fn source(&self, name: &str) -> Option<&str> {
-        self.sources.get(name).map(|text| text.as_str())
-    }
 }
 
 /// A workspace: the `ncc.toml` of a project, and a dialect.

@@ -3,6 +3,8 @@
 use std::{
     collections::HashMap,
     io::{self, Write},
+    path::PathBuf,
+    sync::Arc,
 };
 
 use ariadne::{Color, IndexType, Label, Report, ReportKind};
@@ -11,7 +13,6 @@ use ncc_syntax::visible;
 use serde::Serialize;
 
 use crate::{
-    check::Checked,
     excerpt::{MarkedFile, Shown},
     positions::{Columns, TextIndex},
 };
@@ -28,6 +29,27 @@ impl Positions {
     pub fn at(&self, offset: TextSize) -> (u32, u32) {
         let (line, col) = self.0.line_col(offset, Columns::Characters);
         (line + 1, col + 1)
+    }
+}
+
+/// A checked file and its diagnostics.
+pub(crate) struct CheckedFile {
+    pub path: PathBuf,
+    pub text: Arc<String>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// What a report shows: the checked files, and the text of every file a
+/// diagnostic points into (macrocycle files that were not checked too).
+pub(crate) struct Checked {
+    pub files: Vec<CheckedFile>,
+    pub sources: HashMap<String, Arc<String>>,
+}
+
+impl Checked {
+    /// The text of a file named in a related location.
+    pub fn source(&self, name: &str) -> Option<&str> {
+        self.sources.get(name).map(|text| text.as_str())
     }
 }
 

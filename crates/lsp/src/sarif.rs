@@ -14,7 +14,7 @@ use serde_sarif::sarif::{
     ToolComponent,
 };
 
-use crate::{check::Checked, report::Positions};
+use crate::report::{Checked, Positions};
 
 /// The base that relative artifact URIs are resolved against.
 const SOURCE_ROOT: &str = "SRCROOT";

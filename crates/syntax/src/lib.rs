@@ -9,7 +9,6 @@
 //! addresses, codes and parameters lives in the dialect catalogue and in the
 //! analysis.
 
-pub mod ast;
 mod cnc8x6;
 mod decimal;
 pub mod encoding;
@@ -27,6 +26,8 @@ pub use rowan::{TextRange, TextSize};
 
 pub use ncc_catalog::Dialect;
 
+/// The typed layer over the tree (the CNC8x6 dialect's).
+pub use crate::cnc8x6::ast;
 pub use crate::{
     cnc8x6::{BlockParser, MAX_LINE_CHARS},
     decimal::{Decimal, Sign},

@@ -1,5 +1,7 @@
-//! The MEFI CNC8x6 dialect: its lexer, parser and incremental reparser.
+//! The MEFI CNC8x6 dialect: its typed syntax tree, lexer, parser and
+//! incremental reparser.
 
+pub mod ast;
 mod lexer;
 mod parser;
 mod reparse;

@@ -244,7 +244,7 @@ impl Word {
 
     /// Whether the address is the block-number letter (`N`).
     pub fn is_block_number(&self) -> bool {
-        crate::cnc8x6::is_block_letter(self.address_token().text().as_bytes()[0])
+        super::is_block_letter(self.address_token().text().as_bytes()[0])
     }
 
     /// The address, upper-cased (`&` for length compensation).
