@@ -68,12 +68,19 @@ fn read(path: &Path) -> std::io::Result<String> {
 fn command(out: &mut String, title: &str, args: &[&str]) -> std::process::Output {
     let output = Command::new(env!("CARGO_BIN_EXE_ncc")).args(args).current_dir(workspace()).output().unwrap();
     writeln!(out, "== {title} (exit {:?})", output.status.code()).unwrap();
-    out.push_str(&String::from_utf8_lossy(&output.stdout));
+    out.push_str(&relative(&String::from_utf8_lossy(&output.stdout)));
     if !output.stderr.is_empty() {
         out.push_str("-- stderr\n");
-        out.push_str(&String::from_utf8_lossy(&output.stderr));
+        out.push_str(&relative(&String::from_utf8_lossy(&output.stderr)));
     }
     output
+}
+
+/// `text` with the workspace's absolute path (files found through the
+/// project's `ncc.toml` are named by it) written as `<root>`, so that the
+/// outputs do not depend on where the checkout is.
+fn relative(text: &str) -> String {
+    text.replace(workspace().to_str().unwrap(), "<root>")
 }
 
 fn cli_outputs(out: &mut String, program: &Path, scratch: &Path) {
@@ -86,6 +93,7 @@ fn cli_outputs(out: &mut String, program: &Path, scratch: &Path) {
     let _ = std::fs::remove_file(&svg);
     command(out, "plot", &["plot", "--step-budget", &budget, "-o", svg.to_str().unwrap(), file]);
     if let Ok(picture) = std::fs::read_to_string(&svg) {
+        let picture = relative(&picture);
         out.push_str(&picture);
         if !picture.ends_with('\n') {
             out.push('\n');
