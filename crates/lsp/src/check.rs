@@ -91,7 +91,7 @@ pub(crate) fn load_config(path: &Path) -> Result<Config, String> {
 
 /// The projects met: for each directory the `ncc.toml` that applies, and
 /// each such file's configuration (or why it cannot be read), loaded once.
-#[derive(Default)]
+#[derive(Debug, Default)]
 pub(crate) struct Projects {
     /// The configuration file that applies to every file, when one is named.
     forced_config: Option<PathBuf>,
@@ -106,11 +106,12 @@ impl Projects {
         Projects { forced_config, ..Projects::default() }
     }
 
-    /// The `ncc.toml` that applies to the file at `path`.
-    pub fn config_path(&mut self, path: &Path) -> Option<PathBuf> {
-        if self.forced_config.is_some() {
+    /// The `ncc.toml` that applies to the file at `path`; to a text that is
+    /// no file (`None`), only a configuration named for every file.
+    pub fn config_path(&mut self, path: Option<&Path>) -> Option<PathBuf> {
+        let Some(path) = path.filter(|_| self.forced_config.is_none()) else {
             return self.forced_config.clone();
-        }
+        };
         let directory = path.parent().unwrap_or(Path::new("")).to_path_buf();
         self.config_of_directory.entry(directory).or_insert_with(|| Config::find_for(path)).clone()
     }
@@ -125,7 +126,7 @@ impl Projects {
     /// What the project of the file at `path` says of dialects; a project
     /// whose configuration cannot be read says nothing (reading it reports
     /// the error).
-    pub fn dialects(&mut self, path: &Path) -> Dialects {
+    pub fn dialects(&mut self, path: Option<&Path>) -> Dialects {
         let config_path = self.config_path(path);
         self.config(config_path.as_deref()).as_ref().map(|config| config.dialects.clone()).unwrap_or_default()
     }
@@ -133,8 +134,8 @@ impl Projects {
 
 /// The implementation of the dialect of a program given by name (see
 /// [`Dialects::of_given`]), or why there is none.
-pub(crate) fn dialect_for(path: &Path, forced: Option<DialectId>) -> Result<Dialect, String> {
-    let dialect = Projects::default().dialects(path).of_given(path, forced);
+pub(crate) fn dialect_for(projects: &mut Projects, path: &Path, forced: Option<DialectId>) -> Result<Dialect, String> {
+    let dialect = projects.dialects(Some(path)).of_given(path, forced);
     dialect.implementation().ok_or_else(|| format!("{}: {}", shown_path(path), dialect.not_read()))
 }
 
@@ -156,7 +157,7 @@ pub(crate) fn run(paths: &[PathBuf], format: Format, forced: Option<DialectId>) 
     for result in read {
         match result {
             Ok((path, dialect, text)) => {
-                workspaces.entry((projects.config_path(&path), dialect)).or_default().push((path, text))
+                workspaces.entry((projects.config_path(Some(&path)), dialect)).or_default().push((path, text))
             }
             Err(message) => failures.push(message),
         }
@@ -304,7 +305,7 @@ pub(crate) fn collect_files(paths: &[PathBuf], projects: &mut Projects, forced: 
             }
         };
         if !metadata.is_dir() {
-            let dialect = projects.dialects(path).of_given(path, forced);
+            let dialect = projects.dialects(Some(path)).of_given(path, forced);
             match dialect.implementation() {
                 Some(_) => found.files.push((path.clone(), dialect)),
                 None => found.failures.push(format!("{}: {}", path.display(), dialect.not_read())),
@@ -314,7 +315,7 @@ pub(crate) fn collect_files(paths: &[PathBuf], projects: &mut Projects, forced: 
         for entry in ignore::WalkBuilder::new(path).build() {
             match entry {
                 Ok(entry) if entry.file_type().is_some_and(|t| t.is_file()) => {
-                    match projects.dialects(entry.path()).of_found(entry.path(), forced) {
+                    match projects.dialects(Some(entry.path())).of_found(entry.path(), forced) {
                         Some(dialect) if dialect.implementation().is_some() => {
                             found.files.push((entry.into_path(), dialect))
                         }

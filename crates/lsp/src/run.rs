@@ -90,7 +90,8 @@ fn read(path: &Path) -> Result<String, ExitCode> {
 /// it; a program that cannot be read, or is in a dialect this version does
 /// not read, is exit status 2.
 fn on_program(path: &Path, dialect: Option<DialectId>, command: impl FnOnce(&Program<'_>) -> ExitCode) -> ExitCode {
-    let dialect = match check::dialect_for(path, dialect) {
+    let mut projects = check::Projects::default();
+    let dialect = match check::dialect_for(&mut projects, path, dialect) {
         Ok(dialect) => dialect,
         Err(error) => return config_error(error),
     };
@@ -98,7 +99,7 @@ fn on_program(path: &Path, dialect: Option<DialectId>, command: impl FnOnce(&Pro
         Ok(text) => text,
         Err(code) => return code,
     };
-    let config = Config::find_for(path);
+    let config = projects.config_path(Some(path));
     command(&Program {
         path: Some(path),
         name: path.display().to_string(),
@@ -204,7 +205,7 @@ impl Ran {
         program: &Program<'_>,
         config: &Config,
         progress: Progress,
-        execute: impl FnOnce(&str, &Library) -> Trace,
+        execute: impl FnOnce(&str, &Library<'_>) -> Trace,
     ) -> Ran {
         let text = program.text;
         let library = Library::for_program(program, progress);
@@ -433,7 +434,7 @@ impl crate::plot::Lines for Ran {
 /// The program at `path` parsed in its dialect; the error is the exit code
 /// after the message is printed.
 fn parsed(path: &Path, dialect: Option<DialectId>) -> Result<(String, Parse), ExitCode> {
-    let dialect = check::dialect_for(path, dialect).map_err(config_error)?;
+    let dialect = check::dialect_for(&mut check::Projects::default(), path, dialect).map_err(config_error)?;
     let text = read(path)?;
     let parse = Parse::new(&text, dialect);
     Ok((text, parse))
@@ -916,10 +917,10 @@ impl Serialize for Values<'_> {
 /// (`G72 L9001` calls the file `L9001`, with or without an extension) and
 /// the machine's cycle file, by name. It looks beside the program first,
 /// then anywhere in its project, the directory of its `ncc.toml`.
-struct Library {
+struct Library<'a> {
     candidates: Vec<PathBuf>,
     /// The editor's files, which take the place of the candidates.
-    snapshot: Option<WorkspaceFiles>,
+    snapshot: Option<&'a WorkspaceFiles>,
     /// The files read, with their text.
     read: RefCell<Vec<(Called, PathBuf, String)>>,
     /// A spinner on stderr once a run is long enough to wait for, when a
@@ -927,8 +928,8 @@ struct Library {
     progress: OnceCell<ProgressBar>,
 }
 
-impl Library {
-    fn for_program(program: &Program<'_>, progress: Progress) -> Library {
+impl<'a> Library<'a> {
+    fn for_program(program: &Program<'a>, progress: Progress) -> Library<'a> {
         let candidates = match program.path {
             Some(path) if program.files.is_none() => {
                 let directory = path.parent().filter(|dir| !dir.as_os_str().is_empty()).unwrap_or(Path::new("."));
@@ -946,7 +947,7 @@ impl Library {
             Progress::OnTerminal => OnceCell::new(),
             Progress::Hidden => OnceCell::from(ProgressBar::hidden()),
         };
-        Library { candidates, snapshot: program.files.cloned(), read: RefCell::default(), progress }
+        Library { candidates, snapshot: program.files, read: RefCell::default(), progress }
     }
 
     /// The file `called`: from the editor's snapshot when there is one
@@ -957,7 +958,7 @@ impl Library {
         matches: impl Fn(&Path) -> bool,
         in_snapshot: impl FnOnce(&WorkspaceFiles) -> Option<(&str, &str)>,
     ) -> Option<String> {
-        let (path, text) = match &self.snapshot {
+        let (path, text) = match self.snapshot {
             Some(files) => in_snapshot(files).map(|(path, text)| (PathBuf::from(path), text.to_owned()))?,
             None => {
                 let path = self.candidates.iter().find(|path| matches(path))?;
@@ -982,7 +983,7 @@ impl Library {
     }
 }
 
-impl Environment for Library {
+impl Environment for Library<'_> {
     fn macrocycle(&self, number: u32) -> Option<String> {
         let named = |path: &Path| check::macrocycle_number(path) == Some(number);
         self.read(Called::Macrocycle(number), named, |files| files.macrocycle_file(number))

@@ -15,12 +15,11 @@ use crate::check;
 
 #[derive(Debug, Default)]
 pub(crate) struct Workspaces {
-    /// The configuration file the client named for every document.
-    forced_config: Option<PathBuf>,
     /// The dialect of every document, when the server was started with one.
     forced_dialect: Option<DialectId>,
-    /// Each project's configuration, by its `ncc.toml`, read once.
-    configs: HashMap<Option<PathBuf>, Config>,
+    /// Each project's configuration, read once, or the one the client named
+    /// for every document.
+    projects: check::Projects,
     list: Vec<Workspace>,
 }
 
@@ -60,7 +59,7 @@ impl Workspaces {
     }
 
     pub fn configure(&mut self, config_file: Option<PathBuf>) {
-        self.forced_config = config_file;
+        self.projects = check::Projects::with_config(config_file);
     }
 
     pub fn get(&self, index: usize) -> &AnalysisHost {
@@ -78,27 +77,23 @@ impl Workspaces {
 
     /// The `ncc.toml` that applies to the program at `path` and its
     /// dialect (a document that is no file, `untitled:`, has the default
-    /// one); errors reading a configuration file are returned, and its
-    /// defaults used.
-    fn project_of(&mut self, path: Option<&Path>, errors: &mut Vec<String>) -> (Option<PathBuf>, DialectId) {
-        let config_path = self.forced_config.clone().or_else(|| path.and_then(Config::find_for));
-        let config = self.configs.entry(config_path.clone()).or_insert_with(|| match &config_path {
-            Some(path) => check::load_config(path).unwrap_or_else(|error| {
-                errors.push(error);
-                Config::default()
-            }),
-            None => Config::default(),
-        });
-        let dialect = config.dialects.of_given(path.unwrap_or(Path::new("")), self.forced_dialect);
-        (config_path, dialect)
+    /// one).
+    fn project_of(&mut self, path: Option<&Path>) -> (Option<PathBuf>, DialectId) {
+        let dialect = self.projects.dialects(path).of_given(path.unwrap_or(Path::new("")), self.forced_dialect);
+        (self.projects.config_path(path), dialect)
     }
 
-    /// The workspace of `dialect` in the project of `config_path`.
-    fn workspace_for(&mut self, config_path: Option<PathBuf>, dialect: Dialect) -> usize {
+    /// The workspace of `dialect` in the project of `config_path`; an error
+    /// reading its configuration is returned when the workspace is made,
+    /// and the defaults used.
+    fn workspace_for(&mut self, config_path: Option<PathBuf>, dialect: Dialect, errors: &mut Vec<String>) -> usize {
         if let Some(index) = self.list.iter().position(|w| w.config_path == config_path && w.dialect == dialect) {
             return index;
         }
-        let config = self.configs.get(&config_path).cloned().unwrap_or_default();
+        let config = self.projects.config(config_path.as_deref()).clone().unwrap_or_else(|error| {
+            errors.push(error);
+            Config::default()
+        });
         self.list.push(Workspace {
             config_path,
             dialect,
@@ -112,9 +107,9 @@ impl Workspaces {
     /// Adds a file read from disk unless its workspace has it, or its
     /// dialect is one this version does not read.
     fn add_from_disk(&mut self, path: &Path, errors: &mut Vec<String>) {
-        let (config_path, dialect) = self.project_of(Some(path), errors);
+        let (config_path, dialect) = self.project_of(Some(path));
         let Some(dialect) = dialect.implementation() else { return };
-        let index = self.workspace_for(config_path, dialect);
+        let index = self.workspace_for(config_path, dialect, errors);
         let workspace = &mut self.list[index];
         let name = path.display().to_string();
         if workspace.files.contains_key(&name) {
@@ -135,8 +130,8 @@ impl Workspaces {
     /// Indexes the partprograms and macrocycle files under the workspace
     /// folders, so that calls resolve across files.
     pub fn load_roots(&mut self, roots: &[PathBuf]) -> Vec<String> {
-        let mut projects = check::Projects::with_config(self.forced_config.clone());
-        let check::Found { files, mut failures, .. } = check::collect_files(roots, &mut projects, self.forced_dialect);
+        let check::Found { files, mut failures, .. } =
+            check::collect_files(roots, &mut self.projects, self.forced_dialect);
         for (path, _) in files {
             self.add_from_disk(&path, &mut failures);
         }
@@ -148,11 +143,11 @@ impl Workspaces {
     pub fn open(&mut self, uri: &Uri, text: String) -> Opened {
         let (name, path) = document_path(uri);
         let mut errors = Vec::new();
-        let (config_path, dialect) = self.project_of(path.as_deref(), &mut errors);
+        let (config_path, dialect) = self.project_of(path.as_deref());
         let Some(implementation) = dialect.implementation() else {
             return Opened::NotRead(dialect);
         };
-        let index = self.workspace_for(config_path, implementation);
+        let index = self.workspace_for(config_path, implementation, &mut errors);
         if let Some(path) = &path {
             let beside = check::macrocycles_beside(&[(path.clone(), String::new())]);
             for (macrocycle, _) in beside {
