@@ -25,7 +25,7 @@ use super::{index::*, rules::RunRule, runner::*, trace::*};
 pub const DEFAULT_STEP_BUDGET: usize = 10_000_000;
 
 /// How deep subprogram calls nest before the run stops.
-pub(super) const MAX_CALL_DEPTH: usize = 64;
+const MAX_CALL_DEPTH: usize = 64;
 
 /// What a run needs from where it runs: the files a program uses besides
 /// its own, and someone to tell how far it got.
@@ -258,7 +258,7 @@ pub fn run_beside<S: StepSink + Send>(
 pub(super) struct Batches {
     pub(super) batch: Vec<Step>,
     pub(super) sender: mpsc::SyncSender<Vec<Step>>,
-    pub(super) emptied: Receiver<Vec<Step>>,
+    emptied: Receiver<Vec<Step>>,
 }
 
 impl Batches {
@@ -294,7 +294,7 @@ impl StepSink for Batches {
 /// Steps a streaming run gathers before it hands them on.
 pub(super) const DELIVERY_BATCH: usize = 1024;
 
-pub(super) fn run_in<'a, 's>(
+fn run_in<'a, 's>(
     scope: &'s Scope<'s, 'a>,
     text: &'a str,
     files: &dyn Environment,

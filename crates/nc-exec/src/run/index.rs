@@ -44,10 +44,10 @@ pub(super) struct Blocks<'a> {
     /// Each block's text range in its file.
     pub(super) ranges: Vec<TextRange>,
     /// The first block of each file, in file order.
-    pub(super) file_starts: Vec<usize>,
+    file_starts: Vec<usize>,
     /// The syntax trees of the blocks the plain reader does not read, by
     /// block, in block order (few in CAM output).
-    pub(super) trees: Vec<(usize, GreenNode)>,
+    trees: Vec<(usize, GreenNode)>,
     pub(super) units: Units,
     /// The text of each file added so far.
     pub(super) texts: Vec<Cow<'a, str>>,
@@ -65,7 +65,7 @@ impl<'a> Blocks<'a> {
     /// Like [`Blocks::add`], and gives `each` each block as it is lowered,
     /// with whether it starts a subprogram, until it breaks; reads from
     /// byte `from` on (a block's start).
-    pub(super) fn add_reading(
+    fn add_reading(
         &mut self,
         text: Cow<'a, str>,
         from: usize,
@@ -122,7 +122,7 @@ pub fn expected_blocks(text: &str) -> usize {
 }
 
 /// Blocks the index pass hands to the run at a time.
-pub(super) const STREAM_BATCH: usize = 1024;
+const STREAM_BATCH: usize = 1024;
 
 /// The program's blocks while the index pass still reads them on a
 /// thread of its own, then all blocks of the run. Going block after block,
@@ -142,17 +142,17 @@ pub(super) struct Stream<'a, 's> {
     pub(super) resumed: bool,
     /// Set when the run needs every block: the index pass then goes on
     /// once it stops streaming; else it stops with the run.
-    pub(super) whole_index_wanted: std::sync::Arc<AtomicBool>,
+    whole_index_wanted: std::sync::Arc<AtomicBool>,
     pub(super) batches: Receiver<Vec<Streamed>>,
     /// Batches taken, back to the index pass with the run's spent block
     /// data, whose room it fills again.
-    pub(super) taken_batches: mpsc::SyncSender<Vec<Streamed>>,
+    taken_batches: mpsc::SyncSender<Vec<Streamed>>,
     pub(super) batch: Vec<Streamed>,
     /// Blocks of `batch` the run has taken.
     pub(super) taken: usize,
     /// The index of `batch[taken]`.
     pub(super) next: usize,
-    pub(super) index_pass: ScopedJoinHandle<'s, Blocks<'a>>,
+    index_pass: ScopedJoinHandle<'s, Blocks<'a>>,
 }
 
 /// A block of the program as the index pass lowered it.
@@ -304,7 +304,7 @@ pub(super) struct Units {
     /// Where each unit starts, in block order (each file's first unit is
     /// its main body or macrocycle body, then one per subprogram): the
     /// units are runs of blocks.
-    pub(super) unit_starts: Vec<usize>,
+    unit_starts: Vec<usize>,
     /// Block numbers with their block, sorted; only numbers a jump can
     /// name (`L` is at most 4 digits), in a million-block program's index.
     pub(super) numbers: Vec<(u32, u32)>,
@@ -345,7 +345,7 @@ impl Units {
     }
 
     /// The unit of block `index`.
-    pub(super) fn unit_of(&self, index: usize) -> usize {
+    fn unit_of(&self, index: usize) -> usize {
         self.unit_starts.partition_point(|&start| start <= index)
     }
 

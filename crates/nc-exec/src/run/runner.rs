@@ -36,7 +36,7 @@ pub(super) enum Flow {
 /// The control's state while a program runs.
 #[derive(Clone)]
 pub(super) struct Runner {
-    pub(super) catalogue: &'static Catalogue,
+    catalogue: &'static Catalogue,
     /// The file of the block being run.
     pub(super) source: usize,
     pub(super) machine: std::sync::Arc<MachineConfig>,
@@ -60,16 +60,16 @@ pub(super) struct Runner {
     pub(super) compensated: Vec<Compensated>,
     /// Machine constant 329 decade 3: G96/G97 swapped (1, 3), S in m/min
     /// (2, 3); read once, as every block asks.
-    pub(super) css_setting: u8,
+    css_setting: u8,
     /// Machine constant 329 decade 7: the length-compensation mode (0 = A).
-    pub(super) length_setting: u8,
+    length_setting: u8,
     /// What the address of each machine axis holds (±69999.999), in the
     /// order of the axes, as bounds of the positions (radii on a diameter
     /// axis) with half a µm to spare, outside and under diameter
     /// programming G74; worked out once, as every move asks.
-    pub(super) axis_bounds: [[(f64, f64); MAX_AXES]; 2],
+    axis_bounds: [[(f64, f64); MAX_AXES]; 2],
     /// The literals each address A–Z plainly takes, as every word asks.
-    pub(super) plain_literals: [PlainLiterals; 26],
+    plain_literals: [PlainLiterals; 26],
     /// The zero-offset and correction tables, as the program changes them.
     pub(super) offsets: OffsetTable,
     pub(super) corrections: ToolTable,
@@ -77,14 +77,14 @@ pub(super) struct Runner {
     pub(super) dynamic_set: u8,
     /// The zero offset the block writes, which holds in it alone when it
     /// is G58 or G59.
-    pub(super) block_offset: Option<u8>,
+    block_offset: Option<u8>,
     /// The helix's axis and its travel per turn in mm, from G10.
-    pub(super) helix_lead: Option<(u8, f64)>,
+    helix_lead: Option<(u8, f64)>,
     /// The correction entry D and the length-compensation digits `&`.
     pub(super) correction: u8,
-    pub(super) length_digits: u32,
+    length_digits: u32,
     /// The length correction in force, by letter.
-    pub(super) length_shift: Position,
+    length_shift: Position,
     /// Mirroring, scale and offset G35–G37, and the transformations
     /// G38/G39/G31.
     pub(super) recalculation: Recalculation,
@@ -98,7 +98,7 @@ pub(super) struct Runner {
     pub(super) speed_limit: Option<f64>,
     /// The spindle speed constant cutting speed reached last, which S
     /// takes when it ends (01 §6.9.1).
-    pub(super) speed_reached: Option<f64>,
+    speed_reached: Option<f64>,
     pub(super) position: Position,
     pub(super) params: Parameters,
     /// The steps not handed on yet: `steps[0]` is step `delivered`.
@@ -507,11 +507,7 @@ impl Runner {
     /// or a parameter whose value the address cannot take (02 §3.6: the
     /// control checks them only as the block runs). `codes` are the
     /// block's G and M codes.
-    pub(super) fn refused_value(
-        &self,
-        block: &BlockData,
-        codes: &[(u8, u32, TextRange)],
-    ) -> Option<(TextRange, String)> {
+    fn refused_value(&self, block: &BlockData, codes: &[(u8, u32, TextRange)]) -> Option<(TextRange, String)> {
         let motion = codes
             .iter()
             .rev()
@@ -555,7 +551,7 @@ impl Runner {
     }
 
     /// What follows the block once its work is done ([`block_flow`]).
-    pub(super) fn flow_of(&self, block: &BlockData, has: impl Fn(u8, u32) -> bool) -> BlockFlow {
+    fn flow_of(&self, block: &BlockData, has: impl Fn(u8, u32) -> bool) -> BlockFlow {
         block_flow(block, has, |word| self.integer(word))
     }
 
@@ -613,7 +609,7 @@ impl Runner {
     /// `with_length` (a block of linear or rapid motion) and the active
     /// transformations into the frame from program to machine coordinates.
     /// The tool stays where it is, so its program position moves.
-    pub(super) fn shift_frame(&mut self, with_length: bool) {
+    fn shift_frame(&mut self, with_length: bool) {
         if with_length {
             self.length_shift = self.length_correction();
         }
@@ -658,7 +654,7 @@ impl Runner {
     /// 329 decade 7 = 0) adds (1) or subtracts (2) entry D's length per
     /// digit of `&` for axes 1–4; otherwise D alone applies the entry's
     /// lengths to every axis (mode B; mode C's switch is read as B).
-    pub(super) fn length_correction(&self) -> Position {
+    fn length_correction(&self) -> Position {
         let mut shift = [0.0; 26];
         if self.correction == 0 {
             return shift;
@@ -730,7 +726,7 @@ impl Runner {
     /// [`Compensator`], cancels it on G40, and puts the tool-centre path's
     /// length and time on the steps it belongs to, one block late as the
     /// control's look-ahead fixes them.
-    pub(super) fn compensate(&mut self, start: Position, path: Path) -> Result<(), CompensationError> {
+    fn compensate(&mut self, start: Position, path: Path) -> Result<(), CompensationError> {
         let index = self.delivered + self.steps.len() - 1;
         let plane = match self.modes.active(self.groups.plane) {
             Some(18) => (b'Z', b'X'),
@@ -792,7 +788,7 @@ impl Runner {
 
     /// Puts the length and time of the tool-centre path's `pieces` on the
     /// steps they belong to, in place of the programmed ones.
-    pub(super) fn charge(&mut self, pieces: Vec<ToolElement>) {
+    fn charge(&mut self, pieces: Vec<ToolElement>) {
         let Some(&Compensated { plane, .. }) = self.compensated.last() else { return };
         let (a, b) = (slot(plane.0), slot(plane.1));
         for piece in pieces {
@@ -826,14 +822,7 @@ impl Runner {
     /// Adds a step of the block at `range` that ends at `end`. Its start
     /// time follows from the durations when the run ends.
     /// Records a step; `functions` are its M functions and tool change.
-    pub(super) fn record(
-        &mut self,
-        range: TextRange,
-        end: &Position,
-        moved: Moved,
-        stop: Option<Stop>,
-        functions: Functions,
-    ) {
+    fn record(&mut self, range: TextRange, end: &Position, moved: Moved, stop: Option<Stop>, functions: Functions) {
         let Functions { m_functions, tool_change, mergeable } = functions;
         let Moved { motion, length, duration, feed, path } = moved;
         let (source, end, frame) = (self.source, self.machine_axes(end), self.frames.len() - 1);
@@ -867,7 +856,7 @@ impl Runner {
     }
 
     /// Step `index` of the run, not handed on yet.
-    pub(super) fn step_mut(&mut self, index: usize) -> &mut Step {
+    fn step_mut(&mut self, index: usize) -> &mut Step {
         &mut self.steps[index - self.delivered]
     }
 
@@ -895,13 +884,13 @@ impl Runner {
     }
 
     /// A position by letter over the machine's axes, as steps keep it.
-    pub(super) fn machine_axes(&self, position: &Position) -> Axes {
+    fn machine_axes(&self, position: &Position) -> Axes {
         transform::over_axes(position, &self.machine.axes)
     }
 
     /// The row of the zero-offset table in force (G53–G59): the block's
     /// own, else the modal one.
-    pub(super) fn zero_offset_row(&self) -> u8 {
+    fn zero_offset_row(&self) -> u8 {
         self.block_offset
             .or_else(|| self.modes.active(self.groups.zero_offset).and_then(|code| u8::try_from(code).ok()))
             .unwrap_or(53)
@@ -918,7 +907,7 @@ impl Runner {
 
     /// How many units the program writes per mm the axis `letter` moves:
     /// 2 on the diameter axis under diameter programming, else 1.
-    pub(super) fn written_per_unit(&self, letter: u8) -> f64 {
+    fn written_per_unit(&self, letter: u8) -> f64 {
         if self.diameter && self.machine.diameter_axis == Some(letter) { 2.0 } else { 1.0 }
     }
 
@@ -926,7 +915,7 @@ impl Runner {
     /// and times its moves as steps of the block. Its F, S and spindle
     /// changes stay inside it (03 §1.4 I6). The error says why the
     /// control stops.
-    pub(super) fn built_in_cycle(&mut self, number: u32, range: TextRange) -> Result<(), String> {
+    fn built_in_cycle(&mut self, number: u32, range: TextRange) -> Result<(), String> {
         let spindle = match self.modes.active(self.groups.spindle) {
             Some(3) => Spindle::Clockwise,
             Some(4) => Spindle::CounterClockwise,
@@ -986,7 +975,7 @@ impl Runner {
 
     /// Seconds a rapid move takes: every real axis runs at its own rate,
     /// and the slowest to arrive sets the time.
-    pub(super) fn rapid_seconds(&self, start: &Position, end: &Position) -> f64 {
+    fn rapid_seconds(&self, start: &Position, end: &Position) -> f64 {
         let mut delta: Position = std::array::from_fn(|slot| end[slot] - start[slot]);
         self.frame().real_displacement(&mut delta);
         let minutes = (b'A'..=b'Z')
@@ -1101,7 +1090,7 @@ impl Runner {
 
     /// Feed units and constant cutting speed from group G6, with the swap
     /// of G96/G97 that machine constant 329 decade 3 selects (01 §6.9).
-    pub(super) fn feed_mode(&self) -> FeedMode {
+    fn feed_mode(&self) -> FeedMode {
         let swapped = matches!(self.css_setting, 1 | 3);
         match self.modes.active(self.groups.feed_units) {
             Some(95) => FeedMode { per_revolution: true, css: false },
@@ -1113,7 +1102,7 @@ impl Runner {
 
     /// What the feed is multiplied by: M37 reduces it 1 : 100, M36 (the
     /// reset state) runs it as programmed (01 §6.6).
-    pub(super) fn feed_factor(&self) -> f64 {
+    fn feed_factor(&self) -> f64 {
         if self.modes.active(self.groups.feed_reduction) == Some(37) { 0.01 } else { 1.0 }
     }
 
@@ -1164,7 +1153,7 @@ impl Runner {
     /// speed: the spindle turns at v / (2π r), r the distance of the
     /// controlling coordinate from the spindle axis, up to the `G76` limit
     /// (else 9999 rpm, the largest S); `None` when the cutting speed is 0.
-    pub(super) fn css_minutes(&mut self, step: &Move<'_>, arc: Option<&Arc>, length: f64, feed: f64) -> Option<f64> {
+    fn css_minutes(&mut self, step: &Move<'_>, arc: Option<&Arc>, length: f64, feed: f64) -> Option<f64> {
         // S in 0.1 m/min, or in m/min (decade 3 = 2 or 3); as mm/min.
         let per_unit = if matches!(self.css_setting, 2 | 3) { 1000.0 } else { 100.0 };
         let cutting_speed = self.speed * per_unit;
@@ -1265,7 +1254,7 @@ impl Runner {
 
     /// F as written: a literal, or a parameter's raw value read as digits
     /// without a point (`R26=0.200` is F200, 03 §1.6).
-    pub(super) fn programmed_feed(&self, word: &Word) -> Option<ProgrammedFeed> {
+    fn programmed_feed(&self, word: &Word) -> Option<ProgrammedFeed> {
         match word.value.as_ref()? {
             Value::Literal(decimal) => Some(ProgrammedFeed { value: decimal.to_f64(), point: decimal.has_point() }),
             value => self.raw(value).map(|raw| ProgrammedFeed { value: raw as f64, point: false }),
@@ -1293,7 +1282,7 @@ impl Runner {
 
     /// A dimensionless word's whole number (codes, T): the literal, or a
     /// parameter's raw digits.
-    pub(super) fn integer(&self, word: &Word) -> Option<u32> {
+    fn integer(&self, word: &Word) -> Option<u32> {
         program_flow::integer(word, &self.params)
     }
 
@@ -1302,7 +1291,7 @@ impl Runner {
         arith::reference(value, &self.params)
     }
 
-    pub(super) fn not_run(&mut self, what: &str, range: TextRange) {
+    fn not_run(&mut self, what: &str, range: TextRange) {
         let message = format!("the executor does not run {what} yet: the time leaves them out");
         self.report_once(RunRule::NotRunYet, what, range, &message);
     }

@@ -66,7 +66,7 @@ impl Registers<'_> {
 }
 
 impl ProgramMachine<'_> {
-    pub(super) fn axis_slot(&self, axis: u8) -> Option<usize> {
+    fn axis_slot(&self, axis: u8) -> Option<usize> {
         Some(slot(*self.machine.axes.get(usize::from(axis).checked_sub(1)?)?))
     }
 }
