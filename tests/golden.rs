@@ -15,7 +15,8 @@ use std::{
     process::Command,
 };
 
-use ncc_analysis::{AnalysisHost, Config, CycleTimeHints, TextSize};
+use ncc_analysis::{AnalysisHost, Config, CycleTimeHints, DialectId, TextSize};
+use ncc_catalog::macrocycle_number;
 use ncc_syntax::encoding;
 
 /// Lines of a program whose words are hovered (hover text is long).
@@ -32,7 +33,7 @@ fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().unwrap()
 }
 
-/// The corpus: partprograms (`*.NCP`, macrocycle files `L<n>`) under these
+/// The corpus: the programs of every dialect, by their names, under these
 /// directories, relative to the workspace, sorted.
 fn corpus() -> Vec<PathBuf> {
     let root = workspace();
@@ -44,7 +45,7 @@ fn corpus() -> Vec<PathBuf> {
                 let path = entry.unwrap().path();
                 if path.is_dir() {
                     stack.push(path);
-                } else if is_program(&path) {
+                } else if DialectId::by_default_for(&path).is_some() {
                     programs.push(path.strip_prefix(&root).unwrap().to_owned());
                 }
             }
@@ -52,12 +53,6 @@ fn corpus() -> Vec<PathBuf> {
     }
     programs.sort();
     programs
-}
-
-fn is_program(path: &Path) -> bool {
-    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
-    let macrocycle = stem.strip_prefix('L').is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()));
-    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ncp")) || macrocycle
 }
 
 fn read(path: &Path) -> std::io::Result<String> {
@@ -118,7 +113,9 @@ fn neighbours(path: &Path) -> Vec<PathBuf> {
     let mut found: Vec<PathBuf> = std::fs::read_dir(path.parent().unwrap())
         .unwrap()
         .map(|entry| entry.unwrap().path())
-        .filter(|other| other != path && other.is_file() && is_program(other) && other.extension().is_none())
+        .filter(|other| {
+            other != path && other.is_file() && macrocycle_number(other).is_some() && other.extension().is_none()
+        })
         .collect();
     found.sort();
     found
