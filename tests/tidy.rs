@@ -34,7 +34,7 @@ const DIALECT_DEBT: &[(&str, usize)] = &[
     ("crates/bench/src/main.rs", 7),
     ("crates/bench/src/progen.rs", 7),
     ("crates/catalog/src/explain.rs", 2),
-    ("crates/catalog/src/lib.rs", 7),
+    ("crates/catalog/src/lib.rs", 6),
     ("crates/lsp/src/explain.rs", 3),
     ("crates/lsp/src/rules.rs", 1),
     ("crates/lsp/src/run.rs", 2),
@@ -44,7 +44,6 @@ const DIALECT_DEBT: &[(&str, usize)] = &[
     ("crates/nc-exec/src/run/index.rs", 2),
     ("crates/nc-exec/src/run/runner.rs", 25),
     ("crates/nc-exec/src/run/support.rs", 12),
-    ("crates/syntax/src/lib.rs", 2),
 ];
 
 /// Cycles between a crate's modules still to be broken, each as its
@@ -101,7 +100,8 @@ fn code_of<'t>(path: &str, text: &'t str) -> &'t str {
 
 /// Places in `code` that hold a dialect's knowledge: a G or M letter as a
 /// byte or char (`b'G'`, `'M'`), a code written out (`"G79"`), a group read
-/// by index (`.g(6)`, `m[4]`), or a dialect's catalogue named outright.
+/// by index (`.g(6)`, `m[4]`), or a dialect named outright other than in
+/// a match arm that dispatches on it.
 fn dialect_knowledge(code: &str) -> usize {
     let lines = code.lines().map(str::trim_start).filter(|line| !line.starts_with("//"));
     lines.map(knowledge_in_line).sum()
@@ -109,7 +109,9 @@ fn dialect_knowledge(code: &str) -> usize {
 
 fn knowledge_in_line(line: &str) -> usize {
     let bytes = line.as_bytes();
-    let mut found = line.matches("Dialect::Cnc8x6").count();
+    // A match arm `Dialect::Cnc8x6 =>` dispatches to the dialect's module:
+    // that is where a new dialect joins, not knowledge of one.
+    let mut found = line.matches("Dialect::Cnc8x6").count() - line.matches("Dialect::Cnc8x6 =>").count();
     for (i, &byte) in bytes.iter().enumerate() {
         let before = |n: usize| i.checked_sub(n).map(|at| bytes[at]);
         let after = |n: usize| bytes.get(i + n).copied();
