@@ -51,8 +51,8 @@ use std::{
     path::{Path, PathBuf},
 };
 
-use nc_exec::cnc8x6::tables::{self, Finding, OffsetTable, ToolTable};
-pub use nc_exec::machine::{MachineConfig, TravelLimits, parse_constant};
+use nc_exec::cnc8x6::tables::{self, Finding};
+pub use nc_exec::machine::{MachineConfig, OffsetTable, ToolTable, TravelLimits, parse_constant};
 use ncc_catalog::DialectId;
 use ncc_syntax::Severity;
 use serde::Deserialize;

@@ -18,11 +18,10 @@ use std::{
 
 use indicatif::{ProgressBar, ProgressStyle};
 use nc_exec::{
-    cnc8x6::arith::{Message, MessageDisplay},
     cnc8x6::dynamics,
     cnc8x6::expand::{ExpandError, Expansion},
     cnc8x6::lower::BlockData,
-    run::{Axes, Called, Environment, Motion, Step, Stop, Totals, Trace, expected_blocks},
+    run::{Axes, Called, Environment, Message, MessageDisplay, Motion, Step, Stop, Totals, Trace, expected_blocks},
     velocity::{self, Dynamics, Timer, Timing, TimingSink},
 };
 use ncc_analysis::{Config, Dialect, DialectId, Rule, Severity, Suppressions, WorkspaceFiles, clock};

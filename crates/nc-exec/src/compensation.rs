@@ -28,7 +28,8 @@
 //!    [`Compensator::finish`]: the last element, without a move after it.
 //!
 //! Each [`ToolElement`] names the block it belongs to, so that the runner
-//! charges its time there. [`Settings::of`] reads the machine constants.
+//! charges its time there. The control's [`Settings`] come from its machine
+//! constants (CNC8x6: `cnc8x6::dynamics`).
 //!
 //! On lathes the controlled point is the theoretical tip, a fixed shift of
 //! the nose centre by the tool position P (02 §1.11): the runner adds that
@@ -37,8 +38,6 @@
 use std::{f64::consts::PI, fmt};
 
 use nalgebra::{Point2, Vector2};
-
-use crate::machine::MachineConfig;
 
 /// Lengths (mm) up to this are zero: elements without length, gaps that need
 /// no joining line.
@@ -143,22 +142,6 @@ pub struct Settings {
     /// Machine constant 168 decade 5 = 0: on compensated arcs the programmed
     /// feed holds at the contact point, not at the tool centre (02 §1.13).
     pub contact_feed: bool,
-}
-
-impl Settings {
-    /// The settings of `machine`. The manual gives no unit for the limit
-    /// angle of 339; it is read in thousandths of a degree like 234 (and 39,
-    /// whose angle it should not exceed), so `10015.000` inserts arcs beyond
-    /// 15°.
-    pub fn of(machine: &MachineConfig) -> Settings {
-        let degrees = |thousandths: i64| (thousandths as f64 / 1000.0).to_radians();
-        Settings {
-            insert_arcs: machine.decade(339, 8) == 1,
-            limit_angle: degrees(machine.constant(339).abs() % 1_000_000),
-            continuity_limit: degrees(machine.constant(234).abs()),
-            contact_feed: machine.decade(168, 5) == 0,
-        }
-    }
 }
 
 /// A piece of the tool-centre path.

@@ -20,7 +20,17 @@
 
 use std::collections::VecDeque;
 
-use crate::{run::shift_count, velocity::Profile};
+use crate::trace::shift_count;
+
+/// A move's speed through it, in mm/min: at its start, its highest, and at
+/// its end; with its duration in seconds.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Profile {
+    pub entry: f64,
+    pub peak: f64,
+    pub exit: f64,
+    pub duration: f64,
+}
 
 /// The control plans at most this many blocks ahead (04 §1.9).
 pub const MAX_DEPTH: usize = 500;

@@ -3,8 +3,15 @@
 //! analysis calls into it (the arithmetic, the lowering), never the other
 //! way round.
 //!
+//! Neutral modules know no code number; each dialect's module owns its
+//! language from lowering to steps, and the run driver picks the
+//! interpreter of the machine's control. The modules depend on each other
+//! without a cycle: a dialect uses the neutral modules, never the other
+//! way round, but for the one match in [`run`] that picks the interpreter.
+//!
 //! - [`arc`]: circular arcs from their ends and centre, for the runner and
 //!   the checker alike.
+//! - `axes`: positions by axis letter and over the machine's axes.
 //! - [`cnc8x6`]: what belongs to the CNC8x6 dialect, to become its own
 //!   crate: [`cnc8x6::lower`] (blocks as plain data, read from the syntax
 //!   tree; the analysis uses it too), [`cnc8x6::arith`] (the
@@ -14,17 +21,23 @@
 //!   and M group), [`cnc8x6::program_flow`] (which block runs after a block,
 //!   for the runner and the checker's flow walk alike), [`cnc8x6::cycles`]
 //!   (the built-in fixed cycles G81–G89), [`cnc8x6::tables`] (zero offsets
-//!   and tool corrections in the control's files) and [`cnc8x6::expand`]
-//!   (a run written back as a program of plain motion blocks).
+//!   and tool corrections in the control's files), `cnc8x6::interpreter`
+//!   (the control's state, motion and time block by block, with its block
+//!   index and program flow), [`cnc8x6::dynamics`] (the velocity and
+//!   compensation settings from the machine constants) and
+//!   [`cnc8x6::expand`] (a run written back as a program of plain motion
+//!   blocks).
 //! - [`compensation`]: the tool-centre path of radius compensation G41/G42
 //!   (equidistants, corners, start and cancel), for the runner to drive.
 //! - [`envelope`]: the CNC8x9 envelope velocity, a streaming look-ahead
 //!   planner of up to 500 blocks with linear or jerk-limited ramps.
-//! - [`machine`]: the machine a program runs on (axes, rates, limits,
-//!   constants).
-//! - [`run`]: running a program block by block into a [`run::Trace`]: the
-//!   trace's vocabulary, the run driver with its checkpoints, the block
-//!   index and the interpreter.
+//! - [`machine`]: the machine a program runs on (its control, axes, rates,
+//!   limits, constants and tables).
+//! - [`run`]: running a program on its machine into a [`run::Trace`] or a
+//!   sink, on a thread of its own or this one, from a checkpoint or the
+//!   start.
+//! - [`trace`]: what a run produces and how it hands it on: steps,
+//!   findings and their rules, the sink and the checkpoints.
 //! - [`tool_path`]: the moves and positions of the tool centre, which
 //!   radius compensation moves off the programmed contour.
 //! - [`transform`]: the coordinate recalculations G34–G37 and the
@@ -32,11 +45,13 @@
 //!   coordinates they make.
 
 pub mod arc;
+pub(crate) mod axes;
 pub mod cnc8x6;
 pub(crate) mod compensation;
 pub(crate) mod envelope;
 pub mod machine;
 pub mod run;
 pub mod tool_path;
+pub mod trace;
 pub(crate) mod transform;
 pub mod velocity;

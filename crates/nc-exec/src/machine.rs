@@ -8,11 +8,14 @@ use std::collections::BTreeMap;
 
 use ncc_catalog::Dialect;
 
-use crate::cnc8x6::tables::{self, OffsetTable, ToolTable};
+use ncc_syntax::{Decimal, Sign};
 
 /// The machine the programs run on.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct MachineConfig {
+    /// The control: the language its programs are in, and what its
+    /// machine constants mean.
+    pub control: Dialect,
     /// Letters of axes 1 to 6.
     pub axes: Vec<u8>,
     /// Highest programmable feed in mm/min.
@@ -73,6 +76,7 @@ pub struct TravelLimits {
 impl Default for MachineConfig {
     fn default() -> Self {
         MachineConfig {
+            control: Dialect::default(),
             axes: b"XYZUVC".to_vec(),
             feed_limit: 24_000,
             rapid_rate: 10_000,
@@ -96,7 +100,7 @@ impl Default for MachineConfig {
 impl MachineConfig {
     /// The axes a run's steps keep, in their order: axes 1–6.
     pub fn step_axes(&self) -> &[u8] {
-        &self.axes[..self.axes.len().min(crate::run::MAX_AXES)]
+        &self.axes[..self.axes.len().min(crate::axes::MAX_AXES)]
     }
 
     /// A machine constant's raw value: configured, else the catalogue's
@@ -109,12 +113,13 @@ impl MachineConfig {
     /// catalogue gives one; `None` for a constant without a documented
     /// default that the configuration does not set.
     pub fn known_constant(&self, number: u32) -> Option<i64> {
-        self.constants.get(&number).copied().or_else(|| Self::default_constant(number))
+        self.constants.get(&number).copied().or_else(|| self.default_constant(number))
     }
 
-    /// A machine constant's documented default, from the catalogue.
-    pub fn default_constant(number: u32) -> Option<i64> {
-        Dialect::Cnc8x6.catalogue().machine_constant(number).and_then(|c| c.default.as_deref()).and_then(parse_constant)
+    /// A machine constant's documented default, from the control's
+    /// catalogue.
+    pub fn default_constant(&self, number: u32) -> Option<i64> {
+        self.control.catalogue().machine_constant(number).and_then(|c| c.default.as_deref()).and_then(parse_constant)
     }
 
     /// Decade `decade` (1 = rightmost digit) of a machine constant.
@@ -163,7 +168,59 @@ impl MachineConfig {
 /// Reads a machine-constant value as written in TAB0.REK: with a decimal
 /// point in thousandths (`60.000`), without one as the raw decades.
 pub fn parse_constant(text: &str) -> Option<i64> {
-    let value = tables::signed_decimal(text.trim())?;
+    let value = signed_decimal(text.trim())?;
     let scale = if value.has_point() { 3 } else { 0 };
     i64::try_from(value.scaled(scale)?).ok()
+}
+
+/// The zero-offset table: per row G53-G59 the offset of each axis from the
+/// machine zero (01 §5.5). Rows the configuration does not give are zero.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Hash)]
+pub struct OffsetTable {
+    /// Offsets by G code (53-59), per axis 1-6, in thousandths.
+    pub rows: BTreeMap<u8, [i32; 6]>,
+}
+
+impl OffsetTable {
+    /// The offsets of `G<code>`, per axis.
+    pub fn offset(&self, code: u8) -> [i32; 6] {
+        self.rows.get(&code).copied().unwrap_or_default()
+    }
+}
+
+/// One entry of the correction table.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+pub struct ToolEntry {
+    /// The radius correction `R`, in µm.
+    pub radius: i32,
+    /// Length corrections of axes 1-6, in thousandths.
+    pub lengths: [i32; 6],
+    /// `P`: the position of a lathe tool's tip relative to its nose radius
+    /// centre, 1-9 (000:2243-2251); `None` when not given, which the control
+    /// takes as the centre itself (000:2586-2590).
+    pub tip: Option<u8>,
+}
+
+/// The correction table: entries D1-D99 (02 §1.2). Entries the
+/// configuration does not give are zero.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Hash)]
+pub struct ToolTable {
+    pub entries: BTreeMap<u8, ToolEntry>,
+}
+
+impl ToolTable {
+    /// Entry `D<number>`.
+    pub fn entry(&self, number: u8) -> ToolEntry {
+        self.entries.get(&number).copied().unwrap_or_default()
+    }
+}
+
+/// A number as machine files write it: an optional sign,
+/// digits and an optional decimal point.
+pub(crate) fn signed_decimal(text: &str) -> Option<Decimal> {
+    match text.as_bytes().first() {
+        Some(b'-') => Decimal::parse(Some(Sign::Minus), &text[1..]),
+        Some(b'+') => Decimal::parse(Some(Sign::Plus), &text[1..]),
+        _ => Decimal::parse(None, text),
+    }
 }

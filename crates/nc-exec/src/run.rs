@@ -1,54 +1,103 @@
-//! Running a CNC8x6 program: the modal state, motion and time, block by
-//! block, in the order the control runs them.
-//!
-//! What runs:
-//! - The program's flow: subprogram calls G71 L Q and macrocycle files
-//!   G72 L Q with their repetitions, jumps G73 L Q that run a section Q+1
-//!   times, codes from parameters (`GR20`: 73 jumps, 78 does nothing), G04
-//!   taking Q from a call in its block, M00/M01 stops, M02/M30, and a step
-//!   budget against endless loops.
-//! - Motion: G00, G01, arcs and helices G02/G03 (the centre from I/J/K, the
-//!   plane from the two axes written, 01 §6.4; the helix's lead from G10
-//!   under G09, 02 §4), threads G33, G90/G91.
-//! - Feed and spindle: the modal machine of every group ([`Modes`](crate::cnc8x6::modes::Modes)), F
-//!   with its decimal-point rules per minute or per revolution and M37's
-//!   1 : 100, S, constant cutting speed G96/G97 with the G76 limit, dwell
-//!   (G04 Q, in 10 ms, after the block's motion).
-//! - Parameters: assignments and arithmetic G26–G29 take effect after the
-//!   block's motion, which reads the values from before them.
-//! - Fixed cycles G81–G89 after the block's motion until G80: the bodies of
-//!   the machine's cycle file with the state restored afterwards, or the
-//!   built-in cycles ([`crate::cnc8x6::cycles`]).
-//!
-//! - Offsets: zero offsets G53–G59 with G92/G93, length corrections D/&,
-//!   and radius compensation G41/G42 ([`crate::compensation`]).
-//!
-//! - Coordinates: diameter programming G74/G75 on the machine's diameter
-//!   axis (positions are radii), the recalculations G34–G37 and the
-//!   transformations G38/G39/G31 ([`crate::transform`]).
-//!
-//! Where the control stops on an error, the run stops with a fatal
-//! [`Finding`]: a value its address cannot take ([`crate::cnc8x6::formats`]), a
-//! position beyond an axis's range or the machine's travel limits, an arc
-//! end point off its circle, a call, jump, cycle or arithmetic that cannot
-//! run.
-//!
-//! A block's time is its path length over its feed (G00: the slowest axis
-//! at its own rapid rate), plus dwells; ramps and block joining are the
-//! velocity model's business. Everything else the control does is reported
-//! once per kind as not run yet (copying G05–G07, axis slaving G08, the
-//! reference point G30), so that a total never silently leaves something
-//! out.
+//! Running a program: the driver that runs it on its machine by the
+//! interpreter of the machine's control (CNC8x6:
+//! [`crate::cnc8x6::interpreter`]), to a trace or into a sink, on a thread
+//! of its own or this one, with checkpoints to resume from; and the trace's
+//! vocabulary ([`crate::trace`]), which the interpreters write.
 
-mod driver;
-mod index;
-mod rules;
-mod runner;
-mod support;
-mod trace;
+use std::{sync::mpsc, thread::Scope};
 
-pub(crate) use self::support::{round3, slot};
-pub use self::{driver::*, index::expected_blocks, rules::RunRule, trace::*};
+use ncc_catalog::Dialect;
 
-#[cfg(test)]
-mod tests;
+use crate::{cnc8x6, machine::MachineConfig, transform::Frame};
+
+pub use crate::trace::*;
+
+/// Runs the program `text` from its first block to its end on `machine`,
+/// in the language of the machine's control, following calls of
+/// subprograms and other files, cycles and jumps, for at most `budget`
+/// blocks. Files are read from `files` when first needed, and the run
+/// reports its progress there.
+pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget: usize) -> Trace {
+    std::thread::scope(|scope| run_in(scope, text, files, machine, budget, None, None))
+}
+
+/// The frame of the priority block on `machine`, in which a run starts:
+/// the zero offset G53 of its tables ([`Trace::reset_frame`]).
+pub fn reset_frame(machine: &MachineConfig) -> Frame {
+    match machine.control {
+        Dialect::Cnc8x6 => cnc8x6::interpreter::reset_frame(machine),
+    }
+}
+
+/// Like [`run`], handing the steps to `sink` as they are final instead of
+/// keeping them: the trace's `steps` stay empty, and a run of any length
+/// holds only the few steps radius compensation may still fix.
+pub fn run_into(
+    text: &str,
+    files: &dyn Environment,
+    machine: &MachineConfig,
+    budget: usize,
+    sink: &mut dyn StepSink,
+) -> Trace {
+    std::thread::scope(|scope| run_in(scope, text, files, machine, budget, Some(sink), None))
+}
+
+/// Like [`run_into`], from `checkpoint` (a checkpoint of a run on the
+/// same machine over a text that differs from `text` only after it), or
+/// from the start without one.
+pub fn resume_into(
+    checkpoint: Option<&Checkpoint>,
+    text: &str,
+    files: &dyn Environment,
+    machine: &MachineConfig,
+    budget: usize,
+    sink: &mut dyn StepSink,
+) -> Trace {
+    std::thread::scope(|scope| run_in(scope, text, files, machine, budget, Some(sink), checkpoint))
+}
+
+/// Like [`run_into`], with `sink` on a thread of its own, so that what it
+/// does with the steps (the velocity model) runs beside the executor;
+/// returns the trace and the sink.
+pub fn run_beside<S: StepSink + Send>(
+    text: &str,
+    files: &dyn Environment,
+    machine: &MachineConfig,
+    budget: usize,
+    mut sink: S,
+) -> (Trace, S) {
+    std::thread::scope(|scope| {
+        let (sender, batches) = mpsc::sync_channel::<Vec<Step>>(8);
+        let (recycle, emptied) = mpsc::sync_channel::<Vec<Step>>(8);
+        let beside = scope.spawn(move || {
+            for mut batch in batches {
+                sink.steps(&mut batch);
+                let _ = recycle.try_send(batch);
+            }
+            sink
+        });
+        let mut handing = Batches { batch: Vec::with_capacity(DELIVERY_BATCH), sender, emptied };
+        let trace = run_in(scope, text, files, machine, budget, Some(&mut handing), None);
+        let Batches { batch, sender, .. } = handing;
+        // The sink's thread ends when the last batch is in and the channel
+        // closes.
+        let _ = sender.send(batch);
+        drop(sender);
+        (trace, beside.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
+    })
+}
+
+/// Runs `text` in the language of the machine's control.
+fn run_in<'a, 's>(
+    scope: &'s Scope<'s, 'a>,
+    text: &'a str,
+    files: &dyn Environment,
+    machine: &MachineConfig,
+    budget: usize,
+    sink: Option<&mut dyn StepSink>,
+    checkpoint: Option<&Checkpoint>,
+) -> Trace {
+    match machine.control {
+        Dialect::Cnc8x6 => cnc8x6::interpreter::run_in(scope, text, files, machine, budget, sink, checkpoint),
+    }
+}

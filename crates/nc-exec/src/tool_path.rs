@@ -11,7 +11,7 @@ use smallvec::{SmallVec, smallvec};
 
 use crate::{
     compensation::{Element, ToolElement},
-    run::{Axes, MAX_AXES, Path, Step, Trace},
+    trace::{Axes, MAX_AXES, Path, Step, Trace},
 };
 
 /// A step's part in radius compensation.

@@ -15,7 +15,7 @@
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
-use crate::run::{Axes, MAX_AXES, Position, slot};
+use crate::axes::{Axes, MAX_AXES, Position, slot};
 
 /// Mirroring, scale and independent offset in force (G35, G36, G37).
 #[derive(Debug, Clone, Copy, PartialEq)]

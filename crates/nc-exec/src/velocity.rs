@@ -27,9 +27,10 @@ use std::{collections::VecDeque, ops::ControlFlow};
 
 use ncc_syntax::TextSize;
 
+pub use crate::envelope::Profile;
 use crate::{
     envelope::{Envelope, EnvelopeMove, Limit, MoveKind, Planned, Planner},
-    run::{Axes, Checkpoint, Joining, MAX_AXES, Motion, Path, Step, StepSink, Trace, shift_count, shift_range},
+    trace::{Axes, Checkpoint, Joining, MAX_AXES, Motion, Path, Step, StepSink, Trace, shift_count, shift_range},
 };
 
 /// The interpolator tick of the CNC8x6 (000:2749).
@@ -69,16 +70,6 @@ pub struct Dynamics {
     /// The CNC8x9 envelope velocity, when machine constant R338 switches it
     /// on: it plans the moves instead of the one-block look-ahead.
     pub envelope: Option<Envelope>,
-}
-
-/// A move's speed through it, in mm/min: at its start, its highest, and at
-/// its end; with its duration in seconds.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Profile {
-    pub entry: f64,
-    pub peak: f64,
-    pub exit: f64,
-    pub duration: f64,
 }
 
 /// Why the path speed drops below the programmed feed.

@@ -68,6 +68,7 @@ use ncc_syntax::TextRange;
 use crate::{
     cnc8x6::lower::{BlockData, Value},
     machine::MachineConfig,
+    trace::{Message, MessageDisplay},
 };
 
 /// A parameter value as the control stores it: a signed integer in thousandths.
@@ -232,32 +233,6 @@ impl Machine for UnknownMachine {
     }
     fn write_table(&mut self, _table: u8, _row: u16, _column: u16, _value: Raw) {}
     fn message(&mut self, _message: Message) {}
-}
-
-/// A technologist's message (op 51, `51MMPPTD`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct Message {
-    /// Which message text, 1–99 (decades 6–5). Where the texts are defined is
-    /// not described in the manual.
-    pub code: u8,
-    /// The parameter shown where the text has a lone `$` (decades 4–3).
-    pub parameter: u8,
-    /// Its value when the word ran; the display does not update it.
-    pub value: Option<Raw>,
-    pub display: MessageDisplay,
-}
-
-/// How long a message stays on screen (decade 1, with the time in decade 2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum MessageDisplay {
-    /// 0: remove the message.
-    Cancel,
-    /// 1: until cancelled.
-    Permanent,
-    /// 2: for the duration of one block.
-    OneBlock,
-    /// 3: for 1–9 seconds.
-    Seconds(u8),
 }
 
 /// Settings that change how words are read.

@@ -56,7 +56,7 @@ use std::fmt;
 
 use crate::{
     cnc8x6::arith::{MAX_RAW, Parameters, Raw},
-    run::Position,
+    trace::Position,
 };
 
 const X: usize = (b'X' - b'A') as usize;

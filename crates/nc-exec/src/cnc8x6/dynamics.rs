@@ -1,10 +1,12 @@
 //! The CNC8x6 and CNC8x9 velocity policy: the parameters of the velocity
 //! model and the envelope planner, read from the machine constants (R39,
 //! R52, R97, R236, R237, R338, R382–R432) with what the manual assumes
-//! where the configuration gives none. The planners themselves
-//! (`velocity`, `envelope`) read no machine constant.
+//! where the configuration gives none; and the settings of radius
+//! compensation (R168, R234, R339). The planners themselves (`velocity`,
+//! `envelope`) and the compensator read no machine constant.
 
 use crate::{
+    compensation::Settings,
     envelope::{DynamicSet, Envelope, MAX_DEPTH, P_PER_JERK, ProfileKind, Ramp},
     machine::MachineConfig,
     velocity::Dynamics,
@@ -176,4 +178,20 @@ pub fn envelope(machine: &MachineConfig) -> Option<Envelope> {
         rapid,
         basic: Ramp { acceleration: dynamics.feed_acceleration, jerk: set.ramp.jerk },
     })
+}
+
+impl Settings {
+    /// The settings of `machine`. The manual gives no unit for the limit
+    /// angle of 339; it is read in thousandths of a degree like 234 (and 39,
+    /// whose angle it should not exceed), so `10015.000` inserts arcs beyond
+    /// 15°.
+    pub fn of(machine: &MachineConfig) -> Settings {
+        let degrees = |thousandths: i64| (thousandths as f64 / 1000.0).to_radians();
+        Settings {
+            insert_arcs: machine.decade(339, 8) == 1,
+            limit_angle: degrees(machine.constant(339).abs() % 1_000_000),
+            continuity_limit: degrees(machine.constant(234).abs()),
+            contact_feed: machine.decade(168, 5) == 0,
+        }
+    }
 }

@@ -25,10 +25,11 @@ use ncc_syntax::TextRange;
 use smallvec::SmallVec;
 
 use crate::{
+    cnc8x6::interpreter::reset_frame,
     compensation::ToolElement,
     machine::MachineConfig,
-    run::{Compensated, Motion, Path, Position, Step, StepSink, Stop, reset_frame, round3, slot},
     tool_path::{Centred, tool_moves},
+    trace::{Compensated, Motion, Path, Position, Step, StepSink, Stop, round3, slot},
     transform::{Frame, by_letter, over_axes},
 };
 
@@ -64,7 +65,7 @@ impl From<io::Error> for ExpandError {
 }
 
 /// Writes the moves of a run as program `%number` to `out` while the run
-/// goes: a [`StepSink`] for [`crate::run::run_into`] (a sink on a thread of
+/// goes: a [`StepSink`] for `run::run_into` (a sink on a thread of
 /// its own is not told the frames and the tool-centre path) that writes
 /// the blocks of each step as it comes and keeps nothing of it, so that a
 /// run of any length expands in the same memory.
@@ -418,7 +419,7 @@ N102 G90 G70
     /// expansion runs in G53 the machine positions the original ran.
     #[test]
     fn offsets_and_transformations_are_written_as_machine_positions() {
-        use crate::cnc8x6::tables::{OffsetTable, ToolTable};
+        use crate::machine::{OffsetTable, ToolTable};
         let mut machine = MachineConfig::default();
         (machine.offsets, _) = OffsetTable::parse("$POS\nG53: X=1.0\nG54: X=100.0 Y=-50.0\n", &machine.axes);
         (machine.tools, _) = ToolTable::parse("$KOR\n01: R=0 X=0 Y=0 Z=25.0\n", &machine.axes);

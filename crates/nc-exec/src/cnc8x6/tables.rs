@@ -41,7 +41,7 @@
 
 use std::{collections::BTreeMap, fmt};
 
-use ncc_syntax::{Decimal, Sign};
+use crate::machine::{OffsetTable, ToolTable, signed_decimal};
 
 /// A problem in a table file, at a line and a column (both from 1).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -64,20 +64,7 @@ const COORDINATE_LIMIT: i32 = 69_999_999;
 /// The largest length correction, ±999.999 mm (000:3122-3123).
 const LENGTH_LIMIT: i32 = 999_999;
 
-/// The zero-offset table: per row G53-G59 the offset of each axis from the
-/// machine zero (01 §5.5). Rows the configuration does not give are zero.
-#[derive(Debug, Clone, Default, PartialEq, Eq, Hash)]
-pub struct OffsetTable {
-    /// Offsets by G code (53-59), per axis 1-6, in thousandths.
-    pub rows: BTreeMap<u8, [i32; 6]>,
-}
-
 impl OffsetTable {
-    /// The offsets of `G<code>`, per axis.
-    pub fn offset(&self, code: u8) -> [i32; 6] {
-        self.rows.get(&code).copied().unwrap_or_default()
-    }
-
     /// Reads a TAB0.POS file for a machine with the axes `axes`.
     pub fn parse(text: &str, axes: &[u8]) -> (OffsetTable, Vec<Finding>) {
         let mut table = OffsetTable::default();
@@ -115,32 +102,7 @@ impl OffsetTable {
     }
 }
 
-/// One entry of the correction table.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
-pub struct ToolEntry {
-    /// The radius correction `R`, in µm.
-    pub radius: i32,
-    /// Length corrections of axes 1-6, in thousandths.
-    pub lengths: [i32; 6],
-    /// `P`: the position of a lathe tool's tip relative to its nose radius
-    /// centre, 1-9 (000:2243-2251); `None` when not given, which the control
-    /// takes as the centre itself (000:2586-2590).
-    pub tip: Option<u8>,
-}
-
-/// The correction table: entries D1-D99 (02 §1.2). Entries the
-/// configuration does not give are zero.
-#[derive(Debug, Clone, Default, PartialEq, Eq, Hash)]
-pub struct ToolTable {
-    pub entries: BTreeMap<u8, ToolEntry>,
-}
-
 impl ToolTable {
-    /// Entry `D<number>`.
-    pub fn entry(&self, number: u8) -> ToolEntry {
-        self.entries.get(&number).copied().unwrap_or_default()
-    }
-
     /// Reads a TAB0.KOR file for a machine with the axes `axes` (they
     /// decide where an axis name may be written).
     pub fn parse(text: &str, axes: &[u8]) -> (ToolTable, Vec<Finding>) {
@@ -354,16 +316,6 @@ pub fn axis_list(axes: &[u8]) -> String {
     format!("axes {}", letters.join(" "))
 }
 
-/// A number as the control's table files write it: an optional sign,
-/// digits and an optional decimal point.
-pub(crate) fn signed_decimal(text: &str) -> Option<Decimal> {
-    match text.as_bytes().first() {
-        Some(b'-') => Decimal::parse(Some(Sign::Minus), &text[1..]),
-        Some(b'+') => Decimal::parse(Some(Sign::Plus), &text[1..]),
-        _ => Decimal::parse(None, text),
-    }
-}
-
 /// A coordinate in mm (or degrees) as integer thousandths, written as in the
 /// table files.
 pub fn coordinate(text: &str) -> Result<i32, String> {
@@ -396,6 +348,7 @@ mod tests {
     use expect_test::{Expect, expect};
 
     use super::*;
+    use crate::machine::ToolEntry;
 
     const MILL: &[u8] = b"XYZ";
     const LATHE: &[u8] = b"XZ";

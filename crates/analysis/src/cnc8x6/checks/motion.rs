@@ -8,7 +8,7 @@ use ncc_catalog::{AddressRole, Dialect};
 use ncc_syntax::{Severity, TextEdit, TextRange};
 
 use crate::{
-    Config, Diagnostic, MachineConfig,
+    Config, Diagnostic,
     cnc8x6::checks::block::{assigns_corrections, parameter_raw},
     cnc8x6::flow::{FlowCheck, Known, ModalState, Visit},
     diagnostic::declare_rules,
@@ -85,7 +85,7 @@ pub(crate) fn interpolation_planes(config: &Config) -> impl Iterator<Item = [u8;
 /// Z). A constant of zeros reads as its default (`00233.112`, `00412.434`).
 fn machine_plane(constant: u32, pair: u32, config: &Config) -> Option<[u8; 2]> {
     let planes = match config.machine.constant(constant) {
-        0 => MachineConfig::default_constant(constant)?,
+        0 => config.machine.default_constant(constant)?,
         planes => planes,
     };
     let ordinals = planes.unsigned_abs() / 100u64.pow(pair) % 100;

@@ -13,13 +13,14 @@ use crate::{
     cnc8x6::lower::{BlockData, Value, Word},
     cnc8x6::modes::Modes,
     cnc8x6::program_flow::{self, BlockFlow, block_flow},
-    cnc8x6::tables::{OffsetTable, ToolTable},
     compensation::{CompensationError, Compensator, Element, Settings, Side, ToolElement},
     machine::MachineConfig,
+    machine::{OffsetTable, ToolTable},
     transform::{self, Frame, Kind, Recalculation, Refused, Transformation, Transformations},
 };
 
-use super::{driver::*, rules::RunRule, support::*, trace::*};
+use super::support::*;
+use crate::trace::*;
 
 /// What runs after a block: its own flow, or first a fixed cycle's body.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

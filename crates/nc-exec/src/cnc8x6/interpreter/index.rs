@@ -20,6 +20,7 @@ use crate::{
 };
 
 use super::support::*;
+use crate::trace::expected_blocks;
 
 /// A subprogram or macrocycle call being run.
 pub(super) struct Call {
@@ -113,12 +114,6 @@ impl<'a> Blocks<'a> {
             }
         }
     }
-}
-
-/// About as many blocks as a program of CAM output with this text has, or
-/// more: memory reserved and never used costs nothing, growing costs copies.
-pub fn expected_blocks(text: &str) -> usize {
-    text.len() / 24
 }
 
 /// Blocks the index pass hands to the run at a time.

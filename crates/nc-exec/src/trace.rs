@@ -1,20 +1,22 @@
-//! What a run produces: the steps, the findings and the trace that holds them.
+//! What a run produces: the steps, the findings and the trace that holds
+//! them, and how a run hands them on ([`sink`]). Every control's
+//! interpreter writes this vocabulary.
+
+mod rules;
+mod sink;
+
+pub use self::{rules::RunRule, sink::*};
+pub use crate::axes::{Axes, MAX_AXES, Position};
+pub(crate) use crate::axes::{round3, slot};
 
 use std::ops::Range;
 
 use ncc_syntax::TextRange;
 
-use super::rules::RunRule;
-
 use crate::{
-    cnc8x6::arith::Message,
     compensation::ToolElement,
     transform::{self, Frame},
 };
-
-/// Axes by letter (index = letter − `A`); positions in mm (degrees for
-/// rotary axes).
-pub type Position = [f64; 26];
 
 /// What a block did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -123,14 +125,6 @@ pub struct Step {
     pub mergeable: bool,
 }
 
-/// What else a block does besides its motion, as its step records it.
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct Functions {
-    pub(super) m_functions: u8,
-    pub(super) tool_change: bool,
-    pub(super) mergeable: bool,
-}
-
 /// Block joining, group 2 (04 §1.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Joining {
@@ -152,6 +146,34 @@ pub struct OperatorMessage {
     pub message: Message,
 }
 
+/// A message the program shows the operator: a numbered text with one
+/// parameter's value in it (CNC8x6: operation 51, `51MMPPTD`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Message {
+    /// Which message text (CNC8x6: 1–99, decades 6–5; where the texts are
+    /// defined is not described in the manual).
+    pub code: u8,
+    /// The parameter shown where the text has a lone `$`.
+    pub parameter: u8,
+    /// Its raw value when the message was shown; the display does not
+    /// update it.
+    pub value: Option<i64>,
+    pub display: MessageDisplay,
+}
+
+/// How long a message stays on screen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MessageDisplay {
+    /// Removes the message.
+    Cancel,
+    /// Until cancelled.
+    Permanent,
+    /// For the duration of one block.
+    OneBlock,
+    /// For some seconds.
+    Seconds(u8),
+}
+
 /// Steps that ran under radius compensation: their ends are the
 /// programmed contour, the tool ran on [`Trace::tool_centre`].
 #[derive(Debug, Clone, PartialEq)]
@@ -160,13 +182,6 @@ pub struct Compensated {
     /// The plane's axes, the order of the tool-centre path's coordinates.
     pub plane: (u8, u8),
 }
-
-/// Positions over the machine's axes 1–6, in their order: what a step
-/// keeps, so that a run of a million blocks stays small.
-pub type Axes = [f64; MAX_AXES];
-
-/// The most axes a machine has (axes 1–6).
-pub const MAX_AXES: usize = 6;
 
 /// The shape of a move from its start to its end.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -5,15 +5,15 @@ use nalgebra::Vector2;
 use ncc_syntax::TextRange;
 
 use crate::{
-    cnc8x6::arith::{Machine, Message, Parameters, Raw},
+    cnc8x6::arith::{Machine, Parameters, Raw},
     cnc8x6::lower::{BlockData, Word},
     cnc8x6::modes::{Group, Modes},
-    cnc8x6::tables::{OffsetTable, ToolEntry, ToolTable},
     machine::MachineConfig,
+    machine::{OffsetTable, ToolEntry, ToolTable},
     transform::{self, Frame},
 };
 
-use super::trace::*;
+use crate::trace::*;
 
 /// What parameter arithmetic reads of the machine while a program runs:
 /// the programmed positions (the measured ones are the machine
@@ -133,9 +133,12 @@ pub(super) fn datum(entry: &mut ToolEntry, column: usize) -> Option<&mut i32> {
     }
 }
 
-/// The index of an axis letter in a [`Position`].
-pub(crate) fn slot(axis: u8) -> usize {
-    usize::from(axis - b'A')
+/// What else a block does besides its motion, as its step records it.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Functions {
+    pub(super) m_functions: u8,
+    pub(super) tool_change: bool,
+    pub(super) mergeable: bool,
 }
 
 /// The groups the run reads, resolved once.
@@ -297,11 +300,6 @@ pub(super) fn plane(one: u8, other: u8) -> (u8, u8) {
     }
 }
 
-/// A length on the control's µm grid.
 /// Positions lie on the µm grid; half of one keeps float noise off the
 /// bounds of the axes' ranges.
 pub(super) const HALF_MICROMETRE: f64 = 0.0005;
-
-pub(crate) fn round3(value: f64) -> f64 {
-    (value * 1000.0).round() / 1000.0
-}

@@ -4,12 +4,12 @@ use std::ops::ControlFlow;
 
 use ncc_syntax::TextSize;
 
-use super::{
+use crate::run::{
     Axes, Called, Checkpoint, DELIVERY_BATCH, Environment, Motion, NoFiles, Path, Step, StepSink, Stop, Trace,
     resume_into, round3, run, run_into,
 };
 use crate::{
-    cnc8x6::tables::OffsetTable,
+    machine::OffsetTable,
     machine::{MachineConfig, TravelLimits},
 };
 
@@ -497,7 +497,7 @@ fn the_spatial_transformation_and_what_the_control_refuses() {
 
 #[test]
 fn operation_51_messages_are_kept_with_their_block() {
-    use crate::cnc8x6::arith::{Message, MessageDisplay};
+    use crate::run::{Message, MessageDisplay};
     let trace = run_text("%1\nN1 G00 X10\nN2 R30=12.5 R5=51073053 G26\nN3 R5=51073050 G26\nN4 M30\n");
     assert!(trace.findings.is_empty(), "{:?}", trace.findings);
     let shown: Vec<(usize, Message)> = trace.messages.iter().map(|m| (m.step, m.message)).collect();

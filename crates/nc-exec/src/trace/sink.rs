@@ -1,0 +1,237 @@
+//! How a run hands on what it makes: the sink that takes the steps, the
+//! checkpoints a run can resume from, and the files it reads.
+
+use std::{
+    ops::ControlFlow,
+    sync::mpsc::{self, Receiver},
+};
+
+use ncc_syntax::{TextRange, TextSize};
+
+use crate::{compensation::ToolElement, machine::MachineConfig, transform::Frame};
+
+use super::*;
+
+/// How many blocks a run executes at most before it stops: a jump loop
+/// that never ends or runaway recursion stops here with a finding.
+pub const DEFAULT_STEP_BUDGET: usize = 10_000_000;
+
+/// How deep subprogram calls nest before the run stops.
+pub(crate) const MAX_CALL_DEPTH: usize = 64;
+
+/// What a run needs from where it runs: the files a program uses besides
+/// its own, and someone to tell how far it got.
+pub trait Environment {
+    /// The text of the macrocycle file `L<number>`.
+    fn macrocycle(&self, number: u32) -> Option<String>;
+    /// The text of the fixed-cycle file the machine names (`PCYKLYDG.NCP`).
+    fn cycle_file(&self, name: &str) -> Option<String>;
+    /// Called every [`PROGRESS_INTERVAL`] blocks with the number run so far.
+    fn progress(&self, _blocks_run: usize) {}
+}
+
+/// About as many blocks as a program of CAM output with this text has, or
+/// more: memory reserved and never used costs nothing, growing costs copies.
+pub fn expected_blocks(text: &str) -> usize {
+    text.len() / 24
+}
+
+/// How often a run reports its progress, in blocks.
+pub const PROGRESS_INTERVAL: usize = 1 << 16;
+
+/// The program alone: no other files.
+#[derive(Debug, Clone, Copy)]
+pub struct NoFiles;
+
+impl Environment for NoFiles {
+    fn macrocycle(&self, _number: u32) -> Option<String> {
+        None
+    }
+
+    fn cycle_file(&self, _name: &str) -> Option<String> {
+        None
+    }
+}
+
+/// Takes the steps of a run in order, each once no later block can change
+/// it.
+pub trait StepSink {
+    fn step(&mut self, step: Step);
+
+    /// Takes every step of `steps` in order, leaving it empty.
+    fn steps(&mut self, steps: &mut Vec<Step>) {
+        steps.drain(..).for_each(|step| self.step(step));
+    }
+
+    /// Takes, before the steps about to come, what they refer to: the
+    /// run's frames and spans of radius compensation so far (a step's
+    /// [`Step::frame`] indexes `frames`; the last span may grow), and the
+    /// pieces of the tool-centre path that belong to those steps, in path
+    /// order. The trace keeps them all too. A sink on a thread of its own
+    /// ([`run_beside`]) does not take them.
+    fn references(&mut self, _frames: &[Frame], _compensated: &[Compensated], _tool_centre: &[ToolElement]) {}
+
+    /// Whether to take a [`Checkpoint`] before block `block`, which starts
+    /// at `offset`; asked only where the run can take one.
+    fn checkpoint_wanted(&mut self, _block: usize, _offset: TextSize) -> bool {
+        false
+    }
+
+    /// Takes the checkpoint asked for, once it has every step before it;
+    /// `Break` ends the run there.
+    fn checkpoint(&mut self, _checkpoint: Checkpoint) -> ControlFlow<()> {
+        ControlFlow::Continue(())
+    }
+
+    /// Whether the sink takes no more steps (where it writes has closed):
+    /// the run then ends after the batch it has just taken.
+    fn closed(&self) -> bool {
+        false
+    }
+}
+
+/// The run between two blocks of the program's main body while it goes
+/// block after block (no call, jump, file or radius compensation in
+/// force): enough to run on from there, over the same text or one that
+/// differs only before that block. A run resumed from it reports what
+/// happens after it: its trace's findings, messages and tool-centre path
+/// start there.
+#[derive(Clone)]
+pub struct Checkpoint {
+    /// The interpreter's state, of the machine's control.
+    pub(crate) state: Box<dyn Resumable>,
+    /// The next block, and where it starts.
+    pub(crate) block: usize,
+    pub(crate) offset: TextSize,
+    /// Blocks run before it, for the step budget.
+    pub(crate) executed: usize,
+}
+
+/// What a control's interpreter keeps in a [`Checkpoint`] to run on from.
+pub(crate) trait Resumable: std::any::Any + Send + Sync {
+    fn boxed_clone(&self) -> Box<dyn Resumable>;
+    fn machine(&self) -> &MachineConfig;
+    /// Steps made before it.
+    fn steps(&self) -> usize;
+    fn set_steps(&mut self, steps: usize);
+    /// See [`Checkpoint::same_course`]; false for another control's state.
+    fn same_course(&self, other: &dyn Resumable) -> bool;
+}
+
+impl Clone for Box<dyn Resumable> {
+    fn clone(&self) -> Self {
+        self.boxed_clone()
+    }
+}
+
+impl std::fmt::Debug for Checkpoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Checkpoint")
+            .field("block", &self.block)
+            .field("offset", &self.offset)
+            .field("executed", &self.executed)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Checkpoint {
+    /// Where the next block starts.
+    pub fn offset(&self) -> TextSize {
+        self.offset
+    }
+
+    /// The index of the next block in the program.
+    pub fn block(&self) -> usize {
+        self.block
+    }
+
+    /// The machine the run ran on.
+    pub fn machine(&self) -> &MachineConfig {
+        self.state.machine()
+    }
+
+    /// Blocks the run executed before it.
+    pub fn blocks_run(&self) -> usize {
+        self.executed
+    }
+
+    /// Steps the run made before it.
+    pub fn steps(&self) -> usize {
+        self.state.steps()
+    }
+
+    /// Whether a run from here goes on as one from `other` does over the
+    /// same text after their offsets: the same modes, position,
+    /// parameters, tables and frames; the blocks and steps before them and
+    /// what was reported may differ.
+    pub fn same_course(&self, other: &Checkpoint) -> bool {
+        self.state.same_course(&*other.state)
+    }
+
+    /// This checkpoint in a text where its block starts `text` bytes
+    /// later, after `blocks` more blocks and `steps` more steps.
+    pub fn shifted(&self, text: i64, blocks: i64, steps: i64) -> Checkpoint {
+        let mut shifted = self.clone();
+        shifted.offset = shift_offset(self.offset, text);
+        shifted.block = shift_count(self.block, blocks);
+        shifted.executed = shift_count(self.executed, blocks);
+        shifted.state.set_steps(shift_count(self.state.steps(), steps));
+        shifted
+    }
+}
+
+/// `offset` moved by `by` bytes, held inside the text's range.
+pub fn shift_offset(offset: TextSize, by: i64) -> TextSize {
+    TextSize::from(u32::try_from((i64::from(u32::from(offset)) + by).max(0)).unwrap_or(u32::MAX))
+}
+
+/// `range` moved by `by` bytes.
+pub fn shift_range(range: TextRange, by: i64) -> TextRange {
+    TextRange::new(shift_offset(range.start(), by), shift_offset(range.end(), by))
+}
+
+/// `count` moved by `by`, never below zero.
+pub fn shift_count(count: usize, by: i64) -> usize {
+    usize::try_from((count as i64 + by).max(0)).unwrap_or(usize::MAX)
+}
+
+/// Steps gathered for a sink on another thread, in batches it hands back
+/// emptied: memory used again costs less than new memory.
+pub(crate) struct Batches {
+    pub(crate) batch: Vec<Step>,
+    pub(crate) sender: mpsc::SyncSender<Vec<Step>>,
+    pub(crate) emptied: Receiver<Vec<Step>>,
+}
+
+impl Batches {
+    /// Sends the gathered batch on, with an emptied one in its place.
+    pub(crate) fn send(&mut self) {
+        let next = self.emptied.try_recv().unwrap_or_else(|_| Vec::with_capacity(DELIVERY_BATCH));
+        let full = std::mem::replace(&mut self.batch, next);
+        // A sink that panicked has closed the channel: the join says so.
+        let _ = self.sender.send(full);
+    }
+}
+
+impl StepSink for Batches {
+    fn step(&mut self, step: Step) {
+        self.batch.push(step);
+        if self.batch.len() == DELIVERY_BATCH {
+            self.send();
+        }
+    }
+
+    /// A whole batch goes as it is, without copying its steps; `steps`
+    /// gets an emptied batch's room.
+    fn steps(&mut self, steps: &mut Vec<Step>) {
+        if self.batch.is_empty() {
+            std::mem::swap(&mut self.batch, steps);
+            self.send();
+        } else {
+            steps.drain(..).for_each(|step| self.step(step));
+        }
+    }
+}
+
+/// Steps a streaming run gathers before it hands them on.
+pub(crate) const DELIVERY_BATCH: usize = 1024;
