@@ -1,8 +1,9 @@
 //! The CNC8x6 dialect's part of the executor: its block IR and lowering,
-//! value formats, modal groups, parameter arithmetic, program flow, fixed
+//! value formats, modal groups, arcs, parameter arithmetic, program flow, fixed
 //! cycles, table files, the interpreter and the writer of expanded
 //! programs.
 
+pub mod arcs;
 pub mod arith;
 pub(crate) mod cycles;
 pub mod dynamics;

@@ -12,6 +12,7 @@
 
 use nc_exec::{
     arc::circle_through,
+    cnc8x6::arcs,
     cnc8x6::dynamics::{MIN_CONTINUITY_MS, MIN_TIGHT_JOINING_MS, for_control, tolerance_angle},
     velocity::junction_angle,
 };
@@ -49,9 +50,6 @@ const MANY_SHORT_BLOCKS: usize = 20;
 const DYNAMIC_SETS: std::ops::RangeInclusive<i128> = 1..=4;
 /// The rotary axis letters (degrees), whose moves have no path length.
 const ROTARY_AXES: [u8; 3] = [b'A', b'B', b'C'];
-/// Arc planes by the two axes written in the block, first axis (I) first:
-/// X–Y, Y–Z and Z–X (I along Z, J along X).
-const ARC_PLANES: [[u8; 2]; 3] = [[b'X', b'Y'], [b'Y', b'Z'], [b'Z', b'X']];
 
 /// How the control joins blocks under G23: machine constant R97 decade 1.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -235,9 +233,8 @@ fn line(visit: &Visit<'_>, scale: Option<f64>) -> Option<Path> {
 fn arc_path(visit: &Visit<'_>, scale: f64, clockwise: bool) -> Option<Path> {
     let mut letters: Vec<u8> = axis_words(visit).map(|w| w.letter).collect();
     letters.dedup();
-    let plane = ARC_PLANES
-        .into_iter()
-        .find(|plane| letters.len() == 2 && letters.contains(&plane[0]) && letters.contains(&plane[1]))?;
+    let [one, other] = letters[..] else { return None };
+    let plane = arcs::arc_plane(&visit.config.machine, one, other)?;
     let point = |state: &ModalState| -> Option<[f64; 2]> {
         let mut point = [0.0; 2];
         for (slot, &letter) in plane.iter().enumerate() {

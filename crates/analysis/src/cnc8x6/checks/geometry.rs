@@ -6,7 +6,10 @@
 //! choose only the radius-compensation plane); I is the centre offset along
 //! the plane's first axis and J along the second, both from the start point.
 
-use nc_exec::arc::{OffCircle, circle_through};
+use nc_exec::{
+    arc::{OffCircle, circle_through},
+    cnc8x6::arcs::{self, InvalidRefinement},
+};
 use ncc_syntax::{TextEdit, TextRange};
 
 use crate::{
@@ -25,9 +28,6 @@ declare_rules! {
     HELIX_WITHOUT_PITCH = "M417", "helix-without-pitch", Warning, "G09 with no helix lead programmed by G10 since the program start.";
     G98_NOT_ALONE = "B218", "g98-not-alone", Error, "G98 ending a helix shares its block with other words.";
 }
-
-/// Decade 8 of a refinement E (in thousandths of a µm) picks I or J.
-const REFINEMENT_SELECTOR: u64 = 10_000_000;
 
 /// Margin for the rounding of square roots, in µm.
 const ROUNDING: f64 = 1e-6;
@@ -122,11 +122,7 @@ fn check_helix_end(visit: &Visit<'_>, out: &mut Vec<Diagnostic>) {
 /// preprocessor for arcs from imprecise CAD data).
 enum Refinement {
     Absent,
-    /// Adds `amount` thousandths of a µm to I (`word` 0) or J (`word` 1).
-    Of {
-        word: usize,
-        amount: i64,
-    },
+    Of(arcs::Refinement),
     /// Unknown, or invalid and reported.
     Unusable,
 }
@@ -137,13 +133,9 @@ fn check_refinement(visit: &Visit<'_>, out: &mut Vec<Diagnostic>) -> Refinement 
     let Some(raw) = thousandths(word, visit.substitutions.get(index).copied().flatten()) else {
         return Refinement::Unusable;
     };
-    let selector = raw.unsigned_abs() / REFINEMENT_SELECTOR;
-    let Ok(magnitude) = i64::try_from(raw.unsigned_abs() % REFINEMENT_SELECTOR) else { return Refinement::Unusable };
-    let amount = magnitude * raw.signum();
-    match selector {
-        0 => Refinement::Of { word: 0, amount },
-        1 => Refinement::Of { word: 1, amount },
-        _ => {
+    match arcs::refinement(raw) {
+        Ok(refinement) => Refinement::Of(refinement),
+        Err(InvalidRefinement { selector }) => {
             let found =
                 if selector > 9 { "E has more than eight digits".to_owned() } else { format!("here it is {selector}") };
             out.push(Diagnostic::new(
@@ -251,14 +243,13 @@ fn end_off_circle(visit: &Visit<'_>, arc: &Arc<'_>, refinement: Refinement) -> O
     }
     let [a, b] = arc.axes.as_slice() else { return None };
     let written = [a.letter, b.letter];
-    let [first, second] = motion::interpolation_planes(visit.config)
-        .find(|plane| written.contains(&plane[0]) && written.contains(&plane[1]) && plane[0] != plane[1])?;
+    let [first, second] = arcs::arc_plane(&visit.config.machine, written[0], written[1])?;
     let start = [visit.before.position(first)?, visit.before.position(second)?];
     let end = [visit.after.position(first)?, visit.after.position(second)?];
     let mut centre = [centre_offset(visit, b'I')? as f64, centre_offset(visit, b'J')? as f64];
     match refinement {
         Refinement::Absent => {}
-        Refinement::Of { word, amount } => centre[word] += amount as f64 / 1000.0,
+        Refinement::Of(arcs::Refinement { word, amount }) => centre[word] += amount as f64 / 1000.0,
         Refinement::Unusable => return None,
     }
     // X may be a diameter (G74); whether I/J then are too the manual does

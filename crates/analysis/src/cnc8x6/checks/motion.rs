@@ -3,7 +3,7 @@
 //! the control's 200-block look-ahead); length compensation `&`/D and the
 //! correction-table write `G92 D`.
 
-use nc_exec::cnc8x6::arith::MAX_RAW;
+use nc_exec::cnc8x6::{arcs, arith::MAX_RAW};
 use ncc_catalog::{AddressRole, Dialect};
 use ncc_syntax::{Severity, TextEdit, TextRange};
 
@@ -59,38 +59,15 @@ pub(crate) fn axis_words(block: &BlockData) -> impl Iterator<Item = &Word> {
     block.words.iter().filter(move |w| catalogue.role_of(w.letter) == Some(AddressRole::Axis))
 }
 
-/// The two axes of the compensation plane of G17/G18/G19 (machine
-/// constant 340) or G14/G15/G16 (constant 341), first axis first: the one
-/// I refers to in an arc.
+/// The two axes of the compensation plane of a plane code, first axis
+/// first: the one I refers to in an arc ([`arcs`]).
 pub(crate) fn plane_axes(code: u32, config: &Config) -> Option<[u8; 2]> {
-    match code {
-        17..=19 => machine_plane(340, code - 17, config),
-        14..=16 => machine_plane(341, code - 14, config),
-        _ => None,
-    }
+    arcs::compensation_plane(&config.machine, code)
 }
 
-/// The machine's interpolation planes: the four pairs of each of machine
-/// constants 340 and 341, the first three of which are also the
-/// compensation planes.
+/// The machine's interpolation planes ([`arcs`]).
 pub(crate) fn interpolation_planes(config: &Config) -> impl Iterator<Item = [u8; 2]> {
-    [340, 341]
-        .into_iter()
-        .flat_map(move |constant| (0..4).filter_map(move |pair| machine_plane(constant, pair, config)))
-}
-
-/// Pair `pair` (0 = decades 2–1) of a plane constant: the ordinals of the
-/// plane's first and second axis, as letters of the configured axes (so
-/// the default 12 of G17 is X–Y on a mill and X–Z on a lathe with axes X,
-/// Z). A constant of zeros reads as its default (`00233.112`, `00412.434`).
-fn machine_plane(constant: u32, pair: u32, config: &Config) -> Option<[u8; 2]> {
-    let planes = match config.machine.constant(constant) {
-        0 => config.machine.default_constant(constant)?,
-        planes => planes,
-    };
-    let ordinals = planes.unsigned_abs() / 100u64.pow(pair) % 100;
-    let axis = |ordinal: u64| config.machine.axes.get(usize::try_from(ordinal).ok()?.checked_sub(1)?).copied();
-    Some([axis(ordinals / 10)?, axis(ordinals % 10)?])
+    arcs::interpolation_planes(&config.machine)
 }
 
 fn moves_in_plane(visit: &Visit<'_>, axes: [u8; 2]) -> bool {

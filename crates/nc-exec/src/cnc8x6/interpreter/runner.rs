@@ -7,6 +7,7 @@ use smallvec::SmallVec;
 
 use crate::{
     arc::{OffCircle, circle_through},
+    cnc8x6::arcs,
     cnc8x6::arith::{self, BlockArithmetic, Parameters, Raw},
     cnc8x6::cycles::{self, CycleError, CycleInput, CycleKind, CycleStep, Spindle},
     cnc8x6::formats::{self, PlainLiterals},
@@ -729,11 +730,18 @@ impl Runner {
     /// control's look-ahead fixes them.
     fn compensate(&mut self, start: Position, path: Path) -> Result<(), CompensationError> {
         let index = self.delivered + self.steps.len() - 1;
-        let plane = match self.modes.active(self.groups.plane) {
-            Some(18) => (b'Z', b'X'),
-            Some(19) => (b'Y', b'Z'),
-            _ => (b'X', b'Y'),
+        let code = self.modes.active(self.groups.plane).unwrap_or_default();
+        let Some([first, second]) = arcs::compensation_plane(&self.machine, code) else {
+            if self.modes.active(self.groups.compensation).is_some_and(|code| code != 40) {
+                let range = self.step_mut(index).range;
+                let message = format!(
+                    "radius compensation in the plane of G{code}, which this machine does not have (machine constants R340, R341): the run leaves the compensation out"
+                );
+                self.report_once(RunRule::NotRunYet, "compensation plane", range, &message);
+            }
+            return Ok(());
         };
+        let plane = (first, second);
         // Mirrored in one axis of the plane, the tool changes side.
         let flipped = self.recalculation.flips(plane);
         let side = match self.modes.active(self.groups.compensation) {
@@ -1212,9 +1220,11 @@ impl Runner {
             self.finding(RunRule::ArcPlaneIncomplete, range, message);
             return Ok(None);
         }
-        // The plane's first axis is the one I measures along: X of XY, Y of
-        // YZ, Z of ZX (01 §6.4).
-        let (first, second) = plane(letters[0], letters[1]);
+        // The machine's interpolation plane of the two axes: I measures
+        // along its first axis. A pair the machine has no plane of runs in
+        // the order written.
+        let [first, second] =
+            arcs::arc_plane(&self.machine, letters[0], letters[1]).unwrap_or([letters[0], letters[1]]);
         let (a, b) = (usize::from(first - b'A'), usize::from(second - b'A'));
         // I and J are recalculated as the axes they measure along, and an
         // arc mirrored in one of its axes turns the other way.
@@ -1224,7 +1234,14 @@ impl Runner {
         };
         let counter_clockwise = counter_clockwise != self.recalculation.flips((first, second));
         let (from, to) = ([start[a], start[b]], [end[a], end[b]]);
-        let centre = [from[0] + centre_offset(b'I', first), from[1] + centre_offset(b'J', second)];
+        let mut offsets = [centre_offset(b'I', first), centre_offset(b'J', second)];
+        // The preprocessor's refinement E of I or J, in thousandths of a µm;
+        // the checker reports one the control cannot apply.
+        let refinement = block.word(b'E').and_then(|word| self.number(word)).map(|mm| (mm * 1000.0).round() as i64);
+        if let Some(Ok(arcs::Refinement { word, amount })) = refinement.map(arcs::refinement) {
+            offsets[word] += self.recalculation.apply([first, second][word], amount as f64 / 1e6);
+        }
+        let centre = [from[0] + offsets[0], from[1] + offsets[1]];
         let tolerance = self.machine.arc_tolerance();
         let circle = match circle_through(from, to, centre, counter_clockwise, tolerance) {
             Ok(circle) => circle,

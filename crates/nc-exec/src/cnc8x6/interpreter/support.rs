@@ -290,16 +290,6 @@ pub(super) struct Move<'b> {
     pub(super) end: Position,
 }
 
-/// The plane of two axes in the order I/J measure along them.
-pub(super) fn plane(one: u8, other: u8) -> (u8, u8) {
-    match (one, other) {
-        (b'X', b'Z') | (b'Z', b'X') => (b'Z', b'X'),
-        (b'Z', b'Y') => (b'Y', b'Z'),
-        (b'Y', b'X') => (b'X', b'Y'),
-        pair => pair,
-    }
-}
-
 /// Positions lie on the µm grid; half of one keeps float noise off the
 /// bounds of the axes' ranges.
 pub(super) const HALF_MICROMETRE: f64 = 0.0005;

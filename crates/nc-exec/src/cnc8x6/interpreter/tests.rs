@@ -232,6 +232,35 @@ fn constant_cutting_speed_turns_the_spindle_by_the_radius() {
 }
 
 #[test]
+fn arcs_and_compensation_run_in_the_machine_s_planes() {
+    // Axes X, Z: the default G17 plane 12 is X-Z, so I runs along X and J
+    // along Z, as the checker reads them.
+    let lathe = MachineConfig { axes: b"XZ".to_vec(), diameter_axis: Some(b'X'), ..MachineConfig::default() };
+    let text = "%1\nN1 G75 G00 X20 Z0\nN2 G02 X20 Z-20 I0 J-10 F100\nN3 M30\n";
+    let trace = run(text, &NoFiles, &lathe, 100);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    assert_eq!(trace.steps[1].path, Path::Arc { plane: (b'X', b'Z'), centre: [20.0, -10.0], clockwise: true });
+    // R340 = 21 swaps them: I along Z.
+    let swapped = MachineConfig { constants: [(340, 21)].into(), ..lathe.clone() };
+    let text = "%1\nN1 G75 G00 X20 Z0\nN2 G02 X20 Z-20 I-10 F100\nN3 M30\n";
+    let trace = run(text, &NoFiles, &swapped, 100);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    assert_eq!(trace.steps[1].path, Path::Arc { plane: (b'Z', b'X'), centre: [-10.0, 20.0], clockwise: true });
+    // The refinement E takes 1 µm off J: the end is then on the circle, and
+    // without it 2 µm off, beyond the 1 µm tolerance.
+    let text = |e: &str| format!("%1\nN1 G75 G00 X20 Z0\nN2 G02 X20 Z-20.004 I0 J-10.001 {e} F100\nN3 M30\n");
+    assert!(run(&text("E-10001.000"), &NoFiles, &lathe, 100).findings.is_empty());
+    assert!(run(&text(""), &NoFiles, &lathe, 100).findings[0].message.contains("does not lie on the circle"));
+    // G18's plane names axis 3, which the lathe does not have.
+    let text = "%1\nN1 G18 G00 X20 Z0 D1\nN2 G42 G01 Z-20 F100\nN3 G40 X30\nN4 M30\n";
+    let trace = run(text, &NoFiles, &lathe, 100);
+    let messages: Vec<&str> = trace.findings.iter().map(|finding| finding.message.as_str()).collect();
+    assert_eq!(messages.len(), 1, "{messages:?}");
+    assert!(messages[0].starts_with("radius compensation in the plane of G18, which this machine does not have"));
+    assert!(trace.compensated.is_empty());
+}
+
+#[test]
 fn diameter_programming_halves_the_diameter_axis() {
     use std::f64::consts::TAU;
     let lathe = MachineConfig {
