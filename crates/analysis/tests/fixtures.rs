@@ -142,12 +142,12 @@ impl FixtureFiles<'_> {
 }
 
 impl Environment for FixtureFiles<'_> {
-    fn macrocycle(&self, number: u32) -> Option<String> {
-        self.named(&format!("L{number}")).map(|(_, text)| text.clone())
-    }
-
-    fn cycle_file(&self, name: &str) -> Option<String> {
-        self.named(name).map(|(_, text)| text.clone())
+    fn file(&self, called: &Called) -> Option<String> {
+        let found = match called {
+            Called::Number(number) => self.named(&format!("L{number}")),
+            Called::Name(name) => self.named(name),
+        };
+        found.map(|(_, text)| text.clone())
     }
 }
 
@@ -163,13 +163,10 @@ fn run_check(fixture: &PathBuf) -> Result<Vec<&'static str>, String> {
     let trace = nc_exec::run::run(&files[program].1, &FixtureFiles(&files), &config.machine, RUN_FIXTURE_BUDGET);
     let file_of = |source: usize| match source.checked_sub(1).map(|called| &trace.files[called]) {
         None => program,
-        Some(Called::Macrocycle(number)) => {
+        Some(Called::Number(number)) => {
             files.iter().position(|(path, _)| path.ends_with(format!("L{number}"))).unwrap()
         }
-        Some(Called::CycleFile) => {
-            let name = config.machine.cycle_file.as_deref().unwrap_or_default();
-            files.iter().position(|(path, _)| path.ends_with(name)).unwrap()
-        }
+        Some(Called::Name(name)) => files.iter().position(|(path, _)| path.ends_with(name)).unwrap(),
     };
     let mut report = String::new();
     for (index, (path, text)) in

@@ -953,7 +953,7 @@ impl<'a> Library<'a> {
     /// (`in_snapshot` finds it), else the first candidate that `matches`.
     fn read(
         &self,
-        called: Called,
+        called: &Called,
         matches: impl Fn(&Path) -> bool,
         in_snapshot: impl FnOnce(&WorkspaceFiles) -> Option<(&str, &str)>,
     ) -> Option<String> {
@@ -964,7 +964,7 @@ impl<'a> Library<'a> {
                 (path.clone(), check::read_program(path).ok()?)
             }
         };
-        self.read.borrow_mut().push((called, path, text.clone()));
+        self.read.borrow_mut().push((called.clone(), path, text.clone()));
         Some(text)
     }
 
@@ -983,15 +983,19 @@ impl<'a> Library<'a> {
 }
 
 impl Environment for Library<'_> {
-    fn macrocycle(&self, number: u32) -> Option<String> {
-        let named = |path: &Path| check::macrocycle_number(path) == Some(number);
-        self.read(Called::Macrocycle(number), named, |files| files.macrocycle_file(number))
-    }
-
-    fn cycle_file(&self, name: &str) -> Option<String> {
-        let named =
-            |path: &Path| path.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.eq_ignore_ascii_case(name));
-        self.read(Called::CycleFile, named, |files| files.cycle_file_named(name))
+    fn file(&self, called: &Called) -> Option<String> {
+        match called {
+            &Called::Number(number) => {
+                let named = |path: &Path| check::macrocycle_number(path) == Some(number);
+                self.read(called, named, |files| files.macrocycle_file(number))
+            }
+            Called::Name(name) => {
+                let named = |path: &Path| {
+                    path.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.eq_ignore_ascii_case(name))
+                };
+                self.read(called, named, |files| files.cycle_file_named(name))
+            }
+        }
     }
 
     fn progress(&self, blocks_run: usize) {

@@ -109,31 +109,33 @@ pub struct Step {
     /// The program stops after the block (M00, M01) until the operator
     /// starts it again; the run does not count the wait.
     pub stop: Option<Stop>,
-    /// How the block joins the one before it (G group 2).
-    pub joining: Joining,
+    /// How the path passes into the block from the one before it.
+    pub path_mode: PathMode,
     /// M functions the block runs besides program stops, ends and the tool
     /// change, and whether it changes the tool (M06); each takes the
     /// machine's time for it.
     pub m_functions: u8,
     pub tool_change: bool,
-    /// The envelope velocity's dynamic set in force, 1 to 4 (`G23 I1` …
-    /// `I4`; 1 after reset).
+    /// The control's set of dynamics in force, from 1 (CNC8x6: the
+    /// envelope velocity's `G23 I1` … `I4`, 1 after reset).
     pub dynamic_set: u8,
-    /// A G01 line without technology functions (M, S, T, D), without F
-    /// and not under G91, which machine constant R383 may merge into the
-    /// move before it (04 §1.9.4).
+    /// A line the control may merge into the move before it (CNC8x6: a
+    /// G01 line without M, S, T, D or F and not under G91, which machine
+    /// constant R383 merges, 04 §1.9.4).
     pub mergeable: bool,
 }
 
-/// Block joining, group 2 (04 §1.2).
+/// How the path passes from one block into the next.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Joining {
-    /// G98, the basic state: every block ramps to a stop, with a pause
-    /// before the next (also under the group's other codes, G05–G10).
-    Basic,
-    /// G24: tight joining, a stop and the wait for the in-position window.
-    Tight,
-    /// G23: continuity, manual or recognised as machine constant R97 says.
+pub enum PathMode {
+    /// The axes stop, and the next block is prepared only then: a pause
+    /// (CNC8x6: G98, the basic state, and the group's other codes G05–G10).
+    Stop,
+    /// An exact stop: the axes stop and wait for the in-position window
+    /// (CNC8x6: G24, tight joining).
+    ExactStop,
+    /// A continuous path: the blocks join without a stop where the control
+    /// allows (CNC8x6: G23, manual or recognised as R97 says).
     Continuous,
 }
 
@@ -314,10 +316,12 @@ impl Trace {
     }
 }
 
-/// A file of the run besides the program.
+/// A file a run reads besides the program, as the program or the machine
+/// names it; the [`Environment`] finds it by the dialect's rule.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Called {
-    Macrocycle(u32),
-    /// The machine's fixed-cycle file.
-    CycleFile,
+    /// By number (CNC8x6: the macrocycle file `L<number>`).
+    Number(u32),
+    /// By name (CNC8x6: the machine's fixed-cycle file).
+    Name(String),
 }

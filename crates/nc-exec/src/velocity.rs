@@ -30,7 +30,7 @@ use ncc_syntax::TextSize;
 pub use crate::envelope::Profile;
 use crate::{
     envelope::{Envelope, EnvelopeMove, Limit, MoveKind, Planned, Planner},
-    trace::{Axes, Checkpoint, Joining, MAX_AXES, Motion, Path, Step, StepSink, Trace, shift_count, shift_range},
+    trace::{Axes, Checkpoint, MAX_AXES, Motion, Path, PathMode, Step, StepSink, Trace, shift_count, shift_range},
 };
 
 /// The interpolator tick of the CNC8x6 (000:2749).
@@ -251,7 +251,7 @@ struct Move {
     /// Runs without ramps (threads).
     no_ramps: bool,
     kind: Kind,
-    joining: Joining,
+    path_mode: PathMode,
     beyond_three_axes: bool,
     /// Unit directions at the start and at the end, over the first three axes.
     start_direction: [f64; 3],
@@ -457,7 +457,7 @@ impl Planning {
             end_direction: this.end_direction,
             arc_radius: this.arc_radius,
             stop_before,
-            continuity: this.joining == Joining::Continuous && dynamics.continuity > 0,
+            continuity: this.path_mode == PathMode::Continuous && dynamics.continuity > 0,
             set: step.dynamic_set,
             mergeable: step.mergeable,
         };
@@ -745,9 +745,9 @@ fn move_of(step: &Step, start: &Axes, axes: &[u8], dynamics: &Dynamics) -> Move 
             }
         }
     }
-    let acceleration = match (kind, step.joining) {
+    let acceleration = match (kind, step.path_mode) {
         (Kind::Rapid, _) => dynamics.rapid_acceleration,
-        (Kind::Feed, Joining::Continuous) if dynamics.continuity > 0 => dynamics.continuity_acceleration,
+        (Kind::Feed, PathMode::Continuous) if dynamics.continuity > 0 => dynamics.continuity_acceleration,
         _ => dynamics.feed_acceleration,
     };
     let beyond_three_axes = (3..MAX_AXES).any(|i| (step.end[i] - start[i]).abs() > 0.0);
@@ -758,7 +758,7 @@ fn move_of(step: &Step, start: &Axes, axes: &[u8], dynamics: &Dynamics) -> Move 
         acceleration,
         no_ramps: kind == Kind::Thread || acceleration <= 0.0,
         kind,
-        joining: step.joining,
+        path_mode: step.path_mode,
         beyond_three_axes,
         start_direction,
         end_direction,
@@ -782,11 +782,11 @@ fn stop_reason(this: &Move, next: &Move, dynamics: &Dynamics) -> Option<Reason> 
             Kind::Feed => {}
         }
     }
-    match next.joining {
-        Joining::Basic => return Some(Reason::NoContinuity),
-        Joining::Tight => return Some(Reason::TightJoining),
-        Joining::Continuous if dynamics.continuity == 0 => return Some(Reason::ContinuityOff),
-        Joining::Continuous => {}
+    match next.path_mode {
+        PathMode::Stop => return Some(Reason::NoContinuity),
+        PathMode::ExactStop => return Some(Reason::TightJoining),
+        PathMode::Continuous if dynamics.continuity == 0 => return Some(Reason::ContinuityOff),
+        PathMode::Continuous => {}
     }
     if dynamics.continuity == 2 {
         if this.beyond_three_axes || next.beyond_three_axes {
@@ -821,8 +821,8 @@ fn stopping_speed(this: &Move, from: f64) -> f64 {
 /// block too short to send the next one while it runs pauses as well.
 fn pause_after(this: &Move, next: &Move, dynamics: &Dynamics) -> f64 {
     let too_short_to_prepare =
-        this.joining == Joining::Tight && this.length / this.programmed < dynamics.min_tight_joining;
-    if next.joining == Joining::Basic || too_short_to_prepare { dynamics.block_pause } else { dynamics.settle_time }
+        this.path_mode == PathMode::ExactStop && this.length / this.programmed < dynamics.min_tight_joining;
+    if next.path_mode == PathMode::Stop || too_short_to_prepare { dynamics.block_pause } else { dynamics.settle_time }
 }
 
 /// The move's trapezoid from `entry` to `exit` (mm/s); `fallback` is the

@@ -13,7 +13,7 @@ use std::{fmt::Write as _, ops::ControlFlow, sync::Arc};
 
 use nc_exec::{
     cnc8x6::dynamics,
-    run::{Checkpoint, Environment, Motion, Step, Totals, shift_count, shift_offset, shift_range},
+    run::{Called, Checkpoint, Environment, Motion, Step, Totals, shift_count, shift_offset, shift_range},
     velocity::{self, Break, Reason, Timer, TimerState, TimingSink},
 };
 use ncc_syntax::{BlockParser, SyntaxNode, TextRange, TextSize, ast::AstNode};
@@ -152,12 +152,12 @@ impl WorkspaceFiles {
 }
 
 impl Environment for WorkspaceFiles {
-    fn macrocycle(&self, number: u32) -> Option<String> {
-        self.macrocycle_file(number).map(|(_, text)| text.to_owned())
-    }
-
-    fn cycle_file(&self, name: &str) -> Option<String> {
-        self.cycle_file_named(name).map(|(_, text)| text.to_owned())
+    fn file(&self, called: &Called) -> Option<String> {
+        let found = match called {
+            &Called::Number(number) => self.macrocycle_file(number),
+            Called::Name(name) => self.cycle_file_named(name),
+        };
+        found.map(|(_, text)| text.to_owned())
     }
 }
 

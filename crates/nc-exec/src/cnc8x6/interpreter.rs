@@ -194,8 +194,9 @@ pub(crate) fn run_in<'a, 's>(
                 let program = index.complete();
                 let name = machine.cycle_file.as_deref().unwrap_or_default();
                 let source = *cycle_file.get_or_insert_with(|| {
-                    let text = files.cycle_file(name)?;
-                    called.push(Called::CycleFile);
+                    let file = Called::Name(name.to_owned());
+                    let text = files.file(&file)?;
+                    called.push(file);
                     program.add(Cow::Owned(text))?;
                     Some(program.texts.len() - 1)
                 });
@@ -231,8 +232,9 @@ pub(crate) fn run_in<'a, 's>(
                 let start = if is_macrocycle {
                     let known = loaded.iter().find(|&&(number, _)| number == label).map(|&(_, start)| start);
                     known.unwrap_or_else(|| {
-                        let start = files.macrocycle(label).and_then(|text| {
-                            called.push(Called::Macrocycle(label));
+                        let file = Called::Number(label);
+                        let start = files.file(&file).and_then(|text| {
+                            called.push(file);
                             program.add(Cow::Owned(text))
                         });
                         loaded.push((label, start));

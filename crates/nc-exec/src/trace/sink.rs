@@ -22,10 +22,8 @@ pub(crate) const MAX_CALL_DEPTH: usize = 64;
 /// What a run needs from where it runs: the files a program uses besides
 /// its own, and someone to tell how far it got.
 pub trait Environment {
-    /// The text of the macrocycle file `L<number>`.
-    fn macrocycle(&self, number: u32) -> Option<String>;
-    /// The text of the fixed-cycle file the machine names (`PCYKLYDG.NCP`).
-    fn cycle_file(&self, name: &str) -> Option<String>;
+    /// The text of the file `called`.
+    fn file(&self, called: &Called) -> Option<String>;
     /// Called every [`PROGRESS_INTERVAL`] blocks with the number run so far.
     fn progress(&self, _blocks_run: usize) {}
 }
@@ -44,11 +42,7 @@ pub const PROGRESS_INTERVAL: usize = 1 << 16;
 pub struct NoFiles;
 
 impl Environment for NoFiles {
-    fn macrocycle(&self, _number: u32) -> Option<String> {
-        None
-    }
-
-    fn cycle_file(&self, _name: &str) -> Option<String> {
+    fn file(&self, _called: &Called) -> Option<String> {
         None
     }
 }

@@ -839,10 +839,10 @@ impl Runner {
             [length, duration, feed.unwrap_or(0.0)].iter().chain(&end).all(|value| value.is_finite()),
             "no NaN or infinity leaves the executor: {end:?} {length} {duration} {feed:?}"
         );
-        let joining = match self.modes.active(self.groups.joining) {
-            Some(23) => Joining::Continuous,
-            Some(24) => Joining::Tight,
-            _ => Joining::Basic,
+        let path_mode = match self.modes.active(self.groups.joining) {
+            Some(23) => PathMode::Continuous,
+            Some(24) => PathMode::ExactStop,
+            _ => PathMode::Stop,
         };
         let step = Step {
             source,
@@ -855,7 +855,7 @@ impl Runner {
             end,
             frame,
             stop,
-            joining,
+            path_mode,
             m_functions,
             tool_change,
             dynamic_set: self.dynamic_set,

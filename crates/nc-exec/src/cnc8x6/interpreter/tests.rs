@@ -155,12 +155,8 @@ fn run_text(text: &str) -> Trace {
 struct Library(&'static str);
 
 impl Environment for Library {
-    fn macrocycle(&self, number: u32) -> Option<String> {
-        (number == 9001).then(|| self.0.to_owned())
-    }
-
-    fn cycle_file(&self, _name: &str) -> Option<String> {
-        Some(self.0.to_owned())
+    fn file(&self, called: &Called) -> Option<String> {
+        matches!(called, Called::Number(9001) | Called::Name(_)).then(|| self.0.to_owned())
     }
 }
 
@@ -351,7 +347,7 @@ fn a_cycle_file_body_runs_and_the_state_before_it_returns() {
     let machine = MachineConfig { cycle_file: Some("PC.NCP".to_owned()), ..MachineConfig::default() };
     let trace = run(DRILLING, &Library(body), &machine, 1000);
     assert!(trace.findings.is_empty(), "{:?}", trace.findings);
-    assert_eq!(trace.files, [Called::CycleFile]);
+    assert_eq!(trace.files, [Called::Name("PC.NCP".to_owned())]);
     let lines: Vec<(usize, Motion)> = trace.steps.iter().map(|s| (s.source, s.motion)).collect();
     let body_steps = [(1, Motion::Rapid), (1, Motion::Feed), (1, Motion::Rapid)];
     let mut expected = vec![(0, Motion::None), (0, Motion::Rapid), (0, Motion::Rapid)];
@@ -893,7 +889,7 @@ fn a_macrocycle_file_runs_q_times_with_its_own_jumps() {
         "N1 G79 L9001\nN2 R22=0 R24=1.\nN20 G01 XR20\nN30 R5=1222422 R6=17222123 G27\nN40 GR23 L20 Q9999\nN50 G70\n";
     let trace = run(program, &Library(macro_text), &MachineConfig::default(), 1000);
     assert!(trace.findings.is_empty(), "{:?}", trace.findings);
-    assert_eq!(trace.files, [Called::Macrocycle(9001)]);
+    assert_eq!(trace.files, [Called::Number(9001)]);
     // Two calls, three holes each.
     let moves: Vec<usize> = trace.steps.iter().filter(|s| s.motion == Motion::Feed).map(|s| s.source).collect();
     assert_eq!(moves, [1; 6]);
