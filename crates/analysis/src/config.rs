@@ -383,7 +383,12 @@ impl Config {
             dialects: Dialects { dialect: file.dialect, extensions },
             rules: file.rules,
             report: file.report,
-            machine: MachineConfig::default(),
+            // The machine's control is the project's dialect when this
+            // build reads it; the machine's keys are read in its terms.
+            machine: MachineConfig {
+                control: file.dialect.and_then(DialectId::implementation).unwrap_or_default(),
+                ..MachineConfig::default()
+            },
         };
         if let Some(unknown) = config.rules.keys().find(|key| crate::Rule::find(key).is_none()) {
             return Err(format!("{origin}: [rules] names no rule `{unknown}` (see `ncc rules`)"));

@@ -1,8 +1,9 @@
 //! Fixture programs with the expected diagnostics written inline.
 //!
-//! Every `*.ncp` in `test_data/rules` is analysed and its diagnostics are
-//! compared with the annotations in it. An annotation is a comment-only line
-//! right after the line it describes:
+//! Every program in `test_data/rules` is analysed in the dialect its file
+//! name gives (`*.ncp`: CNC8x6) and its diagnostics are compared with the
+//! annotations in it. An annotation is a line of the dialect's comment
+//! (CNC8x6: `"`) right after the line it describes:
 //!
 //! ```text
 //! N20 G01 X10 Y10
@@ -21,7 +22,7 @@
 use std::{fmt::Write, fs, path::PathBuf};
 
 use nc_exec::run::{Called, Environment};
-use ncc_analysis::{AnalysisHost, Config, Diagnostic, Rule, TextRange};
+use ncc_analysis::{AnalysisHost, Config, Diagnostic, Dialect, DialectId, Rule, TextRange};
 
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
 struct Expected {
@@ -31,11 +32,24 @@ struct Expected {
     name: String,
 }
 
-fn annotations(text: &str) -> Vec<Expected> {
+/// The dialect a fixture's program is in, by its file name; `None` for
+/// files of no dialect this build reads.
+fn dialect_of(path: &std::path::Path) -> Option<Dialect> {
+    DialectId::by_default_for(path).and_then(DialectId::implementation)
+}
+
+/// What starts a line comment in `dialect`, where annotations are written.
+fn comment_start(dialect: Dialect) -> &'static str {
+    match dialect {
+        Dialect::Cnc8x6 => "\"",
+    }
+}
+
+fn annotations(text: &str, dialect: Dialect) -> Vec<Expected> {
     let mut expected = Vec::new();
     let mut target_line = 0;
     for (number, line) in text.lines().enumerate() {
-        let Some(rest) = line.strip_prefix('"') else {
+        let Some(rest) = line.strip_prefix(comment_start(dialect)) else {
             target_line = number;
             continue;
         };
@@ -83,14 +97,15 @@ fn fixtures(directory: &str) -> Vec<PathBuf> {
     let mut entries: Vec<PathBuf> = fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().path())
-        .filter(|p| p.is_dir() || p.extension().is_some_and(|e| e == "ncp"))
+        .filter(|p| p.is_dir() || dialect_of(p).is_some())
         .collect();
     entries.sort();
     entries
 }
 
-/// A fixture's files with their text, and its configuration.
-fn inputs(fixture: &PathBuf) -> Result<(Vec<(PathBuf, String)>, Config), String> {
+/// A fixture's files with their text, its configuration, and the dialect
+/// its programs are in.
+fn inputs(fixture: &PathBuf) -> Result<(Vec<(PathBuf, String)>, Config, Dialect), String> {
     let (files, config_path) = if fixture.is_dir() {
         let mut files: Vec<PathBuf> = fs::read_dir(fixture)
             .unwrap()
@@ -107,12 +122,13 @@ fn inputs(fixture: &PathBuf) -> Result<(Vec<(PathBuf, String)>, Config), String>
     } else {
         Config::default()
     };
-    Ok((files.into_iter().map(|path| (path.clone(), fs::read_to_string(path).unwrap())).collect(), config))
+    let dialect = files.iter().find_map(|path| dialect_of(path)).ok_or("a fixture without a program")?;
+    Ok((files.into_iter().map(|path| (path.clone(), fs::read_to_string(path).unwrap())).collect(), config, dialect))
 }
 
 fn check(fixture: &PathBuf) -> Result<Vec<Diagnostic>, String> {
-    let (files, config) = inputs(fixture)?;
-    let mut host = AnalysisHost::new(config);
+    let (files, config, dialect) = inputs(fixture)?;
+    let mut host = AnalysisHost::in_dialect(dialect, config);
     let ids: Vec<_> = files
         .into_iter()
         .map(|(path, text)| (host.add_file(path.display().to_string(), text.as_str()), path, text))
@@ -123,7 +139,7 @@ fn check(fixture: &PathBuf) -> Result<Vec<Diagnostic>, String> {
     for (file, path, text) in ids {
         let diagnostics = analysis.diagnostics(file);
         let found = diagnostics.iter().map(|d| (actual(&text, d), d.message.clone())).collect();
-        if let Err(mismatch) = compare(&path, &text, found) {
+        if let Err(mismatch) = compare(&path, &text, dialect, found) {
             report.push_str(&mismatch);
         }
         all.extend(diagnostics);
@@ -158,7 +174,7 @@ const RUN_FIXTURE_BUDGET: usize = 1000;
 /// Runs a fixture's program (its `.ncp` file) and compares the findings
 /// in each of its files with their annotations; returns the rules found.
 fn run_check(fixture: &PathBuf) -> Result<Vec<&'static str>, String> {
-    let (files, config) = inputs(fixture)?;
+    let (files, config, dialect) = inputs(fixture)?;
     let program = files.iter().position(|(path, _)| path.extension().is_some_and(|e| e == "ncp")).unwrap();
     let trace = nc_exec::run::run(&files[program].1, &FixtureFiles(&files), &config.machine, RUN_FIXTURE_BUDGET);
     let file_of = |source: usize| match source.checked_sub(1).map(|called| &trace.files[called]) {
@@ -178,7 +194,7 @@ fn run_check(fixture: &PathBuf) -> Result<Vec<&'static str>, String> {
             .filter(|finding| file_of(finding.source) == index)
             .map(|finding| (actual_at(text, finding.range, finding.rule.name()), finding.message.clone()))
             .collect();
-        if let Err(mismatch) = compare(path, text, found) {
+        if let Err(mismatch) = compare(path, text, dialect, found) {
             report.push_str(&mismatch);
         }
     }
@@ -188,8 +204,8 @@ fn run_check(fixture: &PathBuf) -> Result<Vec<&'static str>, String> {
 
 /// Compares what was found in a file, each with its message, with the
 /// file's annotations.
-fn compare(path: &std::path::Path, text: &str, found: Vec<(Expected, String)>) -> Result<(), String> {
-    let mut expected = annotations(text);
+fn compare(path: &std::path::Path, text: &str, dialect: Dialect, found: Vec<(Expected, String)>) -> Result<(), String> {
+    let mut expected = annotations(text, dialect);
     let mut unexpected = Vec::new();
     for (found, message) in found {
         match expected.iter().position(|e| matches(e, &found)) {
