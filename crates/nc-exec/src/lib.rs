@@ -52,6 +52,6 @@ pub(crate) mod envelope;
 pub mod machine;
 pub mod run;
 pub mod tool_path;
-pub mod trace;
+pub(crate) mod trace;
 pub(crate) mod transform;
 pub mod velocity;
