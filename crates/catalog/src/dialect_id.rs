@@ -83,6 +83,14 @@ impl From<Dialect> for DialectId {
     }
 }
 
+impl Dialect {
+    /// Every dialect this build reads, in the registry's order: what tests
+    /// and benchmarks that hold for every dialect go over.
+    pub fn all() -> impl Iterator<Item = Dialect> {
+        DialectId::ALL.into_iter().filter_map(DialectId::implementation)
+    }
+}
+
 impl fmt::Display for DialectId {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())

@@ -1,17 +1,24 @@
-//! Snapshot tests: every program in `test_data/parser` is parsed and its tree
-//! and errors compared with the `.rast` file next to it.
+//! Snapshot tests: every program in `test_data/parser` is parsed in the
+//! dialect its file name gives (`*.ncp`: CNC8x6) and its tree and errors
+//! compared with the `.rast` file next to it.
 //! Run with `UPDATE_EXPECT=1` to accept new output.
 
 use std::{fs, path::PathBuf};
 
+use ncc_catalog::DialectId;
 use ncc_syntax::{Dialect, Parse, TextEdit, TextRange, TextSize};
 
-fn fixtures() -> Vec<(PathBuf, String)> {
+fn dialect_of(path: &std::path::Path) -> Option<Dialect> {
+    DialectId::by_default_for(path).and_then(DialectId::implementation)
+}
+
+/// The fixtures with their text and dialect.
+fn fixtures() -> Vec<(PathBuf, String, Dialect)> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("test_data/parser");
     let mut files: Vec<_> = fs::read_dir(&dir)
         .unwrap()
         .map(|entry| entry.unwrap().path())
-        .filter(|path| path.extension().is_some_and(|ext| ext == "ncp"))
+        .filter(|path| path.extension().is_some_and(|ext| ext != "rast"))
         .collect();
     files.sort();
     assert!(files.len() >= 20, "fixtures missing in {}", dir.display());
@@ -19,15 +26,16 @@ fn fixtures() -> Vec<(PathBuf, String)> {
         .into_iter()
         .map(|path| {
             let text = fs::read_to_string(&path).unwrap();
-            (path, text)
+            let dialect = dialect_of(&path).unwrap_or_else(|| panic!("{}: no dialect reads it", path.display()));
+            (path, text, dialect)
         })
         .collect()
 }
 
 #[test]
 fn parser_snapshots() {
-    for (path, text) in fixtures() {
-        let parse = Parse::new(&text, Dialect::Cnc8x6);
+    for (path, text, dialect) in fixtures() {
+        let parse = Parse::new(&text, dialect);
         assert_eq!(parse.syntax_node().to_string(), text, "{} does not round-trip", path.display());
         let is_error_fixture = path.file_name().unwrap().to_str().unwrap().starts_with("error_");
         let has_errors = parse.errors().iter().any(|e| e.severity() == ncc_syntax::Severity::Error);
@@ -40,8 +48,8 @@ fn parser_snapshots() {
 #[test]
 fn fixtures_cover_every_syntax_error() {
     let mut seen = std::collections::BTreeSet::new();
-    for (_, text) in fixtures() {
-        seen.extend(Parse::new(&text, Dialect::Cnc8x6).errors().iter().map(|e| e.kind));
+    for (_, text, dialect) in fixtures() {
+        seen.extend(Parse::new(&text, dialect).errors().iter().map(|e| e.kind));
     }
     let missing: Vec<_> = ncc_syntax::SyntaxErrorKind::ALL.iter().filter(|k| !seen.contains(k)).collect();
     assert!(missing.is_empty(), "no fixture shows {missing:?}");
@@ -51,8 +59,8 @@ fn fixtures_cover_every_syntax_error() {
 /// position, reparses to the same result as a full parse.
 #[test]
 fn fixture_edits_reparse_like_full_parses() {
-    for (path, text) in fixtures() {
-        let parse = Parse::new(&text, Dialect::Cnc8x6);
+    for (path, text, dialect) in fixtures() {
+        let parse = Parse::new(&text, dialect);
         let boundaries: Vec<usize> = (0..=text.len()).filter(|&i| text.is_char_boundary(i)).collect();
         let mut edits = Vec::new();
         for pair in boundaries.windows(2) {
@@ -67,7 +75,7 @@ fn fixture_edits_reparse_like_full_parses() {
             let mut new_text = text.clone();
             edit.apply(&mut new_text);
             let incremental = parse.reparse(&edit, &new_text);
-            let full = Parse::new(&new_text, Dialect::Cnc8x6);
+            let full = Parse::new(&new_text, dialect);
             assert_eq!(incremental, full, "{}: {edit:?}", path.display());
         }
     }
