@@ -103,9 +103,16 @@ fn fixtures(directory: &str) -> Vec<PathBuf> {
     entries
 }
 
-/// A fixture's files with their text, its configuration, and the dialect
-/// its programs are in.
-fn inputs(fixture: &PathBuf) -> Result<(Vec<(PathBuf, String)>, Config, Dialect), String> {
+/// What a fixture gives the analysis.
+struct Inputs {
+    /// The files, with their text.
+    files: Vec<(PathBuf, String)>,
+    config: Config,
+    /// The dialect its programs are in.
+    dialect: Dialect,
+}
+
+fn inputs(fixture: &PathBuf) -> Result<Inputs, String> {
     let (files, config_path) = if fixture.is_dir() {
         let mut files: Vec<PathBuf> = fs::read_dir(fixture)
             .unwrap()
@@ -123,11 +130,12 @@ fn inputs(fixture: &PathBuf) -> Result<(Vec<(PathBuf, String)>, Config, Dialect)
         Config::default()
     };
     let dialect = files.iter().find_map(|path| dialect_of(path)).ok_or("a fixture without a program")?;
-    Ok((files.into_iter().map(|path| (path.clone(), fs::read_to_string(path).unwrap())).collect(), config, dialect))
+    let files = files.into_iter().map(|path| (path.clone(), fs::read_to_string(path).unwrap())).collect();
+    Ok(Inputs { files, config, dialect })
 }
 
 fn check(fixture: &PathBuf) -> Result<Vec<Diagnostic>, String> {
-    let (files, config, dialect) = inputs(fixture)?;
+    let Inputs { files, config, dialect } = inputs(fixture)?;
     let mut host = AnalysisHost::in_dialect(dialect, config);
     let ids: Vec<_> = files
         .into_iter()
@@ -174,7 +182,7 @@ const RUN_FIXTURE_BUDGET: usize = 1000;
 /// Runs a fixture's program (its `.ncp` file) and compares the findings
 /// in each of its files with their annotations; returns the rules found.
 fn run_check(fixture: &PathBuf) -> Result<Vec<&'static str>, String> {
-    let (files, config, dialect) = inputs(fixture)?;
+    let Inputs { files, config, dialect } = inputs(fixture)?;
     let program = files.iter().position(|(path, _)| path.extension().is_some_and(|e| e == "ncp")).unwrap();
     let trace = nc_exec::run::run(&files[program].1, &FixtureFiles(&files), &config.machine, RUN_FIXTURE_BUDGET);
     let file_of = |source: usize| match source.checked_sub(1).map(|called| &trace.files[called]) {
