@@ -39,7 +39,7 @@ pub fn run_into(
     budget: usize,
     sink: &mut dyn StepSink,
 ) -> Trace {
-    std::thread::scope(|scope| run_in(scope, text, files, machine, budget, Some(sink), None))
+    resume_into(None, text, files, machine, budget, sink)
 }
 
 /// Like [`run_into`], from `checkpoint` (a checkpoint of a run on the
