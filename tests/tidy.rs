@@ -33,8 +33,6 @@ const DIALECT_DEBT: &[(&str, usize)] = &[
     ("crates/analysis/src/ide/symbols.rs", 1),
     ("crates/bench/src/main.rs", 7),
     ("crates/bench/src/progen.rs", 7),
-    ("crates/catalog/src/explain.rs", 2),
-    ("crates/catalog/src/lib.rs", 6),
     ("crates/lsp/src/explain.rs", 3),
     ("crates/lsp/src/rules.rs", 1),
     ("crates/lsp/src/run.rs", 2),
