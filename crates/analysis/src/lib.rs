@@ -300,6 +300,11 @@ impl Analysis {
         ide::cycle_time::program_head(&self.db, file)
     }
 
+    /// The language of every file.
+    pub fn dialect(&self) -> Dialect {
+        *Settings::get(&self.db).dialect(&self.db)
+    }
+
     pub fn path(&self, file: FileId) -> String {
         file.path(&self.db).clone()
     }
