@@ -11,6 +11,7 @@ use ncc_syntax::{TextRange, TextSize};
 use rustc_hash::FxHashMap;
 
 use crate::{
+    cnc8x6::chunks,
     db::{self, Db, SourceFile},
     lower::{BlockData, Value},
 };
@@ -298,7 +299,11 @@ pub fn program(db: &dyn Db, file: SourceFile) -> Program {
     let kind = file_kind(db, file);
     let chunks: Vec<ChunkBlocks> = db::file_chunks(db, file)
         .iter()
-        .map(|c| ChunkBlocks { offset: c.offset, first: c.first, summary: db::chunk_summaries(db, c.chunk).clone() })
+        .map(|c| ChunkBlocks {
+            offset: c.offset,
+            first: c.first,
+            summary: chunks::chunk_summaries(db, c.chunk).clone(),
+        })
         .collect();
     let block_count = chunks.last().map_or(0, |c| c.first + c.summary.blocks.len());
     let mut program = Program {

@@ -11,7 +11,10 @@ use ncc_syntax::{TextRange, TextSize};
 
 use super::{Target, block_at, symbols::Outline, target_at};
 use crate::{
-    cnc8x6::model::{self, FileKind, Program, Transfer},
+    cnc8x6::{
+        chunks,
+        model::{self, FileKind, Program, Transfer},
+    },
     db::{self, BlockChunk, Db, Settings, SourceFile},
     lower::{BlockData, Value},
 };
@@ -226,7 +229,7 @@ fn chunk_parameter_uses<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<Par
     let catalogue = Settings::get(db).dialect(db).catalogue();
     let letter = catalogue.letter_with_role(AddressRole::Parameter).map(char::from);
     let mut uses = Vec::new();
-    for (offset, block) in db::lower_chunk(db, chunk) {
+    for (offset, block) in chunks::lower_chunk(db, chunk) {
         let first = uses.len();
         let words = block.words.iter().map(|w| (&w.value, w.value_range));
         let values = block.assignments.iter().map(|a| (&a.value, a.value_range));
