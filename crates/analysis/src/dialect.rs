@@ -6,10 +6,11 @@ use ncc_catalog::DialectId;
 use ncc_syntax::Dialect;
 
 use crate::{
-    Rule, cnc8x6,
+    Config, Rule, cnc8x6,
     db::{Db, SourceFile},
     diagnostic, findings,
     findings::Findings,
+    lower::{BlockData, Word},
 };
 
 /// The rules of the dialect's checks, by check module.
@@ -53,5 +54,35 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> &Findings {
 pub(crate) fn prepare_states(db: &dyn Db, file: SourceFile) {
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => cnc8x6::states::prepare(db, file),
+    }
+}
+
+/// Whether the machine can run the code `letter` + `number` (completion
+/// leaves out those it cannot).
+pub(crate) fn code_fits_machine(dialect: Dialect, letter: char, number: u32, config: &Config) -> bool {
+    match dialect {
+        Dialect::Cnc8x6 => cnc8x6::ide::code_fits_machine(letter, number, config),
+    }
+}
+
+/// What the centre words of the block's arc mean, by address letter, when
+/// the block draws one.
+pub(crate) fn arc_centre(dialect: Dialect, block: &BlockData, config: &Config) -> Vec<(u8, String)> {
+    match dialect {
+        Dialect::Cnc8x6 => cnc8x6::ide::arc_centre(block, config),
+    }
+}
+
+/// Whether `word` is the code that starts a subprogram.
+pub(crate) fn starts_unit(dialect: Dialect, block: &BlockData, word: &Word) -> bool {
+    match dialect {
+        Dialect::Cnc8x6 => cnc8x6::ide::starts_unit(block, word),
+    }
+}
+
+/// The name of a subprogram with neither number nor label.
+pub(crate) fn unnamed_unit(dialect: Dialect) -> &'static str {
+    match dialect {
+        Dialect::Cnc8x6 => cnc8x6::ide::UNNAMED_UNIT,
     }
 }

@@ -282,13 +282,33 @@ fn literal(block: &BlockData, letter: u8) -> Option<(u32, TextRange)> {
     })
 }
 
+/// What the `L` of a call or jump names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum TransferKind {
+    Subprogram,
+    Macrocycle,
+    Jump,
+}
+
+/// The block's call or jump code (G71, G72, G73), whether or not its `L`
+/// has a value yet: what the `L` names, and the code's range.
+pub(crate) fn transfer_kind(block: &BlockData) -> Option<(TransferKind, TextRange)> {
+    let (code, range) = block.codes(b'G').find(|(c, _)| matches!(c, 71..=73)).map(|(c, w)| (c, w.range))?;
+    let kind = match code {
+        71 => TransferKind::Subprogram,
+        72 => TransferKind::Macrocycle,
+        _ => TransferKind::Jump,
+    };
+    Some((kind, range))
+}
+
 fn transfer(block: &BlockData) -> Option<(Transfer, TextRange)> {
     let (target, _) = literal(block, b'L')?;
-    let (code, range) = block.codes(b'G').find(|(c, _)| matches!(c, 71..=73)).map(|(c, w)| (c, w.range))?;
-    let transfer = match code {
-        71 => Transfer::Subprogram(target),
-        72 => Transfer::Macrocycle(target),
-        _ => Transfer::Jump(target),
+    let (kind, range) = transfer_kind(block)?;
+    let transfer = match kind {
+        TransferKind::Subprogram => Transfer::Subprogram(target),
+        TransferKind::Macrocycle => Transfer::Macrocycle(target),
+        TransferKind::Jump => Transfer::Jump(target),
     };
     Some((transfer, range))
 }
