@@ -21,8 +21,9 @@ pub trait Db: salsa::Database {
 }
 
 /// What a dialect keeps about files outside salsa, because it stays valid
-/// across edits (the checkpoints of the flow walk's state).
-pub trait DialectCache: std::any::Any + Send + Sync {
+/// across edits (the checkpoints of the flow walk's state). Unwind safe, as
+/// a snapshot's question may be cancelled by unwinding.
+pub trait DialectCache: std::any::Any + Send + Sync + std::panic::RefUnwindSafe + std::panic::UnwindSafe {
     /// Lets go of what is kept about `file`.
     fn forget(&self, file: SourceFile);
 }

@@ -24,10 +24,7 @@ use anyhow::Context;
 use clap::{Parser, Subcommand, ValueEnum};
 use ncc_analysis::DialectId;
 use ncc_bench::{
-    cnc8x6::{
-        self,
-        progen::{self, Move, Syntax},
-    },
+    cnc8x6::progen::{self, Move, Syntax},
     edits::{self, Lcg},
     lsp_client::{self, Client, Document},
     rs274,
@@ -230,7 +227,7 @@ fn program_file_name(dialect: Dialect) -> String {
 /// hover.
 pub(crate) fn code_near(dialect: Dialect, text: &str, offset: usize, rng: &mut Lcg) -> Option<usize> {
     match dialect {
-        Dialect::Cnc8x6 => cnc8x6::g_code_near(text, offset, rng),
+        Dialect::Cnc8x6 => progen::g_code_near(text, offset, rng),
     }
 }
 
