@@ -12,7 +12,7 @@ mod explain;
 mod render;
 pub mod schema;
 
-use std::{collections::HashMap, sync::OnceLock};
+use std::{collections::HashMap, ops::RangeInclusive, sync::OnceLock};
 
 pub use crate::{
     dialect_id::{DialectId, UnknownDialect, macrocycle_number},
@@ -135,9 +135,9 @@ pub struct Catalogue {
     /// [`Catalogue::modal_group_index`] of the codes below [`DENSE_CODES`]
     /// of each function letter, which every block asks for.
     modal_groups: Vec<(char, [Option<u8>; DENSE_CODES as usize])>,
-    /// The code ranges whose unlisted codes belong to a group: first and
-    /// last code, and the group's index.
-    unlisted_ranges: Vec<((char, u32), (char, u32), usize)>,
+    /// The code ranges whose unlisted codes belong to a group, with the
+    /// group's index.
+    unlisted_ranges: Vec<(RangeInclusive<(char, u32)>, usize)>,
 }
 
 /// Code numbers looked up in a table rather than a map.
@@ -174,7 +174,7 @@ impl Catalogue {
             .enumerate()
             .filter_map(|(index, group)| {
                 let [first, last] = group.takes_unlisted.as_ref()?;
-                Some((split_code(first)?, split_code(last)?, index))
+                Some((split_code(first)?..=split_code(last)?, index))
             })
             .collect();
         let mut catalogue = Catalogue {
@@ -243,8 +243,7 @@ impl Catalogue {
             Some(code) => self.group(code.group.as_deref()?),
             None => {
                 let code = (letter.to_ascii_uppercase(), number);
-                let (.., index) =
-                    self.unlisted_ranges.iter().find(|(first, last, _)| (*first..=*last).contains(&code))?;
+                let (_, index) = self.unlisted_ranges.iter().find(|(range, _)| range.contains(&code))?;
                 self.groups.get(*index)
             }
         }

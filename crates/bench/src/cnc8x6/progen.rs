@@ -182,7 +182,7 @@ pub fn block_count(moves: &[Move]) -> usize {
 /// parser and the checks find something every few characters.
 pub fn random_line(len: usize, seed: u64) -> String {
     const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
-    let mut rng = crate::edits::Lcg::new(seed);
+    let mut rng = Lcg::new(seed);
     (0..len).map(|_| char::from(ALPHABET[rng.below(ALPHABET.len())])).collect()
 }
 
