@@ -422,7 +422,7 @@ fn lower_prints_the_blocks_as_the_executor_reads_them() {
 /// A CAM program of a million blocks (about 35 MB) is checked completely.
 #[test]
 fn checks_a_35_megabyte_program() {
-    use ncc_bench::progen::{self, Syntax};
+    use ncc_bench::cnc8x6::progen::{self, Syntax};
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("surface.NCP");
     let text = progen::write(&progen::surfacing(1_000_000), Syntax::Cnc8x6);
@@ -950,7 +950,7 @@ fn expand_stops_at_a_move_it_cannot_write() {
 fn a_line_of_random_text_reports_ten_findings_and_counts_the_rest() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("RANDOM.NCP");
-    std::fs::write(&path, ncc_bench::progen::random_line(1 << 20, 7)).unwrap();
+    std::fs::write(&path, ncc_bench::cnc8x6::progen::random_line(1 << 20, 7)).unwrap();
     let path = path.to_str().unwrap();
 
     let output = ncc(&["check", "--format", "short", path]);

@@ -6,9 +6,9 @@
 use std::{process::Command, time::Duration};
 
 use ncc_bench::{
+    cnc8x6::progen::{self, Syntax},
     edits::{Lcg, typing_edit},
     lsp_client::{Client, Document, Message, file_uri, initialize_params},
-    progen::{self, Syntax},
 };
 use serde_json::{Value, json};
 use tempfile::TempDir;

@@ -4,6 +4,8 @@
 //! rules.
 
 pub(crate) mod checks;
+pub(crate) mod chunks;
 pub mod flow;
+pub(crate) mod ide;
 pub(crate) mod model;
 pub(crate) mod states;

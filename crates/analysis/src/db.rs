@@ -6,24 +6,26 @@
 //! incremental reparse keeps every untouched block's node, so only the
 //! chunk the edit touched is lowered and checked again.
 
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
-use ncc_syntax::{Dialect, Parse, SyntaxKind, TextSize, limit::LineLimiter};
+use ncc_syntax::{Dialect, Parse, SyntaxKind, TextSize};
 use rowan::GreenNode;
 
-use crate::{
-    Config, Diagnostic,
-    cnc8x6::model::{BlockSummary, ChunkSummary},
-    cnc8x6::states::StateCache,
-    findings::{self, Findings},
-    lower::BlockData,
-};
+use crate::Config;
 
 #[salsa::db]
 pub trait Db: salsa::Database {
-    /// Modal-state checkpoints, kept outside salsa because they stay valid
-    /// across edits (see `states`).
-    fn state_cache(&self) -> &StateCache;
+    /// What the dialect of the settings keeps outside salsa, made by its
+    /// first use: a database holds files of one dialect.
+    fn dialect_cache(&self) -> &OnceLock<Box<dyn DialectCache>>;
+}
+
+/// What a dialect keeps about files outside salsa, because it stays valid
+/// across edits (the checkpoints of the flow walk's state). Unwind safe, as
+/// a snapshot's question may be cancelled by unwinding.
+pub trait DialectCache: std::any::Any + Send + Sync + std::panic::RefUnwindSafe + std::panic::UnwindSafe {
+    /// Lets go of what is kept about `file`.
+    fn forget(&self, file: SourceFile);
 }
 
 /// A program file of the workspace.
@@ -92,7 +94,7 @@ fn chunk_green<'db>(_db: &'db dyn Db, _chunk: BlockChunk<'db>) -> BlockGreen {
 }
 
 impl<'db> BlockChunk<'db> {
-    fn green(self, db: &'db dyn Db) -> &'db BlockGreen {
+    pub(crate) fn green(self, db: &'db dyn Db) -> &'db BlockGreen {
         chunk_green(db, self)
     }
 
@@ -154,50 +156,13 @@ pub fn file_chunks(db: &dyn Db, file: SourceFile) -> Vec<FileChunk<'_>> {
     chunks
 }
 
-/// The blocks of a chunk lowered, each with its offset from the chunk's
-/// start. Lowering is cheap and its results are large, so they are rebuilt
-/// on demand rather than stored.
-pub fn lower_chunk<'a>(db: &'a dyn Db, chunk: BlockChunk<'a>) -> impl Iterator<Item = (TextSize, BlockData)> + 'a {
-    let mut offset = TextSize::from(0);
-    chunk.blocks(db).map(move |green| {
-        let block = (offset, BlockData::lower(green));
-        offset += green.text_len();
-        block
-    })
-}
-
-/// The findings about the blocks of a chunk that need nothing but each
-/// block and the configuration, limited per line of the chunk; ranges
-/// relative to the chunk's start.
-#[salsa::tracked(returns(ref))]
-pub fn chunk_diagnostics<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Findings {
-    let config = Settings::get(db).config(db);
-    let text = chunk.green(db).0.to_string();
-    let mut limiter = LineLimiter::new(&text);
-    let mut diagnostics = Vec::new();
-    for (offset, data) in lower_chunk(db, chunk) {
-        let mut block: Vec<Diagnostic> =
-            crate::cnc8x6::checks::block::check(&data, config).into_iter().map(|d| d.shifted(offset)).collect();
-        findings::sort_diagnostics(&mut block);
-        diagnostics.extend(block.into_iter().filter(|d| limiter.keep(d.range.start(), findings::key(d))));
-    }
-    Findings { diagnostics, omitted: limiter.finish() }
-}
-
-/// What the program model needs of each block of a chunk; ranges relative
-/// to the chunk's start.
-#[salsa::tracked(returns(ref))]
-pub fn chunk_summaries<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Arc<ChunkSummary> {
-    Arc::new(ChunkSummary::new(lower_chunk(db, chunk).map(|(offset, data)| BlockSummary::of(&data, offset)).collect()))
-}
-
 /// The database. Cloning it gives a handle for another thread.
 #[salsa::db]
 #[derive(Clone, Default)]
 pub struct RootDatabase {
     storage: salsa::Storage<Self>,
     log: Option<Arc<Mutex<Vec<String>>>>,
-    states: Arc<StateCache>,
+    dialect_cache: Arc<OnceLock<Box<dyn DialectCache>>>,
 }
 
 impl RootDatabase {
@@ -212,7 +177,7 @@ impl RootDatabase {
                 }
             }))),
             log: Some(log),
-            states: Arc::default(),
+            dialect_cache: Arc::default(),
         }
     }
 
@@ -233,8 +198,8 @@ impl salsa::Database for RootDatabase {}
 
 #[salsa::db]
 impl Db for RootDatabase {
-    fn state_cache(&self) -> &StateCache {
-        &self.states
+    fn dialect_cache(&self) -> &OnceLock<Box<dyn DialectCache>> {
+        &self.dialect_cache
     }
 }
 

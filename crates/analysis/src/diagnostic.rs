@@ -173,23 +173,21 @@ pub struct Rule {
 }
 
 impl Rule {
-    /// Every rule: the parser's syntax diagnostics, every check module's,
-    /// then the executor's.
-    pub fn all() -> impl Iterator<Item = &'static Rule> {
-        let checks = crate::cnc8x6::checks::RULES.iter().flat_map(|rules| rules.iter().copied());
-        SYNTAX_RULES.iter().chain(checks).chain(RUN_RULES.iter())
-    }
-
     /// The rule of an executor's finding.
     pub fn of_run(rule: RunRule) -> &'static Rule {
         // `RunRule::ALL` lists the rules in their declaration order.
         &RUN_RULES[rule as usize]
     }
+}
 
-    /// The rule with this code or name.
-    pub fn find(key: &str) -> Option<&'static Rule> {
-        Rule::all().find(|rule| rule.code == key || rule.name == key)
-    }
+/// The parser's rules (`Rule::all` lists them with the dialects').
+pub(crate) fn syntax_rules() -> impl Iterator<Item = &'static Rule> {
+    SYNTAX_RULES.iter()
+}
+
+/// The executor's rules.
+pub(crate) fn run_rules() -> impl Iterator<Item = &'static Rule> {
+    RUN_RULES.iter()
 }
 
 /// Declares a check module's rules as statics and lists them in `RULES`.

@@ -11,6 +11,7 @@ pub mod cnc8x6;
 mod config;
 mod db;
 mod diagnostic;
+mod dialect;
 mod findings;
 mod ide;
 mod suppress;
@@ -118,7 +119,9 @@ impl AnalysisHost {
     /// to nothing, and the chunks of its old tree go with their results.
     /// The results replaced are freed at the next revision.
     fn release(&mut self, file: FileId) {
-        self.db.state_cache().forget(file);
+        if let Some(cache) = self.db.dialect_cache().get() {
+            cache.forget(file);
+        }
         let empty = Parse::new("", self.dialect());
         file.set_text(&mut self.db).to(Arc::default());
         file.set_parse(&mut self.db).to(empty);
@@ -242,7 +245,7 @@ impl Analysis {
     /// checkpoints. Long, but a question meanwhile waits a millisecond at
     /// most; meant for idle time.
     pub fn prepare_states(&self, file: FileId) {
-        cnc8x6::states::prepare(&self.db, file);
+        dialect::prepare_states(&self.db, file);
     }
 
     /// The outline: program units, and the blocks jumps go to in each.
@@ -300,6 +303,11 @@ impl Analysis {
         ide::cycle_time::program_head(&self.db, file)
     }
 
+    /// The language of every file.
+    pub fn dialect(&self) -> Dialect {
+        *Settings::get(&self.db).dialect(&self.db)
+    }
+
     pub fn path(&self, file: FileId) -> String {
         file.path(&self.db).clone()
     }
@@ -319,18 +327,14 @@ fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
         diagnostics: parse.errors().iter().map(Diagnostic::from_syntax).collect(),
         omitted: parse.omitted().iter().map(|o| o.map(|kind| (kind.code(), kind.severity()))).collect(),
     };
-    for chunk in db::file_chunks(db, file) {
-        all.append(db::chunk_diagnostics(db, chunk.chunk).clone().shifted(chunk.offset));
-    }
-    all.diagnostics.extend(cnc8x6::checks::structure::check(db, file));
-    all.diagnostics.extend(cnc8x6::checks::cycles::check_file(db, file));
+    all.append(dialect::local_findings(db, file));
     configure(db, file, all)
 }
 
 /// The flow walk's findings of a file, configured.
 #[salsa::tracked(returns(ref))]
 fn configured_flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
-    configure(db, file, cnc8x6::flow::flow_diagnostics(db, file).clone())
+    configure(db, file, dialect::flow_findings(db, file).clone())
 }
 
 /// Applies suppression comments and the configured levels, and limits

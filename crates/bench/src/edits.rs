@@ -82,7 +82,7 @@ pub fn typing_edit(text: &str, rng: &mut Lcg) -> Option<Edit> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::progen::{self, Syntax};
+    use crate::cnc8x6::progen::{self, Syntax};
 
     #[test]
     fn edits_touch_only_coordinates_and_spaces_between_words() {

@@ -5,7 +5,7 @@
 //! and the server's end-to-end tests; and the lookup of the executor's peer,
 //! LinuxCNC's `rs274`.
 
+pub mod cnc8x6;
 pub mod edits;
 pub mod lsp_client;
-pub mod progen;
 pub mod rs274;

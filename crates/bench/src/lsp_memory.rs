@@ -21,9 +21,10 @@ use ncc_bench::{
     edits::{self, Lcg},
     lsp_client::{Client, Document},
 };
+use ncc_syntax::Dialect;
 use serde_json::{Value, json};
 
-use crate::{SEED, g_code_near};
+use crate::{SEED, code_near};
 
 /// The goal: the resident size after all edits within 25 % of the one
 /// after the first sample.
@@ -38,6 +39,7 @@ const VISIBLE_LINES: usize = 50;
 const SETTLE: Duration = Duration::from_secs(1);
 
 pub struct Options {
+    pub dialect: Dialect,
     pub blocks: usize,
     pub edits: usize,
     pub sample_every: usize,
@@ -54,9 +56,9 @@ struct Sample {
 }
 
 pub fn run(server: &Path, options: &Options) -> anyhow::Result<()> {
-    let Options { blocks, edits, sample_every, pause_every, json: as_json } = *options;
+    let Options { dialect, blocks, edits, sample_every, pause_every, json: as_json } = *options;
     anyhow::ensure!(edits > 0 && sample_every > 0 && pause_every > 0, "counts must be at least 1");
-    let (mut client, _workspace, mut doc) = crate::serve_generated_program(server, blocks)?;
+    let (mut client, _workspace, mut doc) = crate::serve_generated_program(server, dialect, blocks)?;
     let bytes = doc.text().len();
     let rss = |client: &Client| client.memory().map(|m| m.rss).context("the server's memory is unknown (no /proc)");
     let before_open = rss(&client)?;
@@ -92,7 +94,7 @@ pub fn run(server: &Path, options: &Options) -> anyhow::Result<()> {
         client.take_received();
         client.notify("textDocument/didChange", doc.change(edit.range.clone(), &edit.insert))?;
         client.diagnostics(&doc.uri, doc.version)?;
-        let target = g_code_near(doc.text(), edit.range.start, &mut rng).context("no G code near the edit")?;
+        let target = code_near(dialect, doc.text(), edit.range.start, &mut rng).context("no G code near the edit")?;
         let hover = client.call("textDocument/hover", doc.at(doc.position(target)))?;
         anyhow::ensure!(hover.error_code().is_none(), "hover failed: {}", hover.json);
         let sample = done % sample_every == 0 || done == edits;

@@ -1,7 +1,7 @@
 //! `ncc-bench`: measurements of ncc against peer tools.
 //!
 //! ```text
-//! cargo run --release -p ncc-bench -- parse [--blocks 1000000] [--runs 3]
+//! cargo run --release -p ncc-bench -- parse [--dialect cnc8x6] [--blocks 1000000] [--runs 3]
 //! cargo run --release -p ncc-bench -- generate --blocks 1000000 --syntax cnc8x6 -o big.NCP
 //! cargo build --release -p ncc -p ncc-bench && target/release/ncc-bench lsp [--json]
 //! cargo build --release -p ncc -p ncc-bench && target/release/ncc-bench lsp-memory [--edits 30000] [--json]
@@ -22,10 +22,11 @@ use std::{
 
 use anyhow::Context;
 use clap::{Parser, Subcommand, ValueEnum};
+use ncc_analysis::DialectId;
 use ncc_bench::{
+    cnc8x6::progen::{self, Move, Syntax},
     edits::{self, Lcg},
     lsp_client::{self, Client, Document},
-    progen::{self, Syntax},
     rs274,
 };
 use ncc_syntax::{Dialect, Parse};
@@ -77,6 +78,8 @@ enum Command {
     /// Parse a generated surfacing program with ncc (lossless CST) and the
     /// same toolpath in NGC syntax with the `gcode` crate.
     Parse {
+        #[command(flatten)]
+        dialect: DialectArg,
         #[arg(long, default_value_t = 1_000_000)]
         blocks: usize,
         /// Timed runs per parser; the best one counts.
@@ -86,6 +89,8 @@ enum Command {
     /// Time incremental reparses after single-character edits at random
     /// places of a generated program, against a full parse.
     Reparse {
+        #[command(flatten)]
+        dialect: DialectArg,
         #[arg(long, default_value_t = 100_000)]
         blocks: usize,
         #[arg(long, default_value_t = 200)]
@@ -93,6 +98,8 @@ enum Command {
     },
     /// Check a generated program with the full analysis: time and peak heap.
     Check {
+        #[command(flatten)]
+        dialect: DialectArg,
         #[arg(long, default_value_t = 1_000_000)]
         blocks: usize,
     },
@@ -105,6 +112,8 @@ enum Command {
         /// The `ncc` binary [default: the one beside ncc-bench].
         #[arg(long)]
         server: Option<PathBuf>,
+        #[command(flatten)]
+        dialect: DialectArg,
         #[arg(long, default_value_t = 100_000)]
         blocks: usize,
         #[arg(long, default_value_t = 200)]
@@ -120,6 +129,8 @@ enum Command {
         /// The `ncc` binary [default: the one beside ncc-bench].
         #[arg(long)]
         server: Option<PathBuf>,
+        #[command(flatten)]
+        dialect: DialectArg,
         #[arg(long, default_value_t = 100_000)]
         blocks: usize,
         #[arg(long, default_value_t = 30_000)]
@@ -141,6 +152,8 @@ enum Command {
         /// The `ncc` binary [default: the one beside ncc-bench].
         #[arg(long)]
         ncc: Option<PathBuf>,
+        #[command(flatten)]
+        dialect: DialectArg,
         #[arg(long, default_value_t = 1_000_000)]
         blocks: usize,
         /// Timed runs of each; the best one counts.
@@ -153,6 +166,8 @@ enum Command {
     /// Parse a file once (for profilers such as perf or callgrind).
     ParseFile {
         path: PathBuf,
+        #[command(flatten)]
+        dialect: DialectArg,
         /// Threads for ncc.
         #[arg(long, default_value_t = 1)]
         threads: usize,
@@ -171,6 +186,51 @@ enum Command {
     },
 }
 
+/// The dialect of the programs a benchmark reads.
+#[derive(clap::Args)]
+struct DialectArg {
+    /// The dialect's name.
+    #[arg(long = "dialect", value_name = "NAME", default_value_t = DialectId::from(Dialect::default()))]
+    id: DialectId,
+}
+
+impl DialectArg {
+    /// The dialect's implementation; for a dialect this build does not
+    /// read, the message and exit status 2.
+    fn implementation(&self) -> Dialect {
+        self.id.implementation().unwrap_or_else(|| {
+            eprintln!("error: {}", self.id.not_read());
+            std::process::exit(2)
+        })
+    }
+}
+
+/// The toolpath `moves` as a program of `dialect`.
+fn program_text(dialect: Dialect, moves: &[Move]) -> String {
+    match dialect {
+        Dialect::Cnc8x6 => progen::write(moves, Syntax::Cnc8x6),
+    }
+}
+
+/// The generated surfacing program of `blocks` blocks in `dialect`.
+fn generated_program(dialect: Dialect, blocks: usize) -> String {
+    program_text(dialect, &progen::surfacing(blocks))
+}
+
+/// The name of the generated program's file: the dialect's extension.
+fn program_file_name(dialect: Dialect) -> String {
+    let extension = DialectId::from(dialect).default_extensions().first().copied().unwrap_or_default();
+    format!("surface.{extension}")
+}
+
+/// A place inside a code word of a generated program near `offset`, to
+/// hover.
+pub(crate) fn code_near(dialect: Dialect, text: &str, offset: usize, rng: &mut Lcg) -> Option<usize> {
+    match dialect {
+        Dialect::Cnc8x6 => progen::g_code_near(text, offset, rng),
+    }
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum SyntaxArg {
     Cnc8x6,
@@ -179,20 +239,26 @@ enum SyntaxArg {
 
 fn main() -> anyhow::Result<()> {
     match Cli::parse().command {
-        Command::Parse { blocks, runs } => parse_benchmark(blocks, runs.max(1)),
-        Command::Reparse { blocks, edits } => reparse_benchmark(blocks, edits),
-        Command::Check { blocks } => check_benchmark(blocks),
-        Command::Lsp { server, blocks, edits, json } => {
-            lsp_benchmark(&server.map_or_else(ncc_beside_bench, Ok)?, blocks, edits, json)
+        Command::Parse { dialect, blocks, runs } => parse_benchmark(dialect.implementation(), blocks, runs.max(1)),
+        Command::Reparse { dialect, blocks, edits } => reparse_benchmark(dialect.implementation(), blocks, edits),
+        Command::Check { dialect, blocks } => check_benchmark(dialect.implementation(), blocks),
+        Command::Lsp { server, dialect, blocks, edits, json } => {
+            let dialect = dialect.implementation();
+            lsp_benchmark(&server.map_or_else(ncc_beside_bench, Ok)?, dialect, blocks, edits, json)
         }
-        Command::LspMemory { server, blocks, edits, sample_every, pause_every, json } => lsp_memory::run(
-            &server.map_or_else(ncc_beside_bench, Ok)?,
-            &lsp_memory::Options { blocks, edits, sample_every, pause_every, json },
-        ),
-        Command::Exec { ncc, blocks, runs, json } => {
-            exec_benchmark(&ncc.map_or_else(ncc_beside_bench, Ok)?, blocks, runs.max(1), json)
+        Command::LspMemory { server, dialect, blocks, edits, sample_every, pause_every, json } => {
+            let dialect = dialect.implementation();
+            lsp_memory::run(
+                &server.map_or_else(ncc_beside_bench, Ok)?,
+                &lsp_memory::Options { dialect, blocks, edits, sample_every, pause_every, json },
+            )
         }
-        Command::ParseFile { path, threads, gcode } => {
+        Command::Exec { ncc, dialect, blocks, runs, json } => {
+            let dialect = dialect.implementation();
+            exec_benchmark(&ncc.map_or_else(ncc_beside_bench, Ok)?, dialect, blocks, runs.max(1), json)
+        }
+        Command::ParseFile { path, dialect, threads, gcode } => {
+            let dialect = dialect.implementation();
             let text = std::fs::read_to_string(&path)?;
             let start = Instant::now();
             if gcode {
@@ -201,7 +267,7 @@ fn main() -> anyhow::Result<()> {
                 std::mem::forget(program);
             } else {
                 let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
-                let parse = pool.install(|| Parse::new(&text, Dialect::Cnc8x6));
+                let parse = pool.install(|| Parse::new(&text, dialect));
                 println!("{} errors in {:?}", parse.errors().len(), start.elapsed());
                 std::mem::forget(parse);
             }
@@ -245,14 +311,14 @@ fn measure<T>(runs: usize, mut f: impl FnMut() -> T) -> Measurement {
     Measurement { best, peak_bytes }
 }
 
-fn parse_benchmark(blocks: usize, runs: usize) -> anyhow::Result<()> {
+fn parse_benchmark(dialect: Dialect, blocks: usize, runs: usize) -> anyhow::Result<()> {
     let moves = progen::surfacing(blocks);
-    let cnc = progen::write(&moves, Syntax::Cnc8x6);
+    let cnc = program_text(dialect, &moves);
     let ngc = progen::write(&moves, Syntax::Ngc);
     drop(moves);
 
     // Sanity: both parsers accept their input completely.
-    let parse = Parse::new(&cnc, Dialect::Cnc8x6);
+    let parse = Parse::new(&cnc, dialect);
     anyhow::ensure!(parse.errors().is_empty(), "ncc found errors: {:?}", &parse.errors()[..1]);
     anyhow::ensure!(parse.tree().blocks().count() == blocks, "ncc block count");
     drop(parse);
@@ -263,13 +329,14 @@ fn parse_benchmark(blocks: usize, runs: usize) -> anyhow::Result<()> {
     let threads = rayon::current_num_threads();
     let single = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     println!(
-        "parse benchmark: {blocks} blocks; CNC8x6 {:.1} MB, NGC {:.1} MB; best of {runs} runs",
+        "parse benchmark: {blocks} blocks; {} {:.1} MB, NGC {:.1} MB; best of {runs} runs",
+        DialectId::from(dialect).title(),
         cnc.len() as f64 / 1e6,
         ngc.len() as f64 / 1e6
     );
     let gcode_rs = measure(runs, || gcode::parse(&ngc));
-    let ncc_one = measure(runs, || single.install(|| Parse::new(&cnc, Dialect::Cnc8x6)));
-    let ncc_all = measure(runs, || Parse::new(&cnc, Dialect::Cnc8x6));
+    let ncc_one = measure(runs, || single.install(|| Parse::new(&cnc, dialect)));
+    let ncc_all = measure(runs, || Parse::new(&cnc, dialect));
 
     let rate = |m: &Measurement| blocks as f64 / m.best.as_secs_f64();
     let row = |name: &str, m: &Measurement| {
@@ -304,12 +371,12 @@ fn percentile(sorted: &[Duration], p: f64) -> Duration {
     sorted[((sorted.len() - 1) as f64 * p) as usize]
 }
 
-fn reparse_benchmark(blocks: usize, edits: usize) -> anyhow::Result<()> {
+fn reparse_benchmark(dialect: Dialect, blocks: usize, edits: usize) -> anyhow::Result<()> {
     use ncc_syntax::{TextEdit, TextRange, TextSize};
 
-    let mut text = progen::write(&progen::surfacing(blocks), Syntax::Cnc8x6);
+    let mut text = generated_program(dialect, blocks);
     let start = Instant::now();
-    let mut parse = Parse::new(&text, Dialect::Cnc8x6);
+    let mut parse = Parse::new(&text, dialect);
     let full = start.elapsed();
 
     let mut rng = Lcg::new(SEED);
@@ -324,7 +391,7 @@ fn reparse_benchmark(blocks: usize, edits: usize) -> anyhow::Result<()> {
         parse = parse.reparse(&edit, &text);
         times.push(start.elapsed());
     }
-    anyhow::ensure!(parse == Parse::new(&text, Dialect::Cnc8x6), "incremental result differs from a full parse");
+    anyhow::ensure!(parse == Parse::new(&text, dialect), "incremental result differs from a full parse");
     times.sort();
     println!("reparse benchmark: {blocks} blocks ({:.1} MB), {edits} single-character edits", text.len() as f64 / 1e6);
     println!("  full parse   {:>9.3} ms", full.as_secs_f64() * 1e3);
@@ -333,14 +400,14 @@ fn reparse_benchmark(blocks: usize, edits: usize) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn check_benchmark(blocks: usize) -> anyhow::Result<()> {
-    let text = progen::write(&progen::surfacing(blocks), Syntax::Cnc8x6);
+fn check_benchmark(dialect: Dialect, blocks: usize) -> anyhow::Result<()> {
+    let text = generated_program(dialect, blocks);
     let mb = text.len() as f64 / 1e6;
     let base = IN_USE.load(Relaxed);
     PEAK.store(base, Relaxed);
     let start = Instant::now();
-    let mut host = ncc_analysis::AnalysisHost::default();
-    let file = host.add_file("surface.NCP", text);
+    let mut host = ncc_analysis::AnalysisHost::in_dialect(dialect, ncc_analysis::Config::default());
+    let file = host.add_file(program_file_name(dialect), text);
     let parsed = start.elapsed();
     let after_parse = IN_USE.load(Relaxed) - base;
     let diagnostics = host.analysis().diagnostics(file);
@@ -495,13 +562,14 @@ fn wake_ups(count: usize) -> Latencies {
 /// opened; the workspace lasts as long as the returned directory.
 pub(crate) fn serve_generated_program(
     server: &Path,
+    dialect: Dialect,
     blocks: usize,
 ) -> anyhow::Result<(Client, tempfile::TempDir, Document)> {
-    let text = progen::write(&progen::surfacing(blocks), Syntax::Cnc8x6);
+    let text = generated_program(dialect, blocks);
     // Editors open files that exist: the server may look beside them, and
     // a closed document stays in the workspace as its file.
     let dir = tempfile::tempdir()?;
-    let path = dir.path().join("surface.NCP");
+    let path = dir.path().join(program_file_name(dialect));
     std::fs::write(&path, &text)?;
     let mut process = Process::new(server);
     process.arg("lsp");
@@ -512,9 +580,9 @@ pub(crate) fn serve_generated_program(
     Ok((client, dir, Document::new(lsp_client::file_uri(&path), text)))
 }
 
-fn lsp_benchmark(server: &Path, blocks: usize, edits: usize, as_json: bool) -> anyhow::Result<()> {
+fn lsp_benchmark(server: &Path, dialect: Dialect, blocks: usize, edits: usize, as_json: bool) -> anyhow::Result<()> {
     anyhow::ensure!(edits > 0, "--edits must be at least 1");
-    let (mut client, _workspace, mut doc) = serve_generated_program(server, blocks)?;
+    let (mut client, _workspace, mut doc) = serve_generated_program(server, dialect, blocks)?;
     let bytes = doc.text().len();
     let cpu_before = CpuTimes::now();
     let opened = client.notify("textDocument/didOpen", doc.did_open())?;
@@ -530,7 +598,7 @@ fn lsp_benchmark(server: &Path, blocks: usize, edits: usize, as_json: bool) -> a
         let sent = client.notify("textDocument/didChange", change)?;
         diagnostics.samples.push(client.diagnostics(&doc.uri, doc.version)?.received - sent);
 
-        let target = g_code_near(doc.text(), edit.range.start, &mut rng).context("no G code near the edit")?;
+        let target = code_near(dialect, doc.text(), edit.range.start, &mut rng).context("no G code near the edit")?;
         let request = client.request("textDocument/hover", doc.at(doc.position(target)))?;
         let response = client.response(&request)?;
         anyhow::ensure!(response.error_code().is_none(), "hover failed: {}", response.json);
@@ -551,7 +619,7 @@ fn lsp_benchmark(server: &Path, blocks: usize, edits: usize, as_json: bool) -> a
     let mut idle_hovers = Latencies::new("hover after a pause", HOVER_GOAL, IDLE_HOVERS);
     for _ in 0..IDLE_HOVERS {
         let anywhere = rng.below(doc.text().len());
-        let target = g_code_near(doc.text(), anywhere, &mut rng).context("no G code in the program")?;
+        let target = code_near(dialect, doc.text(), anywhere, &mut rng).context("no G code in the program")?;
         let request = client.request("textDocument/hover", doc.at(doc.position(target)))?;
         let response = client.response(&request)?;
         anyhow::ensure!(response.error_code().is_none(), "hover failed: {}", response.json);
@@ -711,42 +779,12 @@ fn coordinate_digits(text: &str, rng: &mut Lcg) -> Option<usize> {
     None
 }
 
-/// The offset of a random character of the first G word at or after a
-/// random line within ten lines of `offset`.
-fn g_code_near(text: &str, offset: usize, rng: &mut Lcg) -> Option<usize> {
-    let mut start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
-    let (up, down) = match rng.below(21) {
-        lines @ 0..10 => (lines + 1, 0),
-        lines => (0, lines - 10),
-    };
-    for _ in 0..up {
-        start = text[..start.saturating_sub(1)].rfind('\n').map_or(0, |i| i + 1);
-    }
-    for _ in 0..down {
-        start = text[start..].find('\n').map_or(start, |i| start + i + 1);
-    }
-    let mut line_start = start;
-    for line in text[start..].split_inclusive('\n') {
-        if line.starts_with('N') {
-            let mut word_start = line_start;
-            for word in line.trim_end().split(' ') {
-                if word.len() > 1 && word.starts_with('G') && word.as_bytes()[1].is_ascii_digit() {
-                    return Some(word_start + rng.below(word.len()));
-                }
-                word_start += word.len() + 1;
-            }
-        }
-        line_start += line.len();
-    }
-    None
-}
-
-fn exec_benchmark(ncc: &Path, blocks: usize, runs: usize, as_json: bool) -> anyhow::Result<()> {
+fn exec_benchmark(ncc: &Path, dialect: Dialect, blocks: usize, runs: usize, as_json: bool) -> anyhow::Result<()> {
     let rs274 = rs274::find().context(rs274::MISSING)?;
     anyhow::ensure!(ncc.is_file(), "{} not found: cargo build --release -p ncc", ncc.display());
     let moves = progen::surfacing(blocks);
     let dir = tempfile::tempdir()?;
-    let (cnc, ngc) = (dir.path().join("surface.NCP"), dir.path().join("surface.ngc"));
+    let (cnc, ngc) = (dir.path().join(program_file_name(dialect)), dir.path().join("surface.ngc"));
     // On disk before the runs, so that writing them back does not run
     // beside one tool's runs and not the other's.
     let write_synced = |path: &Path, text: String| -> std::io::Result<()> {
@@ -754,7 +792,7 @@ fn exec_benchmark(ncc: &Path, blocks: usize, runs: usize, as_json: bool) -> anyh
         std::io::Write::write_all(&mut file, text.as_bytes())?;
         file.sync_all()
     };
-    write_synced(&cnc, progen::write(&moves, Syntax::Cnc8x6))?;
+    write_synced(&cnc, program_text(dialect, &moves))?;
     write_synced(&ngc, progen::write(&moves, Syntax::Ngc))?;
     drop(moves);
     let mut ncc_run = Process::new(ncc);

@@ -1,7 +1,7 @@
 //! Looking entries up by what a programmer types: `G40`, `M30`, `R39`,
 //! `op:48`, `X`, `group:G3`.
 
-use crate::{Address, Catalogue, Code, Cycle, Group, MachineConstant, Operation, ParameterStatus};
+use crate::{Address, AddressRole, Catalogue, Code, Cycle, Group, MachineConstant, Operation, ParameterStatus};
 
 /// One thing the catalogue can describe.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -70,8 +70,9 @@ impl Catalogue {
             return vec![Item::Address(address)];
         }
         let Some((letter, number)) = crate::split_code(&upper) else { return Vec::new() };
-        match letter {
-            'R' => {
+        // `split_code` gives an ASCII letter.
+        match u8::try_from(letter).ok().and_then(|byte| self.role_of(byte)) {
+            Some(AddressRole::Parameter) => {
                 let constant = self.machine_constant_item(number);
                 let parameter = self.is_parameter(number).then_some(Item::Parameter(number));
                 // A parameter with a role of its own (R5, R95) is what a
@@ -84,7 +85,7 @@ impl Catalogue {
                     constant.into_iter().chain(parameter).collect()
                 }
             }
-            'G' | 'M' => {
+            Some(AddressRole::Function) => {
                 let mut items = Vec::new();
                 match self.code(letter, number) {
                     Some(code) => items.push(Item::Code(code)),

@@ -12,7 +12,7 @@ mod explain;
 mod render;
 pub mod schema;
 
-use std::{collections::HashMap, sync::OnceLock};
+use std::{collections::HashMap, ops::RangeInclusive, sync::OnceLock};
 
 pub use crate::{
     dialect_id::{DialectId, UnknownDialect, macrocycle_number},
@@ -132,12 +132,15 @@ pub struct Catalogue {
     roles: [Option<AddressRole>; 128],
     /// The index in `addresses` of each address byte, either case.
     address_index: [Option<u8>; 128],
-    /// [`Catalogue::modal_group_index`] of G and M codes below
-    /// [`DENSE_CODES`], which every block asks for.
-    modal_groups: [[Option<u8>; DENSE_CODES as usize]; 2],
+    /// [`Catalogue::modal_group_index`] of the codes below [`DENSE_CODES`]
+    /// of each function letter, which every block asks for.
+    modal_groups: Vec<(char, [Option<u8>; DENSE_CODES as usize])>,
+    /// The code ranges whose unlisted codes belong to a group, with the
+    /// group's index.
+    unlisted_ranges: Vec<(RangeInclusive<(char, u32)>, usize)>,
 }
 
-/// G and M numbers looked up in a table rather than a map.
+/// Code numbers looked up in a table rather than a map.
 const DENSE_CODES: u32 = 128;
 
 impl Catalogue {
@@ -165,6 +168,15 @@ impl Catalogue {
                 }
             }
         }
+        let unlisted_ranges = codes
+            .groups
+            .iter()
+            .enumerate()
+            .filter_map(|(index, group)| {
+                let [first, last] = group.takes_unlisted.as_ref()?;
+                Some((split_code(first)?..=split_code(last)?, index))
+            })
+            .collect();
         let mut catalogue = Catalogue {
             groups: codes.groups,
             codes: codes.codes,
@@ -177,26 +189,31 @@ impl Catalogue {
             codes_by_number,
             roles,
             address_index,
-            modal_groups: [[None; DENSE_CODES as usize]; 2],
+            modal_groups: Vec::new(),
+            unlisted_ranges,
         };
-        for (table, letter) in [(0, 'G'), (1, 'M')] {
-            for number in 0..DENSE_CODES {
-                catalogue.modal_groups[table][number as usize] =
-                    catalogue.find_modal_group(letter, number).and_then(|index| u8::try_from(index).ok());
+        let letters: Vec<char> = catalogue.function_letters().map(char::from).collect();
+        for letter in letters {
+            let mut table = [None; DENSE_CODES as usize];
+            for (number, group) in (0..DENSE_CODES).zip(&mut table) {
+                *group = catalogue.find_modal_group(letter, number).and_then(|index| u8::try_from(index).ok());
             }
+            catalogue.modal_groups.push((letter, table));
         }
         catalogue
+    }
+
+    /// The (upper-case) letters of the codes, in catalogue order.
+    pub fn function_letters(&self) -> impl Iterator<Item = u8> + '_ {
+        self.addresses.iter().filter(|a| a.role == AddressRole::Function).filter_map(|a| a.letter.bytes().next())
     }
 
     /// The index in [`Catalogue::groups`] of the group a code puts itself in
     /// force in: `None` for block-only codes and codes outside the groups.
     pub fn modal_group_index(&self, letter: char, number: u32) -> Option<usize> {
-        let table = match letter.to_ascii_uppercase() {
-            'G' => 0,
-            'M' => 1,
-            _ => return self.find_modal_group(letter, number),
-        };
-        match self.modal_groups[table].get(number as usize) {
+        let upper = letter.to_ascii_uppercase();
+        let table = self.modal_groups.iter().find(|(function, _)| *function == upper);
+        match table.and_then(|(_, table)| table.get(number as usize)) {
             Some(index) => index.map(usize::from),
             None => self.find_modal_group(letter, number),
         }
@@ -219,15 +236,16 @@ impl Catalogue {
         self.groups.iter().find(|g| g.id.eq_ignore_ascii_case(id))
     }
 
-    /// The group of a code: its listed group, or the open group (M14) that
-    /// takes every unlisted M code.
+    /// The group of a code: its listed group, or the group that takes the
+    /// unlisted codes of a range the code is in (`takes_unlisted`).
     pub fn group_of(&self, letter: char, number: u32) -> Option<&Group> {
         match self.code(letter, number) {
             Some(code) => self.group(code.group.as_deref()?),
-            None if letter.eq_ignore_ascii_case(&'M') && (10..=99).contains(&number) => {
-                self.groups.iter().rev().find(|g| g.open && g.id.starts_with('M'))
+            None => {
+                let code = (letter.to_ascii_uppercase(), number);
+                let (_, index) = self.unlisted_ranges.iter().find(|(range, _)| range.contains(&code))?;
+                self.groups.get(*index)
             }
-            None => None,
         }
     }
 

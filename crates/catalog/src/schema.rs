@@ -92,6 +92,10 @@ entry! {
         /// open range that no other group lists belongs here.
         #[serde(default)]
         pub open: bool,
+        /// The first and last code of a range whose codes no group lists
+        /// belong here (`["M10", "M99"]` for M14).
+        #[serde(default)]
+        pub takes_unlisted: Option<[String; 2]>,
         /// The machine constant that defines an open group (`R56` for M10).
         #[serde(default)]
         pub configured_by: Option<String>,

@@ -2,12 +2,13 @@
 
 use std::process::ExitCode;
 
-use ncc_catalog::{Catalogue, Dialect, DialectId};
+use ncc_catalog::{Catalogue, DialectId};
 
-/// Explains `query` in `dialect`'s catalogue (CNC8x6's when none is named;
-/// the command line has refused one this version does not read).
+/// Explains `query` in `dialect`'s catalogue (the default dialect's when
+/// none is named: a query names no program to take one from; the command
+/// line has refused a dialect this version does not read).
 pub(crate) fn run(query: Option<&str>, list: bool, dialect: Option<DialectId>) -> ExitCode {
-    let dialect = dialect.and_then(DialectId::implementation).unwrap_or(Dialect::Cnc8x6);
+    let dialect = dialect.and_then(DialectId::implementation).unwrap_or_default();
     let catalogue = dialect.catalogue();
     if list {
         print!("{}", listing(catalogue));
@@ -45,8 +46,10 @@ fn listing(catalogue: &Catalogue) -> String {
         }
     };
     section("groups", catalogue.groups.iter().map(|g| format!("group:{}", g.id)).collect());
-    section("G codes", catalogue.codes.iter().filter(|c| c.code.starts_with('G')).map(|c| c.code.clone()).collect());
-    section("M codes", catalogue.codes.iter().filter(|c| c.code.starts_with('M')).map(|c| c.code.clone()).collect());
+    for letter in catalogue.function_letters().map(char::from) {
+        let codes = catalogue.codes.iter().filter(|c| c.code.starts_with(letter)).map(|c| c.code.clone());
+        section(&format!("{letter} codes"), codes.collect());
+    }
     section("addresses", catalogue.addresses.iter().map(|a| a.letter.clone()).collect());
     section("program parameters", (0..catalogue.parameters.count).map(|n| format!("R{n}")).collect());
     section(

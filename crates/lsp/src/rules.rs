@@ -44,21 +44,22 @@ fn table<'a>(rules: impl Iterator<Item = &'a Rule>) -> String {
     out
 }
 
-/// What each code letter stands for, in the order the reference lists them.
-const KINDS: &[(char, &str)] = &[
-    ('S', "Syntax"),
-    ('P', "Program structure"),
-    ('B', "Blocks: codes, addresses and values"),
-    ('R', "Parameters"),
-    ('A', "Parameter arithmetic"),
-    ('M', "Motion and compensation"),
-    ('F', "Feed and spindle"),
-    ('T', "Threads"),
-    ('C', "Fixed cycles"),
-    ('X', "Transformations"),
-    ('D', "Dynamics and continuity"),
-    ('Z', "Report limits"),
-    ('E', "Execution (`ncc run`, `ncc expand`, `ncc plot`)"),
+/// What the letter that starts a rule's code stands for, in the order the
+/// reference lists them.
+const KINDS: &[(&str, &str)] = &[
+    ("S", "Syntax"),
+    ("P", "Program structure"),
+    ("B", "Blocks: codes, addresses and values"),
+    ("R", "Parameters"),
+    ("A", "Parameter arithmetic"),
+    ("M", "Motion and compensation"),
+    ("F", "Feed and spindle"),
+    ("T", "Threads"),
+    ("C", "Fixed cycles"),
+    ("X", "Transformations"),
+    ("D", "Dynamics and continuity"),
+    ("Z", "Report limits"),
+    ("E", "Execution (`ncc run`, `ncc expand`, `ncc plot`)"),
 ];
 
 /// The rules as Markdown tables, one section per kind.
@@ -70,9 +71,9 @@ fn reference<'a>(rules: impl Iterator<Item = &'a Rule>) -> String {
          the executor reports while it runs a program; a finding that stops the run is shown whatever its level.\n",
         rules.len()
     );
-    for &(letter, title) in KINDS {
+    for &(prefix, title) in KINDS {
         out.push_str(&format!("\n## {title}\n\n| code | name | severity | checks |\n|---|---|---|---|\n"));
-        for rule in rules.iter().filter(|rule| rule.code.starts_with(letter)) {
+        for rule in rules.iter().filter(|rule| rule.code.starts_with(prefix)) {
             let opt_in = if rule.opt_in { ", opt-in" } else { "" };
             let summary = rule.summary.replace('|', "\\|");
             out.push_str(&format!(

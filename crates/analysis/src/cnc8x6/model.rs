@@ -11,6 +11,7 @@ use ncc_syntax::{TextRange, TextSize};
 use rustc_hash::FxHashMap;
 
 use crate::{
+    cnc8x6::chunks,
     db::{self, Db, SourceFile},
     lower::{BlockData, Value},
 };
@@ -281,13 +282,33 @@ fn literal(block: &BlockData, letter: u8) -> Option<(u32, TextRange)> {
     })
 }
 
+/// What the `L` of a call or jump names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum TransferKind {
+    Subprogram,
+    Macrocycle,
+    Jump,
+}
+
+/// The block's call or jump code (G71, G72, G73), whether or not its `L`
+/// has a value yet: what the `L` names, and the code's range.
+pub(crate) fn transfer_kind(block: &BlockData) -> Option<(TransferKind, TextRange)> {
+    let (code, range) = block.codes(b'G').find(|(c, _)| matches!(c, 71..=73)).map(|(c, w)| (c, w.range))?;
+    let kind = match code {
+        71 => TransferKind::Subprogram,
+        72 => TransferKind::Macrocycle,
+        _ => TransferKind::Jump,
+    };
+    Some((kind, range))
+}
+
 fn transfer(block: &BlockData) -> Option<(Transfer, TextRange)> {
     let (target, _) = literal(block, b'L')?;
-    let (code, range) = block.codes(b'G').find(|(c, _)| matches!(c, 71..=73)).map(|(c, w)| (c, w.range))?;
-    let transfer = match code {
-        71 => Transfer::Subprogram(target),
-        72 => Transfer::Macrocycle(target),
-        _ => Transfer::Jump(target),
+    let (kind, range) = transfer_kind(block)?;
+    let transfer = match kind {
+        TransferKind::Subprogram => Transfer::Subprogram(target),
+        TransferKind::Macrocycle => Transfer::Macrocycle(target),
+        TransferKind::Jump => Transfer::Jump(target),
     };
     Some((transfer, range))
 }
@@ -298,7 +319,11 @@ pub fn program(db: &dyn Db, file: SourceFile) -> Program {
     let kind = file_kind(db, file);
     let chunks: Vec<ChunkBlocks> = db::file_chunks(db, file)
         .iter()
-        .map(|c| ChunkBlocks { offset: c.offset, first: c.first, summary: db::chunk_summaries(db, c.chunk).clone() })
+        .map(|c| ChunkBlocks {
+            offset: c.offset,
+            first: c.first,
+            summary: chunks::chunk_summaries(db, c.chunk).clone(),
+        })
         .collect();
     let block_count = chunks.last().map_or(0, |c| c.first + c.summary.blocks.len());
     let mut program = Program {

@@ -33,7 +33,7 @@ use crate::{
     Config,
     cnc8x6::flow::{Course, Known, ModalState, ParamState, Walk},
     cnc8x6::model::{self, Program},
-    db::{Db, Settings, SourceFile},
+    db::{Db, DialectCache, Settings, SourceFile},
 };
 
 /// Blocks between checkpoints: walking this many costs well under a
@@ -42,7 +42,7 @@ const STRIDE: usize = 128;
 
 /// Checkpoints of every file, shared by the database and its snapshots.
 #[derive(Default)]
-pub struct StateCache {
+struct StateCache {
     files: Mutex<FxHashMap<SourceFile, Checkpoints>>,
     /// Questions waiting for `files`: [`prepare`] lets go for them.
     waiting: AtomicUsize,
@@ -54,11 +54,16 @@ impl std::fmt::Debug for StateCache {
     }
 }
 
-impl StateCache {
-    /// Forgets a file's checkpoints.
-    pub(crate) fn forget(&self, file: SourceFile) {
+impl DialectCache for StateCache {
+    fn forget(&self, file: SourceFile) {
         self.files.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).remove(&file);
     }
+}
+
+/// The checkpoints of the database's files.
+fn state_cache(db: &dyn Db) -> &StateCache {
+    let cache: &dyn std::any::Any = &**db.dialect_cache().get_or_init(|| Box::<StateCache>::default());
+    cache.downcast_ref().expect("a database keeps the cache of its one dialect")
 }
 
 struct Checkpoints {
@@ -477,7 +482,7 @@ pub(crate) fn prepare(db: &dyn Db, file: SourceFile) {
     let mut progress = None;
     loop {
         let (target, now) = {
-            let files = db.state_cache().files.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+            let files = state_cache(db).files.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
             let points = files.get(&file).map_or(&[][..], |checkpoints| checkpoints.points.as_slice());
             let unlinked = points.iter().find(|point| !point.linked).map(|point| point.index);
             let from = points.last().map_or(0, |point| point.index);
@@ -545,7 +550,7 @@ fn walk_to(
     }
     let root = file.parse(db).green().clone();
     let context = Context::of(db, program);
-    let cache = db.state_cache();
+    let cache = state_cache(db);
     let _waiting = (asker == Asker::Question).then(|| {
         cache.waiting.fetch_add(1, Ordering::Relaxed);
         Waiting(&cache.waiting)
@@ -569,8 +574,8 @@ mod tests {
 
     use std::sync::atomic::Ordering;
 
-    use super::{Asker, STRIDE, changed_blocks, main_state_and_walk, main_state_before, walk_to};
-    use crate::{AnalysisHost, Config, TextEdit, TextRange, TextSize, cnc8x6::flow::walked_states, db::Db};
+    use super::{Asker, STRIDE, changed_blocks, main_state_and_walk, main_state_before, state_cache, walk_to};
+    use crate::{AnalysisHost, Config, TextEdit, TextRange, TextSize, cnc8x6::flow::walked_states};
 
     /// What [`changed_blocks`] promises, whatever the tree's shape: the
     /// blocks before and after the change are the same nodes, the text
@@ -733,7 +738,7 @@ mod tests {
         let file = host.add_file("main.NCP", text.as_str());
         host.analysis().prepare_states(file);
         let points = |host: &AnalysisHost| -> Vec<usize> {
-            let files = host.db().state_cache().files.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+            let files = state_cache(host.db()).files.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
             files[&file].points.iter().map(|point| point.index).collect()
         };
         let regular = points(&host).len();
@@ -743,7 +748,7 @@ mod tests {
             host.apply_edit(file, &edit);
             edit.apply(&mut text);
             // A question waits all along: each step walks a block and lets go.
-            let waiting = &host.db().state_cache().waiting;
+            let waiting = &state_cache(host.db()).waiting;
             waiting.fetch_add(1, Ordering::Relaxed);
             for _ in 0..20 {
                 walk_to(host.db(), file, blocks - 1, Asker::Preparation);

@@ -24,11 +24,11 @@ use ncc_catalog::{AddressRole, Catalogue, Code, Item, ParameterRange, ParameterS
 use ncc_syntax::{TextRange, TextSize};
 
 use crate::{
-    Config,
-    cnc8x6::checks::motion::{PLANE_CODES, interpolation_planes, plane_axes},
+    Dialect,
     cnc8x6::flow::{self, show_thousandths},
-    cnc8x6::model,
+    cnc8x6::model::{self, TransferKind},
     db::{Db, Settings, SourceFile},
+    dialect,
     lower::{BlockData, Value, Word},
 };
 
@@ -70,8 +70,9 @@ pub(crate) fn completions(db: &dyn Db, file: SourceFile, offset: TextSize) -> Ve
     if in_comment {
         return Vec::new();
     }
-    let catalogue = Settings::get(db).dialect(db).catalogue();
-    let request = Request { db, catalogue, file, index, start, block: &block };
+    let dialect = *Settings::get(db).dialect(db);
+    let catalogue = dialect.catalogue();
+    let request = Request { db, dialect, catalogue, file, index, start, block: &block };
     match Context::of(catalogue, &block, at, &file.text(db)[usize::from(start)..]) {
         Some(Context::Code { word }) => request.codes(word.letter, Some(word), word.range),
         Some(Context::Address { typed: Some(word) }) => request.addresses(Some(word), word.range),
@@ -79,12 +80,12 @@ pub(crate) fn completions(db: &dyn Db, file: SourceFile, offset: TextSize) -> Ve
         // editor filters it as the word is typed.
         Some(Context::Address { typed: None }) => {
             let mut items = request.addresses(None, TextRange::empty(at));
-            for letter in [b'G', b'M'] {
+            for letter in catalogue.function_letters() {
                 items.extend(request.codes(letter, None, TextRange::empty(at)));
             }
             items
         }
-        Some(Context::Target { code, word }) => request.targets(code, word),
+        Some(Context::Target { kind, word }) => request.targets(kind, word),
         Some(Context::Parameter { replace, assign }) => request.parameters(replace, assign),
         None => Vec::new(),
     }
@@ -96,8 +97,8 @@ enum Context<'a> {
     Code { word: &'a Word },
     /// A new word; `typed` is its letter, if written.
     Address { typed: Option<&'a Word> },
-    /// The L of a call or jump by `code` (G71, G72, G73).
-    Target { code: u32, word: &'a Word },
+    /// The L of a call or jump, which names a target of `kind`.
+    Target { kind: TransferKind, word: &'a Word },
     /// A parameter, referenced (`XR1`) or assigned (`R1=`); `replace` is
     /// relative to the block.
     Parameter { replace: TextRange, assign: bool },
@@ -115,7 +116,7 @@ impl<'a> Context<'a> {
         let Some(word) = block.words.iter().find(|w| inside(w.range)) else {
             return Some(Context::Address { typed: None });
         };
-        let call = block.codes(b'G').map(|(code, _)| code).find(|code| CALLS.contains(code));
+        let call = model::transfer_kind(block).map(|(kind, _)| kind);
         match (&word.value, catalogue.role_of(word.letter), call) {
             (Some(Value::Parameter { .. }), _, _) => {
                 // `XR1`: from the `R` on.
@@ -128,19 +129,17 @@ impl<'a> Context<'a> {
             }
             (_, Some(AddressRole::Function), _) => Some(Context::Code { word }),
             (_, Some(AddressRole::Parameter), _) => Some(Context::Parameter { replace: word.range, assign: true }),
-            (_, Some(AddressRole::Label), Some(code)) => Some(Context::Target { code, word }),
+            (_, Some(AddressRole::Label), Some(kind)) => Some(Context::Target { kind, word }),
             (None, _, _) => Some(Context::Address { typed: Some(word) }),
             (Some(Value::Literal(_)), _, _) => None,
         }
     }
 }
 
-/// The codes whose `L` names a call or jump target.
-const CALLS: std::ops::RangeInclusive<u32> = 71..=73;
-
 /// One completion request: the block under the cursor.
 struct Request<'a> {
     db: &'a dyn Db,
+    dialect: Dialect,
     catalogue: &'static Catalogue,
     file: SourceFile,
     index: usize,
@@ -183,9 +182,7 @@ impl Request<'_> {
             })
             .filter(|(_, code)| code.group.as_deref().is_none_or(|group| !taken.contains(&group)))
             // A plane the machine's axes do not form.
-            .filter(|&(number, _)| {
-                letter != 'G' || !PLANE_CODES.contains(&number) || plane_axes(number, config).is_some()
-            })
+            .filter(|&(number, _)| dialect::code_fits_machine(self.dialect, letter, number, config))
             .collect();
         codes.sort_by_key(|&(number, _)| number);
         codes
@@ -206,13 +203,13 @@ impl Request<'_> {
         let block = self.block;
         let written =
             |letter: u8| block.words.iter().any(|w| w.letter == letter && Some(w.range) != typed.map(|t| t.range));
-        let codes: Vec<&Code> = [b'G', b'M']
-            .into_iter()
+        let codes: Vec<&Code> = catalogue
+            .function_letters()
             .flat_map(|letter| block.codes(letter).filter_map(move |(n, _)| catalogue.code(char::from(letter), n)))
             .collect();
         let required: Vec<&str> = codes.iter().flat_map(|code| code.requires.iter().map(String::as_str)).collect();
         let read: Vec<&str> = codes.iter().flat_map(|code| code.allows.iter().map(String::as_str)).collect();
-        let centre = self.arc_centre(config);
+        let centre = dialect::arc_centre(self.dialect, block, config);
         let mut items: Vec<(u8, CompletionItem)> = Vec::new();
         for address in &catalogue.addresses {
             let Some(&letter) = address.letter.as_bytes().first() else { continue };
@@ -250,34 +247,15 @@ impl Request<'_> {
         items.into_iter().map(|(_, item)| item).collect()
     }
 
-    /// In an arc block (G02, G03) whose plane's two axes are written, what
-    /// the centre words mean: I along the plane's first axis, J along its
-    /// second.
-    fn arc_centre(&self, config: &Config) -> Vec<(u8, String)> {
-        let block = self.block;
-        if !block.has_code(b'G', 2) && !block.has_code(b'G', 3) {
-            return Vec::new();
-        }
-        let written = |axis: u8| block.word(axis).is_some();
-        let Some([first, second]) = interpolation_planes(config).find(|&[a, b]| written(a) && written(b)) else {
-            return Vec::new();
-        };
-        let (first, second) = (char::from(first), char::from(second));
-        vec![
-            (b'I', format!("Arc centre along {first}, the first axis of the {first}–{second} plane")),
-            (b'J', format!("Arc centre along {second}, the second axis of the {first}–{second} plane")),
-        ]
-    }
-
-    /// What the `L` of a G71, G72 or G73 block may name.
-    fn targets(&self, code: u32, typed: &Word) -> Vec<CompletionItem> {
+    /// What the `L` of a call or jump may name.
+    fn targets(&self, kind: TransferKind, typed: &Word) -> Vec<CompletionItem> {
         let db = self.db;
         let program = model::program(db, self.file);
         let item = |number: u32, kind: CompletionKind, (detail, documentation): (String, Option<String>)| {
             self.item(format!("L{number}"), kind, detail, documentation, typed.range)
         };
-        match code {
-            71 => {
+        match kind {
+            TransferKind::Subprogram => {
                 let own = program.unit_of(self.index).map(|unit| unit.blocks.start);
                 program
                     .units
@@ -289,7 +267,7 @@ impl Request<'_> {
                     })
                     .collect()
             }
-            72 => {
+            TransferKind::Macrocycle => {
                 let mut files: Vec<(u32, SourceFile)> =
                     model::macrocycles(db).iter().filter_map(|(&n, files)| Some((n, *files.first()?))).collect();
                 files.sort_by_key(|&(number, _)| number);
@@ -304,7 +282,7 @@ impl Request<'_> {
                     })
                     .collect()
             }
-            _ => {
+            TransferKind::Jump => {
                 let Some(unit) = program.unit_of(self.index) else { return Vec::new() };
                 // Blocks numbered beyond L's range cannot be targets.
                 let label = self.catalogue.addresses.iter().find(|a| a.role == AddressRole::Label);

@@ -16,6 +16,7 @@ use ncc_syntax::{TextRange, TextSize};
 
 use crate::{
     cnc8x6::checks::block::parameter_raw,
+    cnc8x6::chunks,
     cnc8x6::flow::show_thousandths,
     db::{self, Db, Settings, SourceFile},
     lower::Value,
@@ -59,7 +60,7 @@ pub(crate) fn inlay_hints(db: &dyn Db, file: SourceFile, range: Option<TextRange
         if !touches(chunk.offset, chunk_end) {
             continue;
         }
-        for (offset, block) in db::lower_chunk(db, chunk.chunk) {
+        for (offset, block) in chunks::lower_chunk(db, chunk.chunk) {
             let start = chunk.offset + offset;
             if !touches(start, start + block.len) {
                 continue;

@@ -15,7 +15,7 @@ pub(crate) mod inlay;
 pub(crate) mod references;
 pub(crate) mod symbols;
 
-use ncc_catalog::Item;
+use ncc_catalog::{AddressRole, Item};
 use ncc_syntax::{TextRange, TextSize};
 
 use crate::{
@@ -114,7 +114,9 @@ pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<H
             };
             let letter = char::from(word.letter);
             let query = match literal {
-                Some(number) if matches!(letter, 'G' | 'M') => format!("{letter}{number}"),
+                Some(number) if catalogue.role_of(word.letter) == Some(AddressRole::Function) => {
+                    format!("{letter}{number}")
+                }
                 _ => letter.to_string(),
             };
             let items = catalogue.explain(&query).ok()?;
@@ -213,7 +215,7 @@ pub(crate) fn goto_definition(db: &dyn Db, file: SourceFile, offset: TextSize) -
             targets
         }
         // The call's L, or its G71/G72/G73.
-        Some(Target::Word(word)) if matches!(word.letter, b'L' | b'G') => {
+        Some(Target::Word(word)) => {
             let program = model::program(db, file);
             match program.block(index).transfer {
                 Some((transfer, code)) if word.letter == b'L' || code == word.range + start => {

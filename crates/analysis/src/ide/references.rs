@@ -11,8 +11,12 @@ use ncc_syntax::{TextRange, TextSize};
 
 use super::{Target, block_at, symbols::Outline, target_at};
 use crate::{
-    cnc8x6::model::{self, FileKind, Program, Transfer},
+    cnc8x6::{
+        chunks,
+        model::{self, FileKind, Program, Transfer},
+    },
     db::{self, BlockChunk, Db, Settings, SourceFile},
+    dialect,
     lower::{BlockData, Value},
 };
 
@@ -58,8 +62,6 @@ pub(crate) fn references(db: &dyn Db, file: SourceFile, offset: TextSize, includ
         Some(Target::Parameter { index: number, .. }) => parameter_references(db, file, number),
         Some(Target::Word(word)) => {
             let range = word.range + start;
-            let on_code =
-                |letter: u8, code: u32| block.codes(letter).any(|(c, w)| c == code && w.range + start == range);
             let on_label = word.letter == b'L';
             match (info.transfer, info.starts_unit) {
                 _ if info.number_range == Some(range) => jump_target_references(db, file, program, index),
@@ -67,12 +69,16 @@ pub(crate) fn references(db: &dyn Db, file: SourceFile, offset: TextSize, includ
                     transfer_references(db, file, program, index, transfer)
                 }
                 // Calls name a macrocycle file by its file name.
-                (None, Some(Some(number))) if on_label || on_code(b'G', 79) => match program.kind {
-                    FileKind::Macrocycle(own) if program.units.first().is_some_and(|u| u.blocks.start == index) => {
-                        macrocycle_references(db, own)
+                (None, Some(Some(number)))
+                    if on_label || dialect::starts_unit(file.parse(db).dialect(), &block, word) =>
+                {
+                    match program.kind {
+                        FileKind::Macrocycle(own) if program.units.first().is_some_and(|u| u.blocks.start == index) => {
+                            macrocycle_references(db, own)
+                        }
+                        _ => subprogram_references(db, file, program, number),
                     }
-                    _ => subprogram_references(db, file, program, number),
-                },
+                }
                 _ => Vec::new(),
             }
         }
@@ -226,7 +232,7 @@ fn chunk_parameter_uses<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<Par
     let catalogue = Settings::get(db).dialect(db).catalogue();
     let letter = catalogue.letter_with_role(AddressRole::Parameter).map(char::from);
     let mut uses = Vec::new();
-    for (offset, block) in db::lower_chunk(db, chunk) {
+    for (offset, block) in chunks::lower_chunk(db, chunk) {
         let first = uses.len();
         let words = block.words.iter().map(|w| (&w.value, w.value_range));
         let values = block.assignments.iter().map(|a| (&a.value, a.value_range));
@@ -238,7 +244,7 @@ fn chunk_parameter_uses<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<Par
             }
         }
         // Codes that run control words: G26 runs the word in R5.
-        for (code, word) in block.codes(b'G').chain(block.codes(b'M')) {
+        for (code, word) in catalogue.function_letters().flat_map(|letter| block.codes(letter)) {
             let Some(entry) = catalogue.code(char::from(word.letter), code) else { continue };
             for (_, number) in entry.requires.iter().filter_map(|r| split_code(r)).filter(|(l, _)| Some(*l) == letter) {
                 uses.push(ParameterUse { number, kind: ReferenceKind::Read, range: word.range + offset });

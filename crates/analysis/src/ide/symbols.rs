@@ -13,6 +13,7 @@ use rustc_hash::FxHashMap;
 use crate::{
     cnc8x6::model::{self, FileKind, Program, Transfer, Unit},
     db::{Db, SourceFile},
+    dialect,
     lower::BlockData,
 };
 
@@ -74,7 +75,7 @@ pub(crate) fn document_symbols(db: &dyn Db, file: SourceFile) -> Vec<DocumentSym
         let name = match (unit.number, label) {
             (Some(number), _) => format!("L{number}"),
             (None, Some(label)) => outline.text[label].to_owned(),
-            (None, None) => "G79".to_owned(),
+            (None, None) => dialect::unnamed_unit(file.parse(db).dialect()).to_owned(),
         };
         symbols.push(match program.kind {
             FileKind::Program if outline.is_main(index) => {

@@ -3,11 +3,15 @@
 use std::collections::HashMap;
 
 use ncc_analysis::{CompletionKind, Dialect, DocumentSymbol, FoldKind, NavigationTarget, ReferenceKind, SymbolKind};
+use ncc_catalog::{AddressRole, Catalogue};
 use tower_lsp_server::ls_types as lsp;
 
 use super::{Snapshot, convert, semantic};
 
 pub(crate) fn capabilities() -> lsp::ServerCapabilities {
+    // Declared at initialize, before any program is open: the default
+    // dialect's letters and groups.
+    let dialect = Dialect::default();
     lsp::ServerCapabilities {
         position_encoding: Some(lsp::PositionEncodingKind::UTF16),
         text_document_sync: Some(lsp::TextDocumentSyncCapability::Options(lsp::TextDocumentSyncOptions {
@@ -22,8 +26,7 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
             ..Default::default()
         })),
         completion_provider: Some(lsp::CompletionOptions {
-            // Codes and addresses are letters; call targets follow `L`.
-            trigger_characters: Some(["G", "M", "L", "R"].map(String::from).to_vec()),
+            trigger_characters: Some(trigger_characters(dialect.catalogue())),
             ..Default::default()
         }),
         inlay_hint_provider: Some(lsp::OneOf::Left(true)),
@@ -34,7 +37,7 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
         folding_range_provider: Some(lsp::FoldingRangeProviderCapability::Simple(true)),
         semantic_tokens_provider: Some(lsp::SemanticTokensServerCapabilities::SemanticTokensOptions(
             lsp::SemanticTokensOptions {
-                legend: semantic::legend(Dialect::Cnc8x6),
+                legend: semantic::legend(dialect),
                 full: Some(lsp::SemanticTokensFullOptions::Bool(true)),
                 range: Some(true),
                 ..Default::default()
@@ -47,6 +50,14 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
         }),
         ..Default::default()
     }
+}
+
+/// The letters completion answers as soon as they are typed: the codes',
+/// the call target's (`L`) and the parameter letter.
+fn trigger_characters(catalogue: &Catalogue) -> Vec<String> {
+    let roles = [AddressRole::Function, AddressRole::Label, AddressRole::Parameter];
+    let letters = roles.into_iter().flat_map(|role| catalogue.addresses.iter().filter(move |a| a.role == role));
+    letters.map(|address| address.letter.clone()).collect()
 }
 
 /// The analysis's hover, then the predicted time and speed of the block.
@@ -231,5 +242,5 @@ pub(crate) fn semantic_tokens(s: &Snapshot, range: Option<lsp::Range>) -> lsp::S
         Some(range) => s.analysis.highlight_range(s.file, s.map.range_offsets(range)),
         None => s.analysis.highlight(s.file),
     };
-    lsp::SemanticTokens { result_id: None, data: semantic::encode(&s.map, &ranges) }
+    lsp::SemanticTokens { result_id: None, data: semantic::encode(&s.map, &ranges, s.analysis.dialect()) }
 }

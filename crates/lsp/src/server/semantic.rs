@@ -1,8 +1,10 @@
 //! Semantic tokens: the analysis's highlight kinds as the protocol's token
 //! types and modifiers.
 //!
-//! Codes are `keyword` (G) and `macro` (M) tokens with a modifier naming
-//! their catalogue group (`g1` plane, `g3` radius compensation, `m2`
+//! Codes are `keyword` tokens (those of the catalogue's first function
+//! letter, G: the preparatory functions) or `macro` tokens (the others, M:
+//! functions the machine carries out), with a modifier naming their
+//! catalogue group (`g1` plane, `g3` radius compensation, `m2`
 //! spindle, …), so a theme can colour groups apart; parameters are
 //! variables, assigned ones with `declaration`.
 
@@ -35,12 +37,15 @@ pub(crate) fn legend(dialect: Dialect) -> lsp::SemanticTokensLegend {
     }
 }
 
-/// The token type and modifier bits of a kind.
-fn classify(kind: HighlightKind) -> (u32, u32) {
+/// The token type and modifier bits of a kind; `preparatory` is the letter
+/// of the codes that are keywords.
+fn classify(kind: HighlightKind, preparatory: Option<u8>) -> (u32, u32) {
     let group_bit = |group: Option<u8>| group.filter(|&g| g < 31).map_or(0, |g| 1 << (u32::from(g) + 1));
     match kind {
-        HighlightKind::Code { letter: b'M', group } => (type_index("macro"), group_bit(group)),
-        HighlightKind::Code { group, .. } => (type_index("keyword"), group_bit(group)),
+        HighlightKind::Code { letter, group } if Some(letter) == preparatory => {
+            (type_index("keyword"), group_bit(group))
+        }
+        HighlightKind::Code { group, .. } => (type_index("macro"), group_bit(group)),
         HighlightKind::Address(AddressRole::Label) => (type_index("function"), 0),
         HighlightKind::Address(AddressRole::Tool | AddressRole::Offset | AddressRole::LengthCompensation) => {
             (type_index("type"), 0)
@@ -56,8 +61,10 @@ fn classify(kind: HighlightKind) -> (u32, u32) {
     }
 }
 
-/// Encodes ranges (sorted, on one line each) relative to each other.
-pub(crate) fn encode(map: &LineMap, ranges: &[HighlightRange]) -> Vec<lsp::SemanticToken> {
+/// Encodes ranges (sorted, on one line each) of a file in `dialect`
+/// relative to each other.
+pub(crate) fn encode(map: &LineMap, ranges: &[HighlightRange], dialect: Dialect) -> Vec<lsp::SemanticToken> {
+    let preparatory = dialect.catalogue().function_letters().next();
     let mut tokens = Vec::with_capacity(ranges.len());
     let (mut line, mut start) = (0, 0);
     for highlight in ranges {
@@ -67,7 +74,7 @@ pub(crate) fn encode(map: &LineMap, ranges: &[HighlightRange]) -> Vec<lsp::Seman
         }
         let delta_line = range.start.line - line;
         let delta_start = if delta_line == 0 { range.start.character - start } else { range.start.character };
-        let (token_type, token_modifiers_bitset) = classify(highlight.kind);
+        let (token_type, token_modifiers_bitset) = classify(highlight.kind, preparatory);
         tokens.push(lsp::SemanticToken {
             delta_line,
             delta_start,
@@ -88,9 +95,10 @@ mod tests {
     fn every_kind_has_a_type_and_groups_fit_the_modifier_bits() {
         let dialect = Dialect::Cnc8x6;
         let legend = legend(dialect);
+        let preparatory = dialect.catalogue().function_letters().next();
         assert!(legend.token_modifiers.len() <= 32, "{} modifiers", legend.token_modifiers.len());
         for kind in HighlightKind::all(dialect) {
-            let (token_type, modifiers) = classify(kind);
+            let (token_type, modifiers) = classify(kind, preparatory);
             assert!((token_type as usize) < legend.token_types.len(), "{kind:?}");
             assert!(modifiers < 1 << legend.token_modifiers.len(), "{kind:?}");
             if let HighlightKind::Code { group: Some(group), .. } = kind {

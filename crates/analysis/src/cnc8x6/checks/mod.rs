@@ -12,7 +12,11 @@ pub(crate) mod structure;
 pub(crate) mod threads;
 pub(crate) mod transform;
 
-use crate::cnc8x6::flow::FlowCheck;
+use crate::{
+    cnc8x6::{chunks, flow::FlowCheck},
+    db::{self, Db, SourceFile},
+    findings::Findings,
+};
 
 /// The rules of every check module.
 pub(crate) static RULES: &[&[&crate::Rule]] = &[
@@ -27,8 +31,19 @@ pub(crate) static RULES: &[&[&crate::Rule]] = &[
     transform::RULES,
     cycles::RULES,
     dynamics::RULES,
-    crate::findings::RULES,
 ];
+
+/// The findings of a file that need no flow walk: of its blocks, one by
+/// one, and of its structure.
+pub(crate) fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
+    let mut all = Findings::default();
+    for chunk in db::file_chunks(db, file) {
+        all.append(chunks::chunk_diagnostics(db, chunk.chunk).clone().shifted(chunk.offset));
+    }
+    all.diagnostics.extend(structure::check(db, file));
+    all.diagnostics.extend(cycles::check_file(db, file));
+    all
+}
 
 /// The checks that follow the program's flow, fresh for one walk.
 pub(crate) fn flow_checks() -> Vec<Box<dyn FlowCheck>> {

@@ -1,0 +1,88 @@
+//! Where the analysis turns to the dialect in use: one function per thing a
+//! dialect does, each an exhaustive `match` on [`Dialect`], so a new
+//! dialect is added here and the neutral modules never name one.
+
+use ncc_catalog::DialectId;
+use ncc_syntax::Dialect;
+
+use crate::{
+    Config, Rule, cnc8x6,
+    db::{Db, SourceFile},
+    diagnostic, findings,
+    findings::Findings,
+    lower::{BlockData, Word},
+};
+
+/// The rules of the dialect's checks, by check module.
+fn check_rules(dialect: Dialect) -> &'static [&'static [&'static Rule]] {
+    match dialect {
+        Dialect::Cnc8x6 => cnc8x6::checks::RULES,
+    }
+}
+
+impl Rule {
+    /// Every rule: the parser's syntax diagnostics, every dialect's checks,
+    /// the report limits, then the executor's.
+    pub fn all() -> impl Iterator<Item = &'static Rule> {
+        let dialects = DialectId::ALL.into_iter().filter_map(DialectId::implementation);
+        let checks = dialects.flat_map(|dialect| check_rules(dialect).iter().flat_map(|rules| rules.iter().copied()));
+        diagnostic::syntax_rules().chain(checks).chain(findings::RULES.iter().copied()).chain(diagnostic::run_rules())
+    }
+
+    /// The rule with this code or name.
+    pub fn find(key: &str) -> Option<&'static Rule> {
+        Rule::all().find(|rule| rule.code == key || rule.name == key)
+    }
+}
+
+/// The findings of `file` that need no flow walk, besides the syntax's.
+pub(crate) fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
+    match file.parse(db).dialect() {
+        Dialect::Cnc8x6 => cnc8x6::checks::local_findings(db, file),
+    }
+}
+
+/// The findings of the rules that follow the program's flow.
+pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> &Findings {
+    match file.parse(db).dialect() {
+        Dialect::Cnc8x6 => cnc8x6::flow::flow_diagnostics(db, file),
+    }
+}
+
+/// Prepares answers about the state anywhere in `file` (see
+/// [`crate::Analysis::prepare_states`]).
+pub(crate) fn prepare_states(db: &dyn Db, file: SourceFile) {
+    match file.parse(db).dialect() {
+        Dialect::Cnc8x6 => cnc8x6::states::prepare(db, file),
+    }
+}
+
+/// Whether the machine can run the code `letter` + `number` (completion
+/// leaves out those it cannot).
+pub(crate) fn code_fits_machine(dialect: Dialect, letter: char, number: u32, config: &Config) -> bool {
+    match dialect {
+        Dialect::Cnc8x6 => cnc8x6::ide::code_fits_machine(letter, number, config),
+    }
+}
+
+/// What the centre words of the block's arc mean, by address letter, when
+/// the block draws one.
+pub(crate) fn arc_centre(dialect: Dialect, block: &BlockData, config: &Config) -> Vec<(u8, String)> {
+    match dialect {
+        Dialect::Cnc8x6 => cnc8x6::ide::arc_centre(block, config),
+    }
+}
+
+/// Whether `word` is the code that starts a subprogram.
+pub(crate) fn starts_unit(dialect: Dialect, block: &BlockData, word: &Word) -> bool {
+    match dialect {
+        Dialect::Cnc8x6 => cnc8x6::ide::starts_unit(block, word),
+    }
+}
+
+/// The name of a subprogram with neither number nor label.
+pub(crate) fn unnamed_unit(dialect: Dialect) -> &'static str {
+    match dialect {
+        Dialect::Cnc8x6 => cnc8x6::ide::UNNAMED_UNIT,
+    }
+}

@@ -1,0 +1,3 @@
+//! The CNC8x6 dialect's part of the benchmarks.
+
+pub mod progen;
