@@ -21,6 +21,8 @@ const LUA_TIMEOUT_MS: u64 = 3000;
 /// One error: the space after the sign of `X-`.
 const PROGRAM: &str = "%1\nN10 G01 X- 5 F100\nN20 M30\n*\n";
 const MACRO: &str = "N10 G79 L9001\nN20 G90 G00 Z2.\nN30 G70\n*\n";
+/// A Sinumerik program, which this version does not read.
+const SINUMERIK: &str = "G0 X10 Z2\nM30\n";
 
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().unwrap()
@@ -90,6 +92,7 @@ fn neovim_detects_programs_and_shows_diagnostics_hover_and_the_cycle_time() {
     fs::write(project.join("ncc.toml"), "# The project root.\n").unwrap();
     fs::write(programs.join("drill.NCP"), PROGRAM).unwrap();
     fs::write(programs.join("L9001"), MACRO).unwrap();
+    fs::write(programs.join("MAIN.MPF"), SINUMERIK).unwrap();
     // Passed as `configFile`: the server reports S003 as a warning only if it
     // got the file.
     let config = dir.join("machine.toml");
@@ -100,13 +103,15 @@ fn neovim_detects_programs_and_shows_diagnostics_hover_and_the_cycle_time() {
     let state = dir.join("state");
     fs::create_dir(&state).unwrap();
     let output_path = dir.join("output.json");
-    let probes = ["part.Ncp", "L12.txt", "Lathe"].map(|name| programs.join(name));
+    let probes = ["part.Ncp", "L12.txt", "Lathe", "O1234.nc", "PART.TAP", "sub.spf", "O1234.nc.bak", "MPF"]
+        .map(|name| programs.join(name));
     let input = json!({
         "runtime": workspace().join("editors/nvim"),
         "server": env!("CARGO_BIN_EXE_ncc"),
         "config_file": config,
         "macro": programs.join("L9001"),
         "program": programs.join("drill.NCP"),
+        "unread": programs.join("MAIN.MPF"),
         "hover": { "line": 1, "character": line.find("G01").unwrap() },
         "timeout_ms": LUA_TIMEOUT_MS,
         "filetype_probes": probes,
@@ -123,22 +128,33 @@ fn neovim_detects_programs_and_shows_diagnostics_hover_and_the_cycle_time() {
     assert_eq!(output.get("error"), None, "{context}");
 
     let filetypes = &output["filetypes"];
-    for name in ["drill.NCP", "L9001", "part.Ncp"] {
-        assert_eq!(filetypes[name], "cnc8x6", "{name}: {context}");
+    let detected = [
+        ("drill.NCP", "cnc8x6"),
+        ("L9001", "cnc8x6"),
+        ("part.Ncp", "cnc8x6"),
+        ("MAIN.MPF", "sinumerik"),
+        ("sub.spf", "sinumerik"),
+        ("O1234.nc", "haas-lathe"),
+        ("PART.TAP", "haas-lathe"),
+    ];
+    for (name, filetype) in detected {
+        assert_eq!(filetypes[name], filetype, "{name}: {context}");
     }
-    for name in ["L12.txt", "Lathe"] {
-        assert_ne!(filetypes[name], "cnc8x6", "{name}: {context}");
+    for name in ["L12.txt", "Lathe", "O1234.nc.bak", "MPF"] {
+        let filetype = filetypes[name].as_str().unwrap_or_default();
+        assert!(!["cnc8x6", "haas-lathe", "sinumerik"].contains(&filetype), "{name}: {context}");
     }
     assert_eq!(output["highlight"], "cnc8x6GCode", "{context}");
 
-    // One server for the project, found by its `ncc.toml`, serves both files.
+    // One server for the project, found by its `ncc.toml`, serves all three
+    // files.
     let clients = output["clients"].as_array().unwrap();
     assert_eq!(clients.len(), 1, "{context}");
     assert_eq!(clients[0]["name"], "ncc", "{context}");
     assert_eq!(clients[0]["root_dir"], json!(project), "{context}");
     let init_options = json!({ "configFile": config, "cycleTime": { "inlayHints": "perBlock" } });
     assert_eq!(clients[0]["init_options"], init_options, "{context}");
-    assert_eq!(clients[0]["buffers"], json!({ "program": true, "macro": true }), "{context}");
+    assert_eq!(clients[0]["buffers"], json!({ "program": true, "macro": true, "unread": true }), "{context}");
 
     let space_after_sign = json!({
         "code": "S003",
@@ -148,6 +164,15 @@ fn neovim_detects_programs_and_shows_diagnostics_hover_and_the_cycle_time() {
         "character": line.find("- ").unwrap(),
     });
     assert_eq!(output["diagnostics"], json!([space_after_sign]), "{context}");
+
+    // The server's one note on the program it does not read.
+    let not_read = json!({ "source": "ncc", "severity": "INFO", "line": 0, "character": 0 });
+    assert_eq!(output["unread_diagnostics"], json!([not_read]), "{context}");
+    assert_eq!(
+        output["unread_messages"],
+        json!(["ncc does not read Siemens Sinumerik programs yet (dialect `sinumerik`)"]),
+        "{context}"
+    );
 
     // The predicted total on the header: 5 mm at 100 mm/min, with its
     // ramps and the stop at the end.

@@ -298,6 +298,46 @@ describe('the packaged extension in code-server', () => {
     assert.ok(moves.length > 20, `the pocket has many moves: ${moves.length}`);
     assert.ok(moves.includes(rapid), `the rapid move of line ${rapid} is drawn`);
   });
+
+  test('a Sinumerik program gets the note that ncc does not read it, and no error notification', async () => {
+    const note = 'ncc does not read Siemens Sinumerik programs yet';
+    await workbench.openFile('MAIN.MPF');
+    // The mouse rests on the text, so that the workbench asks for a hover
+    // too, besides what it asks for on opening (folding, symbols, tokens).
+    const word = await workbench.page.evaluate((editorLines) => {
+      const token = document.querySelector<HTMLElement>(`${editorLines} .view-line span span`);
+      const box = token?.getBoundingClientRect();
+      return box ? { x: box.x + box.width / 2, y: box.y + box.height / 2 } : undefined;
+    }, EDITOR_LINES);
+    assert.ok(word, 'a word in the editor');
+    await workbench.page.mouse.move(word.x, word.y, { steps: 4 });
+    const shown = await workbench.page.evaluate(() => !!document.querySelector<HTMLElement>('.markers-panel')?.offsetParent);
+    if (!shown) {
+      await workbench.chord(['Control', 'Shift'], 'KeyM');
+    }
+    const problems = await workbench.waitFor(
+      (text) => {
+        const panel = document.querySelector<HTMLElement>('.markers-panel');
+        return panel?.innerText.includes(text) ? panel.innerText : '';
+      },
+      'the note in the Problems panel',
+      note,
+    );
+    await sleep(3000);
+    await workbench.screenshot('5-not-read');
+    await workbench.page.mouse.move(0, 0);
+    assert.match(problems, /MAIN\.MPF/);
+    // The language's name in the status bar.
+    const status = await workbench.page.evaluate(() => document.querySelector<HTMLElement>('.part.statusbar')?.innerText ?? '');
+    assert.match(status, /Siemens Sinumerik/);
+    const toasts = await workbench.page.evaluate(() =>
+      [...document.querySelectorAll<HTMLElement>('.notification-toast')].map((t) => t.innerText),
+    );
+    // The language client's notice of a failed request: "Request
+    // textDocument/semanticTokens/full failed. Message: … is not open".
+    const failures = toasts.filter((toast) => /failed|is not open/.test(toast));
+    assert.deepEqual(failures, [], 'no notification about the requests on MAIN.MPF');
+  });
 });
 
 /** The source lines of the moves drawn in an SVG of `frame`, if it has one. */
@@ -329,7 +369,7 @@ describe('a server that exits as it starts', () => {
       'the notification',
       reason,
     );
-    await workbench.screenshot('5-start-failure');
+    await workbench.screenshot('6-start-failure');
     assert.match(toast, /exited as it started/);
     assert.match(toast, /Show Log/);
     // The client's own notification would cover this one and its button.
@@ -348,6 +388,6 @@ describe('a server that exits as it starts', () => {
       'the reason in the log',
       reason,
     );
-    await workbench.screenshot('6-log');
+    await workbench.screenshot('7-log');
   });
 });

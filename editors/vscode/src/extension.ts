@@ -1,4 +1,4 @@
-// The extension: starts `ncc lsp` for CNC8x6 documents and shows its state.
+// The extension: starts `ncc lsp` for CNC programs and shows its state.
 
 import * as os from 'node:os';
 import * as vscode from 'vscode';
@@ -9,14 +9,20 @@ import {
   ExecuteCommandRequest,
   LanguageClient,
   type LanguageClientOptions,
+  type MessageSignature,
   type ServerOptions,
   State,
 } from 'vscode-languageclient/node';
+import { DOCUMENT_SELECTOR, isNotOpenAnswer } from './documents';
 import { type Environment, type Launch, readSettings, ServerStderr, serverLaunch, startFailure } from './server';
 import { PLOT_COMMAND } from './toolpath';
 import { ToolpathViews } from './toolpathView';
 
-const LANGUAGE_ID = 'cnc8x6';
+/**
+ * The language of the programs the toolpath view draws: the server draws
+ * only what it reads, and of the controls it reads only CNC8x6 yet.
+ */
+const TOOLPATH_LANGUAGE = 'cnc8x6';
 
 /** How long a server that exited at start may take to finish its stderr. */
 const STDERR_WAIT_MS = 2_000;
@@ -63,7 +69,7 @@ async function showToolpath(views: ToolpathViews, resource: unknown): Promise<vo
     document = shown?.document ?? (await vscode.workspace.openTextDocument(resource));
     column = shown?.viewColumn;
   }
-  if (document?.languageId !== LANGUAGE_ID) {
+  if (document?.languageId !== TOOLPATH_LANGUAGE) {
     void vscode.window.showWarningMessage('ncc: the toolpath is drawn for CNC8x6 programs; open one first.');
     return;
   }
@@ -122,10 +128,7 @@ class Server implements vscode.Disposable {
       () => started,
       { command, args },
       {
-        documentSelector: [
-          { scheme: 'file', language: LANGUAGE_ID },
-          { scheme: 'untitled', language: LANGUAGE_ID },
-        ],
+        documentSelector: DOCUMENT_SELECTOR,
         initializationOptions,
         // `ncc.cycleTime` changes reach the running server as
         // workspace/didChangeConfiguration.
@@ -277,6 +280,11 @@ class Server implements vscode.Disposable {
  * failed start itself, with the server's reason and a button to the log, and
  * a second notification (the client's "couldn't create connection") would
  * cover it.
+ *
+ * A request about a document the server has not taken (a program in a
+ * dialect it does not read) gets no answer and no notification: the
+ * server's diagnostic on the document says why once, where notifications
+ * would come with every hover, fold and highlight.
  */
 class StartReportingClient extends LanguageClient {
   constructor(
@@ -289,6 +297,20 @@ class StartReportingClient extends LanguageClient {
 
   override error(message: string, data?: unknown, showNotification: boolean | 'force' = true): void {
     super.error(message, data, this.started() ? showNotification : false);
+  }
+
+  override handleFailedRequest<T>(
+    type: MessageSignature,
+    token: vscode.CancellationToken | undefined,
+    error: unknown,
+    defaultValue: T,
+    showNotification?: boolean,
+    throwOnCancel?: boolean,
+  ): T {
+    if (isNotOpenAnswer(error)) {
+      return defaultValue;
+    }
+    return super.handleFailedRequest(type, token, error, defaultValue, showNotification, throwOnCancel);
   }
 }
 

@@ -1,28 +1,15 @@
-// The language contribution: which files become CNC8x6 documents, and what
-// the language configuration makes of them.
+// The language contributions: which files become documents of which
+// control's language, which of those go to the server, and what the CNC8x6
+// language configuration makes of its documents.
 
 import assert from 'node:assert/strict';
 import { existsSync, readFileSync } from 'node:fs';
 import * as path from 'node:path';
 import { describe, test } from 'node:test';
-import { minimatch } from 'minimatch';
+import { DOCUMENT_SELECTOR, LANGUAGES } from '../src/documents';
+import { languageOf, manifest, root } from './manifest';
 
-const root = path.resolve(__dirname, '..', '..');
-const manifest = JSON.parse(readFileSync(path.join(root, 'package.json'), 'utf8'));
 const [language] = manifest.contributes.languages;
-
-/**
- * Whether VS Code gives a file the language: it compares lowercased
- * extensions, and lowercased file-name patterns without a slash with the
- * lowercased base name.
- */
-function isCnc8x6(file: string): boolean {
-  const name = path.basename(file).toLowerCase();
-  return (
-    language.extensions.some((ext: string) => name.endsWith(ext.toLowerCase())) ||
-    language.filenamePatterns.some((pattern: string) => minimatch(name, pattern.toLowerCase(), { dot: true }))
-  );
-}
 
 describe('language contribution', () => {
   test('is cnc8x6, with a grammar and a configuration that exist', () => {
@@ -35,15 +22,72 @@ describe('language contribution', () => {
 
   test('takes partprograms and macrocycle files', () => {
     for (const file of ['examples/milling/pocket.NCP', 'a.ncp', 'PCYKLYDG.NCP', 'L1', 'L9001', 'dir/l12', 'L0100', 'L12.NCP']) {
-      assert.ok(isCnc8x6(file), file);
+      assert.equal(languageOf(file), 'cnc8x6', file);
     }
   });
 
   test('leaves other files alone', () => {
-    const others = ['L', 'LICENSE', 'Lx1', 'L1a', 'L12345', 'L9001.txt', 'L9001.bak', 'README.md', 'NCP', 'a.NCP.orig', 'ML9001'];
+    const others = [
+      'L',
+      'LICENSE',
+      'Lx1',
+      'L1a',
+      'L12345',
+      'L9001.txt',
+      'L9001.bak',
+      'README.md',
+      'NCP',
+      'a.NCP.orig',
+      'ML9001',
+      'MPF',
+      'a.MPF.bak',
+      'O1234.nc.orig',
+      'a.ncx',
+    ];
     for (const file of others) {
-      assert.ok(!isCnc8x6(file), file);
+      assert.equal(languageOf(file), undefined, file);
     }
+  });
+});
+
+describe('the controls ncc does not read yet', () => {
+  test('Sinumerik main programs and subprograms, in either case', () => {
+    for (const file of ['MAIN.MPF', 'main.mpf', 'dir/SUB.SPF', 'sub.spf']) {
+      assert.equal(languageOf(file), 'sinumerik', file);
+    }
+  });
+
+  test('Haas lathe programs, in either case', () => {
+    for (const file of ['O1234.nc', 'O1234.NC', 'part.tap', 'PART.TAP']) {
+      assert.equal(languageOf(file), 'haas-lathe', file);
+    }
+  });
+
+  test('have no grammar: no highlighting is claimed for them', () => {
+    const grammars = manifest.contributes.grammars.map((grammar: { language: string }) => grammar.language);
+    assert.deepEqual(grammars, ['cnc8x6']);
+  });
+});
+
+describe('documents for the server', () => {
+  test('are the files of every contributed language', () => {
+    const contributed = manifest.contributes.languages.map((language: { id: string }) => language.id);
+    assert.deepEqual([...LANGUAGES].sort(), [...contributed].sort());
+    const files = DOCUMENT_SELECTOR.filter((selector) => selector.scheme === 'file');
+    assert.deepEqual(files.map((selector) => selector.language), [...LANGUAGES]);
+  });
+
+  test('without a file name, only CNC8x6, as the server reads them', () => {
+    const untitled = DOCUMENT_SELECTOR.filter((selector) => selector.scheme !== 'file');
+    assert.deepEqual(untitled, [{ scheme: 'untitled', language: 'cnc8x6' }]);
+  });
+
+  test('the toolpath is offered for CNC8x6 programs, the ones the server draws', () => {
+    const whens = Object.values(manifest.contributes.menus)
+      .flat()
+      .filter((item) => (item as { command: string }).command === 'ncc.showToolpath')
+      .map((item) => (item as { when: string }).when);
+    assert.deepEqual(whens, ['resourceLangId == cnc8x6', 'editorLangId == cnc8x6']);
   });
 });
 

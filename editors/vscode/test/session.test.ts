@@ -29,8 +29,10 @@ import {
   StreamMessageWriter,
   TextDocumentSyncKind,
 } from 'vscode-languageserver-protocol/node';
+import { DOCUMENT_SELECTOR, isNotOpenAnswer } from '../src/documents';
 import { type Launch, readSettings, serverLaunch } from '../src/server';
 import { failureMessage, PLOT_COMMAND, parsePlotted, plotMessage } from '../src/toolpath';
+import { languageOf } from './manifest';
 
 /** How long one answer from a debug build may take. */
 const TIMEOUT_MS = 20_000;
@@ -282,6 +284,48 @@ describe('a session with ncc lsp', () => {
     const shown = failureMessage(failed);
     assert.match(shown.message, /P2\.NCP is not open/);
     assert.equal(shown.svg, undefined);
+  });
+
+  test('a Sinumerik and a Haas lathe program get the note that ncc does not read them yet', async () => {
+    const programs = [
+      { file: 'MAIN.MPF', dialect: 'sinumerik', title: 'Siemens Sinumerik', text: 'G0 X10 Z2\nM30\n' },
+      { file: 'O1234.nc', dialect: 'haas-lathe', title: 'Haas lathe', text: '%\nO1234\nG28 U0 W0\nM30\n%\n' },
+    ];
+    for (const { file, dialect, title, text } of programs) {
+      // The language VS Code gives the file, which the client hands over.
+      const languageId = languageOf(file);
+      assert.equal(languageId, dialect, file);
+      assert.ok(DOCUMENT_SELECTOR.some((selector) => selector.scheme === 'file' && selector.language === languageId));
+      const program = pathToFileURL(path.join(scratch, 'programs', file)).href;
+      await connection.sendNotification(DidOpenTextDocumentNotification.type, {
+        textDocument: { uri: program, languageId, version: 1, text },
+      });
+      const opened = await diagnostics(`the note on ${file}`, (p) => p.uri === program && p.version === 1);
+      assert.deepEqual(opened.diagnostics, [
+        {
+          range: { start: { line: 0, character: 0 }, end: { line: 0, character: 0 } },
+          severity: DiagnosticSeverity.Information,
+          source: 'ncc',
+          message: `ncc does not read ${title} programs yet (dialect \`${dialect}\`)`,
+        },
+      ]);
+
+      // What the editor asks about the program comes back empty, or as the
+      // answer the client passes over without a notification.
+      const hover = await within(
+        `answer to hover on ${file}`,
+        connection
+          .sendRequest(HoverRequest.type, { textDocument: { uri: program }, position: { line: 0, character: 0 } })
+          .then(
+            (result) => ({ result }),
+            (error: unknown) => ({ error }),
+          ),
+      );
+      assert.ok(
+        'error' in hover ? isNotOpenAnswer(hover.error) : hover.result === null,
+        `hover on ${file}: ${JSON.stringify(hover)}`,
+      );
+    }
   });
 
   test('shutdown and exit end the server with status 0', async () => {

@@ -1,8 +1,13 @@
--- Starts the ncc language server for MEFI CNC8x6 partprograms (filetype
--- `cnc8x6`). Works on Neovim 0.7 (Debian 12) and later, without
--- nvim-lspconfig.
+-- Starts the ncc language server for CNC programs. Works on Neovim 0.7
+-- (Debian 12) and later, without nvim-lspconfig.
 
 local M = {}
+
+-- One filetype per control, named as ncc names its dialects. The server
+-- picks each file's dialect itself, from its name and its project's
+-- ncc.toml, and of a program in a dialect it does not read yet it says so
+-- in one diagnostic.
+local filetypes = { "cnc8x6", "haas-lathe", "sinumerik" }
 
 local uv = vim.uv or vim.loop
 
@@ -96,7 +101,8 @@ local function start(config, bufnr)
   end
 end
 
---- Starts (or reuses) the server for every buffer of filetype `cnc8x6`.
+--- Starts (or reuses) the server for every buffer of filetype `cnc8x6`,
+--- `haas-lathe` or `sinumerik`: one server per project root.
 ---
 --- Options, all optional:
 --- - cmd: the server command, default `{ "ncc", "lsp" }`.
@@ -122,12 +128,18 @@ function M.setup(opts)
 
   vim.api.nvim_create_autocmd("FileType", {
     group = vim.api.nvim_create_augroup("ncc", { clear = true }),
-    pattern = "cnc8x6",
+    pattern = filetypes,
     callback = function(args)
       -- Help, terminal and scratch buffers are not files the server can read.
-      if vim.bo[args.buf].buftype == "" then
-        start(client_config(opts, args.buf), args.buf)
+      if vim.bo[args.buf].buftype ~= "" then
+        return
       end
+      -- The server reads a buffer without a file name as CNC8x6, whatever
+      -- its filetype.
+      if args.match ~= "cnc8x6" and vim.api.nvim_buf_get_name(args.buf) == "" then
+        return
+      end
+      start(client_config(opts, args.buf), args.buf)
     end,
   })
 end
