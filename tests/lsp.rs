@@ -597,9 +597,15 @@ fn a_document_of_a_dialect_this_version_does_not_read_gets_one_finding_saying_so
     assert_eq!(diagnostics.len(), 1, "{}", published.json);
     assert_eq!(diagnostics[0]["message"], "ncc does not read Siemens Sinumerik programs yet (dialect `sinumerik`)");
     assert_eq!(diagnostics[0]["severity"], 3);
-    // Nothing else is answered for it, and the server goes on serving.
+    // Every request about it has an empty answer, not an error an editor
+    // would show, and the server goes on serving.
     let hover = client.call("textDocument/hover", doc.at(doc.position(0))).unwrap();
-    assert!(hover.result().is_none_or(Value::is_null), "{}", hover.json);
+    assert_eq!((hover.error_code(), hover.result()), (None, Some(&Value::Null)), "{}", hover.json);
+    let document = json!({ "textDocument": { "uri": doc.uri } });
+    for method in ["textDocument/semanticTokens/full", "textDocument/foldingRange", "textDocument/documentSymbol"] {
+        let answer = client.call(method, document.clone()).unwrap();
+        assert_eq!(answer.error_code(), None, "{method}: {}", answer.json);
+    }
     assert_serving(&mut client, &dir);
 }
 

@@ -333,8 +333,9 @@ describe('the packaged extension in code-server', () => {
     const toasts = await workbench.page.evaluate(() =>
       [...document.querySelectorAll<HTMLElement>('.notification-toast')].map((t) => t.innerText),
     );
-    // The language client's notice of a failed request: "Request
-    // textDocument/semanticTokens/full failed. Message: … is not open".
+    // The language client's notice of a failed request ("Request
+    // textDocument/semanticTokens/full failed. Message: …"): the server
+    // answers every request about MAIN.MPF empty.
     const failures = toasts.filter((toast) => /failed|is not open/.test(toast));
     assert.deepEqual(failures, [], 'no notification about the requests on MAIN.MPF');
   });

@@ -9,11 +9,10 @@ import {
   ExecuteCommandRequest,
   LanguageClient,
   type LanguageClientOptions,
-  type MessageSignature,
   type ServerOptions,
   State,
 } from 'vscode-languageclient/node';
-import { DOCUMENT_SELECTOR, isNotOpenAnswer } from './documents';
+import { DOCUMENT_SELECTOR } from './documents';
 import { type Environment, type Launch, readSettings, ServerStderr, serverLaunch, startFailure } from './server';
 import { PLOT_COMMAND } from './toolpath';
 import { ToolpathViews } from './toolpathView';
@@ -280,11 +279,6 @@ class Server implements vscode.Disposable {
  * failed start itself, with the server's reason and a button to the log, and
  * a second notification (the client's "couldn't create connection") would
  * cover it.
- *
- * A request about a document the server has not taken (a program in a
- * dialect it does not read) gets no answer and no notification: the
- * server's diagnostic on the document says why once, where notifications
- * would come with every hover, fold and highlight.
  */
 class StartReportingClient extends LanguageClient {
   constructor(
@@ -297,20 +291,6 @@ class StartReportingClient extends LanguageClient {
 
   override error(message: string, data?: unknown, showNotification: boolean | 'force' = true): void {
     super.error(message, data, this.started() ? showNotification : false);
-  }
-
-  override handleFailedRequest<T>(
-    type: MessageSignature,
-    token: vscode.CancellationToken | undefined,
-    error: unknown,
-    defaultValue: T,
-    showNotification?: boolean,
-    throwOnCancel?: boolean,
-  ): T {
-    if (isNotOpenAnswer(error)) {
-      return defaultValue;
-    }
-    return super.handleFailedRequest(type, token, error, defaultValue, showNotification, throwOnCancel);
   }
 }
 

@@ -24,7 +24,7 @@ mod semantic;
 mod workspace;
 
 use std::{
-    collections::HashMap,
+    collections::{HashMap, HashSet},
     path::PathBuf,
     process::ExitCode,
     sync::{
@@ -132,6 +132,9 @@ struct Document {
 struct State {
     workspaces: Workspaces,
     documents: HashMap<Uri, Document>,
+    /// Open documents in a dialect this build does not read: their one
+    /// diagnostic says so, and every request about them has an empty answer.
+    unread: HashSet<Uri>,
     /// `ncc.cycleTime.inlayHints`.
     cycle_hints: CycleTimeHints,
     refresh: cycle_time::Refresh,
@@ -206,12 +209,16 @@ impl Server {
         })
     }
 
-    /// Runs `query` on a snapshot of `uri`'s document on the blocking pool.
-    async fn query<T: Send + 'static>(
+    /// Runs `query` on a snapshot of `uri`'s document on the blocking pool;
+    /// a document in a dialect this build does not read has nothing to say.
+    async fn query<T: Send + Default + 'static>(
         &self,
         uri: &Uri,
         query: impl FnOnce(&Snapshot) -> T + Send + 'static,
     ) -> jsonrpc::Result<T> {
+        if self.state().unread.contains(uri) {
+            return Ok(T::default());
+        }
         let snapshot = self.snapshot(uri)?;
         let task =
             tokio::task::spawn_blocking(move || Cancelled::catch(std::panic::AssertUnwindSafe(|| query(&snapshot))));
@@ -436,6 +443,7 @@ impl LanguageServer for Server {
             let (workspace, dialect, file, errors) = match state.workspaces.open(&document.uri, document.text) {
                 Opened::Analysed { index, dialect, file, errors } => (index, dialect, file, errors),
                 Opened::NotRead(dialect) => {
+                    state.unread.insert(document.uri.clone());
                     drop(state);
                     // One finding at the start says why nothing else is said.
                     let diagnostic = lsp::Diagnostic {
@@ -470,7 +478,9 @@ impl LanguageServer for Server {
             let mut guard = self.state();
             let state = &mut *guard;
             let Some(document) = state.documents.get_mut(&uri) else {
-                tracing::warn!("change of {} which is not open", uri.as_str());
+                if !state.unread.contains(&uri) {
+                    tracing::warn!("change of {} which is not open", uri.as_str());
+                }
                 return;
             };
             let host = state.workspaces.host_mut(document.workspace);
@@ -503,6 +513,7 @@ impl LanguageServer for Server {
         let uri = params.text_document.uri;
         {
             let mut state = self.state();
+            state.unread.remove(&uri);
             if let Some(document) = state.documents.remove(&uri) {
                 state.workspaces.close(document.workspace, &uri, document.file);
             }
