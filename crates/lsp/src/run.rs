@@ -18,7 +18,6 @@ use std::{
 
 use indicatif::{ProgressBar, ProgressStyle};
 use nc_exec::{
-    cnc8x6::dynamics,
     cnc8x6::expand::{ExpandError, Expansion},
     cnc8x6::lower::BlockData,
     run::{Axes, Called, Environment, Message, MessageDisplay, Motion, Step, Stop, Totals, Trace, expected_blocks},
@@ -140,7 +139,7 @@ impl Ran {
     fn tally(program: &Program<'_>, step_budget: usize, progress: Progress) -> Result<(Ran, Tally), String> {
         let config = program.config()?;
         let machine = &config.machine;
-        let dynamics = dynamics::dynamics(machine);
+        let dynamics = nc_exec::run::dynamics(machine);
         let tally_with = |places: Places| {
             let timer = Timer::new(machine.step_axes(), &dynamics, Tally { places, ..Tally::default() });
             let mut timed = None;
@@ -182,7 +181,7 @@ impl Ran {
     ) -> Result<(Ran, Plot), String> {
         let config = program.config()?;
         let machine = &config.machine;
-        let dynamics = dynamics::dynamics(machine);
+        let dynamics = nc_exec::run::dynamics(machine);
         let timer = Timer::new(machine.step_axes(), &dynamics, Sketch::new(max_moves));
         let mut sketched = None;
         let mut ran = Ran::run(program, &config, progress, |text, library| {
@@ -213,7 +212,7 @@ impl Ran {
             bar.finish_and_clear();
         }
         let sources = library.sources(&program.name, text, program.dialect, &trace);
-        Ran { trace, config: config.clone(), dynamics: dynamics::dynamics(&config.machine), sources }
+        Ran { trace, config: config.clone(), dynamics: nc_exec::run::dynamics(&config.machine), sources }
     }
 
     /// The run timed with the control's velocity model.

@@ -1,14 +1,15 @@
 //! Running a program: the driver that runs it on its machine by the
 //! interpreter of the machine's control (CNC8x6:
 //! [`crate::cnc8x6::interpreter`]), to a trace or into a sink, on a thread
-//! of its own or this one, with checkpoints to resume from; and the trace's
-//! vocabulary ([`crate::trace`]), which the interpreters write.
+//! of its own or this one, with checkpoints to resume from; the control's
+//! velocity policy that times the steps; and the trace's vocabulary
+//! ([`crate::trace`]), which the interpreters write.
 
 use std::{sync::mpsc, thread::Scope};
 
 use ncc_catalog::Dialect;
 
-use crate::{cnc8x6, machine::MachineConfig, transform::Frame};
+use crate::{cnc8x6, machine::MachineConfig, transform::Frame, velocity::Dynamics};
 
 pub use crate::trace::*;
 
@@ -26,6 +27,14 @@ pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget:
 pub fn reset_frame(machine: &MachineConfig) -> Frame {
     match machine.control {
         Dialect::Cnc8x6 => cnc8x6::interpreter::reset_frame(machine),
+    }
+}
+
+/// The velocity model's parameters on `machine`: its control's policy, read
+/// from its machine constants.
+pub fn dynamics(machine: &MachineConfig) -> Dynamics {
+    match machine.control {
+        Dialect::Cnc8x6 => cnc8x6::dynamics::dynamics(machine),
     }
 }
 

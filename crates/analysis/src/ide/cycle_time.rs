@@ -12,7 +12,6 @@
 use std::{fmt::Write as _, ops::ControlFlow, sync::Arc};
 
 use nc_exec::{
-    cnc8x6::dynamics,
     run::{Called, Checkpoint, Environment, Motion, Step, Totals, shift_count, shift_offset, shift_range},
     velocity::{self, Break, Reason, Timer, TimerState, TimingSink},
 };
@@ -232,7 +231,7 @@ pub fn estimate(
     machine: &MachineConfig,
     budget: usize,
 ) -> Estimate {
-    let dynamics = dynamics::dynamics(machine);
+    let dynamics = nc_exec::run::dynamics(machine);
     let axes = machine.step_axes();
     let change = previous.and_then(|previous| Change::between(previous, text, files, machine, budget));
     let resumed = change.as_ref().and_then(|change| {
@@ -901,7 +900,7 @@ mod tests {
     fn model_total(program: &str) -> f64 {
         let machine = MachineConfig::default();
         let trace = nc_exec::run::run(program, &nc_exec::run::NoFiles, &machine, 1000);
-        velocity::time(&trace, &dynamics::dynamics(&machine)).total_time()
+        velocity::time(&trace, &nc_exec::run::dynamics(&machine)).total_time()
     }
 
     #[test]

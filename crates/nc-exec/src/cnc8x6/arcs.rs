@@ -34,9 +34,40 @@ pub fn interpolation_planes(machine: &MachineConfig) -> impl Iterator<Item = [u8
 /// The interpolation plane of an arc that writes the axes `one` and
 /// `other`, first axis first; `None` when the machine has no such plane.
 pub fn arc_plane(machine: &MachineConfig, one: u8, other: u8) -> Option<[u8; 2]> {
+    arc_plane_of(interpolation_planes(machine), one, other)
+}
+
+fn arc_plane_of(mut planes: impl Iterator<Item = [u8; 2]>, one: u8, other: u8) -> Option<[u8; 2]> {
     let written = [one, other];
-    interpolation_planes(machine)
-        .find(|plane| plane[0] != plane[1] && written.contains(&plane[0]) && written.contains(&plane[1]))
+    planes.find(|plane| plane[0] != plane[1] && written.contains(&plane[0]) && written.contains(&plane[1]))
+}
+
+/// The machine's planes, read once: every arc and every block under radius
+/// compensation asks.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Planes {
+    /// The compensation planes of G14–G19, by code − 14.
+    compensation: [Option<[u8; 2]>; 6],
+    interpolation: Vec<[u8; 2]>,
+}
+
+impl Planes {
+    pub fn of(machine: &MachineConfig) -> Planes {
+        Planes {
+            compensation: std::array::from_fn(|i| compensation_plane(machine, 14 + i as u32)),
+            interpolation: interpolation_planes(machine).collect(),
+        }
+    }
+
+    /// See [`compensation_plane`].
+    pub fn compensation(&self, code: u32) -> Option<[u8; 2]> {
+        *self.compensation.get(usize::try_from(code.checked_sub(14)?).ok()?)?
+    }
+
+    /// See [`arc_plane`].
+    pub fn arc(&self, one: u8, other: u8) -> Option<[u8; 2]> {
+        arc_plane_of(self.interpolation.iter().copied(), one, other)
+    }
 }
 
 /// The centre refinement of an arc, `E` (02 §1.15): the preprocessor's
@@ -100,8 +131,17 @@ mod tests {
         let lathe = MachineConfig { axes: b"XZ".to_vec(), ..MachineConfig::default() };
         assert_eq!(arc_plane(&lathe, b'Z', b'X'), Some(*b"XZ"));
         assert_eq!(compensation_plane(&lathe, 18), None);
-        let swapped = MachineConfig { constants: [(340, 21)].into(), ..lathe };
+        let swapped = MachineConfig { constants: [(340, 21)].into(), ..lathe.clone() };
         assert_eq!(arc_plane(&swapped, b'X', b'Z'), Some(*b"ZX"));
+        for machine in [mill, lathe, swapped] {
+            let planes = Planes::of(&machine);
+            for code in 13..=20 {
+                assert_eq!(planes.compensation(code), compensation_plane(&machine, code));
+            }
+            for (one, other) in [(b'X', b'Y'), (b'Z', b'X'), (b'X', b'Z'), (b'C', b'X')] {
+                assert_eq!(planes.arc(one, other), arc_plane(&machine, one, other));
+            }
+        }
     }
 
     #[test]

@@ -72,6 +72,8 @@ pub(super) struct Runner {
     axis_bounds: [[(f64, f64); MAX_AXES]; 2],
     /// The literals each address A–Z plainly takes, as every word asks.
     plain_literals: [PlainLiterals; 26],
+    /// The machine's planes, as every arc and compensated block asks.
+    planes: arcs::Planes,
     /// The zero-offset and correction tables, as the program changes them.
     pub(super) offsets: OffsetTable,
     pub(super) corrections: ToolTable,
@@ -144,6 +146,7 @@ impl Runner {
             plain_literals: std::array::from_fn(|index| {
                 PlainLiterals::of(Dialect::Cnc8x6.catalogue().address_of(b'A' + index as u8))
             }),
+            planes: arcs::Planes::of(&machine),
             compensator: None,
             compensation: Settings::of(&machine),
             tool_centre: Vec::new(),
@@ -205,6 +208,7 @@ impl Runner {
             length_setting: _,
             axis_bounds: _,
             plain_literals: _,
+            planes: _,
             offsets,
             corrections,
             dynamic_set,
@@ -731,7 +735,7 @@ impl Runner {
     fn compensate(&mut self, start: Position, path: Path) -> Result<(), CompensationError> {
         let index = self.delivered + self.steps.len() - 1;
         let code = self.modes.active(self.groups.plane).unwrap_or_default();
-        let Some([first, second]) = arcs::compensation_plane(&self.machine, code) else {
+        let Some([first, second]) = self.planes.compensation(code) else {
             if self.modes.active(self.groups.compensation).is_some_and(|code| code != 40) {
                 let range = self.step_mut(index).range;
                 let message = format!(
@@ -1223,8 +1227,7 @@ impl Runner {
         // The machine's interpolation plane of the two axes: I measures
         // along its first axis. A pair the machine has no plane of runs in
         // the order written.
-        let [first, second] =
-            arcs::arc_plane(&self.machine, letters[0], letters[1]).unwrap_or([letters[0], letters[1]]);
+        let [first, second] = self.planes.arc(letters[0], letters[1]).unwrap_or([letters[0], letters[1]]);
         let (a, b) = (usize::from(first - b'A'), usize::from(second - b'A'));
         // I and J are recalculated as the axes they measure along, and an
         // arc mirrored in one of its axes turns the other way.
