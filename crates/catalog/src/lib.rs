@@ -208,6 +208,12 @@ impl Catalogue {
         self.addresses.iter().filter(|a| a.role == AddressRole::Function).filter_map(|a| a.letter.bytes().next())
     }
 
+    /// The letter of the preparatory functions (G).
+    pub fn preparatory_letter(&self) -> Option<u8> {
+        let address = self.addresses.iter().find(|a| a.function == Some(FunctionKind::Preparatory))?;
+        address.letter.bytes().next()
+    }
+
     /// The index in [`Catalogue::groups`] of the group a code puts itself in
     /// force in: `None` for block-only codes and codes outside the groups.
     pub fn modal_group_index(&self, letter: char, number: u32) -> Option<usize> {

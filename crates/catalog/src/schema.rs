@@ -62,6 +62,16 @@ macro_rules! entry {
     };
 }
 
+/// What the codes of a function letter do, as ISO programming names them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FunctionKind {
+    /// How the next moves run: motion, plane, units, cycles (G).
+    Preparatory,
+    /// What the machine does besides moving: spindle, coolant, stops (M).
+    Miscellaneous,
+}
+
 /// Whether a function or word holds until changed or only in its block.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -186,6 +196,9 @@ entry! {
     pub struct Address {
         pub letter: String,
         pub role: AddressRole,
+        /// For a function letter, what its codes do.
+        #[serde(default)]
+        pub function: Option<FunctionKind>,
         pub dimensional: Dimensional,
         /// May carry a sign.
         #[serde(default)]

@@ -3,7 +3,7 @@
 
 use std::collections::{BTreeMap, BTreeSet, HashSet};
 
-use ncc_catalog::{Catalogue, Dialect, Doc, Documented, Flavour, Item, Modality, split_code};
+use ncc_catalog::{AddressRole, Catalogue, Dialect, Doc, Documented, Flavour, Item, Modality, split_code};
 use serde::Deserialize;
 
 /// The manual's tables as transcribed in `spec_index.toml`.
@@ -117,6 +117,16 @@ fn every_entry_is_documented() {
     for (name, doc) in docs {
         assert_documented(&name, doc);
     }
+}
+
+#[test]
+fn function_letters_say_what_their_codes_do() {
+    let catalogue = catalogue();
+    for address in &catalogue.addresses {
+        let is_function = address.role == AddressRole::Function;
+        assert_eq!(address.function.is_some(), is_function, "{}: `function` goes with role function", address.letter);
+    }
+    assert_eq!(catalogue.preparatory_letter(), Some(b'G'));
 }
 
 #[test]

@@ -1,9 +1,9 @@
 //! Semantic tokens: the analysis's highlight kinds as the protocol's token
 //! types and modifiers.
 //!
-//! Codes are `keyword` tokens (those of the catalogue's first function
-//! letter, G: the preparatory functions) or `macro` tokens (the others, M:
-//! functions the machine carries out), with a modifier naming their
+//! Codes are `keyword` tokens (the preparatory functions, G) or `macro`
+//! tokens (the others, M: functions the machine carries out), as the
+//! catalogue's function letters say, with a modifier naming their
 //! catalogue group (`g1` plane, `g3` radius compensation, `m2`
 //! spindle, …), so a theme can colour groups apart; parameters are
 //! variables, assigned ones with `declaration`.
@@ -64,7 +64,7 @@ fn classify(kind: HighlightKind, preparatory: Option<u8>) -> (u32, u32) {
 /// Encodes ranges (sorted, on one line each) of a file in `dialect`
 /// relative to each other.
 pub(crate) fn encode(map: &LineMap, ranges: &[HighlightRange], dialect: Dialect) -> Vec<lsp::SemanticToken> {
-    let preparatory = dialect.catalogue().function_letters().next();
+    let preparatory = dialect.catalogue().preparatory_letter();
     let mut tokens = Vec::with_capacity(ranges.len());
     let (mut line, mut start) = (0, 0);
     for highlight in ranges {
@@ -95,7 +95,7 @@ mod tests {
     fn every_kind_has_a_type_and_groups_fit_the_modifier_bits() {
         let dialect = Dialect::Cnc8x6;
         let legend = legend(dialect);
-        let preparatory = dialect.catalogue().function_letters().next();
+        let preparatory = dialect.catalogue().preparatory_letter();
         assert!(legend.token_modifiers.len() <= 32, "{} modifiers", legend.token_modifiers.len());
         for kind in HighlightKind::all(dialect) {
             let (token_type, modifiers) = classify(kind, preparatory);
