@@ -2,7 +2,6 @@
 //! dialect does, each an exhaustive `match` on [`Dialect`], so a new
 //! dialect is added here and the neutral modules never name one.
 
-use ncc_catalog::DialectId;
 use ncc_syntax::Dialect;
 
 use crate::{
@@ -24,8 +23,8 @@ impl Rule {
     /// Every rule: the parser's syntax diagnostics, every dialect's checks,
     /// the report limits, then the executor's.
     pub fn all() -> impl Iterator<Item = &'static Rule> {
-        let dialects = DialectId::ALL.into_iter().filter_map(DialectId::implementation);
-        let checks = dialects.flat_map(|dialect| check_rules(dialect).iter().flat_map(|rules| rules.iter().copied()));
+        let checks =
+            Dialect::all().flat_map(|dialect| check_rules(dialect).iter().flat_map(|rules| rules.iter().copied()));
         diagnostic::syntax_rules().chain(checks).chain(findings::RULES.iter().copied()).chain(diagnostic::run_rules())
     }
 
