@@ -359,7 +359,10 @@ fn expand_program(program: &Program<'_>, path: &Path, output: Option<&Path>, ste
     let name = path.file_name().map_or_else(|| path.display().to_string(), |name| name.to_string_lossy().into_owned());
     let title = format!("EXPANDED FROM {name}");
     let number = program_number(program.text).unwrap_or(1);
-    let mut expansion = Expansion::new(io::BufWriter::new(out), machine, number, &title);
+    // The expansion is written in the program's own dialect.
+    let mut expansion = match program.dialect {
+        Dialect::Cnc8x6 => Expansion::new(io::BufWriter::new(out), machine, number, &title),
+    };
     let ran = Ran::run(program, &config, Progress::OnTerminal, |text, library| {
         nc_exec::run::run_into(text, library, machine, step_budget, &mut expansion)
     });
@@ -457,9 +460,13 @@ pub(crate) fn lower(path: &Path, dialect: Option<DialectId>) -> ExitCode {
     };
     let lines = TextIndex::new(&text);
     let mut out = String::new();
-    for block in parse.tree().blocks() {
-        let line = lines.line_col(block.syntax().text_range().start(), Columns::Characters).0 + 1;
-        let _ = writeln!(out, "{line:>6}  {}", BlockData::lower(block.syntax().green()));
+    match parse.dialect() {
+        Dialect::Cnc8x6 => {
+            for block in parse.tree().blocks() {
+                let line = lines.line_col(block.syntax().text_range().start(), Columns::Characters).0 + 1;
+                let _ = writeln!(out, "{line:>6}  {}", BlockData::lower(block.syntax().green()));
+            }
+        }
     }
     let mut stdout = io::stdout().lock();
     match stdout.write_all(out.as_bytes()).and_then(|()| stdout.flush()) {
