@@ -195,18 +195,23 @@ impl Server {
         lock(&self.state)
     }
 
-    fn snapshot(&self, uri: &Uri) -> jsonrpc::Result<Snapshot> {
+    /// A snapshot of `uri`'s document; `None` for one in a dialect this
+    /// build does not read.
+    fn snapshot(&self, uri: &Uri) -> jsonrpc::Result<Option<Snapshot>> {
         let state = self.state();
+        if state.unread.contains(uri) {
+            return Ok(None);
+        }
         let document =
             state.documents.get(uri).ok_or_else(|| invalid_params(format!("{} is not open", uri.as_str())))?;
-        Ok(Snapshot {
+        Ok(Some(Snapshot {
             analysis: state.workspaces.get(document.workspace).analysis(),
             file: document.file,
             map: document.map.clone(),
             uri: uri.clone(),
             cycle: cycle_time::View::of(&document.cycle),
             cycle_hints: state.cycle_hints,
-        })
+        }))
     }
 
     /// Runs `query` on a snapshot of `uri`'s document on the blocking pool;
@@ -216,10 +221,7 @@ impl Server {
         uri: &Uri,
         query: impl FnOnce(&Snapshot) -> T + Send + 'static,
     ) -> jsonrpc::Result<T> {
-        if self.state().unread.contains(uri) {
-            return Ok(T::default());
-        }
-        let snapshot = self.snapshot(uri)?;
+        let Some(snapshot) = self.snapshot(uri)? else { return Ok(T::default()) };
         let task =
             tokio::task::spawn_blocking(move || Cancelled::catch(std::panic::AssertUnwindSafe(|| query(&snapshot))));
         match task.await {
