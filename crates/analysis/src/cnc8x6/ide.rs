@@ -1,15 +1,17 @@
 //! What the editor answers know of CNC8x6's codes: planes, arcs, and the
 //! `G79` that starts a subprogram.
 
+use nc_exec::cnc8x6::arcs;
+
 use crate::{
     Config,
-    cnc8x6::checks::motion::{PLANE_CODES, interpolation_planes, plane_axes},
+    cnc8x6::checks::motion::PLANE_CODES,
     lower::{BlockData, Word},
 };
 
 /// Whether the machine can run the code: a plane needs both its axes.
 pub(crate) fn code_fits_machine(letter: char, number: u32, config: &Config) -> bool {
-    letter != 'G' || !PLANE_CODES.contains(&number) || plane_axes(number, config).is_some()
+    letter != 'G' || !PLANE_CODES.contains(&number) || arcs::compensation_plane(&config.machine, number).is_some()
 }
 
 /// In an arc block (G02, G03) whose plane's two axes are written, what
@@ -20,7 +22,8 @@ pub(crate) fn arc_centre(block: &BlockData, config: &Config) -> Vec<(u8, String)
         return Vec::new();
     }
     let written = |axis: u8| block.word(axis).is_some();
-    let Some([first, second]) = interpolation_planes(config).find(|&[a, b]| written(a) && written(b)) else {
+    let Some([first, second]) = arcs::interpolation_planes(&config.machine).find(|&[a, b]| written(a) && written(b))
+    else {
         return Vec::new();
     };
     let (first, second) = (char::from(first), char::from(second));

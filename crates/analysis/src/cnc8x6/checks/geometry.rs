@@ -14,7 +14,7 @@ use ncc_syntax::{TextEdit, TextRange};
 
 use crate::{
     Diagnostic,
-    cnc8x6::checks::motion::{self, plane_axes},
+    cnc8x6::checks::motion,
     cnc8x6::flow::{FlowCheck, Known, Visit, thousandths},
     diagnostic::declare_rules,
     lower::Word,
@@ -195,7 +195,7 @@ fn missing_end_coordinate(visit: &Visit<'_>, arc: &Arc<'_>) -> Diagnostic {
 /// compensation plane as the arc's plane, with the value that keeps it
 /// where it is.
 fn missing_coordinate(visit: &Visit<'_>, letter: u8) -> Option<(u8, String)> {
-    let plane = plane_axes(visit.after.g(1)??, visit.config)?;
+    let plane = arcs::compensation_plane(&visit.config.machine, visit.after.g(1)??)?;
     let other = match plane {
         [first, second] if first == letter => second,
         [first, second] if second == letter => first,
@@ -219,7 +219,7 @@ fn millimetres(micrometres: i64) -> String {
 fn extra_axis(visit: &Visit<'_>, arc: &Arc<'_>) -> Option<Diagnostic> {
     // The axis outside the compensation plane when both of its axes are
     // written, else the third one written.
-    let plane = visit.after.g(1).flatten().and_then(|code| plane_axes(code, visit.config));
+    let plane = visit.after.g(1).flatten().and_then(|code| arcs::compensation_plane(&visit.config.machine, code));
     let in_plane = |letter: u8| plane.is_some_and(|plane| plane.contains(&letter));
     let both = arc.axes.iter().filter(|w| in_plane(w.letter)).count() == 2;
     let extra = arc.axes.iter().find(|w| both && !in_plane(w.letter)).or(arc.axes.get(2))?;

@@ -59,17 +59,6 @@ pub(crate) fn axis_words(block: &BlockData) -> impl Iterator<Item = &Word> {
     block.words.iter().filter(move |w| catalogue.role_of(w.letter) == Some(AddressRole::Axis))
 }
 
-/// The two axes of the compensation plane of a plane code, first axis
-/// first: the one I refers to in an arc ([`arcs`]).
-pub(crate) fn plane_axes(code: u32, config: &Config) -> Option<[u8; 2]> {
-    arcs::compensation_plane(&config.machine, code)
-}
-
-/// The machine's interpolation planes ([`arcs`]).
-pub(crate) fn interpolation_planes(config: &Config) -> impl Iterator<Item = [u8; 2]> {
-    arcs::interpolation_planes(&config.machine)
-}
-
 fn moves_in_plane(visit: &Visit<'_>, axes: [u8; 2]) -> bool {
     moves(visit) && axis_words(visit.block).any(|w| axes.contains(&w.letter))
 }
@@ -185,7 +174,7 @@ fn check_compensation(visit: &Visit<'_>, out: &mut Vec<Diagnostic>) {
         return;
     }
     let Some(Some(plane)) = visit.before.g(1) else { return };
-    let Some(axes) = plane_axes(plane, visit.config) else { return };
+    let Some(axes) = arcs::compensation_plane(&visit.config.machine, plane) else { return };
     if !moves_in_plane(visit, axes) {
         out.push(Diagnostic::new(
             &G40_WITHOUT_PLANE_MOTION,
@@ -223,7 +212,7 @@ impl Motion {
     /// Radius compensation bridges at most 200 blocks without motion in
     /// its plane when it looks for the next contour element.
     fn check_lookahead(&mut self, visit: &Visit<'_>, out: &mut Vec<Diagnostic>) {
-        let plane = visit.after.g(1).flatten().and_then(|code| plane_axes(code, visit.config));
+        let plane = visit.after.g(1).flatten().and_then(|code| arcs::compensation_plane(&visit.config.machine, code));
         let Some(axes) = plane.filter(|_| compensation_on(visit.after)) else {
             *self = Motion::default();
             return;
