@@ -20,6 +20,8 @@ use std::sync::Arc;
 
 /// Blocks as plain data, lowered the same way for the executor.
 pub(crate) use nc_exec::cnc8x6::lower;
+/// What the flow walk may not know.
+pub use nc_exec::known::Known;
 pub use ncc_catalog::DialectId;
 use ncc_syntax::Parse;
 pub use ncc_syntax::{Dialect, Severity, TextEdit, TextRange, TextSize};

@@ -231,7 +231,7 @@ fn the_state_at_a_block_follows_each_call() {
         .iter()
         .map(|(modal, params)| {
             let feed = match &modal.feed {
-                ncc_analysis::cnc8x6::flow::Known::Is(Some(setting)) => setting.value.to_string(),
+                ncc_analysis::Known::Is(Some(setting)) => setting.value.to_string(),
                 other => format!("{other:?}"),
             };
             (feed, params.get(2).map(|(raw, _)| raw), modal.position(b'X'))

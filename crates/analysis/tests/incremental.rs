@@ -2,8 +2,8 @@
 //! (a run of blocks) is lowered and checked again, no other.
 
 use ncc_analysis::{
-    AnalysisHost, Config, Dialect, FileId, RootDatabase, TextEdit, TextRange, TextSize,
-    cnc8x6::flow::{Known, ModalState, ParamState},
+    AnalysisHost, Config, Dialect, FileId, Known, RootDatabase, TextEdit, TextRange, TextSize,
+    cnc8x6::flow::{ModalState, ParamState},
 };
 
 fn program(blocks: usize) -> String {
@@ -295,7 +295,7 @@ fn an_edited_subprogram_reaches_the_checkpoints_after_its_calls() {
     let subprogram = "N9993 X1.\nN9994 G17\nN9995 G70\nN9996 G19\nN9997 X5.\n";
     let text = stateful_program(4000, true).replace("N9993 G70\n", subprogram);
     let (mut host, file, mut text) = filled(text, 4000);
-    let plane = |state: &ModalState, code| state.g.contains(&Known::Is(Some(code)));
+    let plane = |state: &ModalState, code| state.modes.g_groups().any(|slot| slot == Known::Is(Some(code)));
     let feed = |state: &ModalState| state.feed.known().flatten().map(|f| f.value.to_string());
     // The checkpoint before N2817 follows the call in N2813 (a multiple of
     // 97), whose feed holds until N2826; the one before N897 follows the

@@ -11,6 +11,6 @@ pub mod expand;
 pub mod formats;
 pub(crate) mod interpreter;
 pub mod lower;
-pub(crate) mod modes;
+pub mod modes;
 pub mod program_flow;
 pub mod tables;

@@ -31,6 +31,7 @@
 //!   (equidistants, corners, start and cancel), for the runner to drive.
 //! - [`envelope`]: the CNC8x9 envelope velocity, a streaming look-ahead
 //!   planner of up to 500 blocks with linear or jerk-limited ramps.
+//! - [`known`]: values a static reading may not know.
 //! - [`machine`]: the machine a program runs on (its control, axes, rates,
 //!   limits, constants and tables).
 //! - [`run`]: running a program on its machine into a [`run::Trace`] or a
@@ -49,6 +50,7 @@ pub(crate) mod axes;
 pub mod cnc8x6;
 pub(crate) mod compensation;
 pub(crate) mod envelope;
+pub mod known;
 pub mod machine;
 pub mod run;
 pub mod tool_path;

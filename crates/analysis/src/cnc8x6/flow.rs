@@ -22,9 +22,11 @@ use std::{ops::Range, sync::Arc};
 
 use nc_exec::{
     cnc8x6::arith::{self, ArithError, BlockArithmetic, Parameters, Raw, UnknownMachine},
+    cnc8x6::modes::{Group, Modes},
     cnc8x6::program_flow::{self, BlockFlow, JumpCounts},
+    known::Known,
 };
-use ncc_catalog::{AddressRole, Catalogue, Modality};
+use ncc_catalog::{AddressRole, Catalogue};
 use ncc_syntax::{Decimal, Sign, TextRange, TextSize};
 use rustc_hash::FxHashMap;
 
@@ -36,22 +38,6 @@ use crate::{
     findings::Findings,
     lower::{BlockData, Value, Word},
 };
-
-/// A value that may not be known statically.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Known<T> {
-    Unknown,
-    Is(T),
-}
-
-impl<T> Known<T> {
-    pub fn known(self) -> Option<T> {
-        match self {
-            Known::Is(value) => Some(value),
-            Known::Unknown => None,
-        }
-    }
-}
 
 /// A modal value as programmed: its number and where it was written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -65,10 +51,8 @@ pub struct Setting {
 /// What the control keeps from block to block.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct ModalState {
-    /// The active code of each G group `G0`…`G11` (`None`: no code active).
-    pub g: [Known<Option<u32>>; 12],
-    /// The active code of each M group `M1`…`M14` (index 0 unused).
-    pub m: [Known<Option<u32>>; 15],
+    /// The code in force in each G and M group (`None`: no code).
+    pub modes: Modes<Known<Option<u32>>>,
     /// F, S, T, D and `&`; `None`: not programmed since the start (the
     /// priority block's zero).
     pub feed: Known<Option<Setting>>,
@@ -110,26 +94,9 @@ impl ModalState {
     }
 
     /// The state after reset: the priority block.
-    pub fn reset(catalogue: &Catalogue) -> ModalState {
-        let mut state = ModalState::unknown();
-        for group in &catalogue.groups {
-            let Some((letter, index)) = group_index(&group.id) else { continue };
-            let default = group.default.as_deref().and_then(ncc_catalog::split_code).map(|(_, n)| n);
-            let slot = Known::Is(default);
-            match letter {
-                'G' => state.g[index] = slot,
-                _ => state.m[index] = slot,
-            }
-        }
-        // Groups without a reset code whose codes hold until changed (G74
-        // and G75) start unknown: the manual gives no default.
-        for group in catalogue.groups.iter().filter(|g| g.default.is_none()) {
-            let Some(('G', index)) = group_index(&group.id) else { continue };
-            if catalogue.codes_in(&group.id).any(|c| c.modality == Modality::Modal) {
-                state.g[index] = Known::Unknown;
-            }
-        }
+    pub fn reset() -> ModalState {
         ModalState {
+            modes: Modes::reset(),
             feed: Known::Is(None),
             speed: Known::Is(None),
             tool: Known::Unknown,
@@ -137,7 +104,7 @@ impl ModalState {
             length: Known::Is(None),
             helix_lead_axis: Known::Is(None),
             offset_written: Known::Is(false),
-            ..state
+            ..ModalState::unknown()
         }
     }
 
@@ -148,8 +115,7 @@ impl ModalState {
 
     pub fn unknown() -> ModalState {
         ModalState {
-            g: [Known::Unknown; 12],
-            m: [Known::Unknown; 15],
+            modes: Modes::all(Known::Unknown),
             feed: Known::Unknown,
             speed: Known::Unknown,
             tool: Known::Unknown,
@@ -161,27 +127,20 @@ impl ModalState {
         }
     }
 
-    /// The active code of G group `group`, if known.
+    /// The code in force in G group `group`, if known.
     pub fn g(&self, group: usize) -> Option<Option<u32>> {
-        self.g[group].known()
+        self.modes.get(Group::g(group)).known()
     }
 
-    /// Whether `code` is known to be the active code of its G group.
+    /// The code in force in M group `group`, if known.
+    pub fn m(&self, group: usize) -> Option<Option<u32>> {
+        self.modes.get(Group::m(group)).known()
+    }
+
+    /// Whether `code` is known to be the code in force in its G group.
     pub fn has_g(&self, group: usize, code: u32) -> bool {
-        self.g[group] == Known::Is(Some(code))
+        self.modes.get(Group::g(group)) == Known::Is(Some(code))
     }
-}
-
-/// `"G3"` → `('G', 3)`.
-fn group_index(id: &str) -> Option<(char, usize)> {
-    let (letter, number) = ncc_catalog::split_code(id)?;
-    let index = usize::try_from(number).ok()?;
-    let fits = match letter {
-        'G' => index < 12,
-        'M' => (1..15).contains(&index),
-        _ => false,
-    };
-    fits.then_some((letter, index))
 }
 
 /// Where a parameter's value came from.
@@ -483,7 +442,7 @@ impl<'db> Walk<'db> {
     fn run(&mut self) {
         let has_main = self.program.has_main();
         if has_main {
-            let (mut state, mut params) = (ModalState::reset(self.catalogue), ParamState::program_start());
+            let (mut state, mut params) = (ModalState::reset(), ParamState::program_start());
             self.from_program_start = true;
             self.walk_unit(0, &mut state, &mut params);
             self.from_program_start = false;
@@ -860,7 +819,7 @@ impl<'db> Walk<'db> {
         self.apply(state, block, &substitutions, &codes, offset);
         let reached = state.position;
         // A fixed cycle moves the tool in its body.
-        if matches!(state.g[8], Known::Is(Some(81..=89)) | Known::Unknown) {
+        if matches!(state.g(8), Some(Some(81..=89)) | None) {
             state.position = [Known::Unknown; 26];
         }
         let arithmetic_error = self.assign(block, offset, params);
@@ -895,24 +854,17 @@ impl<'db> Walk<'db> {
     ) {
         // When constant cutting speed ends without a new S, the control
         // keeps the speed it last reached, not the S written (a cutting speed).
-        let maybe_css = |state: &ModalState| !matches!(state.g[6], Known::Is(Some(94 | 95)));
+        let maybe_css = |state: &ModalState| !matches!(state.g(6), Some(Some(94 | 95)));
         let css_before = maybe_css(after);
         for &(letter, number, _) in codes {
-            let Some(group) = self.catalogue.group_of(char::from(letter), number) else { continue };
-            let Some((_, index)) = group_index(&group.id) else { continue };
-            let modal = self.catalogue.code(char::from(letter), number).is_none_or(|c| c.modality == Modality::Modal);
-            if modal {
-                let slot = if letter == b'G' { &mut after.g[index] } else { &mut after.m[index] };
-                *slot = Known::Is(Some(number));
-            }
+            after.modes.set(letter, number);
         }
         let indirect_code = block.words.iter().zip(substitutions).any(|(w, s)| {
             matches!(w.letter, b'G' | b'M') && matches!(w.value, Some(Value::Parameter { .. })) && s.is_none()
         });
         if indirect_code {
             // A code from an unknown parameter may be any code.
-            after.g = [Known::Unknown; 12];
-            after.m = [Known::Unknown; 15];
+            after.modes = Modes::all(Known::Unknown);
             after.helix_lead_axis = Known::Unknown;
         }
         if codes.iter().any(|&(l, n, _)| l == b'G' && n == 10) {
@@ -961,18 +913,14 @@ impl<'db> Walk<'db> {
         // Offsets and transformations move the program's coordinate system
         // under the tool.
         let frame_changes = [92, 93, 53, 54, 55, 56, 57, 58, 59, 35, 36, 37, 38, 39, 31].iter().any(|&c| has(c));
-        let transformed = !matches!(after.g[11], Known::Is(None) | Known::Is(Some(34)));
+        let transformed = !matches!(after.g(11), Some(None | Some(34)));
         if frame_changes || transformed {
             after.position = [Known::Unknown; 26];
             return;
         }
         let data_block = [10, 92, 93].iter().any(|&c| has(c));
         if !data_block {
-            let incremental = match after.g[9] {
-                Known::Is(Some(91)) => Some(true),
-                Known::Is(_) => Some(false),
-                Known::Unknown => None,
-            };
+            let incremental = after.g(9).map(|code| code == Some(91));
             for (word, substitution) in block.words.iter().zip(substitutions) {
                 if self.catalogue.role_of(word.letter) != Some(AddressRole::Axis) {
                     continue;
@@ -986,7 +934,7 @@ impl<'db> Walk<'db> {
             }
         }
         // A helix moves its lead axis without a word for it.
-        let helix = after.g[2] == Known::Is(Some(9)) && matches!(after.g[0], Known::Is(Some(2 | 3)));
+        let helix = after.has_g(2, 9) && matches!(after.g(0), Some(Some(2 | 3)));
         if helix && !data_block {
             match after.helix_lead_axis {
                 Known::Is(Some(axis)) => after.position[usize::from(axis - b'A')] = Known::Unknown,

@@ -29,9 +29,11 @@ use ncc_syntax::{Dialect, SyntaxKind, TextRange, TextSize};
 use rowan::{GreenNode, NodeOrToken};
 use rustc_hash::FxHashMap;
 
+use nc_exec::known::Known;
+
 use crate::{
     Config,
-    cnc8x6::flow::{Course, Known, ModalState, ParamState, Walk},
+    cnc8x6::flow::{Course, ModalState, ParamState, Walk},
     cnc8x6::model::{self, Program},
     db::{Db, DialectCache, Settings, SourceFile},
 };
@@ -363,8 +365,7 @@ impl Checkpoints {
         let (mut block, mut carried) = match at.checked_sub(1) {
             Some(start) => (points[start].index, (*points[start].state).clone()),
             None => {
-                let catalogue = Settings::get(db).dialect(db).catalogue();
-                let state = (ModalState::reset(catalogue), ParamState::program_start());
+                let state = (ModalState::reset(), ParamState::program_start());
                 (0, Carried { state, course: Course::default(), repeated: 0 })
             }
         };

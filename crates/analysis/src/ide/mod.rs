@@ -18,8 +18,10 @@ pub(crate) mod symbols;
 use ncc_catalog::{AddressRole, Item};
 use ncc_syntax::{TextRange, TextSize};
 
+use nc_exec::known::Known;
+
 use crate::{
-    cnc8x6::flow::{self, Known, ModalState, ParamState, show_thousandths},
+    cnc8x6::flow::{self, ModalState, ParamState, show_thousandths},
     cnc8x6::model::{self, Transfer},
     db::{Db, Settings, SourceFile},
     lower::{BlockData, Value, Word},
@@ -159,8 +161,12 @@ fn modal_text(states: &[(ModalState, ParamState)]) -> String {
     let mut lines: Vec<String> = Vec::new();
     for (state, _) in states {
         let mut parts: Vec<String> = Vec::new();
-        let codes: Vec<String> =
-            state.g.iter().filter_map(|slot| slot.known().flatten()).map(|code| format!("G{code:02}")).collect();
+        let codes: Vec<String> = state
+            .modes
+            .g_groups()
+            .filter_map(|slot| slot.known().flatten())
+            .map(|code| format!("G{code:02}"))
+            .collect();
         parts.push(format!("`{}`", codes.join(" ")));
         let settings = [('F', &state.feed), ('S', &state.speed), ('T', &state.tool), ('D', &state.offset)];
         for (letter, setting) in settings {

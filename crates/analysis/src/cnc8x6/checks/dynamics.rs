@@ -19,10 +19,12 @@ use nc_exec::{
 use ncc_catalog::{AddressRole, Dialect};
 use ncc_syntax::{Decimal, TextRange, TextSize};
 
+use nc_exec::known::Known;
+
 use crate::{
     Config, Diagnostic,
     cnc8x6::checks::motion,
-    cnc8x6::flow::{FlowCheck, Known, ModalState, Visit},
+    cnc8x6::flow::{FlowCheck, ModalState, Visit},
     diagnostic::declare_rules,
     lower::{BlockData, Value, Word},
 };
@@ -81,7 +83,7 @@ fn feed_mm_per_min(state: &ModalState) -> Option<f64> {
     if !matches!(state.g(6)?, Some(94 | 96)) {
         return None;
     }
-    let factor = match state.m[4].known()? {
+    let factor = match state.m(4)? {
         Some(36) => 1.0,
         Some(37) => 0.01,
         _ => return None,

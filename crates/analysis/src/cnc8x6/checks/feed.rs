@@ -4,13 +4,15 @@
 use ncc_catalog::Dialect;
 use ncc_syntax::{TextEdit, TextRange, TextSize};
 
+use nc_exec::known::Known;
+
 use crate::{
     Config, Diagnostic,
     cnc8x6::checks::{
         block::{digit_overflow, parameter_raw},
         motion,
     },
-    cnc8x6::flow::{FlowCheck, Known, ModalState, Setting, Substitution, Visit, show_thousandths},
+    cnc8x6::flow::{FlowCheck, ModalState, Setting, Substitution, Visit, show_thousandths},
     diagnostic::declare_rules,
     lower::{BlockData, Value, Word},
 };

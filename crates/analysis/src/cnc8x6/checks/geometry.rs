@@ -12,10 +12,12 @@ use nc_exec::{
 };
 use ncc_syntax::{TextEdit, TextRange};
 
+use nc_exec::known::Known;
+
 use crate::{
     Diagnostic,
     cnc8x6::checks::motion,
-    cnc8x6::flow::{FlowCheck, Known, Visit, thousandths},
+    cnc8x6::flow::{FlowCheck, Visit, thousandths},
     diagnostic::declare_rules,
     lower::Word,
 };

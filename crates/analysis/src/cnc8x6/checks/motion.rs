@@ -7,10 +7,12 @@ use nc_exec::cnc8x6::{arcs, arith::MAX_RAW};
 use ncc_catalog::{AddressRole, Dialect};
 use ncc_syntax::{Severity, TextEdit, TextRange};
 
+use nc_exec::known::Known;
+
 use crate::{
     Config, Diagnostic,
     cnc8x6::checks::block::{assigns_corrections, parameter_raw},
-    cnc8x6::flow::{FlowCheck, Known, ModalState, Visit},
+    cnc8x6::flow::{FlowCheck, ModalState, Visit},
     diagnostic::declare_rules,
     lower::{BlockData, Value, Word},
 };

@@ -3,9 +3,11 @@
 
 use ncc_catalog::{AddressRole, Dialect};
 
+use nc_exec::known::Known;
+
 use crate::{
     Diagnostic,
-    cnc8x6::flow::{FlowCheck, Known, ModalState, Visit},
+    cnc8x6::flow::{FlowCheck, ModalState, Visit},
     diagnostic::declare_rules,
     lower::{BlockData, Value},
 };
@@ -129,7 +131,7 @@ impl Threads {
 }
 
 fn spindle_stopped(state: &ModalState) -> bool {
-    state.m[2] == Known::Is(Some(5))
+    state.m(2) == Some(Some(5))
 }
 
 /// The block after the empty block programs every axis of the machine

@@ -12,7 +12,7 @@ use crate::{
     cnc8x6::cycles::{self, CycleError, CycleInput, CycleKind, CycleStep, Spindle},
     cnc8x6::formats::{self, PlainLiterals},
     cnc8x6::lower::{BlockData, Value, Word},
-    cnc8x6::modes::Modes,
+    cnc8x6::modes::{Group, Modes},
     cnc8x6::program_flow::{self, BlockFlow, block_flow},
     compensation::{CompensationError, Compensator, Element, Settings, Side, ToolElement},
     machine::MachineConfig,
@@ -43,7 +43,6 @@ pub(super) struct Runner {
     pub(super) source: usize,
     pub(super) machine: std::sync::Arc<MachineConfig>,
     pub(super) modes: Modes,
-    pub(super) groups: Groups,
     /// F as programmed; its unit follows the feed mode in force.
     pub(super) feed: Option<ProgrammedFeed>,
     /// S as programmed: rpm, or the cutting speed under constant cutting
@@ -119,12 +118,10 @@ pub(super) struct Runner {
 impl Runner {
     pub(super) fn new(machine: std::sync::Arc<MachineConfig>) -> Self {
         // The priority block: G01 G17 G90 G94 F0 S0 M05 ….
-        let modes = Modes::reset();
         Runner {
             catalogue: Dialect::Cnc8x6.catalogue(),
             source: 0,
-            groups: Groups::of(&modes),
-            modes,
+            modes: Modes::reset(),
             feed: None,
             speed: 0.0,
             speed_limit: None,
@@ -195,7 +192,6 @@ impl Runner {
             source,
             machine,
             modes,
-            groups: _,
             feed,
             speed,
             in_cycle,
@@ -378,11 +374,11 @@ impl Runner {
         // G58 and G59 hold in their own block only (01 §5.5).
         self.block_offset = codes
             .iter()
-            .find(|&&(letter, number, _)| self.modes.group_of(letter, number) == Some(self.groups.zero_offset))
+            .find(|&&(letter, number, _)| Group::of(letter, number) == Some(Group::ZERO_OFFSET))
             .and_then(|&(_, number, _)| u8::try_from(number).ok());
         // A new zero offset holds from this block; a new length correction
         // from its first block of linear or rapid motion (02 §1.18.2).
-        let motion = self.modes.active(self.groups.motion);
+        let motion = self.modes.get(Group::MOTION);
         // `G23 I1` … `I4` selects the envelope velocity's dynamic set (04
         // §2.2); in an arc block I is the centre.
         if has(b'G', 23)
@@ -496,7 +492,7 @@ impl Runner {
         }
         // The active fixed cycle runs after the block's motion, in every
         // block until G80 (03 §1.4), but not inside its own body.
-        let cycle = self.modes.active(self.groups.cycle).filter(|&number| (81..=89).contains(&number));
+        let cycle = self.modes.get(Group::CYCLE).filter(|&number| (81..=89).contains(&number));
         if let Some(number) = cycle.filter(|_| !self.in_cycle) {
             if self.machine.cycle_file.is_some() {
                 return Flow::Cycle { number, then: self.flow_of(block, has) };
@@ -517,8 +513,8 @@ impl Runner {
         let motion = codes
             .iter()
             .rev()
-            .find(|&&(letter, number, _)| self.modes.modal_group_of(letter, number) == Some(self.groups.motion))
-            .map_or(self.modes.active(self.groups.motion), |&(_, number, _)| Some(number));
+            .find(|&&(letter, number, _)| Group::modal_of(letter, number) == Some(Group::MOTION))
+            .map_or(self.modes.get(Group::MOTION), |&(_, number, _)| Some(number));
         let thread = motion == Some(33);
         let machine = &*self.machine;
         for word in &block.words {
@@ -734,9 +730,9 @@ impl Runner {
     /// control's look-ahead fixes them.
     fn compensate(&mut self, start: Position, path: Path) -> Result<(), CompensationError> {
         let index = self.delivered + self.steps.len() - 1;
-        let code = self.modes.active(self.groups.plane).unwrap_or_default();
+        let code = self.modes.get(Group::PLANE).unwrap_or_default();
         let Some([first, second]) = self.planes.compensation(code) else {
-            if self.modes.active(self.groups.compensation).is_some_and(|code| code != 40) {
+            if self.modes.get(Group::COMPENSATION).is_some_and(|code| code != 40) {
                 let range = self.step_mut(index).range;
                 let message = format!(
                     "radius compensation in the plane of G{code}, which this machine does not have (machine constants R340, R341): the run leaves the compensation out"
@@ -748,7 +744,7 @@ impl Runner {
         let plane = (first, second);
         // Mirrored in one axis of the plane, the tool changes side.
         let flipped = self.recalculation.flips(plane);
-        let side = match self.modes.active(self.groups.compensation) {
+        let side = match self.modes.get(Group::COMPENSATION) {
             Some(41) => Some(if flipped { Side::Right } else { Side::Left }),
             Some(42) => Some(if flipped { Side::Left } else { Side::Right }),
             _ => None,
@@ -843,7 +839,7 @@ impl Runner {
             [length, duration, feed.unwrap_or(0.0)].iter().chain(&end).all(|value| value.is_finite()),
             "no NaN or infinity leaves the executor: {end:?} {length} {duration} {feed:?}"
         );
-        let path_mode = match self.modes.active(self.groups.joining) {
+        let path_mode = match self.modes.get(Group::JOINING) {
             Some(23) => PathMode::Continuous,
             Some(24) => PathMode::ExactStop,
             _ => PathMode::Stop,
@@ -905,7 +901,7 @@ impl Runner {
     /// own, else the modal one.
     fn zero_offset_row(&self) -> u8 {
         self.block_offset
-            .or_else(|| self.modes.active(self.groups.zero_offset).and_then(|code| u8::try_from(code).ok()))
+            .or_else(|| self.modes.get(Group::ZERO_OFFSET).and_then(|code| u8::try_from(code).ok()))
             .unwrap_or(53)
     }
 
@@ -929,7 +925,7 @@ impl Runner {
     /// changes stay inside it (03 §1.4 I6). The error says why the
     /// control stops.
     fn built_in_cycle(&mut self, number: u32, range: TextRange) -> Result<(), String> {
-        let spindle = match self.modes.active(self.groups.spindle) {
+        let spindle = match self.modes.get(Group::SPINDLE) {
             Some(3) => Spindle::Clockwise,
             Some(4) => Spindle::CounterClockwise,
             Some(19) => Spindle::Oriented,
@@ -1001,7 +997,7 @@ impl Runner {
     /// it, restored when the cycle's body returns (03 §1.4 I6).
     pub(super) fn snapshot(&self) -> Snapshot {
         Snapshot {
-            modes: self.modes.clone(),
+            modes: self.modes,
             feed: self.feed,
             speed: self.speed,
             speed_limit: self.speed_limit,
@@ -1032,7 +1028,7 @@ impl Runner {
     pub(super) fn moved(&mut self, step: &Move<'_>) -> Option<Moved> {
         let (range, start, end) = (step.range, step.start, step.end);
         let straight = distance(&start, &end);
-        let motion = self.modes.active(self.groups.motion);
+        let motion = self.modes.get(Group::MOTION);
         let moved = |motion, length, duration, feed, path| Some(Moved { motion, length, duration, feed, path });
         if motion == Some(0) {
             return moved(Motion::Rapid, straight, self.rapid_seconds(&start, &end), None, Path::Straight);
@@ -1105,7 +1101,7 @@ impl Runner {
     /// of G96/G97 that machine constant 329 decade 3 selects (01 §6.9).
     fn feed_mode(&self) -> FeedMode {
         let swapped = matches!(self.css_setting, 1 | 3);
-        match self.modes.active(self.groups.feed_units) {
+        match self.modes.get(Group::FEED_UNITS) {
             Some(95) => FeedMode { per_revolution: true, css: false },
             Some(96) => FeedMode { per_revolution: swapped, css: true },
             Some(97) => FeedMode { per_revolution: !swapped, css: true },
@@ -1116,7 +1112,7 @@ impl Runner {
     /// What the feed is multiplied by: M37 reduces it 1 : 100, M36 (the
     /// reset state) runs it as programmed (01 §6.6).
     fn feed_factor(&self) -> f64 {
-        if self.modes.active(self.groups.feed_reduction) == Some(37) { 0.01 } else { 1.0 }
+        if self.modes.get(Group::FEED_REDUCTION) == Some(37) { 0.01 } else { 1.0 }
     }
 
     /// Why the control cannot move to `position` (program coordinates in
@@ -1159,7 +1155,7 @@ impl Runner {
     }
 
     pub(super) fn incremental(&self) -> bool {
-        self.modes.active(self.groups.dimensions) == Some(91)
+        self.modes.get(Group::DIMENSIONS) == Some(91)
     }
 
     /// Minutes a move takes with feed per revolution under constant cutting
@@ -1211,7 +1207,7 @@ impl Runner {
     /// stops on. Under a helix the axis of its lead turns with the arc.
     pub(super) fn arc(&mut self, step: &Move<'_>, counter_clockwise: bool) -> Result<Option<Arc>, ()> {
         let Move { block, range, axes, start, end } = *step;
-        let helix = self.helix_lead.filter(|_| self.modes.active(self.groups.joining) == Some(9));
+        let helix = self.helix_lead.filter(|_| self.modes.get(Group::JOINING) == Some(9));
         // Under a helix a word for its axis is not a coordinate of the arc.
         let mut letters: Vec<u8> = axes
             .iter()

@@ -50,10 +50,7 @@ pub(super) struct Registers<'r> {
 
 impl Registers<'_> {
     pub(super) fn read(&self, group: u16, column: usize) -> Option<Raw> {
-        let code = |letter: char| {
-            let group = self.modes.find(&format!("{letter}{group}"))?;
-            self.modes.active(group).map(Raw::from)
-        };
+        let code = |letter: char| self.modes.get(Group::numbered(letter, usize::from(group))?).map(Raw::from);
         match column {
             1 => code('M'),
             2 => code('G'),
@@ -139,38 +136,6 @@ pub(super) struct Functions {
     pub(super) m_functions: u8,
     pub(super) tool_change: bool,
     pub(super) mergeable: bool,
-}
-
-/// The groups the run reads, resolved once.
-#[derive(Clone)]
-pub(super) struct Groups {
-    pub(super) motion: Group,
-    pub(super) joining: Group,
-    pub(super) feed_units: Group,
-    pub(super) cycle: Group,
-    pub(super) dimensions: Group,
-    pub(super) spindle: Group,
-    pub(super) zero_offset: Group,
-    pub(super) plane: Group,
-    pub(super) compensation: Group,
-    pub(super) feed_reduction: Group,
-}
-
-impl Groups {
-    pub(super) fn of(modes: &Modes) -> Groups {
-        Groups {
-            motion: modes.group("G0"),
-            joining: modes.group("G2"),
-            feed_units: modes.group("G6"),
-            cycle: modes.group("G8"),
-            dimensions: modes.group("G9"),
-            spindle: modes.group("M2"),
-            zero_offset: modes.group("G5"),
-            plane: modes.group("G1"),
-            compensation: modes.group("G3"),
-            feed_reduction: modes.group("M4"),
-        }
-    }
 }
 
 /// Minutes a thread of `length` mm takes: the lead per revolution at
