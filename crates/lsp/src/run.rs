@@ -572,7 +572,7 @@ impl Grouping {
 struct PlacedBreak {
     source: u32,
     at: TextSize,
-    reason: velocity::Reason,
+    reason: velocity::Stated,
     /// mm/min, as shown.
     speed_before: f32,
     speed_at: f32,

@@ -1,27 +1,30 @@
-//! The CNC8x6 velocity model: how fast the control really runs a trace's
-//! moves, where the path speed must drop, and what each drop costs
-//! (cnc8x6-04 §1.2–§1.7, §1.11, §6.2).
+//! The velocity model: how fast a control really runs a trace's moves,
+//! where the path speed must drop, and what each drop costs. It reads no
+//! machine constant and names no code: a control's policy gives it the
+//! [`Dynamics`] (for CNC8x6, `cnc8x6::dynamics`) and the [`Terms`] its
+//! reasons are told in.
 //!
 //! Every move ramps linearly (trapezoids). A junction between two moves is
-//! smooth or a stop:
+//! smooth or a stop ([`stop_reason`]):
 //!
-//! * smooth only between two working-feed moves (G01/G02/G03) where the
-//!   second is under G23 and machine constant R97 (decade 1) allows
-//!   continuity: manually (1) for every such junction, automatically (2)
-//!   when the angle between the motion directions is below R39 and neither
-//!   move runs axes beyond the first three; and both moves take at least
-//!   the minimum block duration of 60 ms at their programmed speed (4 ms on
-//!   a CNC8x9, which machine constant R338 decade 2 tells);
+//! * smooth only between two working-feed moves where the second is
+//!   programmed for a continuous path and the control joins such moves
+//!   ([`Joining`]): whenever programmed, or automatically only where the
+//!   angle between the motion directions is below the tolerance angle and
+//!   neither move runs axes beyond the first three; and both moves last at
+//!   least the minimum duration for joining at their programmed speed;
 //! * a stop otherwise: the move before ramps to zero, then waits for the
-//!   in-position window (G23/G24) or pauses for the next block to be
-//!   prepared (G98).
+//!   in-position window or, where blocks are not joined at all, pauses for
+//!   the next block to be prepared.
 //!
 //! A smooth junction runs at the lower of the two speeds, and the control
 //! looks one block ahead: the move after a junction must be able to stop
 //! within itself from the junction speed. Arcs run at most at the speed
-//! whose chord per 10 ms tick stays within 1 µm of the circle. Ramps use
-//! R236 under continuity, R52 for other working feed and R237 for rapid;
-//! threads (G33) run without ramps.
+//! whose chord per interpolator tick stays within the chord error of the
+//! circle. Ramps take the continuous-path acceleration under continuity,
+//! the feed acceleration for other working feed and the rapid acceleration
+//! for rapid moves; threads run without ramps. A control with a longer
+//! look-ahead plans with [`Dynamics::envelope`] instead.
 
 use std::{collections::VecDeque, ops::ControlFlow};
 
@@ -33,10 +36,6 @@ use crate::{
     trace::{Axes, Checkpoint, MAX_AXES, Motion, Path, PathMode, Step, StepSink, Trace, shift_count, shift_range},
 };
 
-/// The interpolator tick of the CNC8x6 (000:2749).
-const TICK: f64 = 0.01;
-/// The largest distance of a chord from its circle the control allows (000:2747).
-const CHORD_ERROR: f64 = 0.001;
 /// The spatial angle in degrees between the motion directions (unit
 /// vectors over the first three axes) at a junction, which the control
 /// compares with R39.
@@ -44,51 +43,175 @@ pub fn junction_angle(before: [f64; 3], after: [f64; 3]) -> f64 {
     before.iter().zip(after).map(|(a, b)| a * b).sum::<f64>().clamp(-1.0, 1.0).acos().to_degrees()
 }
 
-/// What the model reads from the machine.
+/// Which moves programmed for a continuous path the control joins.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Joining {
+    /// None: every junction is a stop.
+    Off,
+    /// Every junction into a move programmed for it.
+    Programmed,
+    /// Those, where the path turns by less than the tolerance angle and
+    /// neither move runs axes beyond the first three.
+    Automatic,
+}
+
+/// What the model reads from the machine, as the control's policy gives it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Dynamics {
-    /// Machine constant R97, decade 1: 0 no continuity, 1 manual G23, 2
-    /// automatic recognition.
-    pub continuity: u8,
-    /// R39 in degrees, and its cosine, which junctions compare with.
+    pub joining: Joining,
+    /// The tolerance angle in degrees, and its cosine, which junctions
+    /// compare with.
     pub tolerance_angle: f64,
     pub(crate) tolerance_cosine: f64,
-    /// R52, R236 (R52 when 0) and R237 in mm/s².
+    /// Ramps in mm/s²: working feed, working feed on a continuous path, and
+    /// rapid.
     pub feed_acceleration: f64,
     pub continuity_acceleration: f64,
     pub rapid_acceleration: f64,
-    /// Seconds between blocks under G98, and for the in-position window
-    /// after a stop otherwise.
+    /// Seconds between blocks that are not joined at all, and for the
+    /// in-position window after a stop otherwise.
     pub block_pause: f64,
     pub settle_time: f64,
-    /// The shortest moves (s) continuity and tight joining join.
+    /// The shortest moves (s) that a continuous path, and an exact stop
+    /// without a pause, join.
     pub min_continuity: f64,
     pub min_tight_joining: f64,
+    /// The interpolator tick (s) and the largest distance (mm) of a chord
+    /// from its circle, which bound the speed on arcs.
+    pub tick: f64,
+    pub chord_error: f64,
     /// Seconds an M function and a tool change take.
     pub m_function_time: f64,
     pub tool_change_time: f64,
-    /// The CNC8x9 envelope velocity, when machine constant R338 switches it
-    /// on: it plans the moves instead of the one-block look-ahead.
+    /// A look-ahead planner over many moves, for controls that have one: it
+    /// plans the moves instead of the one-block look-ahead.
     pub envelope: Option<Envelope>,
+    /// How the control tells the reasons of its breaks.
+    pub terms: &'static Terms,
+}
+
+impl Dynamics {
+    /// `reason`, to be told in the control's terms.
+    pub fn state(&self, reason: Reason) -> Stated {
+        Stated { reason, terms: self.terms }
+    }
+
+    /// Why a move of `duration` s at its programmed speed is too short to
+    /// be joined on a continuous path.
+    pub fn too_short_to_join(&self, duration: f64) -> Option<Reason> {
+        (duration < self.min_continuity).then_some(Reason::ShortBlock { duration, limit: self.min_continuity })
+    }
+
+    /// Why automatic joining stops where the path turns from `before` into
+    /// `after` (unit directions over the first three axes).
+    pub fn corner(&self, before: [f64; 3], after: [f64; 3]) -> Option<Reason> {
+        if self.joining != Joining::Automatic {
+            return None;
+        }
+        let cosine: f64 = before.iter().zip(&after).map(|(a, b)| a * b).sum();
+        // Not below the tolerance: the arc cosine only near and past it.
+        if cosine > self.tolerance_cosine + 1e-9 {
+            return None;
+        }
+        let angle = junction_angle(before, after);
+        (angle >= self.tolerance_angle).then_some(Reason::Corner { angle, limit: self.tolerance_angle })
+    }
+
+    /// Why automatic joining stops at a move that runs axes beyond the
+    /// first three.
+    pub fn beyond_three_axes(&self, beyond: bool) -> Option<Reason> {
+        (self.joining == Joining::Automatic && beyond).then_some(Reason::BeyondThreeAxes)
+    }
+
+    /// Why the junction into a feed move programmed with `path_mode` is a
+    /// stop, whatever the moves' geometry.
+    pub fn entered(&self, path_mode: PathMode) -> Option<Reason> {
+        match path_mode {
+            PathMode::Stop => Some(Reason::Unjoined),
+            PathMode::ExactStop => Some(Reason::ExactStop),
+            PathMode::Continuous if self.joining == Joining::Off => Some(Reason::JoiningOff),
+            PathMode::Continuous => None,
+        }
+    }
+
+    /// Whether an exact-stop move of `duration` s at its programmed speed is
+    /// too short for the control to prepare the next block while it runs,
+    /// so that it pauses after it.
+    pub fn too_short_to_prepare(&self, duration: f64) -> bool {
+        duration < self.min_tight_joining
+    }
+
+    /// The distance (mm) a move ramping with `acceleration` needs to stop
+    /// from `speed` (mm/s).
+    pub fn braking_distance(speed: f64, acceleration: f64) -> f64 {
+        speed * speed / (2.0 * acceleration)
+    }
+}
+
+/// How a control names the reasons of its breaks, in its own words.
+pub struct Terms {
+    /// A short name for scripts.
+    pub code: fn(&Reason) -> &'static str,
+    /// A sentence for people.
+    pub describe: fn(&Reason, &mut std::fmt::Formatter<'_>) -> std::fmt::Result,
+}
+
+impl std::fmt::Debug for Terms {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Terms")
+    }
+}
+
+/// One control's terms are one static.
+impl PartialEq for Terms {
+    fn eq(&self, other: &Terms) -> bool {
+        std::ptr::eq(self, other)
+    }
+}
+
+/// A reason with the terms of the control that gave it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stated {
+    pub reason: Reason,
+    terms: &'static Terms,
+}
+
+impl Stated {
+    pub fn code(&self) -> &'static str {
+        (self.terms.code)(&self.reason)
+    }
+
+    pub fn avoidable(&self) -> bool {
+        self.reason.avoidable()
+    }
+}
+
+impl std::fmt::Display for Stated {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        (self.terms.describe)(&self.reason, f)
+    }
 }
 
 /// Why the path speed drops below the programmed feed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Reason {
-    /// G98: blocks are not joined; each ramps to a stop.
-    NoContinuity,
-    /// G24: each block ramps to a stop and waits for the in-position window.
-    TightJoining,
-    /// R97 decade 1 is 0: the control joins no blocks.
-    ContinuityOff,
-    /// The angle between the motion directions (degrees) is not below R39.
+    /// The move is programmed to be joined to none: the one before ramps to
+    /// a stop and the control pauses.
+    Unjoined,
+    /// An exact stop: the move before ramps to a stop and waits for the
+    /// in-position window.
+    ExactStop,
+    /// A continuous path is programmed, but the control joins no moves.
+    JoiningOff,
+    /// The angle between the motion directions (degrees) is not below the
+    /// tolerance angle.
     Corner {
         angle: f64,
         limit: f64,
     },
     /// A rapid move at the junction.
     Rapid,
-    /// A thread (G33) at the junction: it runs without ramps, from a stop.
+    /// A thread at the junction: it runs without ramps, from a stop.
     Thread,
     /// A block without motion (or a dwell) between two moves.
     NonMotion,
@@ -106,24 +229,24 @@ pub enum Reason {
     ArcLimit {
         radius: f64,
     },
-    /// Envelope velocity (CNC8x9): a corner of `angle` degrees, limited by
-    /// the accuracy criterion R384 or the dynamic criterion R385.
+    /// Planned look-ahead: a corner of `angle` degrees, limited by the
+    /// accuracy criterion or the dynamic criterion.
     Accuracy {
         angle: f64,
     },
     Overload {
         angle: f64,
     },
-    /// Envelope velocity: the centrifugal acceleration on an arc.
+    /// Planned look-ahead: the centrifugal acceleration on an arc.
     Centrifugal {
         radius: f64,
     },
-    /// Envelope velocity: the look-ahead of `blocks` ends, and the last
-    /// block planned must be able to stop.
+    /// Planned look-ahead: the window of `blocks` ends, and the last block
+    /// planned must be able to stop.
     WindowEnd {
         blocks: usize,
     },
-    /// Envelope velocity: a block shorter than R382 (mm) breaks continuity.
+    /// Planned look-ahead: a block shorter than `limit` mm breaks the path.
     ContinuityLength {
         limit: f64,
     },
@@ -135,73 +258,6 @@ impl Reason {
     pub fn avoidable(&self) -> bool {
         !matches!(self, Reason::Rapid | Reason::Thread)
     }
-
-    /// A short name for scripts.
-    pub fn code(&self) -> &'static str {
-        match self {
-            Reason::NoContinuity => "g98",
-            Reason::TightJoining => "g24",
-            Reason::ContinuityOff => "continuity-off",
-            Reason::Corner { .. } => "corner",
-            Reason::Rapid => "rapid",
-            Reason::Thread => "thread",
-            Reason::NonMotion => "non-motion",
-            Reason::ShortBlock { .. } => "short-block",
-            Reason::BeyondThreeAxes => "beyond-three-axes",
-            Reason::LookAhead => "look-ahead",
-            Reason::ArcLimit { .. } => "arc-limit",
-            Reason::Accuracy { .. } => "accuracy",
-            Reason::Overload { .. } => "overload",
-            Reason::Centrifugal { .. } => "centrifugal",
-            Reason::WindowEnd { .. } => "window-end",
-            Reason::ContinuityLength { .. } => "continuity-length",
-        }
-    }
-}
-
-/// The reason in the control's terms.
-impl std::fmt::Display for Reason {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Reason::NoContinuity => f.write_str("G98 joins no blocks: a stop and a pause before the next"),
-            Reason::TightJoining => f.write_str("G24 tight joining: a stop and the in-position wait"),
-            Reason::ContinuityOff => f.write_str("G23 without continuity: machine constant R97 decade 1 is 0"),
-            Reason::Corner { angle, limit } => write!(f, "a corner of {angle:.1}°, not below R39 ({limit:.3}°)"),
-            Reason::Rapid => f.write_str("a rapid move (G00) is never joined smoothly"),
-            Reason::Thread => f.write_str("a thread (G33) runs from a stop, without ramps"),
-            Reason::NonMotion => f.write_str("a block without motion between moves"),
-            Reason::ShortBlock { duration, limit } => write!(
-                f,
-                "a block of {:.0} ms at its feed, shorter than the {:.0} ms continuity needs",
-                duration * 1000.0,
-                limit * 1000.0
-            ),
-            Reason::BeyondThreeAxes => f.write_str("continuity is recognised on the first three axes only"),
-            Reason::LookAhead => {
-                f.write_str("one block of look-ahead: the next block must be able to stop within itself")
-            }
-            Reason::ArcLimit { radius } => write!(
-                f,
-                "an arc of radius {radius:.3} mm: at most {:.0} µm chord error per interpolator tick",
-                CHORD_ERROR * 1000.0,
-            ),
-            Reason::Accuracy { angle } => {
-                write!(f, "a corner of {angle:.1}°: the accuracy criterion R384 limits the speed")
-            }
-            Reason::Overload { angle } => {
-                write!(f, "a corner of {angle:.1}°: the dynamic criterion R385 limits the overload")
-            }
-            Reason::Centrifugal { radius } => {
-                write!(f, "an arc of radius {radius:.3} mm: the centrifugal criterion limits the speed")
-            }
-            Reason::WindowEnd { blocks } => {
-                write!(f, "the look-ahead of {blocks} blocks ends: the last block planned must be able to stop")
-            }
-            Reason::ContinuityLength { limit } => {
-                write!(f, "a block shorter than R382 ({limit:.3} mm) breaks continuity")
-            }
-        }
-    }
 }
 
 /// A place where the speed drops: at the end of `step` (or, for an arc
@@ -209,7 +265,7 @@ impl std::fmt::Display for Reason {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Break {
     pub step: usize,
-    pub reason: Reason,
+    pub reason: Stated,
     /// mm/min before the drop and at it.
     pub before: f64,
     pub at: f64,
@@ -457,7 +513,7 @@ impl Planning {
             end_direction: this.end_direction,
             arc_radius: this.arc_radius,
             stop_before,
-            continuity: this.path_mode == PathMode::Continuous && dynamics.continuity > 0,
+            continuity: this.path_mode == PathMode::Continuous && dynamics.joining != Joining::Off,
             set: step.dynamic_set,
             mergeable: step.mergeable,
         };
@@ -521,12 +577,24 @@ impl PlannedSteps {
             let reason = reason_of(limit, &this, None, dynamics)?;
             let cruise = profile.peak / 60.0;
             let lost = (this.length / cruise - this.length / this.programmed).clamp(0.0, deficit);
-            Some(Break { step: index, reason, before: this.programmed * 60.0, at: profile.peak, lost })
+            Some(Break {
+                step: index,
+                reason: dynamics.state(reason),
+                before: this.programmed * 60.0,
+                at: profile.peak,
+                lost,
+            })
         });
         let exit = next.filter(|_| moving).zip(planned.exit_limit).and_then(|((_, next, stop), limit)| {
             let reason = reason_of(limit, &this, Some((next, *stop)), dynamics)?;
             let before = if next.kind == Kind::Still { this.programmed } else { this.programmed.min(next.programmed) };
-            Some(Break { step: index, reason, before: before * 60.0, at: profile.exit, lost: pause })
+            Some(Break {
+                step: index,
+                reason: dynamics.state(reason),
+                before: before * 60.0,
+                at: profile.exit,
+                lost: pause,
+            })
         });
         // What the move loses besides a limit through it goes to the drops
         // at its ends, as the square of each end's shortfall weighs (a
@@ -666,7 +734,10 @@ impl Timed {
                     (before, lost_time(&this, next, entry, exit, before, after))
                 };
                 let lost = lost.max(0.0) + pause;
-                sink.speed_break(&step, Break { step: index, reason, before: before * 60.0, at: 0.0, lost });
+                sink.speed_break(
+                    &step,
+                    Break { step: index, reason: dynamics.state(reason), before: before * 60.0, at: 0.0, lost },
+                );
             }
             (None, Some(next)) if this.kind == Kind::Feed => {
                 // Below what the move reaches on its own only when the next
@@ -674,7 +745,7 @@ impl Timed {
                 let before = this.cruise.min(next.cruise).min(stopping_speed(&this, entry));
                 if exit < before * (1.0 - 1e-9) {
                     let lost = lost_time(&this, next, entry, exit, before, after);
-                    let reason = Reason::LookAhead;
+                    let reason = dynamics.state(Reason::LookAhead);
                     sink.speed_break(
                         &step,
                         Break { step: index, reason, before: before * 60.0, at: exit * 60.0, lost },
@@ -685,7 +756,7 @@ impl Timed {
         }
         if let Some(radius) = this.arc_radius.filter(|_| this.cruise < this.programmed * (1.0 - 1e-9)) {
             let lost = this.length / this.cruise - this.length / this.programmed;
-            let reason = Reason::ArcLimit { radius };
+            let reason = dynamics.state(Reason::ArcLimit { radius });
             let (before, at) = (this.programmed * 60.0, this.cruise * 60.0);
             sink.speed_break(&step, Break { step: index, reason, before, at, lost });
         }
@@ -737,7 +808,7 @@ fn move_of(step: &Step, start: &Axes, axes: &[u8], dynamics: &Dynamics) -> Move 
             end_direction = tangent(&step.end);
             let radius = (step.end[u] - centre[0]).hypot(step.end[v] - centre[1]);
             if radius > 0.0 && kind == Kind::Feed {
-                let limit = (8.0 * radius * CHORD_ERROR).sqrt() / TICK;
+                let limit = (8.0 * radius * dynamics.chord_error).sqrt() / dynamics.tick;
                 if limit < cruise {
                     cruise = limit;
                 }
@@ -747,7 +818,7 @@ fn move_of(step: &Step, start: &Axes, axes: &[u8], dynamics: &Dynamics) -> Move 
     }
     let acceleration = match (kind, step.path_mode) {
         (Kind::Rapid, _) => dynamics.rapid_acceleration,
-        (Kind::Feed, PathMode::Continuous) if dynamics.continuity > 0 => dynamics.continuity_acceleration,
+        (Kind::Feed, PathMode::Continuous) if dynamics.joining != Joining::Off => dynamics.continuity_acceleration,
         _ => dynamics.feed_acceleration,
     };
     let beyond_three_axes = (3..MAX_AXES).any(|i| (step.end[i] - start[i]).abs() > 0.0);
@@ -772,7 +843,8 @@ fn unit(vector: [f64; 3]) -> [f64; 3] {
 }
 
 /// Why the junction from `this` into `next` is a stop, or `None` when it
-/// is smooth.
+/// is smooth; the first reason in the order the control asks, each asked of
+/// [`Dynamics`], as the checker asks them.
 fn stop_reason(this: &Move, next: &Move, dynamics: &Dynamics) -> Option<Reason> {
     for side in [this, next] {
         match side.kind {
@@ -782,32 +854,12 @@ fn stop_reason(this: &Move, next: &Move, dynamics: &Dynamics) -> Option<Reason> 
             Kind::Feed => {}
         }
     }
-    match next.path_mode {
-        PathMode::Stop => return Some(Reason::NoContinuity),
-        PathMode::ExactStop => return Some(Reason::TightJoining),
-        PathMode::Continuous if dynamics.continuity == 0 => return Some(Reason::ContinuityOff),
-        PathMode::Continuous => {}
-    }
-    if dynamics.continuity == 2 {
-        if this.beyond_three_axes || next.beyond_three_axes {
-            return Some(Reason::BeyondThreeAxes);
-        }
-        let cosine: f64 = this.end_direction.iter().zip(&next.start_direction).map(|(a, b)| a * b).sum();
-        // Not below R39: the arc cosine only near and past the limit.
-        if cosine <= dynamics.tolerance_cosine + 1e-9 {
-            let angle = junction_angle(this.end_direction, next.start_direction);
-            if angle >= dynamics.tolerance_angle {
-                return Some(Reason::Corner { angle, limit: dynamics.tolerance_angle });
-            }
-        }
-    }
-    for side in [this, next] {
-        let duration = side.length / side.programmed;
-        if duration < dynamics.min_continuity {
-            return Some(Reason::ShortBlock { duration, limit: dynamics.min_continuity });
-        }
-    }
-    None
+    dynamics
+        .entered(next.path_mode)
+        .or_else(|| dynamics.beyond_three_axes(this.beyond_three_axes || next.beyond_three_axes))
+        .or_else(|| dynamics.corner(this.end_direction, next.start_direction))
+        .or_else(|| dynamics.too_short_to_join(this.length / this.programmed))
+        .or_else(|| dynamics.too_short_to_join(next.length / next.programmed))
 }
 
 /// The highest speed at which `this` can be entered (from `entry`'s side:
@@ -821,7 +873,7 @@ fn stopping_speed(this: &Move, from: f64) -> f64 {
 /// block too short to send the next one while it runs pauses as well.
 fn pause_after(this: &Move, next: &Move, dynamics: &Dynamics) -> f64 {
     let too_short_to_prepare =
-        this.path_mode == PathMode::ExactStop && this.length / this.programmed < dynamics.min_tight_joining;
+        this.path_mode == PathMode::ExactStop && dynamics.too_short_to_prepare(this.length / this.programmed);
     if next.path_mode == PathMode::Stop || too_short_to_prepare { dynamics.block_pause } else { dynamics.settle_time }
 }
 
@@ -878,7 +930,7 @@ fn lost_time(this: &Move, next: &Move, entry: f64, exit: f64, smooth: f64, after
 
 #[cfg(test)]
 mod tests {
-    use super::{Reason, Timing, time};
+    use super::{Joining, Reason, Timing, time};
     use crate::{
         cnc8x6::dynamics,
         machine::MachineConfig,
@@ -906,7 +958,7 @@ mod tests {
     #[test]
     fn unset_constants_take_the_models_assumptions() {
         let dynamics = dynamics::dynamics(&MachineConfig::default());
-        assert_eq!((dynamics.continuity, dynamics.tolerance_angle), (2, 60.0));
+        assert_eq!((dynamics.joining, dynamics.tolerance_angle), (Joining::Automatic, 60.0));
         let accelerations = (dynamics.feed_acceleration, dynamics.continuity_acceleration, dynamics.rapid_acceleration);
         assert_eq!(accelerations, (1000.0, 400.0, 1000.0));
     }
@@ -919,7 +971,7 @@ mod tests {
         assert_eq!((line.entry, line.peak, line.exit), (0.0, 6000.0, 0.0));
         close(line.duration, rest_to_rest(100.0, 100.0, 1000.0) + 0.020);
         close(timing.total_time(), 1.1 + 0.020);
-        let reasons: Vec<Reason> = timing.breaks.iter().map(|b| b.reason).collect();
+        let reasons: Vec<Reason> = timing.breaks.iter().map(|b| b.reason.reason).collect();
         assert_eq!(reasons, [Reason::NonMotion]);
         // The stop costs the ramp down, against going on at 100 mm/s.
         close(timing.breaks[0].lost, 100.0 / 1000.0 / 2.0 + 0.020);
@@ -946,7 +998,7 @@ mod tests {
         assert_eq!(below.breaks.len(), 1);
         close(below.total_time(), 15.0 / 10.0 + 10.0 / 400.0 + 0.010);
         let above = timed("%1\nN1 G23 G01 X10 F600\nN2 X11 Y2\nN3 M30\n");
-        let Reason::Corner { angle, limit } = above.breaks[0].reason else { panic!("{:?}", above.breaks) };
+        let Reason::Corner { angle, limit } = above.breaks[0].reason.reason else { panic!("{:?}", above.breaks) };
         close(angle, 2.0f64.atan().to_degrees());
         assert_eq!(limit, 60.0);
         let second = 5.0f64.sqrt();
@@ -973,8 +1025,8 @@ mod tests {
         let timing = timed("%1\nN1 G02 X2 Y0 I1 J0 F1000\nN2 M30\n");
         let limit = (8.0f64 * 0.001).sqrt() / 0.01;
         close(timing.profiles[0].peak, limit * 60.0);
-        let arc = timing.breaks.iter().find(|b| matches!(b.reason, Reason::ArcLimit { .. })).unwrap();
-        assert_eq!(arc.reason, Reason::ArcLimit { radius: 1.0 });
+        let arc = timing.breaks.iter().find(|b| matches!(b.reason.reason, Reason::ArcLimit { .. })).unwrap();
+        assert_eq!(arc.reason.reason, Reason::ArcLimit { radius: 1.0 });
         close(arc.at, limit * 60.0);
         close(arc.before, 1000.0);
         let length = std::f64::consts::PI;
@@ -985,7 +1037,7 @@ mod tests {
     fn dwell_keeps_its_time_and_breaks_the_path() {
         let timing = timed("%1\nN1 G23 G01 X10 F600\nN2 G04 Q150\nN3 X20\nN4 M30\n");
         close(timing.profiles[1].duration, 1.5);
-        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason)).collect();
+        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason.reason)).collect();
         assert_eq!(reasons, [(0, Reason::NonMotion), (2, Reason::NonMotion)]);
     }
 
@@ -994,12 +1046,12 @@ mod tests {
         // The control brakes one block ahead: the 0.5 mm block must be able
         // to stop within itself, sqrt(2 * 400 * 0.5) = 20 mm/s.
         let timing = timed("%1\nN1 G23 G01 X100 F3000\nN2 X100.5 F3000\nN3 X200\nN4 M30\n");
-        let reasons: Vec<Reason> = timing.breaks.iter().map(|b| b.reason).collect();
+        let reasons: Vec<Reason> = timing.breaks.iter().map(|b| b.reason.reason).collect();
         assert_eq!(reasons[0], Reason::ShortBlock { duration: 0.5 / 50.0, limit: 0.060 });
         // 8 mm take 80 ms at 100 mm/s, but stop within themselves only
         // from sqrt(2 * 400 * 8) = 80 mm/s.
         let timing = timed("%1\nN1 G23 G01 X100 F6000\nN2 X108\nN3 X200\nN4 M30\n");
-        assert_eq!((timing.breaks[0].step, timing.breaks[0].reason), (0, Reason::LookAhead));
+        assert_eq!((timing.breaks[0].step, timing.breaks[0].reason.reason), (0, Reason::LookAhead));
         close(timing.breaks[0].at, 4800.0);
         close(timing.profiles[1].entry, 4800.0);
         // Long enough blocks, one slow: the fast one ends at the slow speed.
@@ -1032,7 +1084,7 @@ mod tests {
         let timing = enveloped(&text);
         let expected = rest_to_rest(100.0, 100.0, 400.0) + 0.010;
         assert!((timing.total_time() - expected).abs() < expected * 1e-3, "{} != {expected}", timing.total_time());
-        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason)).collect();
+        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason.reason)).collect();
         assert_eq!(reasons, [(99, Reason::NonMotion)]);
         // The CNC8x6 stops after every block.
         assert!(timed(&text).total_time() > 3.0 * expected);
@@ -1088,7 +1140,7 @@ mod tests {
         let timing = enveloped("%1\nN1 G23 G01 X100 F6000\nN2 X200 Y100\nN3 M30\n");
         let corner = timing.breaks[0];
         assert_eq!(corner.step, 0);
-        let Reason::Accuracy { angle } = corner.reason else { panic!("{:?}", corner.reason) };
+        let Reason::Accuracy { angle } = corner.reason.reason else { panic!("{:?}", corner.reason) };
         assert!((angle - 45.0).abs() < 1e-9);
         let limit = 0.008 / (0.002 * 22.5f64.to_radians().tan()) * 60.0;
         assert!((corner.at - limit).abs() < limit * 1e-3, "{} != {limit}", corner.at);
@@ -1106,7 +1158,7 @@ mod tests {
         let timing = timed("%1\nN1 G23 G01 X8 F6000\nN2 X200\nN3 M30\n");
         close(timing.profiles[0].exit, 4800.0);
         close(timing.profiles[1].entry, 4800.0);
-        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason)).collect();
+        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason.reason)).collect();
         assert_eq!(reasons, [(1, Reason::NonMotion)]);
     }
 
@@ -1152,7 +1204,7 @@ mod tests {
     #[test]
     fn rapid_moves_stop_at_both_ends() {
         let timing = timed("%1\nN1 G23 G01 X10 F600\nN2 G00 X100\nN3 G01 X110\nN4 M30\n");
-        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason)).collect();
+        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason.reason)).collect();
         assert_eq!(reasons[..2], [(0, Reason::Rapid), (1, Reason::Rapid)]);
         // 90 mm at the default 10 m/min rapid with R237 ramps.
         close(timing.profiles[1].duration, rest_to_rest(90.0, 10_000.0 / 60.0, 1000.0) + 0.010);

@@ -13,7 +13,7 @@ use std::{fmt::Write as _, ops::ControlFlow, sync::Arc};
 
 use nc_exec::{
     run::{Called, Checkpoint, Environment, Motion, Step, Totals, shift_count, shift_offset, shift_range},
-    velocity::{self, Break, Reason, Timer, TimerState, TimingSink},
+    velocity::{self, Break, Stated, Timer, TimerState, TimingSink},
 };
 use ncc_syntax::{BlockParser, SyntaxNode, TextRange, TextSize, ast::AstNode};
 use rustc_hash::FxHashMap;
@@ -95,7 +95,7 @@ impl Clone for BlockTime {
 pub struct BreakAt {
     /// Displayed, the reason in the control's terms; `code()`, its short
     /// name.
-    pub reason: Reason,
+    pub reason: Stated,
     /// mm/min before the drop and at it, in the last execution.
     pub before: f64,
     pub at: f64,

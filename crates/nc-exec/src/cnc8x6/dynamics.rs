@@ -5,12 +5,20 @@
 //! compensation (R168, R234, R339). The planners themselves (`velocity`,
 //! `envelope`) and the compensator read no machine constant.
 
+use std::fmt;
+
 use crate::{
     compensation::Settings,
     envelope::{DynamicSet, Envelope, MAX_DEPTH, P_PER_JERK, ProfileKind, Ramp},
     machine::MachineConfig,
-    velocity::Dynamics,
+    trace::PathMode,
+    velocity::{Dynamics, Joining, Reason, Terms},
 };
+
+/// The interpolator tick of the CNC8x6 (000:2749).
+const TICK: f64 = 0.01;
+/// The largest distance of a chord from its circle the control allows (000:2747).
+const CHORD_ERROR: f64 = 0.001;
 
 /// Moves shorter in time (ms) than these at their programmed speed cannot
 /// be joined smoothly (G23) or tightly (G24), on a CNC8x6 and on a CNC8x9
@@ -33,7 +41,7 @@ pub fn for_control(machine: &MachineConfig, (cnc8x6, cnc8x9): (f64, f64)) -> f64
 /// for, until the machine's configuration sets them: automatic continuity,
 /// R52 and R237 of 1000 mm/s², and the manual's example of 400 mm/s² for
 /// R236. The checker assumes nothing: its continuity rules wait for R97.
-const ASSUMED_CONTINUITY: u8 = 2;
+const ASSUMED_JOINING: Joining = Joining::Automatic;
 const ASSUMED_ACCELERATIONS: [(u32, i64); 3] = [(52, 1000), (236, 400), (237, 1000)];
 
 /// The velocity model's parameters for `machine`: the one-block look-ahead
@@ -54,7 +62,10 @@ fn one_block_look_ahead(machine: &MachineConfig) -> Dynamics {
         value => value,
     };
     Dynamics {
-        continuity: machine.known_decade(97, 1).unwrap_or(ASSUMED_CONTINUITY),
+        // A digit the manual does not define joins as manual continuity does.
+        joining: machine
+            .known_decade(97, 1)
+            .map_or(ASSUMED_JOINING, |decade| joining(decade).unwrap_or(Joining::Programmed)),
         tolerance_angle: tolerance_angle(machine),
         tolerance_cosine: tolerance_angle(machine).to_radians().cos(),
         feed_acceleration,
@@ -64,9 +75,34 @@ fn one_block_look_ahead(machine: &MachineConfig) -> Dynamics {
         settle_time: f64::from(machine.settle_time_ms) / 1000.0,
         min_continuity: for_control(machine, MIN_CONTINUITY_MS) / 1000.0,
         min_tight_joining: for_control(machine, MIN_TIGHT_JOINING_MS) / 1000.0,
+        tick: TICK,
+        chord_error: CHORD_ERROR,
         m_function_time: f64::from(machine.m_function_ms) / 1000.0,
         tool_change_time: f64::from(machine.tool_change_ms) / 1000.0,
         envelope: None,
+        terms: &TERMS,
+    }
+}
+
+/// How a block of the code in force in group G2 is joined to the one
+/// before: G23 on a continuous path, G24 after an exact stop, G98 (and G09
+/// for a helix) after a stop and a pause.
+pub fn path_mode(joining_code: Option<u32>) -> PathMode {
+    match joining_code {
+        Some(23) => PathMode::Continuous,
+        Some(24) => PathMode::ExactStop,
+        _ => PathMode::Stop,
+    }
+}
+
+/// How R97 decade 1 joins G23 blocks: 0 not at all, 1 manually (every
+/// G23 block), 2 by automatic recognition (000:6988-7025).
+pub fn joining(decade: u8) -> Option<Joining> {
+    match decade {
+        0 => Some(Joining::Off),
+        1 => Some(Joining::Programmed),
+        2 => Some(Joining::Automatic),
+        _ => None,
     }
 }
 
@@ -192,6 +228,72 @@ impl Settings {
             limit_angle: degrees(machine.constant(339).abs() % 1_000_000),
             continuity_limit: degrees(machine.constant(234).abs()),
             contact_feed: machine.decade(168, 5) == 0,
+        }
+    }
+}
+
+/// The reasons of breaks as the CNC8x6 manual names them.
+static TERMS: Terms = Terms { code, describe };
+
+/// A short name for scripts.
+fn code(reason: &Reason) -> &'static str {
+    match reason {
+        Reason::Unjoined => "g98",
+        Reason::ExactStop => "g24",
+        Reason::JoiningOff => "continuity-off",
+        Reason::Corner { .. } => "corner",
+        Reason::Rapid => "rapid",
+        Reason::Thread => "thread",
+        Reason::NonMotion => "non-motion",
+        Reason::ShortBlock { .. } => "short-block",
+        Reason::BeyondThreeAxes => "beyond-three-axes",
+        Reason::LookAhead => "look-ahead",
+        Reason::ArcLimit { .. } => "arc-limit",
+        Reason::Accuracy { .. } => "accuracy",
+        Reason::Overload { .. } => "overload",
+        Reason::Centrifugal { .. } => "centrifugal",
+        Reason::WindowEnd { .. } => "window-end",
+        Reason::ContinuityLength { .. } => "continuity-length",
+    }
+}
+
+/// The reason in the control's terms.
+fn describe(reason: &Reason, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+    match reason {
+        Reason::Unjoined => f.write_str("G98 joins no blocks: a stop and a pause before the next"),
+        Reason::ExactStop => f.write_str("G24 tight joining: a stop and the in-position wait"),
+        Reason::JoiningOff => f.write_str("G23 without continuity: machine constant R97 decade 1 is 0"),
+        Reason::Corner { angle, limit } => write!(f, "a corner of {angle:.1}°, not below R39 ({limit:.3}°)"),
+        Reason::Rapid => f.write_str("a rapid move (G00) is never joined smoothly"),
+        Reason::Thread => f.write_str("a thread (G33) runs from a stop, without ramps"),
+        Reason::NonMotion => f.write_str("a block without motion between moves"),
+        Reason::ShortBlock { duration, limit } => write!(
+            f,
+            "a block of {:.0} ms at its feed, shorter than the {:.0} ms continuity needs",
+            duration * 1000.0,
+            limit * 1000.0
+        ),
+        Reason::BeyondThreeAxes => f.write_str("continuity is recognised on the first three axes only"),
+        Reason::LookAhead => f.write_str("one block of look-ahead: the next block must be able to stop within itself"),
+        Reason::ArcLimit { radius } => write!(
+            f,
+            "an arc of radius {radius:.3} mm: at most {:.0} µm chord error per interpolator tick",
+            CHORD_ERROR * 1000.0,
+        ),
+        Reason::Accuracy { angle } => {
+            write!(f, "a corner of {angle:.1}°: the accuracy criterion R384 limits the speed")
+        }
+        Reason::Overload { angle } => {
+            write!(f, "a corner of {angle:.1}°: the dynamic criterion R385 limits the overload")
+        }
+        Reason::Centrifugal { radius } => {
+            write!(f, "an arc of radius {radius:.3} mm: the centrifugal criterion limits the speed")
+        }
+        Reason::WindowEnd { blocks } => {
+            write!(f, "the look-ahead of {blocks} blocks ends: the last block planned must be able to stop")
+        }
+        Reason::ContinuityLength { limit } => {
+            write!(f, "a block shorter than R382 ({limit:.3} mm) breaks continuity")
         }
     }
 }

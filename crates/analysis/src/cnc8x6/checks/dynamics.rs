@@ -4,22 +4,22 @@
 //! 1 manual (a junction is smooth when the block entered is a G23 feed
 //! block), 2 automatic recognition (the control also compares the junction
 //! angle with R39). When the configuration does not give R97, the rules that
-//! depend on it say nothing. Durations are taken at the programmed feed;
-//! the minimum durations are the CNC8x6 ones unless machine constant R338
-//! selects envelope velocity, which only CNC8x9 has. Path lengths come from
-//! the known end positions; [`Arc`] gives the length and tangents of a
-//! G02/G03 block.
+//! depend on it say nothing. Whether a junction stops is the velocity
+//! model's decision ([`velocity::Dynamics`], from the same machine through
+//! `cnc8x6::dynamics`): these rules ask it over what the walk knows, so the
+//! checker and the cycle time cannot disagree. Durations are taken at the
+//! programmed feed. Path lengths come from the known end positions; [`Arc`]
+//! gives the length and tangents of a G02/G03 block.
 
 use nc_exec::{
     arc::circle_through,
     cnc8x6::arcs,
-    cnc8x6::dynamics::{MIN_CONTINUITY_MS, MIN_TIGHT_JOINING_MS, for_control, tolerance_angle},
-    velocity::junction_angle,
+    cnc8x6::dynamics::{self as policy, path_mode},
+    known::Known,
+    velocity::{self, Joining, Reason},
 };
 use ncc_catalog::{AddressRole, Dialect};
 use ncc_syntax::{Decimal, TextRange, TextSize};
-
-use nc_exec::known::Known;
 
 use crate::{
     Config, Diagnostic,
@@ -38,7 +38,7 @@ declare_rules! {
     CONTINUITY_WITH_EXTRA_AXES = "D906", "continuity-with-extra-axes", Info, "With automatic continuity, a G23 block that moves an axis beyond the first three.";
     BLOCK_TOO_SHORT_FOR_CONTINUITY = "D907", "block-too-short-for-continuity", Warning, "A G23 block shorter in time than the minimum for smooth joining.";
     BLOCK_TOO_SHORT_FOR_TIGHT_JOINING = "D908", "block-too-short-for-tight-joining", Info, "A G24 block shorter in time than the minimum for tight joining.";
-    CONTINUITY_BREAK_TOO_SHORT_TO_BRAKE = "D909", "continuity-break-too-short-to-brake", Warning, "A block that ends continuity and is shorter than the braking distance from the speed before it.";
+    CONTINUITY_BREAK_TOO_SHORT_TO_BRAKE = "D909", "continuity-break-too-short-to-brake", Warning, "The last G23 block before continuity ends, shorter than the braking distance from its feed.";
     JUNCTION_ANGLE_STOP = "D910", "junction-angle-stop", Info, "With automatic continuity, a junction whose angle is not below R39, where the axes stop.";
     MISSING_CONTINUITY_MODE = "D911", "missing-continuity-mode", Info, "Many short feed blocks in a row without continuity, G23 not programmed before them.";
     SHORT_BLOCK_NOT_MERGED = "D912", "short-block-not-merged", Info, "A G23 block shorter than R383 that the control cannot merge into its neighbour.";
@@ -53,21 +53,10 @@ const DYNAMIC_SETS: std::ops::RangeInclusive<i128> = 1..=4;
 /// The rotary axis letters (degrees), whose moves have no path length.
 const ROTARY_AXES: [u8; 3] = [b'A', b'B', b'C'];
 
-/// How the control joins blocks under G23: machine constant R97 decade 1.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Joining {
-    Off,
-    Manual,
-    Automatic,
-}
-
+/// How the control joins blocks under G23, when the configuration gives
+/// R97: the velocity model would assume it.
 fn joining(config: &Config) -> Option<Joining> {
-    match config.machine.known_decade(97, 1)? {
-        0 => Some(Joining::Off),
-        1 => Some(Joining::Manual),
-        2 => Some(Joining::Automatic),
-        _ => None,
-    }
+    policy::joining(config.machine.known_decade(97, 1)?)
 }
 
 /// A length limit in mm from a machine constant (R382, R383): `None` when
@@ -97,9 +86,9 @@ fn feed_number(value: Decimal) -> f64 {
     if value.has_point() { value.to_f64() * 1000.0 } else { value.to_f64() }
 }
 
-/// How long a path takes at a feed, in ms.
-fn duration_ms(length: f64, feed: f64) -> f64 {
-    length / feed * 60_000.0
+/// How long a path takes at a feed (mm/min), in s.
+fn duration(length: f64, feed: f64) -> f64 {
+    length / feed * 60.0
 }
 
 type Vector = [f64; 3];
@@ -320,8 +309,11 @@ fn mm(value: f64) -> String {
 /// The last block joined under G23, from which continuity may carry on.
 struct SmoothBlock {
     feed: Option<f64>,
+    length: Option<f64>,
     end: Option<Vector>,
     range: TextRange,
+    /// The path is known to run into it without a stop.
+    entered_moving: bool,
 }
 
 /// A block that stops the axes while G23 stays active.
@@ -332,6 +324,9 @@ struct Interruption {
 
 #[derive(Default)]
 pub(crate) struct Dynamics {
+    /// The velocity model's parameters for the machine, with R97 as the
+    /// configuration gives it.
+    model: Option<velocity::Dynamics>,
     smooth: Option<SmoothBlock>,
     /// The first interruption since `smooth`.
     interruption: Option<Interruption>,
@@ -373,22 +368,25 @@ impl FlowCheck for Dynamics {
         if transfer {
             return;
         }
+        let model = self.model.take().unwrap_or_else(|| {
+            let mut model = policy::dynamics(&visit.config.machine);
+            model.joining = joining.unwrap_or(model.joining);
+            model
+        });
         let path = path(visit);
         let feed = feed_mm_per_min(visit.after);
         let feed_move = motion::moves(visit) && matches!(visit.after.g(0), Some(Some(1..=3)));
-        self.check_without_continuity(visit, feed_move, path.as_ref(), feed, out);
+        self.check_without_continuity(visit, &model, feed_move, path.as_ref(), feed, out);
         if feed_move && visit.after.g(2) == Some(Some(24)) {
-            check_tight_joining(visit, path.as_ref(), feed, out);
+            check_tight_joining(visit, &model, path.as_ref(), feed, out);
         }
-        match joining {
-            Some(mode @ (Joining::Manual | Joining::Automatic)) => {
-                self.continuity(visit, mode, feed_move, path, feed, out);
-            }
-            _ => {
-                self.smooth = None;
-                self.interruption = None;
-            }
+        if joining.is_some_and(|joining| joining != Joining::Off) {
+            self.continuity(visit, &model, feed_move, path, feed, out);
+        } else {
+            self.smooth = None;
+            self.interruption = None;
         }
+        self.model = Some(model);
     }
 
     fn end_of_unit(&mut self, _state: &ModalState, _last: Option<(TextSize, &BlockData)>, _out: &mut Vec<Diagnostic>) {
@@ -436,21 +434,33 @@ fn check_dynamic_set(visit: &Visit<'_>, out: &mut Vec<Diagnostic>) {
 }
 
 /// G24 joins blocks tightly only when each lasts the minimum time.
-fn check_tight_joining(visit: &Visit<'_>, path: Option<&Path>, feed: Option<f64>, out: &mut Vec<Diagnostic>) {
+fn check_tight_joining(
+    visit: &Visit<'_>,
+    model: &velocity::Dynamics,
+    path: Option<&Path>,
+    feed: Option<f64>,
+    out: &mut Vec<Diagnostic>,
+) {
     let (Some(path), Some(feed), Some(range)) = (path, feed, coordinates(visit)) else { return };
-    let minimum = for_control(&visit.config.machine, MIN_TIGHT_JOINING_MS);
-    let duration = duration_ms(path.length, feed);
-    if duration < minimum {
+    let duration = duration(path.length, feed);
+    if model.too_short_to_prepare(duration) {
         let diagnostic = Diagnostic::new(
             &BLOCK_TOO_SHORT_FOR_TIGHT_JOINING,
             range,
             format!(
-                "this G24 move of {} takes {duration:.0} ms at {feed:.0} mm/min, but tight joining needs blocks of at least {minimum:.0} ms, so the control may not join it tightly; lengthen the block or lower the feed",
-                mm(path.length)
+                "this G24 move of {} takes {} at {feed:.0} mm/min, but tight joining needs blocks of at least {}, so the control may not join it tightly; lengthen the block or lower the feed",
+                mm(path.length),
+                ms(duration),
+                ms(model.min_tight_joining)
             ),
         );
         out.push(with_feed_origin(diagnostic, visit));
     }
+}
+
+/// Seconds as whole milliseconds.
+fn ms(seconds: f64) -> String {
+    format!("{:.0} ms", seconds * 1000.0)
 }
 
 impl Dynamics {
@@ -459,17 +469,17 @@ impl Dynamics {
     fn check_without_continuity(
         &mut self,
         visit: &Visit<'_>,
+        model: &velocity::Dynamics,
         feed_move: bool,
         path: Option<&Path>,
         feed: Option<f64>,
         out: &mut Vec<Diagnostic>,
     ) {
-        let minimum = for_control(&visit.config.machine, MIN_CONTINUITY_MS);
         let short = feed_move
             && !self.g23_seen
             && !self.continuity_advised
             && visit.after.g(2) == Some(Some(98))
-            && matches!((path, feed), (Some(path), Some(feed)) if duration_ms(path.length, feed) < minimum);
+            && matches!((path, feed), (Some(path), Some(feed)) if model.too_short_to_join(duration(path.length, feed)).is_some());
         if !short {
             self.short_run = 0;
             return;
@@ -486,7 +496,8 @@ impl Dynamics {
                 &MISSING_CONTINUITY_MODE,
                 range,
                 format!(
-                    "{MANY_SHORT_BLOCKS} or more feed blocks in a row from here last less than {minimum:.0} ms each and run without continuity (G98, the state after reset): the axes ramp down to a stop at the end of every one; program G23 at the start of the program so that the control can join them (machine constant R97 selects how)"
+                    "{MANY_SHORT_BLOCKS} or more feed blocks in a row from here last less than {} each and run without continuity (G98, the state after reset): the axes ramp down to a stop at the end of every one; program G23 at the start of the program so that the control can join them (machine constant R97 selects how)",
+                    ms(model.min_continuity)
                 ),
             ));
         }
@@ -496,7 +507,7 @@ impl Dynamics {
     fn continuity(
         &mut self,
         visit: &Visit<'_>,
-        mode: Joining,
+        model: &velocity::Dynamics,
         feed_move: bool,
         path: Option<Path>,
         feed: Option<f64>,
@@ -505,9 +516,15 @@ impl Dynamics {
         let g23 = visit.after.g(2) == Some(Some(23));
         let moves = motion::moves(visit);
         if feed_move && g23 {
-            self.smooth_block(visit, mode, path.as_ref(), feed, out);
+            let entered_moving = self.smooth_block(visit, model, path.as_ref(), feed, out);
             let range = coordinates(visit).unwrap_or_else(|| head(visit));
-            self.smooth = Some(SmoothBlock { feed, end: path.and_then(|p| p.end), range });
+            self.smooth = Some(SmoothBlock {
+                feed,
+                length: path.as_ref().map(|p| p.length),
+                end: path.and_then(|p| p.end),
+                range,
+                entered_moving,
+            });
             self.interruption = None;
             return;
         }
@@ -538,19 +555,21 @@ impl Dynamics {
         let previous = self.smooth.take().filter(|_| !interrupted);
         let ends = visit.before.g(2) == Some(Some(23)) && visit.after.g(2).is_some() && moves;
         if let Some(previous) = previous.filter(|_| ends) {
-            self.continuity_ends(visit, mode, &previous, path.as_ref(), out);
+            continuity_ends(visit, model, &previous, out);
         }
     }
 
-    /// A G23 feed block: the junction into it and its own length.
+    /// A G23 feed block: the junction into it and its own length. Whether
+    /// the path is known to run into it without a stop.
     fn smooth_block(
         &mut self,
         visit: &Visit<'_>,
-        mode: Joining,
+        model: &velocity::Dynamics,
         path: Option<&Path>,
         feed: Option<f64>,
         out: &mut Vec<Diagnostic>,
-    ) {
+    ) -> bool {
+        let mut entered_moving = false;
         match (&self.smooth, self.interruption.take()) {
             (Some(previous), Some(interruption)) => {
                 let diagnostic = if interruption.rapid {
@@ -568,66 +587,65 @@ impl Dynamics {
                 };
                 out.push(diagnostic.with_related(None, previous.range, "the smooth path before it ends here"));
             }
-            (Some(previous), None) if mode == Joining::Automatic => {
-                check_junction_angle(visit, previous, path, out);
+            (Some(previous), None) => {
+                let corner = check_junction_angle(visit, model, previous, path, out);
+                let durations = [previous.length.zip(previous.feed), path.map(|p| p.length).zip(feed)];
+                let long_enough = durations.iter().all(|known| {
+                    known.is_some_and(|(length, feed)| model.too_short_to_join(duration(length, feed)).is_none())
+                });
+                entered_moving = corner == Some(false) && long_enough;
             }
-            _ => {}
+            (None, _) => {}
         }
-        if mode == Joining::Automatic {
-            check_extra_axes(visit, out);
+        if check_extra_axes(visit, model, out) {
+            entered_moving = false;
         }
         if let Some(path) = path {
-            check_short_smooth_block(visit, path, feed, out);
+            check_short_smooth_block(visit, model, path, feed, out);
         }
+        entered_moving
     }
+}
 
-    /// A moving block that leaves G23 right after a smooth block.
-    fn continuity_ends(
-        &self,
-        visit: &Visit<'_>,
-        mode: Joining,
-        previous: &SmoothBlock,
-        path: Option<&Path>,
-        out: &mut Vec<Diagnostic>,
-    ) {
-        let Some(Some(code)) = visit.after.g(2) else { return };
-        if mode == Joining::Manual
-            && let Some(range) = visit.code_range(b'G', code)
-        {
-            out.push(
-                Diagnostic::new(
-                    &CONTINUITY_BREAK_MANUAL_MODE,
-                    range,
-                    format!(
-                        "with manual continuity (R97 = 1) only G23 feed blocks are entered smoothly: the axes stop before this G{code} block; keep G23 here if the path should run on"
-                    ),
-                )
-                .with_related(None, previous.range, "the last smooth block"),
-            );
-        }
-        // The control brakes at most one block ahead, so the block that ends
-        // continuity must be long enough to stop in.
-        let (Some(path), Some(feed), Some(acceleration), Some(range)) =
-            (path, previous.feed, continuity_acceleration(visit.config), coordinates(visit))
-        else {
-            return;
-        };
-        let speed = feed / 60.0;
-        let braking = speed * speed / (2.0 * acceleration);
-        if path.length < braking {
-            out.push(
-                Diagnostic::new(
-                    &CONTINUITY_BREAK_TOO_SHORT_TO_BRAKE,
-                    range,
-                    format!(
-                        "continuity ends in this G{code} block of {}, but stopping from {feed:.0} mm/min takes {} at {acceleration:.0} mm/s²: the control looks only one block ahead and cannot brake in time; end continuity in a longer block or lower the feed before it",
-                        mm(path.length),
-                        mm(braking)
-                    ),
-                )
-                .with_related(None, previous.range, format!("the smooth block before runs at {feed:.0} mm/min")),
-            );
-        }
+/// A moving block that leaves G23 right after a smooth block.
+fn continuity_ends(visit: &Visit<'_>, model: &velocity::Dynamics, previous: &SmoothBlock, out: &mut Vec<Diagnostic>) {
+    let Some(Some(code)) = visit.after.g(2) else { return };
+    let Some(code_range) = visit.code_range(b'G', code) else { return };
+    let stop = model.entered(path_mode(Some(code)));
+    if model.joining == Joining::Programmed && stop.is_some() {
+        out.push(
+            Diagnostic::new(
+                &CONTINUITY_BREAK_MANUAL_MODE,
+                code_range,
+                format!(
+                    "with manual continuity (R97 = 1) only G23 feed blocks are entered smoothly: the axes stop before this G{code} block; keep G23 here if the path should run on"
+                ),
+            )
+            .with_related(None, previous.range, "the last smooth block"),
+        );
+    }
+    // The stop comes before this block, so the last smooth block must brake
+    // within itself; the control looks one block ahead only, and slows the
+    // path down before that block when it is too short (000:7014-7025).
+    let (Some(length), Some(feed), Some(acceleration)) =
+        (previous.length, previous.feed, continuity_acceleration(visit.config))
+    else {
+        return;
+    };
+    let braking = velocity::Dynamics::braking_distance(feed / 60.0, acceleration);
+    if stop.is_some() && previous.entered_moving && length < braking {
+        out.push(
+            Diagnostic::new(
+                &CONTINUITY_BREAK_TOO_SHORT_TO_BRAKE,
+                previous.range,
+                format!(
+                    "continuity ends at the G{code} block after this one, so the axes must stop within this G23 block of {}; stopping from {feed:.0} mm/min takes {} at {acceleration:.0} mm/s²: the path slows down before it reaches the feed, and the control, which looks only one block ahead, cannot brake any earlier; end continuity after a longer block or lower the feed",
+                    mm(length),
+                    mm(braking)
+                ),
+            )
+            .with_related(None, code_range, format!("continuity ends with G{code} here")),
+        );
     }
 }
 
@@ -642,49 +660,60 @@ fn continuity_acceleration(config: &Config) -> Option<f64> {
 }
 
 /// Automatic continuity stops where the tangents turn by R39 or more.
-fn check_junction_angle(visit: &Visit<'_>, previous: &SmoothBlock, path: Option<&Path>, out: &mut Vec<Diagnostic>) {
-    let (Some(before), Some(after), Some(range)) = (previous.end, path.and_then(|p| p.start), coordinates(visit))
-    else {
-        return;
-    };
-    let angle = junction_angle(before, after);
-    let tolerance = tolerance_angle(&visit.config.machine);
-    if angle >= tolerance {
+/// Whether it does, when the tangents are known.
+fn check_junction_angle(
+    visit: &Visit<'_>,
+    model: &velocity::Dynamics,
+    previous: &SmoothBlock,
+    path: Option<&Path>,
+    out: &mut Vec<Diagnostic>,
+) -> Option<bool> {
+    let (before, after) = (previous.end?, path?.start?);
+    let Some(Reason::Corner { angle, limit }) = model.corner(before, after) else { return Some(false) };
+    if let Some(range) = coordinates(visit) {
         out.push(
             Diagnostic::new(
                 &JUNCTION_ANGLE_STOP,
                 range,
                 format!(
-                    "the path turns by {angle:.1}° into this block, not less than the tolerance angle R39 ({tolerance:.3}°): automatic continuity stops the axes at the end of the previous block and starts again; round the corner if the path should run on"
+                    "the path turns by {angle:.1}° into this block, not less than the tolerance angle R39 ({limit:.3}°): automatic continuity stops the axes at the end of the previous block and starts again; round the corner if the path should run on"
                 ),
             )
             .with_related(None, previous.range, "the previous block ends here"),
         );
     }
+    Some(true)
 }
 
 /// Automatic recognition covers the machine's first three axes only.
-fn check_extra_axes(visit: &Visit<'_>, out: &mut Vec<Diagnostic>) {
+/// Whether the block moves another.
+fn check_extra_axes(visit: &Visit<'_>, model: &velocity::Dynamics, out: &mut Vec<Diagnostic>) -> bool {
     let axes = &visit.config.machine.axes;
     let first_three = axes.get(..3).unwrap_or(axes);
     let extra = axis_words(visit).find(|w| !first_three.contains(&w.letter) && axis_moves(visit, w.letter));
-    if let Some(word) = extra {
-        let first_three: Vec<String> = first_three.iter().map(|&a| char::from(a).to_string()).collect();
-        out.push(Diagnostic::new(
-            &CONTINUITY_WITH_EXTRA_AXES,
-            visit.range(word.range),
-            format!(
-                "automatic continuity recognition (R97 = 2) covers only the first three axes ({}): this G23 block also moves {}, so it may not be joined smoothly",
-                first_three.join(", "),
-                char::from(word.letter)
-            ),
-        ));
-    }
+    let Some(word) = extra.filter(|_| model.beyond_three_axes(true).is_some()) else { return false };
+    let first_three: Vec<String> = first_three.iter().map(|&a| char::from(a).to_string()).collect();
+    out.push(Diagnostic::new(
+        &CONTINUITY_WITH_EXTRA_AXES,
+        visit.range(word.range),
+        format!(
+            "automatic continuity recognition (R97 = 2) covers only the first three axes ({}): this G23 block also moves {}, so it may not be joined smoothly",
+            first_three.join(", "),
+            char::from(word.letter)
+        ),
+    ));
+    true
 }
 
 /// Short G23 blocks: merged (R383), breaking continuity (R382), or too
 /// short in time to be joined.
-fn check_short_smooth_block(visit: &Visit<'_>, path: &Path, feed: Option<f64>, out: &mut Vec<Diagnostic>) {
+fn check_short_smooth_block(
+    visit: &Visit<'_>,
+    model: &velocity::Dynamics,
+    path: &Path,
+    feed: Option<f64>,
+    out: &mut Vec<Diagnostic>,
+) {
     let Some(range) = coordinates(visit) else { return };
     let config = visit.config;
     if let Some(merge_limit) = length_limit(config, 383).filter(|&limit| path.length < limit) {
@@ -716,15 +745,15 @@ fn check_short_smooth_block(visit: &Visit<'_>, path: &Path, feed: Option<f64>, o
         return;
     }
     let Some(feed) = feed else { return };
-    let minimum = for_control(&config.machine, MIN_CONTINUITY_MS);
-    let duration = duration_ms(path.length, feed);
-    if duration < minimum {
+    if let Some(Reason::ShortBlock { duration, limit }) = model.too_short_to_join(duration(path.length, feed)) {
         let diagnostic = Diagnostic::new(
             &BLOCK_TOO_SHORT_FOR_CONTINUITY,
             range,
             format!(
-                "this G23 move of {} takes {duration:.0} ms at {feed:.0} mm/min, but blocks are joined smoothly only when they last at least {minimum:.0} ms: the axes slow down here; combine it with its neighbours or lower the feed",
-                mm(path.length)
+                "this G23 move of {} takes {} at {feed:.0} mm/min, but blocks are joined smoothly only when they last at least {}: the axes slow down here; combine it with its neighbours or lower the feed",
+                mm(path.length),
+                ms(duration),
+                ms(limit)
             ),
         );
         out.push(with_feed_origin(diagnostic, visit));

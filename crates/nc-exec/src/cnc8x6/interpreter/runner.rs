@@ -10,6 +10,7 @@ use crate::{
     cnc8x6::arcs,
     cnc8x6::arith::{self, BlockArithmetic, Parameters, Raw},
     cnc8x6::cycles::{self, CycleError, CycleInput, CycleKind, CycleStep, Spindle},
+    cnc8x6::dynamics,
     cnc8x6::formats::{self, PlainLiterals},
     cnc8x6::lower::{BlockData, Value, Word},
     cnc8x6::modes::{Group, Modes},
@@ -839,11 +840,7 @@ impl Runner {
             [length, duration, feed.unwrap_or(0.0)].iter().chain(&end).all(|value| value.is_finite()),
             "no NaN or infinity leaves the executor: {end:?} {length} {duration} {feed:?}"
         );
-        let path_mode = match self.modes.get(Group::JOINING) {
-            Some(23) => PathMode::Continuous,
-            Some(24) => PathMode::ExactStop,
-            _ => PathMode::Stop,
-        };
+        let path_mode = dynamics::path_mode(self.modes.get(Group::JOINING));
         let step = Step {
             source,
             range,
