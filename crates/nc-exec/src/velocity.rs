@@ -98,12 +98,14 @@ impl Dynamics {
 
     /// Why a move of `duration` s at its programmed speed is too short to
     /// be joined on a continuous path.
+    #[inline]
     pub fn too_short_to_join(&self, duration: f64) -> Option<Reason> {
         (duration < self.min_continuity).then_some(Reason::ShortBlock { duration, limit: self.min_continuity })
     }
 
     /// Why automatic joining stops where the path turns from `before` into
     /// `after` (unit directions over the first three axes).
+    #[inline]
     pub fn corner(&self, before: [f64; 3], after: [f64; 3]) -> Option<Reason> {
         if self.joining != Joining::Automatic {
             return None;
@@ -119,12 +121,14 @@ impl Dynamics {
 
     /// Why automatic joining stops at a move that runs axes beyond the
     /// first three.
+    #[inline]
     pub fn beyond_three_axes(&self, beyond: bool) -> Option<Reason> {
         (self.joining == Joining::Automatic && beyond).then_some(Reason::BeyondThreeAxes)
     }
 
     /// Why the junction into a feed move programmed with `path_mode` is a
     /// stop, whatever the moves' geometry.
+    #[inline]
     pub fn entered(&self, path_mode: PathMode) -> Option<Reason> {
         match path_mode {
             PathMode::Stop => Some(Reason::Unjoined),

@@ -69,13 +69,21 @@ impl Group {
     /// The group a modal code puts itself in force in; `None` for
     /// block-only codes and codes outside the groups.
     pub fn modal_of(letter: u8, number: u32) -> Option<Group> {
-        let index = Dialect::Cnc8x6.catalogue().modal_group_index(char::from(letter), number)?;
-        layout().by_catalogue_index[index]
+        match layout().codes(letter, number) {
+            Some(code) => code.modal,
+            None => {
+                let index = Dialect::Cnc8x6.catalogue().modal_group_index(char::from(letter), number)?;
+                layout().by_catalogue_index[index]
+            }
+        }
     }
 
     /// The group of a code, modal or block-only.
     pub fn of(letter: u8, number: u32) -> Option<Group> {
-        Group::of_id(&Dialect::Cnc8x6.catalogue().group_of(char::from(letter), number)?.id)
+        match layout().codes(letter, number) {
+            Some(code) => code.group,
+            None => Group::of_id(&Dialect::Cnc8x6.catalogue().group_of(char::from(letter), number)?.id),
+        }
     }
 }
 
@@ -157,13 +165,36 @@ enum Reset {
 struct Layout {
     by_catalogue_index: Vec<Option<Group>>,
     reset: [Reset; GROUPS],
+    /// The groups of G00…G99 and M00…M99: a run asks for every code.
+    g_codes: [CodeGroups; DENSE_CODES],
+    m_codes: [CodeGroups; DENSE_CODES],
+}
+
+const DENSE_CODES: usize = 100;
+
+#[derive(Clone, Copy, Default)]
+struct CodeGroups {
+    group: Option<Group>,
+    modal: Option<Group>,
+}
+
+impl Layout {
+    fn codes(&self, letter: u8, number: u32) -> Option<CodeGroups> {
+        let table = match letter.to_ascii_uppercase() {
+            b'G' => &self.g_codes,
+            b'M' => &self.m_codes,
+            _ => return None,
+        };
+        table.get(usize::try_from(number).ok()?).copied()
+    }
 }
 
 fn layout() -> &'static Layout {
     static LAYOUT: OnceLock<Layout> = OnceLock::new();
     LAYOUT.get_or_init(|| {
         let catalogue = Dialect::Cnc8x6.catalogue();
-        let by_catalogue_index = catalogue.groups.iter().map(|group| Group::of_id(&group.id)).collect();
+        let by_catalogue_index: Vec<Option<Group>> =
+            catalogue.groups.iter().map(|group| Group::of_id(&group.id)).collect();
         let mut reset = [Reset::Code(None); GROUPS];
         for (group, slot) in catalogue.groups.iter().filter_map(|group| Some((group, Group::of_id(&group.id)?))) {
             let default = group.default.as_deref().and_then(ncc_catalog::split_code).map(|(_, number)| number);
@@ -173,7 +204,19 @@ fn layout() -> &'static Layout {
                 default => Reset::Code(default),
             };
         }
-        Layout { by_catalogue_index, reset }
+        let codes = |letter: char| {
+            std::array::from_fn(|number| {
+                let number = number as u32;
+                CodeGroups {
+                    group: catalogue.group_of(letter, number).and_then(|group| Group::of_id(&group.id)),
+                    modal: catalogue
+                        .modal_group_index(letter, number)
+                        .and_then(|index| by_catalogue_index.get(index).copied().flatten()),
+                }
+            })
+        };
+        let (g_codes, m_codes) = (codes('G'), codes('M'));
+        Layout { by_catalogue_index, reset, g_codes, m_codes }
     })
 }
 
