@@ -66,6 +66,17 @@ static CNC8X6_FILES: DataFiles = DataFiles {
     cycles: data_file!("cnc8x6", "cycles.toml"),
 };
 
+/// The Haas lathe's data, checked by the tests until the dialect is wired in.
+#[cfg(test)]
+static HAAS_LATHE_FILES: DataFiles = DataFiles {
+    codes: data_file!("haas-lathe", "codes.toml"),
+    addresses: data_file!("haas-lathe", "addresses.toml"),
+    parameters: data_file!("haas-lathe", "parameters.toml"),
+    machine_constants: data_file!("haas-lathe", "machine_constants.toml"),
+    operations: data_file!("haas-lathe", "operations.toml"),
+    cycles: data_file!("haas-lathe", "cycles.toml"),
+};
+
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CodesFile {
@@ -321,49 +332,67 @@ pub fn split_code(code: &str) -> Option<(char, u32)> {
 
 #[cfg(test)]
 mod data_files {
-    //! One test per data file, so that each file can be checked on its own.
+    //! One test per data file and dialect, so that each file can be checked
+    //! on its own.
 
     use super::*;
 
-    fn read(name: &str) -> (&'static str, &'static str) {
-        let path = format!("{}/data/cnc8x6/{name}", env!("CARGO_MANIFEST_DIR"));
+    fn read(dialect: &str, name: &str) -> (&'static str, &'static str) {
+        let path = format!("{}/data/{dialect}/{name}", env!("CARGO_MANIFEST_DIR"));
         let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-        (Box::leak(name.to_owned().into_boxed_str()), Box::leak(text.into_boxed_str()))
+        (Box::leak(format!("{dialect}/{name}").into_boxed_str()), Box::leak(text.into_boxed_str()))
     }
+
+    const DIALECTS: [&str; 2] = ["cnc8x6", "haas-lathe"];
 
     #[test]
     fn codes() {
-        let file: CodesFile = parse(read("codes.toml"));
-        assert!(!file.codes.is_empty() && !file.groups.is_empty());
+        for dialect in DIALECTS {
+            let file: CodesFile = parse(read(dialect, "codes.toml"));
+            assert!(!file.codes.is_empty() && !file.groups.is_empty(), "{dialect}");
+        }
     }
 
     #[test]
     fn addresses() {
-        let file: AddressesFile = parse(read("addresses.toml"));
-        assert!(!file.addresses.is_empty());
+        for dialect in DIALECTS {
+            let file: AddressesFile = parse(read(dialect, "addresses.toml"));
+            assert!(!file.addresses.is_empty(), "{dialect}");
+        }
     }
 
     #[test]
     fn parameters() {
-        let file: ParametersFile = parse(read("parameters.toml"));
+        let file: ParametersFile = parse(read("cnc8x6", "parameters.toml"));
         assert_eq!(file.parameters.count, 96);
+        let file: ParametersFile = parse(read("haas-lathe", "parameters.toml"));
+        assert!(file.ranges.iter().all(|range| range.last < file.parameters.count));
     }
 
     #[test]
     fn machine_constants() {
-        let file: MachineConstantsFile = parse(read("machine_constants.toml"));
-        assert!(!file.constants.is_empty());
+        for dialect in DIALECTS {
+            let file: MachineConstantsFile = parse(read(dialect, "machine_constants.toml"));
+            assert!(!file.constants.is_empty(), "{dialect}");
+        }
     }
 
     #[test]
     fn operations() {
-        let file: OperationsFile = parse(read("operations.toml"));
+        let file: OperationsFile = parse(read("cnc8x6", "operations.toml"));
         assert_eq!(file.operations.len(), 52);
+        let file: OperationsFile = parse(read("haas-lathe", "operations.toml"));
+        assert!(file.operations.iter().all(|op| op.symbol.is_some()));
     }
 
     #[test]
     fn cycles() {
-        let file: CyclesFile = parse(read("cycles.toml"));
-        assert!(!file.cycles.is_empty());
+        for dialect in DIALECTS {
+            let file: CyclesFile = parse(read(dialect, "cycles.toml"));
+            assert!(!file.cycles.is_empty(), "{dialect}");
+        }
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -164,6 +164,7 @@ impl Item<'_> {
                     &mut out,
                     &[
                         ("Defined", (!op.defined).then(|| "no: the manual leaves this code undefined".to_owned())),
+                        ("Written", op.symbol.as_ref().map(|symbol| format!("`{symbol}`"))),
                         ("Operands", Some(op.operands.clone())),
                         ("Result", Some(op.result.clone())),
                         ("Conditional", op.conditional.then(|| "yes".to_owned())),
@@ -174,7 +175,21 @@ impl Item<'_> {
                 doc(&mut out, op.doc());
             }
             Item::Cycle(cycle) => {
-                facts(&mut out, &[("Cycle file", cycle.file.clone())]);
+                let constants = cycle.machine_constants.iter().map(u32::to_string).collect::<Vec<_>>();
+                facts(&mut out, &[("Cycle file", cycle.file.clone()), ("Machine constants read", list(&constants))]);
+                if !cycle.addresses.is_empty() {
+                    out.push_str("| Address | Meaning | Unit |\n|---|---|---|\n");
+                    for a in &cycle.addresses {
+                        let _ = writeln!(
+                            out,
+                            "| {} | {} | {} |",
+                            a.letter,
+                            a.meaning.replace('\n', " "),
+                            a.unit.as_deref().unwrap_or("")
+                        );
+                    }
+                    out.push('\n');
+                }
                 if !cycle.parameters.is_empty() {
                     out.push_str("| Parameter | Meaning | Unit |\n|---|---|---|\n");
                     for p in &cycle.parameters {

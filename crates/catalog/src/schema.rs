@@ -299,9 +299,16 @@ entry! {
 }
 
 entry! {
-    /// A parameter-arithmetic operation (control word `CCAABBTT`, CC = code).
+    /// A parameter-arithmetic operation (control word `CCAABBTT`, CC = code),
+    /// or an operator or function of a dialect's expressions (`SIN`, `EQ`).
     pub struct Operation {
+        /// The operation code; for expression operators, their number in
+        /// the file (1, 2, …).
         pub code: u32,
+        /// How an expression operator is written (`+`, `SIN`, `EQ`); `None`
+        /// for operations chosen by code.
+        #[serde(default)]
+        pub symbol: Option<String>,
         /// False for the code the manual leaves undefined (43).
         #[serde(default = "yes")]
         pub defined: bool,
@@ -340,15 +347,33 @@ pub struct CycleParameter {
     pub unit: Option<String>,
 }
 
+/// One address word a canned cycle reads from its own block (`P`, `U`, `D`).
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CycleAddress {
+    pub letter: String,
+    pub meaning: String,
+    #[serde(default)]
+    pub unit: Option<String>,
+}
+
 entry! {
-    /// A fixed cycle (G81–G89) of the milling or lathe cycle files.
+    /// A fixed cycle (G81–G89) of the milling or lathe cycle files, or a
+    /// canned cycle called with its address words.
     pub struct Cycle {
         pub code: String,
         pub flavour: Flavour,
         /// The `$PC` file it comes from.
         #[serde(default)]
         pub file: Option<String>,
+        /// The program parameters it reads (cycles called through R parameters).
         #[serde(default, rename = "parameter")]
         pub parameters: Vec<CycleParameter>,
+        /// The address words it reads from its block (cycles called with words).
+        #[serde(default, rename = "address")]
+        pub addresses: Vec<CycleAddress>,
+        /// The machine constants (Haas: Settings) that change what it does.
+        #[serde(default)]
+        pub machine_constants: Vec<u32>,
     }
 }

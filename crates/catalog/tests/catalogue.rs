@@ -1,9 +1,10 @@
-//! The catalogue against the manual's tables, its internal consistency, and
-//! the text `ncc explain` and hover show.
+//! The CNC8x6 catalogue against the manual's tables, and the text
+//! `ncc explain` and hover show. The consistency checks that hold for every
+//! dialect's data run in the crate's unit tests (`src/tests`).
 
-use std::collections::{BTreeMap, BTreeSet, HashSet};
+use std::collections::BTreeMap;
 
-use ncc_catalog::{AddressRole, Catalogue, Dialect, Doc, Documented, Flavour, Item, Modality, split_code};
+use ncc_catalog::{Catalogue, Dialect, Doc, Documented, Flavour, Item, split_code};
 use serde::Deserialize;
 
 /// The manual's tables as transcribed in `spec_index.toml`.
@@ -102,85 +103,11 @@ fn every_item_of_the_manuals_tables_has_an_entry() {
 }
 
 #[test]
-fn every_entry_is_documented() {
-    let catalogue = catalogue();
-    let docs = catalogue
-        .groups
-        .iter()
-        .map(|g| (g.id.clone(), g.doc()))
-        .chain(catalogue.codes.iter().map(|c| (c.code.clone(), c.doc())))
-        .chain(catalogue.addresses.iter().map(|a| (a.letter.clone(), a.doc())))
-        .chain(catalogue.parameter_ranges.iter().map(|r| (format!("R{}-R{}", r.first, r.last), r.doc())))
-        .chain(catalogue.machine_constants.iter().map(|c| (format!("MC{}", c.number), c.doc())))
-        .chain(catalogue.operations.iter().map(|o| (format!("op {}", o.code), o.doc())))
-        .chain(catalogue.cycles.iter().map(|c| (format!("{} {:?}", c.code, c.flavour), c.doc())));
-    for (name, doc) in docs {
-        assert_documented(&name, doc);
-    }
-}
-
-#[test]
-fn function_letters_say_what_their_codes_do() {
-    let catalogue = catalogue();
-    for address in &catalogue.addresses {
-        let is_function = address.role == AddressRole::Function;
-        assert_eq!(address.function.is_some(), is_function, "{}: `function` goes with role function", address.letter);
-    }
-    assert_eq!(catalogue.preparatory_letter(), Some(b'G'));
-}
-
-#[test]
-fn groups_are_consistent() {
-    let catalogue = catalogue();
-    let mut seen = HashSet::new();
-    for code in &catalogue.codes {
-        assert!(seen.insert(code.code.as_str()), "{} is listed twice (so in two groups)", code.code);
-        assert!(split_code(&code.code).is_some_and(|(l, _)| l == 'G' || l == 'M'), "{} is no G/M code", code.code);
-        assert_eq!(code.code.len(), 3, "{} is not written with two digits", code.code);
-        if let Some(group) = &code.group {
-            let group = catalogue.group(group).unwrap_or_else(|| panic!("{}: unknown group {group}", code.code));
-            assert_eq!(group.id.as_bytes()[0], code.code.as_bytes()[0], "{} in group {}", code.code, group.id);
-        }
-    }
-    let mut ids = HashSet::new();
-    for group in &catalogue.groups {
-        assert!(ids.insert(group.id.as_str()), "group {} twice", group.id);
-        let members: Vec<_> = catalogue.codes_in(&group.id).collect();
-        let resets: Vec<_> = members.iter().filter(|c| c.reset_default).map(|c| c.code.as_str()).collect();
-        match &group.default {
-            Some(default) => {
-                assert_eq!(resets, [default.as_str()], "group {}: the default is its one reset code", group.id);
-            }
-            None => {
-                assert!(resets.is_empty(), "group {}: reset codes {resets:?} but no default", group.id);
-                assert!(group.default_note.is_some(), "group {} has neither a default nor a note why", group.id);
-            }
-        }
-        if group.open {
-            assert!(members.is_empty(), "open group {} lists codes", group.id);
-        } else {
-            assert!(!members.is_empty(), "group {} has no codes", group.id);
-        }
-        if members.iter().any(|c| c.modality == Modality::Modal) && group.default.is_none() {
-            assert!(group.default_note.is_some(), "group {}: modal codes without a default need a note", group.id);
-        }
-    }
-}
-
-#[test]
-fn modal_codes_put_themselves_in_force_in_their_group() {
-    let catalogue = catalogue();
-    let index_of = |id: &str| catalogue.groups.iter().position(|group| group.id == id);
-    for code in &catalogue.codes {
-        let (letter, number) = split_code(&code.code).expect("checked above");
-        let expected = match code.modality {
-            Modality::Modal => code.group.as_deref().and_then(index_of),
-            Modality::Block => None,
-        };
-        assert_eq!(catalogue.modal_group_index(letter, number), expected, "{}", code.code);
-    }
+fn unlisted_codes_belong_to_the_open_group() {
     // Unlisted M codes of the open range belong to the open group (M14),
-    // above the dense table too; G codes outside the groups to none.
+    // above the dense table too; G codes outside the groups to none. The
+    // checks that hold for every dialect run in the crate's unit tests.
+    let catalogue = catalogue();
     let open = catalogue.groups.iter().rposition(|group| group.open && group.id.starts_with('M'));
     assert_eq!(catalogue.modal_group_index('M', 77), open);
     assert_eq!(catalogue.modal_group_index('m', 77), open);
@@ -189,38 +116,8 @@ fn modal_codes_put_themselves_in_force_in_their_group() {
 }
 
 #[test]
-fn references_between_entries_resolve() {
-    let catalogue = catalogue();
-    let known_addresses: BTreeSet<String> = catalogue.addresses.iter().map(|a| a.letter.to_ascii_uppercase()).collect();
-    let is_word = |name: &str| {
-        known_addresses.contains(name)
-            || split_code(name).is_some_and(|(letter, number)| letter == 'R' && catalogue.is_parameter(number))
-    };
-    for code in &catalogue.codes {
-        for name in code.requires.iter().chain(&code.allows) {
-            assert!(is_word(name), "{}: `{name}` is neither an address nor a parameter", code.code);
-        }
-        for name in &code.cancels {
-            let (letter, number) = split_code(name).unwrap_or_else(|| panic!("{}: cancels `{name}`", code.code));
-            assert!(catalogue.code(letter, number).is_some(), "{}: cancels unknown {name}", code.code);
-        }
-    }
-    for cycle in &catalogue.cycles {
-        assert!(catalogue.code('G', split_code(&cycle.code).unwrap().1).is_some(), "cycle {}", cycle.code);
-        for parameter in &cycle.parameters {
-            assert!(catalogue.is_parameter(parameter.r), "{}: R{}", cycle.code, parameter.r);
-        }
-    }
-    for range in &catalogue.parameter_ranges {
-        assert!(range.first <= range.last && catalogue.is_parameter(range.last), "R{}-R{}", range.first, range.last);
-    }
-    let mut numbers = HashSet::new();
-    for constant in &catalogue.machine_constants {
-        for number in constant.number..=constant.last.unwrap_or(constant.number) {
-            assert!(numbers.insert(number), "machine constant {number} described twice");
-        }
-    }
-    let codes: Vec<u32> = catalogue.operations.iter().map(|op| op.code).collect();
+fn operations_are_numbered_0_to_51() {
+    let codes: Vec<u32> = catalogue().operations.iter().map(|op| op.code).collect();
     assert_eq!(codes, (0..52).collect::<Vec<_>>(), "operations in order 0-51");
 }
 
