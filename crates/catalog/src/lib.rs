@@ -41,6 +41,14 @@ impl Dialect {
     }
 }
 
+/// The catalogue of the Haas lathe (classic control), until the dialect is
+/// registered as a [`Dialect`]: the syntax crate's Haas grammar reads its
+/// expression operators and functions from it.
+pub fn haas_lathe() -> &'static Catalogue {
+    static HAAS_LATHE: OnceLock<Catalogue> = OnceLock::new();
+    HAAS_LATHE.get_or_init(|| Catalogue::load(&HAAS_LATHE_FILES))
+}
+
 /// The data files of one dialect, by name and content.
 struct DataFiles {
     codes: (&'static str, &'static str),
@@ -66,8 +74,7 @@ static CNC8X6_FILES: DataFiles = DataFiles {
     cycles: data_file!("cnc8x6", "cycles.toml"),
 };
 
-/// The Haas lathe's data, checked by the tests until the dialect is wired in.
-#[cfg(test)]
+/// The Haas lathe's data, until the dialect is registered as a [`Dialect`].
 static HAAS_LATHE_FILES: DataFiles = DataFiles {
     codes: data_file!("haas-lathe", "codes.toml"),
     addresses: data_file!("haas-lathe", "addresses.toml"),

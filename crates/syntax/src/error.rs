@@ -89,12 +89,18 @@ syntax_error_kinds! {
     LowercaseAddress = "S012", "lowercase-address", Warning, "A lowercase address letter.";
     IgnoredPreamble = "S013", "ignored-preamble", Info, "Text before the `%` header, which the control ignores.";
     TextAfterEnd = "S014", "text-after-end", Warning, "Text other than comments after the physical end `*`.";
-    MissingProgramNumber = "S015", "missing-program-number", Error, "A `%` header without its program number.";
-    MisplacedPercent = "S016", "misplaced-percent", Error, "A `%` anywhere but at the start of the program.";
+    MissingProgramNumber = "S015", "missing-program-number", Error, "A program header (CNC8x6 `%`, ISO `O`) without its program number.";
+    MisplacedPercent = "S016", "misplaced-percent", Error, "A `%` where the dialect has none: CNC8x6 anywhere but at the start of the program, ISO anywhere but alone on a tape-mark line.";
     ParameterWithoutAssignment = "S017", "parameter-without-assignment", Error, "A parameter `R12` on its own: neither assigned (`R12=5.`) nor used after an address (`XR12`).";
     MissingParameterNumber = "S018", "missing-parameter-number", Error, "`R` without the parameter number.";
     MisplacedEquals = "S019", "misplaced-equals", Error, "An `=` that does not follow a parameter.";
     ByteOrderMark = "S020", "byte-order-mark", Warning, "A file saved as Unicode text with a byte-order mark, which the control does not read.";
+    UnclosedComment = "S021", "unclosed-comment", Error, "A comment `(` without its closing `)` on the line.";
+    SpaceInWord = "S022", "space-in-word", Warning, "A space between an address and its value or between a sign and its digits, which ISO controls may not accept.";
+    DoubledDecimalPoint = "S023", "doubled-decimal-point", Error, "A number with a second decimal point: `7.75.`.";
+    ExpectedExpression = "S024", "expected-expression", Error, "A place where an expression (number, variable, bracket or function) must be.";
+    UnclosedBracket = "S025", "unclosed-bracket", Error, "A `[` without its closing `]` on the line.";
+    MalformedStatement = "S026", "malformed-statement", Error, "A macro statement (IF, GOTO, WHILE, DO, END, assignment) missing a required part, or a keyword out of place.";
 }
 
 /// One syntax diagnostic.

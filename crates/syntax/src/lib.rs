@@ -13,7 +13,10 @@ mod cnc8x6;
 mod decimal;
 pub mod encoding;
 mod error;
+mod expr;
 mod green;
+pub mod haas_lathe;
+mod lexing;
 pub mod limit;
 mod runs;
 mod syntax_kind;
@@ -118,14 +121,19 @@ impl Parse {
 
     /// The tree and the errors as text, for tests and `ncc parse`.
     pub fn debug_dump(&self) -> String {
-        let mut dump = format!("{:#?}", self.syntax_node());
-        for error in self.errors.iter() {
-            dump.push_str(&format!("{error}\n"));
-        }
-        for omitted in self.omitted.iter() {
-            let Omitted { kind, at, count, .. } = omitted;
-            dump.push_str(&format!("{count} more {}[{}] from {at:?} on its line\n", kind.severity(), kind.code()));
-        }
-        dump
+        debug_dump(&self.green, &self.errors, &self.omitted)
     }
+}
+
+/// A tree and its errors as text, for tests and `ncc parse`.
+pub(crate) fn debug_dump(green: &GreenNode, errors: &[SyntaxError], omitted: &[Omitted<SyntaxErrorKind>]) -> String {
+    let mut dump = format!("{:#?}", SyntaxNode::new_root(green.clone()));
+    for error in errors {
+        dump.push_str(&format!("{error}\n"));
+    }
+    for omitted in omitted {
+        let Omitted { kind, at, count, .. } = omitted;
+        dump.push_str(&format!("{count} more {}[{}] from {at:?} on its line\n", kind.severity(), kind.code()));
+    }
+    dump
 }

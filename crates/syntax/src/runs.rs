@@ -10,10 +10,10 @@
 
 use std::hash::Hasher;
 
-use rowan::NodeOrToken;
+use rowan::{NodeOrToken, TextRange};
 
 use crate::{
-    SyntaxKind,
+    SyntaxKind, SyntaxNode,
     green::{self, GreenElement},
 };
 
@@ -72,6 +72,64 @@ fn hash(bytes: &[u8]) -> u64 {
     let mut hasher = rustc_hash::FxHasher::default();
     hasher.write(bytes);
     hasher.finish()
+}
+
+/// The root with the blocks from `first` up to `stop` (or to the end of the
+/// body) replaced by `blocks`, regrouped into runs from the start of
+/// `first`'s run until a new run ends where an old one did.
+pub(crate) fn regroup(
+    root: &SyntaxNode,
+    first: &SyntaxNode,
+    blocks: Vec<GreenElement>,
+    stop: Option<&SyntaxNode>,
+    new_text: &str,
+    end_index: usize,
+) -> rowan::GreenNode {
+    let first_run = first.parent().expect("reparsed blocks are in runs");
+    let mut runs = RunBuilder::new(new_text, usize::from(first_run.text_range().start()));
+    let kept_before = first_run.green().children().take(first.index()).map(|c| c.to_owned()).collect::<Vec<_>>();
+    for block in kept_before.into_iter().chain(blocks) {
+        runs.push(block);
+    }
+    let root_green = root.green();
+    let replaced_end = match stop {
+        None => end_index,
+        Some(stop) => {
+            let stop_run = stop.parent().expect("reparsed blocks are in runs");
+            let mut tail = stop_run.green().children().skip(stop.index()).map(|c| c.to_owned()).collect::<Vec<_>>();
+            let mut replaced_end = stop_run.index() + 1;
+            loop {
+                let mut synced = false;
+                for block in tail {
+                    synced = runs.push(block);
+                }
+                // A new run ends where an old one did: every later run is as before.
+                if synced || replaced_end == end_index {
+                    break replaced_end;
+                }
+                let next = root_green.children().nth(replaced_end).and_then(NodeOrToken::into_node);
+                let Some(next) = next.filter(|n| n.kind() == SyntaxKind::BLOCK_RUN.into()) else { break replaced_end };
+                tail = next.children().map(|c| c.to_owned()).collect();
+                replaced_end += 1;
+            }
+        }
+    };
+    root_green.splice_children(first_run.index()..replaced_end, runs.finish())
+}
+
+/// The text of `range`, read from the smallest element that covers it
+/// (walking the whole tree's text would make every edit cost a full pass).
+pub(crate) fn deleted_text(root: &SyntaxNode, range: TextRange) -> String {
+    if range.is_empty() {
+        return String::new();
+    }
+    let covering = root.covering_element(range);
+    let start = usize::from(range.start() - covering.text_range().start());
+    let text = match covering {
+        NodeOrToken::Node(node) => node.to_string(),
+        NodeOrToken::Token(token) => token.text().to_owned(),
+    };
+    text[start..start + usize::from(range.len())].to_owned()
 }
 
 #[cfg(test)]

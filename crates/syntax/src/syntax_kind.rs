@@ -10,11 +10,14 @@ pub enum SyntaxKind {
     WHITESPACE = 0,
     /// `\n`, `\r\n` or a lone `\r`.
     NEWLINE,
-    /// A comment: `"…"`, or `"…` up to the end of the line.
+    /// A comment: CNC8x6 `"…"` (or `"…` up to the end of the line); ISO
+    /// `(…)` (or `(…` up to the end of the line) and `;…` to the end of the
+    /// line.
     COMMENT,
     /// Text before the program header `%`, which the control skips while loading.
     PREAMBLE,
-    /// Text after the physical end `*`, which the control never reads.
+    /// Text the control never reads: after CNC8x6's physical end `*`, after
+    /// the closing tape mark `%` of an ISO program.
     TRAILER,
     /// The rest of a line past the bytes ncc reads of it
     /// (`MAX_READ_LINE`): only a line far longer than the control's limit
@@ -32,12 +35,24 @@ pub enum SyntaxKind {
     /// `&`, the length-compensation address.
     AMP,
     EQ,
-    /// `/`, block skip.
+    /// `/`: block skip, or division in an expression.
     SLASH,
-    /// `%`, the program header.
+    /// `%`: CNC8x6's program header, an ISO tape mark.
     PERCENT,
-    /// `*`, the physical end of the program.
+    /// `*`: CNC8x6's physical end of the program, multiplication in an
+    /// expression.
     STAR,
+    /// A run of letters that is a keyword, an operator or a function name:
+    /// `GOTO`, `WHILE`, `EQ`, `SIN`.
+    IDENT,
+    /// `#`, which makes a variable of the value after it: `#100`.
+    HASH,
+    /// `[`, opening a bracketed expression.
+    L_BRACK,
+    /// `]`, closing a bracketed expression.
+    R_BRACK,
+    /// `,`, before a corner word: the `,` of `,C1.`.
+    COMMA,
     /// Characters the language does not know.
     ERROR_TOKEN,
 
@@ -54,9 +69,11 @@ pub enum SyntaxKind {
     /// blocks' text, so an incremental reparse gives the same runs as a
     /// full parse.
     BLOCK_RUN,
-    /// One block: from its `N` word up to the next `N` or the end.
+    /// One block. CNC8x6: from its `N` word up to the next `N` or the end;
+    /// ISO dialects: one line, with its line break.
     BLOCK,
-    /// An address with its value: `X-12.5`, `G01`, `FR10`, `&1201`.
+    /// An address with its value: `X-12.5`, `G01`, `FR10`, `&1201`,
+    /// `X#1`, `Z[#2*2]`, and the corner words `,C1.` / `,R2.`.
     WORD,
     /// A parameter used as a value: the `R10` in `FR10`.
     PARAM_REF,
@@ -66,6 +83,35 @@ pub enum SyntaxKind {
     BLOCK_SKIP,
     /// `*` and everything after it.
     END,
+    /// An ISO tape mark `%` on its own line; the closing one holds all the
+    /// text after it, which the control never reads.
+    TAPE_MARK,
+    /// The program number that starts an ISO program: `O1234`, with its
+    /// title comment `(NAME)` in the block.
+    PROGRAM_NUMBER,
+    /// A variable: `#100`, `#[#1+2]`.
+    VAR_REF,
+    /// An assignment to a variable: `#1 = #2 + 1`.
+    ASSIGN,
+    /// A binary operation: `#1 + 2`, `#1 EQ 0`.
+    BIN_EXPR,
+    /// A sign before a value: `-#5`, `-[#1]`.
+    PREFIX_EXPR,
+    /// An expression in brackets: `[#1 + 2]`.
+    BRACKET_EXPR,
+    /// A function applied to its bracketed argument: `SIN[30.]`,
+    /// `ATAN[#1]/[#2]`.
+    CALL_EXPR,
+    /// A number in an expression.
+    LITERAL,
+    /// A conditional: `IF [cond] GOTO n`, `IF [cond] THEN #1 = …`.
+    IF_STMT,
+    /// A jump: `GOTO 10`, `GOTO #1`.
+    GOTO_STMT,
+    /// The start of a loop: `WHILE [cond] DO1`, or `DO1` alone.
+    LOOP_START,
+    /// The end of a loop: `END1`.
+    LOOP_END,
     /// Input the parser could not place; always comes with a syntax error.
     ERROR,
 }
@@ -114,6 +160,11 @@ const ALL_KINDS: [SyntaxKind; SyntaxKind::LAST as usize + 1] = {
         SLASH,
         PERCENT,
         STAR,
+        IDENT,
+        HASH,
+        L_BRACK,
+        R_BRACK,
+        COMMA,
         ERROR_TOKEN,
         __LAST_TOKEN,
         SOURCE_FILE,
@@ -125,6 +176,19 @@ const ALL_KINDS: [SyntaxKind; SyntaxKind::LAST as usize + 1] = {
         PARAM_ASSIGN,
         BLOCK_SKIP,
         END,
+        TAPE_MARK,
+        PROGRAM_NUMBER,
+        VAR_REF,
+        ASSIGN,
+        BIN_EXPR,
+        PREFIX_EXPR,
+        BRACKET_EXPR,
+        CALL_EXPR,
+        LITERAL,
+        IF_STMT,
+        GOTO_STMT,
+        LOOP_START,
+        LOOP_END,
         ERROR,
     ]
 };

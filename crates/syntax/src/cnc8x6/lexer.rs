@@ -6,14 +6,11 @@
 //! the control treats specially (before `%` and after `*`) are cut out by the
 //! parser, not here.
 
-use crate::SyntaxKind::{self, *};
-
-/// A token: its kind and its length in bytes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct Token {
-    pub(crate) kind: SyntaxKind,
-    pub(crate) len: usize,
-}
+pub(crate) use crate::lexing::Token;
+use crate::{
+    SyntaxKind::*,
+    lexing::{number_len, run_len},
+};
 
 /// Quotes that word processors put in place of `"`; accepted with a warning.
 pub(crate) const TYPOGRAPHIC_QUOTES: [&str; 3] = ["\u{201C}", "\u{201D}", "\u{201E}"];
@@ -67,16 +64,6 @@ fn typographic_at(text: &str, pos: usize) -> Option<Typographic> {
     }
 }
 
-fn run_len(bytes: &[u8], pred: impl Fn(u8) -> bool) -> usize {
-    bytes.iter().position(|&b| !pred(b)).unwrap_or(bytes.len())
-}
-
-/// `[0-9]* ('.' [0-9]*)?`: digits with at most one decimal point.
-fn number_len(bytes: &[u8]) -> usize {
-    let int = run_len(bytes, |b| b.is_ascii_digit());
-    if bytes.get(int) == Some(&b'.') { int + 1 + run_len(&bytes[int + 1..], |b| b.is_ascii_digit()) } else { int }
-}
-
 /// A comment runs to its closing quote (included) or to the end of the line
 /// (excluded). One opened by `"` closes only at `"`; one opened by a
 /// typographic quote closes at any quote, straight or typographic.
@@ -121,6 +108,7 @@ fn starts_known_token(text: &str, pos: usize, ch: char) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::SyntaxKind;
 
     fn lex_all(text: &str) -> Vec<(SyntaxKind, &str)> {
         let mut pos = 0;

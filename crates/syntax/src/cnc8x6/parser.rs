@@ -27,12 +27,14 @@ use super::{
     GrammarLetters, grammar_letters, is_block_letter,
     lexer::{self, Token},
 };
+pub(crate) use crate::lexing::{line_end, line_start};
 use crate::{
     SyntaxError, SyntaxErrorKind as E,
     SyntaxKind::{self, *},
     encoding::BYTE_ORDER_MARK,
     error::Errors,
     green::{self, GreenElement, GreenFactory},
+    lexing::{MAX_READ_LINE, read_end},
     limit::{LineLimiter, Omitted},
     runs::RunBuilder,
     visible,
@@ -40,30 +42,6 @@ use crate::{
 
 /// The control's limit on characters per line.
 pub const MAX_LINE_CHARS: usize = 80;
-
-/// How many bytes of a line ncc reads; the rest is one `UNREAD` token.
-/// Far beyond the control's 80 characters, so nothing a person or a CAM
-/// system writes is cut, but bounded: a line of megabytes of random text
-/// would otherwise become millions of words, each a node of the tree.
-pub const MAX_READ_LINE: usize = 1024;
-
-/// Where the read part of the line that starts at `line_start` ends (it
-/// may end earlier, at its line break), at most `limit`.
-fn read_end(text: &str, line_start: usize, limit: usize) -> usize {
-    let mut end = line_start + MAX_READ_LINE;
-    while end < limit && !text.is_char_boundary(end) {
-        end += 1;
-    }
-    end.min(limit)
-}
-
-pub(crate) fn line_start(text: &str, at: usize) -> usize {
-    memchr::memrchr2(b'\n', b'\r', &text.as_bytes()[..at]).map_or(0, |i| i + 1)
-}
-
-pub(crate) fn line_end(text: &str, at: usize, limit: usize) -> usize {
-    memchr::memchr2(b'\n', b'\r', &text.as_bytes()[at..limit]).map_or(limit, |i| at + i)
-}
 
 /// Bodies larger than this are split at block boundaries and parsed in parallel.
 const PARALLEL_THRESHOLD: usize = 1 << 20;

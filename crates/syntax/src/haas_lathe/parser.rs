@@ -1,0 +1,672 @@
+//! The Haas lathe parser.
+//!
+//! File layout (lathe manual §5.1 (001:366-380)):
+//!
+//! ```text
+//! {blank line} [% line] {block} [% {anything}]
+//! ```
+//!
+//! * A block is one line, with its line break. The program number line
+//!   `O1234 (NAME)` is a block too, whose first item is a
+//!   `PROGRAM_NUMBER`: a file may hold several programs, and one line kind
+//!   keeps every edit inside a block.
+//! * A `%` line is a tape mark: the first non-blank line may be one (the
+//!   opening mark), and the next line that starts with `%` ends the program;
+//!   the control never reads what follows it.
+//! * Comments `( … )` and `; …` never span lines, so every line start is a
+//!   block start: the incremental reparse relies on that.
+//! * Macro statements (`#1 = …`, `IF`, `GOTO`, `WHILE … DO1`, `END1`) are
+//!   items of their block; loops are matched later, not here, so an edit
+//!   inside a loop reparses one block.
+
+use std::{ops::Range, sync::OnceLock};
+
+use rowan::{GreenNode, NodeOrToken, TextRange, TextSize};
+
+use super::lexer;
+use crate::{
+    SyntaxError, SyntaxErrorKind as E,
+    SyntaxKind::{self, *},
+    encoding::BYTE_ORDER_MARK,
+    error::Errors,
+    expr::{self, Ahead, Arguments, ExprInput, Grammar},
+    green::{self, GreenElement, GreenFactory},
+    lexing::{MAX_READ_LINE, Token, line_end, read_end},
+    limit::{LineLimiter, Omitted},
+    runs::RunBuilder,
+    visible,
+};
+
+/// The operators of Haas macro expressions, with the Fanuc precedence:
+/// `* / MOD AND` bind tighter than `+ - OR XOR`, which bind tighter than the
+/// comparisons; all are left-associative.
+fn binary(kind: SyntaxKind, text: &str) -> Option<(u8, u8)> {
+    match (kind, text) {
+        (IDENT, "EQ" | "NE" | "GT" | "GE" | "LT" | "LE") => Some((1, 2)),
+        (PLUS | MINUS, _) | (IDENT, "OR" | "XOR") => Some((3, 4)),
+        (STAR | SLASH, _) | (IDENT, "MOD" | "AND") => Some((5, 6)),
+        _ => None,
+    }
+}
+
+/// Functions are the catalogue's named operations that are not binary
+/// operators; `ATAN` also takes the Fanuc form `ATAN[y]/[x]`.
+fn function(name: &str) -> Option<Arguments> {
+    static FUNCTIONS: OnceLock<Vec<String>> = OnceLock::new();
+    let functions = FUNCTIONS.get_or_init(|| {
+        let operations = &ncc_catalog::haas_lathe().operations;
+        operations
+            .iter()
+            .filter_map(|operation| operation.symbol.clone())
+            .filter(|symbol| symbol.bytes().all(|b| b.is_ascii_uppercase()) && binary(IDENT, symbol).is_none())
+            .collect()
+    });
+    match name {
+        "ATAN" => Some(Arguments::OneOrSlashPair),
+        _ if functions.iter().any(|f| f == name) => Some(Arguments::One),
+        _ => None,
+    }
+}
+
+const GRAMMAR: Grammar = Grammar { binary, function };
+
+pub(crate) fn parse_source_file(text: &str) -> (GreenNode, Vec<SyntaxError>, Vec<Omitted<E>>) {
+    let mut children: Vec<GreenElement> = Vec::new();
+    let mut errors = Errors::default();
+    let mut pos = 0;
+    if text.starts_with(BYTE_ORDER_MARK) {
+        pos = BYTE_ORDER_MARK.len_utf8();
+        children.push(NodeOrToken::Token(rowan::GreenToken::new(ERROR_TOKEN.into(), &text[..pos])));
+        errors.kept.push(SyntaxError::new(
+            E::ByteOrderMark,
+            range(0..pos),
+            "the file starts with a byte-order mark: it was saved as Unicode text, but the control reads plain text; save it as plain text",
+        ));
+    }
+    let Layout { opening, body } = layout(text, pos);
+    if let Some(mark) = opening {
+        let mut parser = Parser::new(text, pos, mark);
+        while parser.pos < mark {
+            children.push(parser.bump());
+        }
+        parser.move_to(mark, body.start);
+        children.push(NodeOrToken::Node(parser.opening_mark()));
+        errors.append(parser.into_errors());
+    }
+    let (blocks, block_errors) = parse_blocks(text, body.clone(), &[]);
+    errors.append(block_errors);
+    let mut runs = RunBuilder::new(text, body.start);
+    for block in blocks {
+        runs.push(block);
+    }
+    children.extend(runs.finish());
+    if body.end < text.len() {
+        children.push(NodeOrToken::Node(closing_mark(text, body.end)));
+    }
+    let (errors, omitted) = errors.finish(text);
+    (green::node(SOURCE_FILE, children), errors, omitted)
+}
+
+/// Where the tape marks are.
+pub(crate) struct Layout {
+    /// The opening `%` line's start.
+    pub(crate) opening: Option<usize>,
+    /// The blocks: from after the opening mark's line to the closing mark
+    /// (its line's start) or the end.
+    pub(crate) body: Range<usize>,
+}
+
+pub(crate) fn layout(text: &str, from: usize) -> Layout {
+    let bytes = text.as_bytes();
+    let mut opening = None;
+    let mut body_start = from;
+    let mut at = from;
+    while at < text.len() {
+        let first = at + bytes[at..].iter().take_while(|b| matches!(b, b' ' | b'\t')).count();
+        match bytes.get(first) {
+            Some(b'\n' | b'\r') => at = next_line(text, first),
+            Some(b'%') => {
+                opening = Some(at);
+                body_start = next_line(text, first);
+                break;
+            }
+            _ => break,
+        }
+    }
+    let body_end = closing_mark_at(text, body_start).unwrap_or(text.len());
+    Layout { opening, body: body_start..body_end }
+}
+
+/// The start of the first line at or after `from` (a line start) whose
+/// first character other than spaces is `%`.
+fn closing_mark_at(text: &str, from: usize) -> Option<usize> {
+    let bytes = text.as_bytes();
+    let mut search = from;
+    while let Some(i) = memchr::memchr(b'%', &bytes[search..]) {
+        let percent = search + i;
+        let line = crate::lexing::line_start(text, percent).max(from);
+        if bytes[line..percent].iter().all(|b| matches!(b, b' ' | b'\t')) {
+            return Some(line);
+        }
+        search = percent + 1;
+    }
+    None
+}
+
+fn next_line(text: &str, at: usize) -> usize {
+    crate::limit::next_line_start(text.as_bytes(), at).unwrap_or(text.len())
+}
+
+/// The closing tape mark at `at` (its line's start): spaces, `%` and
+/// everything after it, which the control never reads.
+fn closing_mark(text: &str, at: usize) -> GreenNode {
+    let percent = at + text[at..].find('%').expect("a closing mark has its `%`");
+    let mut children = Vec::new();
+    if percent > at {
+        children.push(NodeOrToken::Token(rowan::GreenToken::new(WHITESPACE.into(), &text[at..percent])));
+    }
+    children.push(NodeOrToken::Token(rowan::GreenToken::new(PERCENT.into(), "%")));
+    if percent + 1 < text.len() {
+        children.push(NodeOrToken::Token(rowan::GreenToken::new(TRAILER.into(), &text[percent + 1..])));
+    }
+    green::node(TAPE_MARK, children)
+}
+
+/// Parses the blocks (lines) of `region`, which starts at a line start.
+/// `replaced` are blocks of an older tree whose words the new blocks share.
+pub(crate) fn parse_blocks(
+    text: &str,
+    region: Range<usize>,
+    replaced: &[&rowan::GreenNodeData],
+) -> (Vec<GreenElement>, Errors) {
+    let mut parser = Parser::new(text, region.start, region.end);
+    for block in replaced {
+        parser.green.share_words_of(block);
+    }
+    let mut blocks = Vec::new();
+    while parser.pos < region.end {
+        blocks.push(NodeOrToken::Node(parser.block()));
+    }
+    (blocks, parser.into_errors())
+}
+
+fn range(r: Range<usize>) -> TextRange {
+    TextRange::new(TextSize::from(r.start as u32), TextSize::from(r.end as u32))
+}
+
+struct Parser<'a> {
+    text: &'a str,
+    pos: usize,
+    /// Where reading stops: `region_end`, or before it where the read part
+    /// of the current line ends (`MAX_READ_LINE`).
+    end: usize,
+    region_end: usize,
+    errors: Vec<SyntaxError>,
+    limiter: LineLimiter<'a, E>,
+    green: GreenFactory<'a>,
+}
+
+impl<'a> Parser<'a> {
+    fn new(text: &'a str, pos: usize, region_end: usize) -> Self {
+        let mut parser = Parser {
+            text,
+            pos,
+            end: region_end,
+            region_end,
+            errors: Vec::new(),
+            limiter: LineLimiter::new(text),
+            green: GreenFactory::new(),
+        };
+        parser.move_to(pos, region_end);
+        parser
+    }
+
+    /// Continues at `pos`, a line start, reading up to `region_end`.
+    fn move_to(&mut self, pos: usize, region_end: usize) {
+        self.pos = pos;
+        self.region_end = region_end;
+        self.end = read_end(self.text, crate::lexing::line_start(self.text, pos), region_end);
+    }
+
+    fn token_at(&self, pos: usize) -> Option<Token> {
+        if pos >= self.region_end {
+            return None;
+        }
+        if pos >= self.end {
+            let unread = line_end(self.text, pos, self.region_end) - pos;
+            if unread > 0 {
+                return Some(Token { kind: UNREAD, len: unread });
+            }
+        }
+        let token = lexer::token_at(self.text, pos);
+        // A line break is whole even where reading the line stops at it.
+        let end = if token.kind == NEWLINE { self.region_end } else { self.end };
+        Some(Token { kind: token.kind, len: token.len.min(end - pos) })
+    }
+
+    fn peek(&self) -> Option<Token> {
+        self.token_at(self.pos)
+    }
+
+    fn kind_at(&self, pos: usize) -> Option<SyntaxKind> {
+        self.token_at(pos).map(|t| t.kind)
+    }
+
+    fn byte_at(&self, pos: usize) -> u8 {
+        self.text.as_bytes()[pos]
+    }
+
+    fn skip_whitespace(&self, mut pos: usize) -> usize {
+        while let Some(Token { kind: WHITESPACE, len }) = self.token_at(pos) {
+            pos += len;
+        }
+        pos
+    }
+
+    fn report(&mut self, kind: E, r: Range<usize>, message: impl Into<String>) {
+        let r = range(r);
+        if self.limiter.keep(r.start(), kind) {
+            self.errors.push(SyntaxError::new(kind, r, message));
+        }
+    }
+
+    fn into_errors(self) -> Errors {
+        Errors { kept: self.errors, omitted: self.limiter.finish() }
+    }
+
+    fn bump(&mut self) -> GreenElement {
+        let token = self.peek().expect("bump past the end");
+        let start = self.pos;
+        let text = &self.text[start..start + token.len];
+        self.pos += token.len;
+        match token.kind {
+            NEWLINE => self.end = read_end(self.text, self.pos, self.region_end),
+            UNREAD => self.report(
+                E::LineTooLong,
+                start..self.pos,
+                format!("line longer than {MAX_READ_LINE} bytes; ncc reads only its first {MAX_READ_LINE} bytes"),
+            ),
+            COMMENT if self.byte_at(start) == b'(' && !text.ends_with(')') => self.report(
+                E::UnclosedComment,
+                start..start + 1,
+                "comment `(` not closed by `)` on its line; the rest of the line is read as comment",
+            ),
+            _ => {}
+        }
+        self.green.token(token.kind, text)
+    }
+
+    /// Bumps whitespace into `children`.
+    fn bump_whitespace(&mut self, children: &mut Vec<GreenElement>) {
+        while self.kind_at(self.pos) == Some(WHITESPACE) {
+            children.push(self.bump());
+        }
+    }
+
+    fn error_token(&mut self, kind: E, message: impl Into<String>) -> GreenElement {
+        let start = self.pos;
+        let element = self.bump();
+        self.report(kind, start..self.pos, message);
+        NodeOrToken::Node(green::node(ERROR, [element]))
+    }
+
+    /// The opening `%` line: spaces, `%`, comments; other text on it is an
+    /// error.
+    fn opening_mark(&mut self) -> GreenNode {
+        let mut children = Vec::new();
+        while let Some(token) = self.peek() {
+            let child = match token.kind {
+                WHITESPACE | COMMENT | NEWLINE | PERCENT | UNREAD => self.bump(),
+                _ => {
+                    self.error_token(E::UnexpectedCharacter, "only a comment may follow the tape mark `%` on its line")
+                }
+            };
+            children.push(child);
+        }
+        green::node(TAPE_MARK, children)
+    }
+
+    /// One line.
+    fn block(&mut self) -> GreenNode {
+        let mut children = Vec::new();
+        let mut started = false;
+        while let Some(token) = self.peek() {
+            let child = match token.kind {
+                NEWLINE => {
+                    children.push(self.bump());
+                    break;
+                }
+                WHITESPACE | COMMENT | UNREAD => {
+                    children.push(self.bump());
+                    continue;
+                }
+                SLASH if !started => self.block_skip(),
+                LETTER if self.byte_at(self.pos).eq_ignore_ascii_case(&b'O') => self.program_number(),
+                LETTER => self.word(Vec::new()),
+                COMMA => self.corner_word(),
+                HASH => self.assignment(),
+                IDENT => self.statement(),
+                NUMBER => self.error_token(E::NumberWithoutAddress, "a number must follow an address letter: `X10.`"),
+                PLUS | MINUS => {
+                    self.error_token(E::SignWithoutAddress, "a sign must follow an address letter: `X-10.`")
+                }
+                EQ => self.error_token(E::MisplacedEquals, "`=` assigns to a variable only: `#1 = 5.`"),
+                PERCENT => self.error_token(E::MisplacedPercent, "a tape mark `%` must be alone on its line"),
+                _ => {
+                    let shown = visible::quoted(&self.text[self.pos..self.pos + token.len]);
+                    self.error_token(E::UnexpectedCharacter, format!("`{shown}` is not allowed here"))
+                }
+            };
+            started = true;
+            children.push(child);
+        }
+        green::node(BLOCK, children)
+    }
+
+    /// `/`, and a digit 1 to 9 directly after it.
+    fn block_skip(&mut self) -> GreenElement {
+        let mut children = vec![self.bump()];
+        if let Some(Token { kind: NUMBER, len: 1 }) = self.peek()
+            && (b'1'..=b'9').contains(&self.byte_at(self.pos))
+        {
+            children.push(self.bump());
+        }
+        NodeOrToken::Node(green::node(BLOCK_SKIP, children))
+    }
+
+    fn address_letter(&mut self) -> GreenElement {
+        let at = self.pos;
+        let letter = self.byte_at(at);
+        if letter.is_ascii_lowercase() {
+            self.report(
+                E::LowercaseAddress,
+                at..at + 1,
+                format!(
+                    "lower-case address `{}`; the control's addresses are upper-case `{}`",
+                    letter as char,
+                    letter.to_ascii_uppercase() as char
+                ),
+            );
+        }
+        self.bump()
+    }
+
+    /// `O` and the program number.
+    fn program_number(&mut self) -> GreenElement {
+        let start = self.pos;
+        let mut children = vec![self.address_letter()];
+        let number_at = self.skip_whitespace(self.pos);
+        if self.kind_at(number_at) == Some(NUMBER) {
+            self.space_in_word(start + 1..number_at);
+            self.bump_whitespace(&mut children);
+            expr::number(self, &mut children);
+        } else {
+            self.report(E::MissingProgramNumber, start..start + 1, "program number missing after `O`: `O1234`");
+        }
+        NodeOrToken::Node(green::node(PROGRAM_NUMBER, children))
+    }
+
+    fn space_in_word(&mut self, space: Range<usize>) {
+        if !space.is_empty() {
+            self.report(
+                E::SpaceInWord,
+                space,
+                "space inside a word; write the value right after its address or sign (`Z-30.`)",
+            );
+        }
+    }
+
+    /// `,C1.` / `,R2.`: a corner word.
+    fn corner_word(&mut self) -> GreenElement {
+        if self.kind_at(self.pos + 1) == Some(LETTER) {
+            let comma = self.bump();
+            return self.word(vec![comma]);
+        }
+        self.error_token(E::UnexpectedCharacter, "`,` must be followed by a corner word: `,C1.` or `,R1.`")
+    }
+
+    /// A word: address letter, value (after `children`, the comma of a
+    /// corner word).
+    fn word(&mut self, mut children: Vec<GreenElement>) -> GreenElement {
+        if children.is_empty()
+            && let Some(word) = self.simple_word()
+        {
+            return word;
+        }
+        let start = self.pos;
+        children.push(self.address_letter());
+        let value_at = self.skip_whitespace(self.pos);
+        if matches!(self.kind_at(value_at), Some(PLUS | MINUS | NUMBER | HASH | L_BRACK)) {
+            self.space_in_word(self.pos..value_at);
+            self.bump_whitespace(&mut children);
+            self.value(&mut children);
+        } else {
+            let address = &self.text[start..start + 1];
+            let message = format!("address `{address}` has no value; write a number (`{address}0` for zero)");
+            self.report(E::MissingValue, start..start + 1, message);
+        }
+        NodeOrToken::Node(green::node(WORD, children))
+    }
+
+    /// The common case, an upper-case letter, an optional sign and a number
+    /// with a digit, served from the word cache.
+    fn simple_word(&mut self) -> Option<GreenElement> {
+        let bytes = &self.text.as_bytes()[..self.end];
+        let start = self.pos;
+        let sign_len = usize::from(matches!(bytes.get(start + 1), Some(b'-' | b'+')));
+        let number_start = start + 1 + sign_len;
+        let len = crate::lexing::number_len(&bytes[number_start..]);
+        let end = number_start + len;
+        let has_digit = bytes[number_start..end].iter().any(u8::is_ascii_digit);
+        if !bytes[start].is_ascii_uppercase() || !has_digit || bytes.get(end) == Some(&b'.') {
+            return None;
+        }
+        self.pos = end;
+        Some(self.green.simple_word(&self.text[start..end], sign_len))
+    }
+
+    /// `[sign [spaces]] (number | variable | bracket)` into `children`.
+    fn value(&mut self, children: &mut Vec<GreenElement>) {
+        if let Some(PLUS | MINUS) = self.kind_at(self.pos) {
+            let sign_start = self.pos;
+            children.push(self.bump());
+            let value_at = self.skip_whitespace(self.pos);
+            if !matches!(self.kind_at(value_at), Some(NUMBER | HASH | L_BRACK)) {
+                self.report(E::MissingValue, sign_start..self.pos, "sign without a value after it");
+                return;
+            }
+            self.space_in_word(self.pos..value_at);
+            self.bump_whitespace(children);
+        }
+        match self.kind_at(self.pos) {
+            Some(NUMBER) => expr::number(self, children),
+            Some(HASH) => children.push(expr::var_ref(self, &GRAMMAR, 0)),
+            Some(L_BRACK) => children.push(expr::bracket(self, &GRAMMAR, 0)),
+            _ => unreachable!("value() without a value"),
+        }
+    }
+
+    /// `#1 = expr`, `#[#2] = expr`.
+    fn assignment(&mut self) -> GreenElement {
+        let start = self.pos;
+        let mut children = vec![expr::var_ref(self, &GRAMMAR, 0)];
+        match self.significant_at(self.pos) {
+            Some(Ahead { kind: EQ, .. }) => {
+                self.bump_trivia(&mut children);
+                children.push(self.bump());
+                self.bump_trivia(&mut children);
+                if let Some(value) = expr::expr(self, &GRAMMAR, "a value after `=`") {
+                    children.push(value);
+                }
+            }
+            _ => {
+                let shown = visible::quoted(&self.text[start..self.pos]);
+                self.report(
+                    E::MalformedStatement,
+                    start..self.pos,
+                    format!("`{shown}` on its own does nothing: assign it a value, `{shown} = 1.`"),
+                );
+            }
+        }
+        NodeOrToken::Node(green::node(ASSIGN, children))
+    }
+
+    fn ident_text(&self) -> &'a str {
+        let len = self.peek().map_or(0, |t| t.len);
+        &self.text[self.pos..self.pos + len]
+    }
+
+    /// A statement that starts with a keyword.
+    fn statement(&mut self) -> GreenElement {
+        match self.ident_text() {
+            "IF" => self.if_statement(),
+            "GOTO" => self.goto_statement(),
+            "WHILE" | "DO" => self.loop_start(),
+            "END" => self.loop_end(),
+            keyword => {
+                let message = format!("`{keyword}` cannot start a statement");
+                self.error_token(E::MalformedStatement, message)
+            }
+        }
+    }
+
+    /// Reports `message` at the keyword that starts at `start`.
+    fn malformed(&mut self, start: usize, keyword_len: usize, message: &str) {
+        self.report(E::MalformedStatement, start..start + keyword_len, message);
+    }
+
+    /// `IF [cond] GOTO n` or `IF [cond] THEN statement`.
+    fn if_statement(&mut self) -> GreenElement {
+        let start = self.pos;
+        let mut children = vec![self.bump()];
+        if !self.bracketed_condition(&mut children) {
+            self.malformed(start, 2, "`IF` needs its condition in brackets: `IF [#1 GT 0] GOTO 10`");
+            return NodeOrToken::Node(green::node(IF_STMT, children));
+        }
+        let then = self.significant_at(self.pos).filter(|next| next.kind == IDENT);
+        match then.map(|next| &self.text[next.range.0..next.range.1]) {
+            Some("GOTO") => {
+                self.bump_trivia(&mut children);
+                children.push(self.goto_statement());
+            }
+            Some("THEN") => {
+                self.bump_trivia(&mut children);
+                let then_start = self.pos;
+                children.push(self.bump());
+                match self.significant_at(self.pos) {
+                    Some(Ahead { kind: HASH, .. }) => {
+                        self.bump_trivia(&mut children);
+                        children.push(self.assignment());
+                    }
+                    _ => self.malformed(then_start, 4, "`THEN` must be followed by an assignment: `THEN #1 = 0`"),
+                }
+            }
+            _ => self.malformed(start, 2, "`IF [condition]` must be followed by `GOTO n` or `THEN #var = value`"),
+        }
+        NodeOrToken::Node(green::node(IF_STMT, children))
+    }
+
+    /// Spaces and a bracket into `children`, if a bracket follows.
+    fn bracketed_condition(&mut self, children: &mut Vec<GreenElement>) -> bool {
+        if self.significant_at(self.pos).is_some_and(|next| next.kind == L_BRACK) {
+            self.bump_trivia(children);
+            children.push(expr::bracket(self, &GRAMMAR, 0));
+            true
+        } else {
+            false
+        }
+    }
+
+    /// `GOTO` and the target block number (a value).
+    fn goto_statement(&mut self) -> GreenElement {
+        let mut children = vec![self.bump()];
+        self.bump_trivia(&mut children);
+        if let Some(target) = expr::atom(self, &GRAMMAR, "the block number to jump to after `GOTO`") {
+            children.push(target);
+        }
+        NodeOrToken::Node(green::node(GOTO_STMT, children))
+    }
+
+    /// `WHILE [cond] DOn`, or `DOn` alone.
+    fn loop_start(&mut self) -> GreenElement {
+        let start = self.pos;
+        let mut children = Vec::new();
+        if self.ident_text() == "WHILE" {
+            children.push(self.bump());
+            if !self.bracketed_condition(&mut children) {
+                self.malformed(start, 5, "`WHILE` needs its condition in brackets: `WHILE [#1 LT 10] DO1`");
+                return NodeOrToken::Node(green::node(LOOP_START, children));
+            }
+            let do_follows = self
+                .significant_at(self.pos)
+                .is_some_and(|next| next.kind == IDENT && &self.text[next.range.0..next.range.1] == "DO");
+            if !do_follows {
+                self.malformed(start, 5, "`WHILE [condition]` must be followed by `DO` and the loop number: `DO1`");
+                return NodeOrToken::Node(green::node(LOOP_START, children));
+            }
+            self.bump_trivia(&mut children);
+        }
+        self.loop_number(&mut children, "`DO` must be followed by the loop number 1, 2 or 3: `DO1`");
+        NodeOrToken::Node(green::node(LOOP_START, children))
+    }
+
+    /// `ENDn`.
+    fn loop_end(&mut self) -> GreenElement {
+        let mut children = Vec::new();
+        self.loop_number(&mut children, "`END` must be followed by the loop number 1, 2 or 3: `END1`");
+        NodeOrToken::Node(green::node(LOOP_END, children))
+    }
+
+    /// The keyword and the loop number after it (spaces allowed).
+    fn loop_number(&mut self, children: &mut Vec<GreenElement>, missing: &str) {
+        let start = self.pos;
+        children.push(self.bump());
+        let keyword_len = self.pos - start;
+        match self.significant_at(self.pos) {
+            Some(Ahead { kind: NUMBER, .. }) => {
+                self.bump_trivia(children);
+                expr::number(self, children);
+            }
+            _ => self.malformed(start, keyword_len, missing),
+        }
+    }
+}
+
+impl ExprInput for Parser<'_> {
+    fn text(&self) -> &str {
+        self.text
+    }
+
+    fn pos(&self) -> usize {
+        self.pos
+    }
+
+    fn significant_at(&self, mut from: usize) -> Option<Ahead> {
+        loop {
+            let token = self.token_at(from)?;
+            match token.kind {
+                WHITESPACE | COMMENT => from += token.len,
+                NEWLINE | UNREAD => return None,
+                kind => return Some(Ahead { kind, range: (from, from + token.len) }),
+            }
+        }
+    }
+
+    fn token_kind_at(&self, pos: usize) -> Option<SyntaxKind> {
+        self.kind_at(pos)
+    }
+
+    fn bump(&mut self) -> GreenElement {
+        Parser::bump(self)
+    }
+
+    fn bump_trivia(&mut self, into: &mut Vec<GreenElement>) {
+        while let Some(WHITESPACE | COMMENT) = self.kind_at(self.pos) {
+            into.push(Parser::bump(self));
+        }
+    }
+
+    fn error(&mut self, kind: E, range: Range<usize>, message: String) {
+        self.report(kind, range, message);
+    }
+}

@@ -1,0 +1,14 @@
+#1 = [#2 + 3
+#2 = 
+#3 = SIN 30
+X[]
+#1
+IF #1 GOTO 5
+IF [#1 EQ 1]
+IF [#1 EQ 1] THEN G0
+WHILE [#1 LT 3]
+WHILE #1 DO1
+END
+THEN
+GOTO
+# = 1

@@ -1,0 +1,8 @@
+G01 X (unclosed comment
+Z- 30. X 10.
+x1.
+12 -
+= %
+O
+, @
+/1 X1. / Y2.
