@@ -285,3 +285,29 @@ proptest! {
         prop_assert_eq!(haas_lathe::reparse(&old, &edit, &new_text), haas_lathe::parse(&new_text));
     }
 }
+
+/// An edit inside a loop rebuilds its own block only: `WHILE … DO1` and
+/// `END1` are separate blocks, matched later.
+#[test]
+fn an_edit_inside_a_loop_reparses_one_block() {
+    let text = "O1\n#1 = 0\nWHILE [#1 LT 10] DO1\nG01 X[#1 * 2.] F0.1\n#1 = #1 + 1\nEND1\nM30\n";
+    let old = haas_lathe::parse(text);
+    let at = text.find("X[#1 * 2.]").unwrap() + 8;
+    let edit = TextEdit::replace(range(at, at + 1), "3");
+    let mut new_text = text.to_owned();
+    edit.apply(&mut new_text);
+    let new = haas_lathe::reparse(&old, &edit, &new_text);
+    assert_eq!(new, haas_lathe::parse(&new_text));
+    let blocks = |parse: &HaasParse| -> Vec<*const rowan::GreenNodeData> {
+        SyntaxNode::new_root(parse.0.clone())
+            .descendants()
+            .filter(|n| n.kind() == SyntaxKind::BLOCK)
+            .map(|n| std::ptr::from_ref::<rowan::GreenNodeData>(n.green()))
+            .collect()
+    };
+    let (old_blocks, new_blocks) = (blocks(&old), blocks(&new));
+    assert_eq!(old_blocks.len(), 7);
+    for i in 0..7 {
+        assert_eq!(old_blocks[i] == new_blocks[i], i != 3, "block {i}");
+    }
+}
