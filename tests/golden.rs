@@ -125,7 +125,13 @@ fn analysis_outputs(out: &mut String, program: &Path) {
     let root = workspace();
     let path = root.join(program);
     let text = read(&path).unwrap();
-    let mut host = AnalysisHost::new(config_for(&path));
+    // Every file of the corpus has a dialect by its name.
+    let dialect = DialectId::by_default_for(&path).expect("the corpus holds programs only");
+    let Some(dialect) = dialect.implementation() else {
+        writeln!(out, "== analysis: {}", dialect.not_read()).unwrap();
+        return;
+    };
+    let mut host = AnalysisHost::in_dialect(dialect, config_for(&path));
     for other in neighbours(&path) {
         let name = other.strip_prefix(&root).unwrap().display().to_string();
         host.add_file(name, read(&other).unwrap());
