@@ -111,6 +111,8 @@ struct ParametersFile {
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct MachineConstantsFile {
+    #[serde(default)]
+    terms: ConstantTerms,
     #[serde(rename = "constant")]
     constants: Vec<MachineConstant>,
 }
@@ -144,6 +146,7 @@ pub struct Catalogue {
     pub parameters: ParameterOverview,
     pub parameter_ranges: Vec<ParameterRange>,
     pub machine_constants: Vec<MachineConstant>,
+    pub constant_terms: ConstantTerms,
     pub operations: Vec<Operation>,
     pub cycles: Vec<Cycle>,
     codes_by_number: HashMap<(char, u32), usize>,
@@ -202,6 +205,7 @@ impl Catalogue {
             parameters: parameters.parameters,
             parameter_ranges: parameters.ranges,
             machine_constants: constants.constants,
+            constant_terms: constants.terms,
             operations: operations.operations,
             cycles: cycles.cycles,
             codes_by_number,

@@ -5,7 +5,10 @@
 
 use std::fmt::Write;
 
-use crate::{AddressRole, Catalogue, Dimensional, Documented, Flavour, Item, Modality, ParameterStatus, schema::Doc};
+use crate::{
+    AddressRole, Catalogue, Dimensional, Documented, Flavour, Item, Modality, ParameterOverview, ParameterStatus,
+    schema::Doc,
+};
 
 impl Item<'_> {
     /// A one-line heading: `G41 — Radius compensation left`.
@@ -19,13 +22,15 @@ impl Item<'_> {
             Item::Address(address) => format!("{} — {}", address.letter, address.title),
             Item::Parameter(number) => {
                 let role = catalogue.parameter_ranges_of(number).next().map(|r| r.title.as_str());
+                let ParameterOverview { written, noun, .. } = &catalogue.parameters;
                 match role {
-                    Some(role) => format!("R{number} — program parameter ({role})"),
-                    None => format!("R{number} — program parameter"),
+                    Some(role) => format!("{written}{number} — {noun} ({role})"),
+                    None => format!("{written}{number} — {noun}"),
                 }
             }
             Item::MachineConstant { number, constant } => {
-                format!("R{number} — machine constant: {}", constant.title)
+                let terms = &catalogue.constant_terms;
+                format!("{}{number} — {}: {}", terms.written, terms.noun, constant.title)
             }
             Item::Operation(op) => format!("Operation {} — {}", op.code, op.title),
             Item::Cycle(cycle) => {
@@ -48,7 +53,10 @@ impl Item<'_> {
                     &[
                         ("Default", group.default.clone()),
                         ("Default note", group.default_note.clone()),
-                        ("Defined by", group.configured_by.as_ref().map(|c| format!("machine constant {c}"))),
+                        (
+                            "Defined by",
+                            group.configured_by.as_ref().map(|c| format!("{} {c}", catalogue.constant_terms.noun)),
+                        ),
                         ("Codes", Some(codes_of(catalogue, &group.id)).filter(|c| !c.is_empty())),
                     ],
                 );
@@ -102,7 +110,7 @@ impl Item<'_> {
                         (
                             "Parameter substitution",
                             Some(if address.substitutable {
-                                format!("allowed (e.g. `{}R1`)", address.letter)
+                                format!("allowed (e.g. `{}{}1`)", address.letter, catalogue.parameters.written)
                             } else {
                                 "not allowed".to_owned()
                             }),
@@ -124,7 +132,8 @@ impl Item<'_> {
                 doc(&mut out, address.doc());
             }
             Item::Parameter(number) => {
-                let _ = writeln!(out, "Program parameter {number} of R0–R{}.\n", catalogue.parameters.count - 1);
+                let ParameterOverview { written, noun, count, .. } = &catalogue.parameters;
+                let _ = writeln!(out, "{} {number} of {written}0–{written}{}.\n", capitalised(noun), count - 1);
                 for range in catalogue.parameter_ranges_of(number) {
                     let _ = writeln!(out, "**{}** ({}): {}\n", range.title, status(range.status), range.summary);
                     if !range.details.is_empty() {
@@ -134,14 +143,12 @@ impl Item<'_> {
                 doc(&mut out, catalogue.parameters.doc());
             }
             Item::MachineConstant { constant, .. } => {
+                let terms = &catalogue.constant_terms;
                 let run = constant
                     .last
                     .filter(|&last| last != constant.number)
-                    .map(|last| format!("R{}–R{last}", constant.number));
-                let _ = writeln!(
-                    out,
-                    "A machine constant: configuration of the control (TAB0.REK), not a program parameter.\n"
-                );
+                    .map(|last| format!("{0}{1}–{0}{last}", terms.written, constant.number));
+                let _ = writeln!(out, "{}\n", terms.kept);
                 facts(
                     &mut out,
                     &[
@@ -195,7 +202,8 @@ impl Item<'_> {
                     for p in &cycle.parameters {
                         let _ = writeln!(
                             out,
-                            "| R{} | {} | {} |",
+                            "| {}{} | {} | {} |",
+                            catalogue.parameters.written,
                             p.r,
                             p.meaning.replace('\n', " "),
                             p.unit.as_deref().unwrap_or("")
@@ -210,6 +218,12 @@ impl Item<'_> {
         out.push('\n');
         out
     }
+}
+
+/// `noun` with its first letter upper-case, to open a sentence.
+fn capitalised(noun: &str) -> String {
+    let mut chars = noun.chars();
+    chars.next().map(|first| first.to_uppercase().chain(chars).collect()).unwrap_or_default()
 }
 
 fn doc(out: &mut String, doc: Doc<'_>) {

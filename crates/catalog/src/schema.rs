@@ -256,11 +256,50 @@ pub enum ParameterStatus {
 }
 
 entry! {
-    /// What holds for all program parameters R0–R95.
+    /// What holds for all program parameters R0–R95 (or a dialect's
+    /// numbered variables).
     pub struct ParameterOverview {
         /// Number of parameters (96).
         pub count: u32,
+        /// What a parameter's number is written after: `R` (`R12`), `#`.
+        #[serde(default = "letter_r")]
+        pub written: String,
+        /// What the dialect calls them: "program parameter", "macro variable".
+        #[serde(default = "program_parameter")]
+        pub noun: String,
     }
+}
+
+/// What a dialect calls its machine constants and where the control keeps
+/// them: the words hover and `ncc explain` use.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConstantTerms {
+    /// What a constant's number is written after: `R` (`R39`), `Setting `.
+    pub written: String,
+    /// "machine constant", "setting".
+    pub noun: String,
+    /// One sentence on where the control keeps them.
+    pub kept: String,
+}
+
+impl Default for ConstantTerms {
+    /// The CNC8x6's.
+    fn default() -> ConstantTerms {
+        ConstantTerms {
+            written: "R".to_owned(),
+            noun: "machine constant".to_owned(),
+            kept: "A machine constant: configuration of the control (TAB0.REK), not a program parameter.".to_owned(),
+        }
+    }
+}
+
+fn letter_r() -> String {
+    "R".to_owned()
+}
+
+fn program_parameter() -> String {
+    "program parameter".to_owned()
 }
 
 entry! {

@@ -232,3 +232,18 @@ fn explain_finds_the_entries() {
     assert_eq!(headings("group:G12S")[0], "Group G12S — Spindle speed mode");
     assert!(catalogue.explain("M16").is_err(), "unknown M codes are unknown");
 }
+
+#[test]
+fn hover_speaks_of_settings_and_macro_variables() {
+    let catalogue = haas_lathe();
+    let constant = catalogue.machine_constant(73).unwrap();
+    let setting = Item::MachineConstant { number: 73, constant };
+    assert!(setting.heading(catalogue).starts_with("Setting 73 — setting: "), "{}", setting.heading(catalogue));
+    let text = setting.markdown(catalogue);
+    assert!(text.contains("SETNG") && !text.contains("TAB0") && !text.contains("R73"), "{text}");
+    let variable = Item::Parameter(100).heading(catalogue);
+    assert!(variable.starts_with("#100 — macro variable"), "{variable}");
+    // X takes a variable as its value (`X#101`).
+    let x = Item::Address(catalogue.address("X").unwrap()).markdown(catalogue);
+    assert!(x.contains("allowed (e.g. `X#1`)") && !x.contains("`XR1`"), "{x}");
+}
