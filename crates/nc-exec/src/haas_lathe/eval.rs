@@ -80,12 +80,22 @@ pub enum EvalError {
 
 /// The macro variables: `#1`–`#33` locals, `#100`–`#199` and `#500`–`#699`
 /// commons (catalogue, from Haas documentation); system variables from
-/// `#1000` on are read as unknown, as nothing here models them.
+/// `#1000` on read as unknown, as nothing here models them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variables {
-    locals: [Known<MacroValue>; 33],
-    common: [Known<MacroValue>; 100],
-    retained: [Known<MacroValue>; 200],
+    /// The locals, then `#100`–`#199`, then `#500`–`#699`.
+    values: [Known<MacroValue>; 333],
+}
+
+/// Where `#number` is kept in [`Variables::values`].
+fn slot(number: u32) -> Option<usize> {
+    let number = usize::try_from(number).ok()?;
+    match number {
+        1..=33 => Some(number - 1),
+        100..=199 => Some(number - 100 + 33),
+        500..=699 => Some(number - 500 + 133),
+        _ => None,
+    }
 }
 
 impl Variables {
@@ -93,46 +103,33 @@ impl Variables {
     /// `#500`–`#699` unknown, as the control keeps them over power-off
     /// (assumption from Haas documentation; not in the manual).
     pub fn at_power_on() -> Variables {
-        let vacant = Known::Is(MacroValue::Vacant);
-        Variables { locals: [vacant; 33], common: [vacant; 100], retained: [Known::Unknown; 200] }
+        let mut values = [Known::Is(MacroValue::Vacant); 333];
+        values[133..].fill(Known::Unknown);
+        Variables { values }
     }
 
     /// Every variable unknown, for reading a program with no assumption
     /// about how it is called.
     pub fn unknown() -> Variables {
-        Variables { locals: [Known::Unknown; 33], common: [Known::Unknown; 100], retained: [Known::Unknown; 200] }
-    }
-
-    fn slot(&mut self, number: u32) -> Option<&mut Known<MacroValue>> {
-        let number = usize::try_from(number).ok()?;
-        match number {
-            1..=33 => self.locals.get_mut(number - 1),
-            100..=199 => self.common.get_mut(number - 100),
-            500..=699 => self.retained.get_mut(number - 500),
-            _ => None,
-        }
+        Variables { values: [Known::Unknown; 333] }
     }
 
     /// The value of `#number`; `None` when the control has no such
     /// variable.
     pub fn get(&self, number: u32) -> Option<Known<MacroValue>> {
-        let index = usize::try_from(number).ok()?;
-        match index {
+        match number {
             0 => Some(Known::Is(MacroValue::Vacant)),
-            1..=33 => self.locals.get(index - 1).copied(),
-            100..=199 => self.common.get(index - 100).copied(),
-            500..=699 => self.retained.get(index - 500).copied(),
             1000.. => Some(Known::Unknown),
-            _ => None,
+            _ => slot(number).map(|slot| self.values[slot]),
         }
     }
 
     /// Stores `value` in `#number`; `false` when the number is not a
     /// writable macro variable (system variables are not modelled).
     pub fn set(&mut self, number: u32, value: Known<MacroValue>) -> bool {
-        match self.slot(number) {
+        match slot(number) {
             Some(slot) => {
-                *slot = value;
+                self.values[slot] = value;
                 true
             }
             None => false,
@@ -151,10 +148,10 @@ impl Variables {
                     .ok_or(EvalError::NoSuchVariable { number, range }),
                 Known::Unknown => Ok(Known::Unknown),
             },
-            ExprKind::Unary(op, operand) => Ok(map(self.eval(operand)?, |value| match (op, value) {
-                (_, MacroValue::Vacant) | (UnaryOp::Plus, _) => Ok(value),
-                (UnaryOp::Minus, MacroValue::Number(v)) => Ok(MacroValue::Number(-v)),
-            })?),
+            ExprKind::Unary(op, operand) => Ok(match (op, self.eval(operand)?) {
+                (UnaryOp::Minus, Known::Is(MacroValue::Number(v))) => Known::Is(MacroValue::Number(-v)),
+                (_, value) => value,
+            }),
             ExprKind::Binary(op, lhs, rhs) => binary(*op, self.eval(lhs)?, self.eval(rhs)?, range),
             ExprKind::Call(function, arguments) => {
                 let mut values = Vec::with_capacity(arguments.len());
@@ -185,31 +182,24 @@ impl Variables {
         })
     }
 
-    /// Runs `#target = value`. With an unknown target number nothing
+    /// Runs `#target = value`. Writes to system variables (`#1000` on)
+    /// are accepted and not kept. With an unknown target number nothing
     /// known remains of the variables it may have written.
     pub fn assign(&mut self, target: &Expr, value: &Expr) -> Result<(), EvalError> {
         let value = self.eval(value)?;
+        let range = target.range;
         match self.variable_number(target)? {
-            Known::Is(0) => Err(EvalError::ReadOnlyVariable { number: 0, range: target.range }),
+            Known::Is(0) => Err(EvalError::ReadOnlyVariable { number: 0, range }),
             Known::Is(number) => match u32::try_from(number) {
-                Ok(n) if self.set(n, value) || n >= 1000 => Ok(()),
-                _ => Err(EvalError::NoSuchVariable { number, range: target.range }),
+                Ok(n) if n >= 1000 => Ok(()),
+                Ok(n) if self.set(n, value) => Ok(()),
+                _ => Err(EvalError::NoSuchVariable { number, range }),
             },
             Known::Unknown => {
                 *self = Variables::unknown();
                 Ok(())
             }
         }
-    }
-}
-
-fn map(
-    value: Known<MacroValue>,
-    f: impl FnOnce(MacroValue) -> Result<MacroValue, EvalError>,
-) -> Result<Known<MacroValue>, EvalError> {
-    match value {
-        Known::Is(value) => f(value).map(Known::Is),
-        Known::Unknown => Ok(Known::Unknown),
     }
 }
 

@@ -85,12 +85,24 @@ impl Value {
     /// block or program (`P10`, `Q20`, `P9010`).
     pub fn whole_number(&self) -> Option<u64> {
         match self {
-            Value::Literal(decimal) if !decimal.is_negative() => {
-                decimal.scaled(0).and_then(|value| u64::try_from(value).ok())
-            }
+            Value::Literal(decimal) => whole_number(decimal),
             _ => None,
         }
     }
+}
+
+impl Expr {
+    /// The literal's value as a whole number (`GOTO 20`).
+    pub fn whole_number(&self) -> Option<u64> {
+        match &self.kind {
+            ExprKind::Literal(decimal) => whole_number(decimal),
+            _ => None,
+        }
+    }
+}
+
+fn whole_number(decimal: &Decimal) -> Option<u64> {
+    decimal.scaled(0).and_then(|value| u64::try_from(value).ok())
 }
 
 /// A macro statement.
@@ -254,7 +266,7 @@ impl HaasBlock {
                         let number = children(node, range.start())
                             .find_map(|(_, c)| token_of(c, SyntaxKind::NUMBER))
                             .and_then(|t| Decimal::parse(None, t.text()))
-                            .and_then(|d| d.scaled(0))
+                            .and_then(|d| whole_number(&d))
                             .and_then(|v| u32::try_from(v).ok());
                         data.program = Some(ProgramStart { number, title: None, range });
                     }
@@ -365,10 +377,10 @@ fn lower_word(node: &GreenNodeData, range: TextRange) -> (Word, bool) {
     let mut literal_parts = 0;
     for (item_range, item) in children(node, range.start()) {
         let item_kind = kind(item.kind());
-        if matches!(item_kind, SyntaxKind::PLUS | SyntaxKind::MINUS | SyntaxKind::NUMBER)
-            || item_kind == SyntaxKind::VAR_REF
-            || item_kind == SyntaxKind::BRACKET_EXPR
-        {
+        if matches!(
+            item_kind,
+            SyntaxKind::PLUS | SyntaxKind::MINUS | SyntaxKind::NUMBER | SyntaxKind::VAR_REF | SyntaxKind::BRACKET_EXPR
+        ) {
             value_start.get_or_insert(item_range.start());
         }
         match (item_kind, item) {

@@ -10,7 +10,7 @@ use std::{
     ops::{Range, RangeInclusive},
 };
 
-use super::lower::{ExprKind, HaasBlock, Statement, Value, Word};
+use super::lower::{HaasBlock, Statement, Value, Word};
 
 /// One program: from its `O` line to the next, or the blocks before the
 /// first `O` line when they hold anything.
@@ -167,6 +167,15 @@ pub enum Ignored {
     AngleInRoughing,
 }
 
+/// The calls by code whose P names their target (lathe manual §6.21
+/// (001:135, 346-347)); M97 takes P as on Haas controls, not the manual's
+/// `N` (lathe manual §11 OQ-15).
+const CALLS: [(u8, u32, ReferenceKind); 3] = [
+    (b'M', 97, ReferenceKind::LocalCall),
+    (b'M', 98, ReferenceKind::ProgramCall),
+    (b'G', 65, ReferenceKind::MacroCall),
+];
+
 /// The programs of a file and what the model finds in them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProgramModel {
@@ -208,12 +217,8 @@ impl ProgramModel {
                     self.read_cycle(blocks, program, index, code, &motions);
                 }
             }
-            for (code, kind) in [(b'M', 97, ReferenceKind::LocalCall), (b'M', 98, ReferenceKind::ProgramCall)]
-                .into_iter()
-                .chain([(b'G', 65, ReferenceKind::MacroCall)])
-                .map(|(letter, number, kind)| (block.has_code(letter, number), kind))
-            {
-                if code {
+            for (letter, number, kind) in CALLS {
+                if block.has_code(letter, number) {
                     self.read_call(block, program, Reference { block: index, kind });
                 }
             }
@@ -224,11 +229,7 @@ impl ProgramModel {
                 };
                 if let Statement::Goto { target, .. } = goto {
                     let reference = Reference { block: index, kind: ReferenceKind::Goto };
-                    let number = match &target.kind {
-                        ExprKind::Literal(decimal) => Value::Literal(*decimal).whole_number(),
-                        _ => None,
-                    };
-                    match number {
+                    match target.whole_number() {
                         Some(number) => {
                             if let Some(target) = self.resolve_block(program, reference, number) {
                                 self.findings.push(Finding::Resolved { reference, target: Target::Block(target) });
