@@ -438,6 +438,7 @@ fn ignored_words(
 #[cfg(test)]
 mod tests {
     use ncc_syntax::haas_lathe;
+    use proptest::prelude::*;
 
     use super::*;
     use crate::haas_lathe::lower::block_nodes;
@@ -585,5 +586,31 @@ mod tests {
         assert_eq!((program.number, program.blocks.clone()), (None, 0..4));
         assert_eq!(program.block_numbers.get(&1), Some(&vec![1, 2]));
         assert_eq!(program.block_numbers.get(&5), Some(&vec![3]));
+    }
+
+    #[test]
+    fn every_fixture_has_a_model() {
+        let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../syntax/test_data/haas-lathe");
+        let mut read = 0;
+        for entry in std::fs::read_dir(fixtures).expect("the Haas fixtures") {
+            let path = entry.expect("a directory entry").path();
+            if path.extension().is_some_and(|e| e == "nc") {
+                let model = model(&std::fs::read_to_string(&path).expect("a fixture"));
+                assert!(!model.programs.is_empty(), "{}", path.display());
+                read += 1;
+            }
+        }
+        assert!(read >= 10, "only {read} fixtures found");
+    }
+
+    proptest! {
+        #[test]
+        fn any_program_text_has_a_model(lines in prop::collection::vec(prop::sample::select(vec![
+            "O1", "O2 (T)", "N10 G00 X20.", "N10 Z-5.", "N20 G01 X#1 K1.", "U-3. W2. ,C1.", "G71 P10 Q20 U.3 D2.",
+            "G72 P20 Q10", "G70 P10", "G73 Q20", "M97 P20", "M98 P2", "G65 P#1", "GOTO 10", "IF [#1 GT 0] GOTO #2",
+            "", "%", "N", "P", "G71 P10. Q20",
+        ]), 0..30)) {
+            model(&lines.join("\n"));
+        }
     }
 }
