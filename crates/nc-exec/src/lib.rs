@@ -29,6 +29,12 @@
 //!   blocks).
 //! - [`compensation`]: the tool-centre path of radius compensation G41/G42
 //!   (equidistants, corners, start and cancel), for the runner to drive.
+//! - [`haas_lathe`]: what belongs to the Haas lathe dialect:
+//!   [`haas_lathe::lower`] (blocks as plain data, read from the syntax
+//!   tree), [`haas_lathe::eval`] (macro expressions over partly unknown
+//!   variables) and [`haas_lathe::program`] (the programs of a file, their
+//!   block numbers, the P/Q contours of G70–G73 and the targets of calls
+//!   and jumps).
 //! - [`envelope`]: the CNC8x9 envelope velocity, a streaming look-ahead
 //!   planner of up to 500 blocks with linear or jerk-limited ramps.
 //! - [`known`]: values a static reading may not know.
@@ -50,6 +56,7 @@ pub(crate) mod axes;
 pub mod cnc8x6;
 pub(crate) mod compensation;
 pub(crate) mod envelope;
+pub mod haas_lathe;
 pub mod known;
 pub mod machine;
 pub mod run;
