@@ -45,3 +45,42 @@ pub(crate) fn line_start(text: &str, at: usize) -> usize {
 pub(crate) fn line_end(text: &str, at: usize, limit: usize) -> usize {
     memchr::memchr2(b'\n', b'\r', &text.as_bytes()[at..limit]).map_or(limit, |i| at + i)
 }
+
+/// The token `lex` finds at `pos`, bounded by the line's read part (up to
+/// `read_end`) and the region (up to `region_end`): past the read part the
+/// rest of the line is one `UNREAD` token, and a line break is whole even
+/// where reading the line stops at it.
+pub(crate) fn bounded_token(
+    text: &str,
+    pos: usize,
+    read_end: usize,
+    region_end: usize,
+    lex: fn(&str, usize) -> Token,
+) -> Option<Token> {
+    if pos >= region_end {
+        return None;
+    }
+    if pos >= read_end {
+        let unread = line_end(text, pos, region_end) - pos;
+        if unread > 0 {
+            return Some(Token { kind: SyntaxKind::UNREAD, len: unread });
+        }
+    }
+    let token = lex(text, pos);
+    let end = if token.kind == SyntaxKind::NEWLINE { region_end } else { read_end };
+    Some(Token { kind: token.kind, len: token.len.min(end - pos) })
+}
+
+/// Every token `lex` finds in `text`, with its text: for the lexers' tests.
+#[cfg(test)]
+pub(crate) fn lex_all(text: &str, lex: fn(&str, usize) -> Token) -> Vec<(SyntaxKind, &str)> {
+    let mut pos = 0;
+    let mut out = Vec::new();
+    while pos < text.len() {
+        let token = lex(text, pos);
+        assert!(token.len > 0);
+        out.push((token.kind, &text[pos..pos + token.len]));
+        pos += token.len;
+    }
+    out
+}

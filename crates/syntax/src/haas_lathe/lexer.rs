@@ -103,15 +103,7 @@ mod tests {
     use crate::SyntaxKind;
 
     fn lex_all(text: &str) -> Vec<(SyntaxKind, &str)> {
-        let mut pos = 0;
-        let mut out = Vec::new();
-        while pos < text.len() {
-            let token = token_at(text, pos);
-            assert!(token.len > 0);
-            out.push((token.kind, &text[pos..pos + token.len]));
-            pos += token.len;
-        }
-        out
+        crate::lexing::lex_all(text, token_at)
     }
 
     #[test]

@@ -31,7 +31,7 @@ use crate::{
     error::Errors,
     expr::{self, Ahead, Arguments, ExprInput, Grammar},
     green::{self, GreenElement, GreenFactory},
-    lexing::{MAX_READ_LINE, Token, line_end, read_end},
+    lexing::{MAX_READ_LINE, Token, read_end},
     limit::{LineLimiter, Omitted},
     runs::RunBuilder,
     visible,
@@ -229,19 +229,7 @@ impl<'a> Parser<'a> {
     }
 
     fn token_at(&self, pos: usize) -> Option<Token> {
-        if pos >= self.region_end {
-            return None;
-        }
-        if pos >= self.end {
-            let unread = line_end(self.text, pos, self.region_end) - pos;
-            if unread > 0 {
-                return Some(Token { kind: UNREAD, len: unread });
-            }
-        }
-        let token = lexer::token_at(self.text, pos);
-        // A line break is whole even where reading the line stops at it.
-        let end = if token.kind == NEWLINE { self.region_end } else { self.end };
-        Some(Token { kind: token.kind, len: token.len.min(end - pos) })
+        crate::lexing::bounded_token(self.text, pos, self.end, self.region_end, lexer::token_at)
     }
 
     fn peek(&self) -> Option<Token> {
