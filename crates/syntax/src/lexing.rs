@@ -46,6 +46,22 @@ pub(crate) fn line_end(text: &str, at: usize, limit: usize) -> usize {
     memchr::memchr2(b'\n', b'\r', &text.as_bytes()[at..limit]).map_or(limit, |i| at + i)
 }
 
+/// Length of a run of three or more letters at the start of `bytes` none of
+/// which has a value, like `MSG` or `roughing`: foreign text, which the
+/// parsers report once rather than letter by letter. The run stops before a
+/// letter `stops_before` names; `value_after(len)` tells whether a value
+/// follows the run's first `len` bytes (then its last letter is a word).
+pub(crate) fn foreign_text_len(
+    bytes: &[u8],
+    stops_before: impl Fn(u8) -> bool,
+    value_after: impl Fn(usize) -> bool,
+) -> usize {
+    let run = bytes.iter().take_while(|&&b| b.is_ascii_alphabetic() && !stops_before(b)).count();
+    let last_has_value = run > 0 && value_after(run);
+    let text_len = run - usize::from(last_has_value);
+    if text_len >= 3 { text_len } else { 0 }
+}
+
 /// The token `lex` finds at `pos`, bounded by the line's read part (up to
 /// `read_end`) and the region (up to `region_end`): past the read part the
 /// rest of the line is one `UNREAD` token, and a line break is whole even

@@ -648,11 +648,11 @@ impl<'a> Parser<'a> {
     /// like `MSG` or `comme`: foreign text, reported once rather than letter
     /// by letter. The run stops before `N`, which always starts a block.
     fn foreign_text_len(&self) -> usize {
-        let bytes = &self.text.as_bytes()[self.pos..self.end];
-        let run = bytes.iter().take_while(|&&b| b.is_ascii_alphabetic() && !self.letters.is_block(b)).count();
-        let last_has_value = run > 0 && self.at_value(self.skip_whitespace(self.pos + run));
-        let text_len = run - usize::from(last_has_value);
-        if text_len >= 3 { text_len } else { 0 }
+        crate::lexing::foreign_text_len(
+            &self.text.as_bytes()[self.pos..self.end],
+            |b| self.letters.is_block(b),
+            |run| self.at_value(self.skip_whitespace(self.pos + run)),
+        )
     }
 
     fn missing_block_number(&mut self) {

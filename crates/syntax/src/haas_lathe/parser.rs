@@ -329,6 +329,7 @@ impl<'a> Parser<'a> {
                     continue;
                 }
                 SLASH if !started => self.block_skip(),
+                LETTER if self.foreign_text_len() > 0 => self.foreign_text(),
                 LETTER if self.byte_at(self.pos).eq_ignore_ascii_case(&b'O') => self.program_number(),
                 LETTER => self.word(Vec::new()),
                 COMMA => self.corner_word(),
@@ -434,6 +435,34 @@ impl<'a> Parser<'a> {
             self.report(E::MissingValue, start..start + 1, message);
         }
         NodeOrToken::Node(green::node(WORD, children))
+    }
+
+    /// Length of foreign text at the current position: three or more
+    /// letters without a value (`roughing pass`), which is not a keyword.
+    fn foreign_text_len(&self) -> usize {
+        let value_at = |pos: usize| {
+            matches!(self.kind_at(self.skip_whitespace(pos)), Some(PLUS | MINUS | NUMBER | HASH | L_BRACK))
+        };
+        crate::lexing::foreign_text_len(
+            &self.text.as_bytes()[self.pos..self.end],
+            |_| false,
+            |run| value_at(self.pos + run),
+        )
+    }
+
+    /// Foreign text, reported once: on the control it is an alarm, in a
+    /// program it belongs in a comment.
+    fn foreign_text(&mut self) -> GreenElement {
+        let start = self.pos;
+        let len = self.foreign_text_len();
+        let text = &self.text[start..start + len];
+        self.pos += len;
+        let message = format!(
+            "unexpected text `{}`: an address letter must be followed by its value; text belongs in a comment `( … )`",
+            visible::quoted(text)
+        );
+        self.report(E::UnexpectedCharacter, start..self.pos, message);
+        NodeOrToken::Node(green::node(ERROR, [NodeOrToken::Token(rowan::GreenToken::new(ERROR_TOKEN.into(), text))]))
     }
 
     /// The common case, an upper-case letter, an optional sign and a number

@@ -6,3 +6,5 @@ x1.
 O
 , @
 /1 X1. / Y2.
+roughing pass
+G00 Z,15 (a comma typed for a point)
