@@ -115,8 +115,8 @@ impl Modes {
         Modes { catalogue, in_force: catalogue.groups.iter().map(|group| default(group.default.as_deref())).collect() }
     }
 
-    /// Puts a code in force if it is modal in a group, and sets the
-    /// codes it cancels back to their groups' defaults (G00/G01 end a drilling
+    /// Puts a code in force if it is modal in a group, and sets the codes
+    /// it cancels back to their groups' defaults (G00/G01 end a drilling
     /// cycle, lathe manual §5.7 (001:1075-1076)).
     fn set(&mut self, letter: char, number: u32) {
         if let Some(group) = self.catalogue.modal_group_index(letter, number) {

@@ -174,10 +174,17 @@ fn what_does_not_run_yet_is_reported_once_per_kind_and_moves_nothing() {
 fn the_manual_s_g71_program_runs_to_its_end() {
     let text = include_str!("../../../../syntax/test_data/haas-lathe/e14_g71_type1_program.nc");
     let trace = run_lathe(text);
-    let not_run: Vec<&str> = trace.findings.iter().map(|finding| finding.message.as_str()).collect();
-    assert!(trace.findings.iter().all(|finding| finding.rule == RunRule::NotRunYet), "{not_run:?}");
-    assert!(not_run.iter().any(|message| message.contains("G70–G76")), "{not_run:?}");
-    assert!(not_run.iter().any(|message| message.contains("G53")), "{not_run:?}");
+    // Once per kind, where first met.
+    let not_run: Vec<(RunRule, &str)> =
+        trace.findings.iter().map(|finding| (finding.rule, text[finding.range].trim())).collect();
+    assert_eq!(
+        not_run,
+        [
+            (RunRule::NotRunYet, "G00 G53 X-100. Z-250."),
+            (RunRule::NotRunYet, "G54 G00 X70. Z3.   ( P0 )"),
+            (RunRule::NotRunYet, "G71 P10 Q20 U0.3 W0.1 D8. F0.3"),
+        ]
+    );
     // The contour after G71 is not run as moves: from G71 the run goes on
     // after N20, and ends at M30.
     let lines: Vec<&str> = trace.steps.iter().map(|step| text[step.range].trim()).collect();
@@ -189,4 +196,13 @@ fn the_manual_s_g71_program_runs_to_its_end() {
     assert_eq!(rapids.len(), 2, "{lines:?}");
     close(rapids[0], 35.0 / 10_000.0 * 60.0);
     assert_eq!(rapids[1], 0.0);
+}
+
+#[test]
+fn words_take_variables_and_failed_arithmetic_stops_the_run() {
+    let trace = run_lathe("O1\n#1 = 30.\nG00 X#1 Z-[#1 / 3]\nU-#1\n#2 = 1 / 0\nG00 X100.\nM30\n");
+    let ends: Vec<(f64, f64)> = trace.steps[1..3].iter().map(|step| (step.end[0], step.end[1])).collect();
+    assert_eq!(ends, [(15.0, -10.0), (0.0, -10.0)]);
+    assert_eq!(rules(&trace), [RunRule::ArithmeticFailed]);
+    assert_eq!(trace.steps.len(), 3);
 }
