@@ -1,8 +1,10 @@
 //! The Haas lathe dialect's part of the executor (classic control,
 //! Fanuc-style ISO code): its block IR and lowering, the macro-expression
-//! evaluator and the program model (programs, block numbers, the P/Q
-//! contours of G70–G73 and the targets of calls and jumps).
+//! evaluator, the program model (programs, block numbers, the P/Q
+//! contours of G70–G73 and the targets of calls and jumps) and the
+//! interpreter that runs a program into a trace.
 
 pub mod eval;
+pub mod interpreter;
 pub mod lower;
 pub mod program;

@@ -32,9 +32,11 @@
 //! - [`haas_lathe`]: what belongs to the Haas lathe dialect:
 //!   [`haas_lathe::lower`] (blocks as plain data, read from the syntax
 //!   tree), [`haas_lathe::eval`] (macro expressions over partly unknown
-//!   variables) and [`haas_lathe::program`] (the programs of a file, their
+//!   variables), [`haas_lathe::program`] (the programs of a file, their
 //!   block numbers, the P/Q contours of G70–G73 and the targets of calls
-//!   and jumps).
+//!   and jumps) and [`haas_lathe::interpreter`] (the modal state, motion,
+//!   macro statements and time of a program, block by block; the run
+//!   driver does not pick it yet).
 //! - [`envelope`]: the CNC8x9 envelope velocity, a streaming look-ahead
 //!   planner of up to 500 blocks with linear or jerk-limited ramps.
 //! - [`known`]: values a static reading may not know.
