@@ -1,9 +1,14 @@
-//! Differential test of the executor against LinuxCNC's `rs274`
-//! interpreter: seeded random programs in the motion subset both dialects
-//! share (G00–G03 with I/J in the XY plane, helices, G90/G91, F), written
-//! as CNC8x6 for `ncc run --format json` and as NGC for `rs274 -g`. Every
-//! motion must end at the same point, with the same kind, feed and path
-//! length.
+//! Differential tests of the executor against LinuxCNC's `rs274`
+//! interpreter: seeded random programs in the motion subset a dialect
+//! shares with NGC, run by ncc and by `rs274 -g`. Every motion must end at
+//! the same point, with the same kind, feed and path length.
+//!
+//! - CNC8x6: G00–G03 with I/J in the XY plane, helices, G90/G91, F, run by
+//!   `ncc run --format json`.
+//! - The Haas lathe: G00–G03 in the ZX plane with X as a diameter, U/W
+//!   increments mixed with X/Z, arcs by I/K (I a radius) or by R, against
+//!   rs274 in lathe diameter mode (`G18 G7`). The dialect is not on the
+//!   command line yet, so its interpreter is run directly.
 //!
 //! Ignored by default because it needs `rs274` (Debian's linuxcnc-uspace);
 //! `.ci/run` installs it and runs this test.
@@ -14,8 +19,14 @@ use std::{
     fs,
     path::Path,
     process::{Command, Stdio},
+    sync::Mutex,
 };
 
+use nc_exec::{
+    haas_lathe::interpreter,
+    machine::MachineConfig,
+    run::{Motion, Path as StepPath},
+};
 use ncc_bench::{edits::Lcg, rs274};
 use serde_json::{Value, json};
 
@@ -214,42 +225,79 @@ fn ncc_motions(file: &Path) -> Vec<Ran> {
         .collect()
 }
 
-/// The motions of `rs274 -g`, from its canonical calls (in mm after G21):
-/// `SET_FEED_RATE(f)`, `STRAIGHT_TRAVERSE(x, y, z, a, b, c)`,
-/// `STRAIGHT_FEED(…)` likewise, and in the XY plane
-/// `ARC_FEED(x, y, centre x, centre y, rotation, z, a, b, c)`.
-fn rs274_motions(rs274: &Path, file: &Path) -> Vec<Ran> {
-    // Without -g it would wait for a key after an error.
-    let output = Command::new(rs274).arg("-g").arg(file).stdin(Stdio::null()).output().unwrap();
+/// A canonical call of `rs274 -g` that moves or sets the feed.
+enum Call {
+    Feed(f64),
+    /// `STRAIGHT_TRAVERSE` or `STRAIGHT_FEED` to (x, y, z).
+    Straight {
+        rapid: bool,
+        end: [f64; 3],
+    },
+    /// `ARC_FEED`'s numbers: the plane's first and second coordinates of the
+    /// end, of the centre, the rotation and the third axis.
+    Arc(Vec<f64>),
+}
+
+/// The calls of `rs274 -g` (in mm after G21).
+fn rs274_calls(rs274: &Path, file: &Path) -> Vec<Call> {
+    // Two rs274 at once now and then die of a bus error (it shares memory
+    // between its runs), and the tests run in parallel: one at a time.
+    static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+    let output = {
+        let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        // Without -g it would wait for a key after an error.
+        Command::new(rs274).arg("-g").arg(file).stdin(Stdio::null()).output().unwrap()
+    };
     assert!(
         output.status.success(),
         "rs274 -g {} failed:\n{}",
         file.display(),
         String::from_utf8_lossy(&output.stderr)
     );
-    let (mut at, mut feed, mut motions) = ([0.0; 3], 0.0, Vec::new());
+    let mut calls = Vec::new();
     for line in String::from_utf8(output.stdout).unwrap().lines() {
         // `   14 N..... STRAIGHT_FEED(10.5000, 2.0000, 3.0000, 0.0000, 0.0000, 0.0000)`
         let Some(call) = line.trim_start().splitn(3, ' ').nth(2) else { continue };
         let Some((name, args)) = call.strip_suffix(')').and_then(|call| call.split_once('(')) else { continue };
         let numbers = || -> Vec<f64> { args.split(", ").map(|arg| arg.parse().unwrap()).collect() };
-        let ran = match name {
-            "SET_FEED_RATE" => {
-                feed = numbers()[0];
+        calls.push(match name {
+            "SET_FEED_RATE" => Call::Feed(numbers()[0]),
+            "STRAIGHT_TRAVERSE" | "STRAIGHT_FEED" => Call::Straight {
+                rapid: name == "STRAIGHT_TRAVERSE",
+                end: <[f64; 3]>::try_from(&numbers()[..3]).unwrap(),
+            },
+            "ARC_FEED" => Call::Arc(numbers()),
+            _ => continue,
+        });
+    }
+    calls
+}
+
+/// The motions of `rs274 -g`: `SET_FEED_RATE(f)`,
+/// `STRAIGHT_TRAVERSE(x, y, z, a, b, c)`, `STRAIGHT_FEED(…)` likewise, and
+/// `ARC_FEED(first, second, centre first, centre second, rotation, third,
+/// a, b, c)` in the plane whose (first, second, third) axes `plane` gives
+/// as indexes of (x, y, z): XY is [0, 1, 2], XZ (rs274 writes Z first) is
+/// [2, 0, 1].
+fn rs274_motions_in(rs274: &Path, file: &Path, plane: [usize; 3]) -> Vec<Ran> {
+    let (mut at, mut feed, mut motions) = ([0.0; 3], 0.0, Vec::new());
+    for call in rs274_calls(rs274, file) {
+        let ran = match call {
+            Call::Feed(rate) => {
+                feed = rate;
                 continue;
             }
-            "STRAIGHT_TRAVERSE" | "STRAIGHT_FEED" => {
-                let end = <[f64; 3]>::try_from(&numbers()[..3]).unwrap();
+            Call::Straight { rapid, end } => {
                 let length = (0..3).map(|axis| (end[axis] - at[axis]).powi(2)).sum::<f64>().sqrt();
-                let rapid = name == "STRAIGHT_TRAVERSE";
                 Ran { rapid, end, feed: (!rapid).then_some(feed), length }
             }
-            "ARC_FEED" => {
-                let n = numbers();
-                let end = [n[0], n[1], n[5]];
-                Ran { rapid: false, end, feed: Some(feed), length: arc_length(at, end, [n[2], n[3]], n[4] as i32) }
+            Call::Arc(n) => {
+                let mut end = [0.0; 3];
+                (end[plane[0]], end[plane[1]], end[plane[2]]) = (n[0], n[1], n[5]);
+                let in_plane = |point: [f64; 3]| plane.map(|axis| point[axis]);
+                let length = arc_length(in_plane(at), in_plane(end), [n[2], n[3]], n[4] as i32);
+                Ran { rapid: false, end, feed: Some(feed), length }
             }
-            _ => continue,
         };
         at = ran.end;
         motions.push(ran);
@@ -257,7 +305,17 @@ fn rs274_motions(rs274: &Path, file: &Path) -> Vec<Ran> {
     motions
 }
 
-/// The length of an ARC_FEED in the XY plane: `rotation` turns
+fn rs274_motions(rs274: &Path, file: &Path) -> Vec<Ran> {
+    rs274_motions_in(rs274, file, [0, 1, 2])
+}
+
+/// In lathe diameter mode rs274 gives X as a radius, like the Haas trace.
+fn rs274_lathe_motions(rs274: &Path, file: &Path) -> Vec<Ran> {
+    rs274_motions_in(rs274, file, [2, 0, 1])
+}
+
+/// The length of an ARC_FEED in its plane, whose coordinates the points
+/// give first and second and the helix axis third: `rotation` turns
 /// counter-clockwise when positive, clockwise when negative, the last one
 /// ending at the end point (a full turn when it is the start); Z rises
 /// evenly along it.
@@ -272,4 +330,171 @@ fn arc_length(start: [f64; 3], end: [f64; 3], centre: [f64; 2], rotation: i32) -
     let turns = sweep.abs() + f64::from(rotation.abs() - 1) * TAU;
     let radius = (start[0] - centre[0]).hypot(start[1] - centre[1]);
     (radius * turns).hypot(end[2] - start[2])
+}
+
+#[test]
+#[ignore = "needs LinuxCNC's rs274; .ci/run installs it"]
+fn lathe_motion_matches_rs274() {
+    let rs274 = rs274::find().expect(rs274::MISSING);
+    let dir = tempfile::tempdir().unwrap();
+    let machine = MachineConfig { axes: b"XZ".to_vec(), diameter_axis: Some(b'X'), ..MachineConfig::default() };
+    let mut largest_difference: f64 = 0.0;
+    for seed in 1..=PROGRAMS {
+        let (haas, ngc, blocks) = generate_lathe(seed);
+        let ngc_file = dir.path().join(format!("{seed}.ngc"));
+        fs::write(&ngc_file, ngc).unwrap();
+        let trace = interpreter::run(&haas, &machine, 10 * MOTIONS_PER_PROGRAM);
+        assert!(trace.findings.is_empty(), "seed {seed}: {:?}", trace.findings);
+        let ncc = lathe_motions(&trace);
+        let peer = rs274_lathe_motions(&rs274, &ngc_file);
+        assert_eq!((ncc.len(), peer.len()), (blocks.len(), blocks.len()), "motions of seed {seed}: (ncc, rs274)");
+        for (index, ((block, ncc), peer)) in blocks.iter().zip(&ncc).zip(&peer).enumerate() {
+            let intended = block.end.map(|um| um as f64 / 1000.0);
+            let intended_reached = (0..3).all(|axis| (ncc.end[axis] - intended[axis]).abs() <= TOLERANCE_MM);
+            assert!(
+                ncc.agrees_with(peer) && intended_reached,
+                "seed {seed}, motion {}:\n  Haas      {}\n  NGC       {}\n  intended  {intended:?}\n  ncc       \
+                 {ncc:?}\n  rs274     {peer:?}",
+                index + 1,
+                block.cnc,
+                block.ngc,
+            );
+            for axis in 0..3 {
+                largest_difference = largest_difference.max((ncc.end[axis] - peer.end[axis]).abs());
+            }
+        }
+    }
+    eprintln!(
+        "{PROGRAMS} lathe programs, {} motions: largest end-point difference {:.4} µm",
+        PROGRAMS as usize * MOTIONS_PER_PROGRAM,
+        largest_difference * 1000.0
+    );
+}
+
+/// A random lathe program as Haas and NGC text, and its blocks, whose ends
+/// are kept as (radius, 0, Z) in µm like the motions compared. NGC writes
+/// every end absolutely; Haas writes each axis as X/Z or as an increment
+/// U/W at random, both in the same block.
+fn generate_lathe(seed: u64) -> (String, String, Vec<Block>) {
+    let mut rng = Lcg::new(seed);
+    let mut haas = String::from("O1\nG98\n");
+    let mut ngc = String::from("G21 G18 G7 G90 G94\n");
+    let mut blocks = Vec::with_capacity(MOTIONS_PER_PROGRAM);
+    // (radius, Z) in µm.
+    let mut at = [0i64; 2];
+    let (mut modal, mut feed_set) = (None, false);
+    let diameter = |radius: i64| mm(2 * radius);
+    for _ in 0..MOTIONS_PER_PROGRAM {
+        let code = [0, 0, 1, 1, 1, 1, 2, 2, 3, 3][rng.below(10)];
+        let mut haas_words = Vec::new();
+        if modal != Some(code) || rng.below(3) > 0 {
+            haas_words.push(format!("G0{code}"));
+        }
+        modal = Some(code);
+        let mut ngc_words = vec![format!("G{code}")];
+        let mut end = at;
+        let mut written = [true, true];
+        let mut centre = None;
+        if code < 2 {
+            let axes = 1 + rng.below(3);
+            written = [axes & 1 == 1, axes & 2 == 2];
+            if written[0] {
+                end[0] = 1_000 + rng.below(149_000) as i64;
+            }
+            if written[1] {
+                end[1] = rng.below(160_001) as i64 - 150_000;
+            }
+        } else {
+            let (to, offset) = lathe_arc(&mut rng, at, code == 2);
+            end = to;
+            centre = Some(offset);
+        }
+        let axis_words = |haas_words: &mut Vec<String>, ngc_words: &mut Vec<String>, rng: &mut Lcg| {
+            if written[0] {
+                let word = if rng.below(3) == 0 {
+                    format!("U{}", diameter(end[0] - at[0]))
+                } else {
+                    format!("X{}", diameter(end[0]))
+                };
+                haas_words.push(word);
+                ngc_words.push(format!("X{}", diameter(end[0])));
+            }
+            if written[1] {
+                let word =
+                    if rng.below(3) == 0 { format!("W{}", mm(end[1] - at[1])) } else { format!("Z{}", mm(end[1])) };
+                haas_words.push(word);
+                ngc_words.push(format!("Z{}", mm(end[1])));
+            }
+        };
+        axis_words(&mut haas_words, &mut ngc_words, &mut rng);
+        if let Some((offset, sweep_over_half)) = centre {
+            // The centre as I/K, or the radius, negative beyond a half turn.
+            if rng.below(2) == 0 {
+                let words = format!("I{} K{}", mm(offset[0]), mm(offset[1]));
+                haas_words.push(words.clone());
+                ngc_words.push(words);
+            } else {
+                let radius = (offset[0] as f64).hypot(offset[1] as f64).round() as i64;
+                let signed = if sweep_over_half { -radius } else { radius };
+                haas_words.push(format!("R{}", mm(signed)));
+                ngc_words.push(format!("R{}", mm(signed)));
+            }
+        }
+        if code > 0 && (!feed_set || rng.below(5) == 0) {
+            let feed = format!("F{}", 1 + rng.below(5_000));
+            haas_words.push(feed.clone());
+            ngc_words.push(feed);
+            feed_set = true;
+        }
+        let block = Block { cnc: haas_words.join(" "), ngc: ngc_words.join(" "), end: [end[0], 0, end[1]] };
+        writeln!(haas, "{}", block.cnc).unwrap();
+        writeln!(ngc, "{}", block.ngc).unwrap();
+        blocks.push(block);
+        at = end;
+    }
+    haas.push_str("M30\n");
+    ngc.push_str("M2\n");
+    (haas, ngc, blocks)
+}
+
+/// An arc in the ZX plane from `start` (radius, Z in µm): its end, its
+/// centre relative to the start (I as a radius, K), and whether it turns
+/// more than half a circle. Sweeps of 2° to 178° or 182° to 358°: an arc
+/// by R near a half turn is ill-conditioned on either side. The centre is
+/// on the grid and the end rounded onto it, within √½ µm of the circle.
+fn lathe_arc(rng: &mut Lcg, start: [i64; 2], clockwise: bool) -> ([i64; 2], ([i64; 2], bool)) {
+    let radius = 2_000.0 + rng.below(60_000) as f64;
+    let from_centre = (rng.below(360_000) as f64 / 1000.0).to_radians();
+    let offset = [(-radius * from_centre.cos()).round() as i64, (-radius * from_centre.sin()).round() as i64];
+    let centre = [start[0] + offset[0], start[1] + offset[1]];
+    let radius = (offset[0] as f64).hypot(offset[1] as f64);
+    let degrees = 2.0 + rng.below(352_000) as f64 / 1000.0;
+    let degrees = if degrees >= 178.0 { degrees + 4.0 } else { degrees };
+    let sweep = degrees.to_radians();
+    // In (Z, X) seen with Z to the right and X up, clockwise turns negative.
+    let angle = |x: f64, z: f64| x.atan2(z);
+    let to_end = angle(-offset[0] as f64, -offset[1] as f64) + if clockwise { -sweep } else { sweep };
+    let end = [centre[0] + (radius * to_end.sin()).round() as i64, centre[1] + (radius * to_end.cos()).round() as i64];
+    (end, (offset, degrees > 180.0))
+}
+
+/// The motions of the Haas interpreter's trace, with X as the radius it
+/// keeps and Y zero.
+fn lathe_motions(trace: &nc_exec::run::Trace) -> Vec<Ran> {
+    let slot = |letter: u8| trace.axes.iter().position(|&axis| axis == letter).unwrap();
+    let (x, z) = (slot(b'X'), slot(b'Z'));
+    trace
+        .steps
+        .iter()
+        .filter(|step| matches!(step.motion, Motion::Rapid | Motion::Feed))
+        .map(|step| {
+            assert!(matches!(step.path, StepPath::Straight | StepPath::Arc { .. }), "{:?}", step.path);
+            Ran {
+                rapid: step.motion == Motion::Rapid,
+                end: [step.end[x], 0.0, step.end[z]],
+                feed: step.feed,
+                length: step.length,
+            }
+        })
+        .collect()
 }
