@@ -39,8 +39,8 @@ const MOTIONS_PER_PROGRAM: usize = 250;
 /// arc tolerance is therefore a real one.
 const TOLERANCE_MM: f64 = 1e-3;
 
-/// One motion block in both dialects and where the generator meant it to
-/// end, in µm.
+/// One motion block in ncc's dialect and in NGC, and where the generator
+/// meant it to end, in µm.
 struct Block {
     cnc: String,
     ngc: String,
@@ -81,28 +81,36 @@ fn motion_matches_rs274() {
         fs::write(&ngc_file, ngc).unwrap();
         let ncc = ncc_motions(&cnc_file);
         let peer = rs274_motions(&rs274, &ngc_file);
-        assert_eq!((ncc.len(), peer.len()), (blocks.len(), blocks.len()), "motions of seed {seed}: (ncc, rs274)");
-        for (index, ((block, ncc), peer)) in blocks.iter().zip(&ncc).zip(&peer).enumerate() {
-            let intended = block.end.map(|um| um as f64 / 1000.0);
-            let intended_reached = (0..3).all(|axis| (ncc.end[axis] - intended[axis]).abs() <= TOLERANCE_MM);
-            assert!(
-                ncc.agrees_with(peer) && intended_reached,
-                "seed {seed}, motion {}:\n  CNC8x6    {}\n  NGC       {}\n  intended  {intended:?}\n  ncc       \
-                 {ncc:?}\n  rs274     {peer:?}",
-                index + 1,
-                block.cnc,
-                block.ngc,
-            );
-            for axis in 0..3 {
-                largest_difference = largest_difference.max((ncc.end[axis] - peer.end[axis]).abs());
-            }
-        }
+        largest_difference = largest_difference.max(compare(seed, "CNC8x6", &blocks, &ncc, &peer));
     }
     eprintln!(
         "{PROGRAMS} programs, {} motions: largest end-point difference {:.4} µm",
         PROGRAMS as usize * MOTIONS_PER_PROGRAM,
         largest_difference * 1000.0
     );
+}
+
+/// Checks that ncc and rs274 ran every block alike and where it was meant
+/// to end; the largest difference of an end point (mm).
+fn compare(seed: u64, dialect: &str, blocks: &[Block], ncc: &[Ran], peer: &[Ran]) -> f64 {
+    assert_eq!((ncc.len(), peer.len()), (blocks.len(), blocks.len()), "motions of seed {seed}: (ncc, rs274)");
+    let mut largest_difference: f64 = 0.0;
+    for (index, ((block, ncc), peer)) in blocks.iter().zip(ncc).zip(peer).enumerate() {
+        let intended = block.end.map(|um| um as f64 / 1000.0);
+        let intended_reached = (0..3).all(|axis| (ncc.end[axis] - intended[axis]).abs() <= TOLERANCE_MM);
+        assert!(
+            ncc.agrees_with(peer) && intended_reached,
+            "seed {seed}, motion {}:\n  {dialect:<9} {}\n  NGC       {}\n  intended  {intended:?}\n  ncc       \
+             {ncc:?}\n  rs274     {peer:?}",
+            index + 1,
+            block.cnc,
+            block.ngc,
+        );
+        for axis in 0..3 {
+            largest_difference = largest_difference.max((ncc.end[axis] - peer.end[axis]).abs());
+        }
+    }
+    largest_difference
 }
 
 /// A program of random motion blocks as CNC8x6 and NGC text, and its
@@ -347,22 +355,7 @@ fn lathe_motion_matches_rs274() {
         assert!(trace.findings.is_empty(), "seed {seed}: {:?}", trace.findings);
         let ncc = lathe_motions(&trace);
         let peer = rs274_lathe_motions(&rs274, &ngc_file);
-        assert_eq!((ncc.len(), peer.len()), (blocks.len(), blocks.len()), "motions of seed {seed}: (ncc, rs274)");
-        for (index, ((block, ncc), peer)) in blocks.iter().zip(&ncc).zip(&peer).enumerate() {
-            let intended = block.end.map(|um| um as f64 / 1000.0);
-            let intended_reached = (0..3).all(|axis| (ncc.end[axis] - intended[axis]).abs() <= TOLERANCE_MM);
-            assert!(
-                ncc.agrees_with(peer) && intended_reached,
-                "seed {seed}, motion {}:\n  Haas      {}\n  NGC       {}\n  intended  {intended:?}\n  ncc       \
-                 {ncc:?}\n  rs274     {peer:?}",
-                index + 1,
-                block.cnc,
-                block.ngc,
-            );
-            for axis in 0..3 {
-                largest_difference = largest_difference.max((ncc.end[axis] - peer.end[axis]).abs());
-            }
-        }
+        largest_difference = largest_difference.max(compare(seed, "Haas", &blocks, &ncc, &peer));
     }
     eprintln!(
         "{PROGRAMS} lathe programs, {} motions: largest end-point difference {:.4} µm",

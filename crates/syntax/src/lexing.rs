@@ -1,7 +1,16 @@
 //! What the lexers and parsers of all dialects share: tokens, numbers and
 //! lines.
 
+use std::ops::Range;
+
+use rowan::{TextRange, TextSize};
+
 use crate::SyntaxKind;
+
+/// A byte range of the text as a `TextRange`.
+pub(crate) fn range(r: Range<usize>) -> TextRange {
+    TextRange::new(TextSize::from(r.start as u32), TextSize::from(r.end as u32))
+}
 
 /// A token: its kind and its length in bytes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

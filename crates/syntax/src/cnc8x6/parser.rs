@@ -21,7 +21,7 @@
 
 use std::ops::Range;
 
-use rowan::{GreenNode, NodeOrToken, TextRange, TextSize};
+use rowan::{GreenNode, NodeOrToken, TextRange};
 
 use super::{
     GrammarLetters, grammar_letters, is_block_letter,
@@ -34,7 +34,7 @@ use crate::{
     encoding::BYTE_ORDER_MARK,
     error::Errors,
     green::{self, GreenElement, GreenFactory},
-    lexing::{MAX_READ_LINE, read_end},
+    lexing::{MAX_READ_LINE, range, read_end},
     limit::{LineLimiter, Omitted},
     runs::RunBuilder,
     visible,
@@ -365,10 +365,6 @@ pub(crate) fn long_lines(text: &str, region: Range<usize>) -> Vec<SyntaxError> {
         }
     }
     errors
-}
-
-fn range(r: Range<usize>) -> TextRange {
-    TextRange::new(TextSize::from(r.start as u32), TextSize::from(r.end as u32))
 }
 
 struct Parser<'a> {

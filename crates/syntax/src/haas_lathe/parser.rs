@@ -21,7 +21,7 @@
 
 use std::{ops::Range, sync::OnceLock};
 
-use rowan::{GreenNode, NodeOrToken, TextRange, TextSize};
+use rowan::{GreenNode, NodeOrToken};
 
 use super::lexer;
 use crate::{
@@ -31,7 +31,7 @@ use crate::{
     error::Errors,
     expr::{self, Ahead, Arguments, ExprInput, Grammar},
     green::{self, GreenElement, GreenFactory},
-    lexing::{MAX_READ_LINE, Token, read_end},
+    lexing::{MAX_READ_LINE, Token, range, read_end},
     limit::{LineLimiter, Omitted},
     runs::RunBuilder,
     visible,
@@ -188,10 +188,6 @@ pub(crate) fn parse_blocks(
         blocks.push(NodeOrToken::Node(parser.block()));
     }
     (blocks, parser.into_errors())
-}
-
-fn range(r: Range<usize>) -> TextRange {
-    TextRange::new(TextSize::from(r.start as u32), TextSize::from(r.end as u32))
 }
 
 struct Parser<'a> {
