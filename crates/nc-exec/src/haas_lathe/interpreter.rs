@@ -178,8 +178,6 @@ struct Interpreter<'a> {
     reported: Vec<String>,
     /// A finding the control stops on was made.
     stopped: bool,
-    /// Each `DOn` block's `ENDn` block, and the way back.
-    loop_ends: Vec<(usize, usize)>,
     /// Each roughing cycle's block and its contour's Q block.
     contour_ends: Vec<(usize, usize)>,
 }
@@ -202,13 +200,11 @@ impl<'a> Interpreter<'a> {
             executed: 0,
             reported: Vec::new(),
             stopped: false,
-            loop_ends: Vec::new(),
             contour_ends: Vec::new(),
         }
     }
 
     fn run(&mut self, program: &Program, more_programs: bool, budget: usize) {
-        self.loop_ends = loop_pairs(&self.blocks[program.blocks.clone()], program.blocks.start);
         let mut at = program.blocks.start;
         while program.blocks.contains(&at) {
             if self.executed >= budget {
@@ -504,7 +500,7 @@ impl<'a> Interpreter<'a> {
             },
             Statement::Goto { target, .. } => self.goto(target, range, program),
             Statement::LoopStart { condition, .. } => {
-                let Some(&(_, end)) = self.loop_ends.iter().find(|&&(start, _)| start == at) else {
+                let Some(end) = program.loop_end(at) else {
                     self.finding(RunRule::CallTargetMissing, range, "no END with the loop's number after its DO");
                     return Flow::End;
                 };
@@ -512,8 +508,8 @@ impl<'a> Interpreter<'a> {
                 let runs = condition.as_ref().is_none_or(|condition| self.condition(condition, range));
                 if runs { Flow::Next } else { Flow::Jump(end + 1) }
             }
-            Statement::LoopEnd { .. } => match self.loop_ends.iter().rev().find(|&&(_, end)| end == at) {
-                Some(&(start, _)) => Flow::Jump(start),
+            Statement::LoopEnd { .. } => match program.loop_start(at) {
+                Some(start) => Flow::Jump(start),
                 None => {
                     self.finding(RunRule::CallTargetMissing, range, "no DO with the loop's number before its END");
                     Flow::End
@@ -624,27 +620,6 @@ impl<'a> Interpreter<'a> {
         self.stopped |= rule.stops();
         self.findings.push(Finding { rule, source: 0, range, message: message.to_owned() });
     }
-}
-
-/// Each `DOn` block of a program with the nearest `ENDn` after it, by
-/// index in the file; `first` is the program's first block.
-fn loop_pairs(blocks: &[HaasBlock], first: usize) -> Vec<(usize, usize)> {
-    let loop_id = |block: &HaasBlock, starts: bool| {
-        block.statements.iter().find_map(|statement| match statement {
-            Statement::LoopStart { id, .. } if starts => Some(*id),
-            Statement::LoopEnd { id, .. } if !starts => Some(*id),
-            _ => None,
-        })
-    };
-    let mut pairs = Vec::new();
-    for (start, block) in blocks.iter().enumerate() {
-        let Some(id) = loop_id(block, true) else { continue };
-        let end = blocks[start + 1..].iter().position(|later| loop_id(later, false) == Some(id));
-        if let Some(end) = end {
-            pairs.push((first + start, first + start + 1 + end));
-        }
-    }
-    pairs
 }
 
 /// The centre of the arc of `radius` from `from` to `to`: on the side that

@@ -24,6 +24,21 @@ pub struct Program {
     /// Every block carrying each number, in file order: numbers need not be
     /// unique or increasing (lathe manual §5.1 (001:2833-2837)).
     pub block_numbers: BTreeMap<u64, Vec<usize>>,
+    /// Each `DOn` block with the nearest `ENDn` after it, by index in the
+    /// file: the loops the run and the checker follow alike.
+    pub loops: Vec<(usize, usize)>,
+}
+
+impl Program {
+    /// The `ENDn` block of the loop that `DOn` block `start` opens.
+    pub fn loop_end(&self, start: usize) -> Option<usize> {
+        self.loops.iter().find(|&&(from, _)| from == start).map(|&(_, end)| end)
+    }
+
+    /// The `DOn` block of the innermost loop that `ENDn` block `end` closes.
+    pub fn loop_start(&self, end: usize) -> Option<usize> {
+        self.loops.iter().rev().find(|&&(_, to)| to == end).map(|&(start, _)| start)
+    }
 }
 
 /// A block that names another block or program by number.
@@ -350,7 +365,29 @@ fn program(blocks: &[HaasBlock], number: Option<u32>, title: Option<String>, ran
             block_numbers.entry(value).or_default().push(index);
         }
     }
-    Program { number, title, blocks: range, block_numbers }
+    let loops = loop_pairs(&blocks[range.clone()], range.start);
+    Program { number, title, blocks: range, block_numbers, loops }
+}
+
+/// Each `DOn` block with the nearest `ENDn` after it, by index in the file;
+/// `first` is the index of `blocks[0]`.
+fn loop_pairs(blocks: &[HaasBlock], first: usize) -> Vec<(usize, usize)> {
+    let loop_id = |block: &HaasBlock, starts: bool| {
+        block.statements.iter().find_map(|statement| match statement {
+            Statement::LoopStart { id, .. } if starts => Some(*id),
+            Statement::LoopEnd { id, .. } if !starts => Some(*id),
+            _ => None,
+        })
+    };
+    let mut pairs = Vec::new();
+    for (start, block) in blocks.iter().enumerate() {
+        let Some(id) = loop_id(block, true) else { continue };
+        let end = blocks[start + 1..].iter().position(|later| loop_id(later, false) == Some(id));
+        if let Some(end) = end {
+            pairs.push((first + start, first + start + 1 + end));
+        }
+    }
+    pairs
 }
 
 /// The motion code (G00–G03) in force after each block, as far as literal
@@ -467,6 +504,17 @@ mod tests {
         assert!(g71.ignored.is_empty());
         assert_eq!((g70.code, g70.blocks.clone(), g70.roughing_type, g70.monotony), (70, 7..=16, None, None));
         assert_eq!(model.findings.len(), 2, "{:?}", model.findings);
+    }
+
+    #[test]
+    fn loops_pair_each_do_with_the_nearest_end_of_its_number() {
+        // Blocks: 0 O1, 1 WHILE … DO1, 2 DO2, 3 END2, 4 END1, 5 END3, 6 DO3, 7 M30.
+        let model = model("O1\nWHILE [#1 LT 3] DO1\nDO2\nEND2\nEND1\nEND3\nDO3\nM30\n");
+        let program = &model.programs[0];
+        assert_eq!(program.loops, [(1, 4), (2, 3)]);
+        assert_eq!((program.loop_end(1), program.loop_start(4), program.loop_start(3)), (Some(4), Some(1), Some(2)));
+        // An END before its DO, and a DO without END, pair with nothing.
+        assert_eq!((program.loop_start(5), program.loop_end(6)), (None, None));
     }
 
     #[test]
