@@ -23,11 +23,11 @@ use std::{
 };
 
 use nc_exec::{
-    haas_lathe::interpreter,
     machine::MachineConfig,
-    run::{Motion, Path as StepPath},
+    run::{self, Motion, NoFiles, Path as StepPath},
 };
 use ncc_bench::{edits::Lcg, rs274};
+use ncc_catalog::Dialect;
 use serde_json::{Value, json};
 
 const PROGRAMS: u64 = 40;
@@ -345,13 +345,13 @@ fn arc_length(start: [f64; 3], end: [f64; 3], centre: [f64; 2], rotation: i32) -
 fn lathe_motion_matches_rs274() {
     let rs274 = rs274::find().expect(rs274::MISSING);
     let dir = tempfile::tempdir().unwrap();
-    let machine = MachineConfig { axes: b"XZ".to_vec(), diameter_axis: Some(b'X'), ..MachineConfig::default() };
+    let machine = MachineConfig::of_control(Dialect::HaasLathe);
     let mut largest_difference: f64 = 0.0;
     for seed in 1..=PROGRAMS {
         let (haas, ngc, blocks) = generate_lathe(seed);
         let ngc_file = dir.path().join(format!("{seed}.ngc"));
         fs::write(&ngc_file, ngc).unwrap();
-        let trace = interpreter::run(&haas, &machine, 10 * MOTIONS_PER_PROGRAM);
+        let trace = run::run(&haas, &NoFiles, &machine, 10 * MOTIONS_PER_PROGRAM);
         assert!(trace.findings.is_empty(), "seed {seed}: {:?}", trace.findings);
         let ncc = lathe_motions(&trace);
         let peer = rs274_lathe_motions(&rs274, &ngc_file);
@@ -473,7 +473,7 @@ fn lathe_arc(rng: &mut Lcg, start: [i64; 2], clockwise: bool) -> ([i64; 2], ([i6
 
 /// The motions of the Haas interpreter's trace, with X as the radius it
 /// keeps and Y zero.
-fn lathe_motions(trace: &nc_exec::run::Trace) -> Vec<Ran> {
+fn lathe_motions(trace: &run::Trace) -> Vec<Ran> {
     let slot = |letter: u8| trace.axes.iter().position(|&axis| axis == letter).unwrap();
     let (x, z) = (slot(b'X'), slot(b'Z'));
     trace

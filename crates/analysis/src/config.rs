@@ -54,7 +54,7 @@ use std::{
 use nc_exec::cnc8x6::tables::{self, Finding};
 pub use nc_exec::machine::{MachineConfig, OffsetTable, ToolTable, TravelLimits, parse_constant};
 use ncc_catalog::DialectId;
-use ncc_syntax::Severity;
+use ncc_syntax::{Dialect, Severity};
 use serde::Deserialize;
 
 use crate::Diagnostic;
@@ -366,6 +366,16 @@ fn relative_to(path: &Path, name: &Path) -> PathBuf {
 }
 
 impl Config {
+    /// This configuration for the programs of `dialect`: a machine
+    /// described for another control (a project that names no dialect
+    /// describes a CNC8x6 machine) gives way to `dialect`'s default one.
+    pub fn for_dialect(mut self, dialect: Dialect) -> Config {
+        if self.machine.control != dialect {
+            self.machine = MachineConfig::of_control(dialect);
+        }
+        self
+    }
+
     /// Reads `ncc.toml`'s text. `path` names the file in errors and is where
     /// the paths it holds start from; `read` reads the files they name.
     pub fn from_toml(text: &str, path: &Path, read: impl Fn(&Path) -> io::Result<String>) -> Result<Config, String> {
@@ -385,10 +395,7 @@ impl Config {
             report: file.report,
             // The machine's control is the project's dialect when this
             // build reads it; the machine's keys are read in its terms.
-            machine: MachineConfig {
-                control: file.dialect.and_then(DialectId::implementation).unwrap_or_default(),
-                ..MachineConfig::default()
-            },
+            machine: MachineConfig::of_control(file.dialect.and_then(DialectId::implementation).unwrap_or_default()),
         };
         if let Some(unknown) = config.rules.keys().find(|key| crate::Rule::find(key).is_none()) {
             return Err(format!("{origin}: [rules] names no rule `{unknown}` (see `ncc rules`)"));

@@ -9,6 +9,7 @@ use crate::{
     db::{Db, SourceFile},
     diagnostic, findings,
     findings::Findings,
+    haas_lathe,
     lower::{BlockData, Word},
 };
 
@@ -16,6 +17,7 @@ use crate::{
 fn check_rules(dialect: Dialect) -> &'static [&'static [&'static Rule]] {
     match dialect {
         Dialect::Cnc8x6 => cnc8x6::checks::RULES,
+        Dialect::HaasLathe => haas_lathe::checks::RULES,
     }
 }
 
@@ -38,6 +40,7 @@ impl Rule {
 pub(crate) fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => cnc8x6::checks::local_findings(db, file),
+        Dialect::HaasLathe => haas_lathe::checks::local_findings(db, file),
     }
 }
 
@@ -45,6 +48,7 @@ pub(crate) fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
 pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> &Findings {
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => cnc8x6::flow::flow_diagnostics(db, file),
+        Dialect::HaasLathe => haas_lathe::checks::flow_findings(db, file),
     }
 }
 
@@ -53,6 +57,8 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> &Findings {
 pub(crate) fn prepare_states(db: &dyn Db, file: SourceFile) {
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => cnc8x6::states::prepare(db, file),
+        // Hover reads nothing prepared about a Haas file.
+        Dialect::HaasLathe => {}
     }
 }
 
@@ -61,6 +67,8 @@ pub(crate) fn prepare_states(db: &dyn Db, file: SourceFile) {
 pub(crate) fn code_fits_machine(dialect: Dialect, letter: char, number: u32, config: &Config) -> bool {
     match dialect {
         Dialect::Cnc8x6 => cnc8x6::ide::code_fits_machine(letter, number, config),
+        // The machine description names no options of a Haas lathe.
+        Dialect::HaasLathe => true,
     }
 }
 
@@ -69,6 +77,7 @@ pub(crate) fn code_fits_machine(dialect: Dialect, letter: char, number: u32, con
 pub(crate) fn arc_centre(dialect: Dialect, block: &BlockData, config: &Config) -> Vec<(u8, String)> {
     match dialect {
         Dialect::Cnc8x6 => cnc8x6::ide::arc_centre(block, config),
+        Dialect::HaasLathe => haas_lathe::ide::arc_centre(block),
     }
 }
 
@@ -76,6 +85,8 @@ pub(crate) fn arc_centre(dialect: Dialect, block: &BlockData, config: &Config) -
 pub(crate) fn starts_unit(dialect: Dialect, block: &BlockData, word: &Word) -> bool {
     match dialect {
         Dialect::Cnc8x6 => cnc8x6::ide::starts_unit(block, word),
+        // Only `O` starts a program, and it is no word of a block.
+        Dialect::HaasLathe => false,
     }
 }
 
@@ -83,5 +94,6 @@ pub(crate) fn starts_unit(dialect: Dialect, block: &BlockData, word: &Word) -> b
 pub(crate) fn unnamed_unit(dialect: Dialect) -> &'static str {
     match dialect {
         Dialect::Cnc8x6 => cnc8x6::ide::UNNAMED_UNIT,
+        Dialect::HaasLathe => "program",
     }
 }

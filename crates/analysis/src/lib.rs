@@ -13,6 +13,7 @@ mod db;
 mod diagnostic;
 mod dialect;
 mod findings;
+mod haas_lathe;
 mod ide;
 mod suppress;
 
@@ -78,7 +79,7 @@ impl AnalysisHost {
 
     /// A host over `db` (e.g. one that logs executions).
     pub fn with_database(db: RootDatabase, dialect: Dialect, config: Config) -> AnalysisHost {
-        Settings::new(&db, dialect, config, Vec::new());
+        Settings::new(&db, dialect, config.for_dialect(dialect), Vec::new());
         AnalysisHost { db }
     }
 

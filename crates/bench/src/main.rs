@@ -209,6 +209,7 @@ impl DialectArg {
 fn program_text(dialect: Dialect, moves: &[Move]) -> String {
     match dialect {
         Dialect::Cnc8x6 => progen::write(moves, Syntax::Cnc8x6),
+        Dialect::HaasLathe => progen::write(moves, Syntax::HaasLathe),
     }
 }
 
@@ -228,6 +229,7 @@ fn program_file_name(dialect: Dialect) -> String {
 pub(crate) fn code_near(dialect: Dialect, text: &str, offset: usize, rng: &mut Lcg) -> Option<usize> {
     match dialect {
         Dialect::Cnc8x6 => progen::g_code_near(text, offset, rng),
+        Dialect::HaasLathe => progen::g_code_near(text, offset, rng),
     }
 }
 
@@ -235,6 +237,7 @@ pub(crate) fn code_near(dialect: Dialect, text: &str, offset: usize, rng: &mut L
 enum SyntaxArg {
     Cnc8x6,
     Ngc,
+    HaasLathe,
 }
 
 fn main() -> anyhow::Result<()> {
@@ -277,6 +280,7 @@ fn main() -> anyhow::Result<()> {
             let syntax = match syntax {
                 SyntaxArg::Cnc8x6 => Syntax::Cnc8x6,
                 SyntaxArg::Ngc => Syntax::Ngc,
+                SyntaxArg::HaasLathe => Syntax::HaasLathe,
             };
             let text = progen::write(&progen::surfacing(blocks), syntax);
             std::fs::write(&output, text).with_context(|| format!("writing {}", output.display()))

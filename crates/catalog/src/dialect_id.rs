@@ -44,7 +44,8 @@ impl DialectId {
     pub fn implementation(self) -> Option<Dialect> {
         match self {
             DialectId::Cnc8x6 => Some(Dialect::Cnc8x6),
-            DialectId::HaasLathe | DialectId::Sinumerik => None,
+            DialectId::HaasLathe => Some(Dialect::HaasLathe),
+            DialectId::Sinumerik => None,
         }
     }
 
@@ -79,6 +80,7 @@ impl From<Dialect> for DialectId {
     fn from(dialect: Dialect) -> DialectId {
         match dialect {
             Dialect::Cnc8x6 => DialectId::Cnc8x6,
+            Dialect::HaasLathe => DialectId::HaasLathe,
         }
     }
 }

@@ -27,6 +27,8 @@ pub enum Dialect {
     /// MEFI CNC836 / CNC846 / CNC856.
     #[default]
     Cnc8x6,
+    /// Haas lathe, classic control (Fanuc-style ISO).
+    HaasLathe,
 }
 
 impl Dialect {
@@ -37,16 +39,12 @@ impl Dialect {
                 static CNC8X6: OnceLock<Catalogue> = OnceLock::new();
                 CNC8X6.get_or_init(|| Catalogue::load(&CNC8X6_FILES))
             }
+            Dialect::HaasLathe => {
+                static HAAS_LATHE: OnceLock<Catalogue> = OnceLock::new();
+                HAAS_LATHE.get_or_init(|| Catalogue::load(&HAAS_LATHE_FILES))
+            }
         }
     }
-}
-
-/// The catalogue of the Haas lathe (classic control), until the dialect is
-/// registered as a [`Dialect`]: the syntax crate's Haas grammar reads its
-/// expression operators and functions from it.
-pub fn haas_lathe() -> &'static Catalogue {
-    static HAAS_LATHE: OnceLock<Catalogue> = OnceLock::new();
-    HAAS_LATHE.get_or_init(|| Catalogue::load(&HAAS_LATHE_FILES))
 }
 
 /// The data files of one dialect, by name and content.
@@ -74,7 +72,6 @@ static CNC8X6_FILES: DataFiles = DataFiles {
     cycles: data_file!("cnc8x6", "cycles.toml"),
 };
 
-/// The Haas lathe's data, until the dialect is registered as a [`Dialect`].
 static HAAS_LATHE_FILES: DataFiles = DataFiles {
     codes: data_file!("haas-lathe", "codes.toml"),
     addresses: data_file!("haas-lathe", "addresses.toml"),

@@ -58,6 +58,7 @@ const KINDS: &[(&str, &str)] = &[
     ("C", "Fixed cycles"),
     ("X", "Transformations"),
     ("D", "Dynamics and continuity"),
+    ("L", "Haas lathe (`L` + the rule's number in the lathe manual's list; L101 on: the project's own)"),
     ("Z", "Report limits"),
     ("E", "Execution (`ncc run`, `ncc expand`, `ncc plot`)"),
 ];

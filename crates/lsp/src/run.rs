@@ -20,6 +20,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use nc_exec::{
     cnc8x6::expand::{ExpandError, Expansion},
     cnc8x6::lower::BlockData,
+    haas_lathe,
     run::{Axes, Called, Environment, Message, MessageDisplay, Motion, Step, Stop, Totals, Trace, expected_blocks},
     velocity::{self, Dynamics, Timer, Timing, TimingSink},
 };
@@ -71,7 +72,7 @@ pub(crate) struct Ran {
 impl Program<'_> {
     /// Its configuration: the machine, and the levels of the run's rules.
     fn config(&self) -> Result<Config, String> {
-        Ok(self.config.map(check::load_config).transpose()?.unwrap_or_default())
+        Ok(self.config.map(check::load_config).transpose()?.unwrap_or_default().for_dialect(self.dialect))
     }
 }
 
@@ -362,6 +363,10 @@ fn expand_program(program: &Program<'_>, path: &Path, output: Option<&Path>, ste
     // The expansion is written in the program's own dialect.
     let mut expansion = match program.dialect {
         Dialect::Cnc8x6 => Expansion::new(io::BufWriter::new(out), machine, number, &title),
+        Dialect::HaasLathe => {
+            eprintln!("error: ncc expand does not write Haas lathe programs yet");
+            return ExitCode::from(2);
+        }
     };
     let ran = Ran::run(program, &config, Progress::OnTerminal, |text, library| {
         nc_exec::run::run_into(text, library, machine, step_budget, &mut expansion)
@@ -465,6 +470,12 @@ pub(crate) fn lower(path: &Path, dialect: Option<DialectId>) -> ExitCode {
             for block in parse.tree().blocks() {
                 let line = lines.line_col(block.syntax().text_range().start(), Columns::Characters).0 + 1;
                 let _ = writeln!(out, "{line:>6}  {}", BlockData::lower(block.syntax().green()));
+            }
+        }
+        Dialect::HaasLathe => {
+            for (range, block) in haas_lathe::lower::block_nodes(parse.green()) {
+                let line = lines.line_col(range.start(), Columns::Characters).0 + 1;
+                let _ = writeln!(out, "{line:>6}  {}", haas_lathe::lower::HaasBlock::lower(block));
             }
         }
     }

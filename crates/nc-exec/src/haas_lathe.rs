@@ -1,9 +1,11 @@
 //! The Haas lathe dialect's part of the executor (classic control,
 //! Fanuc-style ISO code): its block IR and lowering, the macro-expression
 //! evaluator, the program model (programs, block numbers, the P/Q
-//! contours of G70–G73 and the targets of calls and jumps) and the
-//! interpreter that runs a program into a trace.
+//! contours of G70–G73 and the targets of calls and jumps), the
+//! interpreter that runs a program into a trace, and the velocity policy
+//! that times it.
 
+pub mod dynamics;
 pub mod eval;
 pub mod interpreter;
 pub mod lower;

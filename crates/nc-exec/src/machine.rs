@@ -98,6 +98,18 @@ impl Default for MachineConfig {
 }
 
 impl MachineConfig {
+    /// The machine a program for `control` runs on when the configuration
+    /// describes none: for CNC8x6 the default, a machine with axes XYZUVC;
+    /// for the Haas lathe a two-axis lathe, X (a diameter) and Z.
+    pub fn of_control(control: Dialect) -> MachineConfig {
+        match control {
+            Dialect::Cnc8x6 => MachineConfig::default(),
+            Dialect::HaasLathe => {
+                MachineConfig { control, axes: b"XZ".to_vec(), diameter_axis: Some(b'X'), ..MachineConfig::default() }
+            }
+        }
+    }
+
     /// The axes a run's steps keep, in their order: axes 1–6.
     pub fn step_axes(&self) -> &[u8] {
         &self.axes[..self.axes.len().min(crate::axes::MAX_AXES)]

@@ -1,6 +1,7 @@
 //! Running a program: the driver that runs it on its machine by the
 //! interpreter of the machine's control (CNC8x6:
-//! [`crate::cnc8x6::interpreter`]), to a trace or into a sink, on a thread
+//! [`crate::cnc8x6::interpreter`], Haas lathe:
+//! [`crate::haas_lathe::interpreter`]), to a trace or into a sink, on a thread
 //! of its own or this one, with checkpoints to resume from; the control's
 //! velocity policy that times the steps; and the trace's vocabulary
 //! ([`crate::trace`]), which the interpreters write.
@@ -9,7 +10,7 @@ use std::{sync::mpsc, thread::Scope};
 
 use ncc_catalog::Dialect;
 
-use crate::{cnc8x6, machine::MachineConfig, transform::Frame, velocity::Dynamics};
+use crate::{cnc8x6, haas_lathe, machine::MachineConfig, transform::Frame, velocity::Dynamics};
 
 pub use crate::trace::*;
 
@@ -27,6 +28,7 @@ pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget:
 pub fn reset_frame(machine: &MachineConfig) -> Frame {
     match machine.control {
         Dialect::Cnc8x6 => cnc8x6::interpreter::reset_frame(machine),
+        Dialect::HaasLathe => Frame::default(),
     }
 }
 
@@ -35,6 +37,7 @@ pub fn reset_frame(machine: &MachineConfig) -> Frame {
 pub fn dynamics(machine: &MachineConfig) -> Dynamics {
     match machine.control {
         Dialect::Cnc8x6 => cnc8x6::dynamics::dynamics(machine),
+        Dialect::HaasLathe => haas_lathe::dynamics::dynamics(machine),
     }
 }
 
@@ -108,5 +111,6 @@ fn run_in<'a, 's>(
 ) -> Trace {
     match machine.control {
         Dialect::Cnc8x6 => cnc8x6::interpreter::run_in(scope, text, files, machine, budget, sink, checkpoint),
+        Dialect::HaasLathe => haas_lathe::interpreter::run_into(text, machine, budget, sink),
     }
 }

@@ -15,7 +15,7 @@ pub mod encoding;
 mod error;
 mod expr;
 mod green;
-pub mod haas_lathe;
+mod haas_lathe;
 mod lexing;
 pub mod limit;
 mod runs;
@@ -72,23 +72,22 @@ pub struct Parse {
 impl Parse {
     /// Parses a whole program.
     pub fn new(text: &str, dialect: Dialect) -> Parse {
-        match dialect {
-            Dialect::Cnc8x6 => {
-                let (green, errors, omitted) = cnc8x6::parse_source_file(text);
-                Parse { green, errors: errors.into(), omitted: omitted.into(), dialect }
-            }
-        }
+        let (green, errors, omitted) = match dialect {
+            Dialect::Cnc8x6 => cnc8x6::parse_source_file(text),
+            Dialect::HaasLathe => haas_lathe::parse_source_file(text),
+        };
+        Parse { green, errors: errors.into(), omitted: omitted.into(), dialect }
     }
 
     /// Parses `new_text`, the result of applying `edit` to the text of this
     /// parse, reusing every block the edit cannot have changed. The result
     /// equals `Parse::new(new_text, dialect)`.
     pub fn reparse(&self, edit: &TextEdit, new_text: &str) -> Parse {
-        match self.dialect {
-            Dialect::Cnc8x6 => {
-                cnc8x6::reparse_blocks(self, edit, new_text).unwrap_or_else(|| Parse::new(new_text, self.dialect))
-            }
-        }
+        let reparsed = match self.dialect {
+            Dialect::Cnc8x6 => cnc8x6::reparse_blocks(self, edit, new_text),
+            Dialect::HaasLathe => haas_lathe::reparse_blocks(self, edit, new_text),
+        };
+        reparsed.unwrap_or_else(|| Parse::new(new_text, self.dialect))
     }
 
     pub fn dialect(&self) -> Dialect {

@@ -8,10 +8,7 @@
 
 use std::{fs, path::PathBuf};
 
-use ncc_syntax::{
-    Severity, SyntaxKind, SyntaxNode, TextEdit, TextRange, TextSize,
-    haas_lathe::{self, HaasParse},
-};
+use ncc_syntax::{Dialect, Parse, Severity, SyntaxKind, TextEdit, TextRange, TextSize};
 use proptest::prelude::*;
 
 /// What was removed from the manual's text to make each example a program
@@ -48,8 +45,8 @@ fn fixtures() -> Vec<(PathBuf, String)> {
     files.into_iter().map(|path| (path.clone(), fs::read_to_string(&path).unwrap())).collect()
 }
 
-fn text_of(parse: &HaasParse) -> String {
-    SyntaxNode::new_root(parse.0.clone()).to_string()
+fn parse(text: &str) -> Parse {
+    Parse::new(text, Dialect::HaasLathe)
 }
 
 #[test]
@@ -64,12 +61,18 @@ fn every_cleaned_example_has_its_fixture() {
 #[test]
 fn snapshots() {
     for (path, text) in fixtures() {
-        let parse = haas_lathe::parse(&text);
-        assert_eq!(text_of(&parse), text, "{} does not round-trip", path.display());
+        let parse = parse(&text);
+        assert_eq!(parse.syntax_node().to_string(), text, "{} does not round-trip", path.display());
         let is_error_fixture = path.file_name().unwrap().to_str().unwrap().starts_with("error_");
-        let has_errors = parse.1.iter().any(|e| e.severity() == Severity::Error);
-        assert_eq!(has_errors, is_error_fixture, "{}: error fixtures are named error_*\n{:?}", path.display(), parse.1);
-        expect_test::expect_file![path.with_extension("rast")].assert_eq(&haas_lathe::debug_dump(&parse));
+        let has_errors = parse.errors().iter().any(|e| e.severity() == Severity::Error);
+        assert_eq!(
+            has_errors,
+            is_error_fixture,
+            "{}: error fixtures are named error_*\n{:?}",
+            path.display(),
+            parse.errors()
+        );
+        expect_test::expect_file![path.with_extension("rast")].assert_eq(&parse.debug_dump());
     }
 }
 
@@ -78,7 +81,7 @@ fn snapshots() {
 #[test]
 fn fixture_edits_reparse_like_full_parses() {
     for (path, text) in fixtures() {
-        let parse = haas_lathe::parse(&text);
+        let old = parse(&text);
         let boundaries: Vec<usize> = (0..=text.len()).filter(|&i| text.is_char_boundary(i)).collect();
         let mut edits = Vec::new();
         for pair in boundaries.windows(2) {
@@ -92,12 +95,7 @@ fn fixture_edits_reparse_like_full_parses() {
         for edit in edits {
             let mut new_text = text.clone();
             edit.apply(&mut new_text);
-            assert_eq!(
-                haas_lathe::reparse(&parse, &edit, &new_text),
-                haas_lathe::parse(&new_text),
-                "{}: {edit:?}",
-                path.display()
-            );
+            assert_eq!(old.reparse(&edit, &new_text), parse(&new_text), "{}: {edit:?}", path.display());
         }
     }
 }
@@ -108,7 +106,8 @@ fn range(start: usize, end: usize) -> TextRange {
 
 /// The significant tokens of `text`, as (kind, text).
 fn tokens(text: &str) -> Vec<(SyntaxKind, String)> {
-    SyntaxNode::new_root(haas_lathe::parse(text).0)
+    parse(text)
+        .syntax_node()
         .descendants_with_tokens()
         .filter_map(|e| e.into_token())
         .filter(|t| !matches!(t.kind(), SyntaxKind::WHITESPACE | SyntaxKind::NEWLINE))
@@ -143,8 +142,8 @@ fn letters_lex_by_the_longest_keyword() {
 fn comment_contents_are_never_tokenised() {
     use SyntaxKind::*;
     let text = "G0 (X1 #1=2 [ IF GOTO5 ; %) X2. ; (P0 ] WHILE\n";
-    let parse = haas_lathe::parse(text);
-    assert!(parse.1.is_empty(), "{:?}", parse.1);
+    let parse = parse(text);
+    assert!(parse.errors().is_empty(), "{:?}", parse.errors());
     assert_eq!(
         tokens(text),
         [
@@ -160,9 +159,9 @@ fn comment_contents_are_never_tokenised() {
 
 #[test]
 fn precedence_follows_fanuc() {
-    let parse = haas_lathe::parse("#1 = 1 + 2 * 3 EQ -4 OR 5 AND 6\n");
-    assert!(parse.1.is_empty(), "{:?}", parse.1);
-    let root = SyntaxNode::new_root(parse.0);
+    let parse = parse("#1 = 1 + 2 * 3 EQ -4 OR 5 AND 6\n");
+    assert!(parse.errors().is_empty(), "{:?}", parse.errors());
+    let root = parse.syntax_node();
     let top = root.descendants().find(|n| n.kind() == SyntaxKind::BIN_EXPR).unwrap();
     // `EQ` is the loosest operator: the top expression splits at it.
     let operator = top.children_with_tokens().find(|e| e.kind() == SyntaxKind::IDENT).unwrap();
@@ -176,11 +175,11 @@ fn precedence_follows_fanuc() {
 fn a_long_line_is_read_up_to_the_limit() {
     let line = "X1.".repeat(400_000);
     let text = format!("O1\n{line}\nG0 X1.\n");
-    let parse = haas_lathe::parse(&text);
-    let root = SyntaxNode::new_root(parse.0.clone());
+    let parse = parse(&text);
+    let root = parse.syntax_node();
     assert_eq!(root.to_string(), text);
     assert!(root.descendants_with_tokens().count() < 3_000);
-    assert!(parse.1.iter().any(|e| e.kind == ncc_syntax::SyntaxErrorKind::LineTooLong));
+    assert!(parse.errors().iter().any(|e| e.kind == ncc_syntax::SyntaxErrorKind::LineTooLong));
 }
 
 #[test]
@@ -190,8 +189,8 @@ fn deep_nesting_is_bounded() {
         "X".to_owned() + &"-".repeat(5000) + "1",
         "#1=".to_owned() + &"-[".repeat(3000),
     ] {
-        let parse = haas_lathe::parse(&text);
-        assert_eq!(text_of(&parse), text);
+        let parse = parse(&text);
+        assert_eq!(parse.syntax_node().to_string(), text);
     }
 }
 
@@ -248,9 +247,9 @@ fn char_boundary(text: &str, at: usize) -> usize {
     (0..=at.min(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap()
 }
 
-fn assert_well_formed(text: &str, parse: &HaasParse) {
-    assert_eq!(text_of(parse), text);
-    for error in &parse.1 {
+fn assert_well_formed(text: &str, parse: &Parse) {
+    assert_eq!(parse.syntax_node().to_string(), text);
+    for error in parse.errors() {
         let r = std::ops::Range::<usize>::from(error.range);
         assert!(r.end <= text.len() && text.is_char_boundary(r.start) && text.is_char_boundary(r.end), "{error}");
     }
@@ -261,12 +260,12 @@ proptest! {
 
     #[test]
     fn any_string_round_trips(text in any::<String>()) {
-        assert_well_formed(&text, &haas_lathe::parse(&text));
+        assert_well_formed(&text, &parse(&text));
     }
 
     #[test]
     fn haas_like_text_round_trips(text in haas_text()) {
-        assert_well_formed(&text, &haas_lathe::parse(&text));
+        assert_well_formed(&text, &parse(&text));
     }
 
     #[test]
@@ -281,8 +280,8 @@ proptest! {
         let edit = TextEdit::replace(range(start, end), insert);
         let mut new_text = text.clone();
         edit.apply(&mut new_text);
-        let old = haas_lathe::parse(&text);
-        prop_assert_eq!(haas_lathe::reparse(&old, &edit, &new_text), haas_lathe::parse(&new_text));
+        let old = parse(&text);
+        prop_assert_eq!(old.reparse(&edit, &new_text), parse(&new_text));
     }
 }
 
@@ -291,15 +290,16 @@ proptest! {
 #[test]
 fn an_edit_inside_a_loop_reparses_one_block() {
     let text = "O1\n#1 = 0\nWHILE [#1 LT 10] DO1\nG01 X[#1 * 2.] F0.1\n#1 = #1 + 1\nEND1\nM30\n";
-    let old = haas_lathe::parse(text);
+    let old = parse(text);
     let at = text.find("X[#1 * 2.]").unwrap() + 8;
     let edit = TextEdit::replace(range(at, at + 1), "3");
     let mut new_text = text.to_owned();
     edit.apply(&mut new_text);
-    let new = haas_lathe::reparse(&old, &edit, &new_text);
-    assert_eq!(new, haas_lathe::parse(&new_text));
-    let blocks = |parse: &HaasParse| -> Vec<*const rowan::GreenNodeData> {
-        SyntaxNode::new_root(parse.0.clone())
+    let new = old.reparse(&edit, &new_text);
+    assert_eq!(new, parse(&new_text));
+    let blocks = |parse: &Parse| -> Vec<*const rowan::GreenNodeData> {
+        parse
+            .syntax_node()
             .descendants()
             .filter(|n| n.kind() == SyntaxKind::BLOCK)
             .map(|n| std::ptr::from_ref::<rowan::GreenNodeData>(n.green()))

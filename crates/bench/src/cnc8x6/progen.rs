@@ -18,6 +18,10 @@ pub enum Syntax {
     Cnc8x6,
     /// RS274/NGC as LinuxCNC and the `gcode` crate read it: `(comments)`, `M2`.
     Ngc,
+    /// Haas lathe: `O1 (TITLE)`, `(comments)`, `M30`, no block numbers; the
+    /// toolpath in the lathe's ZX plane, Y written as Z and the surface's
+    /// height left out, so that arcs in XY become arcs by I/K in ZX.
+    HaasLathe,
 }
 
 /// One step of the toolpath.
@@ -119,9 +123,12 @@ fn surface(x: f64, y: f64) -> f64 {
 pub fn write(moves: &[Move], syntax: Syntax) -> String {
     let mut out = String::with_capacity(moves.len() * 34);
     let mut n = 0u32;
-    if syntax == Syntax::Cnc8x6 {
-        out.push_str("%1 \"SURFACING\"\n");
+    match syntax {
+        Syntax::Cnc8x6 => out.push_str("%1 \"SURFACING\"\n"),
+        Syntax::HaasLathe => out.push_str("O1 (SURFACING)\n"),
+        Syntax::Ngc => {}
     }
+    let lathe = syntax == Syntax::HaasLathe;
     for m in moves {
         let block_start = out.len();
         if syntax == Syntax::Cnc8x6 && !matches!(m, Move::Comment(_)) {
@@ -134,35 +141,48 @@ pub fn write(moves: &[Move], syntax: Syntax) -> String {
                 // CAM output for this control joins its short segments
                 // with continuity G23.
                 let continuity = if syntax == Syntax::Cnc8x6 { " G23" } else { "" };
-                let _ = write!(out, "G54 G90 G17 {code}{continuity} X{x:.3} Y{y:.3} Z{z:.3} M03 S{spindle_rpm}");
+                if lathe {
+                    let _ = write!(out, "G54 G18 G97 G98 G0 X{x:.3} Z{y:.3} M03 S{spindle_rpm}");
+                } else {
+                    let _ = write!(out, "G54 G90 G17 {code}{continuity} X{x:.3} Y{y:.3} Z{z:.3} M03 S{spindle_rpm}");
+                }
             }
             Move::Rapid { x, y, z } => {
                 out.push_str("G0");
-                for (letter, value) in [('X', x), ('Y', y), ('Z', z)] {
+                let axes = if lathe { [('X', x), ('Z', y), ('Y', None)] } else { [('X', x), ('Y', y), ('Z', z)] };
+                for (letter, value) in axes {
                     if let Some(value) = value {
                         let _ = write!(out, " {letter}{value:.3}");
                     }
                 }
             }
             Move::Linear { x, y, z, feed } => {
-                let _ = write!(out, "G1 X{x:.3} Y{y:.3} Z{z:.3}");
+                if lathe {
+                    let _ = write!(out, "G1 X{x:.3} Z{y:.3}");
+                } else {
+                    let _ = write!(out, "G1 X{x:.3} Y{y:.3} Z{z:.3}");
+                }
                 if let Some(feed) = feed {
                     let _ = write!(out, " F{feed}");
                 }
             }
             Move::Arc { clockwise, x, y, i, j } => {
                 let code = if clockwise { "G2" } else { "G3" };
-                let _ = write!(out, "{code} X{x:.3} Y{y:.3} I{i:.3} J{j:.3}");
+                if lathe {
+                    let _ = write!(out, "{code} X{x:.3} Z{y:.3} I{i:.3} K{j:.3}");
+                } else {
+                    let _ = write!(out, "{code} X{x:.3} Y{y:.3} I{i:.3} J{j:.3}");
+                }
             }
             Move::Comment(ref text) => match syntax {
                 Syntax::Cnc8x6 => {
                     let _ = write!(out, "\"{text}\"");
                 }
-                Syntax::Ngc => {
+                Syntax::Ngc | Syntax::HaasLathe => {
                     let _ = write!(out, "({text})");
                 }
             },
-            Move::End => out.push_str(if syntax == Syntax::Cnc8x6 { "M30" } else { "M2" }),
+            Move::End => out.push_str(if syntax == Syntax::Ngc { "M2" } else { "M30" }),
         }
         debug_assert!(out.len() - block_start <= 80, "generated line too long");
         out.push('\n');

@@ -1,24 +1,19 @@
-//! Checks that hold for the data of every dialect, run over each data set,
-//! including those not yet wired into [`Dialect`]; and the facts of the Haas
-//! lathe's catalogue.
+//! Checks that hold for the data of every dialect, run over each data set;
+//! and the facts of the Haas lathe's catalogue.
 
 mod haas_lathe;
 
-use std::{
-    collections::{BTreeSet, HashSet},
-    sync::OnceLock,
-};
+use std::collections::{BTreeSet, HashSet};
 
 use crate::*;
 
 fn haas_lathe() -> &'static Catalogue {
-    static HAAS_LATHE: OnceLock<Catalogue> = OnceLock::new();
-    HAAS_LATHE.get_or_init(|| Catalogue::load(&HAAS_LATHE_FILES))
+    Dialect::HaasLathe.catalogue()
 }
 
 /// Every data set by name.
-fn data_sets() -> [(&'static str, &'static Catalogue); 2] {
-    [("cnc8x6", Dialect::Cnc8x6.catalogue()), ("haas-lathe", haas_lathe())]
+fn data_sets() -> impl Iterator<Item = (&'static str, &'static Catalogue)> {
+    Dialect::all().map(|dialect| (DialectId::from(dialect).name(), dialect.catalogue()))
 }
 
 fn assert_documented(what: &str, doc: Doc<'_>) {

@@ -288,14 +288,15 @@ fn call(function: Function, arguments: &[Known<MacroValue>], range: TextRange) -
 
 #[cfg(test)]
 mod tests {
-    use ncc_syntax::haas_lathe;
+    use ncc_syntax::{Dialect, Parse};
 
     use super::*;
     use crate::haas_lathe::lower::{HaasBlock, Statement};
 
     /// The value of `#1 = <text>` over `variables`.
     fn eval_with(variables: &Variables, text: &str) -> Result<Known<MacroValue>, EvalError> {
-        let (tree, _, _) = haas_lathe::parse(&format!("#1 = {text}\n"));
+        let parse = Parse::new(&format!("#1 = {text}\n"), Dialect::HaasLathe);
+        let tree = parse.green();
         let run = tree.children().next().and_then(|c| c.into_node()).expect("a block run");
         let block = run.children().next().and_then(|c| c.into_node()).expect("a block");
         match &HaasBlock::lower(block).statements[..] {
@@ -381,7 +382,8 @@ mod tests {
     #[test]
     fn assignments_write_the_variable_the_index_names() {
         let mut variables = Variables::at_power_on();
-        let (tree, _, _) = haas_lathe::parse("#2 = 4\n#[#2 + 100] = -#2 * 2.\n#0 = 1\n");
+        let parse = Parse::new("#2 = 4\n#[#2 + 100] = -#2 * 2.\n#0 = 1\n", Dialect::HaasLathe);
+        let tree = parse.green();
         let run = tree.children().next().and_then(|c| c.into_node()).expect("a block run");
         let mut results = Vec::new();
         for block in run.children().filter_map(|c| c.into_node()) {
@@ -399,7 +401,7 @@ mod tests {
 
     #[test]
     fn every_catalogue_operation_is_evaluated() {
-        for operation in &ncc_catalog::haas_lathe().operations {
+        for operation in &Dialect::HaasLathe.catalogue().operations {
             let symbol = operation.symbol.as_deref().expect("expression operators have a symbol");
             let known = BinaryOp::from_symbol(symbol).is_some() || Function::from_name(symbol).is_some();
             assert!(known, "operation `{symbol}` has no evaluation");

@@ -50,7 +50,7 @@
 //! - T is recorded as written (`T101`: tool 1, offset 1).
 
 use ncc_catalog::{Catalogue, split_code};
-use ncc_syntax::{TextRange, haas_lathe};
+use ncc_syntax::{Dialect, Parse, TextRange};
 
 use super::{
     eval::{EvalError, MacroValue, Variables},
@@ -61,7 +61,7 @@ use crate::{
     arc::{CircleArc, OffCircle, circle_through},
     known::Known,
     machine::MachineConfig,
-    trace::{Finding, Motion, Path, PathMode, Position, RunRule, Step, Stop, Trace, round3, slot},
+    trace::{Finding, Motion, Path, PathMode, Position, RunRule, Step, StepSink, Stop, Trace, round3, slot},
     transform::{Frame, over_axes},
 };
 
@@ -74,26 +74,33 @@ const EXACT_STOP: &str = "G13";
 const SPINDLE: &str = "M2";
 
 /// Runs the first program of `text` on `machine` for at most `budget`
-/// blocks.
-pub fn run(text: &str, machine: &MachineConfig, budget: usize) -> Trace {
-    let (tree, _, _) = haas_lathe::parse(text);
+/// blocks, handing the steps to `sink` when there is one. The run starts
+/// from the beginning every time: it takes no checkpoints.
+pub(crate) fn run_into(text: &str, machine: &MachineConfig, budget: usize, sink: Option<&mut dyn StepSink>) -> Trace {
+    let parse = Parse::new(text, Dialect::HaasLathe);
     let (ranges, blocks): (Vec<TextRange>, Vec<HaasBlock>) =
-        block_nodes(&tree).map(|(range, block)| (range, HaasBlock::lower(block))).unzip();
+        block_nodes(parse.green()).map(|(range, block)| (range, HaasBlock::lower(block))).unzip();
     let model = ProgramModel::new(&blocks);
     let mut interpreter = Interpreter::new(machine, &blocks, &ranges);
     interpreter.contour_ends = model.contours().map(|contour| (contour.cycle, *contour.blocks.end())).collect();
     if let Some(program) = model.programs.first() {
         interpreter.run(program, model.programs.len() > 1, budget);
     }
+    let frames = vec![Frame::default()];
+    let mut steps = interpreter.steps;
+    if let Some(sink) = sink {
+        sink.references(&frames, &[], &[]);
+        sink.steps(&mut steps);
+    }
     Trace {
         axes: machine.step_axes().to_vec(),
         diameter_axis: Some(b'X'),
-        frames: vec![Frame::default()],
+        frames,
         reset_frame: Frame::default(),
         tool_centre: Vec::new(),
         compensated: Vec::new(),
         messages: Vec::new(),
-        steps: interpreter.steps,
+        steps,
         findings: interpreter.findings,
         tools: interpreter.tools,
         files: Vec::new(),
@@ -188,7 +195,7 @@ impl<'a> Interpreter<'a> {
             machine,
             blocks,
             ranges,
-            modes: Modes::at_reset(ncc_catalog::haas_lathe()),
+            modes: Modes::at_reset(Dialect::HaasLathe.catalogue()),
             variables: Variables::at_power_on(),
             position: [0.0; 26],
             feed: None,

@@ -6,6 +6,8 @@
 //! text, so every shape it can build lowers: what is missing or malformed
 //! becomes [`ExprKind::Malformed`] or a `None` value, never a panic.
 
+use std::fmt;
+
 use ncc_syntax::{Decimal, NcLanguage, Sign, SyntaxKind, TextRange, TextSize};
 use rowan::{GreenNodeData, GreenTokenData, NodeOrToken};
 
@@ -176,26 +178,32 @@ pub enum BinaryOp {
     Le,
 }
 
+/// Each operator with its symbol, both ways.
+const OPERATORS: [(BinaryOp, &str); 14] = [
+    (BinaryOp::Add, "+"),
+    (BinaryOp::Sub, "-"),
+    (BinaryOp::Mul, "*"),
+    (BinaryOp::Div, "/"),
+    (BinaryOp::Mod, "MOD"),
+    (BinaryOp::And, "AND"),
+    (BinaryOp::Or, "OR"),
+    (BinaryOp::Xor, "XOR"),
+    (BinaryOp::Eq, "EQ"),
+    (BinaryOp::Ne, "NE"),
+    (BinaryOp::Gt, "GT"),
+    (BinaryOp::Ge, "GE"),
+    (BinaryOp::Lt, "LT"),
+    (BinaryOp::Le, "LE"),
+];
+
 impl BinaryOp {
     /// The operator written as `symbol` (`+`, `MOD`, `EQ`).
     pub fn from_symbol(symbol: &str) -> Option<BinaryOp> {
-        Some(match symbol {
-            "+" => BinaryOp::Add,
-            "-" => BinaryOp::Sub,
-            "*" => BinaryOp::Mul,
-            "/" => BinaryOp::Div,
-            "MOD" => BinaryOp::Mod,
-            "AND" => BinaryOp::And,
-            "OR" => BinaryOp::Or,
-            "XOR" => BinaryOp::Xor,
-            "EQ" => BinaryOp::Eq,
-            "NE" => BinaryOp::Ne,
-            "GT" => BinaryOp::Gt,
-            "GE" => BinaryOp::Ge,
-            "LT" => BinaryOp::Lt,
-            "LE" => BinaryOp::Le,
-            _ => return None,
-        })
+        OPERATORS.iter().find(|&&(_, s)| s == symbol).map(|&(op, _)| op)
+    }
+
+    pub fn symbol(self) -> &'static str {
+        OPERATORS.iter().find(|&&(op, _)| op == self).map_or("?", |&(_, s)| s)
     }
 }
 
@@ -214,23 +222,29 @@ pub enum Function {
     Fup,
 }
 
+/// Each function with its name, both ways.
+const FUNCTIONS: [(Function, &str); 11] = [
+    (Function::Sin, "SIN"),
+    (Function::Cos, "COS"),
+    (Function::Tan, "TAN"),
+    (Function::Atan, "ATAN"),
+    (Function::Asin, "ASIN"),
+    (Function::Acos, "ACOS"),
+    (Function::Sqrt, "SQRT"),
+    (Function::Abs, "ABS"),
+    (Function::Round, "ROUND"),
+    (Function::Fix, "FIX"),
+    (Function::Fup, "FUP"),
+];
+
 impl Function {
     /// The function named `name` (`SIN`).
     pub fn from_name(name: &str) -> Option<Function> {
-        Some(match name {
-            "SIN" => Function::Sin,
-            "COS" => Function::Cos,
-            "TAN" => Function::Tan,
-            "ATAN" => Function::Atan,
-            "ASIN" => Function::Asin,
-            "ACOS" => Function::Acos,
-            "SQRT" => Function::Sqrt,
-            "ABS" => Function::Abs,
-            "ROUND" => Function::Round,
-            "FIX" => Function::Fix,
-            "FUP" => Function::Fup,
-            _ => return None,
-        })
+        FUNCTIONS.iter().find(|&&(_, n)| n == name).map(|&(function, _)| function)
+    }
+
+    pub fn name(self) -> &'static str {
+        FUNCTIONS.iter().find(|&&(function, _)| function == self).map_or("?", |&(_, n)| n)
     }
 }
 
@@ -553,17 +567,121 @@ fn lower_var_index(node: &GreenNodeData, range: TextRange) -> Expr {
     malformed(range)
 }
 
+/// The block as the executor reads it, on one line (what `ncc lower`
+/// prints): the block number, `/` when the block may be skipped, the
+/// program number, the words in order with their values (`?` for a
+/// missing one), the corner words, then the macro statements. Comments
+/// and layout are not part of it; expressions are bracketed as grouped.
+impl fmt::Display for HaasBlock {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut items: Vec<String> = Vec::new();
+        let mut words = self.words.iter().peekable();
+        if self.number.is_some() {
+            items.extend(words.next().map(Word::to_string));
+        }
+        if let Some(skip) = self.skip {
+            items.push(skip.level.map_or_else(|| "/".to_owned(), |level| format!("/{level}")));
+        }
+        if let Some(program) = &self.program {
+            items.push(program.number.map_or_else(|| "O?".to_owned(), |number| format!("O{number}")));
+        }
+        items.extend(words.map(Word::to_string));
+        items.extend(self.corners.iter().map(|corner| format!(",{corner}")));
+        items.extend(self.statements.iter().map(Statement::to_string));
+        f.write_str(&items.join(" "))
+    }
+}
+
+impl fmt::Display for Word {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", char::from(self.letter))?;
+        match &self.value {
+            None => f.write_str("?"),
+            Some(Value::Literal(decimal)) => write!(f, "{decimal}"),
+            Some(Value::Variable { negative, index }) => write!(f, "{}#{}", sign(*negative), Index(index)),
+            Some(Value::Bracket { negative, expr }) => write!(f, "{}[{expr}]", sign(*negative)),
+        }
+    }
+}
+
+fn sign(negative: bool) -> &'static str {
+    if negative { "-" } else { "" }
+}
+
+impl fmt::Display for Statement {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let id = |id: &Option<u32>| id.map_or_else(|| "?".to_owned(), |id| id.to_string());
+        match self {
+            Statement::Assign { target, value, .. } => write!(f, "#{}={value}", Index(target)),
+            Statement::If { condition, then: Some(then), .. } => write!(f, "IF [{condition}] {then}"),
+            Statement::If { condition, then: None, .. } => write!(f, "IF [{condition}] ?"),
+            Statement::Goto { target, .. } => write!(f, "GOTO {target}"),
+            Statement::LoopStart { condition: Some(condition), id: loop_id, .. } => {
+                write!(f, "WHILE [{condition}] DO{}", id(loop_id))
+            }
+            Statement::LoopStart { condition: None, id: loop_id, .. } => write!(f, "DO{}", id(loop_id)),
+            Statement::LoopEnd { id: loop_id, .. } => write!(f, "END{}", id(loop_id)),
+        }
+    }
+}
+
+impl fmt::Display for Expr {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.kind {
+            ExprKind::Literal(decimal) => write!(f, "{decimal}"),
+            ExprKind::Variable(index) => write!(f, "#{}", Index(index)),
+            ExprKind::Unary(op, operand) => {
+                write!(f, "{}{}", if *op == UnaryOp::Minus { "-" } else { "+" }, Operand(operand))
+            }
+            ExprKind::Binary(op, left, right) => write!(f, "{} {} {}", Operand(left), op.symbol(), Operand(right)),
+            ExprKind::Call(function, arguments) => {
+                write!(f, "{}", function.name())?;
+                arguments
+                    .iter()
+                    .enumerate()
+                    .try_for_each(|(i, argument)| write!(f, "{}[{argument}]", if i > 0 { "/" } else { "" }))
+            }
+            ExprKind::Malformed => f.write_str("?"),
+        }
+    }
+}
+
+/// A variable's number: bracketed unless a literal (`#100`, `#[#1]`).
+struct Index<'a>(&'a Expr);
+
+impl fmt::Display for Index<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.0.kind {
+            ExprKind::Literal(_) => write!(f, "{}", self.0),
+            _ => write!(f, "[{}]", self.0),
+        }
+    }
+}
+
+/// An operand: bracketed when it is itself an operation.
+struct Operand<'a>(&'a Expr);
+
+impl fmt::Display for Operand<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.0.kind {
+            ExprKind::Binary(..) | ExprKind::Unary(..) => write!(f, "[{}]", self.0),
+            _ => write!(f, "{}", self.0),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use expect_test::expect;
-    use ncc_syntax::haas_lathe;
+    use ncc_syntax::{Dialect, Parse};
     use proptest::prelude::*;
 
     use super::*;
 
     fn lower_text(text: &str) -> Vec<HaasBlock> {
-        let (tree, _, _) = haas_lathe::parse(text);
-        block_nodes(&tree).map(|(_, block)| HaasBlock::lower(block)).collect()
+        let parse = Parse::new(text, Dialect::HaasLathe);
+        let tree = parse.green();
+        block_nodes(tree).map(|(_, block)| HaasBlock::lower(block)).collect()
     }
 
     /// A compact rendering of an expression, brackets around every operation.

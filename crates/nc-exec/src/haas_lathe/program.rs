@@ -474,15 +474,16 @@ fn ignored_words(
 
 #[cfg(test)]
 mod tests {
-    use ncc_syntax::haas_lathe;
+    use ncc_syntax::{Dialect, Parse};
     use proptest::prelude::*;
 
     use super::*;
     use crate::haas_lathe::lower::block_nodes;
 
     fn model(text: &str) -> ProgramModel {
-        let (tree, _, _) = haas_lathe::parse(text);
-        let blocks: Vec<HaasBlock> = block_nodes(&tree).map(|(_, block)| HaasBlock::lower(block)).collect();
+        let parse = Parse::new(text, Dialect::HaasLathe);
+        let tree = parse.green();
+        let blocks: Vec<HaasBlock> = block_nodes(tree).map(|(_, block)| HaasBlock::lower(block)).collect();
         ProgramModel::new(&blocks)
     }
 

@@ -27,7 +27,7 @@ const STATEMENT_KEYWORDS: [&str; 6] = ["IF", "THEN", "GOTO", "WHILE", "DO", "END
 pub(crate) fn keywords() -> &'static [String] {
     static KEYWORDS: OnceLock<Vec<String>> = OnceLock::new();
     KEYWORDS.get_or_init(|| {
-        let operations = &ncc_catalog::haas_lathe().operations;
+        let operations = &ncc_catalog::Dialect::HaasLathe.catalogue().operations;
         let named = operations
             .iter()
             .filter_map(|operation| operation.symbol.clone())

@@ -54,7 +54,7 @@ fn binary(kind: SyntaxKind, text: &str) -> Option<(u8, u8)> {
 fn function(name: &str) -> Option<Arguments> {
     static FUNCTIONS: OnceLock<Vec<String>> = OnceLock::new();
     let functions = FUNCTIONS.get_or_init(|| {
-        let operations = &ncc_catalog::haas_lathe().operations;
+        let operations = &ncc_catalog::Dialect::HaasLathe.catalogue().operations;
         operations
             .iter()
             .filter_map(|operation| operation.symbol.clone())

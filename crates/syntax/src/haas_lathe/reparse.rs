@@ -10,17 +10,17 @@
 
 use rowan::{NodeOrToken, TextRange, TextSize};
 
-use super::{HaasParse, parser};
+use super::parser;
 use crate::{
-    SyntaxError, SyntaxKind, SyntaxNode, TextEdit,
+    Parse, SyntaxError, SyntaxKind, SyntaxNode, TextEdit,
     encoding::BYTE_ORDER_MARK,
     error::sort_errors,
     limit::Omitted,
     runs::{deleted_text, regroup},
 };
 
-pub(crate) fn reparse_blocks(old: &HaasParse, edit: &TextEdit, new_text: &str) -> Option<HaasParse> {
-    let root = SyntaxNode::new_root(old.0.clone());
+pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Option<Parse> {
+    let root = old.syntax_node();
     let old_len = root.text_range().end();
     if edit.delete.end() > old_len || new_text.len() != usize::from(old_len - edit.delete.len()) + edit.insert.len() {
         return None;
@@ -76,7 +76,7 @@ pub(crate) fn reparse_blocks(old: &HaasParse, edit: &TextEdit, new_text: &str) -
         if range.start() >= old_region_end { TextRange::new(shift(range.start()), shift(range.end())) } else { range }
     };
     let mut errors: Vec<SyntaxError> = old
-        .1
+        .errors()
         .iter()
         .filter(|error| !in_region(error.range.start()))
         .map(|error| SyntaxError { range: moved(error.range), ..error.clone() })
@@ -84,7 +84,7 @@ pub(crate) fn reparse_blocks(old: &HaasParse, edit: &TextEdit, new_text: &str) -
     errors.extend(block_errors.kept);
     sort_errors(&mut errors);
     let mut omitted: Vec<Omitted<_>> = old
-        .2
+        .omitted()
         .iter()
         .filter(|o| !in_region(o.at))
         .map(|o| {
@@ -94,7 +94,7 @@ pub(crate) fn reparse_blocks(old: &HaasParse, edit: &TextEdit, new_text: &str) -
         .collect();
     omitted.extend(block_errors.omitted);
     omitted.sort_by_key(|o| (o.at, o.kind));
-    Some((green, errors, omitted))
+    Some(Parse { green, errors: errors.into(), omitted: omitted.into(), dialect: old.dialect })
 }
 
 /// The block (in its run) that contains the character at `offset`.

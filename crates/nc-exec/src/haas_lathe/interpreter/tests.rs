@@ -1,18 +1,20 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use super::run;
+use ncc_catalog::Dialect;
+
 use crate::{
     machine::MachineConfig,
+    run::{NoFiles, run},
     trace::{Motion, Path, PathMode, RunRule, Stop, Trace},
 };
 
 /// A lathe; the programs' `O` lines make no step.
 fn lathe() -> MachineConfig {
-    MachineConfig { axes: b"XZ".to_vec(), diameter_axis: Some(b'X'), ..MachineConfig::default() }
+    MachineConfig::of_control(Dialect::HaasLathe)
 }
 
 fn run_lathe(text: &str) -> Trace {
-    run(text, &lathe(), 10_000)
+    run(text, &NoFiles, &lathe(), 10_000)
 }
 
 fn close(actual: f64, expected: f64) {
@@ -47,7 +49,7 @@ fn u_and_w_count_from_the_last_position_mixed_with_x_and_z() {
 fn rapid_moves_take_the_slowest_axis_at_its_rate() {
     let machine = MachineConfig { rapid_rates: [(b'Z', 5_000)].into(), ..lathe() };
     // X travels 30 mm of radius at 10 m/min, Z 20 mm at 5 m/min.
-    let trace = run("O1\nG00 X60. Z-20.\nM30\n", &machine, 100);
+    let trace = run("O1\nG00 X60. Z-20.\nM30\n", &NoFiles, &machine, 100);
     assert_eq!(trace.steps[0].motion, Motion::Rapid);
     close(trace.steps[0].duration, 20.0 / 5_000.0 * 60.0);
 }
@@ -145,7 +147,7 @@ fn if_goto_and_goto_jump_to_numbered_blocks() {
 
 #[test]
 fn an_endless_loop_stops_at_the_budget() {
-    let trace = run("O1\nN1 G00 U1.\nGOTO 1\n", &lathe(), 50);
+    let trace = run("O1\nN1 G00 U1.\nGOTO 1\n", &NoFiles, &lathe(), 50);
     assert_eq!(rules(&trace), [RunRule::StepBudget]);
     assert_eq!(trace.blocks_run, 50);
 }
