@@ -223,24 +223,24 @@ impl Analysis {
     /// What the thing at `offset` is: a code's or an address's
     /// documentation, a parameter's with its known values there.
     pub fn hover(&self, file: FileId, offset: TextSize) -> Option<HoverResult> {
-        ide::hover(&self.db, file, offset)
+        dialect::hover(&self.db, file, offset)
     }
 
     /// Where the thing at `offset` is defined: a call's subprogram or
     /// macrocycle file, a jump's block, the assignments a parameter's value
     /// comes from.
     pub fn goto_definition(&self, file: FileId, offset: TextSize) -> Vec<NavigationTarget> {
-        ide::goto_definition(&self.db, file, offset)
+        dialect::goto_definition(&self.db, file, offset)
     }
 
-    /// The modal state and parameters before the block at `offset`, each
-    /// time the program reaches it.
+    /// The modal state and parameters before the block at `offset` of a
+    /// CNC8x6 program, each time the program reaches it.
     pub fn states_at(
         &self,
         file: FileId,
         offset: TextSize,
     ) -> Vec<(cnc8x6::flow::ModalState, cnc8x6::flow::ParamState)> {
-        ide::states_at(&self.db, file, offset)
+        dialect::states_at(&self.db, file, offset)
     }
 
     /// Prepares answers about the modal state (hover) anywhere in the main
@@ -253,12 +253,12 @@ impl Analysis {
 
     /// The outline: program units, and the blocks jumps go to in each.
     pub fn document_symbols(&self, file: FileId) -> Vec<DocumentSymbol> {
-        ide::symbols::document_symbols(&self.db, file)
+        dialect::document_symbols(&self.db, file)
     }
 
     /// Program units and runs of comment lines, sorted by start.
     pub fn folding_ranges(&self, file: FileId) -> Vec<Fold> {
-        ide::folding::folding_ranges(&self.db, file)
+        dialect::folding_ranges(&self.db, file)
     }
 
     /// Every token classified, for semantic highlighting.
@@ -274,13 +274,13 @@ impl Analysis {
     /// The definition (with `include_declaration`) and the uses of the
     /// subprogram, macrocycle, jump target or parameter at `offset`.
     pub fn references(&self, file: FileId, offset: TextSize, include_declaration: bool) -> Vec<Reference> {
-        ide::references::references(&self.db, file, offset, include_declaration)
+        dialect::references(&self.db, file, offset, include_declaration)
     }
 
     /// The edits that format the file: spacing only (the style is in
     /// `ide/format.rs`), sorted and not overlapping.
     pub fn format(&self, file: FileId) -> Vec<TextEdit> {
-        ide::format::format(file.text(&self.db), file.parse(&self.db))
+        dialect::format(&self.db, file)
     }
 
     /// What may be written at `offset`, most relevant first.
@@ -291,7 +291,7 @@ impl Analysis {
     /// The inlay hints of the blocks `range` touches (of every block
     /// without one).
     pub fn inlay_hints(&self, file: FileId, range: Option<TextRange>) -> Vec<InlayHint> {
-        ide::inlay::inlay_hints(&self.db, file, range)
+        dialect::inlay_hints(&self.db, file, range)
     }
 
     /// What a run of the program `file` needs (its text, the machine, the

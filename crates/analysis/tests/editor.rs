@@ -6,8 +6,8 @@ mod strategies;
 
 use expect_test::{Expect, expect};
 use ncc_analysis::{
-    Analysis, AnalysisHost, Config, Dialect, DocumentSymbol, FileId, HighlightKind, RootDatabase, TextEdit, TextRange,
-    TextSize,
+    Analysis, AnalysisHost, Config, Dialect, DialectId, DocumentSymbol, FileId, HighlightKind, RootDatabase, TextEdit,
+    TextRange, TextSize,
 };
 use proptest::prelude::*;
 use strategies::{block_program, crowded_lines, overlong_lines, program_text};
@@ -56,8 +56,14 @@ N3 G70
 
 /// The host with `files` added, the ids, and the cursor (file, offset) if
 /// one of them has `$0`.
+/// A host in the dialect the first file's name gives, with the files.
 fn setup(files: &[(&str, &str)]) -> (AnalysisHost, Vec<FileId>, Option<(FileId, TextSize)>) {
-    let mut host = AnalysisHost::default();
+    let dialect = files
+        .first()
+        .and_then(|(path, _)| DialectId::by_default_for(std::path::Path::new(path)))
+        .and_then(DialectId::implementation)
+        .unwrap_or_default();
+    let mut host = AnalysisHost::in_dialect(dialect, Config::default());
     let mut cursor = None;
     let mut ids = Vec::new();
     for (path, text) in files {
@@ -121,6 +127,7 @@ fn check_folds(path: &str, text: &str, expect: Expect) {
 /// Each line with its highlighted pieces, `text:kind`.
 fn check_highlight(path: &str, text: &str, expect: Expect) {
     let (host, ids, _) = setup(&[(path, text)]);
+    let dialect = host.analysis().dialect();
     let ranges = host.analysis().highlight(ids[0]);
     let mut out = String::new();
     let mut line_start = 0;
@@ -129,7 +136,7 @@ fn check_highlight(path: &str, text: &str, expect: Expect) {
         let pieces: Vec<String> = ranges
             .iter()
             .filter(|h| (line_start..line_end).contains(&usize::from(h.range.start())))
-            .map(|h| format!("{}:{}", &text[h.range], short(h.kind)))
+            .map(|h| format!("{}:{}", &text[h.range], short(h.kind, dialect)))
             .collect();
         out.push_str(&format!("{}\n", pieces.join(" ")));
         line_start = line_end;
@@ -137,10 +144,10 @@ fn check_highlight(path: &str, text: &str, expect: Expect) {
     expect.assert_eq(&out);
 }
 
-fn short(kind: HighlightKind) -> String {
+fn short(kind: HighlightKind, dialect: Dialect) -> String {
     match kind {
         HighlightKind::Code { letter, group } => {
-            let groups = &Dialect::Cnc8x6.catalogue().groups;
+            let groups = &dialect.catalogue().groups;
             format!("{}{}", char::from(letter), group.map_or("?", |g| groups[usize::from(g)].id.as_str()))
         }
         HighlightKind::Address(role) => format!("{role:?}"),
@@ -540,6 +547,158 @@ proptest! {
         }
         for reference in analysis.references(file, TextSize::try_from(at).unwrap(), true) {
             prop_assert!(text.is_char_boundary(usize::from(reference.range.start())));
+        }
+    }
+}
+
+/// A Haas lathe program with a contour, a local subprogram, a loop, a call
+/// of another program and a jump.
+const LATHE: &str = "%
+O1000 (SHAFT)
+(ROUGHING)
+(OD TOOL)
+T0101 (ROUGH OD)
+G50 S3000
+G96 S200 M03
+G00 X60. Z2.
+G71 P10 Q20 U0.4 W0.1 D2. F0.25
+N10 G00 X20.
+G01 Z-20. ,C1.
+N20 X60.
+G70 P10 Q20
+T0202 (GROOVE)
+#1 = 0
+WHILE [#1 LT 3] DO1
+G01 U-[#1 * 2.] F0.1
+#1 = #1 + 1
+END1
+M97 P100
+M98 P2000
+GOTO 30
+N30 M30
+N100 G04 P500
+M99
+%
+";
+
+#[test]
+fn symbols_of_a_lathe_program() {
+    check_symbols(
+        "O1000.nc",
+        LATHE,
+        expect![[r#"
+            Program O1000 (SHAFT): `O1000 (SHAFT)` … `M99` select `O1000`
+              Tool T0101 (ROUGH OD): `T0101 (ROUGH OD)` select `T0101`
+              JumpTarget N10: `N10 G00 X20.` select `N10`
+              JumpTarget N20: `N20 X60.` select `N20`
+              Tool T0202 (GROOVE): `T0202 (GROOVE)` select `T0202`
+              JumpTarget N30: `N30 M30` select `N30`
+              JumpTarget N100: `N100 G04 P500` select `N100`
+        "#]],
+    );
+}
+
+#[test]
+fn folds_lathe_programs_contours_loops_and_comments() {
+    check_folds(
+        "O1000.nc",
+        LATHE,
+        expect![[r#"
+            Region `O1000 (SHAFT)` … `M99`
+            Comment `(ROUGHING)` … `(OD TOOL)`
+            Region `N10 G00 X20.` … `N20 X60.`
+            Region `WHILE [#1 LT 3] DO1` … `END1`"#]],
+    );
+}
+
+#[test]
+fn highlight_a_lathe_program() {
+    let text =
+        "%\nO1000 (SHAFT)\n#1 = #[#2 + 1] * SIN[30.]\nIF [#1 GT 2.] GOTO 20\nN20 G01 X-#1 Z[#1 / 2.] ,C1. F0.1\n%\n";
+    check_highlight(
+        "O1000.nc",
+        text,
+        expect![[r#"
+            %:Keyword
+            O:Keyword 1000:Number (SHAFT):Comment
+            #1:write =:Operator #:read [:Operator #2:read +:Operator 1:Number ]:Operator *:Operator SIN:Keyword [:Operator 30.:Number ]:Operator
+            IF:Keyword [:Operator #1:read GT:Operator 2.:Number ]:Operator GOTO:Keyword 20:Number
+            N20:BlockNumber G01:GG1 X:Axis -:Operator #1:read Z:Axis [:Operator #1:read /:Operator 2.:Number ]:Operator ,:Operator C:Axis 1.:Number F:Feed 0.1:Number
+            %:Keyword
+        "#]],
+    );
+}
+
+#[test]
+fn lathe_references_and_definitions_follow_p_q_m97_m98_and_goto() {
+    let files =
+        |cursor: &str| vec![("O1000.nc", at(LATHE, cursor)), ("O2000.nc", "O2000 (SUB)\nG00 U2.\nM99\n".to_owned())];
+    let refs = |cursor: &str| {
+        let files = files(cursor);
+        let borrowed: Vec<(&str, &str)> = files.iter().map(|(p, t)| (*p, t.as_str())).collect();
+        references(&borrowed, true)
+    };
+    expect![[r#"
+        O1000.nc:10:1: N10 Definition
+        O1000.nc:9:5: P10 Jump
+        O1000.nc:13:5: P10 Jump"#]]
+    .assert_eq(&refs("N10"));
+    assert_eq!(refs("P10 Q20 U"), refs("N10"));
+    expect!["O1000.nc:24:1: N100 Definition\nO1000.nc:20:5: P100 Call"].assert_eq(&refs("N100"));
+    let definition = |cursor: &str| {
+        let files = files(cursor);
+        let borrowed: Vec<(&str, &str)> = files.iter().map(|(p, t)| (*p, t.as_str())).collect();
+        let (host, _, cursor) = setup(&borrowed);
+        let (file, offset) = cursor.unwrap();
+        let analysis = host.analysis();
+        let targets = analysis.goto_definition(file, offset);
+        targets
+            .iter()
+            .map(|t| format!("{} {}", analysis.path(t.file), show(&analysis.text(t.file), t.focus)))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(definition("Q20 U"), ["O1000.nc `N20`"]);
+    assert_eq!(definition("P100"), ["O1000.nc `N100`"]);
+    assert_eq!(definition("P2000"), ["O2000.nc `O2000`"]);
+    assert_eq!(definition("GOTO 30"), ["O1000.nc `N30`"]);
+}
+
+#[test]
+fn lathe_hover_names_the_contour_block_and_the_variable() {
+    let (host, ids, cursor) = setup(&[("O1000.nc", &at(LATHE, "P10 Q20 U"))]);
+    let analysis = host.analysis();
+    let hover = analysis.hover(ids[0], cursor.unwrap().1).unwrap().markdown;
+    assert!(hover.starts_with("The contour's first block: line 10, `N10 G00 X20.`."), "{hover}");
+    let (host, ids, cursor) = setup(&[("O1000.nc", &at(LATHE, "#1 LT"))]);
+    let hover = host.analysis().hover(ids[0], cursor.unwrap().1 + TextSize::from(1)).unwrap().markdown;
+    assert!(hover.contains("macro variable") || hover.contains("Macro variable"), "{hover}");
+    let (host, ids, cursor) = setup(&[("O1000.nc", &at(LATHE, "G71"))]);
+    let hover = host.analysis().hover(ids[0], cursor.unwrap().1).unwrap().markdown;
+    assert!(hover.starts_with("### G71"), "{hover}");
+}
+
+/// Every editor question at every offset of the manual's examples answers
+/// without a panic.
+#[test]
+fn every_lathe_example_answers_everywhere() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../syntax/test_data/haas-lathe");
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|ext| ext != "nc") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        let (host, ids, _) = setup(&[("O1.nc", &text)]);
+        let analysis = host.analysis();
+        let file = ids[0];
+        let _ = (analysis.document_symbols(file), analysis.folding_ranges(file), analysis.highlight(file));
+        let _ = (analysis.diagnostics(file), analysis.inlay_hints(file, None), analysis.format(file));
+        for offset in (0..=text.len()).filter(|&i| text.is_char_boundary(i)) {
+            let offset = TextSize::try_from(offset).unwrap();
+            let _ = analysis.hover(file, offset);
+            let _ = analysis.goto_definition(file, offset);
+            let _ = analysis.references(file, offset, true);
+            let _ = analysis.completions(file, offset);
         }
     }
 }

@@ -59,7 +59,8 @@ impl DialectId {
     }
 
     /// The dialect a file's name gives by default: its extension (any case),
-    /// or a CNC8x6 macrocycle file name `L<number>`.
+    /// a CNC8x6 macrocycle file name `L<number>`, or a Haas program file
+    /// `O<number>` without an extension, as the control stores programs.
     pub fn by_default_for(path: &Path) -> Option<DialectId> {
         let by_extension = path.extension().and_then(|extension| {
             let extension = extension.to_str()?;
@@ -67,7 +68,10 @@ impl DialectId {
                 .into_iter()
                 .find(|dialect| dialect.default_extensions().iter().any(|known| known.eq_ignore_ascii_case(extension)))
         });
-        by_extension.or_else(|| macrocycle_number(path).map(|_| DialectId::Cnc8x6))
+        let bare = || path.extension().is_none().then_some(path);
+        by_extension
+            .or_else(|| macrocycle_number(path).map(|_| DialectId::Cnc8x6))
+            .or_else(|| bare().and_then(program_file_number).map(|_| DialectId::HaasLathe))
     }
 
     /// The message for a program of a dialect this build does not read.
@@ -135,6 +139,15 @@ pub fn macrocycle_number(path: &Path) -> Option<u32> {
     digits.parse().ok()
 }
 
+/// The program number a Haas program file's name gives: `O01234` or
+/// `O1234.nc` → 1234 (`O` and one to five digits).
+pub fn program_file_number(path: &Path) -> Option<u32> {
+    let stem = path.file_stem()?.to_str()?;
+    let digits =
+        stem.strip_prefix('O').filter(|d| (1..=5).contains(&d.len()) && d.bytes().all(|b| b.is_ascii_digit()))?;
+    digits.parse().ok()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -160,6 +173,10 @@ mod tests {
             ("O1234.nc", Some(DialectId::HaasLathe)),
             ("O1234.NC", Some(DialectId::HaasLathe)),
             ("part.tap", Some(DialectId::HaasLathe)),
+            ("O01234", Some(DialectId::HaasLathe)),
+            ("dir/O1", Some(DialectId::HaasLathe)),
+            ("O123456", None),
+            ("Oil", None),
             ("MAIN.MPF", Some(DialectId::Sinumerik)),
             ("cycle.spf", Some(DialectId::Sinumerik)),
             ("README.md", None),

@@ -15,7 +15,7 @@ pub mod schema;
 use std::{collections::HashMap, ops::RangeInclusive, sync::OnceLock};
 
 pub use crate::{
-    dialect_id::{DialectId, UnknownDialect, macrocycle_number},
+    dialect_id::{DialectId, UnknownDialect, macrocycle_number, program_file_number},
     explain::{Item, NotFound},
     schema::*,
 };

@@ -29,11 +29,15 @@ pub enum FoldKind {
 /// The folds of a file, sorted by start (an enclosing fold first).
 pub(crate) fn folding_ranges(db: &dyn Db, file: SourceFile) -> Vec<Fold> {
     let outline = Outline::new(db, file);
-    let mut folds: Vec<Fold> = (0..outline.program.units.len())
-        .filter_map(|unit| outline.unit_range(unit))
-        .filter(|range| outline.text[*range].contains(['\n', '\r']))
-        .map(|range| Fold { range, kind: FoldKind::Region })
-        .collect();
+    let units = (0..outline.program.units.len()).filter_map(|unit| outline.unit_range(unit));
+    with_comment_runs(db, file, units.map(|range| Fold { range, kind: FoldKind::Region }).collect())
+}
+
+/// `regions` that span lines and the runs of comment lines of `file`,
+/// sorted by start (an enclosing fold first).
+pub(crate) fn with_comment_runs(db: &dyn Db, file: SourceFile, regions: Vec<Fold>) -> Vec<Fold> {
+    let text = file.text(db);
+    let mut folds: Vec<Fold> = regions.into_iter().filter(|fold| text[fold.range].contains(['\n', '\r'])).collect();
     let mut lines = CommentLines::default();
     lines.node(file.parse(db).green(), TextSize::from(0));
     lines.end_line();

@@ -221,6 +221,12 @@ impl Walk {
                 SyntaxKind::WORD => self.word(node, range.start()),
                 SyntaxKind::PARAM_ASSIGN => self.assignment(node, range.start()),
                 SyntaxKind::PARAM_REF => self.parameter(node, range.start()),
+                SyntaxKind::PROGRAM_NUMBER => self.program_number(node, range.start()),
+                SyntaxKind::VAR_REF => self.variable(node, range.start(), false),
+                SyntaxKind::ASSIGN => self.variable_assignment(node, range.start()),
+                SyntaxKind::BIN_EXPR | SyntaxKind::PREFIX_EXPR | SyntaxKind::CALL_EXPR => {
+                    self.operation(node, range.start())
+                }
                 SyntaxKind::ERROR => self.nodes(node, range.start(), Some(HighlightKind::Error), true),
                 // The items of a block are separate; a header's, a block
                 // skip's or the end's tokens form one item.
@@ -253,7 +259,11 @@ impl Walk {
     /// A word: its letter decides; the value of an ordinary address is a
     /// number, that of a code or block number is part of the word.
     fn word(&mut self, node: &GreenNodeData, start: TextSize) {
-        let mut items = children(node, start);
+        let mut items = children(node, start).peekable();
+        // The comma of a corner word, `,C1.`.
+        if let Some((range, _)) = items.next_if(|(_, item)| kind(item.kind()) == SyntaxKind::COMMA) {
+            self.out.push(HighlightRange { range, kind: HighlightKind::Operator });
+        }
         let Some((letter_range, NodeOrToken::Token(letter))) = items.next() else {
             return self.nodes(node, start, Some(HighlightKind::Error), true);
         };
@@ -305,6 +315,13 @@ impl Walk {
                     sign = Some(self.out.len());
                     self.out.push(HighlightRange { range, kind: kind_of_digits });
                 }
+                // A variable `#1` or an expression `[#1 + 2.]` as the value.
+                (_, NodeOrToken::Node(_)) => {
+                    if let Some(sign) = sign {
+                        self.out[sign].kind = HighlightKind::Operator;
+                    }
+                    self.element(item, range, None, false);
+                }
                 _ => self.push(range, kind_of_digits, true),
             }
         }
@@ -316,6 +333,57 @@ impl Walk {
         for (range, item) in children(node, start) {
             if kind(item.kind()) != SyntaxKind::WHITESPACE {
                 self.push(range, HighlightKind::Parameter { write: false }, self.out.len() > first);
+            }
+        }
+    }
+
+    /// `O1234`: the letter as a keyword, the program number as a number.
+    fn program_number(&mut self, node: &GreenNodeData, start: TextSize) {
+        for (range, item) in children(node, start) {
+            match kind(item.kind()) {
+                SyntaxKind::LETTER => self.push(range, HighlightKind::Keyword, false),
+                _ => self.element(item, range, None, false),
+            }
+        }
+    }
+
+    /// `#12` (its `#` and number as one parameter), or `#[…]`, whose
+    /// expression is highlighted as such.
+    fn variable(&mut self, node: &GreenNodeData, start: TextSize, write: bool) {
+        let first = self.out.len();
+        for (range, item) in children(node, start) {
+            match (kind(item.kind()), item) {
+                (SyntaxKind::WHITESPACE, _) => {}
+                (_, NodeOrToken::Node(_)) => self.element(item, range, None, false),
+                _ => self.push(range, HighlightKind::Parameter { write }, self.out.len() > first),
+            }
+        }
+    }
+
+    /// `#1 = …`: the assigned variable, `=`, then the expression.
+    fn variable_assignment(&mut self, node: &GreenNodeData, start: TextSize) {
+        let mut assigned = false;
+        for (range, item) in children(node, start) {
+            match (kind(item.kind()), item) {
+                (SyntaxKind::VAR_REF, NodeOrToken::Node(target)) if !assigned => {
+                    assigned = true;
+                    self.variable(target, range.start(), true);
+                }
+                _ => self.element(item, range, None, false),
+            }
+        }
+    }
+
+    /// An operation or a function call: its operator symbols and brackets
+    /// are operators, a function's name a keyword.
+    fn operation(&mut self, node: &GreenNodeData, start: TextSize) {
+        let call = kind(node.kind()) == SyntaxKind::CALL_EXPR;
+        for (range, item) in children(node, start) {
+            match (kind(item.kind()), item) {
+                (SyntaxKind::WHITESPACE, _) => {}
+                (_, NodeOrToken::Node(_)) => self.element(item, range, None, false),
+                (SyntaxKind::IDENT, _) if call => self.push(range, HighlightKind::Keyword, false),
+                _ => self.push(range, HighlightKind::Operator, false),
             }
         }
     }
@@ -379,7 +447,9 @@ fn token_kind_of(token: SyntaxKind) -> Option<HighlightKind> {
         SyntaxKind::COMMENT | SyntaxKind::PREAMBLE | SyntaxKind::TRAILER | SyntaxKind::UNREAD => HighlightKind::Comment,
         SyntaxKind::NUMBER | SyntaxKind::PLUS | SyntaxKind::MINUS => HighlightKind::Number,
         SyntaxKind::PERCENT | SyntaxKind::STAR | SyntaxKind::SLASH => HighlightKind::Keyword,
-        SyntaxKind::EQ => HighlightKind::Operator,
+        SyntaxKind::EQ | SyntaxKind::L_BRACK | SyntaxKind::R_BRACK | SyntaxKind::COMMA => HighlightKind::Operator,
+        // `GOTO`, `WHILE`, `DO1`, `END1`.
+        SyntaxKind::IDENT => HighlightKind::Keyword,
         // Letters outside words occur only in error nodes.
         _ => HighlightKind::Error,
     })

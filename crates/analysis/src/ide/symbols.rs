@@ -43,8 +43,12 @@ pub enum SymbolKind {
     Macrocycle,
     /// A body of a fixed-cycle file (`$PC`).
     CycleBody,
-    /// A block that a `G73 L<n>` of the same unit jumps to.
+    /// A block that a jump, call or contour names (CNC8x6: `G73 L<n>` of
+    /// the same unit; Haas: P, Q, M97 P, GOTO).
     JumpTarget,
+    /// A tool change (Haas: a `T` word), where a lathe program's operations
+    /// begin.
+    Tool,
 }
 
 pub(crate) fn document_symbols(db: &dyn Db, file: SourceFile) -> Vec<DocumentSymbol> {

@@ -207,6 +207,7 @@ pub(crate) fn document_symbols(s: &Snapshot) -> Vec<lsp::DocumentSymbol> {
                 SymbolKind::Program => lsp::SymbolKind::MODULE,
                 SymbolKind::Subprogram | SymbolKind::Macrocycle | SymbolKind::CycleBody => lsp::SymbolKind::FUNCTION,
                 SymbolKind::JumpTarget => lsp::SymbolKind::KEY,
+                SymbolKind::Tool => lsp::SymbolKind::EVENT,
             },
             tags: None,
             deprecated: None,

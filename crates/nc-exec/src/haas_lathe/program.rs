@@ -316,6 +316,11 @@ impl ProgramModel {
         let q = self.target_number(block.word(b'Q'), end, b'Q');
         let p = p.and_then(|number| self.resolve_block(program, start, number));
         let q = q.and_then(|number| self.resolve_block(program, end, number));
+        for (reference, block) in [(start, p), (end, q)] {
+            if let Some(block) = block {
+                self.findings.push(Finding::Resolved { reference, target: Target::Block(block) });
+            }
+        }
         let (Some(p), Some(q)) = (p, q) else { return };
         if q < p {
             self.findings.push(Finding::QBeforeP { cycle, p, q });
@@ -504,7 +509,8 @@ mod tests {
         assert_eq!(g71.monotony, Some(AxisMonotony { axis: b'X', monotony: Monotony::Monotonic }));
         assert!(g71.ignored.is_empty());
         assert_eq!((g70.code, g70.blocks.clone(), g70.roughing_type, g70.monotony), (70, 7..=16, None, None));
-        assert_eq!(model.findings.len(), 2, "{:?}", model.findings);
+        // Besides the contours, the four resolved P and Q words.
+        assert_eq!(model.findings.len(), 6, "{:?}", model.findings);
     }
 
     #[test]
@@ -532,7 +538,9 @@ mod tests {
             model.findings,
             vec![
                 Finding::MissingAddress { block: 0, letter: b'P' },
-                Finding::MissingAddress { block: 2, letter: b'Q' }
+                Finding::Resolved { reference: reference(0, ReferenceKind::ContourEnd), target: Target::Block(1) },
+                Finding::MissingAddress { block: 2, letter: b'Q' },
+                Finding::Resolved { reference: reference(2, ReferenceKind::ContourStart), target: Target::Block(1) },
             ]
         );
     }
@@ -541,18 +549,28 @@ mod tests {
     fn p_and_q_must_name_one_block_of_the_same_program_in_order() {
         let not_found = model("G70 P5 Q6\nN5 X1.\n");
         let end = reference(0, ReferenceKind::ContourEnd);
-        assert_eq!(not_found.findings, vec![Finding::TargetNotFound { reference: end, number: 6 }]);
+        let start = reference(0, ReferenceKind::ContourStart);
+        assert_eq!(
+            not_found.findings,
+            vec![
+                Finding::TargetNotFound { reference: end, number: 6 },
+                Finding::Resolved { reference: start, target: Target::Block(1) }
+            ]
+        );
 
         let reversed = model("N20 X1.\nN10 X2.\nG70 P10 Q20\n");
-        assert_eq!(reversed.findings, vec![Finding::QBeforeP { cycle: 2, p: 1, q: 0 }]);
+        assert_eq!(reversed.findings.last(), Some(&Finding::QBeforeP { cycle: 2, p: 1, q: 0 }));
 
         let duplicated = model("N10 X1.\nN10 X2.\nN20 X3.\nG70 P10 Q20\n");
         let start = reference(3, ReferenceKind::ContourStart);
         let ambiguous = Finding::AmbiguousTarget { reference: start, number: 10, blocks: vec![0, 1] };
-        assert_eq!(duplicated.findings, vec![ambiguous]);
+        assert_eq!(duplicated.findings.first(), Some(&ambiguous));
 
         let computed = model("G70 P#1 Q20\nN20 X1.\n");
-        assert_eq!(computed.findings, vec![Finding::ComputedTarget(reference(0, ReferenceKind::ContourStart))]);
+        assert_eq!(
+            computed.findings.first(),
+            Some(&Finding::ComputedTarget(reference(0, ReferenceKind::ContourStart)))
+        );
 
         // N10 of the first program is not visible from the second.
         let other_program = model("O1\nN10 X1.\nM30\nO2\nG70 P10 Q10\n");

@@ -44,31 +44,6 @@ fn referrer(file: &FileModel, reference: Reference, number: u64) -> String {
     }
 }
 
-/// Where a reference's number stands: the P or Q word, or the GOTO.
-fn reference_range(file: &FileModel, reference: Reference) -> ncc_syntax::TextRange {
-    let letter = match reference.kind {
-        ReferenceKind::ContourEnd => b'Q',
-        ReferenceKind::Goto => {
-            let block = &file.blocks[reference.block];
-            let goto = block.statements.iter().map(statement_range).next();
-            return file.in_file(reference.block, goto.unwrap_or_default());
-        }
-        _ => b'P',
-    };
-    file.word_range(reference.block, letter).unwrap_or_else(|| file.in_file(reference.block, Default::default()))
-}
-
-fn statement_range(statement: &nc_exec::haas_lathe::lower::Statement) -> ncc_syntax::TextRange {
-    use nc_exec::haas_lathe::lower::Statement;
-    match statement {
-        Statement::Assign { range, .. }
-        | Statement::If { range, .. }
-        | Statement::Goto { range, .. }
-        | Statement::LoopStart { range, .. }
-        | Statement::LoopEnd { range, .. } => *range,
-    }
-}
-
 fn model_finding(file: &FileModel, finding: &Finding, out: &mut Vec<Diagnostic>) {
     match finding {
         Finding::MissingAddress { block, letter } => {
@@ -104,7 +79,7 @@ fn model_finding(file: &FileModel, finding: &Finding, out: &mut Vec<Diagnostic>)
                 _ => &CONTOUR_TARGET_MISSING,
             };
             let message = format!("{}: no block N{number} in this program", referrer(file, *reference, *number));
-            out.push(Diagnostic::new(rule, reference_range(file, *reference), message));
+            out.push(Diagnostic::new(rule, file.reference_range(*reference), message));
         }
         Finding::AmbiguousTarget { reference, number, blocks } => {
             let message = format!(
@@ -112,7 +87,7 @@ fn model_finding(file: &FileModel, finding: &Finding, out: &mut Vec<Diagnostic>)
                 referrer(file, *reference, *number),
                 blocks.len()
             );
-            let mut diagnostic = Diagnostic::new(&AMBIGUOUS_BLOCK_NUMBER, reference_range(file, *reference), message);
+            let mut diagnostic = Diagnostic::new(&AMBIGUOUS_BLOCK_NUMBER, file.reference_range(*reference), message);
             for &block in blocks {
                 let range = file.blocks[block].number.map_or_else(Default::default, |n| file.in_file(block, n.range));
                 diagnostic = diagnostic.with_related(None, range, format!("N{number}"));
