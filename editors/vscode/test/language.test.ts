@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import { existsSync, readFileSync } from 'node:fs';
 import * as path from 'node:path';
 import { describe, test } from 'node:test';
-import { DOCUMENT_SELECTOR, LANGUAGES } from '../src/documents';
+import { DOCUMENT_SELECTOR, LANGUAGES, TOOLPATH_LANGUAGES } from '../src/documents';
 import { languageOf, manifest, root } from './manifest';
 
 interface Contribution {
@@ -109,12 +109,14 @@ describe('documents for the server', () => {
     assert.deepEqual(untitled, [{ scheme: 'untitled', language: 'cnc8x6' }]);
   });
 
-  test('the toolpath is offered for CNC8x6 programs, the ones the server draws', () => {
+  test('the toolpath is offered for CNC8x6 and Haas lathe programs, in the menus as in the command', () => {
+    assert.deepEqual(TOOLPATH_LANGUAGES, ['cnc8x6', 'haas-lathe']);
     const whens = Object.values(manifest.contributes.menus)
       .flat()
       .filter((item) => (item as { command: string }).command === 'ncc.showToolpath')
       .map((item) => (item as { when: string }).when);
-    assert.deepEqual(whens, ['resourceLangId == cnc8x6', 'editorLangId == cnc8x6']);
+    const when = (key: string) => TOOLPATH_LANGUAGES.map((id) => `${key} == ${id}`).join(' || ');
+    assert.deepEqual(whens, [when('resourceLangId'), when('editorLangId')]);
   });
 });
 
