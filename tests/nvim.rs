@@ -23,6 +23,36 @@ const PROGRAM: &str = "%1\nN10 G01 X- 5 F100\nN20 M30\n*\n";
 const MACRO: &str = "N10 G79 L9001\nN20 G90 G00 Z2.\nN30 G70\n*\n";
 /// A Sinumerik program, which this version does not read.
 const SINUMERIK: &str = "G0 X10 Z2\nM30\n";
+/// A Haas lathe program, in a file named by its program number.
+const HAAS: &str = "%\nO01234 (SHAFT)\nN10 G28 U0 W0 (HOME)\n/1 N20 T0101 S1200 M03\n\
+    N30 #100 = #[#1+2] * SIN[30.]\nN40 IF [#100 GT 0] GOTO50\nN50 WHILE [#1 LE 3] DO1\n\
+    N60 G01 X-20. ,C1. F.1\nN70 END1\nN80 M30\n%\n";
+/// Where the syntax file highlights what in `HAAS`: the line, the text and
+/// the group at its first character.
+const HAAS_HIGHLIGHT: [(usize, &str, &str); 22] = [
+    (0, "%", "haasLatheTapeMark"),
+    (1, "O01234", "haasLatheProgramNumber"),
+    (1, "SHAFT", "haasLatheProgramName"),
+    (2, "N10", "haasLatheBlockNumber"),
+    (2, "G28", "haasLatheGCode"),
+    (2, "U0", "haasLatheAxis"),
+    (2, "(HOME)", "haasLatheComment"),
+    (3, "/1", "haasLatheBlockSkip"),
+    (3, "T0101", "haasLatheAddress"),
+    (3, "0101", "haasLatheNumber"),
+    (3, "M03", "haasLatheMCode"),
+    (4, "#100", "haasLatheVariable"),
+    (4, "[", "haasLatheBracket"),
+    (4, "SIN", "haasLatheFunction"),
+    (5, "IF", "haasLatheConditional"),
+    (5, "GT", "haasLatheOperatorWord"),
+    (5, "GOTO", "haasLatheGoto"),
+    (6, "WHILE", "haasLatheRepeat"),
+    (6, "DO1", "haasLatheRepeat"),
+    (7, "-20.", "haasLatheNumber"),
+    (7, ",C", "haasLatheCorner"),
+    (9, "M30", "haasLatheFlow"),
+];
 
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().unwrap()
@@ -93,6 +123,7 @@ fn neovim_detects_programs_and_shows_diagnostics_hover_and_the_cycle_time() {
     fs::write(programs.join("drill.NCP"), PROGRAM).unwrap();
     fs::write(programs.join("L9001"), MACRO).unwrap();
     fs::write(programs.join("MAIN.MPF"), SINUMERIK).unwrap();
+    fs::write(programs.join("O01234"), HAAS).unwrap();
     // Passed as `configFile`: the server reports S003 as a warning only if it
     // got the file.
     let config = dir.join("machine.toml");
@@ -103,8 +134,26 @@ fn neovim_detects_programs_and_shows_diagnostics_hover_and_the_cycle_time() {
     let state = dir.join("state");
     fs::create_dir(&state).unwrap();
     let output_path = dir.join("output.json");
-    let probes = ["part.Ncp", "L12.txt", "Lathe", "O1234.nc", "PART.TAP", "sub.spf", "O1234.nc.bak", "MPF"]
-        .map(|name| programs.join(name));
+    let probes = [
+        "part.Ncp",
+        "L12.txt",
+        "Lathe",
+        "O1234.nc",
+        "PART.TAP",
+        "sub.spf",
+        "O1234.nc.bak",
+        "MPF",
+        "O1",
+        "O1234.txt",
+        "Oa1",
+        "OLD",
+    ]
+    .map(|name| programs.join(name));
+    let haas_lines: Vec<&str> = HAAS.lines().collect();
+    let haas_probes: Vec<Value> = HAAS_HIGHLIGHT
+        .iter()
+        .map(|&(line, text, _)| json!({ "line": line, "character": haas_lines[line].find(text).unwrap() }))
+        .collect();
     let input = json!({
         "runtime": workspace().join("editors/nvim"),
         "server": env!("CARGO_BIN_EXE_ncc"),
@@ -112,6 +161,8 @@ fn neovim_detects_programs_and_shows_diagnostics_hover_and_the_cycle_time() {
         "macro": programs.join("L9001"),
         "program": programs.join("drill.NCP"),
         "unread": programs.join("MAIN.MPF"),
+        "haas": programs.join("O01234"),
+        "haas_probes": haas_probes,
         "hover": { "line": 1, "character": line.find("G01").unwrap() },
         "timeout_ms": LUA_TIMEOUT_MS,
         "filetype_probes": probes,
@@ -136,17 +187,22 @@ fn neovim_detects_programs_and_shows_diagnostics_hover_and_the_cycle_time() {
         ("sub.spf", "sinumerik"),
         ("O1234.nc", "haas-lathe"),
         ("PART.TAP", "haas-lathe"),
+        ("O01234", "haas-lathe"),
+        ("O1", "haas-lathe"),
     ];
     for (name, filetype) in detected {
         assert_eq!(filetypes[name], filetype, "{name}: {context}");
     }
-    for name in ["L12.txt", "Lathe", "O1234.nc.bak", "MPF"] {
+    for name in ["L12.txt", "Lathe", "O1234.nc.bak", "MPF", "O1234.txt", "Oa1", "OLD"] {
         let filetype = filetypes[name].as_str().unwrap_or_default();
         assert!(!["cnc8x6", "haas-lathe", "sinumerik"].contains(&filetype), "{name}: {context}");
     }
     assert_eq!(output["highlight"], "cnc8x6GCode", "{context}");
+    let groups: Vec<&str> = HAAS_HIGHLIGHT.iter().map(|&(_, _, group)| group).collect();
+    assert_eq!(output["haas_highlight"], json!(groups), "{context}");
+    assert_eq!(output["haas_commentstring"], "(%s)", "{context}");
 
-    // One server for the project, found by its `ncc.toml`, serves all three
+    // One server for the project, found by its `ncc.toml`, serves all four
     // files.
     let clients = output["clients"].as_array().unwrap();
     assert_eq!(clients.len(), 1, "{context}");
@@ -154,7 +210,11 @@ fn neovim_detects_programs_and_shows_diagnostics_hover_and_the_cycle_time() {
     assert_eq!(clients[0]["root_dir"], json!(project), "{context}");
     let init_options = json!({ "configFile": config, "cycleTime": { "inlayHints": "perBlock" } });
     assert_eq!(clients[0]["init_options"], init_options, "{context}");
-    assert_eq!(clients[0]["buffers"], json!({ "program": true, "macro": true, "unread": true }), "{context}");
+    assert_eq!(
+        clients[0]["buffers"],
+        json!({ "program": true, "macro": true, "unread": true, "haas": true }),
+        "{context}"
+    );
 
     let space_after_sign = json!({
         "code": "S003",

@@ -2,7 +2,9 @@
 -- names ncc maps to each by default: CNC8x6 partprograms `*.NCP` and
 -- macrocycle files `L` and digits without an extension (`L9001`), Sinumerik
 -- `*.MPF` and `*.SPF`, Haas lathe `*.nc` and `*.tap`; extensions in any
--- case. Lua patterns, matched against the whole file name.
+-- case. Besides, Haas program files named `O` and their number, without an
+-- extension (`O01234`), as the control names them. Lua patterns, matched
+-- against the whole file name.
 local names = {
   { ".*%.[nN][cC][pP]", "cnc8x6" },
   { "L%d+", "cnc8x6" },
@@ -10,6 +12,7 @@ local names = {
   { ".*%.[sS][pP][fF]", "sinumerik" },
   { ".*%.[nN][cC]", "haas-lathe" },
   { ".*%.[tT][aA][pP]", "haas-lathe" },
+  { "O%d+", "haas-lathe" },
 }
 
 if vim.fn.has("nvim-0.8") == 1 then
@@ -25,7 +28,15 @@ else
   -- to filetype.lua; autocommands work either way. The globs only narrow
   -- the files: `L1.bak` matches `L[0-9]*` too.
   vim.api.nvim_create_autocmd({ "BufRead", "BufNewFile" }, {
-    pattern = { "*.[nN][cC][pP]", "L[0-9]*", "*.[mM][pP][fF]", "*.[sS][pP][fF]", "*.[nN][cC]", "*.[tT][aA][pP]" },
+    pattern = {
+      "*.[nN][cC][pP]",
+      "L[0-9]*",
+      "*.[mM][pP][fF]",
+      "*.[sS][pP][fF]",
+      "*.[nN][cC]",
+      "*.[tT][aA][pP]",
+      "O[0-9]*",
+    },
     callback = function(args)
       local file = vim.fn.fnamemodify(args.match, ":t")
       for _, name in ipairs(names) do

@@ -16,3 +16,10 @@ export const DOCUMENT_SELECTOR = [
   // language the editor gave it.
   { scheme: 'untitled', language: 'cnc8x6' },
 ];
+
+/**
+ * The languages the toolpath view is offered for: the dialects with an
+ * executor. Of a document in a dialect it does not read, the server answers
+ * `ncc.plot` with an error, which the view shows.
+ */
+export const TOOLPATH_LANGUAGES: readonly (typeof LANGUAGES)[number][] = ['cnc8x6', 'haas-lathe'];

@@ -12,16 +12,10 @@ import {
   type ServerOptions,
   State,
 } from 'vscode-languageclient/node';
-import { DOCUMENT_SELECTOR } from './documents';
+import { DOCUMENT_SELECTOR, TOOLPATH_LANGUAGES } from './documents';
 import { type Environment, type Launch, readSettings, ServerStderr, serverLaunch, startFailure } from './server';
 import { PLOT_COMMAND } from './toolpath';
 import { ToolpathViews } from './toolpathView';
-
-/**
- * The language of the programs the toolpath view draws: the server draws
- * only what it reads, and of the controls it reads only CNC8x6 yet.
- */
-const TOOLPATH_LANGUAGE = 'cnc8x6';
 
 /** How long a server that exited at start may take to finish its stderr. */
 const STDERR_WAIT_MS = 2_000;
@@ -68,8 +62,8 @@ async function showToolpath(views: ToolpathViews, resource: unknown): Promise<vo
     document = shown?.document ?? (await vscode.workspace.openTextDocument(resource));
     column = shown?.viewColumn;
   }
-  if (document?.languageId !== TOOLPATH_LANGUAGE) {
-    void vscode.window.showWarningMessage('ncc: the toolpath is drawn for CNC8x6 programs; open one first.');
+  if (document === undefined || !(TOOLPATH_LANGUAGES as readonly string[]).includes(document.languageId)) {
+    void vscode.window.showWarningMessage('ncc: the toolpath is drawn for CNC8x6 and Haas lathe programs; open one first.');
     return;
   }
   views.show(document, column);

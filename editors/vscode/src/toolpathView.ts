@@ -1,4 +1,4 @@
-// The toolpath view: a webview beside a CNC8x6 document with the picture of
+// The toolpath view: a webview beside a document with the picture of
 // `ncc plot`, drawn by the server from the document's current text. A click
 // on a move selects its line; the line the cursor is on is highlighted. The
 // logic lives in toolpath.ts; this file wires it to VS Code.

@@ -1,71 +1,24 @@
-// The TextMate grammar, run by the tokenizer VS Code uses, on the example
-// programs and on programs with mistakes.
+// The CNC8x6 TextMate grammar, run by the tokenizer VS Code uses, on the
+// example programs and on programs with mistakes.
 
 import assert from 'node:assert/strict';
 import { promises as fs } from 'node:fs';
 import * as path from 'node:path';
 import { before, describe, test } from 'node:test';
-import * as oniguruma from 'vscode-oniguruma';
-import { type IGrammar, INITIAL, parseRawGrammar, Registry } from 'vscode-textmate';
+import type { IGrammar } from 'vscode-textmate';
+import { root } from './manifest';
+import { invalidTokens, loadGrammar, scopesFrom, scopesOfLine, type Token, tokenize as tokenizeWith } from './textmate';
 
-const root = path.resolve(__dirname, '..', '..');
 const examples = path.resolve(root, '..', '..', 'examples');
-const grammarFile = path.join(root, 'syntaxes', 'cnc8x6.tmLanguage.json');
 
 let grammar: IGrammar;
 
 before(async () => {
-  await oniguruma.loadWASM(await fs.readFile(require.resolve('vscode-oniguruma/release/onig.wasm')));
-  const registry = new Registry({
-    onigLib: Promise.resolve({
-      createOnigScanner: (patterns) => new oniguruma.OnigScanner(patterns),
-      createOnigString: (text) => new oniguruma.OnigString(text),
-    }),
-    loadGrammar: async (scopeName) =>
-      scopeName === 'source.cnc8x6' ? parseRawGrammar(await fs.readFile(grammarFile, 'utf8'), grammarFile) : null,
-  });
-  const loaded = await registry.loadGrammar('source.cnc8x6');
-  assert.ok(loaded, 'the grammar loads');
-  grammar = loaded;
+  grammar = await loadGrammar('source.cnc8x6');
 });
 
-interface Token {
-  line: number;
-  text: string;
-  scopes: string[];
-}
-
 function tokenize(text: string): Token[] {
-  const tokens: Token[] = [];
-  let state = INITIAL;
-  text.split(/\r?\n/).forEach((line, number) => {
-    const result = grammar.tokenizeLine(line, state);
-    for (const token of result.tokens) {
-      tokens.push({ line: number, text: line.slice(token.startIndex, token.endIndex), scopes: token.scopes });
-    }
-    state = result.ruleStack;
-  });
-  return tokens;
-}
-
-/** The innermost scope of each of `count` tokens, from the first place where the tokens spell `from`. */
-function scopesFrom(tokens: Token[], from: string, count: number): [string, string][] {
-  const start = tokens.findIndex((_, index) => {
-    let text = '';
-    for (const token of tokens.slice(index)) {
-      text += token.text;
-      if (text.length >= from.length) {
-        return text.startsWith(from);
-      }
-    }
-    return false;
-  });
-  assert.notEqual(start, -1, `no tokens spell ${JSON.stringify(from)}`);
-  return tokens.slice(start, start + count).map((token) => [token.text, token.scopes.at(-1) ?? '']);
-}
-
-function invalidTokens(tokens: Token[]): Token[] {
-  return tokens.filter((token) => token.scopes.some((scope) => scope.startsWith('invalid.')));
+  return tokenizeWith(grammar, text);
 }
 
 async function example(file: string): Promise<Token[]> {
@@ -220,7 +173,7 @@ describe('mistakes and rarer forms', () => {
         'N4 G04 Q100',
       ].join('\n'),
     );
-    const scopes = (line: number) => tokens.filter((t) => t.line === line).map((t) => [t.text, t.scopes.at(-1)]);
+    const scopes = (line: number) => scopesOfLine(tokens, line);
     assert.deepEqual(scopes(0).slice(1, 3), [
       ['  ', 'comment.line.double-quote.cnc8x6'],
       ['$PC', 'keyword.other.cycle-file.cnc8x6'],

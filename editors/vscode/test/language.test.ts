@@ -1,15 +1,26 @@
 // The language contributions: which files become documents of which
-// control's language, which of those go to the server, and what the CNC8x6
-// language configuration makes of its documents.
+// control's language, which of those go to the server, and what the
+// language configurations make of their documents.
 
 import assert from 'node:assert/strict';
 import { existsSync, readFileSync } from 'node:fs';
 import * as path from 'node:path';
 import { describe, test } from 'node:test';
-import { DOCUMENT_SELECTOR, LANGUAGES } from '../src/documents';
+import { DOCUMENT_SELECTOR, LANGUAGES, TOOLPATH_LANGUAGES } from '../src/documents';
 import { languageOf, manifest, root } from './manifest';
 
+interface Contribution {
+  id: string;
+  configuration?: string;
+}
+
 const [language] = manifest.contributes.languages;
+const haas = (manifest.contributes.languages as Contribution[]).find((contribution) => contribution.id === 'haas-lathe');
+
+/** The word pattern of a language configuration, with the global flag that VS Code adds. */
+function wordPattern(configuration: { wordPattern: { pattern: string; flags: string } }): RegExp {
+  return new RegExp(configuration.wordPattern.pattern, configuration.wordPattern.flags + 'g');
+}
 
 describe('language contribution', () => {
   test('is cnc8x6, with a grammar and a configuration that exist', () => {
@@ -43,6 +54,11 @@ describe('language contribution', () => {
       'a.MPF.bak',
       'O1234.nc.orig',
       'a.ncx',
+      'O',
+      'O123456',
+      'Oa1',
+      'O1234.txt',
+      'OS',
     ];
     for (const file of others) {
       assert.equal(languageOf(file), undefined, file);
@@ -50,22 +66,33 @@ describe('language contribution', () => {
   });
 });
 
-describe('the controls ncc does not read yet', () => {
+describe('Haas lathe contribution', () => {
+  test('has a grammar and a configuration that exist', () => {
+    assert.ok(haas?.configuration);
+    assert.ok(existsSync(path.join(root, haas.configuration)));
+    const grammar = manifest.contributes.grammars.find((g: { language: string }) => g.language === 'haas-lathe');
+    assert.equal(grammar.scopeName, 'source.haas-lathe');
+    assert.ok(existsSync(path.join(root, grammar.path)));
+  });
+
+  test('takes programs by extension, in either case, and program files named by their number', () => {
+    const files = ['O1234.nc', 'O1234.NC', 'part.tap', 'PART.TAP', 'O1', 'O1234', 'O01234', 'dir/O99999', 'o0001'];
+    for (const file of files) {
+      assert.equal(languageOf(file), 'haas-lathe', file);
+    }
+  });
+});
+
+describe('the control ncc does not read yet', () => {
   test('Sinumerik main programs and subprograms, in either case', () => {
     for (const file of ['MAIN.MPF', 'main.mpf', 'dir/SUB.SPF', 'sub.spf']) {
       assert.equal(languageOf(file), 'sinumerik', file);
     }
   });
 
-  test('Haas lathe programs, in either case', () => {
-    for (const file of ['O1234.nc', 'O1234.NC', 'part.tap', 'PART.TAP']) {
-      assert.equal(languageOf(file), 'haas-lathe', file);
-    }
-  });
-
-  test('have no grammar: no highlighting is claimed for them', () => {
+  test('has no grammar: no highlighting is claimed for it', () => {
     const grammars = manifest.contributes.grammars.map((grammar: { language: string }) => grammar.language);
-    assert.deepEqual(grammars, ['cnc8x6']);
+    assert.ok(!grammars.includes('sinumerik'));
   });
 });
 
@@ -82,16 +109,18 @@ describe('documents for the server', () => {
     assert.deepEqual(untitled, [{ scheme: 'untitled', language: 'cnc8x6' }]);
   });
 
-  test('the toolpath is offered for CNC8x6 programs, the ones the server draws', () => {
+  test('the toolpath is offered for CNC8x6 and Haas lathe programs, in the menus as in the command', () => {
+    assert.deepEqual(TOOLPATH_LANGUAGES, ['cnc8x6', 'haas-lathe']);
     const whens = Object.values(manifest.contributes.menus)
       .flat()
       .filter((item) => (item as { command: string }).command === 'ncc.showToolpath')
       .map((item) => (item as { when: string }).when);
-    assert.deepEqual(whens, ['resourceLangId == cnc8x6', 'editorLangId == cnc8x6']);
+    const when = (key: string) => TOOLPATH_LANGUAGES.map((id) => `${key} == ${id}`).join(' || ');
+    assert.deepEqual(whens, [when('resourceLangId'), when('editorLangId')]);
   });
 });
 
-describe('language configuration', () => {
+describe('CNC8x6 language configuration', () => {
   const configuration = JSON.parse(readFileSync(path.join(root, language.configuration), 'utf8'));
 
   test('comments a line with a double quote', () => {
@@ -99,9 +128,41 @@ describe('language configuration', () => {
   });
 
   test('takes a word with its value, a parameter or prose as one word', () => {
-    // VS Code adds the global flag to the configured ones.
-    const word = new RegExp(configuration.wordPattern.pattern, configuration.wordPattern.flags + 'g');
+    const word = wordPattern(configuration);
     const text = 'N10 G01X-12.5 FR10 R10=250. &0010 %101 "DRÁŽKA R8"';
     assert.deepEqual(text.match(word), ['N10', 'G01', 'X-12.5', 'FR10', 'R10', '250.', '&0010', '%101', 'DRÁŽKA', 'R8']);
+  });
+});
+
+describe('Haas lathe language configuration', () => {
+  const configuration = JSON.parse(readFileSync(path.join(root, haas?.configuration ?? ''), 'utf8'));
+
+  test('comments a line with a semicolon and a selection with parentheses', () => {
+    assert.deepEqual(configuration.comments, { lineComment: ';', blockComment: ['(', ')'] });
+  });
+
+  test('pairs the brackets of expressions', () => {
+    assert.deepEqual(configuration.brackets, [['[', ']']]);
+  });
+
+  test('takes a word with its value, a variable, a keyword with its number or prose as one word', () => {
+    const text = 'N10 G01X-12.5 T0101 #101=#[#1+2.] IF [#1 GT .5] GOTO10 DO1 ,C1. (HRUBOVÁNÍ)';
+    assert.deepEqual(text.match(wordPattern(configuration)), [
+      'N10',
+      'G01',
+      'X-12.5',
+      'T0101',
+      '#101',
+      '#1',
+      '2.',
+      'IF',
+      '#1',
+      'GT',
+      '.5',
+      'GOTO10',
+      'DO1',
+      'C1.',
+      'HRUBOVÁNÍ',
+    ]);
   });
 });

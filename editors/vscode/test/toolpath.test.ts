@@ -331,17 +331,17 @@ describe('the render schedule', () => {
 describe('the command in the manifest', () => {
   const manifest = JSON.parse(readFileSync(path.join(root, 'package.json'), 'utf8'));
 
-  test('is ncc: Show Toolpath, in the editor title and the palette for CNC8x6', () => {
+  test('is ncc: Show Toolpath, in the editor title and the palette for CNC8x6 and Haas lathe', () => {
     const command = manifest.contributes.commands.find((c: { command: string }) => c.command === 'ncc.showToolpath');
     assert.equal(`${command?.category}: ${command?.title}`, 'ncc: Show Toolpath');
     const title = manifest.contributes.menus['editor/title'].find(
       (m: { command: string }) => m.command === 'ncc.showToolpath',
     );
-    assert.equal(title?.when, 'resourceLangId == cnc8x6');
+    assert.equal(title?.when, 'resourceLangId == cnc8x6 || resourceLangId == haas-lathe');
     assert.equal(title?.group, 'navigation');
     const palette = manifest.contributes.menus.commandPalette.find(
       (m: { command: string }) => m.command === 'ncc.showToolpath',
     );
-    assert.equal(palette?.when, 'editorLangId == cnc8x6');
+    assert.equal(palette?.when, 'editorLangId == cnc8x6 || editorLangId == haas-lathe');
   });
 });
