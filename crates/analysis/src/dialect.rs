@@ -2,14 +2,14 @@
 //! dialect does, each an exhaustive `match` on [`Dialect`], so a new
 //! dialect is added here and the neutral modules never name one.
 
-use ncc_syntax::{Dialect, TextEdit, TextRange, TextSize};
+use ncc_syntax::Dialect;
 
 use crate::{
-    Config, DocumentSymbol, Fold, HoverResult, InlayHint, NavigationTarget, Reference, Rule, cnc8x6,
+    Config, Rule, cnc8x6,
     db::{Db, SourceFile},
     diagnostic, findings,
     findings::Findings,
-    haas_lathe, ide,
+    haas_lathe,
     lower::{BlockData, Word},
 };
 
@@ -95,76 +95,5 @@ pub(crate) fn unnamed_unit(dialect: Dialect) -> &'static str {
     match dialect {
         Dialect::Cnc8x6 => cnc8x6::ide::UNNAMED_UNIT,
         Dialect::HaasLathe => "program",
-    }
-}
-
-/// What the thing at `offset` is.
-pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<HoverResult> {
-    match file.parse(db).dialect() {
-        Dialect::Cnc8x6 => ide::hover(db, file, offset),
-        Dialect::HaasLathe => haas_lathe::ide::hover(db, file, offset),
-    }
-}
-
-/// Where the thing at `offset` is defined.
-pub(crate) fn goto_definition(db: &dyn Db, file: SourceFile, offset: TextSize) -> Vec<NavigationTarget> {
-    match file.parse(db).dialect() {
-        Dialect::Cnc8x6 => ide::goto_definition(db, file, offset),
-        Dialect::HaasLathe => haas_lathe::ide::goto_definition(db, file, offset),
-    }
-}
-
-/// The definition and uses of the thing at `offset`.
-pub(crate) fn references(db: &dyn Db, file: SourceFile, offset: TextSize, include_declaration: bool) -> Vec<Reference> {
-    match file.parse(db).dialect() {
-        Dialect::Cnc8x6 => ide::references::references(db, file, offset, include_declaration),
-        Dialect::HaasLathe => haas_lathe::ide::references(db, file, offset, include_declaration),
-    }
-}
-
-/// The outline.
-pub(crate) fn document_symbols(db: &dyn Db, file: SourceFile) -> Vec<DocumentSymbol> {
-    match file.parse(db).dialect() {
-        Dialect::Cnc8x6 => ide::symbols::document_symbols(db, file),
-        Dialect::HaasLathe => haas_lathe::ide::document_symbols(db, file),
-    }
-}
-
-/// The folds.
-pub(crate) fn folding_ranges(db: &dyn Db, file: SourceFile) -> Vec<Fold> {
-    match file.parse(db).dialect() {
-        Dialect::Cnc8x6 => ide::folding::folding_ranges(db, file),
-        Dialect::HaasLathe => haas_lathe::ide::folding_ranges(db, file),
-    }
-}
-
-/// The edits that format the file.
-pub(crate) fn format(db: &dyn Db, file: SourceFile) -> Vec<TextEdit> {
-    match file.parse(db).dialect() {
-        Dialect::Cnc8x6 => ide::format::format(file.text(db), file.parse(db)),
-        // No style is defined for Haas programs yet: formatting changes nothing.
-        Dialect::HaasLathe => Vec::new(),
-    }
-}
-
-/// The inlay hints of the blocks `range` touches.
-pub(crate) fn inlay_hints(db: &dyn Db, file: SourceFile, range: Option<TextRange>) -> Vec<InlayHint> {
-    match file.parse(db).dialect() {
-        Dialect::Cnc8x6 => ide::inlay::inlay_hints(db, file, range),
-        // The cycle time's hints come from the run, for every dialect.
-        Dialect::HaasLathe => Vec::new(),
-    }
-}
-
-/// The CNC8x6 walk's states before the block at `offset`; none in a file of
-/// another dialect.
-pub(crate) fn states_at(
-    db: &dyn Db,
-    file: SourceFile,
-    offset: TextSize,
-) -> Vec<(cnc8x6::flow::ModalState, cnc8x6::flow::ParamState)> {
-    match file.parse(db).dialect() {
-        Dialect::Cnc8x6 => ide::states_at(db, file, offset),
-        Dialect::HaasLathe => Vec::new(),
     }
 }

@@ -223,14 +223,14 @@ impl Analysis {
     /// What the thing at `offset` is: a code's or an address's
     /// documentation, a parameter's with its known values there.
     pub fn hover(&self, file: FileId, offset: TextSize) -> Option<HoverResult> {
-        dialect::hover(&self.db, file, offset)
+        ide::hover(&self.db, file, offset)
     }
 
     /// Where the thing at `offset` is defined: a call's subprogram or
     /// macrocycle file, a jump's block, the assignments a parameter's value
     /// comes from.
     pub fn goto_definition(&self, file: FileId, offset: TextSize) -> Vec<NavigationTarget> {
-        dialect::goto_definition(&self.db, file, offset)
+        ide::goto_definition(&self.db, file, offset)
     }
 
     /// The modal state and parameters before the block at `offset` of a
@@ -240,7 +240,7 @@ impl Analysis {
         file: FileId,
         offset: TextSize,
     ) -> Vec<(cnc8x6::flow::ModalState, cnc8x6::flow::ParamState)> {
-        dialect::states_at(&self.db, file, offset)
+        ide::states_at(&self.db, file, offset)
     }
 
     /// Prepares answers about the modal state (hover) anywhere in the main
@@ -253,12 +253,12 @@ impl Analysis {
 
     /// The outline: program units, and the blocks jumps go to in each.
     pub fn document_symbols(&self, file: FileId) -> Vec<DocumentSymbol> {
-        dialect::document_symbols(&self.db, file)
+        ide::document_symbols(&self.db, file)
     }
 
     /// Program units and runs of comment lines, sorted by start.
     pub fn folding_ranges(&self, file: FileId) -> Vec<Fold> {
-        dialect::folding_ranges(&self.db, file)
+        ide::folding_ranges(&self.db, file)
     }
 
     /// Every token classified, for semantic highlighting.
@@ -274,13 +274,13 @@ impl Analysis {
     /// The definition (with `include_declaration`) and the uses of the
     /// subprogram, macrocycle, jump target or parameter at `offset`.
     pub fn references(&self, file: FileId, offset: TextSize, include_declaration: bool) -> Vec<Reference> {
-        dialect::references(&self.db, file, offset, include_declaration)
+        ide::references(&self.db, file, offset, include_declaration)
     }
 
     /// The edits that format the file: spacing only (the style is in
     /// `ide/format.rs`), sorted and not overlapping.
     pub fn format(&self, file: FileId) -> Vec<TextEdit> {
-        dialect::format(&self.db, file)
+        ide::format(&self.db, file)
     }
 
     /// What may be written at `offset`, most relevant first.
@@ -291,7 +291,7 @@ impl Analysis {
     /// The inlay hints of the blocks `range` touches (of every block
     /// without one).
     pub fn inlay_hints(&self, file: FileId, range: Option<TextRange>) -> Vec<InlayHint> {
-        dialect::inlay_hints(&self.db, file, range)
+        ide::inlay_hints(&self.db, file, range)
     }
 
     /// What a run of the program `file` needs (its text, the machine, the

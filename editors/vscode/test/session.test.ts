@@ -286,11 +286,32 @@ describe('a session with ncc lsp', () => {
     assert.equal(shown.svg, undefined);
   });
 
-  test('a Sinumerik and a Haas lathe program get the note that ncc does not read them yet', async () => {
-    const programs = [
-      { file: 'MAIN.MPF', dialect: 'sinumerik', title: 'Siemens Sinumerik', text: 'G0 X10 Z2\nM30\n' },
-      { file: 'O1234.nc', dialect: 'haas-lathe', title: 'Haas lathe', text: '%\nO1234\nG28 U0 W0\nM30\n%\n' },
-    ];
+  test('a Haas lathe program is read in its dialect: its findings and hover', async () => {
+    const file = 'O1234.nc';
+    const languageId = languageOf(file);
+    assert.equal(languageId, 'haas-lathe');
+    const program = pathToFileURL(path.join(scratch, 'programs', file)).href;
+    const text = '%\nO1234 (SHAFT)\nG71 P10 Q90 U0.4 W0.1 D2. F0.25\nN10 G00 X20.\nG01 Z-20.\nM30\n%\n';
+    await connection.sendNotification(DidOpenTextDocumentNotification.type, {
+      textDocument: { uri: program, languageId, version: 1, text },
+    });
+    const opened = await diagnostics(`the findings of ${file}`, (p) => p.uri === program && p.version === 1);
+    assert.deepEqual(
+      opened.diagnostics.map((d) => [d.code, d.range.start.line, d.range.start.character]),
+      [['L028', 2, 8]],
+    );
+    const hover = await within(
+      `answer to hover on ${file}`,
+      connection.sendRequest(HoverRequest.type, {
+        textDocument: { uri: program },
+        position: { line: 2, character: 1 },
+      }),
+    );
+    assert.match(JSON.stringify(hover), /G71 — Longitudinal roughing cycle/);
+  });
+
+  test('a Sinumerik program gets the note that ncc does not read it yet', async () => {
+    const programs = [{ file: 'MAIN.MPF', dialect: 'sinumerik', title: 'Siemens Sinumerik', text: 'G0 X10 Z2\nM30\n' }];
     for (const { file, dialect, title, text } of programs) {
       // The language VS Code gives the file, which the client hands over.
       const languageId = languageOf(file);

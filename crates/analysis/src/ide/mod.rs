@@ -10,13 +10,14 @@ pub(crate) mod completion;
 pub(crate) mod cycle_time;
 pub(crate) mod folding;
 pub(crate) mod format;
+mod haas_lathe;
 pub(crate) mod highlight;
 pub(crate) mod inlay;
 pub(crate) mod references;
 pub(crate) mod symbols;
 
 use ncc_catalog::{AddressRole, Item};
-use ncc_syntax::{TextRange, TextSize};
+use ncc_syntax::{Dialect, TextEdit, TextRange, TextSize};
 
 use nc_exec::known::Known;
 
@@ -45,6 +46,81 @@ pub struct NavigationTarget {
     pub focus: TextRange,
 }
 
+/// What the thing at `offset` is.
+pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<HoverResult> {
+    match file.parse(db).dialect() {
+        Dialect::Cnc8x6 => hover_in_unit(db, file, offset),
+        Dialect::HaasLathe => haas_lathe::hover(db, file, offset),
+    }
+}
+
+/// Where the thing at `offset` is defined.
+pub(crate) fn goto_definition(db: &dyn Db, file: SourceFile, offset: TextSize) -> Vec<NavigationTarget> {
+    match file.parse(db).dialect() {
+        Dialect::Cnc8x6 => definition_in_unit(db, file, offset),
+        Dialect::HaasLathe => haas_lathe::goto_definition(db, file, offset),
+    }
+}
+
+/// The definition and uses of the thing at `offset`.
+pub(crate) fn references(
+    db: &dyn Db,
+    file: SourceFile,
+    offset: TextSize,
+    include_declaration: bool,
+) -> Vec<references::Reference> {
+    match file.parse(db).dialect() {
+        Dialect::Cnc8x6 => references::references(db, file, offset, include_declaration),
+        Dialect::HaasLathe => haas_lathe::references(db, file, offset, include_declaration),
+    }
+}
+
+/// The outline.
+pub(crate) fn document_symbols(db: &dyn Db, file: SourceFile) -> Vec<symbols::DocumentSymbol> {
+    match file.parse(db).dialect() {
+        Dialect::Cnc8x6 => symbols::document_symbols(db, file),
+        Dialect::HaasLathe => haas_lathe::document_symbols(db, file),
+    }
+}
+
+/// The folds.
+pub(crate) fn folding_ranges(db: &dyn Db, file: SourceFile) -> Vec<folding::Fold> {
+    match file.parse(db).dialect() {
+        Dialect::Cnc8x6 => folding::folding_ranges(db, file),
+        Dialect::HaasLathe => haas_lathe::folding_ranges(db, file),
+    }
+}
+
+/// The edits that format the file.
+pub(crate) fn format(db: &dyn Db, file: SourceFile) -> Vec<TextEdit> {
+    match file.parse(db).dialect() {
+        Dialect::Cnc8x6 => format::format(file.text(db), file.parse(db)),
+        // No style is defined for Haas programs yet: formatting changes nothing.
+        Dialect::HaasLathe => Vec::new(),
+    }
+}
+
+/// The inlay hints of the blocks `range` touches.
+pub(crate) fn inlay_hints(db: &dyn Db, file: SourceFile, range: Option<TextRange>) -> Vec<inlay::InlayHint> {
+    match file.parse(db).dialect() {
+        Dialect::Cnc8x6 => inlay::inlay_hints(db, file, range),
+        // Parameter values are CNC8x6's; the cycle time's hints come from
+        // the run, for every dialect.
+        Dialect::HaasLathe => Vec::new(),
+    }
+}
+
+/// The CNC8x6 walk's states before the block at `offset`; none in a file
+/// of another dialect.
+pub(crate) fn states_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Vec<(ModalState, ParamState)> {
+    match file.parse(db).dialect() {
+        Dialect::Cnc8x6 => {
+            block_index_at(db, file, offset).map(|index| flow::states_before(db, file, index)).unwrap_or_default()
+        }
+        Dialect::HaasLathe => Vec::new(),
+    }
+}
+
 /// The index of the block of `file` at `offset` (a position at a block's
 /// end belongs to it, so the cursor after the last character still finds
 /// the word).
@@ -57,11 +133,6 @@ pub(crate) fn block_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Optio
     let index = block_index_at(db, file, offset)?;
     let (start, block) = flow::lowered_block(db, file, index)?;
     Some((index, start, block))
-}
-
-/// The modal state and parameters before the block at `offset`.
-pub(crate) fn states_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Vec<(ModalState, ParamState)> {
-    block_index_at(db, file, offset).map(|index| flow::states_before(db, file, index)).unwrap_or_default()
 }
 
 /// What the cursor is on inside a block.
@@ -105,7 +176,7 @@ fn target_at(block: &BlockData, at: TextSize) -> Option<Target<'_>> {
     None
 }
 
-pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<HoverResult> {
+fn hover_in_unit(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<HoverResult> {
     let (index, start, block) = block_at(db, file, offset)?;
     let catalogue = Settings::get(db).dialect(db).catalogue();
     match target_at(&block, offset - start)? {
@@ -207,7 +278,7 @@ fn values_text<'a>(number: u32, states: impl Iterator<Item = &'a ParamState>) ->
     }
 }
 
-pub(crate) fn goto_definition(db: &dyn Db, file: SourceFile, offset: TextSize) -> Vec<NavigationTarget> {
+fn definition_in_unit(db: &dyn Db, file: SourceFile, offset: TextSize) -> Vec<NavigationTarget> {
     let Some((index, start, block)) = block_at(db, file, offset) else { return Vec::new() };
     match target_at(&block, offset - start) {
         Some(Target::Parameter { index: number, .. }) => {

@@ -1,0 +1,351 @@
+//! The editor's answers for a Haas lathe file: hover, go to definition,
+//! references, the outline and folding, all from the file's model
+//! (`crate::haas_lathe::model`).
+
+use std::path::Path;
+
+use nc_exec::haas_lathe::{
+    lower::{Expr, ExprKind, HaasBlock, Statement, Value, Word},
+    program::{Finding, ReferenceKind, Target},
+};
+use ncc_catalog::{AddressRole, Catalogue, Item, program_file_number};
+use ncc_syntax::{Dialect, TextRange, TextSize};
+
+use super::{
+    HoverResult, NavigationTarget,
+    folding::{Fold, FoldKind, with_comment_runs},
+    references::{Reference, ReferenceKind as Use},
+    symbols::{DocumentSymbol, SymbolKind},
+};
+use crate::{
+    db::{Db, Settings, SourceFile},
+    haas_lathe::model::{FileModel, file_model},
+};
+
+/// What the cursor is on inside a block (ranges in the block).
+enum Under<'a> {
+    Word(&'a Word),
+    /// `#n` with a literal number.
+    Variable {
+        number: u32,
+        range: TextRange,
+    },
+    /// A function's name: `SIN` of `SIN[…]`.
+    Function {
+        name: &'static str,
+        range: TextRange,
+    },
+}
+
+fn under(block: &HaasBlock, at: TextSize) -> Option<Under<'_>> {
+    let mut expressions: Vec<&Expr> = Vec::new();
+    for word in block.words.iter().chain(&block.corners) {
+        match &word.value {
+            Some(Value::Variable { index, .. }) if word.value_range.is_some_and(|r| r.contains_inclusive(at)) => {
+                let range = word.value_range.unwrap_or(word.range);
+                if let Some(number) = literal(index) {
+                    return Some(Under::Variable { number, range });
+                }
+                expressions.push(index);
+            }
+            Some(Value::Bracket { expr, .. }) if expr.range.contains_inclusive(at) => expressions.push(expr),
+            _ if word.range.contains_inclusive(at) => return Some(Under::Word(word)),
+            _ => {}
+        }
+    }
+    for statement in &block.statements {
+        statement_expressions(statement, &mut expressions);
+    }
+    expressions.iter().find_map(|expr| in_expression(expr, at))
+}
+
+fn statement_expressions<'a>(statement: &'a Statement, out: &mut Vec<&'a Expr>) {
+    match statement {
+        Statement::Assign { target, value, .. } => {
+            out.push(target);
+            out.push(value);
+        }
+        Statement::If { condition, then, .. } => {
+            out.push(condition);
+            if let Some(then) = then {
+                statement_expressions(then, out);
+            }
+        }
+        Statement::Goto { target, .. } => out.push(target),
+        Statement::LoopStart { condition: Some(condition), .. } => out.push(condition),
+        Statement::LoopStart { condition: None, .. } | Statement::LoopEnd { .. } => {}
+    }
+}
+
+/// The variable or function name at `at` inside `expr`.
+fn in_expression(expr: &Expr, at: TextSize) -> Option<Under<'_>> {
+    if !expr.range.contains_inclusive(at) {
+        return None;
+    }
+    match &expr.kind {
+        ExprKind::Variable(index) => match literal(index) {
+            Some(number) => Some(Under::Variable { number, range: expr.range }),
+            None => in_expression(index, at),
+        },
+        ExprKind::Unary(_, operand) => in_expression(operand, at),
+        ExprKind::Binary(_, left, right) => in_expression(left, at).or_else(|| in_expression(right, at)),
+        ExprKind::Call(function, arguments) => {
+            let name = function.name();
+            let name_range = TextRange::at(expr.range.start(), TextSize::of(name));
+            if name_range.contains_inclusive(at) {
+                return Some(Under::Function { name, range: name_range });
+            }
+            arguments.iter().find_map(|argument| in_expression(argument, at))
+        }
+        ExprKind::Literal(_) | ExprKind::Malformed => None,
+    }
+}
+
+fn literal(expr: &Expr) -> Option<u32> {
+    expr.whole_number().and_then(|number| u32::try_from(number).ok())
+}
+
+pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<HoverResult> {
+    let model = file_model(db, file);
+    let index = model.block_at(offset)?;
+    let start = model.ranges[index].start();
+    let catalogue = Dialect::HaasLathe.catalogue();
+    let (items, range) = match under(&model.blocks[index], offset - start)? {
+        Under::Word(word) => (word_items(catalogue, word)?, word.range),
+        Under::Variable { number, range } => (catalogue.explain(&format!("param:{number}")).ok()?, range),
+        Under::Function { name, range } => {
+            let operation = catalogue.operations.iter().find(|op| op.symbol.as_deref() == Some(name))?;
+            (vec![Item::Operation(operation)], range)
+        }
+    };
+    let item = items.iter().find(|item| !matches!(item, Item::Group(_)))?;
+    let mut markdown = item.markdown(catalogue);
+    if let Some(target) = target_text(db, file, model, range + start) {
+        markdown = format!("{target}\n\n{markdown}");
+    }
+    Some(HoverResult { range: range + start, markdown })
+}
+
+/// The catalogue's entries for a word: `G71` for a code, the address for
+/// any other letter.
+fn word_items<'a>(catalogue: &'a Catalogue, word: &Word) -> Option<Vec<Item<'a>>> {
+    let letter = char::from(word.letter);
+    let code = word.value.as_ref().and_then(Value::whole_number).and_then(|n| u32::try_from(n).ok());
+    let query = match code {
+        Some(number) if catalogue.role_of(word.letter) == Some(AddressRole::Function) => format!("{letter}{number}"),
+        _ => letter.to_string(),
+    };
+    catalogue.explain(&query).ok()
+}
+
+/// Where the reference at `range` leads, in words, for the hover's first
+/// line: `Contour's first block: line 8, N10 G00 X17.`.
+fn target_text(db: &dyn Db, file: SourceFile, model: &FileModel, range: TextRange) -> Option<String> {
+    let targets = definitions(db, file, model, range.start());
+    let reference = references_at(model, range.start()).next()?;
+    let what = match reference.kind {
+        ReferenceKind::ContourStart => "The contour's first block",
+        ReferenceKind::ContourEnd => "The contour's last block",
+        ReferenceKind::LocalCall => "Calls the local subprogram at",
+        ReferenceKind::ProgramCall | ReferenceKind::MacroCall => "Calls the program at",
+        ReferenceKind::Goto => "Jumps to",
+    };
+    let place = match targets.first() {
+        None => "which is not in the workspace".to_owned(),
+        Some(target) => {
+            let text = target.file.text(db);
+            let line = text[..usize::from(target.range.start())].matches('\n').count() + 1;
+            let name = if target.file == file { String::new() } else { format!("{} ", target.file.path(db)) };
+            format!("{name}line {line}, `{}`", &text[target.range])
+        }
+    };
+    Some(format!("{what}: {place}."))
+}
+
+/// The resolved references whose number stands at `offset`.
+fn references_at(model: &FileModel, offset: TextSize) -> impl Iterator<Item = nc_exec::haas_lathe::program::Reference> {
+    model.model.findings.iter().filter_map(move |finding| match finding {
+        Finding::Resolved { reference, .. } if model.reference_range(*reference).contains_inclusive(offset) => {
+            Some(*reference)
+        }
+        _ => None,
+    })
+}
+
+/// Block `index`'s line, without its line break.
+fn line_range(db: &dyn Db, file: SourceFile, model: &FileModel, index: usize) -> TextRange {
+    let range = model.ranges[index];
+    let line = file.text(db)[range].trim_end_matches(['\n', '\r']);
+    TextRange::at(range.start(), TextSize::of(line))
+}
+
+fn block_target(db: &dyn Db, file: SourceFile, model: &FileModel, index: usize) -> NavigationTarget {
+    let range = line_range(db, file, model, index);
+    let block = &model.blocks[index];
+    let name = block.number.map(|number| number.range).or(block.program.as_ref().map(|program| program.range));
+    let focus = name.map_or(range, |name| model.in_file(index, name));
+    NavigationTarget { file, range, focus }
+}
+
+/// The files of the workspace holding program `number`: an `O` line of
+/// that number, or a file named after it (`O01234.nc`).
+fn program_files(db: &dyn Db, number: u64) -> Vec<NavigationTarget> {
+    let mut targets = Vec::new();
+    for &other in Settings::get(db).files(db) {
+        let model = file_model(db, other);
+        let found = model.model.programs.iter().find(|program| program.number.map(u64::from) == Some(number));
+        if let Some(program) = found {
+            targets.push(block_target(db, other, model, program.blocks.start));
+        } else if program_file_number(Path::new(other.path(db))).map(u64::from) == Some(number)
+            && !model.blocks.is_empty()
+        {
+            targets.push(block_target(db, other, model, 0));
+        }
+    }
+    targets
+}
+
+/// Where the reference at `offset` leads.
+fn definitions(db: &dyn Db, file: SourceFile, model: &FileModel, offset: TextSize) -> Vec<NavigationTarget> {
+    let mut targets = Vec::new();
+    for finding in &model.model.findings {
+        let Finding::Resolved { reference, target } = finding else { continue };
+        if !model.reference_range(*reference).contains_inclusive(offset) {
+            continue;
+        }
+        match *target {
+            Target::Block(index) => targets.push(block_target(db, file, model, index)),
+            Target::Program(program) => {
+                targets.push(block_target(db, file, model, model.model.programs[program].blocks.start))
+            }
+            Target::External(number) => targets.extend(program_files(db, number)),
+        }
+    }
+    targets
+}
+
+pub(crate) fn goto_definition(db: &dyn Db, file: SourceFile, offset: TextSize) -> Vec<NavigationTarget> {
+    definitions(db, file, file_model(db, file), offset)
+}
+
+/// The block number at `offset`, or the block a reference there names.
+fn block_named_at(model: &FileModel, offset: TextSize) -> Option<usize> {
+    let own = model.block_at(offset).filter(|&index| {
+        model.blocks[index].number.is_some_and(|number| model.in_file(index, number.range).contains_inclusive(offset))
+    });
+    own.or_else(|| {
+        model.model.findings.iter().find_map(|finding| match finding {
+            Finding::Resolved { reference, target: Target::Block(index) }
+                if model.reference_range(*reference).contains_inclusive(offset) =>
+            {
+                Some(*index)
+            }
+            _ => None,
+        })
+    })
+}
+
+pub(crate) fn references(db: &dyn Db, file: SourceFile, offset: TextSize, include_declaration: bool) -> Vec<Reference> {
+    let model = file_model(db, file);
+    let Some(block) = block_named_at(model, offset) else { return Vec::new() };
+    let mut found = Vec::new();
+    if include_declaration {
+        found.push(Reference { file, range: model.number_range(block), kind: Use::Definition });
+    }
+    for finding in &model.model.findings {
+        if let Finding::Resolved { reference, target: Target::Block(index) } = finding
+            && *index == block
+        {
+            let kind = if reference.kind == ReferenceKind::LocalCall { Use::Call } else { Use::Jump };
+            found.push(Reference { file, range: model.reference_range(*reference), kind });
+        }
+    }
+    found
+}
+
+pub(crate) fn document_symbols(db: &dyn Db, file: SourceFile) -> Vec<DocumentSymbol> {
+    let model = file_model(db, file);
+    let targets: Vec<usize> = model
+        .model
+        .findings
+        .iter()
+        .filter_map(|finding| match finding {
+            Finding::Resolved { target: Target::Block(index), .. } => Some(*index),
+            _ => None,
+        })
+        .collect();
+    let mut symbols = Vec::new();
+    for program in &model.model.programs {
+        let Some(range) = blocks_range(db, file, model, program.blocks.clone()) else { continue };
+        let first = program.blocks.start;
+        let selection = model.blocks[first].program.as_ref().map_or(range, |o| model.in_file(first, o.range));
+        let mut children = Vec::new();
+        for index in program.blocks.clone() {
+            let block = &model.blocks[index];
+            if let Some(tool) = block.word(b'T') {
+                let name = format!("T{}", value_text(tool));
+                let detail = block.comments.first().map(|comment| comment.body.trim().to_owned());
+                let range = line_range(db, file, model, index);
+                let selection_range = model.in_file(index, tool.range);
+                let kind = SymbolKind::Tool;
+                children.push(DocumentSymbol { name, kind, detail, range, selection_range, children: Vec::new() });
+            }
+            if targets.contains(&index)
+                && let Some(number) = block.number.and_then(|number| number.value)
+            {
+                children.push(DocumentSymbol {
+                    name: format!("N{number}"),
+                    kind: SymbolKind::JumpTarget,
+                    detail: None,
+                    range: line_range(db, file, model, index),
+                    selection_range: model.number_range(index),
+                    children: Vec::new(),
+                });
+            }
+        }
+        symbols.push(DocumentSymbol {
+            name: program.number.map_or_else(|| "program".to_owned(), |number| format!("O{number}")),
+            kind: SymbolKind::Program,
+            detail: program.title.clone(),
+            range,
+            selection_range: selection,
+            children,
+        });
+    }
+    symbols
+}
+
+/// A word's value as written in the outline (`0101` of `T0101`).
+fn value_text(word: &Word) -> String {
+    match &word.value {
+        Some(Value::Literal(decimal)) => decimal.to_string(),
+        _ => "?".to_owned(),
+    }
+}
+
+/// From the first block's start to the end of the last block's line.
+fn blocks_range(db: &dyn Db, file: SourceFile, model: &FileModel, blocks: std::ops::Range<usize>) -> Option<TextRange> {
+    let last = blocks.end.checked_sub(1)?;
+    let first = model.ranges.get(blocks.start)?;
+    Some(TextRange::new(first.start(), line_range(db, file, model, last).end()))
+}
+
+/// Programs, loops (`DOn` … `ENDn`) and contours (P … Q), and runs of
+/// comment lines.
+pub(crate) fn folding_ranges(db: &dyn Db, file: SourceFile) -> Vec<Fold> {
+    let model = file_model(db, file);
+    let mut regions: Vec<std::ops::Range<usize>> = model.model.programs.iter().map(|p| p.blocks.clone()).collect();
+    for program in &model.model.programs {
+        regions.extend(program.loops.iter().map(|&(start, end)| start..end + 1));
+    }
+    regions.extend(model.model.contours().map(|contour| *contour.blocks.start()..*contour.blocks.end() + 1));
+    // G70 finishes the contour G71 roughed: one fold.
+    regions.sort_by_key(|blocks| (blocks.start, blocks.end));
+    regions.dedup();
+    let folds = regions
+        .into_iter()
+        .filter_map(|blocks| blocks_range(db, file, model, blocks))
+        .map(|range| Fold { range, kind: FoldKind::Region })
+        .collect();
+    with_comment_runs(db, file, folds)
+}
