@@ -315,25 +315,36 @@ fn measure<T>(runs: usize, mut f: impl FnMut() -> T) -> Measurement {
     Measurement { best, peak_bytes }
 }
 
+/// What the `gcode` crate reads beside a program of `dialect`: the same
+/// bytes where it reads them (a Haas program is plain ISO code to it), else
+/// the same toolpath in NGC (CNC8x6's header, `"` comments and `*` end are
+/// not G-code it knows); and what the output calls it.
+fn gcode_input(dialect: Dialect, moves: &[Move], program: &str) -> (String, &'static str) {
+    match dialect {
+        Dialect::Cnc8x6 => (progen::write(moves, Syntax::Ngc), "NGC"),
+        Dialect::HaasLathe => (program.to_owned(), "the same bytes"),
+    }
+}
+
 fn parse_benchmark(dialect: Dialect, blocks: usize, runs: usize) -> anyhow::Result<()> {
     let moves = progen::surfacing(blocks);
     let cnc = program_text(dialect, &moves);
-    let ngc = progen::write(&moves, Syntax::Ngc);
+    let (ngc, peer_input) = gcode_input(dialect, &moves, &cnc);
     drop(moves);
 
     // Sanity: both parsers accept their input completely.
     let parse = Parse::new(&cnc, dialect);
     anyhow::ensure!(parse.errors().is_empty(), "ncc found errors: {:?}", &parse.errors()[..1]);
-    anyhow::ensure!(parse.tree().blocks().count() == blocks, "ncc block count");
+    anyhow::ensure!(parse.tree().blocks().count() >= blocks, "ncc block count");
     drop(parse);
-    let program = gcode::parse(&ngc).map_err(|e| anyhow::anyhow!("gcode rejected the NGC program: {e:?}"))?;
+    let program = gcode::parse(&ngc).map_err(|e| anyhow::anyhow!("gcode rejected its input: {e:?}"))?;
     anyhow::ensure!(program.blocks.len() >= blocks, "gcode block count {}", program.blocks.len());
     drop(program);
 
     let threads = rayon::current_num_threads();
     let single = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     println!(
-        "parse benchmark: {blocks} blocks; {} {:.1} MB, NGC {:.1} MB; best of {runs} runs",
+        "parse benchmark: {blocks} blocks; {} {:.1} MB, gcode reads {peer_input}, {:.1} MB; best of {runs} runs",
         DialectId::from(dialect).title(),
         cnc.len() as f64 / 1e6,
         ngc.len() as f64 / 1e6
@@ -351,7 +362,7 @@ fn parse_benchmark(dialect: Dialect, blocks: usize, runs: usize) -> anyhow::Resu
             m.peak_bytes as f64 / 1e6
         );
     };
-    row("gcode 0.7 (gcode::parse, NGC)", &gcode_rs);
+    row("gcode 0.7 (gcode::parse)", &gcode_rs);
     row("ncc lossless CST, 1 thread", &ncc_one);
     row(&format!("ncc lossless CST, {threads} threads"), &ncc_all);
     println!(

@@ -62,6 +62,8 @@ pub struct Estimate {
     budget: usize,
     text: Arc<String>,
     files: WorkspaceFiles,
+    /// The machine it ran on (a run without checkpoints has it only here).
+    machine: Arc<MachineConfig>,
 }
 
 /// One block of the file as it ran.
@@ -208,9 +210,7 @@ impl Estimate {
     /// Whether this estimate is the one of `input`: the same text, files
     /// and machine.
     pub fn holds_for(&self, input: &RunInput) -> bool {
-        self.text == input.text
-            && self.files == input.files
-            && self.checkpoints.first().is_some_and(|stored| *stored.run.machine() == input.machine)
+        self.text == input.text && self.files == input.files && *self.machine == input.machine
     }
 }
 
@@ -262,7 +262,7 @@ pub fn estimate(
         }
     };
     let stopped = trace.findings.iter().find(|finding| finding.stops()).map(|finding| finding.message.clone());
-    let mut estimate = charges.into_estimate(text, files, stopped, (trace.blocks_run, budget));
+    let mut estimate = charges.into_estimate(text, files, machine, stopped, (trace.blocks_run, budget));
     estimate.rerun.start = rerun_from;
     estimate
 }
@@ -292,7 +292,7 @@ impl<'a> Change<'a> {
         machine: &MachineConfig,
         budget: usize,
     ) -> Option<Change<'a>> {
-        if previous.checkpoints.first()?.run.machine() != machine {
+        if *previous.machine != *machine {
             return None;
         }
         let (old, new) = (previous.text.as_bytes(), text.as_bytes());
@@ -532,6 +532,7 @@ impl<'a> Charges<'a> {
         mut self,
         text: &Arc<String>,
         files: &WorkspaceFiles,
+        machine: &MachineConfig,
         mut stopped: Option<String>,
         (mut blocks_run, budget): (usize, usize),
     ) -> Estimate {
@@ -575,6 +576,7 @@ impl<'a> Charges<'a> {
             budget,
             text: text.clone(),
             files: files.clone(),
+            machine: Arc::new(machine.clone()),
         }
     }
 }
@@ -1188,6 +1190,22 @@ mod tests {
         // 20 mm more at the last feed, 900 mm/min.
         let longer = resumed.totals.total - first.totals.total;
         assert!((longer - 20.0 / 15.0).abs() < 0.05, "{longer}");
+    }
+
+    /// A run without checkpoints (a Haas lathe run) still knows its input:
+    /// an edit of another file does not run it again.
+    #[test]
+    fn an_estimate_without_checkpoints_holds_for_its_input() {
+        let machine = MachineConfig::of_control(ncc_syntax::Dialect::HaasLathe);
+        let text = Arc::new("O1\nG98 G01 X20. Z-10. F100.\nM30\n".to_owned());
+        let files = WorkspaceFiles::default();
+        let first = estimate(None, &text, &files, &machine, 1000);
+        assert!(first.checkpoints.is_empty());
+        // 5 mm of radius and 10 mm of Z at 100 mm/min, with the ramps.
+        assert!(first.totals.total > 125.0f64.sqrt() / 100.0 * 60.0, "{}", first.totals.total);
+        assert!(first.holds_for(&RunInput { text: text.clone(), machine: machine.clone(), files: files.clone() }));
+        let milling = MachineConfig::default();
+        assert!(!first.holds_for(&RunInput { text: text.clone(), machine: milling, files }));
     }
 
     proptest::proptest! {

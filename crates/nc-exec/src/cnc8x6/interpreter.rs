@@ -70,10 +70,6 @@ impl Resumable for Runner {
         Box::new(self.clone())
     }
 
-    fn machine(&self) -> &MachineConfig {
-        &self.machine
-    }
-
     fn steps(&self) -> usize {
         self.delivered
     }

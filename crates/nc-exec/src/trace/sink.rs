@@ -8,7 +8,7 @@ use std::{
 
 use ncc_syntax::{TextRange, TextSize};
 
-use crate::{compensation::ToolElement, machine::MachineConfig, transform::Frame};
+use crate::{compensation::ToolElement, transform::Frame};
 
 use super::*;
 
@@ -104,7 +104,6 @@ pub struct Checkpoint {
 /// What a control's interpreter keeps in a [`Checkpoint`] to run on from.
 pub(crate) trait Resumable: std::any::Any + Send + Sync {
     fn boxed_clone(&self) -> Box<dyn Resumable>;
-    fn machine(&self) -> &MachineConfig;
     /// Steps made before it.
     fn steps(&self) -> usize;
     fn set_steps(&mut self, steps: usize);
@@ -137,11 +136,6 @@ impl Checkpoint {
     /// The index of the next block in the program.
     pub fn block(&self) -> usize {
         self.block
-    }
-
-    /// The machine the run ran on.
-    pub fn machine(&self) -> &MachineConfig {
-        self.state.machine()
     }
 
     /// Blocks the run executed before it.
