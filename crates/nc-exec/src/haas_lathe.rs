@@ -1,12 +1,15 @@
 //! The Haas lathe dialect's part of the executor (classic control,
 //! Fanuc-style ISO code): its block IR and lowering, the macro-expression
 //! evaluator, the program model (programs, block numbers, the P/Q
-//! contours of G70–G73 and the targets of calls and jumps), the
-//! interpreter that runs a program into a trace, and the velocity policy
-//! that times it.
+//! contours of G70–G73 and the targets of calls and jumps), the canned
+//! cycles as moves (the one-block cycles, and the contour cycles G70–G73),
+//! the interpreter that runs a program into a trace, and the velocity
+//! policy that times it.
 
+pub mod cycles;
 pub mod dynamics;
 pub mod eval;
 pub mod interpreter;
 pub mod lower;
 pub mod program;
+pub mod roughing;
