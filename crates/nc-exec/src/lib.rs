@@ -34,9 +34,11 @@
 //!   tree), [`haas_lathe::eval`] (macro expressions over partly unknown
 //!   variables), [`haas_lathe::program`] (the programs of a file, their
 //!   block numbers, the P/Q contours of G70–G73 and the targets of calls
-//!   and jumps) and [`haas_lathe::interpreter`] (the modal state, motion,
-//!   macro statements and time of a program, block by block; the run
-//!   driver does not pick it yet).
+//!   and jumps), [`haas_lathe::cycles`] and [`haas_lathe::roughing`] (the
+//!   canned cycles as moves), [`haas_lathe::interpreter`] (the modal
+//!   state, motion, cycles, macro statements and time of a program, block
+//!   by block, which [`run`] runs on a Haas machine) and
+//!   [`haas_lathe::dynamics`] (its velocity policy).
 //! - [`envelope`]: the CNC8x9 envelope velocity, a streaming look-ahead
 //!   planner of up to 500 blocks with linear or jerk-limited ramps.
 //! - [`known`]: values a static reading may not know.

@@ -15,6 +15,13 @@
 //!   the spindle M03/M04/M05, dwell G04 P (ms without a decimal point,
 //!   seconds with one, lathe manual §5.3 (001:55-71)), exact stop G09 and
 //!   G61/G64.
+//! - The canned cycles as moves of their block ([`super::cycles`],
+//!   [`super::roughing`]): thread cutting G32; the box cycles G90, G92,
+//!   G94, modal, repeated by each block that moves; G70–G73 over the P..Q
+//!   contour, the run going on after the Q block once a roughing cycle has
+//!   run (lathe manual §6.9 item 8, inferred there) and after the block of
+//!   G70; G74–G76; the drilling and tapping cycles G81–G89, G184 at every
+//!   block that moves while one is in force, until G80, G00 or G01.
 //! - Macro statements through [`super::eval`]: assignments, `IF … GOTO`,
 //!   `IF … THEN`, `GOTO`, `WHILE … DOn` … `ENDn`; the step budget bounds
 //!   the loops.
@@ -26,12 +33,11 @@
 //! replaces its group's.
 //!
 //! Everything else is reported once per kind as not run yet and moves
-//! nothing, so that a total never silently leaves work out: the cycles
-//! G70–G76, G90/G92/G94, G32, drilling and tapping cycles, tool-nose
-//! radius compensation G41/G42, M97/M98/M99, G65, G28/G29, G53, work
-//! offsets, G52, inch units G20, corner chamfers and angles on G01. After
-//! a roughing cycle G71–G73 the run goes on after its Q block, as the
-//! control does (lathe manual §6.9 item 8, inferred there).
+//! nothing, so that a total never silently leaves work out: live-tool
+//! tapping G95, tool-nose radius compensation G41/G42 (in a cycle's
+//! contour too), M97/M98/M99, G65, G28/G29, G53, work offsets, G52, inch
+//! units G20, corner chamfers and angles on G01 (and in the contour of
+//! G70 and G73; the roughing of G71 and G72 ignores them).
 //!
 //! Assumptions the manual does not settle:
 //! - A step's X is the radius, as CNC8x6 keeps it under diameter
@@ -39,9 +45,15 @@
 //!   in the geometry, lengths and times.
 //! - Arcs lie in the plane (Z, X), so that clockwise in it is clockwise
 //!   with +Z to the right and +X up.
-//! - Under G96 the rpm of a move is the one at its mean diameter,
-//!   1000·Vc/(π·D), at most the G50 limit; the limit holds under G97 too.
+//! - Under G96 the rpm is 1000·Vc/(π·D), at most the G50 limit, and
+//!   follows the diameter along a line (the time is its integral); along an
+//!   arc it is the one at the mean diameter. The limit holds under G97 too.
 //!   The machine's own spindle maximum is not modelled.
+//! - F is the lead of G32, G92 and G76 under G98 as under G99 (the manual:
+//!   "F = feed per revolution = thread pitch", §6.8 (001:1490)).
+//! - A cycle changes no modal state but its own (the box cycles' target,
+//!   the drilling words) and the spindle G84/G184 switch on; the modes of
+//!   the contour's blocks stay with them.
 //! - G64, the default, joins blocks continuously; G09 and G61 stop exactly.
 //! - A computed dwell P (`P#1`) counts in ms, as a literal without a point.
 //! - A word whose variable is vacant is left out (Fanuc convention).
@@ -49,13 +61,15 @@
 //! - `GOTO n` goes to the first block numbered n in the program.
 //! - T is recorded as written (`T101`: tool 1, offset 1).
 
+use std::f64::consts::TAU;
+
 use ncc_catalog::{Catalogue, split_code};
 use ncc_syntax::{Dialect, Parse, TextRange};
 
 use super::{
     eval::{EvalError, MacroValue, Variables},
     lower::{Expr, ExprKind, HaasBlock, Statement, Value, Word, block_nodes},
-    program::{Program, ProgramModel},
+    program::{Contour, Program, ProgramModel},
 };
 use crate::{
     arc::{CircleArc, OffCircle, circle_through},
@@ -82,7 +96,7 @@ pub(crate) fn run_into(text: &str, machine: &MachineConfig, budget: usize, sink:
         block_nodes(parse.green()).map(|(range, block)| (range, HaasBlock::lower(block))).unzip();
     let model = ProgramModel::new(&blocks);
     let mut interpreter = Interpreter::new(machine, &blocks, &ranges);
-    interpreter.contour_ends = model.contours().map(|contour| (contour.cycle, *contour.blocks.end())).collect();
+    interpreter.contours = model.contours().cloned().collect();
     if let Some(program) = model.programs.first() {
         interpreter.run(program, model.programs.len() > 1, budget);
     }
@@ -185,8 +199,9 @@ struct Interpreter<'a> {
     reported: Vec<String>,
     /// A finding the control stops on was made.
     stopped: bool,
-    /// Each roughing cycle's block and its contour's Q block.
-    contour_ends: Vec<(usize, usize)>,
+    /// The contours of the cycles G70–G73.
+    contours: Vec<Contour>,
+    cycles: canned::CycleState,
 }
 
 impl<'a> Interpreter<'a> {
@@ -207,7 +222,8 @@ impl<'a> Interpreter<'a> {
             executed: 0,
             reported: Vec::new(),
             stopped: false,
-            contour_ends: Vec::new(),
+            contours: Vec::new(),
+            cycles: canned::CycleState::default(),
         }
     }
 
@@ -244,11 +260,12 @@ impl<'a> Interpreter<'a> {
             return Flow::Next;
         }
         let mut flow = Flow::Next;
-        let (mut dwell, mut exact_stop, mut still) = (false, false, false);
+        let (mut dwell, mut exact_stop, mut still, mut cycle) = (false, false, false, None);
         for code in block.codes(b'G') {
             self.modes.set('G', code);
             match code {
-                0..=3 | 18 | 21 | 32 | 40 | 50 | 61 | 64 | 80 | 90 | 92 | 94 | 96..=100 => {}
+                0..=3 | 32 | 80 | 90 | 92 | 94 => self.cycles.drilling = Default::default(),
+                18 | 21 | 40 | 50 | 61 | 64 | 96..=100 => {}
                 4 => dwell = true,
                 9 => exact_stop = true,
                 20 => self.not_run("inch units G20 (the run reads mm)", range),
@@ -256,7 +273,8 @@ impl<'a> Interpreter<'a> {
                 54..=59 | 110..=129 => {
                     self.not_run("work offsets G54–G59, G110–G129 (positions stay in program coordinates)", range)
                 }
-                81..=89 | 95 | 184 => self.not_run("drilling and tapping cycles", range),
+                81..=89 | 184 => {}
+                95 => self.not_run("live-tool rigid tapping G95", range),
                 101 => self.not_run("mirror image G101", range),
                 28 | 29 => {
                     still = true;
@@ -271,8 +289,7 @@ impl<'a> Interpreter<'a> {
                     self.not_run("macro calls G65", range);
                 }
                 70..=76 => {
-                    still = true;
-                    self.not_run("the multiple-repetitive cycles G70–G76", range);
+                    cycle = Some(code);
                     if (71..=73).contains(&code) {
                         flow = self.after_contour(at).map_or(Flow::Next, Flow::Jump);
                     }
@@ -313,6 +330,8 @@ impl<'a> Interpreter<'a> {
         }
         let moved = if dwell {
             self.dwell(block, range)
+        } else if let Some(code) = cycle {
+            self.canned(code, at, block, range)
         } else if still {
             STILL
         } else {
@@ -345,27 +364,78 @@ impl<'a> Interpreter<'a> {
             dynamic_set: 1,
             mergeable: false,
         };
+        // A cycle's moves before its last, which is the block's own.
+        for (Moved { motion, path, length, duration, feed }, end, stop) in std::mem::take(&mut self.cycles.pending) {
+            let (m_functions, tool_change) = (0, false);
+            let moved =
+                Step { motion, path, duration, length, feed, end, stop, m_functions, tool_change, ..step.clone() };
+            self.steps.push(moved);
+        }
         self.steps.push(step);
         if end { Flow::End } else { flow }
     }
 
     /// The block after the Q block of the roughing cycle in block `cycle`.
     fn after_contour(&self, cycle: usize) -> Option<usize> {
-        self.contour_ends.iter().find(|&&(block, _)| block == cycle).map(|&(_, q)| q + 1)
+        self.contours.iter().find(|contour| contour.cycle == cycle).map(|contour| contour.blocks.end() + 1)
     }
 
     fn dwell(&mut self, block: &HaasBlock, range: TextRange) -> Moved {
-        let Some(word) = block.word(b'P') else { return STILL };
+        match block.word(b'P').and_then(|word| self.seconds(word, range)) {
+            Some(duration) => Moved { motion: Motion::Dwell, duration, ..STILL },
+            None => STILL,
+        }
+    }
+
+    /// A dwell's P in seconds: ms without a decimal point, seconds with one
+    /// (lathe manual §5.3 (001:55-71)).
+    fn seconds(&mut self, word: &Word, range: TextRange) -> Option<f64> {
         let seconds_written = matches!(&word.value, Some(Value::Literal(decimal)) if decimal.has_point());
-        let Some(value) = self.number(word, range) else { return STILL };
-        let duration = if seconds_written { value } else { value / 1000.0 };
-        Moved { motion: Motion::Dwell, duration, ..STILL }
+        let value = self.number(word, range)?;
+        Some(if seconds_written { value } else { value / 1000.0 })
     }
 
     /// The block's move to its end point in the motion mode in force.
     fn motion(&mut self, block: &HaasBlock, range: TextRange) -> Moved {
         let start = self.position;
-        let mut end = start;
+        let Some(end) = self.end_point(block, range, &start) else { return STILL };
+        if let Some(code) = self.modes.get(DRILLING).filter(|&code| code != 80) {
+            // The drilling cycle in force runs at the position instead.
+            return self.drilling(code, block, range, &end);
+        }
+        let motion = self.modes.get(MOTION);
+        if let Some(code @ (32 | 90 | 92 | 94)) = motion {
+            return self.modal_cycle(code, block, range, &end);
+        }
+        self.unrun_corners(block, range, motion);
+        let (z, x) = (slot(b'Z'), slot(b'X'));
+        let (from, to) = ([start[z], start[x]], [end[z], end[x]]);
+        let (path, length) = match motion {
+            Some(code @ (2 | 3)) => {
+                let Some(arc) = self.arc(block, range, from, to, code == 3) else { return STILL };
+                let path = Path::Arc { plane: (b'Z', b'X'), centre: arc.centre, clockwise: arc.sweep < 0.0 };
+                (path, arc.length())
+            }
+            _ => (Path::Straight, (to[0] - from[0]).hypot(to[1] - from[1])),
+        };
+        self.position = end;
+        if motion == Some(0) {
+            return Moved { motion: Motion::Rapid, path, length, duration: self.rapid_seconds(from, to), feed: None };
+        }
+        self.feed_move(range, from, to, path, length)
+    }
+
+    /// Reports the corner words of a G01 block, which the run leaves out.
+    fn unrun_corners(&mut self, block: &HaasBlock, range: TextRange, motion: Option<u32>) {
+        if motion == Some(1) && (!block.corners.is_empty() || "IKRA".bytes().any(|l| block.word(l).is_some())) {
+            self.not_run("corner chamfers, roundings and angles on G01 (the line runs to its end point)", range);
+        }
+    }
+
+    /// Where the block's X, U, Z and W words lead from `start`; `None` when
+    /// it has none.
+    fn end_point(&mut self, block: &HaasBlock, range: TextRange, start: &Position) -> Option<Position> {
+        let mut end = *start;
         let mut moves = false;
         for word in &block.words {
             let (axis, incremental) = match word.letter {
@@ -382,42 +452,17 @@ impl<'a> Interpreter<'a> {
             *at = round3(if incremental { *at * written + value } else { value }) / written;
             moves = true;
         }
-        if !moves {
-            return STILL;
-        }
-        if self.modes.get(DRILLING) != Some(80) {
-            // The drilling cycle in force runs at the position instead.
-            return STILL;
-        }
-        let motion = self.modes.get(MOTION);
-        if matches!(motion, Some(32 | 90 | 92 | 94)) {
-            self.not_run("thread cutting G32 and the cycles G90, G92, G94", range);
-            return STILL;
-        }
-        if motion == Some(1) && (!block.corners.is_empty() || "IKRA".bytes().any(|l| block.word(l).is_some())) {
-            self.not_run("corner chamfers, roundings and angles on G01 (the line runs to its end point)", range);
-        }
-        let (z, x) = (slot(b'Z'), slot(b'X'));
-        let (from, to) = ([start[z], start[x]], [end[z], end[x]]);
-        let (path, length) = match motion {
-            Some(code @ (2 | 3)) => {
-                let Some(arc) = self.arc(block, range, from, to, code == 3) else { return STILL };
-                let path = Path::Arc { plane: (b'Z', b'X'), centre: arc.centre, clockwise: arc.sweep < 0.0 };
-                (path, arc.length())
-            }
-            _ => (Path::Straight, (to[0] - from[0]).hypot(to[1] - from[1])),
-        };
-        self.position = end;
-        if motion == Some(0) {
-            let minutes = [(b'X', to[1] - from[1]), (b'Z', to[0] - from[0])]
-                .map(|(axis, delta)| delta.abs() / f64::from(self.machine.axis_rapid_rate(axis)))
-                .into_iter()
-                .fold(0.0, f64::max);
-            return Moved { motion: Motion::Rapid, path, length, duration: minutes * 60.0, feed: None };
-        }
-        let rate = self.feed_rate(range, start[x] + end[x]);
-        let duration = rate.map_or(0.0, |rate| length / rate * 60.0);
-        Moved { motion: Motion::Feed, path, length, duration, feed: rate }
+        moves.then_some(end)
+    }
+
+    /// Seconds of a rapid move from `from` to `to` (Z, X radius): the
+    /// slowest axis at its own rate.
+    fn rapid_seconds(&self, from: [f64; 2], to: [f64; 2]) -> f64 {
+        let minutes = [(b'X', to[1] - from[1]), (b'Z', to[0] - from[0])]
+            .map(|(axis, delta)| delta.abs() / f64::from(self.machine.axis_rapid_rate(axis)))
+            .into_iter()
+            .fold(0.0, f64::max);
+        minutes * 60.0
     }
 
     /// The arc from `from` to `to` in the plane (Z, X), radii on X; `None`
@@ -460,9 +505,19 @@ impl<'a> Interpreter<'a> {
         }
     }
 
-    /// The path feed in mm/min of a feed move over `diameter` on average;
-    /// `None` after reporting why the axes cannot move.
-    fn feed_rate(&mut self, range: TextRange, diameter: f64) -> Option<f64> {
+    /// A feed move of `length` mm from `from` to `to` (Z, X radius) along
+    /// `path`.
+    fn feed_move(&mut self, range: TextRange, from: [f64; 2], to: [f64; 2], path: Path, length: f64) -> Moved {
+        let minutes = self.feed_minutes(range, from, to, length, path == Path::Straight);
+        let (duration, feed) = minutes.map_or((0.0, None), |minutes| (minutes * 60.0, Some(length / minutes)));
+        Moved { motion: Motion::Feed, path, length, duration, feed }
+    }
+
+    /// Minutes of a feed move of `length` mm from `from` to `to` (Z, X
+    /// radius), along a line or an arc; `None` after reporting why the axes
+    /// cannot move. Under G96 the rpm follows the radius up to the G50
+    /// limit: exactly along a line, at the mean radius along an arc.
+    fn feed_minutes(&mut self, range: TextRange, from: [f64; 2], to: [f64; 2], length: f64, line: bool) -> Option<f64> {
         let Some(feed) = self.feed.filter(|&feed| feed > 0.0) else {
             self.finding(
                 RunRule::MotionWithoutFeed,
@@ -472,13 +527,25 @@ impl<'a> Interpreter<'a> {
             return None;
         };
         if self.modes.get(FEED_MODE) == Some(98) {
-            return Some(feed);
+            return Some(length / feed);
         }
+        let rpm = self.spindle_rpm(range, (from[1] + to[1]) / 2.0)?;
+        if line && self.modes.get(SPEED_MODE) == Some(96) {
+            let limit = self.speed_limit.unwrap_or(f64::INFINITY);
+            return Some(turning_minutes(length, [from[1], to[1]], 1000.0 * self.speed / TAU, limit) / feed);
+        }
+        Some(length / (feed * rpm))
+    }
+
+    /// The spindle's rpm at `radius`: S under G97, the cutting speed S
+    /// (m/min) over the circumference under G96, at most the G50 limit;
+    /// `None` after reporting a spindle that does not turn.
+    fn spindle_rpm(&mut self, range: TextRange, radius: f64) -> Option<f64> {
         let spindle_on = matches!(self.modes.get(SPINDLE), Some(3 | 4));
         let limit = self.speed_limit.unwrap_or(f64::INFINITY);
         let rpm = match self.modes.get(SPEED_MODE) {
             _ if !spindle_on => 0.0,
-            Some(96) => (1000.0 * self.speed / (std::f64::consts::PI * diameter.abs())).min(limit),
+            Some(96) => (1000.0 * self.speed / (TAU * radius.abs())).min(limit),
             _ => self.speed.min(limit),
         };
         if !rpm.is_finite() {
@@ -486,11 +553,12 @@ impl<'a> Interpreter<'a> {
             return None;
         }
         if rpm <= 0.0 {
-            let message = "feed per revolution (G99) with the spindle stopped or at S0: the axes cannot move";
+            let message =
+                "feed per revolution (G99) or a thread with the spindle stopped or at S0: the axes cannot move";
             self.finding(RunRule::MotionWithoutFeed, range, message);
             return None;
         }
-        Some(feed * rpm)
+        Some(rpm)
     }
 
     fn statement(&mut self, statement: &Statement, range: TextRange, at: usize, program: &Program) -> Flow {
@@ -629,6 +697,27 @@ impl<'a> Interpreter<'a> {
     }
 }
 
+/// Minutes of a line `length` mm long from radius `radii[0]` to `radii[1]`
+/// at 1 mm per revolution, the spindle at min(`k`/|r|, `limit`) rpm (G96):
+/// the integral of max(|r|/k, 1/limit) along the line, the radius changing
+/// linearly.
+fn turning_minutes(length: f64, [from, to]: [f64; 2], k: f64, limit: f64) -> f64 {
+    // The radius under which the limit holds.
+    let clamp = k / limit;
+    let per_mm = |r: f64| (r.abs() / k).max(1.0 / limit);
+    // The integral of `per_mm` from 0 to r.
+    let integral = |r: f64| {
+        let a = r.abs();
+        let part = if a <= clamp { a / limit } else { clamp / limit + (a * a - clamp * clamp) / (2.0 * k) };
+        part.copysign(r)
+    };
+    if (to - from).abs() < 1e-9 {
+        length * per_mm(from)
+    } else {
+        length * (integral(to) - integral(from)) / (to - from)
+    }
+}
+
 /// The centre of the arc of `radius` from `from` to `to`: on the side that
 /// makes it at most a half circle, the other side for a negative radius
 /// (lathe manual §5.8 (001:658-660)). `None` when the ends lie farther
@@ -647,5 +736,6 @@ fn centre_by_radius(from: [f64; 2], to: [f64; 2], radius: f64, ccw: bool, tolera
     Some([middle[0] + side * height * left[0], middle[1] + side * height * left[1]])
 }
 
+mod canned;
 #[cfg(test)]
 mod tests;
