@@ -611,3 +611,79 @@ fn the_manual_s_g90_example_cuts_from_the_start_point() {
         close_point(end(pass[3]), [3.0, 26.0]);
     }
 }
+
+mod any_words {
+    use proptest::prelude::*;
+
+    use super::{lathe, run};
+    use nc_exec::haas_lathe::cycles::MAX_MOVES;
+
+    /// A word's value: zero, signs, tiny and odd sizes.
+    fn value() -> impl Strategy<Value = String> {
+        prop::sample::select(vec!["0", "-1.", "0.001", "0.5", "2.", "3.7", "-12.5", "40.", "4.", "1", "#1", "[1/3]"])
+            .prop_map(str::to_owned)
+    }
+
+    /// A cycle with the word it needs most (ending each code) and others.
+    fn cycle() -> impl Strategy<Value = String> {
+        let codes = prop::sample::select(vec![
+            "G70 P10 Q20 F",
+            "G71 P10 Q20 D",
+            "G72 P10 Q20 D",
+            "G73 P10 Q20 D",
+            "G74 Z-20. K",
+            "G75 X20. I",
+            "G76 X50. D",
+            "G90 X",
+            "G92 X",
+            "G94 Z",
+            "G32 Z",
+            "G81 Z",
+            "G83 Z-10. Q",
+            "G84 Z",
+            "G87 Z",
+            "G184 Z",
+        ]);
+        let letters = prop::collection::vec((prop::sample::select(b"XZUWIKDAPQRJL".to_vec()), value()), 0..5);
+        (codes, value(), letters).prop_map(|(code, needed, words)| {
+            let words: Vec<String> =
+                words.into_iter().map(|(letter, value)| format!("{}{value}", char::from(letter))).collect();
+            format!("{code}{needed} {} F0.2", words.join(" "))
+        })
+    }
+
+    fn contour() -> impl Strategy<Value = Vec<String>> {
+        let block = prop::sample::select(vec![
+            "G00 X20.",
+            "G01 Z-10.",
+            "X30. Z-15.",
+            "G02 U10. W-5. R5.",
+            "G03 U-10. W-5. R5.",
+            "G02 W-10. R-6.",
+            "Z-40.",
+            "X10.",
+            "U5. W-3.",
+            "G03 U20. W-10. R10.",
+            "G00 X62.",
+        ]);
+        prop::collection::vec(block, 1..6).prop_map(|blocks| blocks.into_iter().map(str::to_owned).collect())
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+        #[test]
+        fn any_cycle_words_run_to_an_end(cycle in cycle(), contour in contour(), repeat in value()) {
+            let mut text = format!("O1\n#1 = 2.\nG97 S500 M03\nG00 X60. Z2.\n{cycle}\nN10 {}\n", contour[0]);
+            for block in &contour[1..] {
+                text.push_str(block);
+                text.push('\n');
+            }
+            text.push_str(&format!("N20 G00 X{repeat}\nX45.\nM30\n"));
+            let trace = run(&text, &lathe(&[]), 1000);
+            prop_assert!(trace.steps.len() <= 4 * MAX_MOVES);
+            for step in &trace.steps {
+                prop_assert!(step.duration.is_finite() && step.length.is_finite(), "{text}\n{step:?}");
+            }
+        }
+    }
+}
