@@ -7,7 +7,7 @@ use std::{collections::BTreeMap, f64::consts::PI};
 use nc_exec::{
     haas_lathe::cycles::{ThreadMethod, thread_depths},
     machine::MachineConfig,
-    run::{self as runner, Motion, NoFiles, Path, RunRule, Step, Trace},
+    run::{self as runner, Motion, NoFiles, Path, RunRule, Step, Stop, Trace},
 };
 use ncc_catalog::Dialect;
 
@@ -401,6 +401,30 @@ fn g81_drills_from_the_r_plane_and_returns_to_it() {
     assert_eq!(ends, [[2.0, 0.0], [-20.0, 0.0], [2.0, 0.0]]);
     assert_eq!(hole.iter().map(|step| step.motion).collect::<Vec<_>>(), [Motion::Rapid, Motion::Feed, Motion::Rapid]);
     close(hole[1].duration, 22.0 / (0.1 * 800.0) * 60.0);
+}
+
+#[test]
+fn g84_taps_at_one_lead_a_revolution_and_g87_stops_for_the_operator() {
+    // The spindle is stopped: G84 switches it on. In and out at 1.5 × 500.
+    let text = "O1\nG97 S500 M05\nG00 X0. Z5.\nG84 Z-15. R2. F1.5\nG80\nG87 Z-10. R2. F0.1\nM30\n";
+    let trace = run(text, &lathe(&[]), 100);
+    no_findings(&trace);
+    let tap = steps_of(&trace, text, "G84 Z-15. R2. F1.5");
+    assert_eq!(tap.len(), 3);
+    for (step, z) in tap[1..].iter().zip([-15.0, 2.0]) {
+        assert_eq!(step.path, Path::Thread { lead: 1.5, speed: 500.0 });
+        close(step.end[1], z);
+        close(step.duration, 17.0 / (1.5 * 500.0) * 60.0);
+    }
+    // G87 (already at R after the tap): in at feed, a program stop at the
+    // bottom, out after it.
+    let bore = steps_of(&trace, text, "G87 Z-10. R2. F0.1");
+    let stops: Vec<Option<Stop>> = bore.iter().map(|step| step.stop).collect();
+    assert_eq!(stops, [None, Some(Stop::Program), None]);
+    assert_eq!(bore[1].motion, Motion::None);
+    close(bore[1].end[1], -10.0);
+    close(bore[2].end[1], 2.0);
+    assert_eq!(trace.totals().program_stops, 1);
 }
 
 #[test]

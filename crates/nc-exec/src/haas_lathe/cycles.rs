@@ -44,11 +44,14 @@
 //!   the end only); an end left out cuts one groove at the start. The I of
 //!   G75 is a radius, as the I of G74 is. D ("Zdvih", OQ-12, OQ-13) is
 //!   left out.
-//! - Drilling runs along Z at the hole's X. R is an absolute Z (OQ-7);
-//!   without R the plane is the start Z. Every return goes to the R plane
-//!   moved by Setting 52 away from the hole (the manual: Setting 52 "can
-//!   influence the return plane R", 001:1191). W of the depth counts from
-//!   the start Z.
+//! - Drilling runs along Z at the hole's X, reached at rapid first. R is
+//!   an absolute Z (OQ-7); without R the plane is the start Z. Every
+//!   return goes to the R plane, as the manual's steps all do (001:1173,
+//!   1235, 1319, 1373, 1402, 1410; G98/G99 are feed modes on this control,
+//!   so there is no return to the start plane), moved by Setting 52 away
+//!   from the hole (it "can influence the return plane R", 001:1191). W of
+//!   the depth counts from the start Z. L repeats the hole where it is;
+//!   L0 only positions.
 //! - G83 re-enters each peck at rapid down to Setting 22 above the depth
 //!   reached (the "A" of the figure); degressive pecks shrink by J down to
 //!   K, and need K when J is given (else they would vanish).

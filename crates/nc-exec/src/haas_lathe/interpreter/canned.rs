@@ -2,6 +2,20 @@
 //! what stays in force from block to block (the box cycles' target, the
 //! drilling cycle's depth, plane and pecks), reads the P..Q contour, and
 //! times the moves of [`cycles`] and [`roughing`] as steps of the block.
+//!
+//! Assumptions the manual does not settle:
+//! - G90/G92/G94 keep their target and taper for the blocks that repeat
+//!   them with some words (Fanuc keeps them; the manual's example repeats
+//!   with X alone, 001:2833-2837); a block that programs G00–G03, G32,
+//!   G90, G92 or G94 starts anew.
+//! - The contour is read from the tool's position in the motion mode in
+//!   force, as the blocks P to Q program it; the modes they set do not
+//!   outlast the cycle. A cycle whose contour the program model did not
+//!   find (P or Q missing, not found, ambiguous, computed, or Q before P)
+//!   stops the run, as a missing call target does.
+//! - G84/G184 switch the spindle on (001:1380) and leave it on.
+//! - A move of a cycle without a feed or a turning spindle is reported
+//!   once for the block, not once per move.
 
 use ncc_syntax::TextRange;
 
