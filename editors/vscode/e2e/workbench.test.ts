@@ -299,6 +299,47 @@ describe('the packaged extension in code-server', () => {
     assert.ok(moves.includes(rapid), `the rapid move of line ${rapid} is drawn`);
   });
 
+  test('a Haas lathe program is read: hover on G71 shows its documentation, and no error notification', async () => {
+    const heading = execFileSync(NCC_BIN, ['explain', '--dialect', 'haas-lathe', 'G71'], { encoding: 'utf8' })
+      .split('\n')[0]
+      .replace(/^#+\s*/, '');
+    await workbench.openFile('O1000.nc');
+    let attempt = 0;
+    const hover = await until(async () => {
+      const g71 = await workbench.page.evaluate((editorLines) => {
+        const tokens = document.querySelectorAll<HTMLElement>(`${editorLines} .view-line span span`);
+        const token = [...tokens].find((t) => t.innerText.trim() === 'G71');
+        const box = token?.getBoundingClientRect();
+        return box ? { x: box.x + box.width / 2, y: box.y + box.height / 2 } : undefined;
+      }, EDITOR_LINES);
+      if (g71) {
+        attempt += 1;
+        await workbench.page.mouse.move(g71.x + (attempt % 3) - 1, g71.y, { steps: 4 });
+        await sleep(1500);
+      }
+      return workbench.page.evaluate(
+        (text) =>
+          [...document.querySelectorAll<HTMLElement>('.monaco-hover')]
+            .map((h) => (h.offsetParent ? h.innerText : ''))
+            .find((t) => t.includes(text)),
+        heading,
+      );
+    }, 'the hover with the documentation of G71');
+    await workbench.screenshot('5-haas-hover');
+    await workbench.page.mouse.move(0, 0);
+    assert.ok(hover.includes(heading), hover);
+    const status = await workbench.page.evaluate(() => document.querySelector<HTMLElement>('.part.statusbar')?.innerText ?? '');
+    assert.match(status, /Haas lathe/);
+    const toasts = await workbench.page.evaluate(() =>
+      [...document.querySelectorAll<HTMLElement>('.notification-toast')].map((t) => t.innerText),
+    );
+    assert.deepEqual(
+      toasts.filter((toast) => /failed|is not open/.test(toast)),
+      [],
+      'no notification about the requests on O1000.nc',
+    );
+  });
+
   test('a Sinumerik program gets the note that ncc does not read it, and no error notification', async () => {
     const note = 'ncc does not read Siemens Sinumerik programs yet';
     await workbench.openFile('MAIN.MPF');
@@ -324,7 +365,7 @@ describe('the packaged extension in code-server', () => {
       note,
     );
     await sleep(3000);
-    await workbench.screenshot('5-not-read');
+    await workbench.screenshot('6-not-read');
     await workbench.page.mouse.move(0, 0);
     assert.match(problems, /MAIN\.MPF/);
     // The language's name in the status bar.
@@ -370,7 +411,7 @@ describe('a server that exits as it starts', () => {
       'the notification',
       reason,
     );
-    await workbench.screenshot('6-start-failure');
+    await workbench.screenshot('7-start-failure');
     assert.match(toast, /exited as it started/);
     assert.match(toast, /Show Log/);
     // The client's own notification would cover this one and its button.
@@ -389,6 +430,6 @@ describe('a server that exits as it starts', () => {
       'the reason in the log',
       reason,
     );
-    await workbench.screenshot('7-log');
+    await workbench.screenshot('8-log');
   });
 });
