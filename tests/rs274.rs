@@ -61,8 +61,14 @@ struct Ran {
 impl Ran {
     fn agrees_with(&self, other: &Ran) -> bool {
         let close = |a: f64, b: f64| (a - b).abs() <= TOLERANCE_MM;
+        // Feeds the interpreter derives (a thread's lead times the speed)
+        // may differ in the last bit.
+        let same_feed = match (self.feed, other.feed) {
+            (Some(a), Some(b)) => (a - b).abs() <= 1e-9 * a.abs().max(b.abs()),
+            (a, b) => a == b,
+        };
         self.rapid == other.rapid
-            && self.feed == other.feed
+            && same_feed
             && close(self.length, other.length)
             && (0..3).all(|axis| close(self.end[axis], other.end[axis]))
     }
@@ -236,6 +242,10 @@ fn ncc_motions(file: &Path) -> Vec<Ran> {
 /// A canonical call of `rs274 -g` that moves or sets the feed.
 enum Call {
     Feed(f64),
+    /// `SET_SPINDLE_SPEED`'s rpm.
+    Speed(f64),
+    /// `START_SPEED_FEED_SYNC`'s lead in mm per revolution, or its end.
+    Sync(Option<f64>),
     /// `STRAIGHT_TRAVERSE` or `STRAIGHT_FEED` to (x, y, z).
     Straight {
         rapid: bool,
@@ -270,6 +280,10 @@ fn rs274_calls(rs274: &Path, file: &Path) -> Vec<Call> {
         let numbers = || -> Vec<f64> { args.split(", ").map(|arg| arg.parse().unwrap()).collect() };
         calls.push(match name {
             "SET_FEED_RATE" => Call::Feed(numbers()[0]),
+            "SET_SPINDLE_SPEED" => Call::Speed(numbers()[1]),
+            // `START_SPEED_FEED_SYNC(1.500000,0)`: no blank after the comma.
+            "START_SPEED_FEED_SYNC" => Call::Sync(args.split(',').next().and_then(|lead| lead.parse().ok())),
+            "STOP_SPEED_FEED_SYNCH" => Call::Sync(None),
             "STRAIGHT_TRAVERSE" | "STRAIGHT_FEED" => Call::Straight {
                 rapid: name == "STRAIGHT_TRAVERSE",
                 end: <[f64; 3]>::try_from(&numbers()[..3]).unwrap(),
@@ -289,15 +303,26 @@ fn rs274_calls(rs274: &Path, file: &Path) -> Vec<Call> {
 /// [2, 0, 1].
 fn rs274_motions_in(rs274: &Path, file: &Path, plane: [usize; 3]) -> Vec<Ran> {
     let (mut at, mut feed, mut motions) = ([0.0; 3], 0.0, Vec::new());
+    let (mut speed, mut lead) = (0.0, None);
     for call in rs274_calls(rs274, file) {
         let ran = match call {
             Call::Feed(rate) => {
                 feed = rate;
                 continue;
             }
+            Call::Speed(rpm) => {
+                speed = rpm;
+                continue;
+            }
+            Call::Sync(synchronised) => {
+                lead = synchronised;
+                continue;
+            }
             Call::Straight { rapid, end } => {
                 let length = (0..3).map(|axis| (end[axis] - at[axis]).powi(2)).sum::<f64>().sqrt();
-                Ran { rapid, end, feed: (!rapid).then_some(feed), length }
+                // A thread feeds at its lead per spindle revolution.
+                let rate = lead.map_or(feed, |lead| lead * speed);
+                Ran { rapid, end, feed: (!rapid).then_some(rate), length }
             }
             Call::Arc(n) => {
                 let mut end = [0.0; 3];
@@ -367,17 +392,44 @@ fn lathe_motion_matches_rs274() {
 /// A random lathe program as Haas and NGC text, and its blocks, whose ends
 /// are kept as (radius, 0, Z) in µm like the motions compared. NGC writes
 /// every end absolutely; Haas writes each axis as X/Z or as an increment
-/// U/W at random, both in the same block.
+/// U/W at random, both in the same block; a tenth of the moves are
+/// threads (Haas G32 F, rs274 G33 K).
 fn generate_lathe(seed: u64) -> (String, String, Vec<Block>) {
     let mut rng = Lcg::new(seed);
-    let mut haas = String::from("O1\nG98\n");
-    let mut ngc = String::from("G21 G18 G7 G90 G94\n");
+    // Threads run at the lead per revolution of this spindle speed.
+    let mut haas = String::from("O1\nG98\nG97 S500 M03\n");
+    let mut ngc = String::from("G21 G18 G7 G90 G94\nS500 M3\n");
     let mut blocks = Vec::with_capacity(MOTIONS_PER_PROGRAM);
     // (radius, Z) in µm.
     let mut at = [0i64; 2];
     let (mut modal, mut feed_set) = (None, false);
     let diameter = |radius: i64| mm(2 * radius);
     for _ in 0..MOTIONS_PER_PROGRAM {
+        if rng.below(10) == 0 {
+            // A thread G32 (rs274's G33): along Z, tapered at times, at a
+            // lead of 0.5 to 3 mm.
+            let mut end = [at[0], at[1] - 1_000 - rng.below(20_000) as i64];
+            if end[1] < -150_000 {
+                end[1] = at[1] + 1_000 + rng.below(5_000) as i64;
+            }
+            if rng.below(2) == 0 {
+                end[0] = (at[0] + rng.below(4_001) as i64 - 2_000).max(1_000);
+            }
+            let lead = mm(500 + rng.below(2_500) as i64);
+            let (x, z) = (diameter(end[0]), mm(end[1]));
+            let block = Block {
+                cnc: format!("G32 X{x} Z{z} F{lead}"),
+                ngc: format!("G33 X{x} Z{z} K{lead}"),
+                end: [end[0], 0, end[1]],
+            };
+            writeln!(haas, "{}", block.cnc).unwrap();
+            writeln!(ngc, "{}", block.ngc).unwrap();
+            blocks.push(block);
+            at = end;
+            // F was the lead: the next feed move writes its own.
+            (modal, feed_set) = (Some(32), false);
+            continue;
+        }
         let code = [0, 0, 1, 1, 1, 1, 2, 2, 3, 3][rng.below(10)];
         let mut haas_words = Vec::new();
         if modal != Some(code) || rng.below(3) > 0 {
@@ -481,7 +533,11 @@ fn lathe_motions(trace: &run::Trace) -> Vec<Ran> {
         .iter()
         .filter(|step| matches!(step.motion, Motion::Rapid | Motion::Feed))
         .map(|step| {
-            assert!(matches!(step.path, StepPath::Straight | StepPath::Arc { .. }), "{:?}", step.path);
+            assert!(
+                matches!(step.path, StepPath::Straight | StepPath::Arc { .. } | StepPath::Thread { .. }),
+                "{:?}",
+                step.path
+            );
             Ran {
                 rapid: step.motion == Motion::Rapid,
                 end: [step.end[x], 0.0, step.end[z]],
