@@ -37,6 +37,8 @@
 //!   and jumps) and [`haas_lathe::interpreter`] (the modal state, motion,
 //!   macro statements and time of a program, block by block; the run
 //!   driver does not pick it yet).
+//! - [`expand`]: what the writers of expanded programs share, and the
+//!   [`expand::Expand`] interface the command line drives them by.
 //! - [`envelope`]: the CNC8x9 envelope velocity, a streaming look-ahead
 //!   planner of up to 500 blocks with linear or jerk-limited ramps.
 //! - [`known`]: values a static reading may not know.
@@ -58,6 +60,7 @@ pub(crate) mod axes;
 pub mod cnc8x6;
 pub(crate) mod compensation;
 pub(crate) mod envelope;
+pub mod expand;
 pub mod haas_lathe;
 pub mod known;
 pub mod machine;
