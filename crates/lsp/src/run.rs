@@ -367,8 +367,8 @@ fn expand_program(program: &Program<'_>, path: &Path, output: Option<&Path>, ste
             Box::new(cnc8x6::expand::Expansion::new(out, machine, number, &title))
         }
         Dialect::HaasLathe => {
-            eprintln!("error: ncc expand does not write Haas lathe programs yet");
-            return ExitCode::from(2);
+            let number = haas_lathe::program::first_program_number(program.text).unwrap_or(1);
+            Box::new(haas_lathe::expand::Expansion::new(out, machine, number, &title))
         }
     };
     let ran = Ran::run(program, &config, Progress::OnTerminal, |text, library| {

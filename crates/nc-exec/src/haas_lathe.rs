@@ -2,11 +2,12 @@
 //! Fanuc-style ISO code): its block IR and lowering, the macro-expression
 //! evaluator, the program model (programs, block numbers, the P/Q
 //! contours of G70–G73 and the targets of calls and jumps), the
-//! interpreter that runs a program into a trace, and the velocity policy
-//! that times it.
+//! interpreter that runs a program into a trace, the velocity policy
+//! that times it, and the writer of expanded programs.
 
 pub mod dynamics;
 pub mod eval;
+pub mod expand;
 pub mod interpreter;
 pub mod lower;
 pub mod program;

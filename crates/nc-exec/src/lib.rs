@@ -34,9 +34,9 @@
 //!   tree), [`haas_lathe::eval`] (macro expressions over partly unknown
 //!   variables), [`haas_lathe::program`] (the programs of a file, their
 //!   block numbers, the P/Q contours of G70–G73 and the targets of calls
-//!   and jumps) and [`haas_lathe::interpreter`] (the modal state, motion,
-//!   macro statements and time of a program, block by block; the run
-//!   driver does not pick it yet).
+//!   and jumps), [`haas_lathe::interpreter`] (the modal state, motion,
+//!   macro statements and time of a program, block by block) and
+//!   [`haas_lathe::expand`] (a run written back as plain lathe blocks).
 //! - [`expand`]: what the writers of expanded programs share, and the
 //!   [`expand::Expand`] interface the command line drives them by.
 //! - [`envelope`]: the CNC8x9 envelope velocity, a streaming look-ahead
