@@ -742,6 +742,67 @@ fn expand_writes_a_program_with_the_same_moves() {
     assert!(!report.contains(": error"), "{report}");
 }
 
+/// A Haas turning program whose passes a WHILE loop makes, under constant
+/// cutting speed.
+const HAAS_ROUGHING: &str = "%
+O1 (ROUGHING)
+G50 S3000
+G96 S180 M03
+G00 X64. Z2.
+G99 F0.25
+#1 = 60.
+WHILE [#1 GT 48.] DO1
+G00 X#1 Z2.
+G01 Z-30.
+G02 U6. W-3. R3.
+G00 U2. Z2.
+#1 = #1 - 4.
+END1
+G04 P250
+M30
+%
+";
+
+/// `ncc expand` writes a Haas program as plain lathe blocks: the loop
+/// unrolled, X as a diameter, the feed per minute each pass ran at; it
+/// passes `ncc check` and runs the same moves in the same time.
+#[test]
+fn expand_writes_a_haas_program_as_plain_lathe_blocks() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("O1.nc");
+    std::fs::write(&program, HAAS_ROUGHING).unwrap();
+    let (program, expanded) = (program.to_str().unwrap(), dir.path().join("out.nc"));
+    let expanded = expanded.to_str().unwrap();
+    let output = ncc(&["expand", program, "-o", expanded]);
+    assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
+    let text = std::fs::read_to_string(expanded).unwrap();
+    // 180 m/min at Ø60 is 954.93 rpm, at 0.25 mm/rev 238.732 mm/min.
+    assert!(text.starts_with("%\nO1 (EXPANDED FROM O1.nc)\nG18 G21 G40 G97 G98\nG00 X64. Z2.\nG00 X60.\n"), "{text}");
+    assert!(text.contains("\nG01 Z-30. F238.732\nG02 X66. Z-33. I3. K0. F227.364\nG00 X68. Z2.\n"), "{text}");
+    assert_eq!(text.matches("G01 Z-30.").count(), 3, "{text}");
+    assert!(text.ends_with("G00 X60. Z2.\nG04 P250\nM30\n%\n"), "{text}");
+    let check = ncc(&["check", expanded]);
+    assert_eq!(check.status.code(), Some(0), "{}", stdout(&check));
+    assert_eq!(stdout(&check), "All checks passed (1 file checked).\n");
+    let moves = |program: &str| {
+        let output = ncc(&["run", program, "--format", "json"]);
+        assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
+        let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+        let ends: Vec<String> = json["blocks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|b| b["motion"] != "none" && b["length_mm"].as_f64() != Some(0.0))
+            .map(|b| format!("{} {}", b["motion"], b["end"]["program"]))
+            .collect();
+        (ends, json["total_time_s"].as_f64().unwrap())
+    };
+    let ((original, original_time), (again, again_time)) = (moves(program), moves(expanded));
+    assert_eq!(original.len(), 13);
+    assert_eq!(again, original);
+    assert!((again_time - original_time).abs() < 1e-3 * original_time, "{original_time} s, expanded {again_time} s");
+}
+
 /// A contour under radius compensation (D1 of radius 5 on the left, G41):
 /// the control moves the tool centre on the equidistant and displays it.
 const COMPENSATED: &str = "%1\nN1 G92 D1 R0=5.\nN2 G92 X-100 Y0\nN3 G00 X0 Y-20 D1\nN4 G41 G01 X0 Y0 F600\nN5 X50\nN6 Y50\nN7 G40 X70 Y70\nN8 M30\n";

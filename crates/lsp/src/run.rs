@@ -18,8 +18,8 @@ use std::{
 
 use indicatif::{ProgressBar, ProgressStyle};
 use nc_exec::{
-    cnc8x6::expand::{ExpandError, Expansion},
-    cnc8x6::lower::BlockData,
+    cnc8x6::{self, lower::BlockData},
+    expand::{Expand, ExpandError},
     haas_lathe,
     run::{Axes, Called, Environment, Message, MessageDisplay, Motion, Step, Stop, Totals, Trace, expected_blocks},
     velocity::{self, Dynamics, Timer, Timing, TimingSink},
@@ -359,21 +359,24 @@ fn expand_program(program: &Program<'_>, path: &Path, output: Option<&Path>, ste
     };
     let name = path.file_name().map_or_else(|| path.display().to_string(), |name| name.to_string_lossy().into_owned());
     let title = format!("EXPANDED FROM {name}");
-    let number = program_number(program.text).unwrap_or(1);
+    let out = io::BufWriter::new(out);
     // The expansion is written in the program's own dialect.
-    let mut expansion = match program.dialect {
-        Dialect::Cnc8x6 => Expansion::new(io::BufWriter::new(out), machine, number, &title),
+    let mut expansion: Box<dyn Expand> = match program.dialect {
+        Dialect::Cnc8x6 => {
+            let number = program_number(program.text).unwrap_or(1);
+            Box::new(cnc8x6::expand::Expansion::new(out, machine, number, &title))
+        }
         Dialect::HaasLathe => {
-            eprintln!("error: ncc expand does not write Haas lathe programs yet");
-            return ExitCode::from(2);
+            let number = haas_lathe::program::first_program_number(program.text).unwrap_or(1);
+            Box::new(haas_lathe::expand::Expansion::new(out, machine, number, &title))
         }
     };
     let ran = Ran::run(program, &config, Progress::OnTerminal, |text, library| {
-        nc_exec::run::run_into(text, library, machine, step_budget, &mut expansion)
+        nc_exec::run::run_into(text, library, machine, step_budget, &mut *expansion)
     });
     ran.print_findings();
     let failure = match expansion.finish() {
-        Ok(_) => return ran.exit_code(),
+        Ok(()) => return ran.exit_code(),
         Err(ExpandError::Io(error)) if error.kind() == io::ErrorKind::BrokenPipe => return ran.exit_code(),
         Err(failure) => failure,
     };

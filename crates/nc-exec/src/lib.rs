@@ -37,8 +37,11 @@
 //!   and jumps), [`haas_lathe::cycles`] and [`haas_lathe::roughing`] (the
 //!   canned cycles as moves), [`haas_lathe::interpreter`] (the modal
 //!   state, motion, cycles, macro statements and time of a program, block
-//!   by block, which [`run`] runs on a Haas machine) and
-//!   [`haas_lathe::dynamics`] (its velocity policy).
+//!   by block, which [`run`] runs on a Haas machine),
+//!   [`haas_lathe::dynamics`] (its velocity policy) and
+//!   [`haas_lathe::expand`] (a run written back as plain lathe blocks).
+//! - [`expand`]: what the writers of expanded programs share, and the
+//!   [`expand::Expand`] interface the command line drives them by.
 //! - [`envelope`]: the CNC8x9 envelope velocity, a streaming look-ahead
 //!   planner of up to 500 blocks with linear or jerk-limited ramps.
 //! - [`known`]: values a static reading may not know.
@@ -60,6 +63,7 @@ pub(crate) mod axes;
 pub mod cnc8x6;
 pub(crate) mod compensation;
 pub(crate) mod envelope;
+pub mod expand;
 pub mod haas_lathe;
 pub mod known;
 pub mod machine;

@@ -16,17 +16,16 @@
 
 use std::{
     collections::VecDeque,
-    fmt,
     io::{self, Write},
 };
 
 use nalgebra::Point2;
-use ncc_syntax::TextRange;
 use smallvec::SmallVec;
 
 use crate::{
     cnc8x6::interpreter::reset_frame,
     compensation::ToolElement,
+    expand::{Expand, ExpandError, Unwritable, centre_offsets},
     machine::MachineConfig,
     tool_path::{Centred, tool_moves},
     trace::{Compensated, Motion, Path, Position, Step, StepSink, Stop, round3, slot},
@@ -36,33 +35,8 @@ use crate::{
 /// The longest line the control reads (000:612).
 const MAX_LINE: usize = 80;
 
-/// A move the written program cannot express, at its block.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Unwritable {
-    /// The block's file, as in [`Step::source`], and its range there.
-    pub source: usize,
-    pub range: TextRange,
-}
-
-impl fmt::Display for Unwritable {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("an arc turned out of its plane by a transformation (G38/G39/G31) is no arc of any plane")
-    }
-}
-
-/// Why an expansion stopped writing.
-#[derive(Debug)]
-pub enum ExpandError {
-    Unwritable(Unwritable),
-    /// The output could not be written.
-    Io(io::Error),
-}
-
-impl From<io::Error> for ExpandError {
-    fn from(error: io::Error) -> ExpandError {
-        ExpandError::Io(error)
-    }
-}
+/// Why a move is unwritable: the one move this writer cannot express.
+const OUT_OF_PLANE: &str = "an arc turned out of its plane by a transformation (G38/G39/G31) is no arc of any plane";
 
 /// Writes the moves of a run as program `%number` to `out` while the run
 /// goes: a [`StepSink`] for `run::run_into` (a sink on a thread of
@@ -143,7 +117,8 @@ impl<W: Write> Expansion<W> {
         let mut blocks: SmallVec<[Vec<String>; 2]> = SmallVec::new();
         for tool_move in &moves {
             let to = by_letter(&tool_move.end, axes);
-            let unwritable = || ExpandError::Unwritable(Unwritable { source: step.source, range: step.range });
+            let unwritable =
+                || ExpandError::Unwritable(Unwritable { source: step.source, range: step.range, reason: OUT_OF_PLANE });
             let path = frames.path(&tool_move.path, &to).ok_or_else(unwritable)?;
             let to = frames.to_written(&to);
             blocks.push(self.writer.words(axes, step.motion, &path, &to, tool_move.feed, step.duration));
@@ -206,6 +181,12 @@ impl<W: Write> StepSink for Expansion<W> {
     /// Nothing more is written after a failure, so the run need not go on.
     fn closed(&self) -> bool {
         self.failure.is_some()
+    }
+}
+
+impl<W: Write> Expand for Expansion<W> {
+    fn finish(self: Box<Self>) -> Result<(), ExpandError> {
+        Expansion::finish(*self).map(drop)
     }
 }
 
@@ -299,7 +280,8 @@ impl<W: Write> Writer<W> {
                 // first two axes written.
                 words.extend([*a, *b].map(coordinate));
                 words.extend(changed.into_iter().filter(|axis| axis != a && axis != b).map(coordinate));
-                let (i, j) = self.centre_offsets((*a, *b), *centre, &end);
+                let start = [self.at[slot(*a)], self.at[slot(*b)]];
+                let [i, j] = centre_offsets(start, [end[slot(*a)], end[slot(*b)]], *centre);
                 words.push(format!("I{i:.3}"));
                 words.push(format!("J{j:.3}"));
                 words.extend(self.feed_word(feed));
@@ -321,25 +303,6 @@ impl<W: Write> Writer<W> {
             self.feed = Some(feed);
             format!("F{feed}")
         })
-    }
-
-    /// I and J to the micrometre, chosen among the roundings of the centre
-    /// so that the written end lies on the written circle.
-    fn centre_offsets(&self, (a, b): (u8, u8), centre: [f64; 2], end: &Position) -> (f64, f64) {
-        let (start, end) = ([self.at[slot(a)], self.at[slot(b)]], [end[slot(a)], end[slot(b)]]);
-        let exact = [centre[0] - start[0], centre[1] - start[1]];
-        let mismatch = |(i, j): (f64, f64)| {
-            let (ci, cj) = (start[0] + i, start[1] + j);
-            (i.hypot(j) - (end[0] - ci).hypot(end[1] - cj)).abs()
-        };
-        // The plain rounding first, then its neighbours: the first within
-        // half the tolerance, else the best.
-        let near = |value: f64| [0.0, -0.001, 0.001].map(|delta| round3(value) + delta);
-        let candidates: Vec<(f64, f64)> =
-            near(exact[0]).into_iter().flat_map(|i| near(exact[1]).map(move |j| (i, j))).collect();
-        let good = candidates.iter().copied().find(|&candidate| mismatch(candidate) <= 0.0005);
-        let best = || candidates.iter().copied().min_by(|x, y| mismatch(*x).total_cmp(&mismatch(*y)));
-        good.or_else(best).unwrap_or((exact[0], exact[1]))
     }
 
     /// Writes a block, continuing on further lines past the line length.
@@ -443,7 +406,7 @@ N102 G90 G70
         let text = "%1\nN1 G38 X0 Z0 I30\nN2 G38\nN3\nN4 G02 X10 Y0 I5 J0 F500\nN5 M30\n";
         let trace = run_text(text);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
-        let Err(ExpandError::Unwritable(Unwritable { source: 0, range })) =
+        let Err(ExpandError::Unwritable(Unwritable { source: 0, range, .. })) =
             expand_on(&MachineConfig::default(), text, 1, "")
         else {
             panic!("the arc turned out of its plane is written");

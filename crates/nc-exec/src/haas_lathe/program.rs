@@ -10,7 +10,9 @@ use std::{
     ops::{Range, RangeInclusive},
 };
 
-use super::lower::{HaasBlock, Statement, Value, Word};
+use ncc_syntax::{Dialect, Parse};
+
+use super::lower::{HaasBlock, Statement, Value, Word, block_nodes};
 
 /// One program: from its `O` line to the next, or the blocks before the
 /// first `O` line when they hold anything.
@@ -346,6 +348,15 @@ impl ProgramModel {
 }
 
 /// Splits the file's blocks at its `O` lines.
+/// The number of the program a run of `text` runs, the file's first, as
+/// [`ProgramModel`] splits the file: `None` when blocks before any `O` line
+/// make the first program, or its `O` has no number.
+pub fn first_program_number(text: &str) -> Option<u32> {
+    let parse = Parse::new(text, Dialect::HaasLathe);
+    let first = block_nodes(parse.green()).map(|(_, block)| HaasBlock::lower(block)).find(HaasBlock::has_content);
+    first?.program?.number
+}
+
 fn split_programs(blocks: &[HaasBlock]) -> Vec<Program> {
     let starts: Vec<usize> = blocks.iter().enumerate().filter(|(_, b)| b.program.is_some()).map(|(i, _)| i).collect();
     let mut programs = Vec::new();
@@ -479,11 +490,9 @@ fn ignored_words(
 
 #[cfg(test)]
 mod tests {
-    use ncc_syntax::{Dialect, Parse};
     use proptest::prelude::*;
 
     use super::*;
-    use crate::haas_lathe::lower::block_nodes;
 
     fn model(text: &str) -> ProgramModel {
         let parse = Parse::new(text, Dialect::HaasLathe);
@@ -653,6 +662,15 @@ mod tests {
         assert_eq!((program.number, program.blocks.clone()), (None, 0..4));
         assert_eq!(program.block_numbers.get(&1), Some(&vec![1, 2]));
         assert_eq!(program.block_numbers.get(&5), Some(&vec![3]));
+    }
+
+    #[test]
+    fn the_run_s_program_number_is_the_first_program_s() {
+        assert_eq!(first_program_number("%\nO1234 (T)\nG00 X1.\nO5\n%\n"), Some(1234));
+        assert_eq!(first_program_number("\n(NOTE)\nO7\nG00 X1.\n"), Some(7));
+        // Blocks before the first O line are the program a run runs.
+        assert_eq!(first_program_number("G00 X1.\nO5\n"), None);
+        assert_eq!(first_program_number(""), None);
     }
 
     #[test]

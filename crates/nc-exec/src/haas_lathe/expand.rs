@@ -1,0 +1,247 @@
+//! A Haas lathe run written back as a program (`ncc expand`) while it
+//! runs: every move as a plain lathe block, with the macro statements,
+//! loops and jumps resolved, that runs the same moves.
+//!
+//! The program is `%`, `O<number> (<title>)`, a setup block, the moves,
+//! `M30` and `%` (lathe manual §5.1 (001:1800, 3712)):
+//! - The setup block `G18 G21 G40 G97 G98` puts the plane ZX, millimetres,
+//!   no tool-nose radius compensation, the spindle in rpm and the feed per
+//!   minute in force, whatever ran before the program.
+//! - The feed is per minute (G98) because it is what ran: under G99 the
+//!   feed per minute is F times the spindle speed, and under G96 that
+//!   speed, and with it the feed per minute, follows the diameter along
+//!   the move; the run's feed of a block is the average that gives its
+//!   time, so written per minute each block takes the time it took. F is
+//!   written to 0.001 mm/min.
+//! - X is written as the diameter (the run keeps the radius), X and Z to
+//!   the micrometre; like F they are written only when they change, but
+//!   the first move writes both: the run's start at X0 Z0 is its
+//!   assumption, not a place the machine is known to be.
+//! - Rapid moves are G00, lines G01, arcs G02/G03 by I (as a radius, as
+//!   the manual defines it) and K from the start to the centre, rounded so
+//!   that the end lies on the circle within 1 µm; an arc writes both X and
+//!   Z, so that a full circle still moves. G02 turns clockwise seen with
+//!   +Z to the right and +X up (lathe manual §5.8 (001:591-668)), the
+//!   sense the run keeps in its plane (Z, X).
+//! - Threads are G32 with the lead as F, after a block `S<rpm>` when the
+//!   spindle speed changes. The run does not say which way the spindle
+//!   turns, so no M03/M04 is written.
+//! - Dwells are `G04 P` in ms (without a decimal point, lathe manual §5.3
+//!   (001:55-71)), the stops M00/M01 where the run had them; exact stop
+//!   G61, and G64 back, where the run's blocks change between them (G09
+//!   becomes G61 for one block).
+//! - Tools, the spindle's other words and M functions other than stops
+//!   are not written: the expansion is the path and its time.
+//!
+//! No block is numbered: the numbers are optional (lathe manual §5.1
+//! (001:1800-1824)) and nothing jumps in an expansion. The manual names no
+//! line length; blocks of positions within ±99999.999 mm stay under 80
+//! characters. The run applies no work offsets yet, so the positions are
+//! the program's.
+
+use std::io::{self, Write};
+
+use crate::{
+    expand::{Expand, ExpandError, Unwritable, centre_offsets},
+    machine::MachineConfig,
+    trace::{Motion, Path, PathMode, Step, StepSink, Stop, slot},
+    transform::by_letter,
+};
+
+/// The plane of the run's arcs: Z first, the radius X second.
+const PLANE: (u8, u8) = (b'Z', b'X');
+
+const OUT_OF_PLANE: &str = "an arc outside the lathe's plane ZX (G18) cannot be written for a Haas lathe";
+
+/// Writes the moves of a Haas lathe run as program `O<number>` to `out`
+/// while the run goes: a [`StepSink`] that writes the block of each step as
+/// it comes and keeps nothing of it, so that a run of any length expands in
+/// the same memory.
+#[derive(Debug)]
+pub struct Expansion<W: Write> {
+    out: W,
+    axes: Vec<u8>,
+    /// Where the written program has the tool: Z and the diameter X, in µm;
+    /// nowhere before its first move.
+    at: Option<[i64; 2]>,
+    /// The number of the F in force, as written: mm/min, or the lead in
+    /// mm after a thread (one modal F serves both).
+    feed: Option<String>,
+    /// The S in force, rpm.
+    speed: Option<i64>,
+    /// Whether G61 is in force rather than G64.
+    exact_stop: bool,
+    /// What stopped the expansion: nothing is written after it.
+    failure: Option<ExpandError>,
+}
+
+impl<W: Write> Expansion<W> {
+    /// Starts program `O<number>`, with `title` as its comment, for a run on
+    /// `machine`.
+    pub fn new(out: W, machine: &MachineConfig, number: u32, title: &str) -> Expansion<W> {
+        let mut expansion = Expansion {
+            out,
+            axes: machine.step_axes().to_vec(),
+            at: None,
+            feed: None,
+            speed: None,
+            exact_stop: false,
+            failure: None,
+        };
+        // A comment ends at the first `)` and does not nest.
+        let title: String = title.chars().filter(|&c| c != '(' && c != ')' && !c.is_control()).collect();
+        let comment = if title.is_empty() { String::new() } else { format!(" ({title})") };
+        let started = write!(expansion.out, "%\nO{number}{comment}\nG18 G21 G40 G97 G98\n");
+        expansion.failure = started.err().map(ExpandError::Io);
+        expansion
+    }
+
+    /// Ends the program after the run, and hands back the output.
+    pub fn finish(mut self) -> Result<W, ExpandError> {
+        if let Some(failure) = self.failure {
+            return Err(failure);
+        }
+        self.out.write_all(b"M30\n%\n")?;
+        self.out.flush()?;
+        Ok(self.out)
+    }
+
+    /// Writes the blocks of `step`: none for a step without motion, time or
+    /// stop.
+    fn write(&mut self, step: &Step) -> Result<(), ExpandError> {
+        let end = by_letter(&step.end, &self.axes);
+        let to = [thousandths(end[slot(b'Z')]), thousandths(2.0 * end[slot(b'X')])];
+        let moved = self.at.map_or([true, true], |at| [to[0] != at[0], to[1] != at[1]]);
+        let mut words: Vec<String> = Vec::new();
+        match (step.motion, step.path) {
+            (Motion::None, _) => {}
+            (Motion::Dwell, _) => {
+                words.push("G04".to_owned());
+                words.push(format!("P{}", (step.duration * 1000.0).round().max(0.0) as i64));
+            }
+            (Motion::Rapid | Motion::Feed, path) if !moved.contains(&true) && !matches!(path, Path::Arc { .. }) => {}
+            (Motion::Rapid, _) => {
+                words.push("G00".to_owned());
+                words.extend(coordinates(to, moved));
+            }
+            (Motion::Feed, Path::Straight) => {
+                words.push("G01".to_owned());
+                words.extend(coordinates(to, moved));
+                words.extend(self.feed_word(step.feed));
+            }
+            (Motion::Feed, Path::Arc { plane, centre, clockwise }) => {
+                if plane != PLANE {
+                    let unwritable = Unwritable { source: step.source, range: step.range, reason: OUT_OF_PLANE };
+                    return Err(ExpandError::Unwritable(unwritable));
+                }
+                words.push(if clockwise { "G02" } else { "G03" }.to_owned());
+                words.extend(coordinates(to, [true, true]));
+                // The plane's radius X is half the written diameter.
+                let plane_point = |[z, d]: [i64; 2]| [z as f64 / 1000.0, d as f64 / 2000.0];
+                let [k, i] = centre_offsets(plane_point(self.at.unwrap_or_default()), plane_point(to), centre);
+                words.push(format!("I{}", decimal(thousandths(i), 3)));
+                words.push(format!("K{}", decimal(thousandths(k), 3)));
+                words.extend(self.feed_word(step.feed));
+            }
+            (Motion::Feed, Path::Thread { lead, speed }) => {
+                let rpm = speed.round() as i64;
+                if self.speed != Some(rpm) {
+                    self.speed = Some(rpm);
+                    self.line(&[format!("S{rpm}")])?;
+                }
+                words.push("G32".to_owned());
+                words.extend(coordinates(to, moved));
+                // A lead from inches needs the fourth place (1.5875 mm).
+                words.extend(self.f_word(decimal(((lead * 10_000.0).round() as i64).max(1), 4)));
+            }
+        }
+        if matches!(step.motion, Motion::Rapid | Motion::Feed) {
+            self.at = Some(to);
+        }
+        // The exact stop changes with the blocks that move or wait.
+        let exact_stop = step.path_mode == PathMode::ExactStop;
+        if !words.is_empty() && exact_stop != self.exact_stop {
+            self.exact_stop = exact_stop;
+            words.insert(0, if exact_stop { "G61" } else { "G64" }.to_owned());
+        }
+        match step.stop {
+            Some(Stop::Program) => words.push("M00".to_owned()),
+            Some(Stop::Optional) => words.push("M01".to_owned()),
+            None => {}
+        }
+        if !words.is_empty() {
+            self.line(&words)?;
+        }
+        Ok(())
+    }
+
+    /// F for a move at `feed` mm/min, when it differs from the F in force.
+    fn feed_word(&mut self, feed: Option<f64>) -> Option<String> {
+        self.f_word(decimal(thousandths(feed?).max(1), 3))
+    }
+
+    /// F of `number`, when it differs from the F in force: [`decimal`]
+    /// writes each value one way, so equal values are equal numbers.
+    fn f_word(&mut self, number: String) -> Option<String> {
+        (self.feed.as_ref() != Some(&number)).then(|| {
+            let word = format!("F{number}");
+            self.feed = Some(number);
+            word
+        })
+    }
+
+    fn line(&mut self, words: &[String]) -> io::Result<()> {
+        writeln!(self.out, "{}", words.join(" "))
+    }
+}
+
+impl<W: Write> StepSink for Expansion<W> {
+    fn step(&mut self, step: Step) {
+        if self.failure.is_some() {
+            return;
+        }
+        if let Err(failure) = self.write(&step) {
+            self.failure = Some(failure);
+        }
+    }
+
+    /// Nothing more is written after a failure, so the run need not go on.
+    fn closed(&self) -> bool {
+        self.failure.is_some()
+    }
+}
+
+impl<W: Write> Expand for Expansion<W> {
+    fn finish(self: Box<Self>) -> Result<(), ExpandError> {
+        Expansion::finish(*self).map(drop)
+    }
+}
+
+/// X and Z of a move to `to` (Z and the diameter X, in µm) where `written`
+/// says so.
+fn coordinates(to: [i64; 2], written: [bool; 2]) -> impl Iterator<Item = String> {
+    let [z, x] = written;
+    let x = x.then(|| format!("X{}", decimal(to[1], 3)));
+    let z = z.then(|| format!("Z{}", decimal(to[0], 3)));
+    x.into_iter().chain(z)
+}
+
+/// A length or feed in thousandths, the resolution most of the program is
+/// written in.
+fn thousandths(value: f64) -> i64 {
+    (value * 1000.0).round() as i64
+}
+
+/// A number of `scaled` units of `10^-places` as the manual writes
+/// numbers: with a decimal point, without trailing zeros (`20.`, `0.15`,
+/// `-2.5`).
+fn decimal(scaled: i64, places: u32) -> String {
+    let unit = 10u64.pow(places);
+    let sign = if scaled < 0 { "-" } else { "" };
+    let magnitude = scaled.unsigned_abs();
+    let fraction = format!("{:0width$}", magnitude % unit, width = places as usize);
+    format!("{sign}{}.{}", magnitude / unit, fraction.trim_end_matches('0'))
+}
+
+#[cfg(test)]
+mod tests;
