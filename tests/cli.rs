@@ -784,21 +784,43 @@ fn expand_writes_a_haas_program_as_plain_lathe_blocks() {
     let check = ncc(&["check", expanded]);
     assert_eq!(check.status.code(), Some(0), "{}", stdout(&check));
     assert_eq!(stdout(&check), "All checks passed (1 file checked).\n");
-    let moves = |program: &str| {
-        let output = ncc(&["run", program, "--format", "json"]);
-        assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
-        let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
-        let ends: Vec<String> = json["blocks"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .filter(|b| b["motion"] != "none" && b["length_mm"].as_f64() != Some(0.0))
-            .map(|b| format!("{} {}", b["motion"], b["end"]["program"]))
-            .collect();
-        (ends, json["total_time_s"].as_f64().unwrap())
-    };
-    let ((original, original_time), (again, again_time)) = (moves(program), moves(expanded));
+    let ((original, original_time), (again, again_time)) = (run_moves(program), run_moves(expanded));
     assert_eq!(original.len(), 13);
+    assert_eq!(again, original);
+    assert!((again_time - original_time).abs() < 1e-3 * original_time, "{original_time} s, expanded {again_time} s");
+}
+
+/// The moves of `ncc run` (kind and end) and the total time.
+fn run_moves(program: &str) -> (Vec<String>, f64) {
+    let output = ncc(&["run", program, "--format", "json"]);
+    assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let ends: Vec<String> = json["blocks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|b| b["motion"] != "none" && b["length_mm"].as_f64() != Some(0.0))
+        .map(|b| format!("{} {}", b["motion"], b["end"]["program"]))
+        .collect();
+    (ends, json["total_time_s"].as_f64().unwrap())
+}
+
+/// The bundled Haas example expands to a program of the same moves and
+/// time: its cycles (G71/G70, the G75 groove, the G76 thread passes, the
+/// G83 pecks) become plain blocks.
+#[test]
+fn the_haas_example_expands_to_the_same_moves_and_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let expanded = dir.path().join("O1000.nc");
+    let expanded = expanded.to_str().unwrap();
+    let output = ncc(&["expand", "examples/haas-lathe/O1000.nc", "-o", expanded]);
+    assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
+    let text = std::fs::read_to_string(expanded).unwrap();
+    assert!(text.contains("\nS600 M03\nG32 Z-20. F1.5\n"), "{text}");
+    // D0.3·√n reaches 0.9 mm in 9 passes; the 10th cuts to K0.92.
+    assert_eq!(text.matches("G32").count(), 10, "the thread's passes: {text}");
+    let ((original, original_time), (again, again_time)) =
+        (run_moves("examples/haas-lathe/O1000.nc"), run_moves(expanded));
     assert_eq!(again, original);
     assert!((again_time - original_time).abs() < 1e-3 * original_time, "{original_time} s, expanded {again_time} s");
 }

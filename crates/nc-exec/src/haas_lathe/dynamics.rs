@@ -122,7 +122,7 @@ mod tests {
 
     /// The breaks of a run, by the program's line and reason.
     #[derive(Default)]
-    struct Breaks(Vec<(usize, Reason)>, Vec<usize>);
+    struct Breaks(Vec<(usize, Reason)>);
 
     impl TimingSink for Breaks {
         fn speed_break(&mut self, _step: &Step, speed_break: Break) {

@@ -23,9 +23,9 @@
 //!   Z, so that a full circle still moves. G02 turns clockwise seen with
 //!   +Z to the right and +X up (lathe manual §5.8 (001:591-668)), the
 //!   sense the run keeps in its plane (Z, X).
-//! - Threads are G32 with the lead as F, after a block `S<rpm>` when the
-//!   spindle speed changes. The run does not say which way the spindle
-//!   turns, so no M03/M04 is written.
+//! - Threads are G32 with the lead as F, after a block `S<rpm> M03` when
+//!   the spindle speed changes: a thread needs the spindle turning, and the
+//!   run does not say which way it turns, which does not change the time.
 //! - Dwells are `G04 P` in ms (without a decimal point, lathe manual §5.3
 //!   (001:55-71)), the stops M00/M01 where the run had them; exact stop
 //!   G61, and G64 back, where the run's blocks change between them (G09
@@ -147,7 +147,7 @@ impl<W: Write> Expansion<W> {
                 let rpm = speed.round() as i64;
                 if self.speed != Some(rpm) {
                     self.speed = Some(rpm);
-                    self.line(&[format!("S{rpm}")])?;
+                    self.line(&[format!("S{rpm}"), "M03".to_owned()])?;
                 }
                 words.push("G32".to_owned());
                 words.extend(coordinates(to, moved));

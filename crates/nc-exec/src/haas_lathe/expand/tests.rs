@@ -137,14 +137,14 @@ fn threads_are_g32_with_their_lead_after_their_speed() {
         O9 (THREADS)
         G18 G21 G40 G97 G98
         G00 X30. Z5.
-        S500
+        S500 M03
         G32 Z-20. F1.5
         G00 X40.
         G00 Z5.
         G00 X29.
         G32 Z-20.
         G01 X40. F150.
-        S800
+        S800 M03
         G32 Z-40. F1.5875
         M30
         %
