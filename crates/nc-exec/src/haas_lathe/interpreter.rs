@@ -63,12 +63,12 @@
 
 use std::f64::consts::TAU;
 
-use ncc_catalog::{Catalogue, split_code};
 use ncc_syntax::{Dialect, Parse, TextRange};
 
 use super::{
     eval::{EvalError, MacroValue, Variables},
     lower::{Expr, ExprKind, HaasBlock, Statement, Value, Word, block_nodes},
+    modes::Modes,
     program::{Contour, Program, ProgramModel},
 };
 use crate::{
@@ -119,43 +119,6 @@ pub(crate) fn run_into(text: &str, machine: &MachineConfig, budget: usize, sink:
         tools: interpreter.tools,
         files: Vec::new(),
         blocks_run: interpreter.executed,
-    }
-}
-
-/// The code in force of every modal group of the catalogue.
-#[derive(Debug, Clone)]
-struct Modes {
-    catalogue: &'static Catalogue,
-    /// By group index: the code's number.
-    in_force: Vec<Option<u32>>,
-}
-
-impl Modes {
-    fn at_reset(catalogue: &'static Catalogue) -> Modes {
-        let default = |id: Option<&str>| id.and_then(split_code).map(|(_, number)| number);
-        Modes { catalogue, in_force: catalogue.groups.iter().map(|group| default(group.default.as_deref())).collect() }
-    }
-
-    /// Puts a code in force if it is modal in a group, and sets the codes
-    /// it cancels back to their groups' defaults (G00/G01 end a drilling
-    /// cycle, lathe manual §5.7 (001:1075-1076)).
-    fn set(&mut self, letter: char, number: u32) {
-        if let Some(group) = self.catalogue.modal_group_index(letter, number) {
-            self.in_force[group] = Some(number);
-        }
-        let cancels = self.catalogue.code(letter, number).map_or(&[][..], |code| &code.cancels[..]);
-        for (letter, cancelled) in cancels.iter().filter_map(|code| split_code(code)) {
-            let Some(group) = self.catalogue.modal_group_index(letter, cancelled) else { continue };
-            if self.in_force[group] == Some(cancelled) {
-                let default = self.catalogue.groups[group].default.as_deref().and_then(split_code);
-                self.in_force[group] = default.map(|(_, number)| number);
-            }
-        }
-    }
-
-    fn get(&self, group: &str) -> Option<u32> {
-        let index = self.catalogue.groups.iter().position(|g| g.id == group)?;
-        self.in_force[index]
     }
 }
 
