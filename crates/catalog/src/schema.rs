@@ -139,6 +139,23 @@ entry! {
         /// Units of the values it uses, where that matters.
         #[serde(default)]
         pub units: Option<String>,
+        /// An option of the control (`#` in the Haas table): the machine
+        /// needs it.
+        #[serde(default)]
+        pub optional: bool,
+        /// The only machine models that have it (`SL-30`); empty: all.
+        #[serde(default)]
+        pub machines: Vec<String>,
+        /// For service use only, not for part programs.
+        #[serde(default)]
+        pub service: bool,
+        /// False where the manual gives the code no usable description:
+        /// an empty or doubtful table row, no format.
+        #[serde(default = "yes")]
+        pub described: bool,
+        /// Needs a driven (live) tool.
+        #[serde(default)]
+        pub live_tool: bool,
     }
 }
 

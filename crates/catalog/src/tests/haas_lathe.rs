@@ -145,6 +145,29 @@ fn one_shot_codes_never_hold() {
 }
 
 #[test]
+fn options_restrictions_and_undescribed_codes_follow_the_tables() {
+    let catalogue = haas_lathe();
+    let marked = |field: fn(&Code) -> bool| -> Vec<&str> {
+        catalogue.codes.iter().filter(|code| field(code)).map(|code| code.code.as_str()).collect()
+    };
+    // `#` in the tables (001:264, 99, 135, 307, 322-323, 338-341, 349).
+    let mut optional = vec!["G31", "G65", "M19"];
+    let relays = (51..=58).chain(61..=68).map(|n| format!("M{n}"));
+    let relays: Vec<String> = relays.chain((121..=128).map(|n| format!("M{n}"))).collect();
+    optional.extend(relays.iter().map(String::as_str));
+    optional.extend(["M85", "M86", "M88", "M89"]);
+    let mut found = marked(|code| code.optional);
+    found.sort();
+    optional.sort();
+    assert_eq!(found, optional);
+    assert_eq!(marked(|code| !code.machines.is_empty()), ["M41", "M42"]);
+    assert_eq!(code("M41").machines, ["SL-30", "SL-40"]);
+    assert_eq!(marked(|code| code.service), ["M43", "M44", "M82"]);
+    assert_eq!(marked(|code| !code.described), ["G05", "G60", "G103", "G187"]);
+    assert_eq!(marked(|code| code.live_tool), ["G95", "M133", "M134", "M135"]);
+}
+
+#[test]
 fn shared_printed_groups_are_split() {
     // Printed group 12 holds the work offsets and G96/G97; printed group 10
     // the feed mode and the mirror image.
