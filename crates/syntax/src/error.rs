@@ -101,6 +101,7 @@ syntax_error_kinds! {
     ExpectedExpression = "S024", "expected-expression", Error, "A place where an expression (number, variable, bracket or function) must be.";
     UnclosedBracket = "S025", "unclosed-bracket", Error, "A `[` without its closing `]` on the line.";
     MalformedStatement = "S026", "malformed-statement", Error, "A macro statement (IF, GOTO, WHILE, DO, END, assignment) missing a required part, or a keyword out of place.";
+    TemplatePlaceholder = "S027", "template-placeholder", Error, "A placeholder of a manual's formats (`X..`, `Z...`, `....`) where a value must be written.";
 }
 
 /// One syntax diagnostic.

@@ -172,6 +172,10 @@ pub(crate) fn number(input: &mut impl ExprInput, children: &mut Vec<GreenElement
     let start = input.pos();
     children.push(input.bump());
     let end = input.pos();
+    if let Some(message) = placeholder(&input.text()[start..end]) {
+        input.error(E::TemplatePlaceholder, start..end, message);
+        return;
+    }
     if input.text()[start..end].bytes().all(|b| b == b'.') {
         input.error(E::NumberWithoutDigits, start..end, "a number needs at least one digit (`0.` for zero)".into());
     }
@@ -181,6 +185,13 @@ pub(crate) fn number(input: &mut impl ExprInput, children: &mut Vec<GreenElement
         let message = format!("a second decimal point in `{}`", &input.text()[start..input.pos()]);
         input.error(E::DoubledDecimalPoint, end..input.pos(), message);
     }
+}
+
+/// What is wrong with a number token that is a placeholder of a manual's
+/// formats (`..`, `...`): points only.
+pub(crate) fn placeholder(token: &str) -> Option<String> {
+    (token.len() > 1 && token.bytes().all(|b| b == b'.'))
+        .then(|| format!("`{token}` is a placeholder of the manual's formats, not a value: write the number"))
 }
 
 /// `#` and the variable number: `#100`, `#[#1+2]`.

@@ -53,6 +53,9 @@ pub(crate) fn token_at(text: &str, pos: usize) -> Token {
             len => (IDENT, len),
         },
         b'a'..=b'z' => (LETTER, 1),
+        // A run of points is one placeholder (`X..`, `....`), which the
+        // parser reports once.
+        b'.' if bytes.get(pos + 1) == Some(&b'.') => (NUMBER, run_len(&bytes[pos..], |b| b == b'.')),
         b'0'..=b'9' | b'.' => (NUMBER, number_len(&bytes[pos..])),
         b'+' => (PLUS, 1),
         b'-' => (MINUS, 1),
@@ -111,6 +114,14 @@ mod tests {
         for keyword in ["GOTO", "WHILE", "SIN", "ATAN", "EQ", "MOD", "XOR", "FUP"] {
             assert!(keywords().iter().any(|k| k == keyword), "{keyword}");
         }
+    }
+
+    #[test]
+    fn a_run_of_points_is_one_token() {
+        assert_eq!(
+            lex_all("X...Z.5."),
+            vec![(LETTER, "X"), (NUMBER, "..."), (LETTER, "Z"), (NUMBER, ".5"), (NUMBER, ".")]
+        );
     }
 
     #[test]

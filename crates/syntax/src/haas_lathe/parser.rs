@@ -331,7 +331,10 @@ impl<'a> Parser<'a> {
                 COMMA => self.corner_word(),
                 HASH => self.assignment(),
                 IDENT => self.statement(),
-                NUMBER => self.error_token(E::NumberWithoutAddress, "a number must follow an address letter: `X10.`"),
+                NUMBER => match expr::placeholder(&self.text[self.pos..self.pos + token.len]) {
+                    Some(message) => self.error_token(E::TemplatePlaceholder, message),
+                    None => self.error_token(E::NumberWithoutAddress, "a number must follow an address letter: `X10.`"),
+                },
                 PLUS | MINUS => {
                     self.error_token(E::SignWithoutAddress, "a sign must follow an address letter: `X-10.`")
                 }
