@@ -309,9 +309,14 @@ impl HaasBlock {
 
     /// The G or M codes written as unsigned whole literals (`G01` → 1).
     pub fn codes(&self, letter: u8) -> impl Iterator<Item = u32> + '_ {
+        self.code_words(letter).map(|(code, _)| code)
+    }
+
+    /// The G or M codes with their words.
+    pub fn code_words(&self, letter: u8) -> impl Iterator<Item = (u32, &Word)> + '_ {
         self.words_with(letter).filter_map(|w| match &w.value {
             Some(Value::Literal(d)) if !d.has_point() && d.sign().is_none() => {
-                d.scaled(0).and_then(|v| u32::try_from(v).ok())
+                d.scaled(0).and_then(|v| u32::try_from(v).ok()).map(|code| (code, w))
             }
             _ => None,
         })
