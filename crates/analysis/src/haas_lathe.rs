@@ -5,3 +5,4 @@
 pub(crate) mod checks;
 pub(crate) mod ide;
 pub(crate) mod model;
+pub(crate) mod walk;

@@ -60,3 +60,20 @@ fn arc_missing_end_coordinate_fix_repeats_the_unchanged_coordinate() {
     assert_eq!(fixed, "%1\nN10 G90 G17 G00 X0 Y5. F100\nN20 G02 X10. Y5. I5.\nN30 G91 G02 X0 Y0 I5.\nN40 M30\n*\n");
     assert!(diagnostics(&fixed).is_empty(), "{:#?}", diagnostics(&fixed));
 }
+
+#[test]
+fn haas_thread_angle_fix_drops_the_point_of_a_whole_angle() {
+    let text = "O1\nG54 G00 X30. Z3.\nG97 S800 M03\nG76 X27. Z-20. K1.2 D0.3 A60. P1 F2.\nG76 X27. Z-20. K1.2 D0.3 A29.5 P1 F2.\nM30\n";
+    let mut host = AnalysisHost::in_dialect(ncc_analysis::Dialect::HaasLathe, ncc_analysis::Config::default());
+    let file = host.add_file("O1.nc", text);
+    let found = host.analysis().diagnostics(file);
+    let angles: Vec<&Diagnostic> = found.iter().filter(|d| d.name == "thread-angle-with-point").collect();
+    assert_eq!(angles.len(), 2, "{found:#?}");
+    // A29.5 has no whole value to keep: no fix.
+    assert!(angles[1].fixes.is_empty());
+    let fixed = apply_fix(text, angles[0]);
+    assert_eq!(fixed, text.replace("A60.", "A60"));
+    host.apply_edit(file, &angles[0].fixes[0].edits[0]);
+    let left: Vec<&str> = host.analysis().diagnostics(file).iter().map(|d| d.name).collect();
+    assert_eq!(left, ["thread-angle-with-point"]);
+}
