@@ -207,7 +207,8 @@ pub(crate) enum Kind {
 /// What the walk learnt running a contour for its cycle.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct ContourRun {
-    /// The end points (X as a diameter, Z) of its feed moves, where known.
+    /// The end points (X as a diameter, Z) of its feed moves along the
+    /// contour, where known.
     pub feed_points: Vec<(f64, f64)>,
     /// What the P block does.
     pub p_kind: Option<Kind>,
@@ -374,7 +375,10 @@ impl<'a> Walker<'a, '_> {
             if at == *contour.blocks.start() {
                 run.p_kind = Some(step.kind);
             }
-            if let (Kind::Move(Known::Is(1..=3)), Known::Is(x), Known::Is(z)) = (step.kind, step.after.x, step.after.z)
+            // The move that cancels the compensation departs from the contour.
+            let departs = self.file.blocks[at].has_code(b'G', 40);
+            if let (Kind::Move(Known::Is(1..=3)), Known::Is(x), Known::Is(z), false) =
+                (step.kind, step.after.x, step.after.z, departs)
             {
                 run.feed_points.push((x, z));
             }

@@ -47,5 +47,12 @@ G00 X70. Z3.
 G70 P90 Q95 F0.1
 N90 G00 X20.
 N95 G01 Z-10.
+; No allowance: the roughing is the finish. The move that cancels the
+; compensation leaves the contour, beyond the start point.
+G00 X50. Z3.
+G71 P100 Q110 U0 W0 D2. F0.3
+N100 G00 X40.
+G01 Z-10.
+N110 G01 G40 X55.
 G00 X70. Z100.
 M30

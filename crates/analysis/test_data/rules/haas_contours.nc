@@ -10,7 +10,6 @@ G71 P20 U0.5 W0.1 D2. F0.25
 G71 P30 Q20 D2.
 ;       ^^^ q-before-p
 G71 P20 Q30 D2. F0.25
-; @ no-finishing-pass
 N20 G00 X20.
 N25 G01 Z-10. F0.1
 ;             ^^^^ contour-feed-speed-tool
@@ -21,7 +20,6 @@ N27 X25. Z-20.
 ;   ^^^^ uncompensated-contour
 N30 X40. Z-30.
 G72 P40 Q50 D1.
-; @ no-finishing-pass
 N40 G00 Z-40.
 N45 G01 X50. A30.
 ;            ^^^^ contour-angle-ignored

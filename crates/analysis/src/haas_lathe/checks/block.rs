@@ -199,7 +199,7 @@ impl Block<'_> {
             let Some(decimal) = literal(word).filter(|d| !d.has_point() && d.to_f64() != 0.0) else { continue };
             let letter = char::from(word.letter);
             let message = format!(
-                "{letter}{decimal} has no decimal point: the Haas control reads it as {} mm, a control reading thousandths as {} mm; write {letter}{decimal}. to be sure",
+                "{letter}{decimal} has no decimal point: the Haas control reads it as {} whole units (mm, inches under G20), a control that reads thousandths as {}; write {letter}{decimal}. to be sure",
                 decimal.to_f64(),
                 decimal.to_f64() / 1000.0
             );

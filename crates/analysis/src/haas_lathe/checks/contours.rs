@@ -3,7 +3,10 @@
 //! from the walk where the cycle's start point matters.
 
 use nc_exec::{
-    haas_lathe::program::{Contour, Finding, Ignored, Monotony, Reference, ReferenceKind, RoughingType},
+    haas_lathe::{
+        lower::Value,
+        program::{Contour, Finding, Ignored, Monotony, Reference, ReferenceKind, RoughingType},
+    },
     known::Known,
 };
 use ncc_catalog::Dialect;
@@ -62,9 +65,19 @@ fn finishing(file: &FileModel, out: &mut Vec<Diagnostic>) {
                 && finish.blocks == rough.blocks
                 && program.is_some_and(|blocks| blocks.contains(&finish.cycle))
         });
-        if !finished {
-            let message =
-                format!("no later G70 finishes this G{} contour: the allowances U and W stay on the part", rough.code);
+        // Without allowances the roughing is the finish.
+        let allowance: Vec<String> = [b'U', b'W']
+            .into_iter()
+            .filter_map(|letter| file.blocks[rough.cycle].word(letter))
+            .filter(|word| !matches!(&word.value, Some(Value::Literal(decimal)) if decimal.to_f64() == 0.0))
+            .map(ToString::to_string)
+            .collect();
+        if !finished && !allowance.is_empty() {
+            let message = format!(
+                "no later G70 finishes this G{} contour: the allowance {} stays on the part",
+                rough.code,
+                allowance.join(" ")
+            );
             out.push(Diagnostic::new(&NO_FINISHING_PASS, file.code_range(rough.cycle, b'G', rough.code), message));
         }
     }
