@@ -24,7 +24,7 @@ declare_rules! {
     THREAD_ANGLE_WITH_POINT = "L008", "thread-angle-with-point", Error, "The tool angle A of G76 written with a decimal point.";
     DWELL_IN_MILLISECONDS = "L009", "dwell-in-milliseconds", Info, "A dwell P without a decimal point, which counts milliseconds.";
     DWELL_WITHOUT_P = "L010", "dwell-without-p", Error, "G04 without P, the dwell time.";
-    AXIS_WITHOUT_POINT = "L011", "axis-without-point", Info, "A coordinate without a decimal point (`X62`), read as whole millimetres.";
+    AXIS_WITHOUT_POINT = "L011", "axis-without-point", Info, "A coordinate without a decimal point (`X62`), read as whole millimetres (inches under G20).";
     CYCLE_WITHOUT_DEPTH = "L038", "cycle-without-depth", Error, "G71/G72 without a positive depth of cut D, or G73 without a whole positive number of passes D.";
     PECK_WITH_Q_AND_IJK = "L043", "peck-with-q-and-ijk", Error, "G83 with Q (standard pecking) and I, J or K (degressive pecking) in one block.";
     STEP_NOT_POSITIVE = "L044", "step-not-positive", Error, "G83 Q, I, J or K, or G75 I or K, zero or negative.";
@@ -146,7 +146,9 @@ impl Block<'_> {
             out.push(Diagnostic::new(&RESTRICTED_CODE, range, message));
         }
         // Haas live tooling comes with the C axis (Haas documentation, not
-        // in the manual): a machine described without C has none.
+        // in the manual): a machine described without C has none. G75's
+        // deep drilling (001:2572-2581) is written like one groove without
+        // Z (001:2497), so it cannot be told apart.
         if code.live_tool && !config.machine.is_axis(b'C') {
             let message = format!(
                 "{name} needs a live (driven) tool, and the machine described has no C axis, so no live tooling (add C to `[machine] axes` if it has)"
@@ -165,6 +167,7 @@ impl Block<'_> {
             let message = "G04 without P: the block gives no dwell time";
             out.push(Diagnostic::new(&DWELL_WITHOUT_P, self.file.code_range(self.index, b'G', 4), message));
         }
+        // With a point P counts plain seconds: nothing to show.
         for word in self.block.words_with(b'P') {
             let Some(decimal) = literal(word).filter(|d| !d.has_point()) else { continue };
             let milliseconds = decimal.to_f64();

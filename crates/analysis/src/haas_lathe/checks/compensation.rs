@@ -32,7 +32,9 @@ fn on(code: Known<Option<u32>>) -> bool {
 }
 
 /// Rules 22 and 23: the move that starts or cancels the compensation is
-/// the one in the block that switches it, or the next.
+/// the one in the block that switches it, or the next. The digest's rule 22
+/// names cycles too, but the seed writes G90 and G94 with G41/42 (001:1463,
+/// 1471): only arcs are flagged.
 fn switch(visit: &Visit<'_>, out: &mut Out) {
     let Kind::Move(Known::Is(arc @ (2 | 3))) = visit.kind else { return };
     let before = visit.before.code(COMPENSATION);
@@ -63,7 +65,8 @@ fn switch(visit: &Visit<'_>, out: &mut Out) {
     out.push(diagnostic);
 }
 
-/// Rule 24: arcs and tapers want the compensation.
+/// Rule 24: arcs and tapers want the compensation; a hint once a program,
+/// not at every move.
 fn uncompensated(visit: &Visit<'_>, out: &mut Out) {
     let off = |code| code == Known::Is(Some(40));
     // The move that cancels the compensation is rule 23's.

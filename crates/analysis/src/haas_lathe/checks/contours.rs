@@ -138,6 +138,8 @@ pub(crate) fn visit(visit: &Visit<'_>, out: &mut Out) {
     let (Some(min), Some(max)) = (xs.clone().reduce(f64::min), xs.reduce(f64::max)) else { return };
     let Some(top) = run.feed_points.iter().map(|&(_, z)| z).reduce(f64::max) else { return };
     let at = visit.code_range(code);
+    // Between the contour's smallest and largest X the start is inside
+    // whichever side is cut; outside them the side is known for rule 39.
     if min < x && x < max {
         let message = format!(
             "the start point X{x} lies between the contour's smallest X{min} and largest X{max}: the first infeed starts inside the stock"
