@@ -702,3 +702,12 @@ fn every_lathe_example_answers_everywhere() {
         }
     }
 }
+
+#[test]
+fn lathe_hover_shows_the_modal_state_before_the_block() {
+    let (host, ids, cursor) = setup(&[("O1000.nc", &at(LATHE, "G70 P10"))]);
+    let hover = host.analysis().hover(ids[0], cursor.unwrap().1).unwrap().markdown;
+    let state = hover.split("**Modal state before this block:** ").nth(1).unwrap_or_else(|| panic!("{hover}"));
+    // G96 from the program, G99 and G18 from reset.
+    assert!(state.contains("G96") && state.contains("G18") && state.contains("G99"), "{state}");
+}

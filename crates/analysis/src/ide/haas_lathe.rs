@@ -18,8 +18,12 @@ use super::{
     symbols::{DocumentSymbol, SymbolKind},
 };
 use crate::{
+    Known,
     db::{Db, Settings, SourceFile},
-    haas_lathe::model::{FileModel, file_model},
+    haas_lathe::{
+        model::{FileModel, file_model},
+        walk::walk,
+    },
 };
 
 /// What the cursor is on inside a block (ranges in the block).
@@ -123,7 +127,57 @@ pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<H
     if let Some(target) = target_text(db, file, model, range + start) {
         markdown = format!("{target}\n\n{markdown}");
     }
+    markdown.push_str(&modal_text(&modal_states(db, file)[index]));
     Some(HoverResult { range: range + start, markdown })
+}
+
+/// The codes in force before each block of the file, once per distinct
+/// state the checker's walk reached it in (none for a block it does not
+/// reach).
+#[salsa::tracked(returns(ref))]
+fn modal_states(db: &dyn Db, file: SourceFile) -> Vec<Vec<String>> {
+    let model = file_model(db, file);
+    let catalogue = Dialect::HaasLathe.catalogue();
+    let mut states = vec![Vec::new(); model.blocks.len()];
+    walk(model, &mut |visit| {
+        let mut codes = Vec::new();
+        let mut unknown = false;
+        for group in &catalogue.groups {
+            let letter = group.id.chars().next().unwrap_or('G');
+            match visit.before.modes.known(&group.id) {
+                // Of the many M groups, those the program changed.
+                Known::Is(Some(number))
+                    if letter == 'G' || group.default.as_deref() != Some(&format!("M{number:02}")) =>
+                {
+                    codes.push(format!("{letter}{number:02}"));
+                }
+                Known::Is(_) => {}
+                Known::Unknown => unknown = true,
+            }
+        }
+        let line = match (codes.is_empty(), unknown) {
+            (true, true) => "not known here (after a jump, a loop or a call)".to_owned(),
+            (false, true) => format!("`{}` · other groups not known", codes.join(" ")),
+            (_, false) => format!("`{}`", codes.join(" ")),
+        };
+        let seen: &mut Vec<String> = &mut states[visit.index];
+        if !seen.contains(&line) {
+            seen.push(line);
+        }
+    });
+    states
+}
+
+/// The modal states before a block, for its hover.
+fn modal_text(states: &[String]) -> String {
+    match states {
+        [] => String::new(),
+        [one] => format!("\n\n---\n\n**Modal state before this block:** {one}"),
+        many => format!(
+            "\n\n---\n\n**Modal states before this block** (one per way it is reached):\n\n- {}",
+            many.join("\n- ")
+        ),
+    }
 }
 
 /// The catalogue's entries for a word: `G71` for a code, the address for
