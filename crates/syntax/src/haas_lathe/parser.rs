@@ -70,7 +70,14 @@ fn function(name: &str) -> Option<Arguments> {
 
 const GRAMMAR: Grammar = Grammar { binary, function };
 
+/// Bodies from this size on are parsed in parts on all cores.
+const PARALLEL_THRESHOLD: usize = 1 << 20;
+
 pub(crate) fn parse_source_file(text: &str) -> (GreenNode, Vec<SyntaxError>, Vec<Omitted<E>>) {
+    parse_source_file_with(text, PARALLEL_THRESHOLD)
+}
+
+fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, Vec<SyntaxError>, Vec<Omitted<E>>) {
     let mut children: Vec<GreenElement> = Vec::new();
     let mut errors = Errors::default();
     let mut pos = 0;
@@ -93,11 +100,27 @@ pub(crate) fn parse_source_file(text: &str) -> (GreenNode, Vec<SyntaxError>, Vec
         children.push(NodeOrToken::Node(parser.opening_mark()));
         errors.append(parser.into_errors());
     }
-    let (blocks, block_errors) = parse_blocks(text, body.clone(), &[]);
-    errors.append(block_errors);
+    // A block is a line: parts that start at line starts parse alone.
+    let bounds = if body.len() < parallel_threshold {
+        vec![body.start, body.end]
+    } else {
+        split_at_lines(text, body.clone(), rayon::current_num_threads() * 4)
+    };
+    let parse_part = |i: usize| parse_blocks(text, bounds[i]..bounds[i + 1], &[]);
+    let parts: Vec<_> = if bounds.len() > 2 {
+        use rayon::prelude::*;
+        (0..bounds.len() - 1).into_par_iter().map(parse_part).collect()
+    } else {
+        vec![parse_part(0)]
+    };
+    // Runs are formed in one pass over all parts: where a run ends must not
+    // depend on how the text was split.
     let mut runs = RunBuilder::new(text, body.start);
-    for block in blocks {
-        runs.push(block);
+    for (blocks, block_errors) in parts {
+        for block in blocks {
+            runs.push(block);
+        }
+        errors.append(block_errors);
     }
     children.extend(runs.finish());
     if body.end < text.len() {
@@ -105,6 +128,20 @@ pub(crate) fn parse_source_file(text: &str) -> (GreenNode, Vec<SyntaxError>, Vec
     }
     let (errors, omitted) = errors.finish(text);
     (green::node(SOURCE_FILE, children), errors, omitted)
+}
+
+/// About `parts` parts of `region`, each starting at a line start.
+fn split_at_lines(text: &str, region: Range<usize>, parts: usize) -> Vec<usize> {
+    let mut bounds = vec![region.start];
+    for k in 1..parts {
+        let from = (region.start + region.len() * k / parts).max(bounds[bounds.len() - 1]);
+        match text[from..region.end].find('\n') {
+            Some(newline) if from + newline + 1 < region.end => bounds.push(from + newline + 1),
+            _ => break,
+        }
+    }
+    bounds.push(region.end);
+    bounds
 }
 
 /// Where the tape marks are.
@@ -684,5 +721,37 @@ impl ExprInput for Parser<'_> {
 
     fn error(&mut self, kind: E, range: Range<usize>, message: String) {
         self.report(kind, range, message);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_source_file_with;
+
+    /// Parsing in parts gives the tree and the errors of one pass.
+    #[test]
+    fn parts_parse_like_one_pass() {
+        let pieces = [
+            "G01 X[#1 + 2.] Z-#2 F0.1 (CUT)\n",
+            "IF [#1 GT 2] GOTO 20\r\n",
+            "N20 G71 P10 Q20 U0.4 W0.1 D2. ,C1. X12.5. Z\n",
+            "WHILE [#1 LT 3] DO1 ; loop\n",
+            "( unclosed comment\n",
+            // More doubled points on a line than a report keeps.
+            &"X1.2. ".repeat(20),
+            "\n",
+            &"X1. Z2. ".repeat(200),
+            "\n",
+        ];
+        let mut text = String::from("%\nO1 (PARTS)\n");
+        for i in 0..3000 {
+            text.push_str(pieces[i % pieces.len()]);
+        }
+        text.push_str("M30\n%\nafter the mark\n");
+        let sequential = parse_source_file_with(&text, usize::MAX);
+        assert!(!sequential.1.is_empty() && !sequential.2.is_empty(), "errors kept and left out");
+        let parallel = parse_source_file_with(&text, 0);
+        assert_eq!(sequential, parallel);
+        assert_eq!(rowan::SyntaxNode::<crate::NcLanguage>::new_root(parallel.0).to_string(), text);
     }
 }
