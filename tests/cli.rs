@@ -711,6 +711,36 @@ fn run_finds_macrocycle_files_in_the_project() {
     assert_eq!(json["findings"][0]["line"], 3);
 }
 
+/// A Haas program's `M98 P1000` runs the program file `O01000.nc` beside
+/// it; its blocks name that file, and a program with no file stops the run.
+#[test]
+fn run_finds_haas_program_files_beside_the_program() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("O01000.nc"), "O1000\nG98 G01 W-10. F600.\nM99\n").unwrap();
+    let program = dir.path().join("main.nc");
+    std::fs::write(&program, "O1\nM98 P1000 L2\nM98 P2000\nM30\n").unwrap();
+
+    let output = ncc(&["run", program.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(output.status.code(), Some(1));
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let places: Vec<(String, u64)> = json["blocks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| {
+            let file = b["file"].as_str().unwrap().replace('\\', "/");
+            (file.rsplit('/').next().unwrap().to_owned(), b["line"].as_u64().unwrap())
+        })
+        .collect();
+    let expected = [("main.nc", 2), ("O01000.nc", 2), ("O01000.nc", 3), ("O01000.nc", 2), ("O01000.nc", 3)];
+    let expected: Vec<(String, u64)> = expected.into_iter().map(|(f, l)| (f.to_owned(), l)).collect();
+    assert_eq!(places, expected);
+    assert_eq!(json["end_position"]["Z"], -20.0);
+    let message = json["findings"][0]["message"].as_str().unwrap();
+    assert!(message.contains("no program O2000"), "{message}");
+    assert_eq!(json["findings"][0]["line"], 3);
+}
+
 /// `ncc expand` writes a program that runs the same moves in the same time
 /// (to F's whole mm/min), here with a macrocycle file and its dwells
 /// resolved; the expanded program passes `ncc check` without errors.
