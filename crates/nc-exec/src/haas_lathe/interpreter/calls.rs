@@ -1,6 +1,6 @@
 //! Subprograms and macro calls (lathe manual §6.21 (001:135, 346-348)):
-//! M97 P runs the blocks of the same program from block N<P>, M98 P the
-//! program O<P>, G65 P that program as a macro with arguments; each runs
+//! M97 P runs the blocks of the same program from block `N<P>`, M98 P the
+//! program `O<P>`, G65 P that program as a macro with arguments; each runs
 //! until M99 and returns after the calling block, L times.
 //!
 //! Assumptions the manual does not settle (External: Haas and Fanuc
@@ -8,10 +8,10 @@
 //! - M97 takes its block number in P, as Haas controls do (the manual
 //!   prints `M97 N..`, 001:346, OQ-15), and goes to the first block of the
 //!   program with that number.
-//! - M98 and G65 find program O<P> among the programs of the files read so
-//!   far, the calling file's first; else in the file the run's
-//!   environment finds for the number ([`Called::Program`]): the program of
-//!   that number in it, or its first program.
+//! - M98 and G65 find program `O<P>` among the programs of the files read
+//!   so far, the calling file's first; else in the file the run's
+//!   environment finds for the number ([`Called::Program`]): the program
+//!   of that number in it, or its first program.
 //! - L repeats the call, L times in all; L0 calls nothing; without L the
 //!   call runs once.
 //! - G65 assigns its arguments by Fanuc's argument assignment I (the table
@@ -20,10 +20,10 @@
 //!   caller's come back at M99. A letter written twice gives its first
 //!   value: assignment II (I, J, K repeated) is not read. M97 and M98 keep
 //!   the caller's locals.
-//! - M99 P<n> returns to the caller's first block numbered n instead of the
-//!   block after the call. In the main program M99 P<n> goes to block n,
-//!   and M99 alone starts the program again on the control: the run ends
-//!   there.
+//! - `M99 P<n>` returns to the caller's first block numbered n instead of
+//!   the block after the call. In the main program `M99 P<n>` goes to block
+//!   n, and M99 alone starts the program again on the control: the run
+//!   ends there.
 //! - A subprogram that reaches its end without M99 stops the run; M02 and
 //!   M30 in one end it.
 //! - Calls nest at most [`MAX_CALL_DEPTH`] deep, the run's bound against
@@ -192,7 +192,7 @@ impl Interpreter<'_> {
         block
     }
 
-    /// Where program O<P> of the block starts: in a file read so far, the
+    /// Where program `O<P>` of the block starts: in a file read so far, the
     /// calling file's first, or in the file the environment finds; `None`
     /// after reporting that there is none.
     fn program_start(&mut self, block: &HaasBlock, range: TextRange, what: &str) -> Option<Place> {

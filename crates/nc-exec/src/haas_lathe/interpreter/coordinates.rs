@@ -3,10 +3,12 @@
 //! machine coordinates G53 (001:116-124, 464-465) and the reference point
 //! returns G28 and G29 (001:78-97).
 //!
-//! The reference point is the machine zero (001:471-477), where the run
-//! starts. A work offset is the machine position of the program's zero,
-//! from the machine's offset table; G52 shifts the program's zero from
-//! there. Each stretch of steps under one offset and shift has its frame
+//! The reference point is the machine zero (001:471-477); the run starts
+//! there, where the machine finds its position again after power-off by
+//! passing its reference points (001:422-425). A work offset is the
+//! machine position of the program's zero, from the machine's offset
+//! table; G52 shifts the program's zero from there. Each stretch of steps
+//! under one offset and shift has its frame
 //! ([`Trace::frames`](crate::trace::Trace)), so that the steps keep their
 //! program coordinates. Choosing another offset or shift moves nothing:
 //! the tool's program position changes instead.

@@ -28,8 +28,8 @@
 //!   and 9 (and no code) are the centre itself.
 //! - An outside corner that turns by up to 90° joins at the equidistants'
 //!   intersection (Fanuc's offset mode, External); a sharper one goes round
-//!   the corner on an arc of the nose radius, where Fanuc goes round on two
-//!   lines (at most (4 − π)·r longer).
+//!   the corner on an arc of the nose radius, where Fanuc goes round on
+//!   lines, longer by less than the radius.
 //! - G40's I and K, the direction to leave along (001:1058-1064, inferred
 //!   there), do not change the path: the cancel ends on the programmed
 //!   point all the same.
