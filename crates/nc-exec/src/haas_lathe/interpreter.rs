@@ -379,10 +379,9 @@ impl<'a> Interpreter<'a> {
         if block.words.is_empty() && block.statements.is_empty() && block.corners.is_empty() {
             return Flow::Next;
         }
-        let start = self.position;
         if block.has_code(b'G', 65) {
             // Its other words are the macro's arguments.
-            let flow = self.macro_call(place, block, range);
+            let (start, flow) = (self.position, self.macro_call(place, block, range));
             if !self.stopped {
                 self.record(range, &start, STILL, Facts::default());
             }
@@ -416,6 +415,8 @@ impl<'a> Interpreter<'a> {
             }
         }
         self.update_frame();
+        // Where the block's move starts, in the frame it runs in.
+        let start = self.position;
         let (mut stop, mut m_functions, mut end, mut call) = (None, 0u8, false, None);
         for code in block.codes(b'M') {
             self.modes.set('M', code);

@@ -346,6 +346,26 @@ fn nose_radius_compensation_offsets_a_profile_by_the_radius_and_shifts_it_to_the
 }
 
 #[test]
+fn a_new_work_offset_ends_compensation_and_the_next_start_is_in_its_frame() {
+    let machine = MachineConfig { offsets: lathe_with_offsets().offsets, ..lathe_with_nose() };
+    let text = "O1\nT101\nG98 F100.\nG00 X20. Z2.\nG42 G01 Z0\nZ-10.\nG55 Z-20.\nM30\n";
+    let trace = run(text, &NoFiles, &machine, 100);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    // G54 ends with Z-10.'s normal at its end, the tip 0.8 behind it. In
+    // G55 the tool stands at machine Z-210 r-40, program Z40 r-40, and
+    // G42 starts anew from there, in force to the end; no element follows.
+    assert_eq!(
+        pieces(&trace),
+        [
+            (3, Piece::Start, (2.0, 10.0), (-0.8, 10.0)),
+            (4, Piece::Contour, (-0.8, 10.0), (-10.8, 10.0)),
+            (5, Piece::Start, (40.0, -40.0), (-20.0, -40.0)),
+        ]
+    );
+    assert_eq!(trace.compensated.iter().map(|span| span.steps.clone()).collect::<Vec<_>>(), [3..5, 5..7]);
+}
+
+#[test]
 fn nose_radius_compensation_starts_and_ends_on_lines_only() {
     let starts_on_arc = "O1\nT101\nG98 F100.\nG00 X20. Z0\nG42 G02 X40. Z-10. R10.\nG40 G01 X50.\nM30\n";
     let trace = run(starts_on_arc, &NoFiles, &lathe_with_nose(), 100);
