@@ -711,6 +711,36 @@ fn run_finds_macrocycle_files_in_the_project() {
     assert_eq!(json["findings"][0]["line"], 3);
 }
 
+/// A Haas program's `M98 P1000` runs the program file `O01000.nc` beside
+/// it; its blocks name that file, and a program with no file stops the run.
+#[test]
+fn run_finds_haas_program_files_beside_the_program() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("O01000.nc"), "O1000\nG98 G01 W-10. F600.\nM99\n").unwrap();
+    let program = dir.path().join("main.nc");
+    std::fs::write(&program, "O1\nM98 P1000 L2\nM98 P2000\nM30\n").unwrap();
+
+    let output = ncc(&["run", program.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(output.status.code(), Some(1));
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let places: Vec<(String, u64)> = json["blocks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| {
+            let file = b["file"].as_str().unwrap().replace('\\', "/");
+            (file.rsplit('/').next().unwrap().to_owned(), b["line"].as_u64().unwrap())
+        })
+        .collect();
+    let expected = [("main.nc", 2), ("O01000.nc", 2), ("O01000.nc", 3), ("O01000.nc", 2), ("O01000.nc", 3)];
+    let expected: Vec<(String, u64)> = expected.into_iter().map(|(f, l)| (f.to_owned(), l)).collect();
+    assert_eq!(places, expected);
+    assert_eq!(json["end_position"]["Z"], -20.0);
+    let message = json["findings"][0]["message"].as_str().unwrap();
+    assert!(message.contains("no program O2000"), "{message}");
+    assert_eq!(json["findings"][0]["line"], 3);
+}
+
 /// `ncc expand` writes a program that runs the same moves in the same time
 /// (to F's whole mm/min), here with a macrocycle file and its dwells
 /// resolved; the expanded program passes `ncc check` without errors.
@@ -777,15 +807,18 @@ fn expand_writes_a_haas_program_as_plain_lathe_blocks() {
     assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
     let text = std::fs::read_to_string(expanded).unwrap();
     // 180 m/min at Ø60 is 954.93 rpm, at 0.25 mm/rev 238.732 mm/min.
-    assert!(text.starts_with("%\nO1 (EXPANDED FROM O1.nc)\nG18 G21 G40 G97 G98\nG00 X64. Z2.\nG00 X60.\n"), "{text}");
+    assert!(
+        text.starts_with("%\nO1 (EXPANDED FROM O1.nc)\nG18 G21 G40 G54 G97 G98\nG00 X64. Z2.\nG00 X60.\n"),
+        "{text}"
+    );
     assert!(text.contains("\nG01 Z-30. F238.732\nG02 X66. Z-33. I3. K0. F227.364\nG00 X68. Z2.\n"), "{text}");
     assert_eq!(text.matches("G01 Z-30.").count(), 3, "{text}");
     assert!(text.ends_with("G00 X60. Z2.\nG04 P250\nM30\n%\n"), "{text}");
     let check = ncc(&["check", expanded]);
     assert_eq!(check.status.code(), Some(0), "{}", stdout(&check));
-    // The source's hints carry over: no work offset, an arc without
-    // tool-nose compensation, a dwell in milliseconds.
-    let summary = "Found 0 errors, 0 warnings, 3 infos and 0 hints in 1 file.\n";
+    // The source's hints carry over: an arc without tool-nose
+    // compensation, a dwell in milliseconds (the expansion selects G54).
+    let summary = "Found 0 errors, 0 warnings, 2 infos and 0 hints in 1 file.\n";
     assert!(stdout(&check).ends_with(summary), "{}", stdout(&check));
     let ((original, original_time), (again, again_time)) = (run_moves(program), run_moves(expanded));
     assert_eq!(original.len(), 13);

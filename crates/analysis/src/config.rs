@@ -32,6 +32,12 @@
 //! offset-file = "TAB0.POS"                # zero offsets G53-G59
 //! tool-file = "TAB0.KOR"                  # tool corrections D1-D99
 //!
+//! [machine.work-offsets]                   # Haas lathe: G54-G59, G110-G129
+//! G54 = { X = "0", Z = "-250.5" }          # mm from the machine zero, X a diameter
+//!
+//! [machine.tool-offsets]                   # Haas lathe: the offset yy of Txxyy
+//! 1 = { radius = "0.8", tip = 3 }          # nose radius (mm) and tip code 0-9
+//!
 //! [machine.constants]                      # as in TAB0.REK
 //! R339 = "01000000"                        # the eight decades
 //! R39 = "60.000"                           # or with the decimal point
@@ -51,8 +57,11 @@ use std::{
     path::{Path, PathBuf},
 };
 
-use nc_exec::cnc8x6::tables::{self, Finding};
 pub use nc_exec::machine::{MachineConfig, OffsetTable, ToolTable, TravelLimits, parse_constant};
+use nc_exec::{
+    cnc8x6::tables::{self, Finding},
+    haas_lathe::offsets,
+};
 use ncc_catalog::DialectId;
 use ncc_syntax::{Dialect, Severity};
 use serde::Deserialize;
@@ -184,7 +193,19 @@ struct MachineFile {
     offset_file: Option<PathBuf>,
     tool_file: Option<PathBuf>,
     #[serde(default)]
+    work_offsets: BTreeMap<String, BTreeMap<String, String>>,
+    #[serde(default)]
+    tool_offsets: BTreeMap<String, ToolOffsetFile>,
+    #[serde(default)]
     constants: BTreeMap<String, String>,
+}
+
+/// A Haas lathe's tool offset: its nose radius and tip code.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ToolOffsetFile {
+    radius: Option<String>,
+    tip: Option<u8>,
 }
 
 #[derive(Deserialize)]
@@ -200,11 +221,14 @@ struct TableFile {
     named_by: String,
 }
 
-/// The table files the configuration names, read once the axes are known.
+/// The table files the configuration names, read once the axes are known,
+/// and a Haas lathe's work offsets: by G code, each axis's offset by
+/// letter, in thousandths.
 #[derive(Default)]
 struct TableFiles {
     offsets: Option<TableFile>,
     tools: Option<TableFile>,
+    work_offsets: BTreeMap<u8, Vec<(u8, i32)>>,
 }
 
 impl MachineFile {
@@ -298,11 +322,45 @@ impl MachineFile {
             path: relative_to(path, &name),
             named_by: format!("{origin}: {section}{key} `{}`", name.display()),
         };
+        let haas = machine.control == Dialect::HaasLathe;
+        if haas && (self.offset_file.is_some() || self.tool_file.is_some()) {
+            return Err(format!(
+                "{origin}: {section}offset-file and tool-file are the CNC8x6's tables; a Haas lathe gives work-offsets and tool-offsets"
+            ));
+        }
+        let haas_keys = !self.work_offsets.is_empty() || !self.tool_offsets.is_empty();
+        if haas_keys && !haas {
+            return Err(format!(
+                "{origin}: {section}work-offsets and tool-offsets describe a Haas lathe (dialect = \"haas-lathe\"); a CNC8x6 reads offset-file and tool-file"
+            ));
+        }
         if let Some(name) = self.offset_file {
             tables.offsets = Some(table("offset-file", name));
         }
         if let Some(name) = self.tool_file {
             tables.tools = Some(table("tool-file", name));
+        }
+        for (key, axes) in self.work_offsets {
+            let code = offsets::work_offset_code(&key)
+                .ok_or_else(|| format!("{origin}: {section}work-offsets key `{key}` is none of G54-G59, G110-G129"))?;
+            let mut row = Vec::new();
+            for (axis, value) in axes {
+                let letter = axis_letter(&axis).ok_or_else(|| {
+                    format!("{origin}: {section}work-offsets.{key} key `{axis}` is not an axis letter")
+                })?;
+                let value = tables::coordinate(&value)
+                    .map_err(|e| format!("{origin}: {section}work-offsets.{key}.{axis}: {e}"))?;
+                row.push((letter, value));
+            }
+            tables.work_offsets.insert(code, row);
+        }
+        for (key, offset) in self.tool_offsets {
+            let number = offsets::tool_offset_number(&key)
+                .ok_or_else(|| format!("{origin}: {section}tool-offsets key `{key}` is no offset number 1-99"))?;
+            let field = |e: String| format!("{origin}: {section}tool-offsets.{key}: {e}");
+            let radius = offset.radius.map(|radius| tables::coordinate(&radius)).transpose().map_err(field)?;
+            let entry = offsets::tool_offset(radius.unwrap_or(0), offset.tip).map_err(field)?;
+            machine.tools.entries.insert(number, entry);
         }
         for (name, value) in self.constants {
             let number = name
@@ -422,6 +480,20 @@ impl Config {
         if let Some(table) = tables.tools {
             config.machine.tools = table.read(&read, &config.machine.axes, ToolTable::parse)?;
         }
+        for (code, row) in tables.work_offsets {
+            let mut values = [0; 6];
+            for (letter, value) in row {
+                let index = config.machine.axes.iter().position(|&axis| axis == letter).ok_or_else(|| {
+                    let axes = tables::axis_list(&config.machine.axes);
+                    format!(
+                        "{origin}: machine.work-offsets.G{code}: `{}` is not an axis of the machine ({axes})",
+                        char::from(letter)
+                    )
+                })?;
+                values[index] = value;
+            }
+            config.machine.offsets.rows.insert(code, values);
+        }
         Ok(config)
     }
 
@@ -496,6 +568,34 @@ mod tests {
         assert!(load("[unknown]\n", &[]).is_err());
         let error = load("[machine]\nrapid-rate = 0\n", &[]).unwrap_err();
         assert!(error.contains("rapid-rate"), "{error}");
+    }
+
+    #[test]
+    fn a_haas_lathe_gives_its_work_and_tool_offsets() {
+        let ncc = "dialect = \"haas-lathe\"\n[machine]\nfile = \"lathe.toml\"\n[machine.work-offsets]\nG55 = { Z = \"-300\" }\n";
+        let lathe = "[work-offsets]\nG54 = { X = \"-100.5\", Z = \"-250\" }\nG110 = { Z = \"5\" }\n[tool-offsets]\n1 = { radius = \"0.8\", tip = 3 }\n12 = { tip = 8 }\n";
+        let machine = load(ncc, &[("project/lathe.toml", lathe)]).unwrap().machine;
+        assert_eq!(machine.axes, b"XZ");
+        // X as written, a diameter; rows by G code, per axis.
+        assert_eq!(machine.offsets.offset(54), [-100_500, -250_000, 0, 0, 0, 0]);
+        assert_eq!(machine.offsets.offset(55), [0, -300_000, 0, 0, 0, 0]);
+        assert_eq!(machine.offsets.offset(110), [0, 5_000, 0, 0, 0, 0]);
+        assert_eq!((machine.tools.entry(1).radius, machine.tools.entry(1).tip), (800, Some(3)));
+        assert_eq!((machine.tools.entry(12).radius, machine.tools.entry(12).tip), (0, Some(8)));
+        let haas = |keys: &str| load(&format!("dialect = \"haas-lathe\"\n[machine]\n{keys}"), &[]).unwrap_err();
+        for (keys, says) in [
+            ("[machine.work-offsets]\nG53 = { Z = \"1\" }\n", "G53"),
+            ("[machine.work-offsets]\nG54 = { Y = \"1\" }\n", "`Y` is not an axis"),
+            ("[machine.tool-offsets]\n100 = { tip = 3 }\n", "100"),
+            ("[machine.tool-offsets]\n1 = { tip = 10 }\n", "tip code"),
+            ("[machine.tool-offsets]\n1 = { radius = \"-0.4\" }\n", "negative"),
+            ("tool-file = \"TAB0.KOR\"\n", "tool-offsets"),
+        ] {
+            let error = haas(keys);
+            assert!(error.contains(says), "{keys}: {error}");
+        }
+        let error = load("[machine.tool-offsets]\n1 = { tip = 3 }\n", &[]).unwrap_err();
+        assert!(error.contains("haas-lathe"), "{error}");
     }
 
     #[test]

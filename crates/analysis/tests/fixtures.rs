@@ -171,6 +171,7 @@ impl Environment for FixtureFiles<'_> {
         let found = match called {
             Called::Number(number) => self.named(&format!("L{number}")),
             Called::Name(name) => self.named(name),
+            Called::Program(number) => self.named(&format!("O{number}")),
         };
         found.map(|(_, text)| text.clone())
     }
@@ -192,6 +193,9 @@ fn run_check(fixture: &PathBuf) -> Result<Vec<&'static str>, String> {
             files.iter().position(|(path, _)| path.ends_with(format!("L{number}"))).unwrap()
         }
         Some(Called::Name(name)) => files.iter().position(|(path, _)| path.ends_with(name)).unwrap(),
+        Some(Called::Program(number)) => {
+            files.iter().position(|(path, _)| path.ends_with(format!("O{number}"))).unwrap()
+        }
     };
     let mut report = String::new();
     for (index, (path, text)) in

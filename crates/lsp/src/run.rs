@@ -933,9 +933,11 @@ impl Serialize for Values<'_> {
 }
 
 /// Where a run finds the files a program uses: macrocycle files
-/// (`G72 L9001` calls the file `L9001`, with or without an extension) and
-/// the machine's cycle file, by name. It looks beside the program first,
-/// then anywhere in its project, the directory of its `ncc.toml`.
+/// (`G72 L9001` calls the file `L9001`, with or without an extension), the
+/// machine's cycle file, by name, and Haas programs (`M98 P1234` calls the
+/// file `O1234` or `O01234`, with or without an extension). It looks
+/// beside the program first, then anywhere in its project, the directory
+/// of its `ncc.toml`.
 struct Library<'a> {
     candidates: Vec<PathBuf>,
     /// The editor's files, which take the place of the candidates.
@@ -1014,6 +1016,10 @@ impl Environment for Library<'_> {
                     path.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.eq_ignore_ascii_case(name))
                 };
                 self.read(called, named, |files| files.cycle_file_named(name))
+            }
+            &Called::Program(number) => {
+                let named = |path: &Path| ncc_catalog::program_file_number(path) == Some(number);
+                self.read(called, named, |files| files.program_file(number))
             }
         }
     }

@@ -38,9 +38,13 @@ pub struct MachineConfig {
     /// CNC836.KNF), e.g. `PCYKLYDG.NCP` (milling) or `PEVNECY5.NCP`
     /// (lathe): it decides what G81–G89 do.
     pub cycle_file: Option<String>,
-    /// The zero offsets G53-G59 as the control loads them from TAB0.POS.
+    /// CNC8x6: the zero offsets G53-G59 as the control loads them from
+    /// TAB0.POS. Haas lathe: the work offsets G54-G59 and G110-G129 of the
+    /// offset page, X as a diameter.
     pub offsets: OffsetTable,
-    /// The tool corrections D1-D99 as the control loads them from TAB0.KOR.
+    /// CNC8x6: the tool corrections D1-D99 as the control loads them from
+    /// TAB0.KOR. Haas lathe: the tool offsets 1-99 that `Txxyy` selects by
+    /// `yy`, their nose radius and tip only.
     pub tools: ToolTable,
     /// The pause between blocks under G98, where the next block is not
     /// prepared ahead, in ms. It depends on the hardware; the manual gives
@@ -185,11 +189,13 @@ pub fn parse_constant(text: &str) -> Option<i64> {
     i64::try_from(value.scaled(scale)?).ok()
 }
 
-/// The zero-offset table: per row G53-G59 the offset of each axis from the
-/// machine zero (01 §5.5). Rows the configuration does not give are zero.
+/// The zero-offset table: per row the offset of each axis from the
+/// machine zero (CNC8x6: G53-G59, 01 §5.5; Haas lathe: G54-G59 and
+/// G110-G129). Rows the configuration does not give are zero.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Hash)]
 pub struct OffsetTable {
-    /// Offsets by G code (53-59), per axis 1-6, in thousandths.
+    /// Offsets by G code, per axis 1-6, in thousandths (of a diameter on a
+    /// Haas lathe's X).
     pub rows: BTreeMap<u8, [i32; 6]>,
 }
 
@@ -207,21 +213,22 @@ pub struct ToolEntry {
     pub radius: i32,
     /// Length corrections of axes 1-6, in thousandths.
     pub lengths: [i32; 6],
-    /// `P`: the position of a lathe tool's tip relative to its nose radius
-    /// centre, 1-9 (000:2243-2251); `None` when not given, which the control
-    /// takes as the centre itself (000:2586-2590).
+    /// The position of a lathe tool's tip relative to its nose radius
+    /// centre: CNC8x6 `P`, 1-9 (000:2243-2251); Haas lathe, the tip code
+    /// 0-9 (lathe manual §7.1 (001:879-951)). `None` when not given, which
+    /// the controls take as the centre itself (000:2586-2590).
     pub tip: Option<u8>,
 }
 
-/// The correction table: entries D1-D99 (02 §1.2). Entries the
-/// configuration does not give are zero.
+/// The correction table: entries D1-D99 (02 §1.2), or a Haas lathe's tool
+/// offsets 1-99. Entries the configuration does not give are zero.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Hash)]
 pub struct ToolTable {
     pub entries: BTreeMap<u8, ToolEntry>,
 }
 
 impl ToolTable {
-    /// Entry `D<number>`.
+    /// Entry `D<number>` (Haas lathe: offset `number`).
     pub fn entry(&self, number: u8) -> ToolEntry {
         self.entries.get(&number).copied().unwrap_or_default()
     }

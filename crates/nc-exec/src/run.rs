@@ -23,12 +23,13 @@ pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget:
     std::thread::scope(|scope| run_in(scope, text, files, machine, budget, None, None))
 }
 
-/// The frame of the priority block on `machine`, in which a run starts:
-/// the zero offset G53 of its tables ([`Trace::reset_frame`]).
+/// The frame in which a run on `machine` starts ([`Trace::reset_frame`]):
+/// CNC8x6, the zero offset G53 of its tables after the priority block;
+/// Haas lathe, the work offset G54.
 pub fn reset_frame(machine: &MachineConfig) -> Frame {
     match machine.control {
         Dialect::Cnc8x6 => cnc8x6::interpreter::reset_frame(machine),
-        Dialect::HaasLathe => Frame::default(),
+        Dialect::HaasLathe => haas_lathe::interpreter::reset_frame(machine),
     }
 }
 
@@ -111,6 +112,6 @@ fn run_in<'a, 's>(
 ) -> Trace {
     match machine.control {
         Dialect::Cnc8x6 => cnc8x6::interpreter::run_in(scope, text, files, machine, budget, sink, checkpoint),
-        Dialect::HaasLathe => haas_lathe::interpreter::run_into(text, machine, budget, sink),
+        Dialect::HaasLathe => haas_lathe::interpreter::run_into(text, files, machine, budget, sink),
     }
 }

@@ -324,4 +324,8 @@ pub enum Called {
     Number(u32),
     /// By name (CNC8x6: the machine's fixed-cycle file).
     Name(String),
+    /// A program by its number (Haas lathe: `M98 P1234` or `G65 P1234`
+    /// calls program `O1234`, in a file named after it, `O1234` or
+    /// `O01234` with or without an extension).
+    Program(u32),
 }

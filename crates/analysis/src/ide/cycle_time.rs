@@ -1,7 +1,8 @@
 //! The predicted cycle time of a program, block by block.
 //!
 //! The program runs on the executor (`nc_exec::run`) with the workspace's
-//! macrocycle files and cycle file, and the velocity model times the
+//! macrocycle files and cycle file (Haas: program files), and the velocity
+//! model times the
 //! steps. Each block of the file gets the time of all its executions; the
 //! steps of other files (a macrocycle, a cycle body) are charged to the
 //! block of this file that ran last before them: the call.
@@ -126,13 +127,16 @@ pub struct RunInput {
     pub files: WorkspaceFiles,
 }
 
-/// The macrocycle files and possible cycle files of a workspace, as the
-/// editor has them (unsaved edits too): what the inline times and the
-/// plot of an open program run with.
+/// The macrocycle files and possible cycle files of a workspace, or its
+/// Haas program files, as the editor has them (unsaved edits too): what
+/// the inline times and the plot of an open program run with.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct WorkspaceFiles {
     /// Path and text by number.
     macrocycles: FxHashMap<u32, (String, Arc<String>)>,
+    /// Haas program files named after their number (`O01234.nc`): path and
+    /// text by number.
+    programs: FxHashMap<u32, (String, Arc<String>)>,
     /// The files named as the machine's cycle file, by their name without
     /// directory and extension, with their path.
     by_stem: Vec<(String, String, Arc<String>)>,
@@ -142,6 +146,11 @@ impl WorkspaceFiles {
     /// The path and text of the macrocycle file `L<number>`.
     pub fn macrocycle_file(&self, number: u32) -> Option<(&str, &str)> {
         self.macrocycles.get(&number).map(|(path, text)| (path.as_str(), text.as_str()))
+    }
+
+    /// The path and text of the Haas program file of `number`.
+    pub fn program_file(&self, number: u32) -> Option<(&str, &str)> {
+        self.programs.get(&number).map(|(path, text)| (path.as_str(), text.as_str()))
     }
 
     /// The path and text of the cycle file the machine names `name`.
@@ -157,6 +166,7 @@ impl Environment for WorkspaceFiles {
         let found = match called {
             &Called::Number(number) => self.macrocycle_file(number),
             Called::Name(name) => self.cycle_file_named(name),
+            &Called::Program(number) => self.program_file(number),
         };
         found.map(|(_, text)| text.to_owned())
     }
@@ -176,6 +186,13 @@ pub(crate) fn run_input(db: &dyn Db, file: SourceFile) -> Option<RunInput> {
         }
     }
     let machine = &settings.config(db).machine;
+    if *settings.dialect(db) == ncc_syntax::Dialect::HaasLathe {
+        for &other in settings.files(db) {
+            if let Some(number) = ncc_catalog::program_file_number(std::path::Path::new(other.path(db))) {
+                files.programs.entry(number).or_insert_with(|| (other.path(db).clone(), other.text(db).clone()));
+            }
+        }
+    }
     // Only the cycle file the machine names: an edit of another program
     // leaves this one's estimate as it is.
     if let Some(cycle_file) = machine.cycle_file.as_deref().map(model::file_stem) {
@@ -1177,6 +1194,7 @@ mod tests {
             .into_iter()
             .collect(),
             by_stem: Vec::new(),
+            programs: FxHashMap::default(),
         };
         let machine = MachineConfig::default();
         let text = Arc::new(text);
@@ -1190,6 +1208,22 @@ mod tests {
         // 20 mm more at the last feed, 900 mm/min.
         let longer = resumed.totals.total - first.totals.total;
         assert!((longer - 20.0 / 15.0).abs() < 0.05, "{longer}");
+    }
+
+    /// A Haas program's M98 runs the program file named after the number
+    /// in the workspace, as the editor has it.
+    #[test]
+    fn a_haas_program_runs_the_program_files_of_the_workspace() {
+        let mut host = AnalysisHost::in_dialect(ncc_syntax::Dialect::HaasLathe, Config::default());
+        let file = host.add_file("/p/main.nc", "O1\nM98 P1000\nM30\n");
+        host.add_file("/p/O01000.nc", "O1000\nG98 G01 W-10. F600.\nM99\n");
+        host.add_file("/p/other.nc", "O2\nM30\n");
+        let input = host.analysis().run_input(file).expect("a program");
+        assert_eq!(input.files.program_file(1000).map(|(path, _)| path), Some("/p/O01000.nc"));
+        assert_eq!(input.files.program_file(2), None, "found by its file's name only");
+        // 10 mm at 600 mm/min, with the ramps.
+        let total = input.estimate(None, 1000).totals.total;
+        assert!(total >= 1.0, "{total}");
     }
 
     /// A run without checkpoints (a Haas lathe run) still knows its input:

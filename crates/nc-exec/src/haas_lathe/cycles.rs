@@ -61,7 +61,7 @@
 //!   spindle ramps). G87/G88 stop at the bottom for the operator's manual
 //!   retract, counted as a rapid back to the R plane after the stop.
 
-use crate::machine::MachineConfig;
+use crate::{compensation::Side, machine::MachineConfig};
 
 /// A point of the plane (Z, X), X a radius.
 pub type Point = [f64; 2];
@@ -82,6 +82,11 @@ pub enum Move {
     Dwell(f64),
     /// The program stops for the operator (the manual retract of G87/G88).
     Stop,
+    /// Tool-nose radius compensation for the moves after it: G41 (left),
+    /// G42 (right) or none (G40). A pass along a contour of G70–G73 runs
+    /// with the compensation its blocks program (lathe manual §6.9 item 7
+    /// (001:1706)); every other move of a cycle runs without.
+    Nose(Option<Side>),
 }
 
 /// Why the control refuses a cycle: said at its block.

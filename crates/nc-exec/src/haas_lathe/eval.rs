@@ -87,6 +87,30 @@ pub struct Variables {
     values: [Known<MacroValue>; 333],
 }
 
+/// How many locals there are: `#1`–`#33`.
+const LOCALS: usize = 33;
+
+/// The local variables `#1`–`#33` of one macro call level.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Locals([Known<MacroValue>; LOCALS]);
+
+impl Locals {
+    /// Every local vacant, as a macro call level starts (assumption from
+    /// Fanuc).
+    pub fn vacant() -> Locals {
+        Locals([Known::Is(MacroValue::Vacant); LOCALS])
+    }
+
+    /// Sets `#number`, a number from 1 to 33; others are not locals and
+    /// change nothing.
+    pub fn set(&mut self, number: u32, value: Known<MacroValue>) {
+        if let Some(local) = usize::try_from(number).ok().and_then(|n| n.checked_sub(1)).and_then(|i| self.0.get_mut(i))
+        {
+            *local = value;
+        }
+    }
+}
+
 /// Where `#number` is kept in [`Variables::values`].
 fn slot(number: u32) -> Option<usize> {
     let number = usize::try_from(number).ok()?;
@@ -106,6 +130,18 @@ impl Variables {
         let mut values = [Known::Is(MacroValue::Vacant); 333];
         values[133..].fill(Known::Unknown);
         Variables { values }
+    }
+
+    /// The locals `#1`–`#33`, which a macro call (G65) keeps per level.
+    pub fn locals(&self) -> Locals {
+        let mut locals = Locals::vacant();
+        locals.0.copy_from_slice(&self.values[..LOCALS]);
+        locals
+    }
+
+    /// Puts `locals` in place of `#1`–`#33`.
+    pub fn set_locals(&mut self, locals: &Locals) {
+        self.values[..LOCALS].copy_from_slice(&locals.0);
     }
 
     /// Every variable unknown, for reading a program with no assumption

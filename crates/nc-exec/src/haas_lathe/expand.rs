@@ -36,22 +36,33 @@
 //! No block is numbered: the numbers are optional (lathe manual §5.1
 //! (001:1800-1824)) and nothing jumps in an expansion. The manual names no
 //! line length; blocks of positions within ±99999.999 mm stay under 80
-//! characters. The run applies no work offsets yet, so the positions are
-//! the program's.
+//! characters. Positions are written in G54's coordinates, which the
+//! header selects: a step run under another work offset, G52 or G53 is
+//! moved to them (a Haas frame is a shift, so an arc's centre moves with
+//! its end). Under tool-nose radius compensation with a radius the tool's
+//! path is not the programmed one: such a step is not written yet.
 
-use std::io::{self, Write};
+use std::{
+    collections::HashMap,
+    io::{self, Write},
+};
+
+use nalgebra::Point2;
 
 use crate::{
+    compensation::ToolElement,
     expand::{Expand, ExpandError, Unwritable, centre_offsets},
     machine::MachineConfig,
-    trace::{Motion, Path, PathMode, Step, StepSink, Stop, slot},
-    transform::by_letter,
+    trace::{Compensated, Motion, Path, PathMode, Step, StepSink, Stop, slot},
+    transform::{Frame, by_letter},
 };
 
 /// The plane of the run's arcs: Z first, the radius X second.
 const PLANE: (u8, u8) = (b'Z', b'X');
 
 const OUT_OF_PLANE: &str = "an arc outside the lathe's plane ZX (G18) cannot be written for a Haas lathe";
+const COMPENSATED: &str =
+    "under tool-nose radius compensation the tool's path is not the programmed one; ncc expand does not write it yet";
 
 /// Writes the moves of a Haas lathe run as program `O<number>` to `out`
 /// while the run goes: a [`StepSink`] that writes the block of each step as
@@ -71,6 +82,13 @@ pub struct Expansion<W: Write> {
     speed: Option<i64>,
     /// Whether G61 is in force rather than G64.
     exact_stop: bool,
+    /// The run's frames, and G54's, in which the program is written.
+    frames: Vec<Frame>,
+    written: Frame,
+    /// Where each compensated step's tool path ends, by step (Z, X).
+    tool_ends: HashMap<usize, Point2<f64>>,
+    /// The index of the step to come.
+    next: usize,
     /// What stopped the expansion: nothing is written after it.
     failure: Option<ExpandError>,
 }
@@ -86,12 +104,16 @@ impl<W: Write> Expansion<W> {
             feed: None,
             speed: None,
             exact_stop: false,
+            frames: Vec::new(),
+            written: super::interpreter::reset_frame(machine),
+            tool_ends: HashMap::new(),
+            next: 0,
             failure: None,
         };
         // A comment ends at the first `)` and does not nest.
         let title: String = title.chars().filter(|&c| c != '(' && c != ')' && !c.is_control()).collect();
         let comment = if title.is_empty() { String::new() } else { format!(" ({title})") };
-        let started = write!(expansion.out, "%\nO{number}{comment}\nG18 G21 G40 G97 G98\n");
+        let started = write!(expansion.out, "%\nO{number}{comment}\nG18 G21 G40 G54 G97 G98\n");
         expansion.failure = started.err().map(ExpandError::Io);
         expansion
     }
@@ -108,8 +130,17 @@ impl<W: Write> Expansion<W> {
 
     /// Writes the blocks of `step`: none for a step without motion, time or
     /// stop.
-    fn write(&mut self, step: &Step) -> Result<(), ExpandError> {
-        let end = by_letter(&step.end, &self.axes);
+    fn write(&mut self, step: &Step, index: usize) -> Result<(), ExpandError> {
+        let programmed = by_letter(&step.end, &self.axes);
+        if let Some(tool) = self.tool_ends.get(&index)
+            && (tool - Point2::new(programmed[slot(b'Z')], programmed[slot(b'X')])).norm() > 1e-6
+        {
+            let unwritable = Unwritable { source: step.source, range: step.range, reason: COMPENSATED };
+            return Err(ExpandError::Unwritable(unwritable));
+        }
+        let machine = self.frames.get(step.frame).map_or(step.end, |frame| frame.to_machine(&step.end, &self.axes));
+        let end = by_letter(&self.written.to_program(&machine, &self.axes), &self.axes);
+        let shift = [end[slot(b'Z')] - programmed[slot(b'Z')], end[slot(b'X')] - programmed[slot(b'X')]];
         let to = [thousandths(end[slot(b'Z')]), thousandths(2.0 * end[slot(b'X')])];
         let moved = self.at.map_or([true, true], |at| [to[0] != at[0], to[1] != at[1]]);
         let mut words: Vec<String> = Vec::new();
@@ -138,6 +169,7 @@ impl<W: Write> Expansion<W> {
                 words.extend(coordinates(to, [true, true]));
                 // The plane's radius X is half the written diameter.
                 let plane_point = |[z, d]: [i64; 2]| [z as f64 / 1000.0, d as f64 / 2000.0];
+                let centre = [centre[0] + shift[0], centre[1] + shift[1]];
                 let [k, i] = centre_offsets(plane_point(self.at.unwrap_or_default()), plane_point(to), centre);
                 words.push(format!("I{}", decimal(thousandths(i), 3)));
                 words.push(format!("K{}", decimal(thousandths(k), 3)));
@@ -200,8 +232,17 @@ impl<W: Write> StepSink for Expansion<W> {
         if self.failure.is_some() {
             return;
         }
-        if let Err(failure) = self.write(&step) {
+        let index = self.next;
+        self.next += 1;
+        if let Err(failure) = self.write(&step, index) {
             self.failure = Some(failure);
+        }
+    }
+
+    fn references(&mut self, frames: &[Frame], _compensated: &[Compensated], tool_centre: &[ToolElement]) {
+        self.frames.extend_from_slice(frames.get(self.frames.len()..).unwrap_or_default());
+        for piece in tool_centre {
+            self.tool_ends.insert(piece.block, piece.path.end());
         }
     }
 

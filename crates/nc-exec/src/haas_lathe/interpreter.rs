@@ -1,6 +1,6 @@
 //! The Haas lathe interpreter: the modal state, motion and time of the
 //! file's first program, block by block, in the order the control runs
-//! them.
+//! them, with the programs it calls.
 //!
 //! What runs:
 //! - Motion: G00 (the slowest axis at its own rapid rate, lathe manual
@@ -10,6 +10,12 @@
 //!   §5.8 (001:591-668)). X and U are diameters, Z and W lengths; U and W
 //!   count from the last position and mix with X and Z in one block
 //!   (lathe manual §5.4 (001:480-555)).
+//! - Coordinates (module `coordinates`): the work offsets G54–G59 and
+//!   G110–G129 of the machine's table, the local shift G52, moves in
+//!   machine coordinates G53 and the reference point returns G28 and G29.
+//! - Tool-nose radius compensation G41/G42/G40 (module `nose`) with the
+//!   nose radius and tip of the offset T selects, in the passes along the
+//!   contour of G70–G73 too.
 //! - Feed and spindle: F per revolution (G99) or per minute (G98), S in
 //!   rpm (G97) or m/min of cutting speed (G96), the speed limit G50 S,
 //!   the spindle M03/M04/M05, dwell G04 P (ms without a decimal point,
@@ -22,11 +28,14 @@
 //!   run (lathe manual §6.9 item 8, inferred there) and after the block of
 //!   G70; G74–G76; the drilling and tapping cycles G81–G89, G184 at every
 //!   block that moves while one is in force, until G80, G00 or G01.
+//! - Subprograms and macro calls (module `calls`): M97, M98 (a program of
+//!   the file, or of a file beside it that the run's [`Environment`]
+//!   finds), M99 and G65 with its arguments, each with its repeat count L.
 //! - Macro statements through [`super::eval`]: assignments, `IF … GOTO`,
 //!   `IF … THEN`, `GOTO`, `WHILE … DOn` … `ENDn`; the step budget bounds
 //!   the loops.
-//! - M00/M01 stops, M02/M30 end the run; T changes the tool; other M
-//!   functions are counted.
+//! - M00/M01 stops, M02/M30 end the run; T changes the tool and selects
+//!   its offset; other M functions are counted.
 //!
 //! The modal state is the catalogue's: every group starts at its default
 //! (G01, G18, G21, G40, G54, G64, G80, G97, G99, M05, …) and a modal code
@@ -34,10 +43,10 @@
 //!
 //! Everything else is reported once per kind as not run yet and moves
 //! nothing, so that a total never silently leaves work out: live-tool
-//! tapping G95, tool-nose radius compensation G41/G42 (in a cycle's
-//! contour too), M97/M98/M99, G65, G28/G29, G53, work offsets, G52, inch
-//! units G20, corner chamfers and angles on G01 (and in the contour of
-//! G70 and G73; the roughing of G71 and G72 ignores them).
+//! tapping G95, inch units G20, mirror image G101, tool-nose radius
+//! compensation in the cycles that have no pass along a contour, corner
+//! chamfers and angles on G01 (and in the contour of G70 and G73; the
+//! roughing of G71 and G72 ignores them).
 //!
 //! Assumptions the manual does not settle:
 //! - A step's X is the radius, as CNC8x6 keeps it under diameter
@@ -59,13 +68,16 @@
 //! - A word whose variable is vacant is left out (Fanuc convention).
 //! - Block delete `/` is off: the blocks run.
 //! - `GOTO n` goes to the first block numbered n in the program.
-//! - T is recorded as written (`T101`: tool 1, offset 1).
+//! - T is recorded as written (`T101`: tool 1, offset 1); its last two
+//!   digits select the offset (`Txxyy`, lathe manual §7.1 (001:825-826)),
+//!   so that `T1` selects offset 1.
 
-use std::f64::consts::TAU;
+use std::{f64::consts::TAU, rc::Rc};
 
 use ncc_syntax::{Dialect, Parse, TextRange};
 
 use super::{
+    cycles::Point,
     eval::{EvalError, MacroValue, Variables},
     lower::{Expr, ExprKind, HaasBlock, Statement, Value, Word, block_nodes},
     modes::Modes,
@@ -73,11 +85,17 @@ use super::{
 };
 use crate::{
     arc::{CircleArc, OffCircle, circle_through},
+    compensation::{Side, ToolElement},
     known::Known,
     machine::MachineConfig,
-    trace::{Finding, Motion, Path, PathMode, Position, RunRule, Step, StepSink, Stop, Trace, round3, slot},
-    transform::{Frame, over_axes},
+    trace::{
+        Axes, Called, Compensated, Environment, Finding, Motion, PROGRESS_INTERVAL, Path, PathMode, Position, RunRule,
+        Step, StepSink, Stop, Trace, round3, slot,
+    },
+    transform::{Frame, by_letter, over_axes},
 };
+
+pub(crate) use coordinates::reset_frame;
 
 /// The catalogue's groups the interpreter reads.
 const MOTION: &str = "G1";
@@ -88,44 +106,81 @@ const EXACT_STOP: &str = "G13";
 const SPINDLE: &str = "M2";
 
 /// Runs the first program of `text` on `machine` for at most `budget`
-/// blocks, handing the steps to `sink` when there is one. The run starts
-/// from the beginning every time: it takes no checkpoints.
-pub(crate) fn run_into(text: &str, machine: &MachineConfig, budget: usize, sink: Option<&mut dyn StepSink>) -> Trace {
-    let parse = Parse::new(text, Dialect::HaasLathe);
-    let (ranges, blocks): (Vec<TextRange>, Vec<HaasBlock>) =
-        block_nodes(parse.green()).map(|(range, block)| (range, HaasBlock::lower(block))).unzip();
-    let model = ProgramModel::new(&blocks);
-    let mut interpreter = Interpreter::new(machine, &blocks, &ranges);
-    interpreter.contours = model.contours().cloned().collect();
-    if let Some(program) = model.programs.first() {
-        interpreter.run(program, model.programs.len() > 1, budget);
-    }
-    let frames = vec![Frame::default()];
-    let mut steps = interpreter.steps;
+/// blocks, reading the programs it calls from other files through `files`,
+/// and handing the steps to `sink` when there is one. The run starts from
+/// the beginning every time: it takes no checkpoints.
+pub(crate) fn run_into(
+    text: &str,
+    files: &dyn Environment,
+    machine: &MachineConfig,
+    budget: usize,
+    sink: Option<&mut dyn StepSink>,
+) -> Trace {
+    let mut interpreter = Interpreter::new(machine, files, Unit::read(text));
+    interpreter.run(budget);
+    interpreter.end_compensation();
+    // Pieces come in the order compensation fixes them, a move late.
+    interpreter.tool_centre.sort_by_key(|piece| piece.block);
     if let Some(sink) = sink {
-        sink.references(&frames, &[], &[]);
-        sink.steps(&mut steps);
+        sink.references(&interpreter.frames, &interpreter.compensated, &interpreter.tool_centre);
+        sink.steps(&mut interpreter.steps);
     }
     Trace {
         axes: machine.step_axes().to_vec(),
         diameter_axis: Some(b'X'),
-        frames,
-        reset_frame: Frame::default(),
-        tool_centre: Vec::new(),
-        compensated: Vec::new(),
+        reset_frame: reset_frame(machine),
+        frames: interpreter.frames,
+        tool_centre: interpreter.tool_centre,
+        compensated: interpreter.compensated,
         messages: Vec::new(),
-        steps,
+        steps: interpreter.steps,
         findings: interpreter.findings,
         tools: interpreter.tools,
-        files: Vec::new(),
+        files: interpreter.called,
         blocks_run: interpreter.executed,
     }
+}
+
+/// One file of a run, lowered: the program's (source 0) or one that a
+/// call read.
+struct Unit {
+    blocks: Vec<HaasBlock>,
+    /// Each block's range in the file.
+    ranges: Vec<TextRange>,
+    model: ProgramModel,
+}
+
+impl Unit {
+    fn read(text: &str) -> Unit {
+        let parse = Parse::new(text, Dialect::HaasLathe);
+        let (ranges, blocks): (Vec<TextRange>, Vec<HaasBlock>) =
+            block_nodes(parse.green()).map(|(range, block)| (range, HaasBlock::lower(block))).unzip();
+        let model = ProgramModel::new(&blocks);
+        Unit { blocks, ranges, model }
+    }
+
+    /// The contour of the cycle in block `cycle`.
+    fn contour(&self, cycle: usize) -> Option<&Contour> {
+        self.model.contours().find(|contour| contour.cycle == cycle)
+    }
+}
+
+/// Where a block is: its file (as [`Step::source`]), the program in that
+/// file ([`ProgramModel::programs`]) and the block's index in the file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Place {
+    source: usize,
+    program: usize,
+    block: usize,
 }
 
 /// Which block runs after one.
 enum Flow {
     Next,
+    /// A block of the same program.
     Jump(usize),
+    /// Into a call, or back from one.
+    Go(Place),
     End,
 }
 
@@ -140,14 +195,46 @@ struct Moved {
 
 const STILL: Moved = Moved { motion: Motion::None, path: Path::Straight, length: 0.0, duration: 0.0, feed: None };
 
+/// What a block's step records besides its move.
+#[derive(Default)]
+struct Facts {
+    stop: Option<Stop>,
+    exact: bool,
+    m_functions: u8,
+    tool_change: bool,
+    /// The tool-nose radius compensation its move runs with.
+    nose: Option<Side>,
+    /// A G53 block: it ends in machine coordinates.
+    machine: bool,
+}
+
 struct Interpreter<'a> {
     machine: &'a MachineConfig,
-    blocks: &'a [HaasBlock],
-    ranges: &'a [TextRange],
+    /// Where the programs that calls name are read from.
+    files: &'a dyn Environment,
+    /// The files of the run: the program's, then those calls read, in the
+    /// order of [`Interpreter::called`].
+    units: Vec<Rc<Unit>>,
+    called: Vec<Called>,
+    /// The file of the block being run.
+    source: usize,
+    /// The calls being run, the innermost last.
+    calls: Vec<calls::Call>,
     modes: Modes,
     variables: Variables,
-    /// Program coordinates, X as a radius.
+    /// Program coordinates in the frame in force, X as a radius.
     position: Position,
+    /// The frames of the steps, and the one in force.
+    frames: Vec<Frame>,
+    frame: usize,
+    coordinates: coordinates::Coordinates,
+    /// The tool offset T selects.
+    offset: u8,
+    /// Tool-nose radius compensation in force, the tool path it made, and
+    /// the steps it ran over.
+    nose: Option<nose::Nose>,
+    tool_centre: Vec<ToolElement>,
+    compensated: Vec<Compensated>,
     /// F as written: mm/rev or mm/min by the feed mode.
     feed: Option<f64>,
     /// S as written: rpm under G97, m/min under G96.
@@ -162,20 +249,28 @@ struct Interpreter<'a> {
     reported: Vec<String>,
     /// A finding the control stops on was made.
     stopped: bool,
-    /// The contours of the cycles G70–G73.
-    contours: Vec<Contour>,
     cycles: canned::CycleState,
 }
 
 impl<'a> Interpreter<'a> {
-    fn new(machine: &'a MachineConfig, blocks: &'a [HaasBlock], ranges: &'a [TextRange]) -> Self {
-        Interpreter {
+    fn new(machine: &'a MachineConfig, files: &'a dyn Environment, program: Unit) -> Self {
+        let mut interpreter = Interpreter {
             machine,
-            blocks,
-            ranges,
+            files,
+            units: vec![Rc::new(program)],
+            called: Vec::new(),
+            source: 0,
+            calls: Vec::new(),
             modes: Modes::at_reset(Dialect::HaasLathe.catalogue()),
             variables: Variables::at_power_on(),
             position: [0.0; 26],
+            frames: Vec::new(),
+            frame: 0,
+            coordinates: coordinates::Coordinates::default(),
+            offset: 0,
+            nose: None,
+            tool_centre: Vec::new(),
+            compensated: Vec::new(),
             feed: None,
             speed: 0.0,
             speed_limit: None,
@@ -185,76 +280,95 @@ impl<'a> Interpreter<'a> {
             executed: 0,
             reported: Vec::new(),
             stopped: false,
-            contours: Vec::new(),
             cycles: canned::CycleState::default(),
-        }
+        };
+        interpreter.start_coordinates();
+        interpreter
     }
 
-    fn run(&mut self, program: &Program, more_programs: bool, budget: usize) {
-        let mut at = program.blocks.start;
-        while program.blocks.contains(&at) {
+    /// Runs the file's first program for at most `budget` blocks, with the
+    /// programs it calls.
+    fn run(&mut self, budget: usize) {
+        let Some(first) = self.units[0].model.programs.first() else { return };
+        let mut place = Place { source: 0, program: 0, block: first.blocks.start };
+        loop {
+            let unit = Rc::clone(&self.units[place.source]);
+            let program = &unit.model.programs[place.program];
+            self.source = place.source;
+            if !program.blocks.contains(&place.block) {
+                self.ran_off(place, &unit);
+                return;
+            }
             if self.executed >= budget {
                 let message = format!("the run went past its budget of {budget} blocks");
-                self.finding(RunRule::StepBudget, self.ranges[at], &message);
+                self.finding(RunRule::StepBudget, unit.ranges[place.block], &message);
                 return;
             }
             self.executed += 1;
-            let flow = self.block(at, program);
+            if self.executed.is_multiple_of(PROGRESS_INTERVAL) {
+                self.files.progress(self.executed);
+            }
+            let flow = self.block(place, program);
             if self.stopped {
                 return;
             }
-            at = match flow {
-                Flow::Next => at + 1,
-                Flow::Jump(target) => target,
+            place = match flow {
+                Flow::Next => Place { block: place.block + 1, ..place },
+                Flow::Jump(block) => Place { block, ..place },
+                Flow::Go(to) => to,
                 Flow::End => return,
             };
         }
-        if more_programs && at == program.blocks.end {
-            let range = self.ranges[at];
+    }
+
+    /// The run has reached the end of the program at `place` without M30,
+    /// M02 or M99.
+    fn ran_off(&mut self, place: Place, unit: &Unit) {
+        let program = &unit.model.programs[place.program];
+        if !self.calls.is_empty() {
+            let last = program.blocks.end.checked_sub(1).and_then(|last| unit.ranges.get(last));
+            let message = "the called program ends without M99: the control stops";
+            self.finding(RunRule::MacrocycleWithoutReturn, last.copied().unwrap_or_default(), message);
+        } else if let Some(&range) = unit.ranges.get(place.block).filter(|_| unit.model.programs.len() > 1) {
             self.finding(RunRule::RunsIntoSubprogram, range, "the program runs into the next one without M30 or M02");
         }
     }
 
-    /// Runs block `at`: its codes, motion, then its macro statement.
-    fn block(&mut self, at: usize, program: &Program) -> Flow {
-        let block = &self.blocks[at];
-        let range = self.ranges[at];
+    /// Runs the block at `place` of `program`: its codes, motion, macro
+    /// statement, then its call or return.
+    fn block(&mut self, place: Place, program: &Program) -> Flow {
+        let unit = Rc::clone(&self.units[place.source]);
+        let (block, range) = (&unit.blocks[place.block], unit.ranges[place.block]);
         if block.words.is_empty() && block.statements.is_empty() && block.corners.is_empty() {
             return Flow::Next;
         }
+        if block.has_code(b'G', 65) {
+            // Its other words are the macro's arguments.
+            let (start, flow) = (self.position, self.macro_call(place, block, range));
+            if !self.stopped {
+                self.record(range, &start, STILL, Facts::default());
+            }
+            return flow;
+        }
         let mut flow = Flow::Next;
-        let (mut dwell, mut exact_stop, mut still, mut cycle) = (false, false, false, None);
+        let (mut dwell, mut exact_stop, mut still, mut cycle, mut coordinates) = (false, false, false, None, None);
         for code in block.codes(b'G') {
             self.modes.set('G', code);
             match code {
                 0..=3 | 32 | 80 | 90 | 92 | 94 => self.cycles.drilling = Default::default(),
-                18 | 21 | 40 | 50 | 61 | 64 | 96..=100 => {}
+                18 | 21 | 40..=42 | 50 | 54..=59 | 61 | 64 | 96..=100 | 110..=129 => {}
                 4 => dwell = true,
                 9 => exact_stop = true,
                 20 => self.not_run("inch units G20 (the run reads mm)", range),
-                41 | 42 => self.not_run("tool-nose radius compensation G41/G42", range),
-                54..=59 | 110..=129 => {
-                    self.not_run("work offsets G54–G59, G110–G129 (positions stay in program coordinates)", range)
-                }
+                28 | 29 | 52 | 53 => coordinates = Some(code),
                 81..=89 | 184 => {}
                 95 => self.not_run("live-tool rigid tapping G95", range),
                 101 => self.not_run("mirror image G101", range),
-                28 | 29 => {
-                    still = true;
-                    self.not_run("reference point returns G28/G29", range);
-                }
-                53 => {
-                    still = true;
-                    self.not_run("moves in machine coordinates G53", range);
-                }
-                65 => {
-                    still = true;
-                    self.not_run("macro calls G65", range);
-                }
                 70..=76 => {
                     cycle = Some(code);
                     if (71..=73).contains(&code) {
-                        flow = self.after_contour(at).map_or(Flow::Next, Flow::Jump);
+                        let after = unit.contour(place.block).map(|contour| contour.blocks.end() + 1);
+                        flow = after.map_or(Flow::Next, Flow::Jump);
                     }
                 }
                 _ => {
@@ -263,7 +377,10 @@ impl<'a> Interpreter<'a> {
                 }
             }
         }
-        let (mut stop, mut m_functions, mut end) = (None, 0u8, false);
+        self.update_frame();
+        // Where the block's move starts, in the frame it runs in.
+        let start = self.position;
+        let (mut stop, mut m_functions, mut end, mut call) = (None, 0u8, false, None);
         for code in block.codes(b'M') {
             self.modes.set('M', code);
             match code {
@@ -271,7 +388,7 @@ impl<'a> Interpreter<'a> {
                 1 => stop = Some(Stop::Optional),
                 2 | 30 => end = true,
                 3..=5 => {}
-                97..=99 => self.not_run("subprogram calls and returns M97/M98/M99", range),
+                97..=99 => call = Some(code),
                 _ => m_functions = m_functions.saturating_add(1),
             }
         }
@@ -285,16 +402,19 @@ impl<'a> Interpreter<'a> {
                 self.speed = speed;
             }
         }
-        let tool = block.word(b'T').and_then(|word| self.number(word, range));
-        if let Some(tool) = tool.map(|tool| tool as u32)
-            && !self.tools.contains(&tool)
-        {
-            self.tools.push(tool);
+        let tool = block.word(b'T').and_then(|word| self.number(word, range)).map(|tool| tool as u32);
+        if let Some(tool) = tool {
+            self.offset = (tool % 100) as u8;
+            if !self.tools.contains(&tool) {
+                self.tools.push(tool);
+            }
         }
         let moved = if dwell {
             self.dwell(block, range)
+        } else if let Some(code) = coordinates {
+            self.coordinates(code, block, range)
         } else if let Some(code) = cycle {
-            self.canned(code, at, block, range)
+            self.canned(code, place.block, block, range)
         } else if still {
             STILL
         } else {
@@ -304,43 +424,78 @@ impl<'a> Interpreter<'a> {
             return Flow::End;
         }
         for statement in &block.statements {
-            flow = self.statement(statement, range, at, program);
+            flow = self.statement(statement, range, place.block, program);
             if self.stopped {
                 return Flow::End;
             }
         }
-        let exact = exact_stop || self.modes.get(EXACT_STOP) == Some(61);
+        if let Some(code) = call {
+            flow = self.call_or_return(code, place, block, range, program);
+            if self.stopped {
+                return Flow::End;
+            }
+        }
+        let facts = Facts {
+            stop,
+            exact: exact_stop || self.modes.get(EXACT_STOP) == Some(61),
+            m_functions,
+            tool_change: tool.is_some(),
+            // G28, G29 and G53 run without compensation.
+            nose: if coordinates.is_some() { None } else { self.nose_side() },
+            machine: coordinates == Some(53),
+        };
+        self.record(range, &start, moved, facts);
+        if end { Flow::End } else { flow }
+    }
+
+    /// Adds the block's steps, the block having started at `start`: the
+    /// moves of its cycle before the last, then its own `moved`, each
+    /// followed by tool-nose radius compensation.
+    fn record(&mut self, range: TextRange, start: &Position, moved: Moved, facts: Facts) {
+        let (frame, end) = match facts.machine {
+            true => (self.frame_of([0.0; 2]), self.in_machine(&self.position)),
+            false => (self.frame, self.position),
+        };
         let step = Step {
-            source: 0,
+            source: self.source,
             range,
             motion: moved.motion,
             path: moved.path,
             duration: moved.duration,
             length: moved.length,
             feed: moved.feed,
-            end: over_axes(&self.position, self.machine.step_axes()),
-            frame: 0,
-            stop,
-            path_mode: if exact { PathMode::ExactStop } else { PathMode::Continuous },
-            m_functions,
-            tool_change: tool.is_some(),
+            end: over_axes(&end, self.machine.step_axes()),
+            frame,
+            stop: facts.stop,
+            path_mode: if facts.exact { PathMode::ExactStop } else { PathMode::Continuous },
+            m_functions: facts.m_functions,
+            tool_change: facts.tool_change,
             dynamic_set: 1,
             mergeable: false,
         };
-        // A cycle's moves before its last, which is the block's own.
-        for (Moved { motion, path, length, duration, feed }, end, stop) in std::mem::take(&mut self.cycles.pending) {
+        // A cycle's moves run with the compensation it gives them.
+        let nose = self.cycles.nose.take().unwrap_or(facts.nose);
+        let mut from = [start[slot(b'Z')], start[slot(b'X')]];
+        for canned::CycleStep { moved: Moved { motion, path, length, duration, feed }, end, stop, nose } in
+            std::mem::take(&mut self.cycles.pending)
+        {
             let (m_functions, tool_change) = (0, false);
             let moved =
                 Step { motion, path, duration, length, feed, end, stop, m_functions, tool_change, ..step.clone() };
             self.steps.push(moved);
+            let to = self.plane_point(&end);
+            self.compensate(self.steps.len() - 1, from, to, nose);
+            from = to;
         }
+        let to = self.plane_point(&step.end);
         self.steps.push(step);
-        if end { Flow::End } else { flow }
+        self.compensate(self.steps.len() - 1, from, to, nose);
     }
 
-    /// The block after the Q block of the roughing cycle in block `cycle`.
-    fn after_contour(&self, cycle: usize) -> Option<usize> {
-        self.contours.iter().find(|contour| contour.cycle == cycle).map(|contour| contour.blocks.end() + 1)
+    /// A step end's (Z, X radius).
+    fn plane_point(&self, end: &Axes) -> Point {
+        let position = by_letter(end, self.machine.step_axes());
+        [position[slot(b'Z')], position[slot(b'X')]]
     }
 
     fn dwell(&mut self, block: &HaasBlock, range: TextRange) -> Moved {
@@ -390,7 +545,10 @@ impl<'a> Interpreter<'a> {
 
     /// Reports the corner words of a G01 block, which the run leaves out.
     fn unrun_corners(&mut self, block: &HaasBlock, range: TextRange, motion: Option<u32>) {
-        if motion == Some(1) && (!block.corners.is_empty() || "IKRA".bytes().any(|l| block.word(l).is_some())) {
+        // I and K with G40 give the direction the compensation leaves along
+        // (lathe manual §7.1 (001:1058-1064)), which moves no end point.
+        let letters = if block.has_code(b'G', 40) { "RA" } else { "IKRA" };
+        if motion == Some(1) && (!block.corners.is_empty() || letters.bytes().any(|l| block.word(l).is_some())) {
             self.not_run("corner chamfers, roundings and angles on G01 (the line runs to its end point)", range);
         }
     }
@@ -472,7 +630,10 @@ impl<'a> Interpreter<'a> {
     /// `path`.
     fn feed_move(&mut self, range: TextRange, from: [f64; 2], to: [f64; 2], path: Path, length: f64) -> Moved {
         let minutes = self.feed_minutes(range, from, to, length, path == Path::Straight);
-        let (duration, feed) = minutes.map_or((0.0, None), |minutes| (minutes * 60.0, Some(length / minutes)));
+        // Per minute the path feed is F itself, not F back from the time.
+        let per_minute = self.feed.filter(|_| self.modes.get(FEED_MODE) == Some(98));
+        let (duration, feed) =
+            minutes.map_or((0.0, None), |minutes| (minutes * 60.0, per_minute.or(Some(length / minutes))));
         Moved { motion: Motion::Feed, path, length, duration, feed }
     }
 
@@ -603,8 +764,21 @@ impl<'a> Interpreter<'a> {
     /// A word's value; `None` when it has none (vacant, unknown, or an
     /// error reported).
     fn number(&mut self, word: &Word, range: TextRange) -> Option<f64> {
+        match self.word_value(word, range)? {
+            Known::Is(MacroValue::Number(value)) => Some(value),
+            Known::Is(MacroValue::Vacant) => None,
+            Known::Unknown => {
+                self.unknown(range);
+                None
+            }
+        }
+    }
+
+    /// A word's value as the variables hold it; `None` when it has none
+    /// written or after reporting an error.
+    fn word_value(&mut self, word: &Word, range: TextRange) -> Option<Known<MacroValue>> {
         let (negative, value) = match word.value.as_ref()? {
-            Value::Literal(decimal) => return Some(decimal.to_f64()),
+            Value::Literal(decimal) => return Some(Known::Is(MacroValue::Number(decimal.to_f64()))),
             Value::Variable { negative, index } => {
                 let variable = Expr { kind: ExprKind::Variable(Box::new(index.clone())), range: index.range };
                 (*negative, self.variables.eval(&variable))
@@ -612,12 +786,8 @@ impl<'a> Interpreter<'a> {
             Value::Bracket { negative, expr } => (*negative, self.variables.eval(expr)),
         };
         match value {
-            Ok(Known::Is(MacroValue::Number(value))) => Some(if negative { -value } else { value }),
-            Ok(Known::Is(MacroValue::Vacant)) => None,
-            Ok(Known::Unknown) => {
-                self.unknown(range);
-                None
-            }
+            Ok(Known::Is(MacroValue::Number(value))) if negative => Some(Known::Is(MacroValue::Number(-value))),
+            Ok(value) => Some(value),
             Err(error) => {
                 self.eval_failed(error, range);
                 None
@@ -656,7 +826,7 @@ impl<'a> Interpreter<'a> {
 
     fn finding(&mut self, rule: RunRule, range: TextRange, message: &str) {
         self.stopped |= rule.stops();
-        self.findings.push(Finding { rule, source: 0, range, message: message.to_owned() });
+        self.findings.push(Finding { rule, source: self.source, range, message: message.to_owned() });
     }
 }
 
@@ -699,6 +869,9 @@ fn centre_by_radius(from: [f64; 2], to: [f64; 2], radius: f64, ccw: bool, tolera
     Some([middle[0] + side * height * left[0], middle[1] + side * height * left[1]])
 }
 
+mod calls;
 mod canned;
+mod coordinates;
+mod nose;
 #[cfg(test)]
 mod tests;

@@ -40,6 +40,11 @@
 //! - G73 shares I and K evenly over its D passes, the last one shifted by
 //!   the allowances only (OQ-28); each pass runs the contour from the start
 //!   point and returns to it.
+//! - The passes along the contour run with the tool-nose radius
+//!   compensation its blocks program, from the one in force at the cycle
+//!   (G71: lathe manual §6.11 (001:1706); G70 finishes the contour as
+//!   programmed, §6.9 item 7; G72 and G73 are taken alike); the levels,
+//!   the moves between passes and the returns run without.
 //! - Every return to the start point goes Z first when the start's X is
 //!   smaller than the Q block's, X first otherwise, at rapid: the rule of
 //!   G70 and G71 (lathe manual §6.9 item 6 (001:1565-1567)), taken for G72
@@ -48,7 +53,10 @@
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use super::cycles::{MAX_PASSES, Move, Point, Refused, bounded};
-use crate::arc::{CircleArc, circle_through};
+use crate::{
+    arc::{CircleArc, circle_through},
+    compensation::Side,
+};
 
 const EPS: f64 = 1e-9;
 
@@ -99,6 +107,9 @@ pub struct Profile {
     /// The P block's move from the start, then the moves of the blocks
     /// after it through Q.
     pub pieces: Vec<Piece>,
+    /// The tool-nose radius compensation of each piece's block, G41 or
+    /// G42 (none: G40); a piece without one runs without.
+    pub nose: Vec<Option<Side>>,
 }
 
 impl Profile {
@@ -113,10 +124,20 @@ impl Profile {
         self.pieces.iter().map(|piece| piece.shifted(by)).collect()
     }
 
-    /// One pass along the contour shifted by `by`, and back to the start.
+    /// One pass along the contour shifted by `by`, with the compensation
+    /// its blocks program, and back to the start without.
     fn pass(&self, by: Point, moves: &mut Vec<Move>) {
         let pieces = self.shifted(by);
-        moves.extend(pieces.iter().map(|piece| piece.as_move()));
+        let mut nose = None;
+        for (index, piece) in pieces.iter().enumerate() {
+            let side = self.nose.get(index).copied().flatten();
+            if nose != Some(side) {
+                moves.push(Move::Nose(side));
+                nose = Some(side);
+            }
+            moves.push(piece.as_move());
+        }
+        moves.push(Move::Nose(None));
         moves.extend(self.back_from(pieces.last().map_or(self.start, Piece::to)));
     }
 

@@ -111,7 +111,7 @@ impl RunRule {
                 "E010",
                 "macrocycle-without-return",
                 true,
-                "A called file ends without returning to its caller: the control stops.",
+                "A called file or program ends without returning to its caller: the control stops.",
             ),
             RunRule::CycleFailed => (
                 "E011",

@@ -21,7 +21,12 @@ fn lathe() -> MachineConfig {
 /// `text` run on a lathe and written as program `O<number>`, through the
 /// interface the command line drives.
 fn expand(text: &str, number: u32, title: &str) -> String {
-    let machine = lathe();
+    expand_on(&lathe(), text, number, title)
+}
+
+/// [`expand`] on `machine`.
+fn expand_on(machine: &MachineConfig, text: &str, number: u32, title: &str) -> String {
+    let machine = machine.clone();
     let mut written = Vec::new();
     let mut expansion: Box<dyn Expand + '_> = Box::new(Expansion::new(&mut written, &machine, number, title));
     let trace = run_into(text, &NoFiles, &machine, BUDGET, &mut *expansion);
@@ -62,7 +67,7 @@ fn a_program_is_written_as_plain_lathe_blocks() {
     expect![[r#"
         %
         O1234 (EXPANDED FROM O1234 DEMO.nc)
-        G18 G21 G40 G97 G98
+        G18 G21 G40 G54 G97 G98
         G00 X40. Z2.
         G01 Z-20. F100.
         G02 X60. Z-30. I10. K0.
@@ -84,7 +89,7 @@ fn a_program_is_written_as_plain_lathe_blocks() {
 #[test]
 fn the_first_move_writes_both_axes() {
     let expanded = expand("O1\nG00 X70.\nZ2.\nX70. Z-1.\nM30\n", 1, "");
-    assert_eq!(expanded, "%\nO1\nG18 G21 G40 G97 G98\nG00 X70. Z0.\nG00 Z2.\nG00 Z-1.\nM30\n%\n");
+    assert_eq!(expanded, "%\nO1\nG18 G21 G40 G54 G97 G98\nG00 X70. Z0.\nG00 Z2.\nG00 Z-1.\nM30\n%\n");
 }
 
 /// A step over the lathe's axes X (the radius) and Z, as the interpreter
@@ -135,7 +140,7 @@ fn threads_are_g32_with_their_lead_after_their_speed() {
     expect![[r#"
         %
         O9 (THREADS)
-        G18 G21 G40 G97 G98
+        G18 G21 G40 G54 G97 G98
         G00 X30. Z5.
         S500 M03
         G32 Z-20. F1.5
@@ -408,5 +413,39 @@ fn stops_are_written_where_the_run_had_them() {
     expansion.step(Step { stop: Some(Stop::Program), ..step(Motion::Rapid, Path::Straight, 5.0, 1.0, None) });
     expansion.step(Step { stop: Some(Stop::Optional), ..step(Motion::None, Path::Straight, 5.0, 1.0, None) });
     let expanded = String::from_utf8(expansion.finish().expect("written")).expect("ASCII");
-    assert_eq!(expanded, "%\nO3\nG18 G21 G40 G97 G98\nG00 X10. Z1. M00\nM01\nM30\n%\n");
+    assert_eq!(expanded, "%\nO3\nG18 G21 G40 G54 G97 G98\nG00 X10. Z1. M00\nM01\nM30\n%\n");
+}
+
+/// Moves under G55, G52 and G53 are written in G54's coordinates, which
+/// the expansion selects: they reach the same machine positions, arcs
+/// included.
+#[test]
+fn offsets_are_written_in_g54s_coordinates() {
+    let rows = [(54, [-100_000, -200_000, 0, 0, 0, 0]), (55, [0, -250_000, 0, 0, 0, 0])].into();
+    let machine = MachineConfig { offsets: crate::machine::OffsetTable { rows }, ..lathe() };
+    let text = "O7\nG54 G98 G00 X20. Z5.\nG01 Z-10. F100.\nG55 G00 X30. Z2.\nG02 X40. Z-3. R5.\nG52 Z-10.\nG01 Z-5.\nG53 X-50. Z-100.\nM30\n";
+    let original = run(text, &NoFiles, &machine, BUDGET);
+    assert!(original.findings.is_empty(), "{:?}", original.findings);
+    let expanded = expand_on(&machine, text, 7, "OFFSETS");
+    assert!(expanded.contains("G18 G21 G40 G54 G97 G98\n"), "{expanded}");
+    let again = run(&expanded, &NoFiles, &machine, BUDGET);
+    assert!(again.findings.is_empty(), "{:?}\n{expanded}", again.findings);
+    let machine_ends = |trace: &Trace| -> Vec<[f64; 2]> {
+        let axis = |letter: u8| trace.axes.iter().position(|&a| a == letter).expect("X and Z");
+        let (x, z) = (axis(b'X'), axis(b'Z'));
+        (0..trace.steps.len())
+            .filter(|&i| matches!(trace.steps[i].motion, Motion::Rapid | Motion::Feed) && trace.steps[i].length > 0.0)
+            .map(|i| {
+                let end = trace.machine_end(i);
+                [end[x], end[z]]
+            })
+            .collect()
+    };
+    let (before, after) = (machine_ends(&original), machine_ends(&again));
+    assert_eq!(before.len(), after.len(), "{expanded}");
+    for (a, b) in before.iter().zip(&after) {
+        assert!((a[0] - b[0]).abs() <= 0.001 && (a[1] - b[1]).abs() <= 0.001, "{before:?}\n{after:?}\n{expanded}");
+    }
+    // The G53 move's machine Z-100 is G54's Z100.
+    assert!(expanded.contains("Z100."), "{expanded}");
 }

@@ -8,20 +8,23 @@
 //!   them with some words (Fanuc keeps them; the manual's example repeats
 //!   with X alone, 001:2833-2837); a block that programs G00–G03, G32,
 //!   G90, G92 or G94 starts anew.
-//! - The contour is read from the tool's position in the motion mode in
-//!   force, as the blocks P to Q program it; the modes they set do not
-//!   outlast the cycle. A cycle whose contour the program model did not
+//! - The contour is read from the tool's position in the motion mode and
+//!   the tool-nose radius compensation in force, as the blocks P to Q
+//!   program them; the modes they set do not outlast the cycle. A cycle whose contour the program model did not
 //!   find (P or Q missing, not found, ambiguous, computed, or Q before P)
 //!   stops the run, as a missing call target does.
 //! - G84/G184 switch the spindle on (001:1380) and leave it on.
 //! - A move of a cycle without a feed or a turning spindle is reported
 //!   once for the block, not once per move.
 
+use std::rc::Rc;
+
 use ncc_syntax::TextRange;
 
 use super::{FEED_MODE, Interpreter, MOTION, Moved, STILL};
 use crate::{
     arc::circle_through,
+    compensation::Side,
     haas_lathe::{
         cycles::{self, Chamfer, Grooving, Hole, Move, MultiThread, Pecks, Point, Refused, Settings, ThreadMethod},
         lower::HaasBlock,
@@ -44,9 +47,20 @@ pub(super) struct CycleState {
     box_words: Option<(Point, f64)>,
     /// Cleared where G80 or a motion code ends the drilling cycle.
     pub(super) drilling: DrillingWords,
-    /// The block's moves before its last, with their ends and stops: the
-    /// block turns them into steps before its own.
-    pub(super) pending: Vec<(Moved, Axes, Option<Stop>)>,
+    /// The block's moves before its last: the block turns them into steps
+    /// before its own.
+    pub(super) pending: Vec<CycleStep>,
+    /// The tool-nose radius compensation of a cycle's last move, which the
+    /// block's own step makes; `None` when the block ran no cycle.
+    pub(super) nose: Option<Option<Side>>,
+}
+
+/// A move of a cycle, timed, with its end, stop and compensation.
+pub(super) struct CycleStep {
+    pub(super) moved: Moved,
+    pub(super) end: Axes,
+    pub(super) stop: Option<Stop>,
+    pub(super) nose: Option<Side>,
 }
 
 /// The drilling cycle's words as last written, for the blocks that repeat
@@ -70,9 +84,12 @@ impl Interpreter<'_> {
         let mut value = |letter| self.value(block, letter, range);
         let (u, w, i, k, d, p, a) =
             (value(b'U'), value(b'W'), value(b'I'), value(b'K'), value(b'D'), value(b'P'), value(b'A'));
+        if code >= 74 {
+            self.uncompensated(range);
+        }
         let moves = match code {
             70..=73 => {
-                let Some(contour) = self.contours.iter().find(|contour| contour.cycle == at).cloned() else {
+                let Some(contour) = self.units[self.source].contour(at).cloned() else {
                     let message = format!(
                         "G{code}: no contour to run: P or Q is missing, names no block or several, is computed, or Q comes before P"
                     );
@@ -129,6 +146,7 @@ impl Interpreter<'_> {
 
     /// A block in G32, G90, G92 or G94 that reaches `end`.
     pub(super) fn modal_cycle(&mut self, code: u32, block: &HaasBlock, range: TextRange, end: &Position) -> Moved {
+        self.uncompensated(range);
         let (z, x) = (slot(b'Z'), slot(b'X'));
         let start = [self.position[z], self.position[x]];
         let lead = self.feed.unwrap_or(0.0);
@@ -166,6 +184,7 @@ impl Interpreter<'_> {
             // Reported as not run where G95 is programmed.
             return STILL;
         }
+        self.uncompensated(range);
         let (z, x) = (slot(b'Z'), slot(b'X'));
         let mut value = |letter| self.value(block, letter, range);
         let (plane, q, i, j, k, repeats) =
@@ -242,22 +261,24 @@ impl Interpreter<'_> {
     }
 
     /// The moves of the blocks P to Q from the tool's position, in the
-    /// motion modes they program from the one in force; the P block's move
-    /// first (zero long when it has no X or Z). `None` after reporting an
-    /// arc off its circle.
+    /// motion modes and tool-nose radius compensation they program from the
+    /// ones in force; the P block's move first (zero long when it has no X
+    /// or Z). `None` after reporting an arc off its circle.
     fn profile(&mut self, contour: &Contour) -> Option<Profile> {
         let (z, x) = (slot(b'Z'), slot(b'X'));
-        let blocks = self.blocks;
+        let unit = Rc::clone(&self.units[self.source]);
         let mut position = self.position;
         let start = [position[z], position[x]];
-        let mut mode = self.modes.get(MOTION);
-        let mut pieces = Vec::new();
+        let (mut mode, mut side) = (self.modes.get(MOTION), self.nose_side());
+        let (mut pieces, mut nose) = (Vec::new(), Vec::new());
         for index in contour.blocks.clone() {
-            let (block, range) = (&blocks[index], self.ranges[index]);
+            let (block, range) = (&unit.blocks[index], unit.ranges[index]);
             for code in block.codes(b'G') {
                 match code {
                     0..=3 => mode = Some(code),
-                    41 | 42 => self.not_run("tool-nose radius compensation G41/G42", range),
+                    40 => side = None,
+                    41 => side = Some(Side::Left),
+                    42 => side = Some(Side::Right),
                     _ => {}
                 }
             }
@@ -268,6 +289,7 @@ impl Interpreter<'_> {
             let Some(end) = self.end_point(block, range, &position) else {
                 if pieces.is_empty() {
                     pieces.push(Piece::Line { to: start, rapid: mode == Some(0) });
+                    nose.push(side);
                 }
                 continue;
             };
@@ -279,16 +301,17 @@ impl Interpreter<'_> {
                 }
                 _ => Piece::Line { to, rapid: mode == Some(0) },
             });
+            nose.push(side);
             position = end;
         }
-        Some(Profile { start, pieces })
+        Some(Profile { start, pieces, nose })
     }
 
     /// Times a cycle's moves from the tool's position, moving it: the last
     /// move is returned for the block's step, the others wait in
     /// [`CycleState::pending`]. A refused cycle is reported and moves
     /// nothing.
-    fn emit(&mut self, range: TextRange, moves: Result<Vec<Move>, Refused>) -> Moved {
+    pub(super) fn emit(&mut self, range: TextRange, moves: Result<Vec<Move>, Refused>) -> Moved {
         let moves = match moves {
             Ok(moves) => moves,
             Err(Refused(why)) => {
@@ -298,10 +321,14 @@ impl Interpreter<'_> {
         };
         let (z, x) = (slot(b'Z'), slot(b'X'));
         let findings = self.findings.len();
-        let mut last: Option<(Moved, Axes, Option<Stop>)> = None;
+        let (mut last, mut nose): (Option<CycleStep>, _) = (None, None);
         for step in moves {
             let from = [self.position[z], self.position[x]];
             let (moved, to, stop) = match step {
+                Move::Nose(side) => {
+                    nose = side;
+                    continue;
+                }
                 Move::Rapid(to) | Move::Feed(to) | Move::Thread { to, .. } | Move::Arc { to, .. }
                     if (to[0] - from[0]).hypot(to[1] - from[1]) < 1e-9 =>
                 {
@@ -327,7 +354,7 @@ impl Interpreter<'_> {
             };
             (self.position[z], self.position[x]) = (to[0], to[1]);
             let end = over_axes(&self.position, self.machine.step_axes());
-            if let Some(before) = last.replace((moved, end, stop)) {
+            if let Some(before) = last.replace(CycleStep { moved, end, stop, nose }) {
                 self.cycles.pending.push(before);
             }
         }
@@ -340,12 +367,28 @@ impl Interpreter<'_> {
             }
         }
         match last {
-            Some((moved, _, None)) => moved,
+            Some(CycleStep { moved, stop: None, nose, .. }) => {
+                self.cycles.nose = Some(nose);
+                moved
+            }
             Some(stopping) => {
+                self.cycles.nose = Some(None);
                 self.cycles.pending.push(stopping);
                 STILL
             }
-            None => STILL,
+            None => {
+                self.cycles.nose = Some(None);
+                STILL
+            }
+        }
+    }
+
+    /// Reports tool-nose radius compensation in force at a cycle that has
+    /// no pass along a contour, whose moves run without it.
+    fn uncompensated(&mut self, range: TextRange) {
+        if self.nose_side().is_some() {
+            let what = "tool-nose radius compensation in G32, G74–G76, G90/G92/G94 and the drilling cycles (their moves run without it)";
+            self.not_run(what, range);
         }
     }
 

@@ -3,9 +3,10 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use ncc_catalog::Dialect;
 
 use crate::{
-    machine::MachineConfig,
+    compensation::Piece,
+    machine::{MachineConfig, OffsetTable, ToolEntry, ToolTable},
     run::{NoFiles, run},
-    trace::{Motion, Path, PathMode, RunRule, Stop, Trace},
+    trace::{Called, Environment, Motion, Path, PathMode, RunRule, Step, Stop, Trace},
 };
 
 /// A lathe; the programs' `O` lines make no step.
@@ -164,40 +165,35 @@ fn stops_ends_tools_and_m_functions() {
 }
 
 #[test]
-fn what_does_not_run_yet_is_reported_once_per_kind_and_moves_nothing() {
-    let text = "O1\nG00 X50. Z0\nG28 U0 W0\nG28 U0\nG65 P9010 A1.\nM98 P100\nG41 G98 G01 X30. F100.\nM30\n";
+fn what_does_not_run_yet_is_reported_once_per_kind() {
+    let text = "O1\nG20\nG98 G01 X30. K-1. F100.\nZ-5. ,C1.\nG20\nG101 X0\nM30\n";
     let trace = run_lathe(text);
-    assert_eq!(rules(&trace), [RunRule::NotRunYet; 4]);
-    assert_eq!(trace.steps[1].end, trace.steps[0].end);
-    assert_eq!(trace.steps[3].motion, Motion::None);
+    let not_run: Vec<(RunRule, &str)> =
+        trace.findings.iter().map(|finding| (finding.rule, text[finding.range].trim())).collect();
+    assert_eq!(
+        not_run,
+        [(RunRule::NotRunYet, "G20"), (RunRule::NotRunYet, "G98 G01 X30. K-1. F100."), (RunRule::NotRunYet, "G101 X0"),]
+    );
 }
 
 #[test]
 fn the_manual_s_g71_program_runs_to_its_end() {
     let text = include_str!("../../../../syntax/test_data/haas-lathe/e14_g71_type1_program.nc");
     let trace = run_lathe(text);
-    // Once per kind, where first met; the compensation in the contour is
-    // met when G71 reads it.
-    let not_run: Vec<(RunRule, &str)> =
-        trace.findings.iter().map(|finding| (finding.rule, text[finding.range].trim())).collect();
-    assert_eq!(
-        not_run,
-        [
-            (RunRule::NotRunYet, "G00 G53 X-100. Z-250."),
-            (RunRule::NotRunYet, "G54 G00 X70. Z3.   ( P0 )"),
-            (RunRule::NotRunYet, "G01 G42 X17. Z0 ( P2 )"),
-        ]
-    );
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
     // The contour after G71 is not run as moves: from G71 the run goes on
     // after N20, and ends at M30.
     let lines: Vec<&str> = trace.steps.iter().map(|step| text[step.range].trim()).collect();
     assert!(!lines.iter().any(|line| line.starts_with("N10")), "{lines:?}");
     assert_eq!(lines.last(), Some(&"M30"));
-    // The positioning move to Ø70 Z3 is timed from the start; the second
-    // one, before G70, finds the tool back there after G71.
-    let rapid = |line: &str| trace.steps.iter().find(|step| text[step.range].trim() == line).map(|s| s.duration);
-    close(rapid("G54 G00 X70. Z3.   ( P0 )").unwrap(), 35.0 / 10_000.0 * 60.0);
-    assert_eq!(rapid("G54 G00 X70. Z3."), Some(0.0));
+    // From the machine zero, where the run starts, G53 goes to X-100.
+    // Z-250. in machine coordinates (radius -50): Z's 250 mm at 10 m/min.
+    // The offsets are zero, so G54's X70. Z3. is 253 mm of Z away.
+    let step = |line: &str| trace.steps.iter().find(|step| text[step.range].trim() == line).expect(line);
+    let g53 = step("G00 G53 X-100. Z-250.");
+    close(g53.duration, 250.0 / 10_000.0 * 60.0);
+    assert_eq!(g53.end[..2], [-50.0, -250.0]);
+    close(step("G54 G00 X70. Z3.   ( P0 )").duration, 253.0 / 10_000.0 * 60.0);
 }
 
 #[test]
@@ -207,4 +203,365 @@ fn words_take_variables_and_failed_arithmetic_stops_the_run() {
     assert_eq!(ends, [(15.0, -10.0), (0.0, -10.0)]);
     assert_eq!(rules(&trace), [RunRule::ArithmeticFailed]);
     assert_eq!(trace.steps.len(), 3);
+}
+
+/// (Z, X radius) of a step's end; the lathe's axes are X then Z.
+fn zx(step: &Step) -> (f64, f64) {
+    (step.end[1], step.end[0])
+}
+
+fn close_zx(actual: (f64, f64), expected: (f64, f64)) {
+    close(actual.0, expected.0);
+    close(actual.1, expected.1);
+}
+
+#[test]
+fn g28_returns_through_its_intermediate_point_and_g29_comes_back_through_it() {
+    let text = "O1\nG00 X40. Z10.\nG28 U10. W5.\nG29 X30. Z-5.\nG28 U0\nM30\n";
+    let trace = run_lathe(text);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    let ends: Vec<(f64, f64)> = trace.steps.iter().map(zx).collect();
+    // From (Z10, r20): U10. W5. is the intermediate point (15, 25), then
+    // the reference point, the machine zero (0, 0). G29 goes back through
+    // (15, 25) to X30. Z-5. (-5, 15); G28 U0 sends X alone home.
+    assert_eq!(ends, [(10.0, 20.0), (15.0, 25.0), (0.0, 0.0), (15.0, 25.0), (-5.0, 15.0), (-5.0, 0.0), (-5.0, 0.0)]);
+    let times: Vec<f64> = trace.steps.iter().map(|step| step.duration).collect();
+    // Rapid, the longest axis at 10 m/min: 5 mm, 25 mm, 25 mm, 20 mm, 15 mm.
+    for (time, travel) in times[1..6].iter().zip([5.0, 25.0, 25.0, 20.0, 15.0]) {
+        close(*time, travel / 10_000.0 * 60.0);
+    }
+    assert!(trace.steps[1..6].iter().all(|step| step.motion == Motion::Rapid));
+}
+
+/// A lathe whose G54 lies at X-100. (a diameter) Z-200. and G55 at Z-250.
+/// from the machine zero.
+fn lathe_with_offsets() -> MachineConfig {
+    let rows = [(54, [-100_000, -200_000, 0, 0, 0, 0]), (55, [0, -250_000, 0, 0, 0, 0])].into();
+    MachineConfig { offsets: OffsetTable { rows }, ..lathe() }
+}
+
+#[test]
+fn work_offsets_move_the_machine_positions_and_g53_moves_in_machine_coordinates() {
+    let text = "O1\nG00 X20. Z5.\nG55 G00 X20. Z5.\nG52 Z-10.\nG00 Z0\nG53 X-60. Z-100.\nG54 U0\nM30\n";
+    let trace = run(text, &NoFiles, &lathe_with_offsets(), 100);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    let machine: Vec<[f64; 2]> =
+        (0..trace.steps.len()).map(|i| [trace.machine_end(i)[1], trace.machine_end(i)[0]]).collect();
+    // G54: program Z5. r10 is machine Z-195 r-40; from the machine zero the
+    // rapid takes Z's 195 mm.
+    assert_eq!(zx(&trace.steps[0]), (5.0, 10.0));
+    assert_eq!(machine[0], [-195.0, -40.0]);
+    close(trace.steps[0].duration, 195.0 / 10_000.0 * 60.0);
+    assert_eq!(trace.reset_frame, trace.frames[trace.steps[0].frame]);
+    // G55: the same program point is machine Z-245 r10, 50 mm away on both.
+    assert_eq!(machine[1], [-245.0, 10.0]);
+    close(trace.steps[1].duration, 50.0 / 10_000.0 * 60.0);
+    // G52 Z-10. moves nothing and shifts the zero: Z0 is machine Z-260.
+    assert_eq!((trace.steps[2].motion, machine[2]), (Motion::None, [-245.0, 10.0]));
+    assert_eq!(machine[3], [-260.0, 10.0]);
+    // G53 X-60. Z-100. is machine r-30 Z-100 at rapid, in its own frame.
+    assert_eq!(zx(&trace.steps[4]), (-100.0, -30.0));
+    assert_eq!(machine[4], [-100.0, -30.0]);
+    assert_eq!(trace.steps[4].motion, Motion::Rapid);
+    close(trace.steps[4].duration, 160.0 / 10_000.0 * 60.0);
+    // Back in G54 (with G52's Z-10.), the tool stays where it is: program
+    // Z-100 - (-200 - 10) = 110, r-30 - (-50) = 20.
+    assert_eq!(zx(&trace.steps[5]), (110.0, 20.0));
+    assert_eq!(machine[5], [-100.0, -30.0]);
+    for index in 1..trace.steps.len() {
+        assert_eq!(trace.machine_start(index), trace.machine_end(index - 1));
+    }
+}
+
+/// A lathe whose offsets 1 and 3 have a nose radius of 0.8 mm and tip 3.
+fn lathe_with_nose() -> MachineConfig {
+    let nose = ToolEntry { radius: 800, lengths: [0; 6], tip: Some(3) };
+    let entries = [(1, nose), (3, nose)].into();
+    MachineConfig { tools: ToolTable { entries }, ..lathe() }
+}
+
+/// A piece of the tool path: its step, kind, start and end (Z, X radius).
+type Shown = (usize, Piece, (f64, f64), (f64, f64));
+
+/// The tool path's pieces, to a nanometre.
+fn pieces(trace: &Trace) -> Vec<Shown> {
+    let round = |v: f64| (v * 1e6).round() / 1e6 + 0.0;
+    let at = |point: nalgebra::Point2<f64>| (round(point.x), round(point.y));
+    trace
+        .tool_centre
+        .iter()
+        .map(|piece| (piece.block, piece.kind, at(piece.path.start()), at(piece.path.end())))
+        .collect()
+}
+
+#[test]
+fn nose_radius_compensation_offsets_a_profile_by_the_radius_and_shifts_it_to_the_tip() {
+    // OD: up the face at Z0 to Ø20, along Z to Z-10, a 45° taper to Ø30 at
+    // Z-15, along Z to Z-25, G42 (the tool above the contour).
+    let text = "O1\nT101\nG98 F100.\nG00 X10. Z2.\nG42 G01 Z0\nX20.\nZ-10.\nX30. Z-15.\nZ-25.\nG40 G00 X40.\nM30\n";
+    let trace = run(text, &NoFiles, &lathe_with_nose(), 100);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    // By hand, (Z, r): the nose centre runs 0.8 from the contour: Z0.8
+    // before the face, r10.8 above the first straight, on z + r = 0.8·√2 =
+    // 1.131371 beside the taper z + r = 0, and r15.8 above the second
+    // straight. The corners are the intersections: (0.8, 10.8) (a right
+    // angle outside), (1.131371 - 10.8, 10.8) = (-9.668629, 10.8) (inside),
+    // (1.131371 - 15.8, 15.8) = (-14.668629, 15.8) (outside, 45°). The
+    // start ends on the face's normal at its start, (0.8, 5); the last
+    // element on its normal at its end, (-25, 15.8). Tip 3 puts the
+    // imaginary tip 0.8 toward -X and -Z of the centre: the tool path is
+    // the centre's shifted by (-0.8, -0.8), the tip on the programmed line
+    // along the axes and r·(2 - √2) = 0.468629 behind it along the taper.
+    assert_eq!(
+        pieces(&trace),
+        [
+            (3, Piece::Start, (2.0, 5.0), (0.0, 4.2)),
+            (4, Piece::Contour, (0.0, 4.2), (0.0, 10.0)),
+            (5, Piece::Contour, (0.0, 10.0), (-10.468629, 10.0)),
+            (6, Piece::Contour, (-10.468629, 10.0), (-15.468629, 15.0)),
+            (7, Piece::Contour, (-15.468629, 15.0), (-25.8, 15.0)),
+            (8, Piece::Cancel, (-25.8, 15.0), (-25.0, 20.0)),
+        ]
+    );
+    assert_eq!(trace.compensated.len(), 1);
+    assert_eq!((trace.compensated[0].steps.clone(), trace.compensated[0].plane), (3..9, (b'Z', b'X')));
+    // The steps keep the programmed points and take the tool path's length
+    // and time: the straight 10.468629 mm and the taper 5·√2 mm at
+    // 100 mm/min, the cancel at rapid (5 mm of X).
+    assert_eq!(zx(&trace.steps[6]), (-15.0, 15.0));
+    close(trace.steps[5].length, 10.0 + 0.8 * (2.0 - 2f64.sqrt()));
+    close(trace.steps[6].length, 50f64.sqrt());
+    close(trace.steps[6].duration, 50f64.sqrt() / 100.0 * 60.0);
+    close(trace.steps[3].length, 4.64f64.sqrt());
+    close(trace.steps[8].length, 25.64f64.sqrt());
+    close(trace.steps[8].duration, 5.0 / 10_000.0 * 60.0);
+    // Where the tool is at the taper's end: the tip, behind the programmed
+    // point along Z.
+    let tip = trace.tool_end(6, &trace.steps[6].end);
+    close_zx((tip[1], tip[0]), (-15.0 - 0.8 * (2.0 - 2f64.sqrt()), 15.0));
+    // Without a radius (the default) the path is the programmed one.
+    let plain = run_lathe(text);
+    assert!(plain.findings.is_empty() && plain.tool_centre.is_empty() && plain.compensated.is_empty());
+    close(plain.steps[5].length, 10.0);
+}
+
+#[test]
+fn a_new_work_offset_ends_compensation_and_the_next_start_is_in_its_frame() {
+    let machine = MachineConfig { offsets: lathe_with_offsets().offsets, ..lathe_with_nose() };
+    let text = "O1\nT101\nG98 F100.\nG00 X20. Z2.\nG42 G01 Z0\nZ-10.\nG55 Z-20.\nM30\n";
+    let trace = run(text, &NoFiles, &machine, 100);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    // G54 ends with Z-10.'s normal at its end, the tip 0.8 behind it. In
+    // G55 the tool stands at machine Z-210 r-40, program Z40 r-40, and
+    // G42 starts anew from there, in force to the end; no element follows.
+    assert_eq!(
+        pieces(&trace),
+        [
+            (3, Piece::Start, (2.0, 10.0), (-0.8, 10.0)),
+            (4, Piece::Contour, (-0.8, 10.0), (-10.8, 10.0)),
+            (5, Piece::Start, (40.0, -40.0), (-20.0, -40.0)),
+        ]
+    );
+    assert_eq!(trace.compensated.iter().map(|span| span.steps.clone()).collect::<Vec<_>>(), [3..5, 5..7]);
+}
+
+#[test]
+fn nose_radius_compensation_starts_and_ends_on_lines_only() {
+    let starts_on_arc = "O1\nT101\nG98 F100.\nG00 X20. Z0\nG42 G02 X40. Z-10. R10.\nG40 G01 X50.\nM30\n";
+    let trace = run(starts_on_arc, &NoFiles, &lathe_with_nose(), 100);
+    assert_eq!(rules(&trace), [RunRule::CompensationFailed]);
+    let ends_on_arc = "O1\nT101\nG98 F100.\nG00 X20. Z2.\nG42 G01 Z0\nZ-10.\nG40 G02 X40. Z-20. R10.\nM30\n";
+    let trace = run(ends_on_arc, &NoFiles, &lathe_with_nose(), 100);
+    assert_eq!(rules(&trace), [RunRule::CompensationFailed]);
+    assert_eq!(&text_of(ends_on_arc, &trace), "G40 G02 X40. Z-20. R10.");
+}
+
+/// The line of the run's first finding.
+fn text_of(text: &str, trace: &Trace) -> String {
+    text[trace.findings[0].range].trim().to_owned()
+}
+
+/// The manual's start and cancel examples (lathe manual §7.1, E5–E7
+/// (001:975-995, 1021-1031, 1049-1064)), each in a program around it. The
+/// placeholders `X.. Z..` are filled, and the cancels after an arc take
+/// the G01 that the table's format `G1/0 G40` (001:101) asks for.
+#[test]
+fn the_manual_s_compensation_examples_run_without_findings() {
+    let od = ["G42 X40.", "G42 Z0", "G42 X30. Z0", "G42 X40. Z0"]
+        .map(|start| format!("G00 X50. Z5.\nG01 {start}\nX50. Z-10.\nZ-20.\nG40 G00 X60."));
+    let id = ["G41 Z0", "G41 X90.", "G41 X90. Z0", "G41 X95. Z0"]
+        .map(|start| format!("G00 X100. Z5.\nG01 {start}\nX80. Z-10.\nZ-20.\nG40 G00 X70."));
+    let cancels = [
+        "G00 X20. Z5.\nG01 G42 X20. Z0\nG2 X40. Z-10. R10.\nG01 G40 X60. Z-10.",
+        "G00 X20. Z5.\nG01 G42 X20. Z0\nG1 X40. Z-60.\nG40 X60. Z-60.",
+        "G00 X20. Z5.\nG01 G42 X20. Z0\nG1 X0 Z0\nG40 X10. Z5.",
+        "G00 X20. Z5.\nG01 G42 X20. Z0\nG1 Z-40.\nG40 I50.K-30. X80. Z-50.",
+    ];
+    for example in od.iter().chain(&id).map(String::as_str).chain(cancels) {
+        let text = format!("O1\nT101\nG98 F100.\n{example}\nM30\n");
+        let trace = run(&text, &NoFiles, &lathe_with_nose(), 100);
+        assert!(trace.findings.is_empty(), "{example}: {:?}", trace.findings);
+        assert_eq!(trace.compensated.len(), 1, "{example}");
+        // After the cancel the tip is on the programmed point.
+        let last = trace.steps.len() - 2;
+        assert_eq!(trace.tool_end(last, &trace.steps[last].end), trace.steps[last].end, "{example}");
+    }
+}
+
+#[test]
+fn g70_follows_the_compensated_contour_and_g71_compensates_its_pass_along_it() {
+    let text = "O1\nT101\nG98\nG00 X30. Z5.\nG70 P10 Q20 F100.\nM30\nN10 G00 X10.\nG01 G42 Z0\nX20.\nZ-10.\nN20 G00 G40 X30.\n";
+    let trace = run(text, &NoFiles, &lathe_with_nose(), 100);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    // G70's moves: the P block to (5, 5), the start to Z0, up the face, along
+    // Z, the cancel to r15 and back to the start (5, 15). The tip: as in
+    // the profile above, the face at Z0 up to r10, along r10 to the normal
+    // at Z-10 (the centre at -10, the tip at -10.8), then onto X30.
+    let ends: Vec<(f64, f64)> = pieces(&trace).iter().map(|&(_, _, _, end)| end).collect();
+    assert_eq!(ends, [(0.0, 4.2), (0.0, 10.0), (-10.8, 10.0), (-10.0, 15.0)]);
+    assert_eq!(trace.compensated.len(), 1);
+    // The manual's G71 program on the same tool: the roughing levels run
+    // as they are, the pass along the contour and G70 compensated.
+    let e14 = include_str!("../../../../syntax/test_data/haas-lathe/e14_g71_type1_program.nc");
+    let trace = run(e14, &NoFiles, &lathe_with_nose(), 10_000);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    let lines: Vec<&str> =
+        trace.compensated.iter().map(|span| e14[trace.steps[span.steps.start].range].trim()).collect();
+    assert_eq!(lines, ["G71 P10 Q20 U0.3 W0.1 D8. F0.3", "G70 P10 Q20 F0.1"]);
+    // G71's 25 moves: to the shifted start, three levels of four moves,
+    // the pass (the P block's move, the start on the G42 block, seven
+    // moves, the cancel on the Q block) and two back. The start, the seven
+    // and the cancel are compensated; the P block's move is not.
+    let g71_steps = trace.steps.iter().filter(|step| e14[step.range].starts_with("G71")).count();
+    assert_eq!((trace.compensated[0].steps.len(), g71_steps), (9, 25));
+}
+
+/// The programs beside the one that runs: O1000 only.
+struct Library(&'static str);
+
+impl Environment for Library {
+    fn file(&self, called: &Called) -> Option<String> {
+        (*called == Called::Program(1000)).then(|| self.0.to_owned())
+    }
+}
+
+#[test]
+fn m97_runs_a_local_subprogram_l_times_and_m99_p_returns_to_a_block() {
+    let text = "O1\nG98 G01 F600.\nM97 P100 L3\nM97 P200\nG00 X100.\nN300 G00 X50.\nM30\nN100 G01 W-1.\nM99\nN200 G01 U2.\nM99 P300\n";
+    let trace = run_lathe(text);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    let lines: Vec<&str> = trace.steps.iter().map(|step| text[step.range].trim()).collect();
+    assert_eq!(
+        lines,
+        [
+            "G98 G01 F600.",
+            "M97 P100 L3",
+            "N100 G01 W-1.",
+            "M99",
+            "N100 G01 W-1.",
+            "M99",
+            "N100 G01 W-1.",
+            "M99",
+            "M97 P200",
+            "N200 G01 U2.",
+            "M99 P300",
+            "N300 G00 X50.",
+            "M30"
+        ]
+    );
+    // Three times W-1. at 600 mm/min: 0.1 s each; U2. is 1 mm of radius.
+    close_zx(zx(&trace.steps[10]), (-3.0, 1.0));
+    close(trace.totals().time(Motion::Feed), 0.3 + 0.1);
+}
+
+#[test]
+fn m98_calls_a_program_of_the_file_and_one_beside_it() {
+    let text = "O1\nM98 P2\nM98 P1000 L2\nM30\nO2\nG98 G01 W-1. F600.\nM99\n";
+    let beside = "O1000\nG98 G01 U2. F600.\nM99\n";
+    let trace = run(text, &Library(beside), &lathe(), 100);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    assert_eq!(trace.files, [Called::Program(1000)]);
+    let sources: Vec<(usize, &str)> = trace
+        .steps
+        .iter()
+        .map(|step| (step.source, if step.source == 0 { &text[step.range] } else { &beside[step.range] }.trim()))
+        .collect();
+    assert_eq!(
+        sources,
+        [
+            (0, "M98 P2"),
+            (0, "G98 G01 W-1. F600."),
+            (0, "M99"),
+            (0, "M98 P1000 L2"),
+            (1, "G98 G01 U2. F600."),
+            (1, "M99"),
+            (1, "G98 G01 U2. F600."),
+            (1, "M99"),
+            (0, "M30"),
+        ]
+    );
+    // Twice U2.: 2 mm of radius.
+    close_zx(zx(trace.steps.last().unwrap()), (-1.0, 2.0));
+    // A file without the program's O line runs from its start, read once.
+    let trace = run("O1\nM98 P1000\nM98 P1000\nM30\n", &Library("G98 G01 U2. F600.\nM99\n"), &lathe(), 100);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    assert_eq!(trace.files, [Called::Program(1000)]);
+    close_zx(zx(trace.steps.last().unwrap()), (0.0, 2.0));
+    // A program neither in the file nor beside it stops the run there.
+    let missing = run("O1\nM98 P5000\nG00 X10.\nM30\n", &Library(beside), &lathe(), 100);
+    assert_eq!(rules(&missing), [RunRule::CallTargetMissing]);
+    assert!(missing.steps.is_empty());
+}
+
+#[test]
+fn g65_passes_its_arguments_as_locals_and_gives_the_caller_its_own_back() {
+    // A → #1, B → #2, C → #3: each run moves W-[1 + 2·10 + 3·100] = -321.
+    // Each of the two runs starts from the arguments, whatever the last
+    // left in #1; back in the caller, #1 is its own 7. again.
+    let text = "O1\n#1 = 7.\nG65 P9010 A1. B2. C3. L2\nG00 X#1\nM30\nO9010\nG00 W-[#1 + #2 * 10. + #3 * 100.]\n#1 = 50.\nM99\n";
+    let trace = run_lathe(text);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    close_zx(zx(trace.steps.last().unwrap()), (-642.0, 3.5));
+}
+
+#[test]
+fn runaway_recursion_stops_at_the_depth_limit() {
+    for text in ["O1\nM98 P1\nM30\n", "O1\nG65 P1 A1.\nM30\n", "O1\nN1 M97 P1\nM30\n"] {
+        let trace = run_lathe(text);
+        assert_eq!(rules(&trace), [RunRule::CallDepth], "{text}");
+        assert!(trace.blocks_run < 200, "{text}: {}", trace.blocks_run);
+    }
+    // A subprogram without M99 stops where it ends.
+    let trace = run_lathe("O1\nM98 P2\nM30\nO2\nG00 X10.\n");
+    assert_eq!(rules(&trace), [RunRule::MacrocycleWithoutReturn]);
+}
+
+mod properties {
+    use proptest::prelude::*;
+
+    use super::{Library, lathe_with_nose, lathe_with_offsets};
+    use crate::{machine::MachineConfig, run::run};
+
+    proptest! {
+        #[test]
+        fn any_calls_coordinates_and_compensation_run_to_an_end(lines in prop::collection::vec(prop::sample::select(vec![
+            "O1", "O2", "O1000", "N10 G00 X20. Z2.", "N20 G01 X30. Z-5. F0.2", "G02 X40. Z-10. R5.", "G03 W-3. U-4. R2.",
+            "G42 G01 Z0", "G41 X10.", "G40 G00 X50.", "G01 X0", "M97 P10", "M97 P20 L2", "M98 P2", "M98 P1000",
+            "M98 P7 L0", "G65 P2 A1. B#1", "M99", "M99 P10", "M30", "G28 U0 W0", "G28", "G29 X10. Z5.",
+            "G53 X-10. Z-20.", "G52 Z-5.", "G55", "G54", "G70 P10 Q20", "G71 P10 Q20 D1. U0.2", "#1 = #1 + 1",
+            "IF [#1 GT 3] GOTO 20", "T101", "T303", "M98 P#2", "G65 P1", "G97 S500 M03", "G90 X10. Z-3.",
+        ]), 0..25)) {
+            let text = lines.join("\n");
+            let machine = MachineConfig { offsets: lathe_with_offsets().offsets, ..lathe_with_nose() };
+            let trace = run(&text, &Library("O1000\nG01 U1. F0.1\nM99\n"), &machine, 2000);
+            prop_assert!(trace.blocks_run <= 2000);
+            for step in &trace.steps {
+                prop_assert!(step.duration.is_finite() && step.length.is_finite(), "{text}\n{step:?}");
+                prop_assert!(step.end.iter().all(|value| value.is_finite()), "{text}\n{step:?}");
+            }
+            for piece in &trace.tool_centre {
+                prop_assert!(piece.path.length().is_finite(), "{text}\n{piece:?}");
+            }
+        }
+    }
 }
