@@ -681,18 +681,7 @@ fn run_finds_macrocycle_files_in_the_project() {
     let program = dir.path().join("parts/MAIN.NCP");
     std::fs::write(&program, "%1\nN1 G72 L9001 Q3\nN2 G72 L9002\nN3 M30\n").unwrap();
 
-    let output = ncc(&["run", program.to_str().unwrap(), "--format", "json"]);
-    assert_eq!(output.status.code(), Some(1));
-    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
-    let places: Vec<(String, u64)> = json["blocks"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|b| {
-            let file = b["file"].as_str().unwrap().replace('\\', "/");
-            (file.rsplit('/').next().unwrap().to_owned(), b["line"].as_u64().unwrap())
-        })
-        .collect();
+    let (json, places) = run_places(&program);
     // The failed call runs as a block too: the run stops after it.
     let expected = [
         ("MAIN.NCP", 2),
@@ -720,18 +709,7 @@ fn run_finds_haas_program_files_beside_the_program() {
     let program = dir.path().join("main.nc");
     std::fs::write(&program, "O1\nM98 P1000 L2\nM98 P2000\nM30\n").unwrap();
 
-    let output = ncc(&["run", program.to_str().unwrap(), "--format", "json"]);
-    assert_eq!(output.status.code(), Some(1));
-    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
-    let places: Vec<(String, u64)> = json["blocks"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|b| {
-            let file = b["file"].as_str().unwrap().replace('\\', "/");
-            (file.rsplit('/').next().unwrap().to_owned(), b["line"].as_u64().unwrap())
-        })
-        .collect();
+    let (json, places) = run_places(&program);
     let expected = [("main.nc", 2), ("O01000.nc", 2), ("O01000.nc", 3), ("O01000.nc", 2), ("O01000.nc", 3)];
     let expected: Vec<(String, u64)> = expected.into_iter().map(|(f, l)| (f.to_owned(), l)).collect();
     assert_eq!(places, expected);
@@ -1296,4 +1274,22 @@ fn run_findings_are_rules_that_ncc_toml_configures() {
         records,
         [r#""E015" "dynamic-set-out-of-range" "error" 4 false"#, r#""E007" "call-target-missing" "error" 6 true"#]
     );
+}
+
+/// `ncc run --format json` of a program whose run stops on an error: its
+/// output, and each block's file name and line.
+fn run_places(program: &Path) -> (serde_json::Value, Vec<(String, u64)>) {
+    let output = ncc(&["run", program.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(output.status.code(), Some(1));
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let places = json["blocks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| {
+            let file = b["file"].as_str().unwrap().replace('\\', "/");
+            (file.rsplit('/').next().unwrap().to_owned(), b["line"].as_u64().unwrap())
+        })
+        .collect();
+    (json, places)
 }

@@ -152,6 +152,31 @@ impl Dynamics {
     }
 }
 
+impl Reason {
+    /// A short name for scripts, for the reasons every control names alike;
+    /// a control's [`Terms`] name the others.
+    pub fn neutral_code(&self) -> &'static str {
+        match self {
+            Reason::Unjoined => "unjoined",
+            Reason::ExactStop => "exact-stop",
+            Reason::JoiningOff => "continuity-off",
+            Reason::Corner { .. } => "corner",
+            Reason::Rapid => "rapid",
+            Reason::Thread => "thread",
+            Reason::NonMotion => "non-motion",
+            Reason::ShortBlock { .. } => "short-block",
+            Reason::BeyondThreeAxes => "beyond-three-axes",
+            Reason::LookAhead => "look-ahead",
+            Reason::ArcLimit { .. } => "arc-limit",
+            Reason::Accuracy { .. } => "accuracy",
+            Reason::Overload { .. } => "overload",
+            Reason::Centrifugal { .. } => "centrifugal",
+            Reason::WindowEnd { .. } => "window-end",
+            Reason::ContinuityLength { .. } => "continuity-length",
+        }
+    }
+}
+
 /// How a control names the reasons of its breaks, in its own words.
 pub struct Terms {
     /// A short name for scripts.

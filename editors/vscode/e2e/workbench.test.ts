@@ -225,30 +225,8 @@ describe('the packaged extension in code-server', () => {
     // The heading `ncc explain` gives the code: `### G90 — Absolute dimensions`.
     const heading = execFileSync(NCC_BIN, ['explain', 'G90'], { encoding: 'utf8' }).split('\n')[0].replace(/^#+\s*/, '');
     await workbench.openFile('pocket.NCP');
-    // The mouse rests on G90 in `N10 G90 …`, as a user's would; it moves
-    // there again while the lines still move (the code lens above them comes
-    // with the estimate).
-    let attempt = 0;
-    const hover = await until(async () => {
-      const g90 = await workbench.page.evaluate((editorLines) => {
-        const tokens = document.querySelectorAll<HTMLElement>(`${editorLines} .view-line span span`);
-        const token = [...tokens].find((t) => t.innerText.trim() === 'G90' && t.closest('.view-line')?.textContent?.startsWith('N10'));
-        const box = token?.getBoundingClientRect();
-        return box ? { x: box.x + box.width / 2, y: box.y + box.height / 2 } : undefined;
-      }, EDITOR_LINES);
-      if (g90) {
-        attempt += 1;
-        await workbench.page.mouse.move(g90.x + (attempt % 3) - 1, g90.y, { steps: 4 });
-        await sleep(1500);
-      }
-      return workbench.page.evaluate(
-        (text) =>
-          [...document.querySelectorAll<HTMLElement>('.monaco-hover')]
-            .map((h) => (h.offsetParent ? h.innerText : ''))
-            .find((t) => t.includes(text)),
-        heading,
-      );
-    }, 'the hover with the documentation of G90');
+    // The mouse rests on G90 in `N10 G90 …`, as a user's would.
+    const hover = await hoverOn(workbench, 'G90', 'N10', heading);
     await workbench.screenshot('2-hover');
     await workbench.page.mouse.move(0, 0);
     assert.ok(hover.includes(heading), hover);
@@ -304,27 +282,7 @@ describe('the packaged extension in code-server', () => {
       .split('\n')[0]
       .replace(/^#+\s*/, '');
     await workbench.openFile('O1000.nc');
-    let attempt = 0;
-    const hover = await until(async () => {
-      const g71 = await workbench.page.evaluate((editorLines) => {
-        const tokens = document.querySelectorAll<HTMLElement>(`${editorLines} .view-line span span`);
-        const token = [...tokens].find((t) => t.innerText.trim() === 'G71');
-        const box = token?.getBoundingClientRect();
-        return box ? { x: box.x + box.width / 2, y: box.y + box.height / 2 } : undefined;
-      }, EDITOR_LINES);
-      if (g71) {
-        attempt += 1;
-        await workbench.page.mouse.move(g71.x + (attempt % 3) - 1, g71.y, { steps: 4 });
-        await sleep(1500);
-      }
-      return workbench.page.evaluate(
-        (text) =>
-          [...document.querySelectorAll<HTMLElement>('.monaco-hover')]
-            .map((h) => (h.offsetParent ? h.innerText : ''))
-            .find((t) => t.includes(text)),
-        heading,
-      );
-    }, 'the hover with the documentation of G71');
+    const hover = await hoverOn(workbench, 'G71', 'G71', heading);
     await workbench.screenshot('5-haas-hover');
     await workbench.page.mouse.move(0, 0);
     assert.ok(hover.includes(heading), hover);
@@ -381,6 +339,43 @@ describe('the packaged extension in code-server', () => {
     assert.deepEqual(failures, [], 'no notification about the requests on MAIN.MPF');
   });
 });
+
+/**
+ * Rests the mouse on the word `word` of the first editor line that starts
+ * with `line`, as a user's would, until a hover shows `text`; it moves
+ * there again while the lines still move (the code lens above them comes
+ * with the estimate).
+ */
+async function hoverOn(workbench: Workbench, word: string, line: string, text: string): Promise<string> {
+  let attempt = 0;
+  return until(async () => {
+    const box = await workbench.page.evaluate(
+      (editorLines, word, line) => {
+        const tokens = document.querySelectorAll<HTMLElement>(`${editorLines} .view-line span span`);
+        const token = [...tokens].find(
+          (t) => t.innerText.trim() === word && t.closest('.view-line')?.textContent?.startsWith(line),
+        );
+        const box = token?.getBoundingClientRect();
+        return box ? { x: box.x + box.width / 2, y: box.y + box.height / 2 } : undefined;
+      },
+      EDITOR_LINES,
+      word,
+      line,
+    );
+    if (box) {
+      attempt += 1;
+      await workbench.page.mouse.move(box.x + (attempt % 3) - 1, box.y, { steps: 4 });
+      await sleep(1500);
+    }
+    return workbench.page.evaluate(
+      (text) =>
+        [...document.querySelectorAll<HTMLElement>('.monaco-hover')]
+          .map((h) => (h.offsetParent ? h.innerText : ''))
+          .find((t) => t.includes(text)),
+      text,
+    );
+  }, `the hover with ${text}`);
+}
 
 /** The source lines of the moves drawn in an SVG of `frame`, if it has one. */
 function svgMoveLines(frame: Frame): Promise<number[] | undefined> {

@@ -240,20 +240,7 @@ fn code(reason: &Reason) -> &'static str {
     match reason {
         Reason::Unjoined => "g98",
         Reason::ExactStop => "g24",
-        Reason::JoiningOff => "continuity-off",
-        Reason::Corner { .. } => "corner",
-        Reason::Rapid => "rapid",
-        Reason::Thread => "thread",
-        Reason::NonMotion => "non-motion",
-        Reason::ShortBlock { .. } => "short-block",
-        Reason::BeyondThreeAxes => "beyond-three-axes",
-        Reason::LookAhead => "look-ahead",
-        Reason::ArcLimit { .. } => "arc-limit",
-        Reason::Accuracy { .. } => "accuracy",
-        Reason::Overload { .. } => "overload",
-        Reason::Centrifugal { .. } => "centrifugal",
-        Reason::WindowEnd { .. } => "window-end",
-        Reason::ContinuityLength { .. } => "continuity-length",
+        other => other.neutral_code(),
     }
 }
 
