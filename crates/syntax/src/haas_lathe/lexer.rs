@@ -73,6 +73,11 @@ pub(crate) fn token_at(text: &str, pos: usize) -> Token {
 }
 
 fn keyword_len(rest: &[u8]) -> usize {
+    // Every keyword is two upper-case letters or more: an address followed
+    // by anything else (`X12.`, `G01`) starts none, without a search.
+    if !rest.get(1).is_some_and(u8::is_ascii_uppercase) {
+        return 0;
+    }
     keywords().iter().find(|keyword| rest.starts_with(keyword.as_bytes())).map_or(0, String::len)
 }
 
