@@ -277,20 +277,17 @@ describe('the packaged extension in code-server', () => {
     assert.ok(moves.includes(rapid), `the rapid move of line ${rapid} is drawn`);
   });
 
-  test('a Haas lathe program is read: hover on G18 shows its documentation, and no error notification', async () => {
-    const heading = execFileSync(NCC_BIN, ['explain', '--dialect', 'haas-lathe', 'G18'], { encoding: 'utf8' })
-      .split('\n')[0]
-      .replace(/^#+\s*/, '');
+  test('a Haas lathe program opens in its language, and no request about it fails', async () => {
     await workbench.openFile('O1000.nc');
-    // The editor may open scrolled down; line 6, `G18 G21 G40 G99`, is
-    // shown once the cursor is at the top.
-    await workbench.chord(['Control'], 'Home');
-    const hover = await hoverOn(workbench, 'G18', 'G18', heading);
-    await workbench.screenshot('5-haas-hover');
-    await workbench.page.mouse.move(0, 0);
-    assert.ok(hover.includes(heading), hover);
-    const status = await workbench.page.evaluate(() => document.querySelector<HTMLElement>('.part.statusbar')?.innerText ?? '');
-    assert.match(status, /Haas lathe/);
+    // The language's name in the status bar, once the editor shows the file.
+    await workbench.waitFor(
+      () => document.querySelector<HTMLElement>('.part.statusbar')?.innerText.includes('Haas lathe'),
+      'Haas lathe in the status bar',
+    );
+    // The server answers what the workbench asks on opening (diagnostics,
+    // folding, symbols, semantic tokens, the cycle time's code lens).
+    await sleep(3000);
+    await workbench.screenshot('5-haas');
     const toasts = await workbench.page.evaluate(() =>
       [...document.querySelectorAll<HTMLElement>('.notification-toast')].map((t) => t.innerText),
     );
