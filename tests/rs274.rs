@@ -77,20 +77,28 @@ impl Ran {
 #[test]
 #[ignore = "needs LinuxCNC's rs274; .ci/run installs it"]
 fn motion_matches_rs274() {
+    differential("CNC8x6", |rs274, dir, seed| {
+        let (cnc, ngc, blocks) = generate(seed);
+        let (cnc_file, ngc_file) = (dir.join(format!("{seed}.NCP")), dir.join(format!("{seed}.ngc")));
+        fs::write(&cnc_file, cnc).unwrap();
+        fs::write(&ngc_file, ngc).unwrap();
+        (blocks, ncc_motions(&cnc_file), rs274_motions(rs274, &ngc_file))
+    });
+}
+
+/// Runs `PROGRAMS` random programs, each made and run by ncc and rs274 in
+/// `run_both` (its blocks, ncc's motions, rs274's), compares them, and
+/// prints the largest end-point difference.
+fn differential(dialect: &str, mut run_both: impl FnMut(&Path, &Path, u64) -> (Vec<Block>, Vec<Ran>, Vec<Ran>)) {
     let rs274 = rs274::find().expect(rs274::MISSING);
     let dir = tempfile::tempdir().unwrap();
     let mut largest_difference: f64 = 0.0;
     for seed in 1..=PROGRAMS {
-        let (cnc, ngc, blocks) = generate(seed);
-        let (cnc_file, ngc_file) = (dir.path().join(format!("{seed}.NCP")), dir.path().join(format!("{seed}.ngc")));
-        fs::write(&cnc_file, cnc).unwrap();
-        fs::write(&ngc_file, ngc).unwrap();
-        let ncc = ncc_motions(&cnc_file);
-        let peer = rs274_motions(&rs274, &ngc_file);
-        largest_difference = largest_difference.max(compare(seed, "CNC8x6", &blocks, &ncc, &peer));
+        let (blocks, ncc, peer) = run_both(&rs274, dir.path(), seed);
+        largest_difference = largest_difference.max(compare(seed, dialect, &blocks, &ncc, &peer));
     }
     eprintln!(
-        "{PROGRAMS} programs, {} motions: largest end-point difference {:.4} µm",
+        "{PROGRAMS} {dialect} programs, {} motions: largest end-point difference {:.4} µm",
         PROGRAMS as usize * MOTIONS_PER_PROGRAM,
         largest_difference * 1000.0
     );
@@ -368,25 +376,15 @@ fn arc_length(start: [f64; 3], end: [f64; 3], centre: [f64; 2], rotation: i32) -
 #[test]
 #[ignore = "needs LinuxCNC's rs274; .ci/run installs it"]
 fn lathe_motion_matches_rs274() {
-    let rs274 = rs274::find().expect(rs274::MISSING);
-    let dir = tempfile::tempdir().unwrap();
     let machine = MachineConfig::of_control(Dialect::HaasLathe);
-    let mut largest_difference: f64 = 0.0;
-    for seed in 1..=PROGRAMS {
+    differential("Haas", |rs274, dir, seed| {
         let (haas, ngc, blocks) = generate_lathe(seed);
-        let ngc_file = dir.path().join(format!("{seed}.ngc"));
+        let ngc_file = dir.join(format!("{seed}.ngc"));
         fs::write(&ngc_file, ngc).unwrap();
         let trace = run::run(&haas, &NoFiles, &machine, 10 * MOTIONS_PER_PROGRAM);
         assert!(trace.findings.is_empty(), "seed {seed}: {:?}", trace.findings);
-        let ncc = lathe_motions(&trace);
-        let peer = rs274_lathe_motions(&rs274, &ngc_file);
-        largest_difference = largest_difference.max(compare(seed, "Haas", &blocks, &ncc, &peer));
-    }
-    eprintln!(
-        "{PROGRAMS} lathe programs, {} motions: largest end-point difference {:.4} µm",
-        PROGRAMS as usize * MOTIONS_PER_PROGRAM,
-        largest_difference * 1000.0
-    );
+        (blocks, lathe_motions(&trace), rs274_lathe_motions(rs274, &ngc_file))
+    });
 }
 
 /// A random lathe program as Haas and NGC text, and its blocks, whose ends
