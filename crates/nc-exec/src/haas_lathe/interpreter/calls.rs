@@ -14,11 +14,16 @@
 //!   of that number in it, or its first program.
 //! - L repeats the call, L times in all; L0 calls nothing; without L the
 //!   call runs once.
-//! - G65 assigns its arguments by Fanuc's argument assignment I (the table
-//!   [`ARGUMENTS`]). Each macro call level has its own locals #1–#33, vacant
-//!   but for the arguments, every repetition starting from them; the
-//!   caller's come back at M99. A letter written twice gives its first
-//!   value: assignment II (I, J, K repeated) is not read. M97 and M98 keep
+//! - G65 assigns its arguments by Fanuc's argument assignments I and II,
+//!   which the control tells apart by the letters ([`argument_local`]):
+//!   A, B, C are #1–#3; the I, J, K of each set go to the set's three
+//!   locals from #4 on (#4–#6, #7–#9, … #31–#33), a set ending where a
+//!   letter does not follow the set's last in the order I, J, K; every other
+//!   letter has assignment I's local (D #7, E #8, … Z #26). Where two words
+//!   give one local, the later in the block holds. Words that are no
+//!   argument (G, L, N, O, P) are skipped. Each macro call level has its own
+//!   locals #1–#33, vacant but for the arguments, every repetition
+//!   starting from them; the caller's come back at M99. M97 and M98 keep
 //!   the caller's locals.
 //! - `M99 P<n>` returns to the caller's first block numbered n instead of
 //!   the block after the call. In the main program `M99 P<n>` goes to block
@@ -54,7 +59,7 @@ pub(super) struct Call {
 }
 
 /// Fanuc's argument assignment I: the local each argument letter of G65
-/// sets.
+/// sets, where assignment II does not give I, J and K theirs.
 const ARGUMENTS: [(u8, u32); 21] = [
     (b'A', 1),
     (b'B', 2),
@@ -78,6 +83,36 @@ const ARGUMENTS: [(u8, u32); 21] = [
     (b'Y', 25),
     (b'Z', 26),
 ];
+
+/// The sets of I, J, K assignment II has: #4–#6 up to #31–#33.
+const IJK_SETS: u32 = 10;
+
+/// Where the argument words of a G65 block go, word by word.
+#[derive(Default)]
+struct ArgumentSets {
+    /// The I, J, K set under way (0 for #4–#6) and the last of its letters
+    /// written (0 for I), if any.
+    set: Option<(u32, u32)>,
+}
+
+impl ArgumentSets {
+    /// The local the argument `letter` sets, in the order the block writes
+    /// its words; `None` for a word that is no argument, or an I, J or K
+    /// beyond the tenth set.
+    fn argument_local(&mut self, letter: u8) -> Option<u32> {
+        let Some(offset) = b"IJK".iter().position(|&l| l == letter) else {
+            return ARGUMENTS.iter().find(|&&(l, _)| l == letter).map(|&(_, local)| local);
+        };
+        let offset = offset as u32;
+        let set = match self.set {
+            Some((set, last)) if offset > last => set,
+            Some((set, _)) => set + 1,
+            None => 0,
+        };
+        self.set = Some((set, offset));
+        (set < IJK_SETS).then_some(4 + 3 * set + offset)
+    }
+}
 
 impl Interpreter<'_> {
     /// M97, M98 (`code`) or M99 in the block at `place` of `program`.
@@ -109,8 +144,10 @@ impl Interpreter<'_> {
     /// words as its arguments.
     pub(super) fn macro_call(&mut self, place: Place, block: &HaasBlock, range: TextRange) -> Flow {
         let mut arguments = Locals::vacant();
-        for (letter, local) in ARGUMENTS {
-            if let Some(value) = block.word(letter).and_then(|word| self.word_value(word, range)) {
+        let mut sets = ArgumentSets::default();
+        for word in &block.words {
+            let Some(local) = sets.argument_local(word.letter) else { continue };
+            if let Some(value) = self.word_value(word, range) {
                 arguments.set(local, value);
             }
         }

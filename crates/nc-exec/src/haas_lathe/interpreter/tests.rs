@@ -525,6 +525,17 @@ fn g65_passes_its_arguments_as_locals_and_gives_the_caller_its_own_back() {
 }
 
 #[test]
+fn g65_reads_argument_assignment_ii_for_repeated_i_j_k() {
+    // I2. J3. fill the first set (#4, #5); I4. starts no new set after J,
+    // so a second one: #7, and K5. is its K, #9; D6. gives #7 too and,
+    // later in the block, holds; I1. after K starts the third set, #10.
+    let text = "O1\nG65 P9020 I2. J3. I4. K5. D6. I1.\nM30\nO9020\nG00 X0 W-[#4 + #5 * 10. + #7 * 100. + #9 * 1000. + #10 * 10000.]\nM99\n";
+    let trace = run_lathe(text);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    close_zx(zx(trace.steps.last().unwrap()), (-15632.0, 0.0));
+}
+
+#[test]
 fn runaway_recursion_stops_at_the_depth_limit() {
     for text in ["O1\nM98 P1\nM30\n", "O1\nG65 P1 A1.\nM30\n", "O1\nN1 M97 P1\nM30\n"] {
         let trace = run_lathe(text);
