@@ -16,8 +16,11 @@ impl Item<'_> {
         match *self {
             Item::Group(group) => format!("Group {} — {}", group.id, group.title),
             Item::Code(code) => format!("{} — {}", code.code, code.title),
-            Item::UnlistedCode { letter, number, group } => {
+            Item::UnlistedCode { letter, number, group } if group.open => {
                 format!("{letter}{number:02} — machine-defined function (group {})", group.id)
+            }
+            Item::UnlistedCode { letter, number, group } => {
+                format!("{letter}{number:02} — {} (group {})", group.title, group.id)
             }
             Item::Address(address) => format!("{} — {}", address.letter, address.title),
             Item::Parameter(number) => {
