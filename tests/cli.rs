@@ -472,6 +472,24 @@ fn explain_list_prints_the_counts() {
     }
 }
 
+#[test]
+fn explain_reads_the_catalogue_of_a_dialect_whose_programs_it_does_not_read() {
+    let output = ncc(&["explain", "--dialect", "sinumerik", "bspline"]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    let text = stdout(&output);
+    assert!(text.starts_with("### BSPLINE — B-spline"), "{text}");
+    assert!(text.contains("`G[1]=7` selects it"), "{text}");
+    let text = stdout(&ncc(&["explain", "--dialect", "sinumerik", "$P_XYZ"]));
+    assert!(text.starts_with("### $P_… — a system variable ncc does not document"), "{text}");
+    let text = stdout(&ncc(&["explain", "--dialect", "sinumerik", "--list"]));
+    for heading in ["G group words (", "keywords (", "functions (", "system variables (", "fixed cycles (11)"] {
+        assert!(text.contains(heading), "{heading} missing from\n{text}");
+    }
+    let output = ncc(&["explain", "--dialect", "sinumerik", "GOTOX"]);
+    assert_eq!(output.status.code(), Some(1));
+    assert!(stderr(&output).contains("of Siemens Sinumerik"), "{}", stderr(&output));
+}
+
 /// `ncc plot` draws the moves with their lines, rapids dashed, an arc as
 /// chords, the breaks marked and the total time in the legend.
 #[test]

@@ -1,7 +1,11 @@
 //! Looking entries up by what a programmer types: `G40`, `M30`, `R39`,
-//! `op:48`, `X`, `group:G3`.
+//! `op:48`, `X`, `group:G3`; Sinumerik's `BSPLINE`, `GOTOF`, `SIN`, `<<`,
+//! `$P_GG[6]`, `CYCLE832`.
 
-use crate::{Address, AddressRole, Catalogue, Code, Cycle, Group, MachineConstant, Operation, ParameterStatus};
+use crate::{
+    Address, AddressRole, Catalogue, Code, Cycle, Function, Group, Keyword, MachineConstant, Operation,
+    ParameterStatus, SystemVariable, SystemVariableInfo, VariablePrefix,
+};
 
 /// One thing the catalogue can describe.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,6 +29,11 @@ pub enum Item<'a> {
     },
     Operation(&'a Operation),
     Cycle(&'a Cycle),
+    Keyword(&'a Keyword),
+    Function(&'a Function),
+    SystemVariable(&'a SystemVariable),
+    /// A system variable the catalogue does not list, known by its prefix.
+    UndocumentedVariable(&'a VariablePrefix),
 }
 
 /// A query that matches nothing, with the closest entries.
@@ -66,8 +75,33 @@ impl Catalogue {
         if let Some(id) = upper.strip_prefix("GROUP:") {
             return self.group(id.trim()).map(Item::Group).into_iter().collect();
         }
+        if upper.starts_with('$') {
+            return match self.system_variable(&upper) {
+                Some(SystemVariableInfo::Documented(variable)) => vec![Item::SystemVariable(variable)],
+                Some(SystemVariableInfo::MachineData { constant, .. }) => {
+                    vec![Item::MachineConstant { number: constant.number, constant }]
+                }
+                Some(SystemVariableInfo::Undocumented { prefix }) => vec![Item::UndocumentedVariable(prefix)],
+                None => Vec::new(),
+            };
+        }
         if let Some(address) = self.address(&upper) {
             return vec![Item::Address(address)];
+        }
+        if let Some(code) = self.word_code(&upper) {
+            return vec![Item::Code(code)];
+        }
+        let mut words: Vec<Item<'_>> = Vec::new();
+        words.extend(self.keyword(&upper).map(Item::Keyword));
+        words.extend(self.function(&upper).map(Item::Function));
+        words.extend(
+            self.operations.iter().filter(|op| op.symbol.as_deref() == Some(upper.as_str())).map(Item::Operation),
+        );
+        if crate::split_code(&upper).is_none() {
+            words.extend(self.cycles_for(&upper).map(Item::Cycle));
+        }
+        if !words.is_empty() {
+            return words;
         }
         let Some((letter, number)) = crate::split_code(&upper) else { return Vec::new() };
         // `split_code` gives an ASCII letter.
@@ -118,6 +152,11 @@ impl Catalogue {
         names.extend((0..self.parameters.count).map(|n| format!("R{n}")));
         names.extend(self.machine_constants.iter().map(|c| format!("R{}", c.number)));
         names.extend(self.operations.iter().map(|op| format!("op:{}", op.code)));
+        names.extend(self.operations.iter().filter_map(|op| op.symbol.clone()));
+        names.extend(self.keywords.iter().map(|k| k.word.clone()));
+        names.extend(self.functions.iter().map(|f| f.name.clone()));
+        names.extend(self.system_variables.iter().map(|v| v.name.clone()));
+        names.extend(self.cycles.iter().filter(|c| crate::split_code(&c.code).is_none()).map(|c| c.code.clone()));
         names.sort();
         names.dedup();
         let mut scored: Vec<(f64, String)> = names

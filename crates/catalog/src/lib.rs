@@ -55,6 +55,15 @@ struct DataFiles {
     machine_constants: (&'static str, &'static str),
     operations: (&'static str, &'static str),
     cycles: (&'static str, &'static str),
+    /// The language's keywords, functions and system variables, for
+    /// dialects with a language beyond addresses and codes (Sinumerik).
+    language: Option<LanguageFiles>,
+}
+
+struct LanguageFiles {
+    keywords: (&'static str, &'static str),
+    functions: (&'static str, &'static str),
+    system_variables: (&'static str, &'static str),
 }
 
 macro_rules! data_file {
@@ -70,6 +79,7 @@ static CNC8X6_FILES: DataFiles = DataFiles {
     machine_constants: data_file!("cnc8x6", "machine_constants.toml"),
     operations: data_file!("cnc8x6", "operations.toml"),
     cycles: data_file!("cnc8x6", "cycles.toml"),
+    language: None,
 };
 
 static HAAS_LATHE_FILES: DataFiles = DataFiles {
@@ -79,7 +89,37 @@ static HAAS_LATHE_FILES: DataFiles = DataFiles {
     machine_constants: data_file!("haas-lathe", "machine_constants.toml"),
     operations: data_file!("haas-lathe", "operations.toml"),
     cycles: data_file!("haas-lathe", "cycles.toml"),
+    language: None,
 };
+
+static SINUMERIK_FILES: DataFiles = DataFiles {
+    codes: data_file!("sinumerik", "codes.toml"),
+    addresses: data_file!("sinumerik", "addresses.toml"),
+    parameters: data_file!("sinumerik", "parameters.toml"),
+    machine_constants: data_file!("sinumerik", "machine_constants.toml"),
+    operations: data_file!("sinumerik", "operations.toml"),
+    cycles: data_file!("sinumerik", "cycles.toml"),
+    language: Some(LanguageFiles {
+        keywords: data_file!("sinumerik", "keywords.toml"),
+        functions: data_file!("sinumerik", "functions.toml"),
+        system_variables: data_file!("sinumerik", "system_variables.toml"),
+    }),
+};
+
+impl DialectId {
+    /// The catalogue of this dialect, including those this build does not
+    /// read programs of yet (Sinumerik): `ncc explain` and the data tests
+    /// need no more.
+    pub fn catalogue(self) -> &'static Catalogue {
+        match self.implementation() {
+            Some(dialect) => dialect.catalogue(),
+            None => {
+                static SINUMERIK: OnceLock<Catalogue> = OnceLock::new();
+                SINUMERIK.get_or_init(|| Catalogue::load(&SINUMERIK_FILES))
+            }
+        }
+    }
+}
 
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -101,7 +141,7 @@ struct AddressesFile {
 #[serde(deny_unknown_fields)]
 struct ParametersFile {
     parameters: ParameterOverview,
-    #[serde(rename = "range")]
+    #[serde(default, rename = "range")]
     ranges: Vec<ParameterRange>,
 }
 
@@ -128,6 +168,29 @@ struct CyclesFile {
     cycles: Vec<Cycle>,
 }
 
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct KeywordsFile {
+    #[serde(rename = "keyword")]
+    keywords: Vec<Keyword>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FunctionsFile {
+    #[serde(rename = "function")]
+    functions: Vec<Function>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SystemVariablesFile {
+    #[serde(rename = "prefix")]
+    prefixes: Vec<VariablePrefix>,
+    #[serde(rename = "variable")]
+    variables: Vec<SystemVariable>,
+}
+
 fn parse<T: serde::de::DeserializeOwned>((name, text): (&str, &str)) -> T {
     // The files are part of the program and checked by the tests; a broken
     // one is a build defect, never a user error.
@@ -146,7 +209,14 @@ pub struct Catalogue {
     pub constant_terms: ConstantTerms,
     pub operations: Vec<Operation>,
     pub cycles: Vec<Cycle>,
+    pub keywords: Vec<Keyword>,
+    pub functions: Vec<Function>,
+    pub system_variables: Vec<SystemVariable>,
+    /// Longest first, so that `$AA_` is tried before `$A_`.
+    pub variable_prefixes: Vec<VariablePrefix>,
     codes_by_number: HashMap<(char, u32), usize>,
+    /// The codes written as words, by their upper-case spelling.
+    codes_by_word: HashMap<String, usize>,
     roles: [Option<AddressRole>; 128],
     /// The index in `addresses` of each address byte, either case.
     address_index: [Option<u8>; 128],
@@ -173,12 +243,31 @@ impl Catalogue {
         let constants: MachineConstantsFile = parse(files.machine_constants);
         let operations: OperationsFile = parse(files.operations);
         let cycles: CyclesFile = parse(files.cycles);
+        let (keywords, functions, system_variables) = match &files.language {
+            Some(language) => {
+                let keywords: KeywordsFile = parse(language.keywords);
+                let functions: FunctionsFile = parse(language.functions);
+                let variables: SystemVariablesFile = parse(language.system_variables);
+                (keywords.keywords, functions.functions, variables)
+            }
+            None => (Vec::new(), Vec::new(), SystemVariablesFile { prefixes: Vec::new(), variables: Vec::new() }),
+        };
+        let mut variable_prefixes = system_variables.prefixes;
+        variable_prefixes.sort_by_key(|prefix| std::cmp::Reverse(prefix.prefix.len()));
 
         let codes_by_number =
             codes.codes.iter().enumerate().filter_map(|(i, code)| Some((split_code(&code.code)?, i))).collect();
+        let codes_by_word = codes
+            .codes
+            .iter()
+            .enumerate()
+            .filter(|(_, code)| code.is_word())
+            .map(|(i, code)| (code.code.to_ascii_uppercase(), i))
+            .collect();
         let mut roles = [None; 128];
         let mut address_index = [None; 128];
-        for (index, address) in addresses.addresses.iter().enumerate() {
+        // Only one-character addresses: the bytes of `CR` are no addresses.
+        for (index, address) in addresses.addresses.iter().enumerate().filter(|(_, a)| a.letter.len() == 1) {
             for byte in address.letter.bytes().filter(u8::is_ascii) {
                 for case in [byte.to_ascii_uppercase(), byte.to_ascii_lowercase()] {
                     roles[usize::from(case)] = Some(address.role);
@@ -205,7 +294,12 @@ impl Catalogue {
             constant_terms: constants.terms,
             operations: operations.operations,
             cycles: cycles.cycles,
+            keywords,
+            functions,
+            system_variables: system_variables.variables,
+            variable_prefixes,
             codes_by_number,
+            codes_by_word,
             roles,
             address_index,
             modal_groups: Vec::new(),
@@ -255,6 +349,33 @@ impl Catalogue {
     /// The code `letter` + `number` (`'G', 1` is G01), if the catalogue lists it.
     pub fn code(&self, letter: char, number: u32) -> Option<&Code> {
         self.codes_by_number.get(&(letter.to_ascii_uppercase(), number)).map(|&i| &self.codes[i])
+    }
+
+    /// The code written as the word `word` (`BSPLINE`), any case.
+    pub fn word_code(&self, word: &str) -> Option<&Code> {
+        self.codes_by_word.get(&word.to_ascii_uppercase()).map(|&i| &self.codes[i])
+    }
+
+    /// The code `name` however it is written: `G01`, `G1`, `BSPLINE`.
+    pub fn code_named(&self, name: &str) -> Option<&Code> {
+        match split_code(name) {
+            Some((letter, number)) => self.code(letter, number),
+            None => self.word_code(name),
+        }
+    }
+
+    /// The index in [`Catalogue::groups`] of the group a code written as a
+    /// word puts itself in force in, like [`Catalogue::modal_group_index`].
+    pub fn word_modal_group_index(&self, word: &str) -> Option<usize> {
+        let code = self.word_code(word).filter(|code| code.modality == Modality::Modal)?;
+        let id = code.group.as_deref()?;
+        self.groups.iter().position(|group| group.id == id)
+    }
+
+    /// The code of `group` with number `index` inside it: what Sinumerik's
+    /// `G[1]=2` selects (G1).
+    pub fn code_at(&self, group: &str, index: u32) -> Option<&Code> {
+        self.codes.iter().find(|code| code.group.as_deref() == Some(group) && code.index == Some(index))
     }
 
     pub fn group(&self, id: &str) -> Option<&Group> {
@@ -320,11 +441,57 @@ impl Catalogue {
         self.operations.iter().find(|op| op.code == code)
     }
 
+    pub fn keyword(&self, word: &str) -> Option<&Keyword> {
+        self.keywords.iter().find(|k| k.word.eq_ignore_ascii_case(word))
+    }
+
+    pub fn function(&self, name: &str) -> Option<&Function> {
+        self.functions.iter().find(|f| f.name.eq_ignore_ascii_case(name))
+    }
+
+    /// What the catalogue knows of the system variable `name` (`$P_GG`,
+    /// `$P_GG[6]`, `$MC_MM_NUM_R_PARAM`); `None` when no known prefix starts it.
+    pub fn system_variable(&self, name: &str) -> Option<SystemVariableInfo<'_>> {
+        let name = name.split('[').next().unwrap_or_default().trim();
+        if let Some(variable) = self.system_variables.iter().find(|v| v.name.eq_ignore_ascii_case(name)) {
+            return Some(SystemVariableInfo::Documented(variable));
+        }
+        let upper = name.to_ascii_uppercase();
+        let prefix = self.variable_prefixes.iter().find(|p| upper.starts_with(&p.prefix.to_ascii_uppercase()))?;
+        let rest = &upper[prefix.prefix.len()..];
+        let constant = prefix
+            .machine_data
+            .then(|| {
+                self.machine_constants.iter().find(|c| c.name.as_deref().is_some_and(|n| n.eq_ignore_ascii_case(rest)))
+            })
+            .flatten();
+        Some(match constant {
+            Some(constant) => SystemVariableInfo::MachineData { prefix, constant },
+            None => SystemVariableInfo::Undocumented { prefix },
+        })
+    }
+
     /// The fixed cycles with this code (one per flavour).
     pub fn cycles_for(&self, code: &str) -> impl Iterator<Item = &Cycle> + use<'_> {
         let code = code.to_ascii_uppercase();
         self.cycles.iter().filter(move |c| c.code.eq_ignore_ascii_case(&code))
     }
+}
+
+/// What the catalogue knows of a system variable.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SystemVariableInfo<'a> {
+    Documented(&'a SystemVariable),
+    /// Machine data the catalogue describes, read through its prefix.
+    MachineData {
+        prefix: &'a VariablePrefix,
+        constant: &'a MachineConstant,
+    },
+    /// A name with a known prefix that the catalogue does not list: a system
+    /// variable ncc does not document, never an error.
+    Undocumented {
+        prefix: &'a VariablePrefix,
+    },
 }
 
 /// `"G01"` → `('G', 1)`.
@@ -351,7 +518,7 @@ mod data_files {
         (Box::leak(format!("{dialect}/{name}").into_boxed_str()), Box::leak(text.into_boxed_str()))
     }
 
-    const DIALECTS: [&str; 2] = ["cnc8x6", "haas-lathe"];
+    const DIALECTS: [&str; 3] = ["cnc8x6", "haas-lathe", "sinumerik"];
 
     #[test]
     fn codes() {
@@ -391,6 +558,16 @@ mod data_files {
         assert_eq!(file.operations.len(), 52);
         let file: OperationsFile = parse(read("haas-lathe", "operations.toml"));
         assert!(file.operations.iter().all(|op| op.symbol.is_some()));
+    }
+
+    #[test]
+    fn language() {
+        let file: KeywordsFile = parse(read("sinumerik", "keywords.toml"));
+        assert!(!file.keywords.is_empty());
+        let file: FunctionsFile = parse(read("sinumerik", "functions.toml"));
+        assert!(!file.functions.is_empty());
+        let file: SystemVariablesFile = parse(read("sinumerik", "system_variables.toml"));
+        assert!(!file.prefixes.is_empty() && !file.variables.is_empty());
     }
 
     #[test]

@@ -6,8 +6,8 @@
 use std::fmt::Write;
 
 use crate::{
-    AddressRole, Catalogue, Dimensional, Documented, Flavour, Item, Modality, ParameterOverview, ParameterStatus,
-    schema::Doc,
+    Access, AddressRole, Catalogue, Dimensional, Documented, Flavour, Item, KeywordKind, Modality, ParameterOverview,
+    ParameterStatus, schema::Doc,
 };
 
 impl Item<'_> {
@@ -16,8 +16,11 @@ impl Item<'_> {
         match *self {
             Item::Group(group) => format!("Group {} — {}", group.id, group.title),
             Item::Code(code) => format!("{} — {}", code.code, code.title),
-            Item::UnlistedCode { letter, number, group } => {
+            Item::UnlistedCode { letter, number, group } if group.open => {
                 format!("{letter}{number:02} — machine-defined function (group {})", group.id)
+            }
+            Item::UnlistedCode { letter, number, group } => {
+                format!("{letter}{number:02} — {} (group {})", group.title, group.id)
             }
             Item::Address(address) => format!("{} — {}", address.letter, address.title),
             Item::Parameter(number) => {
@@ -39,6 +42,12 @@ impl Item<'_> {
                     Flavour::Lathe => "lathe",
                 };
                 format!("{} ({flavour} cycle) — {}", cycle.code, cycle.title)
+            }
+            Item::Keyword(keyword) => format!("{} — {}", keyword.word, keyword.title),
+            Item::Function(function) => format!("{} — {}", function.name, function.title),
+            Item::SystemVariable(variable) => format!("{} — {}", variable.name, variable.title),
+            Item::UndocumentedVariable(prefix) => {
+                format!("{}… — a system variable ncc does not document ({})", prefix.prefix, prefix.title)
             }
         }
     }
@@ -81,16 +90,32 @@ impl Item<'_> {
                         ("Reads", list(&code.allows)),
                         ("Cancels", list(&code.cancels)),
                         ("Units", code.units.clone()),
+                        (
+                            "Number in its group",
+                            code.index.zip(group).map(|(index, group)| {
+                                let number = group.id.trim_start_matches(|c: char| c.is_ascii_alphabetic());
+                                format!("{index} (`$P_GG[{number}]` reads it, `G[{number}]={index}` selects it)")
+                            }),
+                        ),
                     ],
                 );
+                syntax(&mut out, &code.syntax);
                 doc(&mut out, code.doc());
             }
             Item::UnlistedCode { group, .. } => {
-                let _ = writeln!(
-                    out,
-                    "The manual does not define this code; it belongs to group {} ({}), whose functions the machine builder defines in the PLC program.\n",
-                    group.id, group.title
-                );
+                if group.open {
+                    let _ = writeln!(
+                        out,
+                        "The manual does not define this code; it belongs to group {} ({}), whose functions the machine builder defines in the PLC program.\n",
+                        group.id, group.title
+                    );
+                } else if let Some([first, last]) = &group.takes_unlisted {
+                    let _ = writeln!(
+                        out,
+                        "One of the codes {first}–{last} of group {} ({}), which the catalogue describes together.\n",
+                        group.id, group.title
+                    );
+                }
                 doc(&mut out, group.doc());
             }
             Item::Address(address) => {
@@ -110,7 +135,8 @@ impl Item<'_> {
                         (
                             "Parameter substitution",
                             Some(if address.substitutable {
-                                format!("allowed (e.g. `{}{}1`)", address.letter, catalogue.parameters.written)
+                                let ParameterOverview { written, value_separator, .. } = &catalogue.parameters;
+                                format!("allowed (e.g. `{}{value_separator}{written}1`)", address.letter)
                             } else {
                                 "not allowed".to_owned()
                             }),
@@ -172,6 +198,7 @@ impl Item<'_> {
                     &[
                         ("Defined", (!op.defined).then(|| "no: the manual leaves this code undefined".to_owned())),
                         ("Written", op.symbol.as_ref().map(|symbol| format!("`{symbol}`"))),
+                        ("Precedence", op.precedence.map(|level| format!("{level} (1 binds tightest)"))),
                         ("Operands", Some(op.operands.clone())),
                         ("Result", Some(op.result.clone())),
                         ("Conditional", op.conditional.then(|| "yes".to_owned())),
@@ -197,6 +224,23 @@ impl Item<'_> {
                     }
                     out.push('\n');
                 }
+                if !cycle.arguments.is_empty() {
+                    let names: Vec<&str> = cycle.arguments.iter().map(|a| a.name.as_str()).collect();
+                    let _ = writeln!(out, "`{}({})`\n", cycle.code, names.join(", "));
+                    out.push_str("| # | Argument | Type | Meaning | Unit |\n|---|---|---|---|---|\n");
+                    for (number, a) in cycle.arguments.iter().enumerate() {
+                        let _ = writeln!(
+                            out,
+                            "| {} | {} | {} | {} | {} |",
+                            number + 1,
+                            a.name,
+                            a.ty,
+                            a.meaning.replace('\n', " "),
+                            a.unit.as_deref().unwrap_or("")
+                        );
+                    }
+                    out.push('\n');
+                }
                 if !cycle.parameters.is_empty() {
                     out.push_str("| Parameter | Meaning | Unit |\n|---|---|---|\n");
                     for p in &cycle.parameters {
@@ -212,6 +256,62 @@ impl Item<'_> {
                     out.push('\n');
                 }
                 doc(&mut out, cycle.doc());
+            }
+            Item::Keyword(keyword) => {
+                facts(
+                    &mut out,
+                    &[("Kind", Some(keyword_kind(keyword.kind).to_owned())), ("Goes with", list(&keyword.related))],
+                );
+                syntax(&mut out, &keyword.syntax);
+                doc(&mut out, keyword.doc());
+            }
+            Item::Function(function) => {
+                let kind = if function.returns.is_some() { "function" } else { "procedure (a statement of its own)" };
+                facts(&mut out, &[("Kind", Some(kind.to_owned()))]);
+                let _ = writeln!(out, "```\n{}\n```\n", function.signature());
+                if !function.parameters.is_empty() {
+                    out.push_str("| Parameter | Type | Meaning |\n|---|---|---|\n");
+                    for p in &function.parameters {
+                        let optional = if p.optional { " (may be left out)" } else { "" };
+                        let _ = writeln!(out, "| {} | {} | {}{optional} |", p.name, p.ty, p.meaning.replace('\n', " "));
+                    }
+                    out.push('\n');
+                }
+                doc(&mut out, function.doc());
+            }
+            Item::SystemVariable(variable) => {
+                let access = match variable.access {
+                    Access::Read => "read only",
+                    Access::ReadWrite => "read and write",
+                };
+                facts(
+                    &mut out,
+                    &[
+                        ("Type", Some(variable.ty.clone())),
+                        ("Access", Some(access.to_owned())),
+                        ("Index", variable.index.as_ref().map(|index| format!("`{}[…]`: {index}", variable.name))),
+                        (
+                            "Value",
+                            Some(
+                                if variable.main_run {
+                                    "current (main run); reading it outside a synchronous action stops preprocessing"
+                                } else {
+                                    "programmed (preprocessing)"
+                                }
+                                .to_owned(),
+                            ),
+                        ),
+                    ],
+                );
+                doc(&mut out, variable.doc());
+            }
+            Item::UndocumentedVariable(prefix) => {
+                let _ = writeln!(
+                    out,
+                    "The catalogue does not list this variable; its prefix `{}` says what kind it is. A program may use it: the control decides whether it exists.\n",
+                    prefix.prefix
+                );
+                doc(&mut out, prefix.doc());
             }
         }
         out.truncate(out.trim_end().len());
@@ -235,6 +335,13 @@ fn doc(out: &mut String, doc: Doc<'_>) {
         let _ = writeln!(out, "Example:\n\n```\n{}\n```\n", example.trim());
     }
     let _ = writeln!(out, "Manual: {}", doc.source.trim());
+}
+
+/// The written forms, one per line, as a code block.
+fn syntax(out: &mut String, forms: &[String]) {
+    if !forms.is_empty() {
+        let _ = writeln!(out, "```\n{}\n```\n", forms.join("\n"));
+    }
 }
 
 fn facts(out: &mut String, facts: &[(&str, Option<String>)]) {
@@ -300,5 +407,23 @@ fn role(role: AddressRole) -> &'static str {
         AddressRole::BlockSkip => "block skip",
         AddressRole::ProgramNumber => "program number",
         AddressRole::ProgramEnd => "physical end",
+        AddressRole::Corner => "corner chamfer or rounding",
+        AddressRole::Spline => "spline parameter",
+        AddressRole::Orientation => "tool orientation",
+        AddressRole::Tolerance => "path tolerance",
+    }
+}
+
+fn keyword_kind(kind: KeywordKind) -> &'static str {
+    match kind {
+        KeywordKind::Declaration => "declaration",
+        KeywordKind::Type => "data type",
+        KeywordKind::Literal => "literal",
+        KeywordKind::Control => "control structure",
+        KeywordKind::Jump => "jump",
+        KeywordKind::Subprogram => "subprogram call or end",
+        KeywordKind::Transformation => "kinematic transformation",
+        KeywordKind::SynchronousAction => "synchronous action",
+        KeywordKind::Statement => "statement",
     }
 }

@@ -89,7 +89,8 @@ fn yes() -> bool {
 entry! {
     /// A group of G or M functions, of which one may be written per block.
     pub struct Group {
-        /// `G0` … `G11`, `M1` … `M14`.
+        /// `G0` … `G11`, `M1` … `M14`; Sinumerik's G groups 1 … n are `G1` …
+        /// `Gn`, whatever their members are written as.
         pub id: String,
         /// The code set at reset and by M02/M30 (the `+` code, or the
         /// priority block's where the dictionary marks none).
@@ -113,10 +114,21 @@ entry! {
 }
 
 entry! {
-    /// A G or M code.
+    /// A G or M code, or a word that stands in a G group like one
+    /// (Sinumerik's `BSPLINE`, `SOFT`, `TRANS`).
     pub struct Code {
-        /// Letter and two digits: `G00`, `M30`.
+        /// Letter and digits (`G00`, `M30`; Sinumerik `G0`, `G641`), or a
+        /// word ([`Code::is_word`]).
         pub code: String,
+        /// Its number inside its group, from 1, where the control numbers
+        /// them: Sinumerik's `$P_GG[n]` reads it and `G[n]=k` selects by it.
+        #[serde(default)]
+        pub index: Option<u32>,
+        /// How it is written with what it takes, one form per line, where
+        /// it takes more than the addresses of `requires` and `allows`
+        /// (`TRANS X… Y… Z…`, `POLY PO[X]=(…)`).
+        #[serde(default)]
+        pub syntax: Vec<String>,
         /// The group; `None` for codes the manual uses outside the groups.
         #[serde(default)]
         pub group: Option<String>,
@@ -159,6 +171,14 @@ entry! {
     }
 }
 
+impl Code {
+    /// Written as a word (`BSPLINE`, `CUT3DC`) rather than a letter and a
+    /// number.
+    pub fn is_word(&self) -> bool {
+        crate::split_code(&self.code).is_none()
+    }
+}
+
 /// What an address does in the grammar and the program.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -194,6 +214,14 @@ pub enum AddressRole {
     ProgramNumber,
     /// `*`.
     ProgramEnd,
+    /// Chamfer or rounding of the corner at the block's end (`CHF`, `RND`).
+    Corner,
+    /// A spline's degree, point weight or knot interval (`SD`, `PW`, `PL`).
+    Spline,
+    /// Tool orientation: direction vector, angles, lead and tilt (`A3`, `LEAD`).
+    Orientation,
+    /// A tolerance or smoothing distance of the path (`OTOL`, `ADIS`).
+    Tolerance,
 }
 
 /// Whether a word carries a unit (the manual's "dimensional word").
@@ -209,7 +237,9 @@ pub enum Dimensional {
 }
 
 entry! {
-    /// An address letter (or `&`, `/`, `%`, `*`).
+    /// An address letter (or `&`, `/`, `%`, `*`), or an address of several
+    /// characters (Sinumerik's `CR`, `A3`, `OTOL`), which takes its value
+    /// after `=`.
     pub struct Address {
         pub letter: String,
         pub role: AddressRole,
@@ -278,6 +308,10 @@ entry! {
     pub struct ParameterOverview {
         /// Number of parameters (96).
         pub count: u32,
+        /// What stands between an address and a parameter as its value:
+        /// nothing (`XR1`) or `=` (Sinumerik `X=R1`).
+        #[serde(default)]
+        pub value_separator: String,
         /// What a parameter's number is written after: `R` (`R12`), `#`.
         #[serde(default = "letter_r")]
         pub written: String,
@@ -342,6 +376,10 @@ entry! {
     /// not a program parameter.
     pub struct MachineConstant {
         pub number: u32,
+        /// The name a program reads it by, after the prefix of its kind
+        /// (Sinumerik `MM_NUM_R_PARAM` in `$MC_MM_NUM_R_PARAM`).
+        #[serde(default)]
+        pub name: Option<String>,
         /// For a run of constants described together (`R356`–`R381`).
         #[serde(default)]
         pub last: Option<u32>,
@@ -358,6 +396,10 @@ entry! {
     /// A parameter-arithmetic operation (control word `CCAABBTT`, CC = code),
     /// or an operator or function of a dialect's expressions (`SIN`, `EQ`).
     pub struct Operation {
+        /// How tightly the operator binds, 1 the tightest; binary operators
+        /// of one level go left to right.
+        #[serde(default)]
+        pub precedence: Option<u8>,
         /// The operation code; for expression operators, their number in
         /// the file (1, 2, …).
         pub code: u32,
@@ -403,6 +445,20 @@ pub struct CycleParameter {
     pub unit: Option<String>,
 }
 
+/// One argument of a cycle called like a procedure (Sinumerik
+/// `CYCLE81(RTP, RFP, …)`), in order.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CycleArgument {
+    pub name: String,
+    /// `REAL`, `INT`, `STRING[32]`, …
+    #[serde(rename = "type")]
+    pub ty: String,
+    pub meaning: String,
+    #[serde(default)]
+    pub unit: Option<String>,
+}
+
 /// One address word a canned cycle reads from its own block (`P`, `U`, `D`).
 #[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -428,8 +484,141 @@ entry! {
         /// The address words it reads from its block (cycles called with words).
         #[serde(default, rename = "address")]
         pub addresses: Vec<CycleAddress>,
+        /// Its arguments in order (cycles called like a procedure).
+        #[serde(default, rename = "argument")]
+        pub arguments: Vec<CycleArgument>,
         /// The machine constants (Haas: Settings) that change what it does.
         #[serde(default)]
         pub machine_constants: Vec<u32>,
+    }
+}
+
+/// What kind of word of the language a keyword is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum KeywordKind {
+    /// Defines or declares a name: `DEF`, `PROC`, `EXTERN`.
+    Declaration,
+    /// A data type: `REAL`, `STRING`.
+    Type,
+    /// A constant value: `TRUE`.
+    Literal,
+    /// Structures the flow: `IF`, `WHILE`, `FOR`, `CASE`.
+    Control,
+    /// Jumps to a label or block number: `GOTOF`.
+    Jump,
+    /// Calls or leaves a subprogram: `MCALL`, `RET`.
+    Subprogram,
+    /// Switches a kinematic transformation: `TRAORI`.
+    Transformation,
+    /// Part of a synchronous action: `ID`, `WHENEVER`, `DO`.
+    SynchronousAction,
+    /// A statement of its own: `STOPRE`.
+    Statement,
+}
+
+entry! {
+    /// A word of a dialect's language that is neither an address nor a
+    /// code of a group: a declaration, type, control structure, jump, …
+    /// (Sinumerik `DEF`, `GOTOF`, `TRAORI`).
+    pub struct Keyword {
+        pub word: String,
+        pub kind: KeywordKind,
+        /// How it is written, one form per line (`DEF <type> <name>[=<value>]`).
+        pub syntax: Vec<String>,
+        /// The words it goes with (`ENDIF` for `IF`).
+        #[serde(default)]
+        pub related: Vec<String>,
+    }
+}
+
+/// One parameter of a function or procedure, in order.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FunctionParameter {
+    pub name: String,
+    /// `REAL`, `INT`, `STRING`, `VAR INT` (by reference), `REAL…` (a list).
+    #[serde(rename = "type")]
+    pub ty: String,
+    pub meaning: String,
+    /// May be left out.
+    #[serde(default)]
+    pub optional: bool,
+}
+
+entry! {
+    /// A predefined function (`SIN`, returns a value) or procedure (`WRITE`,
+    /// a statement of its own) of a dialect's language.
+    pub struct Function {
+        pub name: String,
+        #[serde(default, rename = "parameter")]
+        pub parameters: Vec<FunctionParameter>,
+        /// The type of the value; `None` for a procedure.
+        #[serde(default)]
+        pub returns: Option<String>,
+    }
+}
+
+impl Function {
+    /// `SIN(REAL x) → REAL`, `WRITE(VAR INT error, STRING file, STRING line)`.
+    pub fn signature(&self) -> String {
+        let mut text = format!("{}(", self.name);
+        for (index, parameter) in self.parameters.iter().enumerate() {
+            let separator = if index == 0 { "" } else { ", " };
+            let parameter_text = format!("{} {}", parameter.ty, parameter.name);
+            if parameter.optional {
+                text.push_str(&format!("[{separator}{parameter_text}]"));
+            } else {
+                text.push_str(&format!("{separator}{parameter_text}"));
+            }
+        }
+        text.push(')');
+        if let Some(returns) = &self.returns {
+            text.push_str(&format!(" → {returns}"));
+        }
+        text
+    }
+}
+
+/// Whether a program may write a system variable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Access {
+    Read,
+    ReadWrite,
+}
+
+entry! {
+    /// A system variable (Sinumerik `$P_F`, `$AA_IM[X]`): a value of the
+    /// control with a fixed meaning.
+    pub struct SystemVariable {
+        /// With its prefix and without an index: `$P_GG`.
+        pub name: String,
+        /// `REAL`, `INT`, `BOOL`, `STRING`, …
+        #[serde(rename = "type")]
+        pub ty: String,
+        pub access: Access,
+        /// What the index in brackets names (`G group number`, `axis`);
+        /// `None` when it takes none.
+        #[serde(default)]
+        pub index: Option<String>,
+        /// A main-run value: current, not programmed. Outside a synchronous
+        /// action, reading it stops preprocessing until the run catches up.
+        #[serde(default)]
+        pub main_run: bool,
+    }
+}
+
+entry! {
+    /// What the variables whose names start with a prefix are (`$P_`:
+    /// programmed values), so that one the catalogue does not list is
+    /// still known for a system variable.
+    pub struct VariablePrefix {
+        /// `$P_`, `$AA_`, `$MC_`.
+        pub prefix: String,
+        /// Machine or setting data: the name after the prefix is a machine
+        /// constant's (`$MC_MM_NUM_R_PARAM`).
+        #[serde(default)]
+        pub machine_data: bool,
     }
 }

@@ -2,13 +2,13 @@
 
 use std::process::ExitCode;
 
-use ncc_catalog::{Catalogue, DialectId};
+use ncc_catalog::{Catalogue, Dialect, DialectId};
 
 /// Explains `query` in `dialect`'s catalogue (the default dialect's when
-/// none is named: a query names no program to take one from; the command
-/// line has refused a dialect this version does not read).
+/// none is named: a query names no program to take one from). Dialects whose
+/// programs this version does not read have a catalogue too.
 pub(crate) fn run(query: Option<&str>, list: bool, dialect: Option<DialectId>) -> ExitCode {
-    let dialect = dialect.and_then(DialectId::implementation).unwrap_or_default();
+    let dialect = dialect.unwrap_or_else(|| Dialect::default().into());
     let catalogue = dialect.catalogue();
     if list {
         print!("{}", listing(catalogue));
@@ -25,7 +25,7 @@ pub(crate) fn run(query: Option<&str>, list: bool, dialect: Option<DialectId>) -
             eprintln!(
                 "error: `{}` is not a code, address, parameter, machine constant or operation of {}",
                 not_found.query,
-                DialectId::from(dialect).title()
+                dialect.title()
             );
             if !not_found.suggestions.is_empty() {
                 eprintln!("help: did you mean {}?", not_found.suggestions.join(", "));
@@ -47,8 +47,12 @@ fn listing(catalogue: &Catalogue) -> String {
     };
     section("groups", catalogue.groups.iter().map(|g| format!("group:{}", g.id)).collect());
     for letter in catalogue.function_letters().map(char::from) {
-        let codes = catalogue.codes.iter().filter(|c| c.code.starts_with(letter)).map(|c| c.code.clone());
-        section(&format!("{letter} codes"), codes.collect());
+        let codes = catalogue.codes.iter().filter(|c| !c.is_word() && c.code.starts_with(letter));
+        section(&format!("{letter} codes"), codes.map(|c| c.code.clone()).collect());
+    }
+    let words: Vec<String> = catalogue.codes.iter().filter(|c| c.is_word()).map(|c| c.code.clone()).collect();
+    if !words.is_empty() {
+        section("G group words", words);
     }
     section("addresses", catalogue.addresses.iter().map(|a| a.letter.clone()).collect());
     section("program parameters", (0..catalogue.parameters.count).map(|n| format!("R{n}")).collect());
@@ -67,6 +71,18 @@ fn listing(catalogue: &Catalogue) -> String {
     section(
         "fixed cycles",
         catalogue.cycles.iter().map(|c| format!("{}({})", c.code, format!("{:?}", c.flavour).to_lowercase())).collect(),
+    );
+    let mut language = |title: &str, names: Vec<String>| {
+        if !names.is_empty() {
+            section(title, names);
+        }
+    };
+    language("keywords", catalogue.keywords.iter().map(|k| k.word.clone()).collect());
+    language("functions", catalogue.functions.iter().map(|f| f.name.clone()).collect());
+    language("system variables", catalogue.system_variables.iter().map(|v| v.name.clone()).collect());
+    language(
+        "system variable prefixes",
+        catalogue.variable_prefixes.iter().map(|p| format!("{}…", p.prefix)).collect(),
     );
     out
 }

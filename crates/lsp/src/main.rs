@@ -175,7 +175,9 @@ enum Command {
 
 fn main() -> ExitCode {
     let Cli { dialect, command } = Cli::parse();
-    if let Some(unread) = dialect.filter(|dialect| dialect.implementation().is_none()) {
+    // `explain` reads only the catalogue, which every dialect has.
+    let reads_programs = !matches!(command, Command::Explain { .. });
+    if let Some(unread) = dialect.filter(|dialect| reads_programs && dialect.implementation().is_none()) {
         eprintln!("error: {}", unread.not_read());
         return ExitCode::from(2);
     }

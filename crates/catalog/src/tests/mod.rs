@@ -1,7 +1,8 @@
 //! Checks that hold for the data of every dialect, run over each data set;
-//! and the facts of the Haas lathe's catalogue.
+//! and the facts of the Haas lathe's and Sinumerik's catalogues.
 
 mod haas_lathe;
+mod sinumerik;
 
 use std::collections::{BTreeSet, HashSet};
 
@@ -11,9 +12,13 @@ fn haas_lathe() -> &'static Catalogue {
     Dialect::HaasLathe.catalogue()
 }
 
-/// Every data set by name.
+fn sinumerik() -> &'static Catalogue {
+    DialectId::Sinumerik.catalogue()
+}
+
+/// Every data set by name, also of dialects this build does not read yet.
 fn data_sets() -> impl Iterator<Item = (&'static str, &'static Catalogue)> {
-    Dialect::all().map(|dialect| (DialectId::from(dialect).name(), dialect.catalogue()))
+    DialectId::ALL.into_iter().map(|dialect| (dialect.name(), dialect.catalogue()))
 }
 
 fn assert_documented(what: &str, doc: Doc<'_>) {
@@ -34,19 +39,27 @@ fn every_entry_is_documented() {
             .chain(catalogue.parameter_ranges.iter().map(|r| (format!("range {}-{}", r.first, r.last), r.doc())))
             .chain(catalogue.machine_constants.iter().map(|c| (format!("constant {}", c.number), c.doc())))
             .chain(catalogue.operations.iter().map(|o| (format!("op {}", o.code), o.doc())))
-            .chain(catalogue.cycles.iter().map(|c| (format!("{} {:?}", c.code, c.flavour), c.doc())));
+            .chain(catalogue.cycles.iter().map(|c| (format!("{} {:?}", c.code, c.flavour), c.doc())))
+            .chain(catalogue.keywords.iter().map(|k| (format!("keyword {}", k.word), k.doc())))
+            .chain(catalogue.functions.iter().map(|f| (format!("function {}", f.name), f.doc())))
+            .chain(catalogue.system_variables.iter().map(|v| (v.name.clone(), v.doc())))
+            .chain(catalogue.variable_prefixes.iter().map(|p| (format!("prefix {}", p.prefix), p.doc())));
         for (name, doc) in docs {
             assert_documented(&format!("{set} {name}"), doc);
         }
         assert_documented(&format!("{set} parameters"), catalogue.parameters.doc());
-        // Every code, address, operation and cycle has an example (data/README.md).
+        // Every code, address, operation, cycle, keyword, function and
+        // system variable has an example (data/README.md).
         let examples = catalogue
             .codes
             .iter()
             .map(|c| (c.code.clone(), c.doc()))
             .chain(catalogue.addresses.iter().map(|a| (a.letter.clone(), a.doc())))
             .chain(catalogue.operations.iter().map(|o| (format!("op {}", o.code), o.doc())))
-            .chain(catalogue.cycles.iter().map(|c| (format!("cycle {}", c.code), c.doc())));
+            .chain(catalogue.cycles.iter().map(|c| (format!("cycle {}", c.code), c.doc())))
+            .chain(catalogue.keywords.iter().map(|k| (format!("keyword {}", k.word), k.doc())))
+            .chain(catalogue.functions.iter().map(|f| (format!("function {}", f.name), f.doc())))
+            .chain(catalogue.system_variables.iter().map(|v| (v.name.clone(), v.doc())));
         for (name, doc) in examples {
             assert!(doc.example.is_some_and(|e| !e.trim().is_empty()), "{set} {name}: no example");
         }
@@ -64,22 +77,50 @@ fn function_letters_say_what_their_codes_do() {
     }
 }
 
+/// A word of the language: upper-case letters, digits and `_`, starting
+/// with a letter or `_` (`BSPLINE`, `CUT3DC`, `_FINISH`).
+fn is_word(name: &str) -> bool {
+    name.starts_with(|c: char| c.is_ascii_uppercase() || c == '_')
+        && name.bytes().all(|b| b.is_ascii_uppercase() || b.is_ascii_digit() || b == b'_')
+}
+
 #[test]
 fn groups_are_consistent() {
     for (set, catalogue) in data_sets() {
         let mut seen = HashSet::new();
+        // Whether the codes below 10 are written with two digits (`G01`) or
+        // one (Sinumerik's `G1`): one spelling per data set.
+        let mut padding = HashSet::new();
         for code in &catalogue.codes {
             let name = &code.code;
             assert!(seen.insert(name.as_str()), "{set}: {name} is listed twice (so in two groups)");
-            assert!(split_code(name).is_some_and(|(l, _)| l == 'G' || l == 'M'), "{set}: {name} is no G/M code");
-            // Two digits at least (`G01`), and no leading zero beyond them.
-            let digits = &name[1..];
-            assert!(digits.len() == 2 || (digits.len() > 2 && !digits.starts_with('0')), "{set}: {name} is misspelt");
+            match split_code(name) {
+                Some((letter, number)) => {
+                    assert!(letter == 'G' || letter == 'M', "{set}: {name} is no G/M code");
+                    let padded = format!("{letter}{number:02}");
+                    assert!(*name == padded || *name == format!("{letter}{number}"), "{set}: {name} is misspelt");
+                    if number < 10 {
+                        padding.insert(*name == padded);
+                    }
+                }
+                None => {
+                    assert!(is_word(name), "{set}: {name} is neither a code nor a word");
+                    assert!(code.group.as_deref().is_some_and(|g| g.starts_with('G')), "{set}: {name} in no G group");
+                }
+            }
             if let Some(group) = &code.group {
                 let group = catalogue.group(group).unwrap_or_else(|| panic!("{set} {name}: unknown group {group}"));
-                assert_eq!(group.id.as_bytes()[0], name.as_bytes()[0], "{set}: {name} in group {}", group.id);
+                if !code.is_word() {
+                    assert_eq!(group.id.as_bytes()[0], name.as_bytes()[0], "{set}: {name} in group {}", group.id);
+                }
+                if let Some(index) = code.index {
+                    assert!(index >= 1, "{set}: {name}'s number in its group counts from 1");
+                    let at = catalogue.code_at(&group.id, index).map(|c| c.code.as_str());
+                    assert_eq!(at, Some(name.as_str()), "{set}: number {index} of group {} twice", group.id);
+                }
             }
         }
+        assert!(padding.len() <= 1, "{set}: codes below 10 written both with and without a leading zero");
         let mut ids = HashSet::new();
         for group in &catalogue.groups {
             let id = &group.id;
@@ -109,12 +150,15 @@ fn modal_codes_put_themselves_in_force_in_their_group() {
     for (set, catalogue) in data_sets() {
         let index_of = |id: &str| catalogue.groups.iter().position(|group| group.id == id);
         for code in &catalogue.codes {
-            let (letter, number) = split_code(&code.code).expect("checked above");
             let expected = match code.modality {
                 Modality::Modal => code.group.as_deref().and_then(index_of),
                 Modality::Block => None,
             };
-            assert_eq!(catalogue.modal_group_index(letter, number), expected, "{set} {}", code.code);
+            let found = match split_code(&code.code) {
+                Some((letter, number)) => catalogue.modal_group_index(letter, number),
+                None => catalogue.word_modal_group_index(&code.code),
+            };
+            assert_eq!(found, expected, "{set} {}", code.code);
         }
     }
 }
@@ -134,20 +178,19 @@ fn references_between_entries_resolve() {
                 assert!(known.contains(name) || is_parameter(name), "{set} {}: `{name}` is no address", code.code);
             }
             for name in &code.cancels {
-                let (letter, number) =
-                    split_code(name).unwrap_or_else(|| panic!("{set} {}: cancels `{name}`", code.code));
-                assert!(catalogue.code(letter, number).is_some(), "{set} {}: cancels unknown {name}", code.code);
+                assert!(catalogue.code_named(name).is_some(), "{set} {}: cancels unknown {name}", code.code);
             }
         }
         for group in &catalogue.groups {
             if let Some(default) = &group.default {
-                let (letter, number) = split_code(default).unwrap_or_else(|| panic!("{set} {}: default", group.id));
-                assert!(catalogue.code(letter, number).is_some(), "{set} group {}: unknown default", group.id);
+                assert!(catalogue.code_named(default).is_some(), "{set} group {}: unknown default", group.id);
             }
         }
         for cycle in &catalogue.cycles {
-            let (letter, number) = split_code(&cycle.code).unwrap_or_else(|| panic!("{set} cycle {}", cycle.code));
-            assert!(catalogue.code(letter, number).is_some(), "{set}: cycle {} is no code", cycle.code);
+            // A cycle is a code (`G81`), or called by its name with arguments
+            // (`CYCLE81(…)`).
+            let called = !cycle.arguments.is_empty() && is_word(&cycle.code);
+            assert!(called || catalogue.code_named(&cycle.code).is_some(), "{set}: cycle {} is no code", cycle.code);
             for parameter in &cycle.parameters {
                 assert!(catalogue.is_parameter(parameter.r), "{set} {}: R{}", cycle.code, parameter.r);
             }
@@ -173,6 +216,67 @@ fn references_between_entries_resolve() {
         let mut symbols = HashSet::new();
         for symbol in catalogue.operations.iter().filter_map(|op| op.symbol.as_deref()) {
             assert!(symbols.insert(symbol), "{set}: operator {symbol} described twice");
+        }
+        let ranked = catalogue.operations.iter().filter(|op| op.precedence.is_some()).count();
+        assert!(ranked == 0 || ranked == catalogue.operations.len(), "{set}: precedence for some operators only");
+    }
+}
+
+#[test]
+fn language_entries_are_consistent() {
+    for (set, catalogue) in data_sets() {
+        // Each name means one thing: `explain` finds exactly it.
+        let mut names = HashSet::new();
+        let words = catalogue
+            .keywords
+            .iter()
+            .map(|k| &k.word)
+            .chain(catalogue.functions.iter().map(|f| &f.name))
+            .chain(catalogue.codes.iter().filter(|c| c.is_word()).map(|c| &c.code))
+            .chain(catalogue.addresses.iter().filter(|a| a.letter.len() > 1).map(|a| &a.letter));
+        for word in words {
+            assert!(is_word(word), "{set}: `{word}` is no upper-case word");
+            assert!(names.insert(word.as_str()), "{set}: `{word}` has two entries");
+            let found = catalogue.explain(word).unwrap_or_else(|e| panic!("{set}: {e:?}"));
+            assert_eq!(found.len(), 1, "{set}: `{word}` explains as {found:?}");
+        }
+        for keyword in &catalogue.keywords {
+            assert!(!keyword.syntax.is_empty(), "{set} {}: no syntax", keyword.word);
+            for related in &keyword.related {
+                assert!(catalogue.explain(related).is_ok(), "{set} {}: goes with unknown {related}", keyword.word);
+            }
+        }
+        for function in &catalogue.functions {
+            let mut parameters = HashSet::new();
+            for parameter in &function.parameters {
+                assert!(parameters.insert(&parameter.name), "{set} {}: {} twice", function.name, parameter.name);
+                assert!(!parameter.ty.is_empty() && !parameter.meaning.is_empty(), "{set} {}", function.name);
+            }
+        }
+        for cycle in catalogue.cycles.iter().filter(|c| !c.arguments.is_empty()) {
+            let mut arguments = HashSet::new();
+            for argument in &cycle.arguments {
+                assert!(arguments.insert(&argument.name), "{set} {}: {} twice", cycle.code, argument.name);
+            }
+        }
+        for variable in &catalogue.system_variables {
+            let name = &variable.name;
+            assert!(!name.contains('['), "{set} {name}: the index is no part of the name");
+            let prefix = catalogue.variable_prefixes.iter().any(|p| name.starts_with(&p.prefix));
+            assert!(prefix, "{set} {name}: no prefix describes it");
+            assert_eq!(catalogue.system_variable(name), Some(SystemVariableInfo::Documented(variable)), "{set} {name}");
+        }
+        for prefix in &catalogue.variable_prefixes {
+            let p = &prefix.prefix;
+            assert!(p.starts_with('$') && p.ends_with('_'), "{set}: prefix {p}");
+        }
+        // Machine data with a name is read through a machine-data prefix.
+        let machine_data = catalogue.variable_prefixes.iter().find(|p| p.machine_data);
+        for constant in &catalogue.machine_constants {
+            if let (Some(name), Some(prefix)) = (&constant.name, machine_data) {
+                let found = catalogue.system_variable(&format!("{}{name}", prefix.prefix));
+                assert!(matches!(found, Some(SystemVariableInfo::MachineData { .. })), "{set}: {name} as a variable");
+            }
         }
     }
 }
