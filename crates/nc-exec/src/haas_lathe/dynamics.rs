@@ -261,10 +261,14 @@ mod tests {
 
     #[test]
     fn g187_refuses_a_level_or_tolerance_it_has_not() {
-        for modes in ["G187 P4", "G187 E0", "G187 P1.5"] {
+        for modes in ["G187 P4", "G187 E0", "G187 P1.5", "G187 P3 G103 P1"] {
             let trace = run(&zigzag(modes), &NoFiles, &lathe(), 1000);
             assert_eq!(trace.findings.len(), 1, "{modes}: {:?}", trace.findings);
-            assert!(trace.findings[0].message.starts_with("G187"), "{modes}: {:?}", trace.findings);
+            assert!(
+                trace.findings[0].stops() && trace.findings[0].message.starts_with("G1"),
+                "{modes}: {:?}",
+                trace.findings
+            );
         }
     }
 

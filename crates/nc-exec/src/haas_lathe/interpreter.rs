@@ -75,8 +75,8 @@
 //!   a cut starts, the rpm of the diameter where it ends; a cut commands
 //!   the rpm of its start and follows the diameter to its end.
 //! - A G187 or G103 word the control cannot take (a P other than 1–3, an
-//!   E not above 0; a negative or fractional G103 P) stops the run, as
-//!   an alarm would.
+//!   E not above 0; a negative or fractional G103 P; a P in a block of
+//!   both, which could be either's) stops the run, as an alarm would.
 //! - A computed dwell P (`P#1`) counts in ms, as a literal without a point.
 //! - A word whose variable is vacant is left out (Fanuc convention).
 //! - Block delete `/` is off: the blocks run.
@@ -369,6 +369,12 @@ impl<'a> Interpreter<'a> {
                 self.record(range, &start, STILL, Facts::default());
             }
             return flow;
+        }
+        if block.has_code(b'G', 103) && block.has_code(b'G', 187) && block.word(b'P').is_some() {
+            let message =
+                "G103 and G187 both read P: the block cannot tell whose it is; write them in blocks of their own";
+            self.finding(RunRule::ValueRefused, range, message);
+            return Flow::End;
         }
         let mut flow = Flow::Next;
         let (mut dwell, mut exact_stop, mut still, mut cycle, mut coordinates) = (false, false, false, None, None);
