@@ -22,7 +22,8 @@
 //! within itself from the junction speed. Where the control bounds corners
 //! by a tolerance ([`Step::corner_tolerance`]), a joined corner runs at
 //! most at [`corner_speed`]: the speed of the arc that blends it within
-//! the tolerance at the continuous-path acceleration. Arcs run at most at the speed
+//! the tolerance at the continuous-path acceleration (the envelope planner
+//! has its own accuracy criterion instead). Arcs run at most at the speed
 //! whose chord per interpolator tick stays within the chord error of the
 //! circle. Ramps take the continuous-path acceleration under continuity,
 //! the feed acceleration for other working feed and the rapid acceleration
