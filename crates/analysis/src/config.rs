@@ -28,6 +28,10 @@
 //! tool-change-ms = 6000                   # M06
 //! look-ahead-blocks = 500                 # envelope velocity (CNC8x9): blocks planned ahead
 //! envelope-tick-us = 2000                 # envelope velocity: interpolator tick Ts
+//! feed-acceleration = 1000                # Haas lathe: mm/s², working feed
+//! rapid-acceleration = 1000               # Haas lathe: mm/s², G00
+//! spindle-acceleration = 1000             # Haas lathe: rpm/s
+//! corner-rounding = "0.05"                # Haas lathe: Setting 85, mm
 //! cycle-file = "PCYKLYDG.NCP"             # CNC836.KNF $17: what G81-G89 do
 //! offset-file = "TAB0.POS"                # zero offsets G53-G59
 //! tool-file = "TAB0.KOR"                  # tool corrections D1-D99
@@ -189,6 +193,10 @@ struct MachineFile {
     tool_change_ms: Option<u32>,
     look_ahead_blocks: Option<u32>,
     envelope_tick_us: Option<u32>,
+    feed_acceleration: Option<u32>,
+    rapid_acceleration: Option<u32>,
+    spindle_acceleration: Option<u32>,
+    corner_rounding: Option<String>,
     cycle_file: Option<String>,
     offset_file: Option<PathBuf>,
     tool_file: Option<PathBuf>,
@@ -276,6 +284,39 @@ impl MachineFile {
             }
             machine.envelope_tick_us = tick;
         }
+        let haas = machine.control == Dialect::HaasLathe;
+        let haas_dynamics = [
+            ("feed-acceleration", self.feed_acceleration, &mut machine.feed_acceleration),
+            ("rapid-acceleration", self.rapid_acceleration, &mut machine.rapid_acceleration),
+            ("spindle-acceleration", self.spindle_acceleration, &mut machine.spindle_acceleration),
+        ];
+        for (key, value, slot) in haas_dynamics {
+            let Some(value) = value else { continue };
+            if !haas {
+                return Err(format!(
+                    "{origin}: {section}{key} describes a Haas lathe (dialect = \"haas-lathe\"); a CNC8x6 reads its ramps from R52, R236 and R237"
+                ));
+            }
+            if value == 0 {
+                return Err(format!("{origin}: {section}{key} must be above 0"));
+            }
+            *slot = Some(value);
+        }
+        if let Some(rounding) = self.corner_rounding {
+            if !haas {
+                return Err(format!(
+                    "{origin}: {section}corner-rounding is a Haas lathe's Setting 85 (dialect = \"haas-lathe\")"
+                ));
+            }
+            let value = tables::coordinate(&rounding)
+                .ok()
+                .and_then(|um| u32::try_from(um).ok())
+                .filter(|&um| um > 0)
+                .ok_or_else(|| {
+                format!("{origin}: {section}corner-rounding `{rounding}` must be a length above 0 mm, to the µm")
+            })?;
+            machine.corner_rounding_um = Some(value);
+        }
         if let Some(rate) = self.rapid_rate {
             if rate == 0 {
                 return Err(format!("{origin}: {section}rapid-rate must be above 0 mm/min"));
@@ -322,7 +363,6 @@ impl MachineFile {
             path: relative_to(path, &name),
             named_by: format!("{origin}: {section}{key} `{}`", name.display()),
         };
-        let haas = machine.control == Dialect::HaasLathe;
         if haas && (self.offset_file.is_some() || self.tool_file.is_some()) {
             return Err(format!(
                 "{origin}: {section}offset-file and tool-file are the CNC8x6's tables; a Haas lathe gives work-offsets and tool-offsets"
@@ -596,6 +636,28 @@ mod tests {
         }
         let error = load("[machine.tool-offsets]\n1 = { tip = 3 }\n", &[]).unwrap_err();
         assert!(error.contains("haas-lathe"), "{error}");
+    }
+
+    #[test]
+    fn a_haas_lathe_gives_its_ramps_spindle_and_setting_85() {
+        let keys = "feed-acceleration = 800\nrapid-acceleration = 2500\nspindle-acceleration = 600\ncorner-rounding = \"0.02\"\n";
+        let machine = load(&format!("dialect = \"haas-lathe\"\n[machine]\n{keys}"), &[]).unwrap().machine;
+        assert_eq!((machine.feed_acceleration, machine.rapid_acceleration), (Some(800), Some(2500)));
+        assert_eq!((machine.spindle_acceleration, machine.corner_rounding_um), (Some(600), Some(20)));
+        let haas = |keys: &str| load(&format!("dialect = \"haas-lathe\"\n[machine]\n{keys}"), &[]).unwrap_err();
+        for (keys, says) in [
+            ("feed-acceleration = 0\n", "feed-acceleration must be above 0"),
+            ("corner-rounding = \"0\"\n", "above 0 mm"),
+            ("corner-rounding = \"-0.1\"\n", "above 0 mm"),
+            ("corner-rounding = \"0.0001\"\n", "to the µm"),
+        ] {
+            let error = haas(keys);
+            assert!(error.contains(says), "{keys}: {error}");
+        }
+        let error = load("[machine]\nrapid-acceleration = 1000\n", &[]).unwrap_err();
+        assert!(error.contains("R52, R236 and R237"), "{error}");
+        let error = load("[machine]\ncorner-rounding = \"0.1\"\n", &[]).unwrap_err();
+        assert!(error.contains("Setting 85"), "{error}");
     }
 
     #[test]

@@ -211,8 +211,11 @@ pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &st
     }
     let _ = writeln!(out, "</g>");
     for speed_break in &sketch.breaks {
-        let Some(&end) = drawn.get(speed_break.step).and_then(|drawn| drawn.tool.last()) else { continue };
-        let (x, y) = pixel(end);
+        let tool = drawn.get(speed_break.step).map(|drawn| &drawn.tool);
+        let place =
+            if speed_break.at_start() { tool.and_then(|tool| tool.first()) } else { tool.and_then(|tool| tool.last()) };
+        let Some(&place) = place else { continue };
+        let (x, y) = pixel(place);
         let fill = if speed_break.at == 0.0 { "#d1342f" } else { "#f4a259" };
         let line = lines.line_of(speed_break.step);
         let source = source_attributes(lines, speed_break.step);

@@ -67,6 +67,16 @@ pub struct MachineConfig {
     /// R385 example (10000 mm/s²) takes over from the accuracy criterion
     /// at about 20 µm, as it says R385 does when R384 is off or 50 µm.
     pub envelope_tick_us: u32,
+    /// Haas lathe: the ramps of working feed and of rapid traverse in
+    /// mm/s², and how fast the spindle changes its speed in rpm/s; `None`
+    /// takes what the control's velocity policy assumes. A CNC8x6 reads
+    /// its ramps from machine constants R52, R236 and R237.
+    pub feed_acceleration: Option<u32>,
+    pub rapid_acceleration: Option<u32>,
+    pub spindle_acceleration: Option<u32>,
+    /// Haas lathe: Setting 85, the largest corner rounding in µm, which
+    /// G187 without P or E restores; `None` takes the policy's assumption.
+    pub corner_rounding_um: Option<u32>,
 }
 
 /// How far an axis may travel, in thousandths (µm, or thousandths of a
@@ -97,6 +107,10 @@ impl Default for MachineConfig {
             tool_change_ms: 0,
             look_ahead_blocks: 500,
             envelope_tick_us: 2000,
+            feed_acceleration: None,
+            rapid_acceleration: None,
+            spindle_acceleration: None,
+            corner_rounding_um: None,
         }
     }
 }

@@ -34,7 +34,7 @@ pub fn reset_frame(machine: &MachineConfig) -> Frame {
 }
 
 /// The velocity model's parameters on `machine`: its control's policy, read
-/// from its machine constants.
+/// from its machine description.
 pub fn dynamics(machine: &MachineConfig) -> Dynamics {
     match machine.control {
         Dialect::Cnc8x6 => cnc8x6::dynamics::dynamics(machine),

@@ -123,6 +123,16 @@ pub struct Step {
     /// G01 line without M, S, T, D or F and not under G91, which machine
     /// constant R383 merges, 04 §1.9.4).
     pub mergeable: bool,
+    /// The spindle's commanded speed in rpm (negative under M04, 0 where
+    /// it stands or the control's model does not follow it) as the step
+    /// starts and as it ends; they differ on a cut under constant cutting
+    /// speed, where it follows the diameter. Single precision is ample
+    /// for rpm and keeps the steps of a long run small.
+    pub spindle: [f32; 2],
+    /// How far (mm) the path may leave the corner where this move is
+    /// joined to the one before (Haas lathe: G187); infinite where the
+    /// control bounds the corner speed by no tolerance.
+    pub corner_tolerance: f32,
 }
 
 /// How the path passes from one block into the next.

@@ -19,12 +19,26 @@
 //!
 //! A smooth junction runs at the lower of the two speeds, and the control
 //! looks one block ahead: the move after a junction must be able to stop
-//! within itself from the junction speed. Arcs run at most at the speed
+//! within itself from the junction speed. Where the control bounds corners
+//! by a tolerance ([`Step::corner_tolerance`]), a joined corner runs at
+//! most at [`corner_speed`]: the speed of the arc that blends it within
+//! the tolerance at the continuous-path acceleration (the envelope planner
+//! has its own accuracy criterion instead). Arcs run at most at the speed
 //! whose chord per interpolator tick stays within the chord error of the
 //! circle. Ramps take the continuous-path acceleration under continuity,
 //! the feed acceleration for other working feed and the rapid acceleration
 //! for rapid moves; threads run without ramps. A control with a longer
 //! look-ahead plans with [`Dynamics::envelope`] instead.
+//!
+//! The spindle ([`Step::spindle`]) changes its speed at the spindle
+//! acceleration while the steps run: from the rpm it has reached towards
+//! the one the step commands. A cut (a feed move or a thread) with the
+//! spindle commanded to turn waits at its start until the spindle has
+//! reached the cut's starting rpm, so that rapid moves, dwells and other
+//! blocks before it hide the change; the wait adds to the cut's time and
+//! is a break of its own ([`Reason::Spindle`]). Along a cut the spindle is
+//! taken to follow the rpm the cut commands (under constant cutting speed,
+//! the diameter's), however fast that changes.
 
 use std::{collections::VecDeque, ops::ControlFlow};
 
@@ -33,6 +47,7 @@ use ncc_syntax::TextSize;
 pub use crate::envelope::Profile;
 use crate::{
     envelope::{Envelope, EnvelopeMove, Limit, MoveKind, Planned, Planner},
+    machine::MachineConfig,
     trace::{Axes, Checkpoint, MAX_AXES, Motion, Path, PathMode, Step, StepSink, Trace, shift_count, shift_range},
 };
 
@@ -41,6 +56,23 @@ use crate::{
 /// compares with R39.
 pub fn junction_angle(before: [f64; 3], after: [f64; 3]) -> f64 {
     before.iter().zip(after).map(|(a, b)| a * b).sum::<f64>().clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// The highest speed (mm/s) at which a path turning from `before` into
+/// `after` (unit directions) stays within `tolerance` mm of the corner with
+/// `acceleration` (mm/s²). The path blends the corner with the arc tangent
+/// to both moves whose middle lies `tolerance` from the corner: for a turn
+/// of θ its radius is r = ε·cos(θ/2) / (1 − cos(θ/2)), which runs at most
+/// at v = sqrt(a·r). Unbounded where the path runs straight on or the
+/// tolerance is infinite; zero at a reversal.
+pub fn corner_speed(before: [f64; 3], after: [f64; 3], tolerance: f64, acceleration: f64) -> f64 {
+    let cosine: f64 = before.iter().zip(after).map(|(a, b)| a * b).sum();
+    // cos(θ/2) from cos θ.
+    let half = ((1.0 + cosine.clamp(-1.0, 1.0)) / 2.0).sqrt();
+    if !tolerance.is_finite() || half >= 1.0 - 1e-12 {
+        return f64::INFINITY;
+    }
+    (acceleration * tolerance * half / (1.0 - half)).sqrt()
 }
 
 /// Which moves programmed for a continuous path the control joins.
@@ -68,10 +100,8 @@ pub struct Dynamics {
     pub feed_acceleration: f64,
     pub continuity_acceleration: f64,
     pub rapid_acceleration: f64,
-    /// Seconds between blocks that are not joined at all, and for the
-    /// in-position window after a stop otherwise.
-    pub block_pause: f64,
-    pub settle_time: f64,
+    /// The machine's own waits and the times of its functions.
+    pub times: MachineTimes,
     /// The shortest moves (s) that a continuous path, and an exact stop
     /// without a pause, join.
     pub min_continuity: f64,
@@ -80,14 +110,39 @@ pub struct Dynamics {
     /// from its circle, which bound the speed on arcs.
     pub tick: f64,
     pub chord_error: f64,
-    /// Seconds an M function and a tool change take.
-    pub m_function_time: f64,
-    pub tool_change_time: f64,
+    /// How fast the spindle changes its speed, in rpm/s; infinite where it
+    /// is taken to follow at once.
+    pub spindle_acceleration: f64,
     /// A look-ahead planner over many moves, for controls that have one: it
     /// plans the moves instead of the one-block look-ahead.
     pub envelope: Option<Envelope>,
     /// How the control tells the reasons of its breaks.
     pub terms: &'static Terms,
+}
+
+/// The times every control's policy reads alike from the machine
+/// description, in seconds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MachineTimes {
+    /// Between blocks that are not joined at all, and for the in-position
+    /// window after a stop otherwise.
+    pub block_pause: f64,
+    pub settle_time: f64,
+    /// What an M function and a tool change take.
+    pub m_function_time: f64,
+    pub tool_change_time: f64,
+}
+
+impl MachineTimes {
+    pub fn of(machine: &MachineConfig) -> MachineTimes {
+        let seconds = |ms: u32| f64::from(ms) / 1000.0;
+        MachineTimes {
+            block_pause: seconds(machine.block_pause_ms),
+            settle_time: seconds(machine.settle_time_ms),
+            m_function_time: seconds(machine.m_function_ms),
+            tool_change_time: seconds(machine.tool_change_ms),
+        }
+    }
 }
 
 impl Dynamics {
@@ -173,6 +228,7 @@ impl Reason {
             Reason::Centrifugal { .. } => "centrifugal",
             Reason::WindowEnd { .. } => "window-end",
             Reason::ContinuityLength { .. } => "continuity-length",
+            Reason::Spindle { .. } => "spindle",
         }
     }
 }
@@ -279,6 +335,11 @@ pub enum Reason {
     ContinuityLength {
         limit: f64,
     },
+    /// A cut waits at rest for the spindle to get from `from` to `to` rpm.
+    Spindle {
+        from: f64,
+        to: f64,
+    },
 }
 
 impl Reason {
@@ -290,7 +351,7 @@ impl Reason {
 }
 
 /// A place where the speed drops: at the end of `step` (or, for an arc
-/// limit, through it).
+/// limit, through it; for a wait for the spindle, at its start).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Break {
     pub step: usize,
@@ -300,6 +361,13 @@ pub struct Break {
     pub at: f64,
     /// Seconds the drop costs against a smooth join at the programmed feed.
     pub lost: f64,
+}
+
+impl Break {
+    /// Whether the drop is where its step starts rather than where it ends.
+    pub fn at_start(&self) -> bool {
+        matches!(self.reason.reason, Reason::Spindle { .. })
+    }
 }
 
 /// The model's timing of a whole trace.
@@ -342,6 +410,8 @@ struct Move {
     start_direction: [f64; 3],
     end_direction: [f64; 3],
     arc_radius: Option<f64>,
+    /// The tolerance (mm) of the corner into this move.
+    corner_tolerance: f64,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -408,6 +478,86 @@ pub struct Timer<'a, S> {
     count: usize,
     end: Axes,
     model: Model,
+    spindle: Spindle,
+}
+
+/// The spindle as the model follows it: `elapsed` s after it had `from`
+/// rpm, ramping at the spindle acceleration towards `target`; at rest once
+/// it is there (`from` is `target`). `step` is the next step to time.
+#[derive(Debug, Default, Clone, PartialEq)]
+struct Spindle {
+    from: f64,
+    target: f64,
+    elapsed: f64,
+    step: usize,
+}
+
+impl Spindle {
+    /// The rpm it has reached.
+    fn rpm(&self, acceleration: f64) -> f64 {
+        let gap = self.target - self.from;
+        if self.elapsed >= gap.abs() / acceleration {
+            self.target
+        } else {
+            self.from + (self.elapsed * acceleration).copysign(gap)
+        }
+    }
+
+    /// Ramps from where it is towards `rpm`.
+    fn command(&mut self, rpm: f64, acceleration: f64) {
+        if rpm != self.target {
+            *self = Spindle { from: self.rpm(acceleration), target: rpm, elapsed: 0.0, step: self.step };
+        }
+    }
+
+    /// Follows `step`, which takes `duration` s once it runs, and hands
+    /// back how long it waits first for the spindle and from what rpm.
+    fn pass(&mut self, step: &Step, duration: f64, acceleration: f64) -> (f64, f64) {
+        let [start, end] = step.spindle.map(f64::from);
+        let cuts = matches!(kind_of(step), Kind::Feed | Kind::Thread);
+        let (from, wait) = if cuts {
+            self.command(start, acceleration);
+            let reached = self.rpm(acceleration);
+            let wait = if start == 0.0 { 0.0 } else { (start - reached).abs() / acceleration };
+            (reached, wait)
+        } else {
+            self.command(end, acceleration);
+            (self.rpm(acceleration), 0.0)
+        };
+        self.elapsed += wait + duration;
+        // Along a cut the spindle follows; at its target it is at rest, which
+        // keeps the state the same however long ago it got there.
+        if (cuts && start != end) || self.rpm(acceleration) == self.target {
+            *self = Spindle { from: end, target: end, elapsed: 0.0, step: self.step };
+        }
+        self.step += 1;
+        (wait, from)
+    }
+}
+
+/// A sink that adds the spindle's waits to the cuts' times, as breaks.
+struct Waiting<'s, S> {
+    spindle: &'s mut Spindle,
+    sink: &'s mut S,
+    dynamics: &'s Dynamics,
+}
+
+impl<S: TimingSink> TimingSink for Waiting<'_, S> {
+    fn speed_break(&mut self, step: &Step, speed_break: Break) {
+        self.sink.speed_break(step, speed_break);
+    }
+
+    fn timed(&mut self, step: &Step, mut profile: Profile) {
+        let index = self.spindle.step;
+        let (wait, from) = self.spindle.pass(step, profile.duration, self.dynamics.spindle_acceleration);
+        if wait > 0.0 {
+            let reason = self.dynamics.state(Reason::Spindle { from, to: f64::from(step.spindle[0]) });
+            let before = step.feed.unwrap_or(0.0);
+            self.sink.speed_break(step, Break { step: index, reason, before, at: 0.0, lost: wait });
+            profile.duration += wait;
+        }
+        self.sink.timed(step, profile);
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -435,7 +585,7 @@ impl<'a, S: TimingSink> Timer<'a, S> {
             Some(envelope) => Model::Envelope(Planning::new(envelope.clone())),
             None => Model::OneBlock(OneBlock::default()),
         };
-        Timer { axes, dynamics, sink, count: 0, end: [0.0; MAX_AXES], model }
+        Timer { axes, dynamics, sink, count: 0, end: [0.0; MAX_AXES], model, spindle: Spindle::default() }
     }
 
     /// Takes the next step of the run.
@@ -444,17 +594,20 @@ impl<'a, S: TimingSink> Timer<'a, S> {
         let next = move_of(&step, &self.end, self.axes, dynamics);
         self.end = step.end;
         self.count += 1;
+        let sink = &mut Waiting { spindle: &mut self.spindle, sink: &mut self.sink, dynamics };
         match &mut self.model {
-            Model::OneBlock(model) => model.push(self.count - 1, step, next, dynamics, &mut self.sink),
-            Model::Envelope(planning) => planning.push(step, next, dynamics, &mut self.sink),
+            Model::OneBlock(model) => model.push(self.count - 1, step, next, dynamics, sink),
+            Model::Envelope(planning) => planning.push(step, next, dynamics, sink),
         }
     }
 
     /// Times the last steps, which end at rest, and hands back the sink.
     pub fn finish(mut self) -> S {
+        let dynamics = self.dynamics;
+        let sink = &mut Waiting { spindle: &mut self.spindle, sink: &mut self.sink, dynamics };
         match self.model {
-            Model::OneBlock(model) => model.finish(self.count, self.dynamics, &mut self.sink),
-            Model::Envelope(planning) => planning.finish(self.dynamics, &mut self.sink),
+            Model::OneBlock(model) => model.finish(self.count, dynamics, sink),
+            Model::Envelope(planning) => planning.finish(dynamics, sink),
         }
         self.sink
     }
@@ -466,19 +619,23 @@ impl OneBlock {
             return;
         };
         let entry = self.entry;
-        let (exit, stop) = match stop_reason(&this, &next, dynamics) {
-            Some(reason) => (0.0, Some(reason)),
+        let (exit, stop, corner) = match stop_reason(&this, &next, dynamics) {
+            Some(reason) => (0.0, Some(reason), None),
             // One block of look-ahead: the next move must be able to stop
-            // within itself; and this one must reach the speed.
+            // within itself, the corner keep its tolerance; and this move
+            // must reach the speed.
             None => {
                 let speed = this.cruise.min(next.cruise).min(stopping_speed(&next, 0.0));
-                (speed.min(stopping_speed(&this, entry)), None)
+                let (before, after) = (this.end_direction, next.start_direction);
+                let corner = corner_speed(before, after, next.corner_tolerance, dynamics.continuity_acceleration);
+                let limited = (corner < speed).then(|| Reason::Accuracy { angle: junction_angle(before, after) });
+                (speed.min(corner).min(stopping_speed(&this, entry)), None, limited)
             }
         };
         if let Some(before) = self.waiting.take() {
             before.finish(Some(&this), exit, dynamics, sink);
         }
-        self.waiting = Some(Timed { index: index - 1, step: this_step, this, entry, exit, stop });
+        self.waiting = Some(Timed { index: index - 1, step: this_step, this, entry, exit, stop, corner });
         self.entry = exit;
     }
 
@@ -487,7 +644,7 @@ impl OneBlock {
             if let Some(before) = self.waiting.take() {
                 before.finish(Some(&this), 0.0, dynamics, sink);
             }
-            let last = Timed { index: count - 1, step, this, entry: self.entry, exit: 0.0, stop: None };
+            let last = Timed { index: count - 1, step, this, entry: self.entry, exit: 0.0, stop: None, corner: None };
             last.finish(None, 0.0, dynamics, sink);
         }
     }
@@ -664,7 +821,8 @@ impl<S: TimingSink> StepSink for Timer<'_, S> {
     }
 
     fn checkpoint(&mut self, checkpoint: Checkpoint) -> ControlFlow<()> {
-        let state = TimerState { count: self.count, end: self.end, model: self.model.clone() };
+        let state =
+            TimerState { count: self.count, end: self.end, model: self.model.clone(), spindle: self.spindle.clone() };
         self.sink.checkpoint(checkpoint, state)
     }
 }
@@ -676,6 +834,7 @@ pub struct TimerState {
     count: usize,
     end: Axes,
     model: Model,
+    spindle: Spindle,
 }
 
 impl TimerState {
@@ -684,6 +843,7 @@ impl TimerState {
     pub fn shifted(&self, text: i64, steps: i64) -> TimerState {
         let mut shifted = self.clone();
         shifted.count = shift_count(self.count, steps);
+        shifted.spindle.step = shift_count(self.spindle.step, steps);
         let move_step = |step: &mut Step| step.range = shift_range(step.range, text);
         match &mut shifted.model {
             Model::OneBlock(model) => {
@@ -715,8 +875,11 @@ impl TimerState {
     /// which an edit before it moves.
     pub fn same_course(&self, other: &TimerState, text: i64) -> bool {
         let steps = self.count as i64 - other.count as i64;
-        match (&self.model, &other.shifted(text, steps).model) {
-            (Model::OneBlock(this), Model::OneBlock(that)) => self.end == other.end && this == that,
+        let other = other.shifted(text, steps);
+        match (&self.model, &other.model) {
+            (Model::OneBlock(this), Model::OneBlock(that)) => {
+                self.end == other.end && this == that && self.spindle == other.spindle
+            }
             _ => false,
         }
     }
@@ -726,8 +889,8 @@ impl<'a, S: TimingSink> Timer<'a, S> {
     /// A timer that goes on from `state`, taken at a checkpoint of a run
     /// on the same machine.
     pub fn resume(axes: &'a [u8], dynamics: &'a Dynamics, state: TimerState, sink: S) -> Self {
-        let TimerState { count, end, model } = state;
-        Timer { axes, dynamics, sink, count, end, model }
+        let TimerState { count, end, model, spindle } = state;
+        Timer { axes, dynamics, sink, count, end, model, spindle }
     }
 }
 
@@ -739,15 +902,17 @@ struct Timed {
     this: Move,
     entry: f64,
     exit: f64,
-    /// Why it ends in a stop.
+    /// Why it ends in a stop, or why its smooth exit is limited by the
+    /// corner's tolerance.
     stop: Option<Reason>,
+    corner: Option<Reason>,
 }
 
 impl Timed {
     /// Hands on the move's breaks and profile; `next` is the move after it,
     /// and `after` where that one ends.
     fn finish(self, next: Option<&Move>, after: f64, dynamics: &Dynamics, sink: &mut impl TimingSink) {
-        let Timed { index, step, this, entry, exit, stop } = self;
+        let Timed { index, step, this, entry, exit, stop, corner } = self;
         let mut profile = profile(&this, entry, exit, step.duration);
         profile.duration += extra_time(&step, dynamics);
         match (stop, next) {
@@ -774,7 +939,7 @@ impl Timed {
                 let before = this.cruise.min(next.cruise).min(stopping_speed(&this, entry));
                 if exit < before * (1.0 - 1e-9) {
                     let lost = lost_time(&this, next, entry, exit, before, after);
-                    let reason = dynamics.state(Reason::LookAhead);
+                    let reason = dynamics.state(corner.unwrap_or(Reason::LookAhead));
                     sink.speed_break(
                         &step,
                         Break { step: index, reason, before: before * 60.0, at: exit * 60.0, lost },
@@ -795,19 +960,13 @@ impl Timed {
 
 /// Seconds the step's M functions and tool change add.
 fn extra_time(step: &Step, dynamics: &Dynamics) -> f64 {
-    f64::from(step.m_functions) * dynamics.m_function_time
-        + if step.tool_change { dynamics.tool_change_time } else { 0.0 }
+    let times = &dynamics.times;
+    f64::from(step.m_functions) * times.m_function_time + if step.tool_change { times.tool_change_time } else { 0.0 }
 }
 
 /// The step as a move: its speeds, acceleration and directions.
 fn move_of(step: &Step, start: &Axes, axes: &[u8], dynamics: &Dynamics) -> Move {
-    let kind = match (step.motion, step.path) {
-        _ if step.length <= 0.0 || step.duration <= 0.0 => Kind::Still,
-        (Motion::Feed, Path::Thread { .. }) => Kind::Thread,
-        (Motion::Feed, _) => Kind::Feed,
-        (Motion::Rapid, _) => Kind::Rapid,
-        _ => Kind::Still,
-    };
+    let kind = kind_of(step);
     // The speed the trace timed the move at: the feed, or the rapid of its slowest axis.
     let programmed = if step.duration > 0.0 { step.length / step.duration } else { 0.0 };
     let mut chord = [0.0; 3];
@@ -863,6 +1022,18 @@ fn move_of(step: &Step, start: &Axes, axes: &[u8], dynamics: &Dynamics) -> Move 
         start_direction,
         end_direction,
         arc_radius,
+        corner_tolerance: f64::from(step.corner_tolerance),
+    }
+}
+
+/// What the model makes of a step.
+fn kind_of(step: &Step) -> Kind {
+    match (step.motion, step.path) {
+        _ if step.length <= 0.0 || step.duration <= 0.0 => Kind::Still,
+        (Motion::Feed, Path::Thread { .. }) => Kind::Thread,
+        (Motion::Feed, _) => Kind::Feed,
+        (Motion::Rapid, _) => Kind::Rapid,
+        _ => Kind::Still,
     }
 }
 
@@ -903,7 +1074,8 @@ fn stopping_speed(this: &Move, from: f64) -> f64 {
 fn pause_after(this: &Move, next: &Move, dynamics: &Dynamics) -> f64 {
     let too_short_to_prepare =
         this.path_mode == PathMode::ExactStop && dynamics.too_short_to_prepare(this.length / this.programmed);
-    if next.path_mode == PathMode::Stop || too_short_to_prepare { dynamics.block_pause } else { dynamics.settle_time }
+    let times = &dynamics.times;
+    if next.path_mode == PathMode::Stop || too_short_to_prepare { times.block_pause } else { times.settle_time }
 }
 
 /// The move's trapezoid from `entry` to `exit` (mm/s); `fallback` is the
@@ -959,7 +1131,7 @@ fn lost_time(this: &Move, next: &Move, entry: f64, exit: f64, smooth: f64, after
 
 #[cfg(test)]
 mod tests {
-    use super::{Joining, Reason, Timing, time};
+    use super::{Joining, Reason, Timing, corner_speed, time};
     use crate::{
         cnc8x6::dynamics,
         machine::MachineConfig,
@@ -990,6 +1162,16 @@ mod tests {
         assert_eq!((dynamics.joining, dynamics.tolerance_angle), (Joining::Automatic, 60.0));
         let accelerations = (dynamics.feed_acceleration, dynamics.continuity_acceleration, dynamics.rapid_acceleration);
         assert_eq!(accelerations, (1000.0, 400.0, 1000.0));
+    }
+
+    #[test]
+    fn the_corner_speed_keeps_the_blend_within_the_tolerance() {
+        let (x, y) = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+        // 90°: r = ε·cos 45° / (1 − cos 45°) = ε (1 + √2).
+        close(corner_speed(x, y, 0.1, 1000.0), (1000.0 * 0.1 * (1.0 + 2.0f64.sqrt())).sqrt());
+        assert_eq!(corner_speed(x, x, 0.1, 1000.0), f64::INFINITY);
+        assert_eq!(corner_speed(x, [-1.0, 0.0, 0.0], 0.1, 1000.0), 0.0);
+        assert_eq!(corner_speed(x, [-1.0, 0.0, 0.0], f64::INFINITY, 1000.0), f64::INFINITY);
     }
 
     #[test]

@@ -12,7 +12,7 @@ use crate::{
     envelope::{DynamicSet, Envelope, MAX_DEPTH, P_PER_JERK, ProfileKind, Ramp},
     machine::MachineConfig,
     trace::PathMode,
-    velocity::{Dynamics, Joining, Reason, Terms},
+    velocity::{Dynamics, Joining, MachineTimes, Reason, Terms},
 };
 
 /// The interpolator tick of the CNC8x6 (000:2749).
@@ -71,14 +71,13 @@ fn one_block_look_ahead(machine: &MachineConfig) -> Dynamics {
         feed_acceleration,
         continuity_acceleration,
         rapid_acceleration: acceleration(237),
-        block_pause: f64::from(machine.block_pause_ms) / 1000.0,
-        settle_time: f64::from(machine.settle_time_ms) / 1000.0,
+        times: MachineTimes::of(machine),
         min_continuity: for_control(machine, MIN_CONTINUITY_MS) / 1000.0,
         min_tight_joining: for_control(machine, MIN_TIGHT_JOINING_MS) / 1000.0,
         tick: TICK,
         chord_error: CHORD_ERROR,
-        m_function_time: f64::from(machine.m_function_ms) / 1000.0,
-        tool_change_time: f64::from(machine.tool_change_ms) / 1000.0,
+        // The manual gives no spindle run-up: the spindle is taken to follow.
+        spindle_acceleration: f64::INFINITY,
         envelope: None,
         terms: &TERMS,
     }
@@ -282,5 +281,6 @@ fn describe(reason: &Reason, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         Reason::ContinuityLength { limit } => {
             write!(f, "a block shorter than R382 ({limit:.3} mm) breaks continuity")
         }
+        Reason::Spindle { from, to } => write!(f, "the cut waits for the spindle to get from {from:.0} to {to:.0} rpm"),
     }
 }

@@ -29,9 +29,14 @@
 //! - Dwells are `G04 P` in ms (without a decimal point, lathe manual §5.3
 //!   (001:55-71)), the stops M00/M01 where the run had them; exact stop
 //!   G61, and G64 back, where the run's blocks change between them (G09
-//!   becomes G61 for one block).
+//!   becomes G61 for one block); `G103 P1` and `G103` where the blocks
+//!   change between stopping for the look-ahead limit and not, and
+//!   `G187 E` where the corner tolerance changes, in the block of a move
+//!   (a block of their own would stop the path), before a dwell or a
+//!   thread on a line of their own.
 //! - Tools, the spindle's other words and M functions other than stops
-//!   are not written: the expansion is the path and its time.
+//!   are not written: the expansion is the path and its time, without
+//!   the waits for the spindle that the velocity model adds to cuts.
 //!
 //! No block is numbered: the numbers are optional (lathe manual §5.1
 //! (001:1800-1824)) and nothing jumps in an expansion. The manual names no
@@ -80,8 +85,11 @@ pub struct Expansion<W: Write> {
     feed: Option<String>,
     /// The S in force, rpm.
     speed: Option<i64>,
-    /// Whether G61 is in force rather than G64.
+    /// Whether G61 is in force rather than G64, G103 P1 rather than no
+    /// limit, and the corner tolerance in µm.
     exact_stop: bool,
+    unjoined: bool,
+    corner_tolerance: i64,
     /// The run's frames, and G54's, in which the program is written.
     frames: Vec<Frame>,
     written: Frame,
@@ -104,6 +112,8 @@ impl<W: Write> Expansion<W> {
             feed: None,
             speed: None,
             exact_stop: false,
+            unjoined: false,
+            corner_tolerance: thousandths(super::dynamics::corner_rounding(machine)),
             frames: Vec::new(),
             written: super::interpreter::reset_frame(machine),
             tool_ends: HashMap::new(),
@@ -190,7 +200,7 @@ impl<W: Write> Expansion<W> {
         if matches!(step.motion, Motion::Rapid | Motion::Feed) {
             self.at = Some(to);
         }
-        // The exact stop changes with the blocks that move or wait.
+        self.path_modes(step, &mut words)?;
         let exact_stop = step.path_mode == PathMode::ExactStop;
         if !words.is_empty() && exact_stop != self.exact_stop {
             self.exact_stop = exact_stop;
@@ -203,6 +213,36 @@ impl<W: Write> Expansion<W> {
         }
         if !words.is_empty() {
             self.line(&words)?;
+        }
+        Ok(())
+    }
+
+    /// Writes where `step` changes the look-ahead limit or the corner
+    /// tolerance: into its block's `words`, where a line of its own would
+    /// stop a path the run joined, else on a line before it. A G103 P1
+    /// line stops no more than the limit does; a block that moves nothing
+    /// passes its G187 and its end of the limit on to the next.
+    fn path_modes(&mut self, step: &Step, words: &mut Vec<String>) -> io::Result<()> {
+        // Under an exact stop the look-ahead limit changes no time.
+        let unjoined = step.path_mode == PathMode::Stop;
+        let joined_move = !words.is_empty() && words[0] != "G04" && words[0] != "G32";
+        if step.path_mode != PathMode::ExactStop && unjoined != self.unjoined {
+            if unjoined {
+                self.line(&["G103 P1".to_owned()])?;
+                self.unjoined = true;
+            } else if joined_move {
+                words.insert(0, "G103".to_owned());
+                self.unjoined = false;
+            } else if !words.is_empty() {
+                self.line(&["G103".to_owned()])?;
+                self.unjoined = false;
+            }
+        }
+        let corner_tolerance = thousandths(f64::from(step.corner_tolerance));
+        if !words.is_empty() && corner_tolerance != self.corner_tolerance {
+            self.corner_tolerance = corner_tolerance;
+            let word = format!("G187 E{}", decimal(corner_tolerance, 3));
+            if joined_move { words.insert(0, word) } else { self.line(&[word])? }
         }
         Ok(())
     }

@@ -20,7 +20,14 @@
 //!   rpm (G97) or m/min of cutting speed (G96), the speed limit G50 S,
 //!   the spindle M03/M04/M05, dwell G04 P (ms without a decimal point,
 //!   seconds with one, lathe manual §5.3 (001:55-71)), exact stop G09 and
-//!   G61/G64.
+//!   G61/G64; each step records the rpm the spindle is commanded to
+//!   ([`Step::spindle`]), for the velocity model's spindle run-up.
+//! - The path's modes of Haas's documentation (not in the manual, which
+//!   names the codes only, 001:232, 001:279), held until changed: the
+//!   corner tolerance of G187 (E, or the smoothness level P1–P3, or
+//!   without either Setting 85) and the look-ahead limit of G103 P (P1:
+//!   every junction stops, as unjoined blocks do); their figures and
+//!   model are `super::dynamics`'s.
 //! - The canned cycles as moves of their block ([`super::cycles`],
 //!   [`super::roughing`]): thread cutting G32; the box cycles G90, G92,
 //!   G94, modal, repeated by each block that moves; G70–G73 over the P..Q
@@ -64,6 +71,12 @@
 //!   the drilling words) and the spindle G84/G184 switch on; the modes of
 //!   the contour's blocks stay with them.
 //! - G64, the default, joins blocks continuously; G09 and G61 stop exactly.
+//! - Under G96 the control commands, as a rapid move or a block without
+//!   a cut starts, the rpm of the diameter where it ends; a cut commands
+//!   the rpm of its start and follows the diameter to its end.
+//! - A G187 or G103 word the control cannot take (a P other than 1–3, an
+//!   E not above 0; a negative or fractional G103 P; a P in a block of
+//!   both, which could be either's) stops the run, as an alarm would.
 //! - A computed dwell P (`P#1`) counts in ms, as a literal without a point.
 //! - A word whose variable is vacant is left out (Fanuc convention).
 //! - Block delete `/` is off: the blocks run.
@@ -78,6 +91,7 @@ use ncc_syntax::{Dialect, Parse, TextRange};
 
 use super::{
     cycles::Point,
+    dynamics,
     eval::{EvalError, MacroValue, Variables},
     lower::{Expr, ExprKind, HaasBlock, Statement, Value, Word, block_nodes},
     modes::Modes,
@@ -241,6 +255,10 @@ struct Interpreter<'a> {
     speed: f64,
     /// G50 S.
     speed_limit: Option<f64>,
+    /// The corner tolerance in mm (Setting 85, or G187's), and the blocks
+    /// the control reads ahead, G103 P (0: no limit).
+    corner_tolerance: f64,
+    look_ahead: u32,
     steps: Vec<Step>,
     findings: Vec<Finding>,
     tools: Vec<u32>,
@@ -274,6 +292,8 @@ impl<'a> Interpreter<'a> {
             feed: None,
             speed: 0.0,
             speed_limit: None,
+            corner_tolerance: dynamics::corner_rounding(machine),
+            look_ahead: 0,
             steps: Vec::new(),
             findings: Vec::new(),
             tools: Vec::new(),
@@ -350,6 +370,12 @@ impl<'a> Interpreter<'a> {
             }
             return flow;
         }
+        if block.has_code(b'G', 103) && block.has_code(b'G', 187) && block.word(b'P').is_some() {
+            let message =
+                "G103 and G187 both read P: the block cannot tell whose it is; write them in blocks of their own";
+            self.finding(RunRule::ValueRefused, range, message);
+            return Flow::End;
+        }
         let mut flow = Flow::Next;
         let (mut dwell, mut exact_stop, mut still, mut cycle, mut coordinates) = (false, false, false, None, None);
         for code in block.codes(b'G') {
@@ -357,6 +383,8 @@ impl<'a> Interpreter<'a> {
             match code {
                 0..=3 | 32 | 80 | 90 | 92 | 94 => self.cycles.drilling = Default::default(),
                 18 | 21 | 40..=42 | 50 | 54..=59 | 61 | 64 | 96..=100 | 110..=129 => {}
+                103 => self.limit_look_ahead(block, range),
+                187 => self.accuracy(block, range),
                 4 => dwell = true,
                 9 => exact_stop = true,
                 20 => self.not_run("inch units G20 (the run reads mm)", range),
@@ -467,11 +495,18 @@ impl<'a> Interpreter<'a> {
             end: over_axes(&end, self.machine.step_axes()),
             frame,
             stop: facts.stop,
-            path_mode: if facts.exact { PathMode::ExactStop } else { PathMode::Continuous },
+            path_mode: match facts.exact {
+                true => PathMode::ExactStop,
+                false if self.look_ahead == 1 => PathMode::Stop,
+                false => PathMode::Continuous,
+            },
             m_functions: facts.m_functions,
             tool_change: facts.tool_change,
             dynamic_set: 1,
             mergeable: false,
+            // Each step's own, from where it starts and ends: below.
+            spindle: [0.0; 2],
+            corner_tolerance: self.corner_tolerance as f32,
         };
         // A cycle's moves run with the compensation it gives them.
         let nose = self.cycles.nose.take().unwrap_or(facts.nose);
@@ -480,14 +515,27 @@ impl<'a> Interpreter<'a> {
             std::mem::take(&mut self.cycles.pending)
         {
             let (m_functions, tool_change) = (0, false);
-            let moved =
-                Step { motion, path, duration, length, feed, end, stop, m_functions, tool_change, ..step.clone() };
-            self.steps.push(moved);
             let to = self.plane_point(&end);
+            let spindle = self.commanded_rpm(motion, from[1], to[1]);
+            let moved = Step {
+                motion,
+                path,
+                duration,
+                length,
+                feed,
+                end,
+                stop,
+                m_functions,
+                tool_change,
+                spindle,
+                ..step.clone()
+            };
+            self.steps.push(moved);
             self.compensate(self.steps.len() - 1, from, to, nose);
             from = to;
         }
         let to = self.plane_point(&step.end);
+        let step = Step { spindle: self.commanded_rpm(step.motion, from[1], to[1]), ..step };
         self.steps.push(step);
         self.compensate(self.steps.len() - 1, from, to, nose);
     }
@@ -496,6 +544,40 @@ impl<'a> Interpreter<'a> {
     fn plane_point(&self, end: &Axes) -> Point {
         let position = by_letter(end, self.machine.step_axes());
         [position[slot(b'Z')], position[slot(b'X')]]
+    }
+
+    /// G187: the corner tolerance from this block on is E's, else that of
+    /// the smoothness level P, else Setting 85.
+    fn accuracy(&mut self, block: &HaasBlock, range: TextRange) {
+        let tolerance = block.word(b'E').and_then(|word| self.number(word, range));
+        let level = block.word(b'P').and_then(|word| self.number(word, range));
+        self.corner_tolerance = match (tolerance, level) {
+            (Some(tolerance), _) if tolerance > 0.0 => tolerance,
+            (Some(_), _) => {
+                self.finding(RunRule::ValueRefused, range, "G187 E is the corner tolerance: a length above 0 mm");
+                return;
+            }
+            (None, Some(level)) => match dynamics::smoothness_level(level) {
+                Some(tolerance) => tolerance,
+                None => {
+                    let message = "G187 P is the smoothness level: 1 (rough), 2 (medium) or 3 (finish)";
+                    self.finding(RunRule::ValueRefused, range, message);
+                    return;
+                }
+            },
+            (None, None) => dynamics::corner_rounding(self.machine),
+        };
+    }
+
+    /// G103: the control reads at most P blocks ahead from this block on;
+    /// without P, or with P0, as many as it can.
+    fn limit_look_ahead(&mut self, block: &HaasBlock, range: TextRange) {
+        let blocks = block.word(b'P').and_then(|word| self.number(word, range)).unwrap_or(0.0);
+        if blocks < 0.0 || blocks.fract() != 0.0 {
+            self.finding(RunRule::ValueRefused, range, "G103 P is a number of blocks, a whole number from 0");
+            return;
+        }
+        self.look_ahead = blocks as u32;
     }
 
     fn dwell(&mut self, block: &HaasBlock, range: TextRange) -> Moved {
@@ -661,17 +743,40 @@ impl<'a> Interpreter<'a> {
         Some(length / (feed * rpm))
     }
 
-    /// The spindle's rpm at `radius`: S under G97, the cutting speed S
-    /// (m/min) over the circumference under G96, at most the G50 limit;
-    /// `None` after reporting a spindle that does not turn.
-    fn spindle_rpm(&mut self, range: TextRange, radius: f64) -> Option<f64> {
+    /// The spindle's rpm at `radius`: 0 when it stands, S under G97, the
+    /// cutting speed S (m/min) over the circumference under G96 (infinite
+    /// at the centre without a limit), at most the G50 limit.
+    fn rpm_at(&self, radius: f64) -> f64 {
         let spindle_on = matches!(self.modes.get(SPINDLE), Some(3 | 4));
         let limit = self.speed_limit.unwrap_or(f64::INFINITY);
-        let rpm = match self.modes.get(SPEED_MODE) {
+        match self.modes.get(SPEED_MODE) {
             _ if !spindle_on => 0.0,
             Some(96) => (1000.0 * self.speed / (TAU * radius.abs())).min(limit),
             _ => self.speed.min(limit),
+        }
+    }
+
+    /// The rpm the control commands as a `motion` from radius `from` to
+    /// `to` starts and ends, negative under M04 ([`Step::spindle`]): a
+    /// cut's follows the radius, any other step's is the one at its end.
+    /// Where G96 has no limit at the centre the rpm stays as it was.
+    fn commanded_rpm(&self, motion: Motion, from: f64, to: f64) -> [f32; 2] {
+        let sign = if self.modes.get(SPINDLE) == Some(4) { -1.0 } else { 1.0 };
+        let last = self.steps.last().map_or(0.0, |step| step.spindle[1]);
+        let at = |radius: f64| {
+            let rpm = self.rpm_at(radius);
+            if rpm.is_finite() { (sign * rpm) as f32 } else { last }
         };
+        match motion {
+            Motion::Feed => [at(from), at(to)],
+            _ => [at(to); 2],
+        }
+    }
+
+    /// The spindle's rpm at `radius` ([`Interpreter::rpm_at`]); `None`
+    /// after reporting a spindle that does not turn.
+    fn spindle_rpm(&mut self, range: TextRange, radius: f64) -> Option<f64> {
+        let rpm = self.rpm_at(radius);
         if !rpm.is_finite() {
             self.not_run("constant cutting speed G96 at the spindle's centre without a G50 limit", range);
             return None;

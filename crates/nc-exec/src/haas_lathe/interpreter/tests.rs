@@ -576,3 +576,19 @@ mod properties {
         }
     }
 }
+
+#[test]
+fn steps_record_the_spindle_speed_and_the_path_modes_in_force() {
+    // Under G96 a rapid commands the rpm at its end, a cut follows the
+    // diameter from its start to its end up to the G50 limit; M04 turns
+    // the other way, M05 stops.
+    let text = "O1\nG50 S2000\nG96 S100 M04\nG00 X40. Z0\nG99 F0.1 G01 X10.\nG97 S500 M03 G187 P3\nG103 P1 G01 Z-5.\nM05\nM30\n";
+    let trace = run_lathe(text);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    let rpm = |diameter: f64| (1000.0 * 100.0 / (PI * diameter)) as f32;
+    let spindles: Vec<[f32; 2]> = trace.steps.iter().map(|step| step.spindle).collect();
+    assert_eq!(spindles[..4], [[0.0; 2], [-2000.0; 2], [-rpm(40.0); 2], [-rpm(40.0), -2000.0]]);
+    assert_eq!(spindles[4..7], [[500.0; 2], [500.0; 2], [0.0; 2]]);
+    let modes: Vec<(PathMode, f32)> = trace.steps[3..6].iter().map(|s| (s.path_mode, s.corner_tolerance)).collect();
+    assert_eq!(modes, [(PathMode::Continuous, 0.05), (PathMode::Continuous, 0.01), (PathMode::Stop, 0.01)]);
+}
