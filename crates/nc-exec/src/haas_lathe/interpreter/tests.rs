@@ -565,3 +565,5 @@ mod properties {
         }
     }
 }
+
+mod resume;
