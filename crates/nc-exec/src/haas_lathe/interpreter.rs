@@ -40,14 +40,16 @@
 //! A run into a sink hands on each step once no later block can change it:
 //! all but the last one or few that tool-nose radius compensation may still
 //! change, a batch at a time. It takes the checkpoints the sink asks for
-//! before blocks of the main program that it has not gone past yet, outside
-//! calls, before another file is read and without compensation in force,
-//! and resumes from them. Not before a block where a cycle after it reads a
-//! contour before it (G70 after the contour G71 went past), and a later
-//! pass of a loop takes none: the text before such a block would decide
-//! the run after it. A checkpoint's course includes the block numbers
-//! before it, which `GOTO`, M97 and M99 P look up, and the text of the
-//! blocks the run jumped over, which a later jump may run.
+//! before blocks of the main program that it has not gone past yet, so that
+//! every step before a checkpoint is of a block before it: outside calls,
+//! before a call of a subprogram written after the main program or of
+//! another file, and without compensation in force; and resumes from them.
+//! Not before a block where a cycle after it reads a contour before it (G70
+//! after the contour G71 went past), and a later pass of a loop takes none:
+//! the text before such a block would decide the run after it. A
+//! checkpoint's course includes the block numbers before it, which `GOTO`,
+//! M97 and M99 P look up, and the text of the blocks the run jumped over,
+//! which a later jump may run.
 //!
 //! The modal state is the catalogue's: every group starts at its default
 //! (G01, G18, G21, G40, G54, G64, G80, G97, G99, M05, …) and a modal code
@@ -391,9 +393,8 @@ struct Interpreter<'a> {
     /// A finding the control stops on was made.
     stopped: bool,
     cycles: canned::CycleState,
-    /// One past the furthest block of the main program run outside calls,
-    /// and what a run after it may read of the text before it
-    /// ([`Resumed::before`]).
+    /// One past the furthest block of the main file run, and what a run
+    /// after it may read of the text before it ([`Resumed::before`]).
     reached: usize,
     before: u64,
 }
@@ -451,13 +452,15 @@ impl<'a> Interpreter<'a> {
                 self.ran_off(place, &unit);
                 return;
             }
-            // A block of the main program the run has not gone past yet.
-            let fresh = place.source == 0 && self.calls.is_empty() && place.block >= self.reached;
+            // A block of the main file the run has not gone past yet, in
+            // the main program or in a call.
+            let fresh = place.source == 0 && place.block >= self.reached;
             if fresh {
                 self.pass_to(place.block);
             }
             if let Some(sink) = sink.as_deref_mut()
                 && fresh
+                && self.calls.is_empty()
                 && self.called.is_empty()
                 && self.nose.is_none()
                 && !covers(&read_back, place.block)
@@ -513,8 +516,8 @@ impl<'a> Interpreter<'a> {
         self.steps.deliver(sink, open, &self.frames, &self.compensated, &mut self.tool_centre);
     }
 
-    /// Goes past the blocks of the main program from the furthest one run
-    /// to `block`, which a jump or a cycle has skipped.
+    /// Goes past the blocks of the main file from the furthest one run to
+    /// `block`, which a jump, a cycle or a call has skipped.
     fn pass_to(&mut self, block: usize) {
         let unit = Rc::clone(&self.units[0]);
         for skipped in self.reached..block {

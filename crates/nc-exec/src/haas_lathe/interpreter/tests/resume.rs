@@ -49,7 +49,9 @@ fn long_compensated_program() -> String {
     for i in 0..2500 {
         text.push_str(&format!("X{}. Z-{}.\n", 20 + (i % 2) * 2, i + 1));
     }
-    text.push_str("G40 G00 X40.\n#1 = 0\nWHILE [#1 LT 3] DO1\nM97 P100 L2\n#1 = #1 + 1\nEND1\nM30\nN100 G01 W-1.\nM99\n");
+    text.push_str(
+        "G40 G00 X40.\n#1 = 0\nWHILE [#1 LT 3] DO1\nM97 P100 L2\n#1 = #1 + 1\nEND1\nM30\nN100 G01 W-1.\nM99\n",
+    );
     text
 }
 
@@ -147,8 +149,8 @@ fn a_run_resumed_from_a_checkpoint_goes_on_as_the_whole_run() {
     let text = long_compensated_program();
     let blocks = assert_resumes_as_the_whole_run(&text, &lathe_with_nose(), 1);
     // Up to G42's block, then none until G40's has run; the loop's blocks
-    // on its first pass, and M30 after it; none in the calls.
-    assert_eq!(blocks, [0, 1, 2, 3, 2505, 2506, 2507, 2508, 2509, 2510]);
+    // up to the first call of the subprogram after M30, and none after it.
+    assert_eq!(blocks, [0, 1, 2, 3, 2505, 2506, 2507]);
 }
 
 #[test]
@@ -160,7 +162,7 @@ fn checkpoints_skip_calls_compensation_later_loop_passes_and_spans_a_later_cycle
     let lines: Vec<&str> = sink.taken.iter().map(|c| text[usize::from(c.offset())..].lines().next().unwrap()).collect();
     // Not between the contour's start and G70, which reads it (G71 goes
     // on after the contour); each loop block once; not under G42 before
-    // the cancel has run; not in the call.
+    // the cancel has run; none after the call of the subprogram after M30.
     assert_eq!(
         lines,
         [
@@ -173,8 +175,7 @@ fn checkpoints_skip_calls_compensation_later_loop_passes_and_spans_a_later_cycle
             "#1 = #1 + 1",
             "END1",
             "G42 G01 W-1.",
-            "M97 P100",
-            "M30"
+            "M97 P100"
         ]
     );
     assert_resumes_as_the_whole_run(text, &lathe_with_nose(), 1);
@@ -221,7 +222,8 @@ fn checkpoints_after_an_edit_take_the_same_course_once_the_edit_no_longer_matter
 #[test]
 fn a_block_jumped_over_before_a_checkpoint_is_part_of_its_course() {
     // N20 runs only after the checkpoints: its text decides the run.
-    let program = |x: &str| format!("O1\nG98 G01 F100.\nGOTO 30\nN20 G01 U{x}\nM99 P40\nN30 U1.\nW-1.\nM97 P20\nN40 M30\n");
+    let program =
+        |x: &str| format!("O1\nG98 G01 F100.\nGOTO 30\nN20 G01 U{x}\nM99 P40\nN30 U1.\nW-1.\nM97 P20\nN40 M30\n");
     let (short, long) = (checkpoints(&program("1."), 1), checkpoints(&program("10."), 1));
     assert_eq!(short.iter().map(Checkpoint::block).collect::<Vec<_>>(), [0, 1, 2, 5, 6, 7, 8]);
     assert!(!short[4].same_course(&long[4].shifted(-1, 0, 0)));
