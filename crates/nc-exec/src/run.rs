@@ -112,6 +112,6 @@ fn run_in<'a, 's>(
 ) -> Trace {
     match machine.control {
         Dialect::Cnc8x6 => cnc8x6::interpreter::run_in(scope, text, files, machine, budget, sink, checkpoint),
-        Dialect::HaasLathe => haas_lathe::interpreter::run_into(text, files, machine, budget, sink),
+        Dialect::HaasLathe => haas_lathe::interpreter::run_in(text, files, machine, budget, sink, checkpoint),
     }
 }

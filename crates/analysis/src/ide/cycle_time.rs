@@ -1226,20 +1226,82 @@ mod tests {
         assert!(total >= 1.0, "{total}");
     }
 
-    /// A run without checkpoints (a Haas lathe run) still knows its input:
-    /// an edit of another file does not run it again.
+    /// A Haas lathe estimate knows its input: an edit of another file
+    /// does not run it again.
     #[test]
-    fn an_estimate_without_checkpoints_holds_for_its_input() {
+    fn a_haas_estimate_holds_for_its_input() {
         let machine = MachineConfig::of_control(ncc_syntax::Dialect::HaasLathe);
         let text = Arc::new("O1\nG98 G01 X20. Z-10. F100.\nM30\n".to_owned());
         let files = WorkspaceFiles::default();
         let first = estimate(None, &text, &files, &machine, 1000);
-        assert!(first.checkpoints.is_empty());
+        assert_eq!(first.checkpoints.iter().map(|stored| stored.run.block()).collect::<Vec<_>>(), [0]);
         // 5 mm of radius and 10 mm of Z at 100 mm/min, with the ramps.
         assert!(first.totals.total > 125.0f64.sqrt() / 100.0 * 60.0, "{}", first.totals.total);
         assert!(first.holds_for(&RunInput { text: text.clone(), machine: machine.clone(), files: files.clone() }));
         let milling = MachineConfig::default();
         assert!(!first.holds_for(&RunInput { text: text.clone(), machine: milling, files }));
+    }
+
+    /// A long Haas lathe program: moves from CAM, a dwell now and then, and
+    /// a local subprogram after its end that edits may call.
+    fn long_haas_program(blocks: usize) -> String {
+        let mut text = String::from("O1\nG54 G18 G97 G98 G00 X0 Z5. M03 S1000\n#100 = 1.\nG01 Z0 F1200.\n");
+        for i in 0..blocks {
+            let (x, z) = ((i % 97) as f64 * 0.7, -((i / 97) as f64 * 1.3 + (i % 5) as f64 * 0.2));
+            let block = match i % 250 {
+                17 => "G04 P10".to_owned(),
+                31 => format!("G00 X{x:.3} Z{z:.3}"),
+                32 => format!("G01 X{x:.3} Z{z:.3} F900."),
+                _ => format!("X{x:.3} Z{z:.3}"),
+            };
+            text.push_str(&format!("N{} {block}\n", i + 3));
+        }
+        text.push_str("N99999 G00 X100. M30\nN90000 G01 W-0.5\nW0.5\nM99\n");
+        text
+    }
+
+    fn haas_estimate_of(text: &str, previous: Option<&Estimate>) -> Estimate {
+        let machine = MachineConfig::of_control(ncc_syntax::Dialect::HaasLathe);
+        estimate(previous, &Arc::new(text.to_owned()), &WorkspaceFiles::default(), &machine, 1_000_000)
+    }
+
+    #[test]
+    fn a_haas_run_takes_no_checkpoints_after_calling_a_subprogram_written_after_the_main_program() {
+        let text = long_haas_program(5000).replace("N1503 ", "M97 P90000\nN1503 ");
+        let first = haas_estimate_of(&text, None);
+        let call = TextSize::of(&text[..text.find("M97 P90000").expect("the call")]);
+        let blocks: Vec<usize> = first.checkpoints.iter().map(|stored| stored.run.block()).collect();
+        assert!(first.checkpoints.iter().all(|stored| stored.run.offset() < call), "{blocks:?}");
+        assert_eq!(blocks, [0, 1000]);
+        let at = text.find("N2503 X").expect("the block") + "N2503 X".len();
+        let edited = format!("{}7{}", &text[..at], &text[at..]);
+        let resumed = haas_estimate_of(&edited, Some(&first));
+        assert_alike(&resumed, &haas_estimate_of(&edited, None));
+        assert!(edited[usize::from(resumed.rerun.start)..].starts_with("N999 "));
+    }
+
+    #[test]
+    fn an_edit_of_a_haas_program_reruns_from_the_checkpoint_before_it_to_where_the_run_takes_its_course_again() {
+        let text = long_haas_program(5000);
+        let first = haas_estimate_of(&text, None);
+        assert_eq!(first.stopped, None);
+        assert!(first.checkpoints.len() >= 5, "{} checkpoints", first.checkpoints.len());
+        // A digit typed into an absolute coordinate in the middle.
+        let at = text.find("N2503 X").expect("the block") + "N2503 X".len();
+        let edited = format!("{}7{}", &text[..at], &text[at..]);
+        let resumed = haas_estimate_of(&edited, Some(&first));
+        let whole = haas_estimate_of(&edited, None);
+        assert_alike(&resumed, &whole);
+        assert!(resumed.totals.total > first.totals.total, "the move got longer");
+        // From the checkpoint at block 2000 (N1999) to the one at block 3000.
+        let rerun = usize::from(resumed.rerun.start)..usize::from(resumed.rerun.end);
+        assert!(edited[rerun.clone()].starts_with("N1999 ") && edited[rerun.end..].starts_with("N2999 "), "{rerun:?}");
+        // Edited again, from the resumed estimate: its checkpoints hold.
+        let at = edited.find("N4321 X").expect("the block") + "N4321 X".len();
+        let again = format!("{}{}", &edited[..at], &edited[at + 1..]);
+        let resumed = haas_estimate_of(&again, Some(&resumed));
+        assert_alike(&resumed, &haas_estimate_of(&again, None));
+        assert!(resumed.rerun.end < TextSize::of(again.as_str()));
     }
 
     proptest::proptest! {
@@ -1287,6 +1349,41 @@ mod tests {
                 }
                 let resumed = estimate_of(&text, Some(&previous));
                 assert_alike(&resumed, &estimate_of(&text, None));
+                previous = resumed;
+            }
+        }
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(12))]
+
+        /// Resumed estimates of a Haas lathe program equal whole runs, edit
+        /// after edit: digits typed or deleted, blocks inserted or removed,
+        /// a jump back or forward once, a jump to no block (the run stops
+        /// there), a call, a block numbered like a jump's target.
+        #[test]
+        fn resumed_haas_estimates_equal_whole_runs(
+            edits in proptest::collection::vec((0.0f64..1.0, 0u8..8), 1..4),
+        ) {
+            let mut text = long_haas_program(2500);
+            let mut previous = haas_estimate_of(&text, None);
+            for (place, kind) in edits {
+                let line_start = text[..(place * text.len() as f64) as usize].rfind('\n').map_or(0, |i| i + 1);
+                let line_end = text[line_start..].find('\n').map_or(text.len(), |i| line_start + i + 1);
+                let word = text[line_start..line_end].find(" X").map(|i| line_start + i + 2);
+                match (kind, word) {
+                    (0, Some(at)) => text.insert(at, '3'),
+                    (1, Some(at)) => { text.remove(at); }
+                    (2, _) => text.insert_str(line_start, "N5 G01 X1. Z1. F2000.\n"),
+                    (3, _) if line_start > 0 => text.insert_str(line_start, "#1 = #1 + 1\nIF [#1 LT 2] GOTO 1000\n"),
+                    (4, _) if line_start > 0 => text.insert_str(line_start, "GOTO 77777\n"),
+                    (5, _) if line_start > 0 => text.insert_str(line_start, "M97 P90000\n"),
+                    (6, _) if line_start > 0 => text.insert_str(line_start, "N1000 G01 X2.\n"),
+                    _ if line_start > 0 && line_end < text.len() => text.replace_range(line_start..line_end, ""),
+                    _ => {}
+                }
+                let resumed = haas_estimate_of(&text, Some(&previous));
+                assert_alike(&resumed, &haas_estimate_of(&text, None));
                 previous = resumed;
             }
         }

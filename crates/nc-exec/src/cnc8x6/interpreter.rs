@@ -71,11 +71,11 @@ impl Resumable for Runner {
     }
 
     fn steps(&self) -> usize {
-        self.delivered
+        self.steps.delivered
     }
 
     fn set_steps(&mut self, steps: usize) {
-        self.delivered = steps;
+        self.steps.delivered = steps;
     }
 
     fn same_course(&self, other: &dyn Resumable) -> bool {
@@ -108,7 +108,7 @@ pub(crate) fn run_in<'a, 's>(
         _ => (fresh, Index::start(scope, text, None), 0, 0),
     };
     // Most programs run each block about once.
-    runner.steps.reserve(if sink.is_some() { DELIVERY_BATCH } else { expected_blocks(text) });
+    runner.steps.steps.reserve(if sink.is_some() { DELIVERY_BATCH } else { expected_blocks(text) });
     // Macrocycle numbers called, and where each file's body starts; the
     // cycle file's source once read; the files read, in source order.
     let mut loaded: Vec<(u32, Option<usize>)> = Vec::new();
@@ -278,7 +278,7 @@ pub(crate) fn run_in<'a, 's>(
             break;
         }
         if let Some(sink) = sink.as_deref_mut()
-            && runner.steps.len() >= DELIVERY_BATCH
+            && runner.steps.steps.len() >= DELIVERY_BATCH
         {
             runner.deliver(sink, false);
             if sink.closed() {
@@ -300,7 +300,7 @@ pub(crate) fn run_in<'a, 's>(
         messages: runner.messages,
         frames: runner.frames,
         reset_frame,
-        steps: runner.steps,
+        steps: runner.steps.steps,
         findings: runner.findings,
         tools: runner.tools,
         files: called,

@@ -93,7 +93,8 @@ pub struct Expansion<W: Write> {
     /// The run's frames, and G54's, in which the program is written.
     frames: Vec<Frame>,
     written: Frame,
-    /// Where each compensated step's tool path ends, by step (Z, X).
+    /// Where each compensated step's tool path ends, by step (Z, X), until
+    /// the step is written.
     tool_ends: HashMap<usize, Point2<f64>>,
     /// The index of the step to come.
     next: usize,
@@ -142,7 +143,7 @@ impl<W: Write> Expansion<W> {
     /// stop.
     fn write(&mut self, step: &Step, index: usize) -> Result<(), ExpandError> {
         let programmed = by_letter(&step.end, &self.axes);
-        if let Some(tool) = self.tool_ends.get(&index)
+        if let Some(tool) = self.tool_ends.remove(&index)
             && (tool - Point2::new(programmed[slot(b'Z')], programmed[slot(b'X')])).norm() > 1e-6
         {
             let unwritable = Unwritable { source: step.source, range: step.range, reason: COMPENSATED };

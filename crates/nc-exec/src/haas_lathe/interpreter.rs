@@ -44,6 +44,20 @@
 //! - M00/M01 stops, M02/M30 end the run; T changes the tool and selects
 //!   its offset; other M functions are counted.
 //!
+//! A run into a sink hands on each step once no later block can change it:
+//! all but the last one or few that tool-nose radius compensation may still
+//! change, a batch at a time. It takes the checkpoints the sink asks for
+//! before blocks of the main program that it has not gone past yet, so that
+//! every step before a checkpoint is of a block before it: outside calls,
+//! before a call of a subprogram written after the main program or of
+//! another file, and without compensation in force; and resumes from them.
+//! Not before a block where a cycle after it reads a contour before it (G70
+//! after the contour G71 went past), and a later pass of a loop takes none:
+//! the text before such a block would decide the run after it. A
+//! checkpoint's course includes the block numbers before it, which `GOTO`,
+//! M97 and M99 P look up, and the text of the blocks the run jumped over,
+//! which a later jump may run.
+//!
 //! The modal state is the catalogue's: every group starts at its default
 //! (G01, G18, G21, G40, G54, G64, G80, G97, G99, M05, …) and a modal code
 //! replaces its group's.
@@ -85,7 +99,14 @@
 //!   digits select the offset (`Txxyy`, lathe manual §7.1 (001:825-826)),
 //!   so that `T1` selects offset 1.
 
-use std::{f64::consts::TAU, rc::Rc};
+use std::{
+    any::Any,
+    f64::consts::TAU,
+    hash::{DefaultHasher, Hash, Hasher},
+    ops::Range,
+    rc::Rc,
+    sync::Arc,
+};
 
 use ncc_syntax::{Dialect, Parse, TextRange};
 
@@ -103,8 +124,8 @@ use crate::{
     known::Known,
     machine::MachineConfig,
     trace::{
-        Axes, Called, Compensated, Environment, Finding, Motion, PROGRESS_INTERVAL, Path, PathMode, Position, RunRule,
-        Step, StepSink, Stop, Trace, round3, slot,
+        Axes, Called, Checkpoint, Compensated, DELIVERY_BATCH, Environment, Finding, Motion, PROGRESS_INTERVAL, Path,
+        PathMode, Position, Resumable, RunRule, Step, StepSink, Stop, Trace, Undelivered, round3, slot,
     },
     transform::{Frame, by_letter, over_axes},
 };
@@ -121,24 +142,25 @@ const SPINDLE: &str = "M2";
 
 /// Runs the first program of `text` on `machine` for at most `budget`
 /// blocks, reading the programs it calls from other files through `files`,
-/// and handing the steps to `sink` when there is one. The run starts from
-/// the beginning every time: it takes no checkpoints.
-pub(crate) fn run_into(
+/// from its start or from `checkpoint`, and handing the steps to `sink` as
+/// they are final when there is one.
+pub(crate) fn run_in(
     text: &str,
     files: &dyn Environment,
     machine: &MachineConfig,
     budget: usize,
-    sink: Option<&mut dyn StepSink>,
+    mut sink: Option<&mut dyn StepSink>,
+    checkpoint: Option<&Checkpoint>,
 ) -> Trace {
-    let mut interpreter = Interpreter::new(machine, files, Unit::read(text));
-    interpreter.run(budget);
+    let mut interpreter = Interpreter::new(Arc::new(machine.clone()), files, text);
+    let start = checkpoint.and_then(|checkpoint| interpreter.resume(checkpoint));
+    interpreter.run(budget, start, sink.as_deref_mut());
     interpreter.end_compensation();
+    if let Some(sink) = sink {
+        interpreter.deliver(sink, true);
+    }
     // Pieces come in the order compensation fixes them, a move late.
     interpreter.tool_centre.sort_by_key(|piece| piece.block);
-    if let Some(sink) = sink {
-        sink.references(&interpreter.frames, &interpreter.compensated, &interpreter.tool_centre);
-        sink.steps(&mut interpreter.steps);
-    }
     Trace {
         axes: machine.step_axes().to_vec(),
         diameter_axis: Some(b'X'),
@@ -147,7 +169,7 @@ pub(crate) fn run_into(
         tool_centre: interpreter.tool_centre,
         compensated: interpreter.compensated,
         messages: Vec::new(),
-        steps: interpreter.steps,
+        steps: interpreter.steps.steps,
         findings: interpreter.findings,
         tools: interpreter.tools,
         files: interpreter.called,
@@ -199,6 +221,7 @@ enum Flow {
 }
 
 /// A block's move, before it becomes a step.
+#[derive(Clone, PartialEq)]
 struct Moved {
     motion: Motion,
     path: Path,
@@ -222,10 +245,139 @@ struct Facts {
     machine: bool,
 }
 
+/// The run between two blocks of the main program outside calls, which a
+/// [`Checkpoint`] keeps: the modal state, the position and frames, the
+/// variables, the cycles' words, the offset and feed in force.
+#[derive(Clone)]
+struct Resumed {
+    machine: Arc<MachineConfig>,
+    modes: Modes,
+    variables: Variables,
+    position: Position,
+    frames: Vec<Frame>,
+    frame: usize,
+    coordinates: coordinates::Coordinates,
+    offset: u8,
+    feed: Option<f64>,
+    speed: f64,
+    speed_limit: Option<f64>,
+    corner_tolerance: f64,
+    look_ahead: u32,
+    last_rpm: f32,
+    cycles: canned::CycleState,
+    reported: Vec<String>,
+    /// What the run after the checkpoint may read of the text before it,
+    /// besides the blocks it ran, which a run revisiting them shows in its
+    /// steps: the block numbers, which `GOTO`, M97, M99 P and contours look
+    /// up, and the text of the blocks it went past without running them.
+    before: u64,
+    /// Steps made before it.
+    steps: usize,
+}
+
+impl Resumed {
+    /// See [`Checkpoint::same_course`].
+    fn same_course(&self, other: &Resumed) -> bool {
+        // Every field named, so that a new one must be placed here.
+        let Resumed {
+            machine,
+            modes,
+            variables,
+            position,
+            frames,
+            frame,
+            coordinates,
+            offset,
+            feed,
+            speed,
+            speed_limit,
+            corner_tolerance,
+            look_ahead,
+            last_rpm,
+            cycles,
+            reported,
+            before,
+            steps: _,
+        } = self;
+        **machine == *other.machine
+            && *modes == other.modes
+            && *variables == other.variables
+            && *position == other.position
+            && *frames == other.frames
+            && *frame == other.frame
+            && *coordinates == other.coordinates
+            && *offset == other.offset
+            && *feed == other.feed
+            && *speed == other.speed
+            && *speed_limit == other.speed_limit
+            && *corner_tolerance == other.corner_tolerance
+            && *look_ahead == other.look_ahead
+            && *last_rpm == other.last_rpm
+            && *cycles == other.cycles
+            && *reported == other.reported
+            && *before == other.before
+    }
+}
+
+impl Resumable for Resumed {
+    fn boxed_clone(&self) -> Box<dyn Resumable> {
+        Box::new(self.clone())
+    }
+
+    fn steps(&self) -> usize {
+        self.steps
+    }
+
+    fn set_steps(&mut self, steps: usize) {
+        self.steps = steps;
+    }
+
+    fn same_course(&self, other: &dyn Resumable) -> bool {
+        (other as &dyn Any).downcast_ref::<Resumed>().is_some_and(|other| Resumed::same_course(self, other))
+    }
+}
+
+/// `before` with `part` folded in.
+fn fold(before: u64, part: impl Hash) -> u64 {
+    let mut hasher = DefaultHasher::new();
+    (before, part).hash(&mut hasher);
+    hasher.finish()
+}
+
+/// The blocks of `unit` before which a run takes no checkpoint because a
+/// cycle after them reads a contour that starts before them (G70 after
+/// the contour G71 skipped): the text before such a checkpoint would
+/// decide the run after it. Sorted and apart.
+fn contours_read_back(unit: &Unit) -> Vec<Range<usize>> {
+    let mut spans: Vec<Range<usize>> = unit
+        .model
+        .contours()
+        .filter(|contour| *contour.blocks.start() < contour.cycle)
+        .map(|contour| contour.blocks.start() + 1..contour.cycle + 1)
+        .collect();
+    spans.sort_by_key(|span| span.start);
+    let mut merged: Vec<Range<usize>> = Vec::with_capacity(spans.len());
+    for span in spans {
+        match merged.last_mut() {
+            Some(last) if span.start <= last.end => last.end = last.end.max(span.end),
+            _ => merged.push(span),
+        }
+    }
+    merged
+}
+
+/// Whether one of the sorted, disjoint `spans` holds `block`.
+fn covers(spans: &[Range<usize>], block: usize) -> bool {
+    let after = spans.partition_point(|span| span.end <= block);
+    spans.get(after).is_some_and(|span| span.start <= block)
+}
+
 struct Interpreter<'a> {
-    machine: &'a MachineConfig,
+    machine: Arc<MachineConfig>,
     /// Where the programs that calls name are read from.
     files: &'a dyn Environment,
+    /// The program's text.
+    text: &'a str,
     /// The files of the run: the program's, then those calls read, in the
     /// order of [`Interpreter::called`].
     units: Vec<Rc<Unit>>,
@@ -259,7 +411,9 @@ struct Interpreter<'a> {
     /// the control reads ahead, G103 P (0: no limit).
     corner_tolerance: f64,
     look_ahead: u32,
-    steps: Vec<Step>,
+    /// The rpm the last step ended with ([`Step::spindle`]).
+    last_rpm: f32,
+    steps: Undelivered,
     findings: Vec<Finding>,
     tools: Vec<u32>,
     executed: usize,
@@ -268,14 +422,20 @@ struct Interpreter<'a> {
     /// A finding the control stops on was made.
     stopped: bool,
     cycles: canned::CycleState,
+    /// One past the furthest block of the main file run, and what a run
+    /// after it may read of the text before it ([`Resumed::before`]).
+    reached: usize,
+    before: u64,
 }
 
 impl<'a> Interpreter<'a> {
-    fn new(machine: &'a MachineConfig, files: &'a dyn Environment, program: Unit) -> Self {
+    fn new(machine: Arc<MachineConfig>, files: &'a dyn Environment, text: &'a str) -> Self {
+        let corner_tolerance = dynamics::corner_rounding(&machine);
         let mut interpreter = Interpreter {
             machine,
             files,
-            units: vec![Rc::new(program)],
+            text,
+            units: vec![Rc::new(Unit::read(text))],
             called: Vec::new(),
             source: 0,
             calls: Vec::new(),
@@ -292,25 +452,31 @@ impl<'a> Interpreter<'a> {
             feed: None,
             speed: 0.0,
             speed_limit: None,
-            corner_tolerance: dynamics::corner_rounding(machine),
+            corner_tolerance,
             look_ahead: 0,
-            steps: Vec::new(),
+            last_rpm: 0.0,
+            steps: Undelivered::default(),
             findings: Vec::new(),
             tools: Vec::new(),
             executed: 0,
             reported: Vec::new(),
             stopped: false,
             cycles: canned::CycleState::default(),
+            reached: 0,
+            before: 0,
         };
         interpreter.start_coordinates();
         interpreter
     }
 
     /// Runs the file's first program for at most `budget` blocks, with the
-    /// programs it calls.
-    fn run(&mut self, budget: usize) {
+    /// programs it calls, from its start or from `start`; hands `sink` the
+    /// steps as they are final and the checkpoints it asks for.
+    fn run(&mut self, budget: usize, start: Option<Place>, mut sink: Option<&mut (dyn StepSink + '_)>) {
         let Some(first) = self.units[0].model.programs.first() else { return };
-        let mut place = Place { source: 0, program: 0, block: first.blocks.start };
+        let mut place = start.unwrap_or(Place { source: 0, program: 0, block: first.blocks.start });
+        self.reached = self.reached.max(first.blocks.start);
+        let read_back = contours_read_back(&self.units[0]);
         loop {
             let unit = Rc::clone(&self.units[place.source]);
             let program = &unit.model.programs[place.program];
@@ -318,6 +484,32 @@ impl<'a> Interpreter<'a> {
             if !program.blocks.contains(&place.block) {
                 self.ran_off(place, &unit);
                 return;
+            }
+            // A block of the main file the run has not gone past yet, in
+            // the main program or in a call.
+            let fresh = place.source == 0 && place.block >= self.reached;
+            if fresh {
+                self.pass_to(place.block);
+            }
+            if let Some(sink) = sink.as_deref_mut()
+                && fresh
+                && self.calls.is_empty()
+                && self.called.is_empty()
+                && self.nose.is_none()
+                && !covers(&read_back, place.block)
+                && sink.checkpoint_wanted(place.block, unit.ranges[place.block].start())
+            {
+                self.deliver(sink, false);
+                let offset = unit.ranges[place.block].start();
+                let checkpoint =
+                    Checkpoint { state: Box::new(self.resumed()), block: place.block, offset, executed: self.executed };
+                if sink.checkpoint(checkpoint).is_break() {
+                    return;
+                }
+            }
+            if fresh {
+                self.before = fold(self.before, (0u8, unit.blocks[place.block].number.and_then(|n| n.value)));
+                self.reached = place.block + 1;
             }
             if self.executed >= budget {
                 let message = format!("the run went past its budget of {budget} blocks");
@@ -338,7 +530,139 @@ impl<'a> Interpreter<'a> {
                 Flow::Go(to) => to,
                 Flow::End => return,
             };
+            if let Some(sink) = sink.as_deref_mut()
+                && self.steps.steps.len() >= DELIVERY_BATCH
+            {
+                self.deliver(sink, false);
+                if sink.closed() {
+                    return;
+                }
+            }
         }
+    }
+
+    /// Hands `sink` the steps no later block can change: all at the `end`,
+    /// else those before the first one tool-nose radius compensation may
+    /// still change.
+    fn deliver(&mut self, sink: &mut dyn StepSink, end: bool) {
+        let open = self.nose.as_ref().filter(|_| !end).map(nose::Nose::open_step);
+        self.steps.deliver(sink, open, &self.frames, &self.compensated, &mut self.tool_centre);
+    }
+
+    /// Goes past the blocks of the main file from the furthest one run to
+    /// `block`, which a jump, a cycle or a call has skipped.
+    fn pass_to(&mut self, block: usize) {
+        let unit = Rc::clone(&self.units[0]);
+        for skipped in self.reached..block {
+            let text = &self.text[unit.ranges[skipped]];
+            self.before = fold(self.before, (1u8, unit.blocks[skipped].number.and_then(|n| n.value), text));
+        }
+        self.reached = block;
+    }
+
+    /// The state to resume from before the next block, every step before it
+    /// handed on.
+    fn resumed(&self) -> Resumed {
+        // Every field named, so that a new one must be placed here.
+        let Interpreter {
+            machine,
+            files: _,
+            text: _,
+            units: _,
+            // None read: a checkpoint is taken only before the program
+            // calls another file.
+            called: _,
+            source: _,
+            calls: _,
+            modes,
+            variables,
+            position,
+            frames,
+            frame,
+            coordinates,
+            offset,
+            // None in force at a checkpoint.
+            nose: _,
+            // Reported by the run up to the checkpoint.
+            tool_centre: _,
+            compensated: _,
+            findings: _,
+            tools: _,
+            feed,
+            speed,
+            speed_limit,
+            corner_tolerance,
+            look_ahead,
+            last_rpm,
+            steps,
+            executed: _,
+            reported,
+            stopped: _,
+            cycles,
+            reached: _,
+            before,
+        } = self;
+        Resumed {
+            machine: Arc::clone(machine),
+            modes: modes.clone(),
+            variables: variables.clone(),
+            position: *position,
+            frames: frames.clone(),
+            frame: *frame,
+            coordinates: coordinates.clone(),
+            offset: *offset,
+            feed: *feed,
+            speed: *speed,
+            speed_limit: *speed_limit,
+            corner_tolerance: *corner_tolerance,
+            look_ahead: *look_ahead,
+            last_rpm: *last_rpm,
+            cycles: cycles.clone(),
+            reported: reported.clone(),
+            before: *before,
+            steps: steps.next(),
+        }
+    }
+
+    /// Goes on from `checkpoint`, a checkpoint of a run of this program on
+    /// this machine: where it resumes; `None`, to run from the start, for a
+    /// checkpoint of another control or machine, or of a block this text
+    /// does not have there.
+    fn resume(&mut self, checkpoint: &Checkpoint) -> Option<Place> {
+        let state = (&*checkpoint.state as &dyn Any).downcast_ref::<Resumed>()?;
+        let program = self.units[0].model.programs.first()?;
+        let block = checkpoint.block;
+        let here = program.blocks.contains(&block) && self.units[0].ranges[block].start() == checkpoint.offset;
+        if !here || *state.machine != *self.machine {
+            return None;
+        }
+        let Resumed {
+            machine,
+            modes,
+            variables,
+            position,
+            frames,
+            frame,
+            coordinates,
+            offset,
+            feed,
+            speed,
+            speed_limit,
+            corner_tolerance,
+            look_ahead,
+            last_rpm,
+            cycles,
+            reported,
+            before,
+            steps,
+        } = state.clone();
+        (self.machine, self.modes, self.variables, self.position) = (machine, modes, variables, position);
+        (self.frames, self.frame, self.coordinates, self.offset) = (frames, frame, coordinates, offset);
+        (self.feed, self.speed, self.speed_limit, self.cycles) = (feed, speed, speed_limit, cycles);
+        (self.corner_tolerance, self.look_ahead, self.last_rpm) = (corner_tolerance, look_ahead, last_rpm);
+        (self.reported, self.before, self.steps.delivered) = (reported, before, steps);
+        (self.executed, self.reached) = (checkpoint.executed, block);
+        Some(Place { source: 0, program: 0, block })
     }
 
     /// The run has reached the end of the program at `place` without M30,
@@ -531,13 +855,13 @@ impl<'a> Interpreter<'a> {
                 ..step.clone()
             };
             self.steps.push(moved);
-            self.compensate(self.steps.len() - 1, from, to, nose);
+            self.compensate(self.steps.next() - 1, from, to, nose);
             from = to;
         }
         let to = self.plane_point(&step.end);
         let step = Step { spindle: self.commanded_rpm(step.motion, from[1], to[1]), ..step };
         self.steps.push(step);
-        self.compensate(self.steps.len() - 1, from, to, nose);
+        self.compensate(self.steps.next() - 1, from, to, nose);
     }
 
     /// A step end's (Z, X radius).
@@ -565,7 +889,7 @@ impl<'a> Interpreter<'a> {
                     return;
                 }
             },
-            (None, None) => dynamics::corner_rounding(self.machine),
+            (None, None) => dynamics::corner_rounding(&self.machine),
         };
     }
 
@@ -760,17 +1084,19 @@ impl<'a> Interpreter<'a> {
     /// `to` starts and ends, negative under M04 ([`Step::spindle`]): a
     /// cut's follows the radius, any other step's is the one at its end.
     /// Where G96 has no limit at the centre the rpm stays as it was.
-    fn commanded_rpm(&self, motion: Motion, from: f64, to: f64) -> [f32; 2] {
+    fn commanded_rpm(&mut self, motion: Motion, from: f64, to: f64) -> [f32; 2] {
         let sign = if self.modes.get(SPINDLE) == Some(4) { -1.0 } else { 1.0 };
-        let last = self.steps.last().map_or(0.0, |step| step.spindle[1]);
+        let last = self.last_rpm;
         let at = |radius: f64| {
             let rpm = self.rpm_at(radius);
             if rpm.is_finite() { (sign * rpm) as f32 } else { last }
         };
-        match motion {
+        let rpm = match motion {
             Motion::Feed => [at(from), at(to)],
             _ => [at(to); 2],
-        }
+        };
+        self.last_rpm = rpm[1];
+        rpm
     }
 
     /// The spindle's rpm at `radius` ([`Interpreter::rpm_at`]); `None`

@@ -75,6 +75,13 @@ impl Modes {
     }
 }
 
+impl PartialEq for Modes {
+    /// The same codes in force of the same catalogue's groups.
+    fn eq(&self, other: &Modes) -> bool {
+        std::ptr::eq(self.catalogue, other.catalogue) && self.in_force == other.in_force
+    }
+}
+
 /// A group's default code as its number.
 fn default(id: Option<&str>) -> Option<u32> {
     id.and_then(split_code).map(|(_, number)| number)

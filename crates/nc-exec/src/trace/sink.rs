@@ -223,3 +223,95 @@ impl StepSink for Batches {
 
 /// Steps a streaming run gathers before it hands them on.
 pub(crate) const DELIVERY_BATCH: usize = 1024;
+
+/// The steps of a run not handed on yet: `steps[0]` is the run's step
+/// `delivered`. Radius compensation may still change the last few.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Undelivered {
+    pub(crate) steps: Vec<Step>,
+    pub(crate) delivered: usize,
+}
+
+impl Undelivered {
+    /// The index in the run of the step to come.
+    pub(crate) fn next(&self) -> usize {
+        self.delivered + self.steps.len()
+    }
+
+    pub(crate) fn push(&mut self, step: Step) {
+        self.steps.push(step);
+    }
+
+    /// Step `index` of the run, not handed on yet.
+    pub(crate) fn get(&self, index: usize) -> &Step {
+        &self.steps[index - self.delivered]
+    }
+
+    pub(crate) fn get_mut(&mut self, index: usize) -> &mut Step {
+        &mut self.steps[index - self.delivered]
+    }
+
+    /// Hands `sink` the steps before the run's step `open`, the first one
+    /// compensation may still change (all of them without one), after
+    /// what they refer to: the run's `frames` and `compensated` spans, and
+    /// the pieces of its tool-centre path that belong to them, in path
+    /// order. Of `tool_centre`, the pieces of the steps handed on before
+    /// come first, sorted; the others come in the order compensation fixed
+    /// them, and are sorted here.
+    pub(crate) fn deliver(
+        &mut self,
+        sink: &mut dyn StepSink,
+        open: Option<usize>,
+        frames: &[Frame],
+        compensated: &[Compensated],
+        tool_centre: &mut [ToolElement],
+    ) {
+        let open = open.map_or(self.steps.len(), |open| open - self.delivered);
+        let first = tool_centre.partition_point(|piece| piece.block < self.delivered);
+        self.delivered += open;
+        let fresh = &mut tool_centre[first..];
+        fresh.sort_by_key(|piece| piece.block);
+        let fixed = first + fresh.partition_point(|piece| piece.block < self.delivered);
+        sink.references(frames, compensated, &tool_centre[first..fixed]);
+        if open == self.steps.len() {
+            sink.steps(&mut self.steps);
+        } else {
+            self.steps.drain(..open).for_each(|step| sink.step(step));
+        }
+    }
+}
+
+#[cfg(test)]
+impl StepSink for Vec<Step> {
+    fn step(&mut self, step: Step) {
+        self.push(step);
+    }
+}
+
+/// The steps of a run after its first `before`, and a checkpoint
+/// every `every` blocks (none for 0).
+#[cfg(test)]
+#[derive(Default)]
+pub(crate) struct Checkpoints {
+    pub(crate) before: usize,
+    pub(crate) steps: Vec<Step>,
+    pub(crate) taken: Vec<Checkpoint>,
+    pub(crate) every: usize,
+}
+
+#[cfg(test)]
+impl StepSink for Checkpoints {
+    fn step(&mut self, step: Step) {
+        self.steps.push(step);
+    }
+
+    fn checkpoint_wanted(&mut self, block: usize, _offset: TextSize) -> bool {
+        self.every > 0 && block.is_multiple_of(self.every)
+    }
+
+    fn checkpoint(&mut self, checkpoint: Checkpoint) -> ControlFlow<()> {
+        assert_eq!(checkpoint.steps(), self.before + self.steps.len(), "every step before it is handed on");
+        self.taken.push(checkpoint);
+        ControlFlow::Continue(())
+    }
+}

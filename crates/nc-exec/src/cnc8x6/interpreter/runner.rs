@@ -105,9 +105,8 @@ pub(super) struct Runner {
     speed_reached: Option<f64>,
     pub(super) position: Position,
     pub(super) params: Parameters,
-    /// The steps not handed on yet: `steps[0]` is step `delivered`.
-    pub(super) steps: Vec<Step>,
-    pub(super) delivered: usize,
+    /// The steps not handed on yet.
+    pub(super) steps: Undelivered,
     pub(super) findings: Vec<Finding>,
     /// T in force, and every T in order of first use.
     pub(super) tool: Option<u32>,
@@ -164,8 +163,7 @@ impl Runner {
             frames: vec![Frame::default()],
             position: [0.0; 26],
             params: Parameters::zeroed(),
-            steps: Vec::new(),
-            delivered: 0,
+            steps: Undelivered::default(),
             findings: Vec::new(),
             tool: None,
             tools: Vec::new(),
@@ -224,7 +222,6 @@ impl Runner {
             position,
             params,
             steps,
-            delivered: _,
             findings: _,
             tool,
             tools: _,
@@ -253,8 +250,8 @@ impl Runner {
             && *speed_reached == other.speed_reached
             && *position == other.position
             && *params == other.params
-            && steps.is_empty()
-            && other.steps.is_empty()
+            && steps.steps.is_empty()
+            && other.steps.steps.is_empty()
             && *tool == other.tool
             && *reported == other.reported
     }
@@ -454,7 +451,7 @@ impl Runner {
         let end = self.position;
         self.record(range, &end, moved, stop.filter(|_| dwell.is_none()), functions);
         if let Err(error) = self.compensate(start, path) {
-            let range = self.step_mut(error.block()).range;
+            let range = self.steps.get(error.block()).range;
             self.finding(RunRule::CompensationFailed, range, &format!("radius compensation: {error}"));
             return Flow::Block(BlockFlow::End);
         }
@@ -470,7 +467,7 @@ impl Runner {
             offsets: &mut self.offsets,
             corrections: &mut self.corrections,
             messages: &mut self.messages,
-            step: self.delivered + self.steps.len() - 1,
+            step: self.steps.next() - 1,
             registers: Registers {
                 modes: &self.modes,
                 speed: self.speed,
@@ -730,11 +727,11 @@ impl Runner {
     /// length and time on the steps it belongs to, one block late as the
     /// control's look-ahead fixes them.
     fn compensate(&mut self, start: Position, path: Path) -> Result<(), CompensationError> {
-        let index = self.delivered + self.steps.len() - 1;
+        let index = self.steps.next() - 1;
         let code = self.modes.get(Group::PLANE).unwrap_or_default();
         let Some([first, second]) = self.planes.compensation(code) else {
             if self.modes.get(Group::COMPENSATION).is_some_and(|code| code != 40) {
-                let range = self.step_mut(index).range;
+                let range = self.steps.get(index).range;
                 let message = format!(
                     "radius compensation in the plane of G{code}, which this machine does not have (machine constants R340, R341): the run leaves the compensation out"
                 );
@@ -754,7 +751,7 @@ impl Runner {
         let point = |position: &Position| Point2::new(position[a], position[b]);
         let (from, to) = (point(&start), point(&self.position));
         let moves_in_plane = from != to || matches!(path, Path::Arc { .. });
-        let linear = matches!(self.step_mut(index).motion, Motion::Rapid | Motion::Feed) && path == Path::Straight;
+        let linear = matches!(self.steps.get(index).motion, Motion::Rapid | Motion::Feed) && path == Path::Straight;
         let pieces = match (self.compensator.take(), side) {
             (None, Some(side)) if moves_in_plane && linear => {
                 let radius = f64::from(self.corrections.entry(self.correction).radius) / 1000.0;
@@ -803,7 +800,7 @@ impl Runner {
         let (a, b) = (slot(plane.0), slot(plane.1));
         for piece in pieces {
             let length = piece.path.length();
-            let step = self.step_mut(piece.block);
+            let step = self.steps.get(piece.block);
             let duration = match (step.motion, step.feed) {
                 (Motion::Feed, Some(feed)) => length / (feed * piece.feed_scale) * 60.0,
                 _ => {
@@ -819,7 +816,7 @@ impl Runner {
             // one or two calls (its corner, then its contour): its first
             // one replaces the programmed length and time.
             let first = self.tool_centre.last().is_none_or(|last| last.block != piece.block);
-            let step = self.step_mut(piece.block);
+            let step = self.steps.get_mut(piece.block);
             if first {
                 (step.length, step.duration) = (0.0, 0.0);
             }
@@ -865,32 +862,11 @@ impl Runner {
         self.steps.push(step);
     }
 
-    /// Step `index` of the run, not handed on yet.
-    fn step_mut(&mut self, index: usize) -> &mut Step {
-        &mut self.steps[index - self.delivered]
-    }
-
     /// Hands `sink` the steps no later block can change: all at the `end`,
     /// else those before the first one radius compensation may still fix.
     pub(super) fn deliver(&mut self, sink: &mut dyn StepSink, end: bool) {
-        let open = match &self.compensator {
-            Some(compensator) if !end => compensator.open_block() - self.delivered,
-            _ => self.steps.len(),
-        };
-        // The pieces of the steps handed on so far come first; the others,
-        // of the steps handed on now and of the open one, in the order
-        // compensation fixed them.
-        let first = self.tool_centre.partition_point(|piece| piece.block < self.delivered);
-        self.delivered += open;
-        let fresh = &mut self.tool_centre[first..];
-        fresh.sort_by_key(|piece| piece.block);
-        let fixed = first + fresh.partition_point(|piece| piece.block < self.delivered);
-        sink.references(&self.frames, &self.compensated, &self.tool_centre[first..fixed]);
-        if open == self.steps.len() {
-            sink.steps(&mut self.steps);
-        } else {
-            self.steps.drain(..open).for_each(|step| sink.step(step));
-        }
+        let open = self.compensator.as_ref().filter(|_| !end).map(Compensator::open_block);
+        self.steps.deliver(sink, open, &self.frames, &self.compensated, &mut self.tool_centre);
     }
 
     /// A position by letter over the machine's axes, as steps keep it.

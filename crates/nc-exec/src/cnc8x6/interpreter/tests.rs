@@ -1,23 +1,13 @@
 use std::f64::consts::PI;
 
-use std::ops::ControlFlow;
-
-use ncc_syntax::TextSize;
-
 use crate::run::{
-    Axes, Called, Checkpoint, DELIVERY_BATCH, Environment, Motion, NoFiles, Path, Step, StepSink, Stop, Trace,
-    resume_into, round3, run, run_into,
+    Axes, Called, Checkpoint, Checkpoints, DELIVERY_BATCH, Environment, Motion, NoFiles, Path, Step, StepSink, Stop,
+    Trace, resume_into, round3, run, run_into,
 };
 use crate::{
     machine::OffsetTable,
     machine::{MachineConfig, TravelLimits},
 };
-
-impl StepSink for Vec<Step> {
-    fn step(&mut self, step: Step) {
-        self.push(step);
-    }
-}
 
 /// Takes steps until it has `room` of them, then is closed.
 struct Closing {
@@ -63,32 +53,6 @@ fn a_streamed_run_hands_on_the_steps_a_kept_run_keeps() {
     assert!(trace.steps.is_empty());
     assert_eq!(streamed, kept.steps);
     assert_eq!(Trace { steps: streamed, ..trace }, kept);
-}
-
-/// The steps of a run after its first `before`, and a checkpoint
-/// every `every` blocks (none for 0).
-#[derive(Default)]
-struct Checkpoints {
-    before: usize,
-    steps: Vec<Step>,
-    taken: Vec<Checkpoint>,
-    every: usize,
-}
-
-impl StepSink for Checkpoints {
-    fn step(&mut self, step: Step) {
-        self.steps.push(step);
-    }
-
-    fn checkpoint_wanted(&mut self, block: usize, _offset: TextSize) -> bool {
-        self.every > 0 && block.is_multiple_of(self.every)
-    }
-
-    fn checkpoint(&mut self, checkpoint: Checkpoint) -> ControlFlow<()> {
-        assert_eq!(checkpoint.steps(), self.before + self.steps.len(), "every step before it is handed on");
-        self.taken.push(checkpoint);
-        ControlFlow::Continue(())
-    }
 }
 
 /// Modal state, a parameter and a zero offset set early, then blocks

@@ -39,7 +39,7 @@ use crate::{
 const THREAD_CHAMFER: &str = "M10";
 
 /// What the canned cycles keep between blocks.
-#[derive(Default)]
+#[derive(Clone, Default, PartialEq)]
 pub(super) struct CycleState {
     /// G90/G92/G94: the last target (Z, X radius) and taper, for the blocks
     /// that repeat the cycle with some of its words (lathe manual §6.18
@@ -56,6 +56,7 @@ pub(super) struct CycleState {
 }
 
 /// A move of a cycle, timed, with its end, stop and compensation.
+#[derive(Clone, PartialEq)]
 pub(super) struct CycleStep {
     pub(super) moved: Moved,
     pub(super) end: Axes,
@@ -66,7 +67,7 @@ pub(super) struct CycleStep {
 /// The drilling cycle's words as last written, for the blocks that repeat
 /// it at another position (lathe manual §6.1 (001:1077-1078)): kept until
 /// the cycle ends, as Fanuc and Haas do (the manual does not say).
-#[derive(Default)]
+#[derive(Clone, Default, PartialEq)]
 pub(super) struct DrillingWords {
     depth: Option<f64>,
     plane: Option<f64>,
@@ -77,7 +78,7 @@ pub(super) struct DrillingWords {
 impl Interpreter<'_> {
     /// A G70–G76 block: its cycle's moves, the last one the block's own.
     pub(super) fn canned(&mut self, code: u32, at: usize, block: &HaasBlock, range: TextRange) -> Moved {
-        let settings = Settings::of(self.machine);
+        let settings = Settings::of(&self.machine);
         let (z, x) = (slot(b'Z'), slot(b'X'));
         let position = self.position;
         let start = [position[z], position[x]];
@@ -171,7 +172,7 @@ impl Interpreter<'_> {
         let moves = match code {
             90 => cycles::turning(start, target, taper),
             94 => cycles::facing(start, target, taper),
-            _ => cycles::threading_pass(start, target, taper, lead, self.chamfer(lead, &Settings::of(self.machine))),
+            _ => cycles::threading_pass(start, target, taper, lead, self.chamfer(lead, &Settings::of(&self.machine))),
         };
         self.emit(range, Ok(moves))
     }
@@ -219,7 +220,7 @@ impl Interpreter<'_> {
             _ => 0.0,
         };
         let hole = Hole { code, x: end[x], plane, depth, pecks, dwell, lead };
-        let settings = Settings::of(self.machine);
+        let settings = Settings::of(&self.machine);
         let moves = match repeats.unwrap_or(1.0) {
             times if times >= 0.0 && times.fract() == 0.0 && times <= cycles::MAX_PASSES as f64 => {
                 cycles::drilling(&hole, &settings).and_then(|one| {

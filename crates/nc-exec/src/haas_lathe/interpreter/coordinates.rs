@@ -50,7 +50,7 @@ use ncc_syntax::TextRange;
 const WORK_OFFSET: &str = "G12";
 
 /// What the coordinates keep between blocks.
-#[derive(Default)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub(super) struct Coordinates {
     /// G52's shift (Z, X radius).
     local: Point,
@@ -84,18 +84,18 @@ pub(crate) fn reset_frame(machine: &MachineConfig) -> Frame {
 impl Interpreter<'_> {
     /// The run's first frame, the tool at the machine zero.
     pub(super) fn start_coordinates(&mut self) {
-        self.coordinates.translation = work_offset(self.machine, 54);
+        self.coordinates.translation = work_offset(&self.machine, 54);
         let [z, x] = self.coordinates.translation;
         // 0 - 0 is 0, where -0 would print as -0.
         (self.position[slot(b'Z')], self.position[slot(b'X')]) = (0.0 - z, 0.0 - x);
-        self.frames = vec![frame(self.machine, [z, x])];
+        self.frames = vec![frame(&self.machine, [z, x])];
     }
 
     /// Puts in force the frame of the work offset and G52 in force: the
     /// tool stays where it is, its program position changes.
     pub(super) fn update_frame(&mut self) {
         let code = self.modes.get(WORK_OFFSET).and_then(|code| u8::try_from(code).ok()).unwrap_or(54);
-        let [z, x] = work_offset(self.machine, code);
+        let [z, x] = work_offset(&self.machine, code);
         let translation = [z + self.coordinates.local[0], x + self.coordinates.local[1]];
         let before = std::mem::replace(&mut self.coordinates.translation, translation);
         if before == translation {
@@ -108,7 +108,7 @@ impl Interpreter<'_> {
 
     /// The index of the frame of `translation`, added when new.
     pub(super) fn frame_of(&mut self, translation: Point) -> usize {
-        let frame = frame(self.machine, translation);
+        let frame = frame(&self.machine, translation);
         match self.frames.iter().position(|known| *known == frame) {
             Some(index) => index,
             None => {

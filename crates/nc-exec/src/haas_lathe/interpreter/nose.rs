@@ -76,6 +76,13 @@ pub(super) struct Nose {
     frame: usize,
 }
 
+impl Nose {
+    /// The first step whose tool path may still change.
+    pub(super) fn open_step(&self) -> usize {
+        self.compensator.open_block()
+    }
+}
+
 impl Interpreter<'_> {
     /// The side G41 or G42 puts the tool on; `None` under G40.
     pub(super) fn nose_side(&self) -> Option<Side> {
@@ -92,7 +99,7 @@ impl Interpreter<'_> {
     /// length and time on the steps it belongs to, one move late as the
     /// control's look-ahead fixes them.
     pub(super) fn compensate(&mut self, index: usize, from: Point, to: Point, side: Option<Side>) {
-        let step = &self.steps[index];
+        let step = self.steps.get(index);
         let (range, frame) = (step.range, step.frame);
         let moves = from != to || matches!(step.path, Path::Arc { .. });
         let line = matches!(step.motion, Motion::Rapid | Motion::Feed) && step.path == Path::Straight;
@@ -161,7 +168,7 @@ impl Interpreter<'_> {
     }
 
     fn compensation_failed(&mut self, error: &CompensationError) {
-        let range = self.steps[error.block()].range;
+        let range = self.steps.get(error.block()).range;
         let message = match *error {
             CompensationError::NoIntersection { .. } => {
                 "the nose-centre paths of this move and the one before do not meet: the control stops".to_owned()
@@ -181,7 +188,7 @@ impl Interpreter<'_> {
             let piece = ToolElement { path: shifted(piece.path, tip), ..piece };
             let length = piece.path.length();
             let (start, end) = (piece.path.start(), piece.path.end());
-            let step = &self.steps[piece.block];
+            let step = self.steps.get(piece.block);
             let duration = match (step.motion, step.feed) {
                 (Motion::Feed, Some(feed)) => length / feed * 60.0,
                 (Motion::Feed, None) => 0.0,
@@ -190,7 +197,7 @@ impl Interpreter<'_> {
             // A block's pieces come together (its corner, then its
             // contour): the first replaces the programmed length and time.
             let first = self.tool_centre.last().is_none_or(|last| last.block != piece.block);
-            let step = &mut self.steps[piece.block];
+            let step = self.steps.get_mut(piece.block);
             if first {
                 (step.length, step.duration) = (0.0, 0.0);
             }
