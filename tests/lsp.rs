@@ -458,6 +458,41 @@ fn the_plot_command_draws_a_lathe_in_the_view_asked_for() {
     assert_serving(&mut client, &dir);
 }
 
+/// Completion in a Haas lathe program: the calls' targets, each replacing
+/// its word, and the letters that ask for them announced.
+#[test]
+fn completion_in_a_haas_program_offers_the_targets() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut client = server();
+    let initialized = client.initialize(dir.path(), None).unwrap();
+    let triggers = &initialized.result().unwrap()["capabilities"]["completionProvider"]["triggerCharacters"];
+    for letter in ["#", "G", "L", "M", "P", "Q", "R"] {
+        assert!(triggers.as_array().is_some_and(|t| t.contains(&json!(letter))), "{letter} in {triggers}");
+    }
+    let called = document(&dir, "O02000.nc", "%\nO02000 (SUB)\nM99\n%\n");
+    open(&mut client, &called);
+    let text = "%\nO01000\nM97 P20\nM98 P2\nM30\nN20 G00 X10.\nM99\n%\n";
+    let doc = document(&dir, "O01000.nc", text);
+    open(&mut client, &doc);
+    let complete = |client: &mut Client, after: &str| {
+        let offset = text.find(after).unwrap() + after.len();
+        let answer = client.call("textDocument/completion", doc.at(doc.position(offset))).unwrap();
+        answer.result().unwrap_or_else(|| panic!("{}", answer.json)).clone()
+    };
+    let items = complete(&mut client, "M97 P2");
+    assert_eq!(items[0]["label"], "P20", "{items}");
+    assert_eq!(items[0]["kind"], 18, "a reference: {items}");
+    assert_eq!(
+        items[0]["textEdit"]["range"],
+        json!({ "start": { "line": 2, "character": 4 }, "end": { "line": 2, "character": 7 } })
+    );
+    let items = complete(&mut client, "M98 P2");
+    assert_eq!(items[0]["label"], "P2000", "{items}");
+    assert_eq!(items[0]["detail"], "SUB", "{items}");
+    assert_eq!(items[0]["kind"], 3, "a function: {items}");
+    assert_serving(&mut client, &dir);
+}
+
 #[test]
 fn shutdown_then_exit_ends_with_success() {
     let (mut client, dir) = session();
