@@ -515,6 +515,69 @@ fn plot_draws_the_toolpath_as_svg() {
     assert!(svg.contains("XY plane · total time"), "{svg}");
 }
 
+/// A lathe's picture in either view: the cut at X50. (a diameter) runs at
+/// the scale's mark 25 in the radius view and at the marks 50 on both
+/// sides of the spindle axis in the diameter view, the default, which
+/// mirrors the path there; a mill's picture has no scale.
+#[test]
+fn plot_draws_a_lathe_in_the_radius_or_the_diameter_view() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("O0001.nc");
+    let text = "%\nO00001\nG18 G21 G99 G54\nT101\nG97 S1000 M03\nG00 X50. Z10.\nG01 Z-20. F0.2\nG00 X60.\nM30\n%\n";
+    std::fs::write(&program, text).unwrap();
+    let draw = |view: Option<&str>| {
+        let svg = dir.path().join("lathe.svg");
+        let mut args = vec!["plot", program.to_str().unwrap(), "-o", svg.to_str().unwrap()];
+        args.extend(view.map(|view| ["--view", view]).into_iter().flatten());
+        let output = ncc(&args);
+        assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
+        std::fs::read_to_string(svg).unwrap()
+    };
+    // The height of the cut (line 7), and of the scale's marks labelled `label`.
+    let cut_height = |svg: &str| -> f64 {
+        let cut = svg.lines().find(|line| line.starts_with("<path data-line=\"7\"")).unwrap();
+        let d = cut.split(" d=\"").nth(1).unwrap().split('"').next().unwrap();
+        d.rsplit(' ').next().unwrap().parse().unwrap()
+    };
+    let marks = |svg: &str, label: &str| -> Vec<f64> {
+        let scale = &svg[svg.find("<g id=\"scale\"").unwrap_or_else(|| panic!("no scale: {svg}"))..];
+        let scale = &scale[..scale.find("</g>").unwrap()];
+        let text = format!(">{label}</text>");
+        // Each label sits 2 pixels above its grid line.
+        scale
+            .lines()
+            .filter(|line| line.ends_with(&text))
+            .map(|line| line.split(" y=\"").nth(1).unwrap().split('"').next().unwrap().parse::<f64>().unwrap() + 2.0)
+            .collect()
+    };
+
+    let radius = draw(Some("radius"));
+    assert_eq!(marks(&radius, "25"), [cut_height(&radius)], "{radius}");
+    assert!(marks(&radius, "50").is_empty(), "{radius}");
+    assert!(!radius.contains("mirror-image") && radius.contains("ZX plane, X as a radius"), "{radius}");
+
+    let diameter = draw(Some("diameter"));
+    assert_eq!(draw(None), diameter, "the diameter view is the default");
+    let (cut, axis) = (cut_height(&diameter), spindle_axis_height(&diameter));
+    assert_eq!(marks(&diameter, "50"), [cut, 2.0 * axis - cut], "{diameter}");
+    assert!(diameter.contains(&format!("<g id=\"mirror-image\" transform=\"matrix(1 0 0 -1 0 {:.2})\"", 2.0 * axis)));
+    assert!(diameter.contains("ZX plane, X as a diameter"), "{diameter}");
+
+    let mill = dir.path().join("MILL.NCP");
+    std::fs::write(&mill, "%1\nN1 G00 X10 Y0\nN2 G01 X20 F600\nN3 M30\n").unwrap();
+    let svg = dir.path().join("mill.svg");
+    let output = ncc(&["plot", mill.to_str().unwrap(), "-o", svg.to_str().unwrap(), "--view", "radius"]);
+    assert_eq!(output.status.code(), Some(0));
+    let svg = std::fs::read_to_string(svg).unwrap();
+    assert!(!svg.contains("id=\"scale\"") && !svg.contains("mirror-image") && svg.contains("XY plane ·"), "{svg}");
+}
+
+/// The height in pixels of a lathe picture's spindle axis.
+fn spindle_axis_height(svg: &str) -> f64 {
+    let axis = svg.lines().find(|line| line.starts_with("<line id=\"spindle-axis\"")).unwrap();
+    axis.split(" y1=\"").nth(1).unwrap().split('"').next().unwrap().parse().unwrap()
+}
+
 /// On a lathe the summary gives the end on the diameter axis as the
 /// diameter the program wrote (`N640 G00 X100. Z100.`), the JSON as a radius.
 #[test]

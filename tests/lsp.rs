@@ -370,6 +370,7 @@ fn the_plot_command_draws_the_document_as_edited() {
     let first_time = result["totalTimeS"].as_f64().unwrap();
     assert!(first_time > 0.0, "{result}");
     assert_eq!(result["findings"], json!([]));
+    assert_eq!(result["view"], Value::Null, "a mill has no view to choose: {result}");
 
     // An edit that is not saved: a move on a new line 5.
     let n40 = doc.text().find("N40").unwrap();
@@ -393,8 +394,10 @@ fn the_plot_command_draws_the_document_as_edited() {
     for (arguments, expected) in [
         (json!([elsewhere]), "is not open"),
         (json!(["not a uri"]), "is not a URI"),
-        (json!([]), "takes one argument"),
-        (json!([{ "uri": doc.uri }]), "takes one argument"),
+        (json!([]), "takes the document's URI"),
+        (json!([{ "uri": doc.uri }]), "takes the document's URI"),
+        (json!([doc.uri, { "view": "sideways" }]), "unknown variant `sideways`"),
+        (json!([doc.uri, { "zoom": 2 }]), "unknown field `zoom`"),
     ] {
         let answer = plot(&mut client, arguments.clone());
         assert_eq!(answer.error_code(), Some(INVALID_PARAMS), "{arguments}: {}", answer.json);
@@ -419,6 +422,74 @@ fn the_plot_command_draws_the_document_as_edited() {
     let answer = plot(&mut client, json!([untitled.uri]));
     let result = answer.result().unwrap_or_else(|| panic!("{}", answer.json));
     assert_eq!(plotted_moves(result["svg"].as_str().unwrap()), [(2, None)], "{result}");
+    assert_serving(&mut client, &dir);
+}
+
+/// `ncc.plot` draws a lathe's program in the view asked for, the diameter
+/// view by default, as `ncc plot --view` does, and says which it drew.
+#[test]
+fn the_plot_command_draws_a_lathe_in_the_view_asked_for() {
+    let (mut client, dir) = session();
+    let text = "%\nO00001\nG18 G21 G99 G54\nT101\nG97 S1000 M03\nG00 X50. Z10.\nG01 Z-20. F0.2\nM30\n%\n";
+    let doc = document(&dir, "O0001.nc", text);
+    open(&mut client, &doc);
+    let program = dir.path().join("O0001.nc");
+    std::fs::write(&program, text).unwrap();
+    for (options, view) in
+        [(None, "diameter"), (Some(json!({})), "diameter"), (Some(json!({ "view": "radius" })), "radius")]
+    {
+        let arguments = match &options {
+            Some(options) => json!([doc.uri, options]),
+            None => json!([doc.uri]),
+        };
+        let answer = plot(&mut client, arguments);
+        let result = answer.result().unwrap_or_else(|| panic!("{}", answer.json));
+        assert_eq!(result["view"], view, "{options:?}: {result}");
+        let out = dir.path().join("plot.svg");
+        let status = Command::new(env!("CARGO_BIN_EXE_ncc"))
+            .args(["plot", "--view", view, "-o"])
+            .arg(&out)
+            .arg(&program)
+            .status()
+            .unwrap();
+        assert!(status.success());
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), result["svg"], "{options:?}: ncc plot and ncc.plot differ");
+    }
+    assert_serving(&mut client, &dir);
+}
+
+/// Completion in a Haas lathe program: the calls' targets, each replacing
+/// its word, and the letters that ask for them announced.
+#[test]
+fn completion_in_a_haas_program_offers_the_targets() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut client = server();
+    let initialized = client.initialize(dir.path(), None).unwrap();
+    let triggers = &initialized.result().unwrap()["capabilities"]["completionProvider"]["triggerCharacters"];
+    for letter in ["#", "G", "L", "M", "P", "Q", "R"] {
+        assert!(triggers.as_array().is_some_and(|t| t.contains(&json!(letter))), "{letter} in {triggers}");
+    }
+    let called = document(&dir, "O02000.nc", "%\nO02000 (SUB)\nM99\n%\n");
+    open(&mut client, &called);
+    let text = "%\nO01000\nM97 P20\nM98 P2\nM30\nN20 G00 X10.\nM99\n%\n";
+    let doc = document(&dir, "O01000.nc", text);
+    open(&mut client, &doc);
+    let complete = |client: &mut Client, after: &str| {
+        let offset = text.find(after).unwrap() + after.len();
+        let answer = client.call("textDocument/completion", doc.at(doc.position(offset))).unwrap();
+        answer.result().unwrap_or_else(|| panic!("{}", answer.json)).clone()
+    };
+    let items = complete(&mut client, "M97 P2");
+    assert_eq!(items[0]["label"], "P20", "{items}");
+    assert_eq!(items[0]["kind"], 18, "a reference: {items}");
+    assert_eq!(
+        items[0]["textEdit"]["range"],
+        json!({ "start": { "line": 2, "character": 4 }, "end": { "line": 2, "character": 7 } })
+    );
+    let items = complete(&mut client, "M98 P2");
+    assert_eq!(items[0]["label"], "P2000", "{items}");
+    assert_eq!(items[0]["detail"], "SUB", "{items}");
+    assert_eq!(items[0]["kind"], 3, "a function: {items}");
     assert_serving(&mut client, &dir);
 }
 

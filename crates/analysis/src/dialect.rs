@@ -72,15 +72,6 @@ pub(crate) fn code_fits_machine(dialect: Dialect, letter: char, number: u32, con
     }
 }
 
-/// What the centre words of the block's arc mean, by address letter, when
-/// the block draws one.
-pub(crate) fn arc_centre(dialect: Dialect, block: &BlockData, config: &Config) -> Vec<(u8, String)> {
-    match dialect {
-        Dialect::Cnc8x6 => cnc8x6::ide::arc_centre(block, config),
-        Dialect::HaasLathe => haas_lathe::ide::arc_centre(block),
-    }
-}
-
 /// Whether `word` is the code that starts a subprogram.
 pub(crate) fn starts_unit(dialect: Dialect, block: &BlockData, word: &Word) -> bool {
     match dialect {

@@ -4,7 +4,7 @@
 mod strategies;
 
 use expect_test::{Expect, expect};
-use ncc_analysis::{AnalysisHost, CompletionItem, CompletionKind, Config, TextRange, TextSize};
+use ncc_analysis::{AnalysisHost, CompletionItem, CompletionKind, Config, Dialect, TextRange, TextSize};
 use proptest::prelude::*;
 use strategies::{block_program, crowded_lines, overlong_lines, program_text};
 
@@ -310,6 +310,167 @@ proptest! {
         }
         for hint in analysis.inlay_hints(file, Some(TextRange::empty(offset))) {
             prop_assert!(hint.offset <= end);
+        }
+    }
+}
+
+/// A Haas lathe program with contours, calls, a jump and macro variables;
+/// `$0` goes in where a test puts it.
+const HAAS: &str = "%
+O01000 (MAIN)
+#100=2.5
+#101=#100*2
+G00 X50. Z2. (START #7)
+G71 P10 Q20 U0.4 W0.1 D2. F0.25
+N10 G00 X20.
+N15 G01 Z-20.
+N20 X50.
+G70 P10 Q20
+M97 P100
+M98 P2000
+IF [#100 GT 1] GOTO 30
+G01 X#101 Z0
+N30 M30
+N100 G01 X10.
+M99
+%
+";
+
+/// The completions in a Haas lathe workspace with `HAAS` as `O01000.nc`,
+/// `before` replaced by `after` (with its `$0`), beside a program O02000
+/// and a file named after program 3000.
+fn haas_completions(before: &str, after: &str) -> (String, Vec<CompletionItem>) {
+    assert!(HAAS.contains(before), "`{before}` in the program");
+    let program = HAAS.replacen(before, after, 1);
+    let mut host = AnalysisHost::in_dialect(Dialect::HaasLathe, Config::default());
+    let main = host.add_file("O01000.nc", program.replace("$0", ""));
+    host.add_file("O02000.nc", "%\nO02000 (SUB)\nG00 X1.\nM99\n%\n");
+    host.add_file("O3000.nc", "G01 U-1.\nM99\n");
+    let offset = TextSize::try_from(program.find("$0").expect("a `$0` cursor")).unwrap();
+    let analysis = host.analysis();
+    (analysis.text(main).to_string(), analysis.completions(main, offset))
+}
+
+/// P of a contour cycle: the numbered blocks after the cycle; Q: those
+/// from the P block on; each with its block's line and what it replaces.
+#[test]
+fn haas_contour_words_complete_the_blocks_of_the_program() {
+    let (text, items) = haas_completions("G71 P10 Q20", "G71 P1$0 Q20");
+    expect![[r#"
+        P10 (Block) N10 G00 X20. [P1]
+        P15 (Block) N15 G01 Z-20. [P1]
+        P20 (Block) N20 X50. [P1]
+        P30 (Block) N30 M30 [P1]
+        P100 (Block) N100 G01 X10. [P1]"#]]
+    .assert_eq(&show(&text, &items));
+    assert_eq!(items[0].documentation.as_deref(), Some("```text\nN10 G00 X20.\n```"));
+    let (_, items) = haas_completions("G70 P10 Q20", "G70 P15 Q$0");
+    assert_eq!(labels(&items), "Q15 Q20 Q30 Q100");
+    // A P that names no block: Q from the cycle on.
+    let (_, items) = haas_completions("G70 P10 Q20", "G70 P99 Q$0");
+    assert_eq!(labels(&items), "Q30 Q100");
+}
+
+/// M97 P and GOTO name any numbered block of the program; M98 P and G65 P
+/// the other programs of the workspace, by `O` line or by file name.
+#[test]
+fn haas_calls_and_jumps_complete_their_targets() {
+    let (_, items) = haas_completions("M97 P100", "M97 P$0");
+    assert_eq!(labels(&items), "P10 P15 P20 P30 P100");
+    let (text, items) = haas_completions("GOTO 30", "GOTO 3$0");
+    expect![[r#"
+        10 (Block) N10 G00 X20. [3]
+        15 (Block) N15 G01 Z-20. [3]
+        20 (Block) N20 X50. [3]
+        30 (Block) N30 M30 [3]
+        100 (Block) N100 G01 X10. [3]"#]]
+    .assert_eq(&show(&text, &items));
+    for (call, typed) in [("M98 P$0", "P"), ("G65 P2$0 A1.", "P2")] {
+        let (text, items) = haas_completions("M98 P2000", call);
+        let expected = format!("P2000 (Program) SUB [{typed}]\nP3000 (Program) G01 U-1. [{typed}]");
+        assert_eq!(show(&text, &items), expected, "{call}");
+        assert_eq!(items[0].documentation.as_deref(), Some("`O02000.nc`\n\n```text\nO02000 (SUB)\n```"), "{call}");
+    }
+}
+
+/// After `#`: the variables the program uses, with their values before the
+/// block as far as the walk knows them, then those the catalogue
+/// documents; a comment's `#7` is no variable.
+#[test]
+fn haas_variables_complete_with_their_values() {
+    let (text, items) = haas_completions("G00 X50. Z2.", "G00 X#10$0 Z2.");
+    let shown = show(&text, &items);
+    let lines: Vec<&str> = shown.lines().collect();
+    let values = ["#10 (Parameter) = vacant [#10]", "#100 (Parameter) = 2.5 [#10]", "#101 (Parameter) = 5 [#10]"];
+    assert_eq!(lines[..3], values, "{shown}");
+    assert!(items[1].documentation.as_ref().unwrap().ends_with("**Before this block:** 2.5"), "{:?}", items[1]);
+    assert!(!labels(&items).split(' ').any(|label| label == "#7"), "{shown}");
+    // The documented ranges: short ones in full, long ones by their first.
+    assert!(lines.contains(&"#1 (Parameter) Local variables (macro arguments) (#1–#33) [#10]"), "{shown}");
+    assert!(labels(&items).split(' ').any(|label| label == "#3001"), "{shown}");
+    assert!(
+        labels(&items).split(' ').any(|label| label == "#5201")
+            && !labels(&items).split(' ').any(|label| label == "#5202"),
+        "{shown}"
+    );
+    // Before the second assignment, the first one holds.
+    let (_, items) = haas_completions("#101=#100*2", "#101=#$0100*2");
+    assert_eq!(items[..2].iter().map(|item| item.detail.as_str()).collect::<Vec<_>>(), ["= 2.5", "= vacant"]);
+    assert_eq!(items[0].replace.len(), TextSize::from(4), "`#100` whole");
+}
+
+/// The macro keywords where a statement starts, after a condition, and in
+/// expressions: functions where an operand starts, named operators after
+/// one.
+#[test]
+fn haas_keywords_complete_where_the_language_takes_them() {
+    let (text, items) = haas_completions("IF [#100 GT 1] GOTO 30", "WH$0");
+    expect![[r#"
+        IF (Keyword) IF [condition] GOTO n, or IF [condition] THEN #v = e [WH]
+        GOTO (Keyword) GOTO n: go on at block Nn [WH]
+        WHILE (Keyword) WHILE [condition] DOn … ENDn [WH]
+        DO (Keyword) DOn … ENDn: loop n, while the condition of a WHILE before it holds [WH]
+        END (Keyword) ENDn: the end of loop n [WH]"#]]
+    .assert_eq(&show(&text, &items));
+    let (_, items) = haas_completions("GOTO 30", "$0");
+    assert_eq!(labels(&items), "THEN GOTO");
+    let (_, items) = haas_completions("IF [#100 GT 1] GOTO 30", "WHILE [#100 LT 3] $0");
+    assert_eq!(labels(&items), "DO");
+    let (_, items) = haas_completions("#101=#100*2", "#101=S$0");
+    assert_eq!(labels(&items), "SIN COS TAN ATAN ASIN ACOS SQRT ABS ROUND FIX FUP");
+    assert!(items[0].documentation.as_ref().unwrap().contains("SIN"), "{:?}", items[0]);
+    let (_, items) = haas_completions("[#100 GT 1]", "[#100 $0GT 1]");
+    assert_eq!(labels(&items), "MOD EQ NE GT GE LT LE AND OR XOR");
+    // Where a word starts: the addresses, the codes and the statements.
+    let (_, items) = haas_completions("N30 M30", "N30 $0M30");
+    let found = labels(&items);
+    let found: Vec<&str> = found.split(' ').collect();
+    for label in ["X", "Z", "#", "G00", "G71", "M98", "IF", "WHILE", "END"] {
+        assert!(found.contains(&label), "{label} in {found:?}");
+    }
+    assert!(!found.contains(&"THEN") && !found.contains(&"Y"), "{found:?}");
+    // In a comment, nothing.
+    assert!(haas_completions("(START #7)", "(START $0#7)").1.is_empty());
+}
+
+/// Completion at every position of Haas texts, whole and broken: no
+/// panic, and every item replaces text around the cursor.
+#[test]
+fn haas_completions_anywhere() {
+    let broken =
+        "%\nO1 (ÚVOD 🙂\nIF [#1 EQ [SIN[#[#2] GOTO\n#3=#\nWHILE [ DO1\nM98 P-1.5 (x)\nG71 P Q\nN1 END1 #1=ROUND[\r\n";
+    for text in [HAAS, broken] {
+        let mut host = AnalysisHost::in_dialect(Dialect::HaasLathe, Config::default());
+        let file = host.add_file("O00001.nc", text);
+        let analysis = host.analysis();
+        for offset in (0..=text.len()).filter(|&at| text.is_char_boundary(at)) {
+            let offset = TextSize::try_from(offset).unwrap();
+            for item in analysis.completions(file, offset) {
+                assert!(
+                    item.replace.contains_inclusive(offset) && item.replace.end() <= TextSize::of(text),
+                    "{item:?}"
+                );
+            }
         }
     }
 }

@@ -142,6 +142,11 @@ enum Command {
         /// in the legend stay the whole run's).
         #[arg(long, default_value_t = plot::DEFAULT_MAX_MOVES)]
         max_moves: usize,
+        /// On a lathe: `diameter` draws the whole profile, mirrored about
+        /// the spindle axis, with X labelled as the program's diameters;
+        /// `radius` draws the machined half with X labelled as radii.
+        #[arg(long, value_enum, default_value_t = plot::View::Diameter)]
+        view: plot::View,
     },
     /// Write a program as the moves it runs: plain numbered blocks with
     /// calls, jumps, cycles and parameters resolved.
@@ -193,8 +198,8 @@ fn main() -> ExitCode {
         Command::Run { file, format, step_budget } => run::run(&file, dialect, format, step_budget),
         Command::Expand { file, output, step_budget } => run::expand(&file, dialect, output.as_deref(), step_budget),
         Command::Lower { file } => run::lower(&file, dialect),
-        Command::Plot { file, output, step_budget, max_moves } => {
-            run::plot(&file, dialect, &output, step_budget, max_moves)
+        Command::Plot { file, output, step_budget, max_moves, view } => {
+            run::plot(&file, dialect, &output, step_budget, max_moves, view)
         }
         Command::Parse { file } => run::parse(&file, dialect),
     }

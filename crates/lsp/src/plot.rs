@@ -12,6 +12,16 @@
 //!
 //! A long run draws its first moves only ([`Sketch`]): a picture of
 //! millions of moves is of no use to a browser, and would hold them all.
+//!
+//! A lathe's picture ([`Trace::diameter_axis`]) has a scale in program
+//! units along both axes and one of two [`View`]s. Either is drawn to true
+//! scale, so that tapers keep their angle and arcs stay round: the
+//! diameter view, the default since the program's X words are diameters,
+//! draws the part's whole profile, the path mirrored about the spindle
+//! axis, and labels the X scale with diameters, so that a move to X50.
+//! runs at the mark 50; the radius view draws the machined half and labels
+//! radii. Stretching X to twice its scale instead would put X50. at 50 too,
+//! but bend every taper and arc of the picture.
 
 use std::fmt::Write as _;
 
@@ -29,6 +39,24 @@ const LEGEND_HEIGHT: f64 = 70.0;
 const PALETTE: [&str; 5] = ["#3b4cc0", "#6f9bf5", "#a9c66a", "#f4a259", "#d1342f"];
 /// The programmed contour under radius compensation.
 const PROGRAMMED_STYLE: &str = r##"stroke="#111" stroke-width="0.8" stroke-dasharray="1.5 2""##;
+
+/// How a lathe's picture shows the diameter axis.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, clap::ValueEnum, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub(crate) enum View {
+    /// The machined half profile, X labelled as a radius.
+    Radius,
+    /// The whole profile, mirrored about the spindle axis, X labelled as a
+    /// diameter.
+    #[default]
+    Diameter,
+}
+
+/// The scale's tick labels, the centre line and the mirror image.
+const SCALE_STYLE: &str = r##"fill="#666" font-size="10" stroke="white" stroke-width="3" paint-order="stroke""##;
+const GRID_STYLE: &str = r##"stroke="#e4e4e4" stroke-width="0.6""##;
+const CENTRE_LINE_STYLE: &str = r##"stroke="#555" stroke-width="0.8" stroke-dasharray="12 3 2 3""##;
+const MIRROR_OPACITY: f64 = 0.35;
 
 /// The moves a picture draws at most unless told otherwise: a browser
 /// still shows this many, each with its tooltip.
@@ -112,8 +140,9 @@ struct Drawn {
 }
 
 /// The SVG text of the run `sketch` kept, whose kept steps `trace` holds,
-/// titled `title`.
-pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &str) -> String {
+/// titled `title`; a lathe's in `view`.
+pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &str, view: View) -> String {
+    let lathe_view = trace.diameter_axis.map(|_| view);
     let (across, up) = view_axes(trace);
     let slot = |letter: u8| trace.axes.iter().position(|&axis| axis == letter);
     let (Some(u), Some(v)) = (slot(across), slot(up)) else { return String::new() };
@@ -145,6 +174,10 @@ pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &st
         min = (0.0, 0.0);
         max = (1.0, 1.0);
     }
+    if lathe_view == Some(View::Diameter) {
+        let reach = min.1.abs().max(max.1.abs());
+        (min.1, max.1) = (-reach, reach);
+    }
     let span = (max.0 - min.0).max(max.1 - min.1).max(1e-3);
     let scale = (WIDTH - 2.0 * MARGIN) / span;
     let height = (max.1 - min.1) * scale + 2.0 * MARGIN;
@@ -171,6 +204,20 @@ pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &st
     );
     let _ = writeln!(out, "<title>{}</title>", escape(title));
     let _ = writeln!(out, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    // Written over the drawing, so that no move hides them.
+    let mut scale_labels = String::new();
+    if let Some(view) = lathe_view {
+        let axis_y = pixel((0.0, 0.0)).1;
+        scale_labels = lathe_scale(&mut out, view, (min, max), &pixel, axis_y);
+        if view == View::Diameter {
+            // The other half of the profile, as the same layers reflected.
+            let _ = writeln!(
+                out,
+                r##"<g id="mirror-image" transform="matrix(1 0 0 -1 0 {:.2})" opacity="{MIRROR_OPACITY}"><use href="#tool-centre"/><use href="#programmed-contour"/></g>"##,
+                2.0 * axis_y
+            );
+        }
+    }
     let _ = writeln!(out, r#"<g id="tool-centre">"#);
     for (index, drawn) in drawn.iter().enumerate() {
         if drawn.tool.len() < 2 || !drawable(index) {
@@ -228,9 +275,79 @@ pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &st
             speed_break.lost
         );
     }
-    legend(&mut out, height, fastest, sketch, (across, up), compensated);
+    out.push_str(&scale_labels);
+    legend(&mut out, height, fastest, sketch, (across, up), compensated, lathe_view);
     out.push_str("</svg>\n");
     out
+}
+
+/// The lathe's scale: grid lines at round steps in program units, and the
+/// spindle axis as a centre line where it is in the picture, under the
+/// drawing; the lines' values, X as `view` labels it, to write over it.
+fn lathe_scale(
+    out: &mut String,
+    view: View,
+    (min, max): ((f64, f64), (f64, f64)),
+    pixel: &impl Fn((f64, f64)) -> (f64, f64),
+    axis_y: f64,
+) -> String {
+    let (left, top) = pixel((min.0, max.1));
+    let (right, bottom) = pixel((max.0, min.1));
+    let mut labels = format!("<g id=\"scale\" {SCALE_STYLE}>\n");
+    let _ = writeln!(out, r#"<g id="grid" {GRID_STYLE}>"#);
+    for (value, label) in ticks(min.0, max.0) {
+        let x = pixel((value, 0.0)).0;
+        let _ = writeln!(out, r#"<line x1="{x:.2}" y1="{top:.2}" x2="{x:.2}" y2="{bottom:.2}"/>"#);
+        let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, x + 2.0, bottom + 12.0);
+    }
+    let marks = match view {
+        View::Radius => ticks(min.1, max.1),
+        // Round diameters, on both halves of the profile alike.
+        View::Diameter => ticks(0.0, 2.0 * max.1)
+            .into_iter()
+            .flat_map(|(diameter, label)| {
+                let mirrored = (diameter > 0.0).then(|| (-diameter / 2.0, label.clone()));
+                [(diameter / 2.0, label)].into_iter().chain(mirrored)
+            })
+            .collect(),
+    };
+    for (value, label) in marks {
+        let y = pixel((0.0, value)).1;
+        let _ = writeln!(out, r#"<line x1="{left:.2}" y1="{y:.2}" x2="{right:.2}" y2="{y:.2}"/>"#);
+        let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, left + 2.0, y - 2.0);
+    }
+    let _ = writeln!(out, "</g>");
+    labels.push_str("</g>\n");
+    if (top - 0.01..=bottom + 0.01).contains(&axis_y) {
+        let _ = writeln!(
+            out,
+            r#"<line id="spindle-axis" x1="{left:.2}" y1="{axis_y:.2}" x2="{right:.2}" y2="{axis_y:.2}" {CENTRE_LINE_STYLE}/>"#
+        );
+    }
+    labels
+}
+
+/// The round values from `low` to `high`, about eight of them, each with
+/// its label.
+fn ticks(low: f64, high: f64) -> Vec<(f64, String)> {
+    let step = tick_step(low, high);
+    let places = (-step.log10().floor()).max(0.0) as usize;
+    let first = (low / step - 1e-9).ceil() as i64;
+    let last = (high / step + 1e-9).floor() as i64;
+    (first..=last)
+        .map(|i| {
+            let value = i as f64 * step;
+            // Adding zero makes -0 print as 0.
+            (value, format!("{:.places$}", value + 0.0))
+        })
+        .collect()
+}
+
+/// 1, 2 or 5 times a power of ten, for about eight ticks over the span.
+fn tick_step(low: f64, high: f64) -> f64 {
+    let rough = ((high - low) / 8.0).max(1e-3);
+    let power = 10f64.powf(rough.log10().floor());
+    [1.0, 2.0, 5.0, 10.0].into_iter().map(|factor| factor * power).find(|&step| step >= rough).unwrap_or(10.0 * power)
 }
 
 /// The plane of the picture: ZX on a lathe (the diameter axis up), else
@@ -278,7 +395,15 @@ fn colour(speed: f64, fastest: f64) -> &'static str {
     PALETTE[bucket.min(PALETTE.len() - 1)]
 }
 
-fn legend(out: &mut String, top: f64, fastest: f64, sketch: &Sketch, (across, up): (u8, u8), compensated: bool) {
+fn legend(
+    out: &mut String,
+    top: f64,
+    fastest: f64,
+    sketch: &Sketch,
+    (across, up): (u8, u8),
+    compensated: bool,
+    lathe_view: Option<View>,
+) {
     let y = top + 20.0;
     let buckets = PALETTE.len() as f64;
     for (i, colour) in PALETTE.iter().enumerate() {
@@ -305,9 +430,14 @@ fn legend(out: &mut String, top: f64, fastest: f64, sketch: &Sketch, (across, up
         let _ = writeln!(out, r#"<text x="{}" y="{y2}">programmed contour (G41/G42)</text>"#, x + 30.0);
         x += 220.0;
     }
+    let view = match lathe_view {
+        Some(View::Radius) => format!(", {} as a radius", char::from(up)),
+        Some(View::Diameter) => format!(", {} as a diameter", char::from(up)),
+        None => String::new(),
+    };
     let _ = writeln!(
         out,
-        r#"<text x="{x}" y="{y2}">{}{} plane · total time {} · {} breaks</text>"#,
+        r#"<text x="{x}" y="{y2}">{}{} plane{view} · total time {} · {} breaks</text>"#,
         char::from(across),
         char::from(up),
         ncc_analysis::clock(sketch.total_time),

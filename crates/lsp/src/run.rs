@@ -30,7 +30,7 @@ use serde::Serialize;
 
 use crate::{
     check::{self, shown_path},
-    plot::Sketch,
+    plot::{Sketch, View},
     positions::{Columns, TextIndex},
 };
 
@@ -173,11 +173,12 @@ impl Ran {
 
     /// Runs `program` through the velocity model as the steps come, keeping
     /// what the picture draws of the first `max_moves` ([`Sketch`]), and
-    /// draws it: the trace keeps those steps only.
+    /// draws it, a lathe's in `view`: the trace keeps those steps only.
     pub(crate) fn plotted(
         program: &Program<'_>,
         step_budget: usize,
         max_moves: usize,
+        view: View,
         progress: Progress,
     ) -> Result<(Ran, Plot), String> {
         let config = program.config()?;
@@ -193,9 +194,10 @@ impl Ran {
         let mut sketch = sketched.unwrap_or_else(|| Sketch::new(max_moves));
         ran.trace.steps = std::mem::take(&mut sketch.steps);
         let title = format!("{} · ncc plot", ran.sources[0].name);
-        let svg = crate::plot::svg(&ran.trace, &sketch, &ran, &title);
+        let svg = crate::plot::svg(&ran.trace, &sketch, &ran, &title, view);
         let capped = sketch.capped().map(|drawn| crate::plot::capped_note(drawn, sketch.moves));
-        Ok((ran, Plot { svg, total_time: sketch.total_time, capped }))
+        let view = ran.trace.diameter_axis.map(|_| view);
+        Ok((ran, Plot { svg, total_time: sketch.total_time, capped, view }))
     }
 
     /// Runs `program` with `execute` (which keeps the steps or hands them
@@ -281,6 +283,8 @@ pub(crate) struct Plot {
     pub total_time: f64,
     /// What the picture says when it draws only the first moves.
     pub capped: Option<String>,
+    /// The view of a lathe's picture; `None` off a lathe.
+    pub view: Option<View>,
 }
 
 /// Whether a long run shows a spinner.
@@ -399,19 +403,20 @@ fn expand_program(program: &Program<'_>, path: &Path, output: Option<&Path>, ste
 }
 
 /// `ncc plot FILE -o OUT`: the toolpath as an SVG picture of the first
-/// `max_moves` moves.
+/// `max_moves` moves, a lathe's in `view`.
 pub(crate) fn plot(
     path: &Path,
     dialect: Option<DialectId>,
     output: &Path,
     step_budget: usize,
     max_moves: usize,
+    view: View,
 ) -> ExitCode {
-    on_program(path, dialect, |program| plot_program(program, output, step_budget, max_moves))
+    on_program(path, dialect, |program| plot_program(program, output, step_budget, max_moves, view))
 }
 
-fn plot_program(program: &Program<'_>, output: &Path, step_budget: usize, max_moves: usize) -> ExitCode {
-    let (ran, picture) = match Ran::plotted(program, step_budget, max_moves, Progress::OnTerminal) {
+fn plot_program(program: &Program<'_>, output: &Path, step_budget: usize, max_moves: usize, view: View) -> ExitCode {
+    let (ran, picture) = match Ran::plotted(program, step_budget, max_moves, view, Progress::OnTerminal) {
         Ok(plotted) => plotted,
         Err(error) => return config_error(error),
     };

@@ -31,6 +31,8 @@ pub use ncc_catalog::Dialect;
 
 /// The typed layer over the tree (the CNC8x6 dialect's).
 pub use crate::cnc8x6::ast;
+/// The Haas lathe's macro statement words, with their forms.
+pub use crate::haas_lathe::STATEMENT_KEYWORDS as HAAS_STATEMENT_KEYWORDS;
 pub use crate::{
     cnc8x6::{BlockParser, MAX_LINE_CHARS},
     decimal::{Decimal, Sign},

@@ -14,7 +14,7 @@ import {
 } from 'vscode-languageclient/node';
 import { DOCUMENT_SELECTOR, TOOLPATH_LANGUAGES } from './documents';
 import { type Environment, type Launch, readSettings, ServerStderr, serverLaunch, startFailure } from './server';
-import { PLOT_COMMAND } from './toolpath';
+import { type LatheView, PLOT_COMMAND, plotArguments } from './toolpath';
 import { ToolpathViews } from './toolpathView';
 
 /** How long a server that exited at start may take to finish its stderr. */
@@ -24,8 +24,8 @@ let server: Server | undefined;
 
 export function activate(context: vscode.ExtensionContext): Promise<void> {
   const output = vscode.window.createOutputChannel('ncc', { log: true });
-  const views = new ToolpathViews(context.extensionUri, (uri) =>
-    server ? server.plot(uri) : Promise.reject(new Error('The ncc language server is not running.')),
+  const views = new ToolpathViews(context.extensionUri, (uri, view) =>
+    server ? server.plot(uri, view) : Promise.reject(new Error('The ncc language server is not running.')),
   );
   server = new Server(output, () => views.refresh());
   context.subscriptions.push(
@@ -200,17 +200,21 @@ class Server implements vscode.Disposable {
 
   /**
    * The picture of the open document at `uri`, drawn by the server from its
-   * current text (`ncc.plot`). Rejects with the server's error, whose `data`
-   * may hold the picture of a run that stopped.
+   * current text (`ncc.plot`), a lathe's in `view` (else the server's
+   * default). Rejects with the server's error, whose `data` may hold the
+   * picture of a run that stopped.
    */
-  async plot(uri: string): Promise<unknown> {
+  async plot(uri: string, view: LatheView | undefined): Promise<unknown> {
     // A restart in progress brings a client to ask.
     await this.restarting;
     const client = this.client;
     if (client === undefined || !client.isRunning()) {
       throw new Error('The ncc language server is not running.');
     }
-    return client.sendRequest(ExecuteCommandRequest.type, { command: PLOT_COMMAND, arguments: [uri] });
+    return client.sendRequest(ExecuteCommandRequest.type, {
+      command: PLOT_COMMAND,
+      arguments: plotArguments(uri, view),
+    });
   }
 
   /** Stops the server if it runs, and starts it. */

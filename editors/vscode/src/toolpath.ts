@@ -3,6 +3,9 @@
 // between the page and the extension, the line a click means, the answers
 // of the server's `ncc.plot` command and when to ask for them again.
 //
+// A lathe's picture comes in the radius or the diameter view (`ncc plot
+// --view`); the page offers the choice when the server says it drew one.
+//
 // The picture is the SVG of `ncc plot`, pure data: every move and mark
 // carries `data-line` (its line, from 1) and, when a macrocycle file or the
 // cycle file made it, `data-file` (that file's path). The page's script
@@ -17,12 +20,26 @@ export const VIEW_SCRIPT = 'toolpath.js';
 /** How long the document must rest before the picture is drawn again. */
 export const RENDER_DELAY_MS = 500;
 
+/** How a lathe's picture shows X: the machined half, or the whole profile labelled with diameters. */
+export type LatheView = 'radius' | 'diameter';
+
 /** The answer of `ncc.plot`. */
 export interface Plotted {
   svg: string;
   /** Seconds, with the control's velocity model. */
   totalTimeS: number;
   findings: Finding[];
+  /** The lathe's view drawn; `null` for a machine without a diameter axis. */
+  view: LatheView | null;
+}
+
+/** The arguments of `ncc.plot`: the document, and the view once one was chosen (else the server's default). */
+export function plotArguments(uri: string, view: LatheView | undefined): unknown[] {
+  return view === undefined ? [uri] : [uri, { view }];
+}
+
+function isLatheView(value: unknown): value is LatheView {
+  return value === 'radius' || value === 'diameter';
 }
 
 /** What the run did not run, or where it stopped. */
@@ -37,12 +54,12 @@ export interface Finding {
 
 /** Messages from the extension to the page. */
 export type ToView =
-  | { type: 'plot'; svg: string; summary: string; notes: string[] }
-  | { type: 'error'; message: string; svg?: string; notes: string[] }
+  | { type: 'plot'; svg: string; summary: string; notes: string[]; view: LatheView | null }
+  | { type: 'error'; message: string; svg?: string; notes: string[]; view?: LatheView | null }
   | { type: 'highlight'; line: number | null };
 
 /** Messages from the page to the extension. */
-export type FromView = { type: 'ready' } | Reveal;
+export type FromView = { type: 'ready' } | Reveal | { type: 'view'; view: LatheView };
 
 /** A click on a move or mark: show its line. */
 export interface Reveal {
@@ -93,9 +110,12 @@ export function parseFromView(message: unknown): FromView | undefined {
   if (typeof message !== 'object' || message === null) {
     return undefined;
   }
-  const { type, line, file } = message as Record<string, unknown>;
+  const { type, line, file, view } = message as Record<string, unknown>;
   if (type === 'ready') {
     return { type: 'ready' };
+  }
+  if (type === 'view') {
+    return isLatheView(view) ? { type: 'view', view } : undefined;
   }
   if (type !== 'reveal' || typeof line !== 'number' || !Number.isSafeInteger(line) || line < 1) {
     return undefined;
@@ -171,7 +191,7 @@ export function parsePlotted(value: unknown): Plotted | undefined {
   if (typeof value !== 'object' || value === null) {
     return undefined;
   }
-  const { svg, totalTimeS, findings } = value as Record<string, unknown>;
+  const { svg, totalTimeS, findings, view } = value as Record<string, unknown>;
   if (typeof svg !== 'string' || typeof totalTimeS !== 'number' || !Number.isFinite(totalTimeS)) {
     return undefined;
   }
@@ -183,7 +203,7 @@ export function parsePlotted(value: unknown): Plotted | undefined {
       checked.push(typeof file === 'string' ? { ...base, file } : base);
     }
   }
-  return { svg, totalTimeS, findings: checked };
+  return { svg, totalTimeS, findings: checked, view: isLatheView(view) ? view : null };
 }
 
 /** A finding as the page lists it: `line 12: …`, or `L9001 line 3: …` in another file. */
@@ -203,6 +223,7 @@ export function plotMessage(plotted: Plotted): ToView {
     svg: plotted.svg,
     summary: `Total time ${clock(plotted.totalTimeS)}`,
     notes: plotted.findings.map(noteOf),
+    view: plotted.view,
   };
 }
 
@@ -219,7 +240,13 @@ export function failureMessage(error: unknown): ToView & { type: 'error' } {
   if (partial === undefined) {
     return { type: 'error', message, notes: [] };
   }
-  return { type: 'error', message, svg: partial.svg, notes: partial.findings.filter((f) => !f.stopped).map(noteOf) };
+  return {
+    type: 'error',
+    message,
+    svg: partial.svg,
+    notes: partial.findings.filter((f) => !f.stopped).map(noteOf),
+    view: partial.view,
+  };
 }
 
 /** A nonce for the page's Content-Security-Policy, from random bytes (16 or more): their hex digits. */
@@ -259,7 +286,11 @@ export function pageHtml({ nonce, scriptUri, title }: PageOptions): string {
 <style nonce="${escapeHtml(nonce)}">${PAGE_STYLE}</style>
 </head>
 <body>
-<header><span id="summary">Drawing…</span></header>
+<header><span id="summary">Drawing…</span>
+<fieldset id="views" hidden><legend>X as</legend>
+<label><input type="radio" name="view" value="diameter"> diameter (whole profile)</label>
+<label><input type="radio" name="view" value="radius"> radius (machined half)</label>
+</fieldset></header>
 <div id="error" role="alert" hidden></div>
 <ul id="notes"></ul>
 <main id="plot"></main>
@@ -271,7 +302,10 @@ export function pageHtml({ nonce, scriptUri, title }: PageOptions): string {
 
 const PAGE_STYLE = `
 body { padding: 0 12px; color: var(--vscode-foreground); font-family: var(--vscode-font-family); }
-header { padding: 6px 0; }
+header { padding: 6px 0; display: flex; gap: 16px; align-items: center; flex-wrap: wrap; }
+#views { display: flex; gap: 10px; border: none; margin: 0; padding: 0; }
+#views[hidden] { display: none; }
+#views legend { float: left; padding: 0; margin-right: 4px; }
 #error { padding: 6px 8px; margin-bottom: 6px; border: 1px solid var(--vscode-inputValidation-errorBorder, #be1100);
   background: var(--vscode-inputValidation-errorBackground, #5a1d1d); white-space: pre-wrap; }
 #notes { margin: 0 0 6px; padding-left: 18px; color: var(--vscode-descriptionForeground); }

@@ -15,6 +15,7 @@ import {
   parsePlotted,
   plotMessage,
   RenderSchedule,
+  type LatheView,
   type Reveal,
   revealTarget,
   sourceFiles,
@@ -22,8 +23,11 @@ import {
   VIEW_SCRIPT,
 } from './toolpath';
 
-/** Asks the server for the picture of the document at `uri`; rejects with the server's error. */
-export type Plot = (uri: string) => Promise<unknown>;
+/**
+ * Asks the server for the picture of the document at `uri`, a lathe's in
+ * `view` (else the server's default); rejects with the server's error.
+ */
+export type Plot = (uri: string, view: LatheView | undefined) => Promise<unknown>;
 
 /** One view per document, opened by `ncc.showToolpath`. */
 export class ToolpathViews implements vscode.Disposable {
@@ -70,6 +74,8 @@ class ToolpathView {
   private last: ToView | undefined;
   /** The other files the picture names: the only ones a click may open. */
   private files: ReadonlySet<string> = new Set();
+  /** The lathe's view the page chose; until then the server's default. */
+  private view: LatheView | undefined;
   private disposed = false;
 
   constructor(
@@ -146,7 +152,7 @@ class ToolpathView {
   private async render(): Promise<void> {
     let message: ToView;
     try {
-      const plotted = parsePlotted(await this.plot(this.key));
+      const plotted = parsePlotted(await this.plot(this.key, this.view));
       if (plotted === undefined) {
         throw new Error('The server answered ncc.plot without a picture.');
       }
@@ -176,6 +182,9 @@ class ToolpathView {
       this.highlight(editor?.selection.active.line);
     } else if (parsed?.type === 'reveal') {
       void this.revealLine(parsed);
+    } else if (parsed?.type === 'view' && parsed.view !== this.view) {
+      this.view = parsed.view;
+      void this.schedule.now();
     }
   }
 

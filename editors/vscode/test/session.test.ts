@@ -31,7 +31,7 @@ import {
 } from 'vscode-languageserver-protocol/node';
 import { DOCUMENT_SELECTOR } from '../src/documents';
 import { type Launch, readSettings, serverLaunch } from '../src/server';
-import { failureMessage, PLOT_COMMAND, parsePlotted, plotMessage } from '../src/toolpath';
+import { failureMessage, PLOT_COMMAND, parsePlotted, plotArguments, plotMessage } from '../src/toolpath';
 import { languageOf } from './manifest';
 
 /** How long one answer from a debug build may take. */
@@ -308,6 +308,27 @@ describe('a session with ncc lsp', () => {
       }),
     );
     assert.match(JSON.stringify(hover), /G71 — Longitudinal roughing cycle/);
+
+    // The toolpath view's lathe views: the server's default, then the one chosen.
+    const turned = pathToFileURL(path.join(scratch, 'programs', 'O1235.nc')).href;
+    await connection.sendNotification(DidOpenTextDocumentNotification.type, {
+      textDocument: { uri: turned, languageId, version: 1, text: '%\nO1235\nG00 X50. Z2.\nG01 Z-20. F0.2\nM30\n%\n' },
+    });
+    for (const [chosen, drawn] of [
+      [undefined, 'diameter'],
+      ['radius', 'radius'],
+    ] as const) {
+      const answer = await within(
+        `answer to ncc.plot of ${file} in view ${chosen}`,
+        connection.sendRequest(ExecuteCommandRequest.type, {
+          command: PLOT_COMMAND,
+          arguments: plotArguments(turned, chosen),
+        }),
+      );
+      const plotted = parsePlotted(answer);
+      assert.equal(plotted?.view, drawn, JSON.stringify(answer));
+      assert.match(plotted?.svg ?? '', new RegExp(`ZX plane, X as a ${drawn}`));
+    }
   });
 
   test('a Sinumerik program gets the note that ncc does not read it yet', async () => {

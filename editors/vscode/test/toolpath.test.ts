@@ -16,6 +16,7 @@ import {
   panelTitle,
   parseFromView,
   parsePlotted,
+  plotArguments,
   plotMessage,
   RenderSchedule,
   revealOf,
@@ -77,6 +78,8 @@ describe('messages from the page', () => {
       file: '/p/L1',
     });
     assert.deepEqual(parseFromView({ type: 'ready' }), { type: 'ready' });
+    assert.deepEqual(parseFromView({ type: 'view', view: 'radius' }), { type: 'view', view: 'radius' });
+    assert.deepEqual(parseFromView({ type: 'view', view: 'diameter' }), { type: 'view', view: 'diameter' });
   });
 
   test('anything else is dropped', () => {
@@ -95,6 +98,9 @@ describe('messages from the page', () => {
       { type: 'reveal', line: 3, file: 42 },
       { type: 'reveal', line: 3, file: '' },
       { type: 'open', line: 3 },
+      { type: 'view' },
+      { type: 'view', view: 'Radius' },
+      { type: 'view', view: 'side' },
     ];
     for (const message of bad) {
       assert.equal(parseFromView(message), undefined, JSON.stringify(message));
@@ -168,6 +174,12 @@ describe('the page', () => {
     assert.notEqual(nonceOf(crypto.getRandomValues(new Uint8Array(16))), nonceOf(new Uint8Array(16)));
   });
 
+  test('offers the lathe’s two views, hidden until a lathe’s picture comes', () => {
+    assert.match(html, /<fieldset id="views" hidden>/);
+    const values = [...html.matchAll(/<input type="radio" name="view" value="([a-z]+)">/g)].map((match) => match[1]);
+    assert.deepEqual(values, ['diameter', 'radius']);
+  });
+
   test('loads the script the bundler writes and the package ships', () => {
     const esbuild = readFileSync(path.join(root, 'esbuild.mjs'), 'utf8');
     assert.match(esbuild, new RegExp(`outfile: 'dist/${VIEW_SCRIPT}'`));
@@ -195,7 +207,27 @@ describe('the answer of ncc.plot', () => {
       svg: SVG,
       summary: 'Total time 0:01:23.457',
       notes: ['line 4: the executor does not run G08 yet', 'L9001 line 2: G36: refused'],
+      view: null,
     });
+  });
+
+  test('says which lathe view it drew, and nothing off a lathe or for a view it does not know', () => {
+    assert.equal(parsePlotted({ ...answer, view: 'radius' })?.view, 'radius');
+    assert.deepEqual(plotMessage({ ...answer, findings: [], view: 'diameter' }), {
+      type: 'plot',
+      svg: SVG,
+      summary: 'Total time 0:01:23.457',
+      notes: [],
+      view: 'diameter',
+    });
+    for (const view of [null, undefined, 'mirrored', 2]) {
+      assert.equal(parsePlotted({ ...answer, view })?.view, null, String(view));
+    }
+  });
+
+  test('asks for the view chosen, else leaves the default to the server', () => {
+    assert.deepEqual(plotArguments('file:///O1000.nc', undefined), ['file:///O1000.nc']);
+    assert.deepEqual(plotArguments('file:///O1000.nc', 'radius'), ['file:///O1000.nc', { view: 'radius' }]);
   });
 
   test('without a picture is no answer', () => {
@@ -212,6 +244,7 @@ describe('the answer of ncc.plot', () => {
       message: 'the run stopped at line 4: G03: no arc',
       svg: SVG,
       notes: ['line 4: the executor does not run G08 yet'],
+      view: null,
     });
     const notOpen = Object.assign(new Error('ncc.plot: file:///x.NCP is not open'), { code: -32602 });
     assert.deepEqual(failureMessage(notOpen), { type: 'error', message: notOpen.message, notes: [] });

@@ -1,10 +1,10 @@
 //! What the editor features ask the Haas lathe dialect.
 
-use crate::lower::BlockData;
+use nc_exec::haas_lathe::lower::HaasBlock;
 
 /// What I and K mean in an arc block: the centre from the start point, I
 /// along X as a radius, K along Z (lathe manual §5.8 (001:611-613)).
-pub(crate) fn arc_centre(block: &BlockData) -> Vec<(u8, String)> {
+pub(crate) fn arc_centre(block: &HaasBlock) -> Vec<(u8, String)> {
     if !block.has_code(b'G', 2) && !block.has_code(b'G', 3) {
         return Vec::new();
     }

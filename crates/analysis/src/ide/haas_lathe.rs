@@ -1,6 +1,8 @@
 //! The editor's answers for a Haas lathe file: hover, go to definition,
-//! references, the outline and folding, all from the file's model
-//! (`crate::haas_lathe::model`).
+//! references, the outline, folding and completion, all from the file's
+//! model (`crate::haas_lathe::model`).
+
+pub(crate) mod completion;
 
 use std::path::Path;
 
@@ -241,22 +243,36 @@ fn block_target(db: &dyn Db, file: SourceFile, model: &FileModel, index: usize) 
     NavigationTarget { file, range, focus }
 }
 
-/// The files of the workspace holding program `number`: an `O` line of
-/// that number, or a file named after it (`O01234.nc`).
-fn program_files(db: &dyn Db, number: u64) -> Vec<NavigationTarget> {
-    let mut targets = Vec::new();
+/// The programs of the workspace: each file's by number with the block
+/// that starts them, an `O` line, or the first block of a file named after
+/// a number no `O` line of it has (`O01234.nc`).
+fn workspace_programs(db: &dyn Db) -> Vec<(u32, SourceFile, usize)> {
+    let mut programs = Vec::new();
     for &other in Settings::get(db).files(db) {
         let model = file_model(db, other);
-        let found = model.model.programs.iter().find(|program| program.number.map(u64::from) == Some(number));
-        if let Some(program) = found {
-            targets.push(block_target(db, other, model, program.blocks.start));
-        } else if program_file_number(Path::new(other.path(db))).map(u64::from) == Some(number)
+        let mut numbers: Vec<u32> = Vec::new();
+        for program in &model.model.programs {
+            if let Some(number) = program.number.filter(|number| !numbers.contains(number)) {
+                numbers.push(number);
+                programs.push((number, other, program.blocks.start));
+            }
+        }
+        if let Some(number) = program_file_number(Path::new(other.path(db))).filter(|number| !numbers.contains(number))
             && !model.blocks.is_empty()
         {
-            targets.push(block_target(db, other, model, 0));
+            programs.push((number, other, 0));
         }
     }
-    targets
+    programs
+}
+
+/// The files of the workspace holding program `number`.
+fn program_files(db: &dyn Db, number: u64) -> Vec<NavigationTarget> {
+    workspace_programs(db)
+        .into_iter()
+        .filter(|&(program, _, _)| u64::from(program) == number)
+        .map(|(_, file, start)| block_target(db, file, file_model(db, file), start))
+        .collect()
 }
 
 /// Where the reference at `offset` leads.

@@ -6,6 +6,7 @@
 //! the block counts, so a subprogram called with different values shows
 //! them all.
 
+mod cnc8x6;
 pub(crate) mod completion;
 pub(crate) mod cycle_time;
 pub(crate) mod folding;

@@ -3,7 +3,7 @@
 use std::collections::HashMap;
 
 use ncc_analysis::{CompletionKind, Dialect, DocumentSymbol, FoldKind, NavigationTarget, ReferenceKind, SymbolKind};
-use ncc_catalog::{AddressRole, Catalogue};
+use ncc_catalog::AddressRole;
 use tower_lsp_server::ls_types as lsp;
 
 use super::{Snapshot, convert, semantic};
@@ -26,7 +26,7 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
             ..Default::default()
         })),
         completion_provider: Some(lsp::CompletionOptions {
-            trigger_characters: Some(trigger_characters(dialect.catalogue())),
+            trigger_characters: Some(trigger_characters()),
             ..Default::default()
         }),
         inlay_hint_provider: Some(lsp::OneOf::Left(true)),
@@ -52,12 +52,19 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
     }
 }
 
-/// The letters completion answers as soon as they are typed: the codes',
-/// the call target's (`L`) and the parameter letter.
-fn trigger_characters(catalogue: &Catalogue) -> Vec<String> {
+/// The letters completion answers as soon as they are typed, in every
+/// dialect (the capabilities are the server's, not a document's): the
+/// codes', the call targets' (`L`; `P`, `Q`) and the parameters' (`R`, `#`).
+fn trigger_characters() -> Vec<String> {
     let roles = [AddressRole::Function, AddressRole::Label, AddressRole::Parameter];
-    let letters = roles.into_iter().flat_map(|role| catalogue.addresses.iter().filter(move |a| a.role == role));
-    letters.map(|address| address.letter.clone()).collect()
+    let mut letters: Vec<String> = Dialect::all()
+        .flat_map(|dialect| dialect.catalogue().addresses.iter())
+        .filter(|address| roles.contains(&address.role))
+        .map(|address| address.letter.clone())
+        .collect();
+    letters.sort();
+    letters.dedup();
+    letters
 }
 
 /// The analysis's hover, then the predicted time and speed of the block.
@@ -120,9 +127,12 @@ pub(crate) fn completion(s: &Snapshot, position: lsp::Position) -> Vec<lsp::Comp
         .enumerate()
         .map(|(rank, item)| lsp::CompletionItem {
             kind: Some(match item.kind {
-                CompletionKind::Code => lsp::CompletionItemKind::KEYWORD,
+                CompletionKind::Code | CompletionKind::Keyword => lsp::CompletionItemKind::KEYWORD,
                 CompletionKind::Address => lsp::CompletionItemKind::FIELD,
-                CompletionKind::Subprogram | CompletionKind::Macrocycle => lsp::CompletionItemKind::FUNCTION,
+                CompletionKind::Subprogram
+                | CompletionKind::Macrocycle
+                | CompletionKind::Program
+                | CompletionKind::Function => lsp::CompletionItemKind::FUNCTION,
                 CompletionKind::Block => lsp::CompletionItemKind::REFERENCE,
                 CompletionKind::Parameter => lsp::CompletionItemKind::VARIABLE,
             }),

@@ -2,15 +2,17 @@
 //! `ncc plot` draws, of an open document's current text, unsaved edits
 //! included, for the editor's toolpath view.
 //!
-//! Arguments: the document's URI. The answer is `{ svg, totalTimeS,
-//! findings }`. A run that stops on an error answers a `RequestFailed`
+//! Arguments: the document's URI, then optionally `{ view }`, how a
+//! lathe's picture shows X (`"radius"` or `"diameter"`, the default, as
+//! `ncc plot --view`). The answer is `{ svg, totalTimeS, findings, view }`,
+//! `view` the one drawn, or null for a machine without a diameter axis. A run that stops on an error answers a `RequestFailed`
 //! error whose message says where and why, with the picture of the run
 //! up to there as its `data`.
 
 use std::{path::PathBuf, sync::Arc};
 
 use ncc_analysis::{Dialect, WorkspaceFiles};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use tower_lsp_server::{
     jsonrpc::{self, ErrorCode},
@@ -19,7 +21,7 @@ use tower_lsp_server::{
 
 use super::{Server, invalid_params};
 use crate::{
-    plot::DEFAULT_MAX_MOVES,
+    plot::{DEFAULT_MAX_MOVES, View},
     run::{Program, Progress, Ran},
 };
 
@@ -38,6 +40,16 @@ struct Plotted {
     total_time_s: f64,
     /// What the run did not run, and where it stopped.
     findings: Vec<Finding>,
+    /// The lathe's view drawn; `None` off a lathe, which has no choice.
+    view: Option<View>,
+}
+
+/// The optional second argument.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Options {
+    #[serde(default)]
+    view: View,
 }
 
 #[derive(Serialize)]
@@ -61,15 +73,29 @@ struct Job {
     name: String,
     dialect: Dialect,
     config: Option<PathBuf>,
+    view: View,
 }
 
-/// Runs the command: `arguments` is `[uri]`.
+/// Runs the command: `arguments` is `[uri]` or `[uri, options]`.
 pub(crate) async fn execute(server: &Server, arguments: Vec<Value>) -> jsonrpc::Result<Option<Value>> {
-    let uri = match arguments.as_slice() {
-        [Value::String(uri)] => {
-            uri.parse::<Uri>().map_err(|error| invalid_params(format!("{COMMAND}: `{uri}` is not a URI: {error}")))?
+    let (uri, options) = match arguments.as_slice() {
+        [Value::String(uri)] => (uri, None),
+        [Value::String(uri), options] => (uri, Some(options)),
+        _ => {
+            return Err(invalid_params(format!(
+                "{COMMAND} takes the document's URI, then optionally {{ \"view\": \"radius\" | \"diameter\" }}"
+            )));
         }
-        _ => return Err(invalid_params(format!("{COMMAND} takes one argument, the document's URI"))),
+    };
+    let uri =
+        uri.parse::<Uri>().map_err(|error| invalid_params(format!("{COMMAND}: `{uri}` is not a URI: {error}")))?;
+    let view = match options {
+        Some(options) => {
+            Options::deserialize(options)
+                .map_err(|error| invalid_params(format!("{COMMAND}: the options {options}: {error}")))?
+                .view
+        }
+        None => View::default(),
     };
     let job = {
         let state = server.state();
@@ -82,7 +108,7 @@ pub(crate) async fn execute(server: &Server, arguments: Vec<Value>) -> jsonrpc::
         let config = state.workspaces.config_path(document.workspace).map(PathBuf::from);
         let files =
             state.workspaces.get(document.workspace).analysis().run_input(document.file).map(|input| input.files);
-        Job { text: document.map.text.clone(), files, path, name, dialect: document.dialect, config }
+        Job { text: document.map.text.clone(), files, path, name, dialect: document.dialect, config, view }
     };
     // A run takes as long as the program's blocks; the blocking pool keeps
     // it off the threads that answer the other requests.
@@ -108,9 +134,12 @@ fn plot(job: Job) -> jsonrpc::Result<Value> {
         files: job.files.as_ref(),
     };
     let (ran, picture) =
-        Ran::plotted(&program, nc_exec::run::DEFAULT_STEP_BUDGET, DEFAULT_MAX_MOVES, Progress::Hidden).map_err(
-            |error| jsonrpc::Error { code: ErrorCode::ServerError(REQUEST_FAILED), message: error.into(), data: None },
-        )?;
+        Ran::plotted(&program, nc_exec::run::DEFAULT_STEP_BUDGET, DEFAULT_MAX_MOVES, job.view, Progress::Hidden)
+            .map_err(|error| jsonrpc::Error {
+                code: ErrorCode::ServerError(REQUEST_FAILED),
+                message: error.into(),
+                data: None,
+            })?;
     let findings = ran
         .findings()
         .map(|finding| Finding {
@@ -124,7 +153,7 @@ fn plot(job: Job) -> jsonrpc::Result<Value> {
         let place = if stop.in_program { String::new() } else { format!("{} ", stop.file) };
         format!("the run stopped at {place}line {}: {}", stop.line, stop.message)
     });
-    let plotted = Plotted { svg: picture.svg, total_time_s: picture.total_time, findings };
+    let plotted = Plotted { svg: picture.svg, total_time_s: picture.total_time, findings, view: picture.view };
     let plotted = serde_json::to_value(plotted).map_err(|_| jsonrpc::Error::internal_error())?;
     match stop {
         Some(message) => Err(jsonrpc::Error {

@@ -193,6 +193,21 @@ const CALLS: [(u8, u32, ReferenceKind); 3] = [
     (b'G', 65, ReferenceKind::MacroCall),
 ];
 
+/// The G codes of the cycles that run a contour P..Q.
+const CONTOUR_CYCLES: RangeInclusive<u32> = 70..=73;
+
+/// What the `letter` word (P or Q) of `block` names: a contour's first or
+/// last block (G70–G73), or a call's target (P of M97, M98, G65).
+pub fn reference_kind(block: &HaasBlock, letter: u8) -> Option<ReferenceKind> {
+    let contour = block.codes(b'G').any(|code| CONTOUR_CYCLES.contains(&code));
+    match letter {
+        b'P' if contour => Some(ReferenceKind::ContourStart),
+        b'Q' if contour => Some(ReferenceKind::ContourEnd),
+        b'P' => CALLS.iter().find(|&&(l, number, _)| block.has_code(l, number)).map(|&(_, _, kind)| kind),
+        _ => None,
+    }
+}
+
 /// The programs of a file and what the model finds in them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProgramModel {
@@ -230,7 +245,7 @@ impl ProgramModel {
         for index in range.clone() {
             let block = &blocks[index];
             for code in block.codes(b'G') {
-                if (70..=73).contains(&code) {
+                if CONTOUR_CYCLES.contains(&code) {
                     self.read_cycle(blocks, program, index, code, &motions);
                 }
             }

@@ -19,9 +19,16 @@ use crate::{
     lexing::{Token, number_len, run_len},
 };
 
-/// The words of the statements; operators and functions come from the
-/// catalogue.
-const STATEMENT_KEYWORDS: [&str; 6] = ["IF", "THEN", "GOTO", "WHILE", "DO", "END"];
+/// The words of the statements, each with the form it belongs to;
+/// operators and functions come from the catalogue.
+pub const STATEMENT_KEYWORDS: [(&str, &str); 6] = [
+    ("IF", "IF [condition] GOTO n, or IF [condition] THEN #v = e"),
+    ("THEN", "IF [condition] THEN #v = e"),
+    ("GOTO", "GOTO n: go on at block Nn"),
+    ("WHILE", "WHILE [condition] DOn … ENDn"),
+    ("DO", "DOn … ENDn: loop n, while the condition of a WHILE before it holds"),
+    ("END", "ENDn: the end of loop n"),
+];
 
 /// Every keyword, longest first.
 pub(crate) fn keywords() -> &'static [String] {
@@ -32,7 +39,7 @@ pub(crate) fn keywords() -> &'static [String] {
             .iter()
             .filter_map(|operation| operation.symbol.clone())
             .filter(|symbol| symbol.len() >= 2 && symbol.bytes().all(|b| b.is_ascii_uppercase()));
-        let mut keywords: Vec<String> = STATEMENT_KEYWORDS.iter().map(|k| (*k).to_owned()).chain(named).collect();
+        let mut keywords: Vec<String> = STATEMENT_KEYWORDS.iter().map(|(k, _)| (*k).to_owned()).chain(named).collect();
         keywords.sort_by(|a, b| b.len().cmp(&a.len()).then(a.cmp(b)));
         keywords.dedup();
         keywords

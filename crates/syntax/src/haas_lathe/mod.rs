@@ -5,5 +5,6 @@ mod lexer;
 mod parser;
 mod reparse;
 
+pub use lexer::STATEMENT_KEYWORDS;
 pub(crate) use parser::parse_source_file;
 pub(crate) use reparse::reparse_blocks;

@@ -4,7 +4,7 @@
 // and marks of the line the cursor is on. The decisions are in
 // ../toolpath.ts, where node tests run them.
 
-import { type FromView, highlightSelector, revealOf, type ToView } from '../toolpath';
+import { type FromView, highlightSelector, type LatheView, revealOf, type ToView } from '../toolpath';
 
 declare function acquireVsCodeApi(): { postMessage(message: FromView): void };
 
@@ -22,6 +22,7 @@ const plot = element('plot');
 const summary = element('summary');
 const error = element('error');
 const notes = element('notes');
+const views = element('views');
 
 /** The document's line the cursor is on, from 1. */
 let highlighted: number | null = null;
@@ -57,6 +58,14 @@ function showError(message: string | undefined): void {
   error.textContent = message ?? '';
 }
 
+/** Offers the lathe's views, `view` chosen; none off a lathe (`null`). */
+function showView(view: LatheView | null): void {
+  views.hidden = view === null;
+  for (const input of Array.from(views.querySelectorAll('input'))) {
+    input.checked = input.value === view;
+  }
+}
+
 function highlight(line: number | null): void {
   for (const old of Array.from(plot.querySelectorAll('.selected'))) {
     old.classList.remove('selected');
@@ -76,6 +85,7 @@ window.addEventListener('message', (event: MessageEvent<ToView>) => {
       if (showPicture(message.svg)) {
         summary.textContent = message.summary;
         showError(undefined);
+        showView(message.view);
         document.body.classList.remove('stale');
       } else {
         showError('The server sent a picture that is not SVG.');
@@ -87,6 +97,7 @@ window.addEventListener('message', (event: MessageEvent<ToView>) => {
       showNotes(message.notes);
       if (message.svg !== undefined && showPicture(message.svg)) {
         summary.textContent = 'The run up to where it stopped';
+        showView(message.view ?? null);
         document.body.classList.remove('stale');
       } else {
         // The last picture stays, faded: it no longer shows the text.
@@ -103,6 +114,13 @@ plot.addEventListener('click', (event) => {
   const reveal = revealOf(event.target instanceof Element ? event.target : null);
   if (reveal !== undefined) {
     vscode.postMessage(reveal);
+  }
+});
+
+views.addEventListener('change', (event) => {
+  const value = event.target instanceof HTMLInputElement ? event.target.value : undefined;
+  if (value === 'radius' || value === 'diameter') {
+    vscode.postMessage({ type: 'view', view: value });
   }
 });
 
