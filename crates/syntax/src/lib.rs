@@ -18,6 +18,7 @@ mod green;
 mod haas_lathe;
 mod lexing;
 pub mod limit;
+mod line_reparse;
 mod runs;
 mod syntax_kind;
 pub mod visible;
