@@ -21,7 +21,7 @@ use crate::{
 /// The deepest nesting of brackets and signs an expression may have: deeper
 /// input is reported instead of recursed into, so no line can exhaust the
 /// stack.
-const MAX_DEPTH: usize = 64;
+pub(crate) const MAX_DEPTH: usize = 64;
 
 /// A token found ahead: its kind and where it is.
 #[derive(Debug, Clone, Copy)]

@@ -20,6 +20,7 @@ mod lexing;
 pub mod limit;
 mod line_reparse;
 mod runs;
+pub mod sinumerik;
 mod syntax_kind;
 pub mod visible;
 
