@@ -179,8 +179,10 @@ pub enum SyntaxKind {
     CASE_STMT,
     /// One arm of a CASE: `1 GOTOF L1`, `DEFAULT GOTOF L2`.
     CASE_ARM,
-    /// A synchronous action: `WHENEVER cond DO actions`.
+    /// A synchronous action: `WHENEVER cond DO actions`, or `DO actions`.
     SYNC_ACTION,
+    /// A macro: `DEFINE name AS text`, the text kept as tokens.
+    MACRO_DEF,
     /// Input the parser could not place; always comes with a syntax error.
     ERROR,
 }
@@ -286,6 +288,7 @@ const ALL_KINDS: [SyntaxKind; SyntaxKind::LAST as usize + 1] = {
         CASE_STMT,
         CASE_ARM,
         SYNC_ACTION,
+        MACRO_DEF,
         ERROR,
     ]
 };

@@ -14,7 +14,9 @@
 //! * Any other letter is one `LETTER`, an address: `X10` is `X` `10`,
 //!   `G641` is `G` `641`, `A3=1` is `A` `3` `=` `1` (the parser makes an
 //!   address with an extension of it), and `X10Y20` is two words.
-//! * `$` with a name after it is one `IDENT`: a system variable `$P_UIFR`.
+//! * `$` with a name after it is one `IDENT`: a system variable `$P_UIFR`,
+//!   or with `$$` machine data read in the main run (`$$MA_…`, as the
+//!   control's own files write them).
 //!
 //! Case does not matter to names (004:1450), so letters of either case lex
 //! alike; the parser compares keywords ignoring case.
@@ -44,7 +46,10 @@ pub(crate) fn token_at(text: &str, pos: usize) -> Token {
             (IDENT, name_len(rest))
         }
         b'A'..=b'Z' | b'a'..=b'z' => (LETTER, 1),
-        b'$' if next.is_some_and(|b| b.is_ascii_alphabetic() || b == b'_') => (IDENT, 1 + name_len(&rest[1..])),
+        b'$' => match system_variable_len(rest) {
+            0 => (ERROR_TOKEN, unknown_run_len(text, pos)),
+            len => (IDENT, len),
+        },
         // A run of points is one placeholder (`X..`, `...`), which the
         // parser reports once.
         b'.' if next == Some(b'.') => (NUMBER, run_len(rest, |b| b == b'.')),
@@ -73,6 +78,16 @@ pub(crate) fn token_at(text: &str, pos: usize) -> Token {
         _ => (ERROR_TOKEN, unknown_run_len(text, pos)),
     };
     Token { kind, len }
+}
+
+/// `$NAME`, or `$$NAME` (machine data read in the main run); 0 when no
+/// name follows.
+fn system_variable_len(rest: &[u8]) -> usize {
+    let dollars = if rest.get(1) == Some(&b'$') { 2 } else { 1 };
+    match rest.get(dollars) {
+        Some(b) if b.is_ascii_alphabetic() || *b == b'_' => dollars + name_len(&rest[dollars..]),
+        _ => 0,
+    }
 }
 
 fn name_len(rest: &[u8]) -> usize {
@@ -199,5 +214,17 @@ mod tests {
     #[test]
     fn unknown_characters_group_until_a_known_token() {
         assert_eq!(lex_all("€#X"), vec![(ERROR_TOKEN, "€#"), (LETTER, "X")]);
+        assert_eq!(
+            lex_all("$ $$1 $$A"),
+            vec![
+                (ERROR_TOKEN, "$"),
+                (WHITESPACE, " "),
+                (ERROR_TOKEN, "$"),
+                (ERROR_TOKEN, "$"),
+                (NUMBER, "1"),
+                (WHITESPACE, " "),
+                (IDENT, "$$A")
+            ]
+        );
     }
 }

@@ -26,6 +26,9 @@
 //! assign    := target "=" expr                    `R1=5`, `R[R1+2]=0`, `A[1,2]=3`,
 //!                                                 `$TC_DP1[1,1]=120`, `G[8]=2`, `CR=10`
 //! call      := name [args]                        `TRAORI`, `CYCLE81(10,0,2)`, `MSG("…")`
+//!            | ("L" | "M") digits args             `L140(1)`, `M6(T1)`: numbered subprograms
+//!            | "CALL" expr ["BLOCK" expr "TO" expr]
+//! macro     := "DEFINE" name "AS" text            the text is kept as tokens
 //!            | "MCALL" [name [args]]
 //! def       := "DEF" [NCK|CHAN] type decl {"," decl}
 //! decl      := name ["[" expr {"," expr} "]"] ["=" expr]
@@ -39,7 +42,7 @@
 //!            | "CASE" expr "OF" {(value | "DEFAULT") jump}
 //!            | jump
 //! jump      := ("GOTO" | "GOTOF" | "GOTOB" | "GOTOC") (block-number | expr) | "GOTOS"
-//! sync      := ("WHEN" | "WHENEVER" | "EVERY" | "FROM") expr "DO" statement*
+//! sync      := [("WHEN" | "WHENEVER" | "EVERY" | "FROM") expr] "DO" statement*
 //! ```
 //!
 //! Names and addresses (004:1444-1450): a letter followed by a letter or
@@ -70,7 +73,9 @@
 //!
 //! Operators and their priority follow digest §2.4 (the Siemens table):
 //! `NOT`, signs; `* / DIV MOD`; `+ -`; `B_AND`; `B_XOR`; `B_OR`; `AND`;
-//! `XOR`; `OR`; `<<`; comparisons.
+//! `XOR`; `OR`; `<<`; comparisons. A leading `<<` converts to a string
+//! (`MSG(<<R1)`), `:` chains frames, and `(1,2,3)` is a list of values
+//! (an array's initial values), an `ARG_LIST`.
 //!
 //! Assumptions: the scopes `NCK`/`CHAN` after `DEF`, `FRAME`, `LOOP`,
 //! `REPEAT`/`UNTIL`, `GOTOC`/`GOTOS`, synchronous actions, quoted

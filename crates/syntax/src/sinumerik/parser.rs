@@ -33,12 +33,14 @@ const DEF_SCOPES: [&str; 2] = ["NCK", "CHAN"];
 const JUMPS: [&str; 5] = ["GOTO", "GOTOF", "GOTOB", "GOTOC", "GOTOS"];
 
 /// Keywords that only continue another statement.
-const CONTINUATIONS: [&str; 5] = ["TO", "OF", "DEFAULT", "DO", "BLOCK"];
+const CONTINUATIONS: [&str; 5] = ["TO", "OF", "DEFAULT", "AS", "BLOCK"];
 
 /// The left and right binding powers of a binary operator; higher binds
 /// tighter and every operator is left-associative. The order is the
 /// Siemens priority list of digest §2.4: comparisons, then `<<`, `OR`,
-/// `XOR`, `AND`, `B_OR`, `B_XOR`, `B_AND`, `+ -`, `* / DIV MOD`.
+/// `XOR`, `AND`, `B_OR`, `B_XOR`, `B_AND`, `+ -`, `* / DIV MOD`; the frame
+/// chaining `:`, which the list does not name, binds tightest
+/// (assumption: it joins frames only, so no other operator meets it).
 fn binary(kind: SyntaxKind, text: &str) -> Option<(u8, u8)> {
     let word = |name: &str| kind == IDENT && text.eq_ignore_ascii_case(name);
     match kind {
@@ -46,6 +48,8 @@ fn binary(kind: SyntaxKind, text: &str) -> Option<(u8, u8)> {
         CONCAT => Some((3, 4)),
         PLUS | MINUS => Some((17, 18)),
         STAR | SLASH => Some((19, 20)),
+        // Frame chaining: `CTRANS(X,10):CROT(Z,45)`.
+        COLON => Some((21, 22)),
         _ if word("OR") => Some((5, 6)),
         _ if word("XOR") => Some((7, 8)),
         _ if word("AND") => Some((9, 10)),
@@ -58,7 +62,10 @@ fn binary(kind: SyntaxKind, text: &str) -> Option<(u8, u8)> {
 }
 
 /// `NOT` and `B_NOT` bind tighter than every binary operator, like a sign.
-const PREFIX_POWER: u8 = 21;
+const PREFIX_POWER: u8 = 23;
+
+/// A leading `<<` takes what a binary `<<` would take on its right.
+const CONVERSION_POWER: u8 = 4;
 
 pub(crate) fn parse_source_file(text: &str) -> (GreenNode, Vec<SyntaxError>, Vec<Omitted<E>>) {
     let mut children: Vec<GreenElement> = Vec::new();
@@ -357,12 +364,30 @@ impl<'a> Parser<'a> {
             let target = self.param_ref();
             return self.assignment_to(target, start);
         }
+        if self.numbered_call_at(start) {
+            let mut children = vec![self.bump(), self.bump()];
+            self.trivia(&mut children);
+            children.push(self.arg_list(0));
+            return Self::node(CALL_STMT, children);
+        }
         if self.kind_at(start + 1) == Some(L_BRACK) {
             let name = self.bump();
             let target = self.index_expr(Self::node(NAME_REF, vec![name]), 0);
             return self.assignment_to(target, start);
         }
         self.word()
+    }
+
+    /// A numbered subprogram (`L` and digits, the older naming the Siemens
+    /// manual keeps) or an M function a subprogram replaces, with arguments
+    /// glued to it: `L140(1)`, `M6(T1)` (assumptions, the seed has none).
+    /// Without arguments `L140` and `M6` are words, which the lowering
+    /// reads as the call.
+    fn numbered_call_at(&self, pos: usize) -> bool {
+        let Some(Token { kind: NUMBER, len }) = self.token_at(pos + 1) else { return false };
+        matches!(self.text.as_bytes()[pos].to_ascii_uppercase(), b'L' | b'M')
+            && !self.text_at(pos + 1).contains('.')
+            && self.kind_at(pos + 1 + len) == Some(L_PAREN)
     }
 
     /// `R` directly followed by its number or index.
@@ -514,7 +539,11 @@ impl<'a> Parser<'a> {
             "PROC" => self.proc_statement(),
             "EXTERN" => self.extern_statement(),
             "WHEN" | "WHENEVER" | "EVERY" | "FROM" => self.sync_action(),
+            // A synchronous action without a condition: `IDS=1 DO …`.
+            "DO" => self.sync_actions(Vec::new()),
             "MCALL" => self.modal_call(),
+            "CALL" => self.indirect_call(),
+            "DEFINE" => self.macro_definition(),
             _ if CONTINUATIONS.contains(&keyword.as_str()) => {
                 let message = format!("`{keyword}` continues another statement and cannot start one");
                 self.error_node(E::MalformedStatement, message)
@@ -919,7 +948,14 @@ impl<'a> Parser<'a> {
             );
             return Self::node(SYNC_ACTION, children);
         }
-        self.bump_significant(&mut children);
+        self.trivia(&mut children);
+        self.sync_actions(children)
+    }
+
+    /// `DO` and the actions after it, to the end of the line, after
+    /// `children` (the condition, if any).
+    fn sync_actions(&mut self, mut children: Vec<GreenElement>) -> GreenElement {
+        children.push(self.bump());
         while let Some(token) = self.peek() {
             match token.kind {
                 NEWLINE => break,
@@ -928,6 +964,72 @@ impl<'a> Parser<'a> {
             }
         }
         Self::node(SYNC_ACTION, children)
+    }
+
+    /// `CALL program [BLOCK start TO end]`: a call by a computed name, or
+    /// of a program section (assumption: the Siemens form with `BLOCK`,
+    /// digest §8 item 9).
+    fn indirect_call(&mut self) -> GreenElement {
+        let start = self.pos;
+        let mut children = vec![self.bump()];
+        let keyword_end = self.pos;
+        if self.significant_kind().is_none() {
+            self.report(
+                E::MalformedStatement,
+                start..keyword_end,
+                "`CALL` must be followed by the program: `CALL \"/_N_SPF_DIR/_N_SUB_SPF\"`",
+            );
+            return Self::node(CALL_STMT, children);
+        }
+        self.trivia(&mut children);
+        if let Some(program) = self.expr("the program to call") {
+            children.push(program);
+        }
+        if self.keyword_ahead("BLOCK") {
+            self.bump_significant(&mut children);
+            self.trivia(&mut children);
+            if let Some(from) = self.expr("the label the section starts at") {
+                children.push(from);
+            }
+            if self.keyword_ahead("TO") {
+                self.bump_significant(&mut children);
+                self.trivia(&mut children);
+                if let Some(to) = self.expr("the label the section ends at") {
+                    children.push(to);
+                }
+            }
+        }
+        Self::node(CALL_STMT, children)
+    }
+
+    /// `DEFINE name AS text`: a macro, whose text (the rest of the line)
+    /// the lowering substitutes; it is kept as tokens, not parsed.
+    fn macro_definition(&mut self) -> GreenElement {
+        let start = self.pos;
+        let mut children = vec![self.bump()];
+        let keyword_end = self.pos;
+        let name = self.significant_kind().is_some_and(|kind| matches!(kind, IDENT | LETTER));
+        let as_at =
+            name.then(|| self.significant_at(self.pos)).flatten().and_then(|name| self.significant_at(name.range.1));
+        let has_as =
+            as_at.is_some_and(|next| next.kind == IDENT && self.text_at(next.range.0).eq_ignore_ascii_case("AS"));
+        if !has_as {
+            self.report(
+                E::MalformedStatement,
+                start..keyword_end,
+                "`DEFINE` must be followed by a name, `AS` and its text: `DEFINE COOLANT_ON AS M8`",
+            );
+            return Self::node(MACRO_DEF, children);
+        }
+        self.bump_significant(&mut children);
+        self.bump_significant(&mut children);
+        while let Some(token) = self.peek() {
+            if matches!(token.kind, NEWLINE) {
+                break;
+            }
+            children.push(self.bump());
+        }
+        Self::node(MACRO_DEF, children)
     }
 
     /// `( [expr] {, [expr]} )`: empty arguments are omitted ones.
@@ -1026,7 +1128,8 @@ impl<'a> Parser<'a> {
             return None;
         };
         let text = self.text_at(next.range.0);
-        let prefix = matches!(next.kind, PLUS | MINUS)
+        // A leading `<<` converts its operand to a string: `<<R1`.
+        let prefix = matches!(next.kind, PLUS | MINUS | CONCAT)
             || (next.kind == IDENT && (text.eq_ignore_ascii_case("NOT") || text.eq_ignore_ascii_case("B_NOT")));
         if depth >= MAX_DEPTH && (prefix || matches!(next.kind, L_PAREN | L_BRACK | IDENT | LETTER)) {
             self.report(
@@ -1037,9 +1140,10 @@ impl<'a> Parser<'a> {
             return None;
         }
         if prefix {
+            let power = if next.kind == CONCAT { CONVERSION_POWER } else { PREFIX_POWER };
             let mut children = vec![self.bump()];
             self.trivia(&mut children);
-            if let Some(operand) = self.expr_bp(PREFIX_POWER, depth + 1, "a value after the sign") {
+            if let Some(operand) = self.expr_bp(power, depth + 1, "a value after the sign") {
                 children.push(operand);
             }
             return Some(Self::node(PREFIX_EXPR, children));
@@ -1058,12 +1162,22 @@ impl<'a> Parser<'a> {
                 if let Some(inner) = self.expr_bp(0, depth + 1, "an expression inside the parentheses") {
                     children.push(inner);
                 }
+                // A list of values, which initialises an array: `(1,2,3)`.
+                let mut kind = BRACKET_EXPR;
+                while self.significant_kind() == Some(COMMA) {
+                    kind = ARG_LIST;
+                    self.bump_significant(&mut children);
+                    self.trivia(&mut children);
+                    if let Some(value) = self.expr_bp(0, depth + 1, "a value of the list") {
+                        children.push(value);
+                    }
+                }
                 if self.significant_kind() == Some(R_PAREN) {
                     self.bump_significant(&mut children);
                 } else {
                     self.report(E::UnclosedParenthesis, open..open + 1, "`(` is not closed by `)` on its line");
                 }
-                Some(Self::node(BRACKET_EXPR, children))
+                Some(Self::node(kind, children))
             }
             LETTER if self.is_parameter_at(self.pos) => Some(self.param_ref()),
             LETTER => {
