@@ -307,7 +307,12 @@ fn valid_statement() -> impl Strategy<Value = String> {
         Just("ENDWHILE".to_owned()),
         Just("REPEAT".to_owned()),
         (name.clone(), 1u32..9).prop_map(|(n, k)| format!("DEF REAL {n}[{k},2]={k}")),
-        (name, 1u32..40).prop_map(|(n, k)| format!("DEF STRING[{k}] {n}=\"x\"")),
+        (name.clone(), 1u32..40).prop_map(|(n, k)| format!("DEF STRING[{k}] {n}=\"x\"")),
+        (name.clone(), 1u32..4).prop_map(|(n, k)| format!("DEF INT {n}[{k}]=(1,2,3)")),
+        name.clone().prop_map(|n| format!("DEFINE {n} AS M8 $A_DBB[1]")),
+        name.clone().prop_map(|n| format!("CALL \"_N_{n}_SPF\"")),
+        (1u32..9, expr.clone()).prop_map(|(k, e)| format!("IDS={k} DO $$AC_PARAM[{k}]={e}")),
+        name.prop_map(|n| format!("L10({n}) M6({n},1)")),
     ]
 }
 
@@ -316,7 +321,7 @@ fn is_keyword(name: &str) -> bool {
         "IF", "ELSE", "ENDIF", "WHILE", "ENDWHILE", "FOR", "ENDFOR", "REPEAT", "UNTIL", "LOOP", "ENDLOOP", "CASE",
         "OF", "DEFAULT", "TO", "DO", "BLOCK", "GOTO", "GOTOF", "GOTOB", "GOTOC", "GOTOS", "DEF", "PROC", "EXTERN",
         "WHEN", "WHENEVER", "EVERY", "FROM", "MCALL", "AND", "OR", "XOR", "NOT", "DIV", "MOD", "B_AND", "B_OR",
-        "B_XOR", "B_NOT", "VAR", "INT", "REAL", "BOOL", "CHAR", "STRING", "AXIS", "FRAME",
+        "B_XOR", "B_NOT", "VAR", "INT", "REAL", "BOOL", "CHAR", "STRING", "AXIS", "FRAME", "AS", "DEFINE", "CALL",
     ]
     .contains(&name)
 }
@@ -338,6 +343,8 @@ fn expression() -> BoxedStrategy<String> {
             inner.clone().prop_map(|a| format!("({a})")),
             inner.clone().prop_map(|a| format!("-{a}")),
             inner.clone().prop_map(|a| format!("NOT {a}")),
+            inner.clone().prop_map(|a| format!("<<{a}")),
+            (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("CTRANS(X,{a}):CROT(Z,{b})")),
             inner.clone().prop_map(|a| format!("SIN({a})")),
             (inner.clone(), inner).prop_map(|(a, b)| format!("ATAN2({a},{b})")),
         ]
