@@ -1100,23 +1100,8 @@ impl<'a> Parser<'a> {
     }
 
     fn expr_bp(&mut self, min_bp: u8, depth: usize, what: &str) -> Option<GreenElement> {
-        let mut lhs = self.atom(what, depth)?;
-        while let Some(op) = self.significant_at(self.pos) {
-            let op_text = &self.text[op.range.0..op.range.1];
-            let Some((left, right)) = binary(op.kind, op_text) else { break };
-            if left < min_bp {
-                break;
-            }
-            let mut children = vec![lhs];
-            self.bump_significant(&mut children);
-            self.trivia(&mut children);
-            let what = format!("a value after `{op_text}`");
-            if let Some(rhs) = self.expr_bp(right, depth, &what) {
-                children.push(rhs);
-            }
-            lhs = Self::node(BIN_EXPR, children);
-        }
-        Some(lhs)
+        let lhs = self.atom(what, depth)?;
+        Some(expr::binary_tail(self, binary, lhs, min_bp, |parser, right, what| parser.expr_bp(right, depth, what)))
     }
 
     /// A value without binary operators: a literal, a name (indexed or
@@ -1141,9 +1126,10 @@ impl<'a> Parser<'a> {
         }
         if prefix {
             let power = if next.kind == CONCAT { CONVERSION_POWER } else { PREFIX_POWER };
+            let what = format!("a value after `{text}`");
             let mut children = vec![self.bump()];
             self.trivia(&mut children);
-            if let Some(operand) = self.expr_bp(power, depth + 1, "a value after the sign") {
+            if let Some(operand) = self.expr_bp(power, depth + 1, &what) {
                 children.push(operand);
             }
             return Some(Self::node(PREFIX_EXPR, children));
