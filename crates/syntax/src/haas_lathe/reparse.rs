@@ -1,11 +1,11 @@
 //! Incremental reparsing of Haas programs: the shared reparse of line
-//! blocks (`line_reparse`), refused where an edit could move a tape mark
+//! blocks (`line_blocks`), refused where an edit could move a tape mark
 //! `%`.
 
 use super::parser;
 use crate::{
     Parse, SyntaxKind, SyntaxNode, TextEdit,
-    line_reparse::{LineDialect, reparse_line_blocks},
+    line_blocks::{LineDialect, reparse_line_blocks},
     runs::deleted_text,
 };
 

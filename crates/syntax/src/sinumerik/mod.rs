@@ -88,11 +88,11 @@ mod parser;
 
 use rowan::GreenNode;
 
-pub use crate::line_reparse::Parts;
+pub use crate::line_blocks::Parts;
 use crate::{
     SyntaxError, SyntaxErrorKind, SyntaxNode, TextEdit,
     limit::Omitted,
-    line_reparse::{self, LineDialect},
+    line_blocks::{self, LineDialect},
 };
 
 /// Parses a whole program: the tree (every byte of the text), the syntax
@@ -115,7 +115,7 @@ pub fn reparse_blocks(
         region_ok: |_: &SyntaxNode, _: &str| true,
         parse_blocks: parser::parse_blocks,
     };
-    line_reparse::reparse_line_blocks(old, edit, new_text, dialect)
+    line_blocks::reparse_line_blocks(old, edit, new_text, dialect)
 }
 
 /// The tree and the errors as text, for tests and `ncc parse`.

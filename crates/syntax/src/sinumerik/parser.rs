@@ -15,8 +15,7 @@ use crate::{
     green::{self, GreenElement, GreenFactory},
     lexing::{MAX_READ_LINE, Token, range, read_end},
     limit::{LineLimiter, Omitted},
-    runs::RunBuilder,
-    visible,
+    line_blocks, visible,
 };
 
 /// The types of definitions and formal parameters (004:1484, 1676, 4915;
@@ -68,6 +67,10 @@ const PREFIX_POWER: u8 = 23;
 const CONVERSION_POWER: u8 = 4;
 
 pub(crate) fn parse_source_file(text: &str) -> (GreenNode, Vec<SyntaxError>, Vec<Omitted<E>>) {
+    parse_source_file_with(text, line_blocks::PARALLEL_THRESHOLD)
+}
+
+fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, Vec<SyntaxError>, Vec<Omitted<E>>) {
     let mut children: Vec<GreenElement> = Vec::new();
     let mut errors = Errors::default();
     let mut start = 0;
@@ -80,12 +83,8 @@ pub(crate) fn parse_source_file(text: &str) -> (GreenNode, Vec<SyntaxError>, Vec
             "the file starts with a byte-order mark: it was saved as Unicode text, but the control reads plain text; save it as plain text",
         ));
     }
-    let (blocks, block_errors) = parse_blocks(text, start..text.len(), &[]);
-    let mut runs = RunBuilder::new(text, start);
-    for block in blocks {
-        runs.push(block);
-    }
-    children.extend(runs.finish());
+    let (runs, block_errors) = line_blocks::parse_in_parts(text, start..text.len(), parallel_threshold, parse_blocks);
+    children.extend(runs);
     errors.append(block_errors);
     let (errors, omitted) = errors.finish(text);
     (green::node(SOURCE_FILE, children), errors, omitted)
@@ -1240,5 +1239,37 @@ impl ExprInput for Parser<'_> {
 
     fn error(&mut self, kind: E, range: Range<usize>, message: String) {
         self.report(kind, range, message);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_source_file_with;
+
+    /// Parsing in parts gives the tree and the errors of one pass.
+    #[test]
+    fn parts_parse_like_one_pass() {
+        let pieces = [
+            "N10 G1 X=R1+2 Y-3.5 F100 ; cut\n",
+            "IF R1>2 GOTOF LABEL\r\n",
+            "LABEL: DEF REAL A[2,3]=(1,2,3) MSG(\"x\"<<R1)\n",
+            "WHILE R1<3 ; loop\n",
+            "MSG(\"unclosed\n",
+            // More doubled points on a line than a report keeps.
+            &"X1.2. ".repeat(20),
+            "\n",
+            &"X1 Z2 ".repeat(200),
+            "\n",
+        ];
+        let mut text = String::from("%_N_PARTS_MPF\n");
+        for i in 0..3000 {
+            text.push_str(pieces[i % pieces.len()]);
+        }
+        text.push_str("M30\n");
+        let sequential = parse_source_file_with(&text, usize::MAX);
+        assert!(!sequential.1.is_empty() && !sequential.2.is_empty(), "errors kept and left out");
+        let parallel = parse_source_file_with(&text, 0);
+        assert_eq!(sequential, parallel);
+        assert_eq!(rowan::SyntaxNode::<crate::NcLanguage>::new_root(parallel.0).to_string(), text);
     }
 }

@@ -1,5 +1,10 @@
-//! Incremental reparsing for dialects whose blocks are lines (Haas,
-//! Sinumerik): after an edit, reparse only the lines it touched.
+//! Parsing for dialects whose blocks are lines (Haas, Sinumerik): large
+//! programs in parts on all cores, and after an edit only the lines it
+//! touched.
+//!
+//! A part that starts at a line start parses alone, so a large body is
+//! split at line starts and its parts parsed in parallel; the runs are
+//! formed in one pass over all parts, so they do not depend on the split.
 //!
 //! A block is a line, so the blocks an edit can change are the one before
 //! it (a line break deleted or inserted at its end joins or splits it) up
@@ -19,8 +24,60 @@ use crate::{
     error::{Errors, sort_errors},
     green::GreenElement,
     limit::Omitted,
-    runs::regroup,
+    runs::{RunBuilder, regroup},
 };
+
+/// Bodies from this size on are parsed in parts on all cores.
+pub(crate) const PARALLEL_THRESHOLD: usize = 1 << 20;
+
+/// The blocks of `body` (which starts at a line start) grouped into runs,
+/// parsed by `parse_blocks` in parts on all cores when the body is at least
+/// `parallel_threshold` long, and their errors.
+pub(crate) fn parse_in_parts<P>(
+    text: &str,
+    body: Range<usize>,
+    parallel_threshold: usize,
+    parse_blocks: P,
+) -> (Vec<GreenElement>, Errors)
+where
+    P: Fn(&str, Range<usize>, &[&GreenNodeData]) -> (Vec<GreenElement>, Errors) + Sync,
+{
+    let bounds = if body.len() < parallel_threshold {
+        vec![body.start, body.end]
+    } else {
+        split_at_lines(text, body.clone(), rayon::current_num_threads() * 4)
+    };
+    let parse_part = |i: usize| parse_blocks(text, bounds[i]..bounds[i + 1], &[]);
+    let parts: Vec<_> = if bounds.len() > 2 {
+        use rayon::prelude::*;
+        (0..bounds.len() - 1).into_par_iter().map(parse_part).collect()
+    } else {
+        vec![parse_part(0)]
+    };
+    let mut errors = Errors::default();
+    let mut runs = RunBuilder::new(text, body.start);
+    for (blocks, block_errors) in parts {
+        for block in blocks {
+            runs.push(block);
+        }
+        errors.append(block_errors);
+    }
+    (runs.finish(), errors)
+}
+
+/// About `parts` parts of `region`, each starting at a line start.
+fn split_at_lines(text: &str, region: Range<usize>, parts: usize) -> Vec<usize> {
+    let mut bounds = vec![region.start];
+    for k in 1..parts {
+        let from = (region.start + region.len() * k / parts).max(bounds[bounds.len() - 1]);
+        match text[from..region.end].find('\n') {
+            Some(newline) if from + newline + 1 < region.end => bounds.push(from + newline + 1),
+            _ => break,
+        }
+    }
+    bounds.push(region.end);
+    bounds
+}
 
 /// A tree with its errors, as [`crate::Parse`] holds them.
 pub type Parts = (GreenNode, Vec<SyntaxError>, Vec<Omitted<SyntaxErrorKind>>);
