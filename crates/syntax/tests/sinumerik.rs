@@ -322,6 +322,7 @@ fn is_keyword(name: &str) -> bool {
         "OF", "DEFAULT", "TO", "DO", "BLOCK", "GOTO", "GOTOF", "GOTOB", "GOTOC", "GOTOS", "DEF", "PROC", "EXTERN",
         "WHEN", "WHENEVER", "EVERY", "FROM", "MCALL", "AND", "OR", "XOR", "NOT", "DIV", "MOD", "B_AND", "B_OR",
         "B_XOR", "B_NOT", "VAR", "INT", "REAL", "BOOL", "CHAR", "STRING", "AXIS", "FRAME", "AS", "DEFINE", "CALL",
+        "PCALL",
     ]
     .contains(&name)
 }

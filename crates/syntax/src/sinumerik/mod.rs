@@ -28,6 +28,7 @@
 //! call      := name [args]                        `TRAORI`, `CYCLE81(10,0,2)`, `MSG("…")`
 //!            | ("L" | "M") digits args             `L140(1)`, `M6(T1)`: numbered subprograms
 //!            | "CALL" expr ["BLOCK" expr "TO" expr]
+//!            | "PCALL" path [args]                `PCALL /_N_CST_DIR/_N_SUB_SPF(1)`
 //! macro     := "DEFINE" name "AS" text            the text is kept as tokens
 //!            | "MCALL" [name [args]]
 //! def       := "DEF" [NCK|CHAN] type decl {"," decl}

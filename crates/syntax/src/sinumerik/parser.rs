@@ -542,6 +542,7 @@ impl<'a> Parser<'a> {
             "DO" => self.sync_actions(Vec::new()),
             "MCALL" => self.modal_call(),
             "CALL" => self.indirect_call(),
+            "PCALL" => self.path_call(),
             "DEFINE" => self.macro_definition(),
             _ if CONTINUATIONS.contains(&keyword.as_str()) => {
                 let message = format!("`{keyword}` continues another statement and cannot start one");
@@ -922,7 +923,7 @@ impl<'a> Parser<'a> {
                     return;
                 }
                 _ => {
-                    self.report(E::UnclosedParenthesis, open..open + 1, "`(` is not closed by `)` on its line");
+                    self.close_paren(open, children, true);
                     return;
                 }
             }
@@ -1001,6 +1002,33 @@ impl<'a> Parser<'a> {
         Self::node(CALL_STMT, children)
     }
 
+    /// `PCALL path(args)`: a call of a program by its path written out,
+    /// `PCALL /_N_CST_DIR/_N_SUB_SPF(1,2)` (assumption: the Siemens form,
+    /// the seed has none); the path is its `/` and name tokens.
+    fn path_call(&mut self) -> GreenElement {
+        let start = self.pos;
+        let mut children = vec![self.bump()];
+        let keyword_end = self.pos;
+        let path_at = self.skip_whitespace(self.pos);
+        if !matches!(self.kind_at(path_at), Some(SLASH | IDENT)) {
+            self.report(
+                E::MalformedStatement,
+                start..keyword_end,
+                "`PCALL` must be followed by the program's path: `PCALL /_N_SPF_DIR/_N_SUB_SPF`",
+            );
+            return Self::node(CALL_STMT, children);
+        }
+        self.trivia(&mut children);
+        while let Some(SLASH | IDENT) = self.kind_at(self.pos) {
+            children.push(self.bump());
+        }
+        if self.significant_kind() == Some(L_PAREN) {
+            self.trivia(&mut children);
+            children.push(self.arg_list(0));
+        }
+        Self::node(CALL_STMT, children)
+    }
+
     /// `DEFINE name AS text`: a macro, whose text (the rest of the line)
     /// the lowering substitutes; it is kept as tokens, not parsed.
     fn macro_definition(&mut self) -> GreenElement {
@@ -1045,22 +1073,66 @@ impl<'a> Parser<'a> {
                 Some(_) => {
                     self.trivia(&mut children);
                     let Some(argument) = self.expr_bp(0, depth + 1, "an argument") else {
-                        self.report(E::UnclosedParenthesis, open..open + 1, "`(` is not closed by `)` on its line");
+                        self.close_paren(open, &mut children, false);
                         break;
                     };
                     children.push(argument);
                     if !matches!(self.significant_kind(), Some(COMMA | R_PAREN)) {
-                        self.report(E::UnclosedParenthesis, open..open + 1, "`(` is not closed by `)` on its line");
+                        self.close_paren(open, &mut children, true);
                         break;
                     }
                 }
                 None => {
-                    self.report(E::UnclosedParenthesis, open..open + 1, "`(` is not closed by `)` on its line");
+                    self.close_paren(open, &mut children, true);
                     break;
                 }
             }
         }
         Self::node(ARG_LIST, children)
+    }
+
+    /// The `)` that closes the `(` at `open`, into `children`. Anything
+    /// before a `)` later on the line is kept in an `ERROR` node and
+    /// reported once (unless `report_skipped` is false: a missing value was
+    /// reported already); without a `)` the `(` is unclosed.
+    fn close_paren(&mut self, open: usize, children: &mut Vec<GreenElement>, report_skipped: bool) {
+        let Some(close) = self.matching_paren(self.pos) else {
+            self.report(E::UnclosedParenthesis, open..open + 1, "`(` is not closed by `)` on its line");
+            return;
+        };
+        self.trivia(children);
+        if self.pos < close {
+            let start = self.pos;
+            let mut skipped = Vec::new();
+            while self.pos < close {
+                skipped.push(self.bump());
+            }
+            let text = self.text[start..close].trim_end();
+            if report_skipped {
+                let message =
+                    format!("`{}` is not allowed here: an operator, `,` or `)` must follow", visible::quoted(text));
+                self.report(E::UnexpectedCharacter, start..start + text.len(), message);
+            }
+            children.push(Self::node(ERROR, skipped));
+        }
+        children.push(self.bump());
+    }
+
+    /// Where the `)` is that closes a `(` before `from`, if it is on the
+    /// line.
+    fn matching_paren(&self, mut from: usize) -> Option<usize> {
+        let mut depth = 0usize;
+        while let Some(token) = self.token_at(from) {
+            match token.kind {
+                NEWLINE | COMMENT | UNREAD => return None,
+                L_PAREN => depth += 1,
+                R_PAREN if depth == 0 => return Some(from),
+                R_PAREN => depth -= 1,
+                _ => {}
+            }
+            from += token.len;
+        }
+        None
     }
 
     /// `name[i, j]`: `name` with its index.
@@ -1144,9 +1216,9 @@ impl<'a> Parser<'a> {
                 let open = self.pos;
                 let mut children = vec![self.bump()];
                 self.trivia(&mut children);
-                if let Some(inner) = self.expr_bp(0, depth + 1, "an expression inside the parentheses") {
-                    children.push(inner);
-                }
+                let inner = self.expr_bp(0, depth + 1, "an expression inside the parentheses");
+                let complete = inner.is_some();
+                children.extend(inner);
                 // A list of values, which initialises an array: `(1,2,3)`.
                 let mut kind = BRACKET_EXPR;
                 while self.significant_kind() == Some(COMMA) {
@@ -1157,11 +1229,7 @@ impl<'a> Parser<'a> {
                         children.push(value);
                     }
                 }
-                if self.significant_kind() == Some(R_PAREN) {
-                    self.bump_significant(&mut children);
-                } else {
-                    self.report(E::UnclosedParenthesis, open..open + 1, "`(` is not closed by `)` on its line");
-                }
+                self.close_paren(open, &mut children, complete);
                 Some(Self::node(kind, children))
             }
             LETTER if self.is_parameter_at(self.pos) => Some(self.param_ref()),
