@@ -100,8 +100,11 @@ syntax_error_kinds! {
     DoubledDecimalPoint = "S023", "doubled-decimal-point", Error, "A number with a second decimal point: `7.75.`.";
     ExpectedExpression = "S024", "expected-expression", Error, "A place where an expression (number, variable, bracket or function) must be.";
     UnclosedBracket = "S025", "unclosed-bracket", Error, "A `[` without its closing `]` on the line.";
-    MalformedStatement = "S026", "malformed-statement", Error, "A macro statement (IF, GOTO, WHILE, DO, END, assignment) missing a required part, or a keyword out of place.";
+    MalformedStatement = "S026", "malformed-statement", Error, "A statement (IF, GOTO, WHILE, DO, END, assignment; Sinumerik also DEF, PROC, FOR, CASE, …) missing a required part, or a keyword out of place.";
     TemplatePlaceholder = "S027", "template-placeholder", Error, "A placeholder of a manual's formats (`X..`, `Z...`, `....`) where a value must be written.";
+    UnclosedString = "S028", "unclosed-string", Error, "A string `\"` without its closing `\"` on the line.";
+    UnclosedParenthesis = "S029", "unclosed-parenthesis", Error, "A `(` without its closing `)` on the line.";
+    ParenthesisComment = "S030", "parenthesis-comment", Error, "A Fanuc-style comment `( … )` where Sinumerik reads code: its comments start with `;`.";
 }
 
 /// One syntax diagnostic.

@@ -1,4 +1,6 @@
-//! Macro expressions: a Pratt parser shared by the ISO dialects.
+//! Macro expressions: a Pratt parser shared by the ISO dialects, whose
+//! operator loop and number rules the Sinumerik parser shares too (its
+//! values, names with indices and argument lists, are its own).
 //!
 //! The dialect supplies its tokens through [`ExprInput`] and its operators
 //! through a [`Grammar`]: which tokens are binary operators with what
@@ -21,7 +23,7 @@ use crate::{
 /// The deepest nesting of brackets and signs an expression may have: deeper
 /// input is reported instead of recursed into, so no line can exhaust the
 /// stack.
-const MAX_DEPTH: usize = 64;
+pub(crate) const MAX_DEPTH: usize = 64;
 
 /// A token found ahead: its kind and where it is.
 #[derive(Debug, Clone, Copy)]
@@ -87,10 +89,26 @@ fn expr_bp(
     depth: usize,
     what: &str,
 ) -> Option<GreenElement> {
-    let mut lhs = prefix(input, grammar, depth, what)?;
+    let lhs = prefix(input, grammar, depth, what)?;
+    Some(binary_tail(input, grammar.binary, lhs, min_bp, |input, right, what| {
+        expr_bp(input, grammar, right, depth, what)
+    }))
+}
+
+/// The binary operations that follow `lhs` and bind at least `min_bp`:
+/// the operator loop of the Pratt parser. `operand` parses a right-hand
+/// side at the given binding power; a dialect with its own values (the
+/// Sinumerik parser) shares the loop through it.
+pub(crate) fn binary_tail<I: ExprInput>(
+    input: &mut I,
+    binary: fn(SyntaxKind, &str) -> Option<(u8, u8)>,
+    mut lhs: GreenElement,
+    min_bp: u8,
+    mut operand: impl FnMut(&mut I, u8, &str) -> Option<GreenElement>,
+) -> GreenElement {
     while let Some(op) = input.significant_at(input.pos()) {
         let op_text = &input.text()[op.range.0..op.range.1];
-        let Some((left, right)) = (grammar.binary)(op.kind, op_text) else { break };
+        let Some((left, right)) = binary(op.kind, op_text) else { break };
         if left < min_bp {
             break;
         }
@@ -100,12 +118,12 @@ fn expr_bp(
         children.push(input.bump());
         input.bump_trivia(&mut children);
         let what = format!("a value after `{op_text}`");
-        if let Some(rhs) = expr_bp(input, grammar, right, depth, &what) {
+        if let Some(rhs) = operand(input, right, &what) {
             children.push(rhs);
         }
         lhs = NodeOrToken::Node(green::node(BIN_EXPR, children));
     }
-    Some(lhs)
+    lhs
 }
 
 fn prefix(input: &mut impl ExprInput, grammar: &Grammar, depth: usize, what: &str) -> Option<GreenElement> {

@@ -18,7 +18,9 @@ mod green;
 mod haas_lathe;
 mod lexing;
 pub mod limit;
+mod line_blocks;
 mod runs;
+pub mod sinumerik;
 mod syntax_kind;
 pub mod visible;
 

@@ -12,7 +12,7 @@ pub enum SyntaxKind {
     NEWLINE,
     /// A comment: CNC8x6 `"…"` (or `"…` up to the end of the line); ISO
     /// `(…)` (or `(…` up to the end of the line) and `;…` to the end of the
-    /// line.
+    /// line; Sinumerik `;…` only.
     COMMENT,
     /// Text before the program header `%`, which the control skips while loading.
     PREAMBLE,
@@ -43,7 +43,8 @@ pub enum SyntaxKind {
     /// expression.
     STAR,
     /// A run of letters that is a keyword, an operator or a function name:
-    /// `GOTO`, `WHILE`, `EQ`, `SIN`.
+    /// `GOTO`, `WHILE`, `EQ`, `SIN`; Sinumerik: any name (two letters or
+    /// `_` first, then letters, digits and `_`), and `$` with a name.
     IDENT,
     /// `#`, which makes a variable of the value after it: `#100`.
     HASH,
@@ -55,13 +56,37 @@ pub enum SyntaxKind {
     COMMA,
     /// Characters the language does not know.
     ERROR_TOKEN,
+    /// Sinumerik: a string `"…"` (or `"…` up to the end of the line), or a
+    /// quoted constant `'H1F'`.
+    STRING,
+    /// `(`: Sinumerik arguments and grouping.
+    L_PAREN,
+    /// `)`.
+    R_PAREN,
+    /// `:`: after a Sinumerik label, or the main block number `:10`.
+    COLON,
+    /// `==`.
+    EQ_EQ,
+    /// `<>`.
+    NEQ,
+    /// `<`.
+    LT,
+    /// `<=`.
+    LT_EQ,
+    /// `>`.
+    GT,
+    /// `>=`.
+    GT_EQ,
+    /// `<<`, Sinumerik string concatenation.
+    CONCAT,
 
     #[doc(hidden)]
     __LAST_TOKEN,
 
     // Nodes.
     SOURCE_FILE,
-    /// `%` with the program number and its comment.
+    /// `%` with the program number and its comment; Sinumerik: a file
+    /// header line `%_N_NAME_MPF`.
     HEADER,
     /// A run of consecutive blocks. Runs mean nothing: they bound how much
     /// of the tree an edit rebuilds (a flat root with a million children is
@@ -75,7 +100,8 @@ pub enum SyntaxKind {
     /// An address with its value: `X-12.5`, `G01`, `FR10`, `&1201`,
     /// `X#1`, `Z[#2*2]`, and the corner words `,C1.` / `,R2.`.
     WORD,
-    /// A parameter used as a value: the `R10` in `FR10`.
+    /// A parameter used as a value: the `R10` in `FR10`; Sinumerik: `R10`,
+    /// `R[R1+2]`.
     PARAM_REF,
     /// A parameter assignment: `R12=-0.864`.
     PARAM_ASSIGN,
@@ -91,27 +117,72 @@ pub enum SyntaxKind {
     PROGRAM_NUMBER,
     /// A variable: `#100`, `#[#1+2]`.
     VAR_REF,
-    /// An assignment to a variable: `#1 = #2 + 1`.
+    /// An assignment to a variable: `#1 = #2 + 1`; Sinumerik: `R1=5`,
+    /// `A[1,2]=3`, `$TC_DP1[1,1]=120`, and the multi-letter addresses
+    /// (`CR=10`, `SD=3`), which only the catalogue tells from variables.
     ASSIGN,
     /// A binary operation: `#1 + 2`, `#1 EQ 0`.
     BIN_EXPR,
     /// A sign before a value: `-#5`, `-[#1]`.
     PREFIX_EXPR,
-    /// An expression in brackets: `[#1 + 2]`.
+    /// An expression in brackets: `[#1 + 2]`; Sinumerik: in parentheses,
+    /// `(R1 + 2)`.
     BRACKET_EXPR,
     /// A function applied to its bracketed argument: `SIN[30.]`,
     /// `ATAN[#1]/[#2]`.
     CALL_EXPR,
     /// A number in an expression.
     LITERAL,
-    /// A conditional: `IF [cond] GOTO n`, `IF [cond] THEN #1 = …`.
+    /// A conditional: `IF [cond] GOTO n`, `IF [cond] THEN #1 = …`;
+    /// Sinumerik: `IF cond` opening a block structure, or `IF cond GOTOF L`.
     IF_STMT,
-    /// A jump: `GOTO 10`, `GOTO #1`.
+    /// A jump: `GOTO 10`, `GOTO #1`; Sinumerik: `GOTOF LABEL`, `GOTOB N10`,
+    /// `GOTO "N"<<R3`.
     GOTO_STMT,
-    /// The start of a loop: `WHILE [cond] DO1`, or `DO1` alone.
+    /// The start of a loop: `WHILE [cond] DO1`, or `DO1` alone; Sinumerik:
+    /// `WHILE cond`, `FOR I=1 TO 10`, `REPEAT`, `LOOP`.
     LOOP_START,
-    /// The end of a loop: `END1`.
+    /// The end of a loop: `END1`; Sinumerik: `ENDWHILE`, `ENDFOR`,
+    /// `ENDLOOP`, `UNTIL cond`.
     LOOP_END,
+    /// Sinumerik `N10` or `:10` at the start of a block.
+    BLOCK_NUMBER,
+    /// Sinumerik jump label `NAME:`.
+    LABEL,
+    /// A name used as a value or a target: a variable, a system variable
+    /// `$P_F`, an axis `X1`, a label, a constant `TRUE`.
+    NAME_REF,
+    /// An indexed name: `A[1,I+1]`, `$P_UIFR[1,X,TR]`, `G[8]`.
+    INDEX_EXPR,
+    /// Arguments in parentheses, empty ones allowed: `(,TRUE,2.14)`.
+    ARG_LIST,
+    /// A named command or subprogram call on its own: `TRAORI`,
+    /// `CYCLE81(10,0,2)`, `MSG("…")`, `MCALL CYCLE81(…)`, `PROFIL`.
+    CALL_STMT,
+    /// `DEF [scope] type declarations`.
+    DEF_STMT,
+    /// A type in a definition or a parameter list: `REAL`, `STRING[20]`.
+    TYPE,
+    /// One declared variable: `A[2,3]`, `B=5`.
+    VAR_DECL,
+    /// `PROC name (parameters) attributes`.
+    PROC_STMT,
+    /// A formal parameter: `VAR REAL X[3]`, or a type alone in `EXTERN`.
+    PARAM,
+    /// `EXTERN name (types)`.
+    EXTERN_STMT,
+    /// `ELSE`.
+    ELSE_STMT,
+    /// `ENDIF`.
+    ENDIF_STMT,
+    /// `CASE expr OF` with its arms.
+    CASE_STMT,
+    /// One arm of a CASE: `1 GOTOF L1`, `DEFAULT GOTOF L2`.
+    CASE_ARM,
+    /// A synchronous action: `WHENEVER cond DO actions`, or `DO actions`.
+    SYNC_ACTION,
+    /// A macro: `DEFINE name AS text`, the text kept as tokens.
+    MACRO_DEF,
     /// Input the parser could not place; always comes with a syntax error.
     ERROR,
 }
@@ -166,6 +237,17 @@ const ALL_KINDS: [SyntaxKind; SyntaxKind::LAST as usize + 1] = {
         R_BRACK,
         COMMA,
         ERROR_TOKEN,
+        STRING,
+        L_PAREN,
+        R_PAREN,
+        COLON,
+        EQ_EQ,
+        NEQ,
+        LT,
+        LT_EQ,
+        GT,
+        GT_EQ,
+        CONCAT,
         __LAST_TOKEN,
         SOURCE_FILE,
         HEADER,
@@ -189,6 +271,24 @@ const ALL_KINDS: [SyntaxKind; SyntaxKind::LAST as usize + 1] = {
         GOTO_STMT,
         LOOP_START,
         LOOP_END,
+        BLOCK_NUMBER,
+        LABEL,
+        NAME_REF,
+        INDEX_EXPR,
+        ARG_LIST,
+        CALL_STMT,
+        DEF_STMT,
+        TYPE,
+        VAR_DECL,
+        PROC_STMT,
+        PARAM,
+        EXTERN_STMT,
+        ELSE_STMT,
+        ENDIF_STMT,
+        CASE_STMT,
+        CASE_ARM,
+        SYNC_ACTION,
+        MACRO_DEF,
         ERROR,
     ]
 };

@@ -60,6 +60,15 @@ fn fixtures_cover_every_syntax_error() {
             seen.extend(Parse::new(&text, Dialect::HaasLathe).errors().iter().map(|e| e.kind));
         }
     }
+    // So has Sinumerik, which is no `Dialect` yet.
+    let sinumerik = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("test_data/sinumerik/constructs");
+    for entry in fs::read_dir(sinumerik).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|ext| ext == "mpf") {
+            let text = fs::read_to_string(&path).unwrap();
+            seen.extend(ncc_syntax::sinumerik::parse_source_file(&text).1.iter().map(|e| e.kind));
+        }
+    }
     let missing: Vec<_> = ncc_syntax::SyntaxErrorKind::ALL.iter().filter(|k| !seen.contains(k)).collect();
     assert!(missing.is_empty(), "no fixture shows {missing:?}");
 }

@@ -33,8 +33,7 @@ use crate::{
     green::{self, GreenElement, GreenFactory},
     lexing::{MAX_READ_LINE, Token, range, read_end},
     limit::{LineLimiter, Omitted},
-    runs::RunBuilder,
-    visible,
+    line_blocks, visible,
 };
 
 /// The operators of Haas macro expressions, with the Fanuc precedence:
@@ -70,11 +69,8 @@ fn function(name: &str) -> Option<Arguments> {
 
 const GRAMMAR: Grammar = Grammar { binary, function };
 
-/// Bodies from this size on are parsed in parts on all cores.
-const PARALLEL_THRESHOLD: usize = 1 << 20;
-
 pub(crate) fn parse_source_file(text: &str) -> (GreenNode, Vec<SyntaxError>, Vec<Omitted<E>>) {
-    parse_source_file_with(text, PARALLEL_THRESHOLD)
+    parse_source_file_with(text, line_blocks::PARALLEL_THRESHOLD)
 }
 
 fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, Vec<SyntaxError>, Vec<Omitted<E>>) {
@@ -100,48 +96,14 @@ fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, 
         children.push(NodeOrToken::Node(parser.opening_mark()));
         errors.append(parser.into_errors());
     }
-    // A block is a line: parts that start at line starts parse alone.
-    let bounds = if body.len() < parallel_threshold {
-        vec![body.start, body.end]
-    } else {
-        split_at_lines(text, body.clone(), rayon::current_num_threads() * 4)
-    };
-    let parse_part = |i: usize| parse_blocks(text, bounds[i]..bounds[i + 1], &[]);
-    let parts: Vec<_> = if bounds.len() > 2 {
-        use rayon::prelude::*;
-        (0..bounds.len() - 1).into_par_iter().map(parse_part).collect()
-    } else {
-        vec![parse_part(0)]
-    };
-    // Runs are formed in one pass over all parts: where a run ends must not
-    // depend on how the text was split.
-    let mut runs = RunBuilder::new(text, body.start);
-    for (blocks, block_errors) in parts {
-        for block in blocks {
-            runs.push(block);
-        }
-        errors.append(block_errors);
-    }
-    children.extend(runs.finish());
+    let (runs, block_errors) = line_blocks::parse_in_parts(text, body.clone(), parallel_threshold, parse_blocks);
+    children.extend(runs);
+    errors.append(block_errors);
     if body.end < text.len() {
         children.push(NodeOrToken::Node(closing_mark(text, body.end)));
     }
     let (errors, omitted) = errors.finish(text);
     (green::node(SOURCE_FILE, children), errors, omitted)
-}
-
-/// About `parts` parts of `region`, each starting at a line start.
-fn split_at_lines(text: &str, region: Range<usize>, parts: usize) -> Vec<usize> {
-    let mut bounds = vec![region.start];
-    for k in 1..parts {
-        let from = (region.start + region.len() * k / parts).max(bounds[bounds.len() - 1]);
-        match text[from..region.end].find('\n') {
-            Some(newline) if from + newline + 1 < region.end => bounds.push(from + newline + 1),
-            _ => break,
-        }
-    }
-    bounds.push(region.end);
-    bounds
 }
 
 /// Where the tape marks are.

@@ -1,108 +1,31 @@
-//! Incremental reparsing: after an edit, reparse only the lines it touched.
-//!
-//! A block is a line, so the blocks an edit can change are the one before
-//! it (a line break deleted or inserted at its end joins or splits it) up
-//! to the one holding its end; every other block keeps its text and so its
-//! tree. The runs around them are regrouped (see `runs`). Edits that could
-//! move a tape mark `%`, or that touch the text outside the blocks, make us
-//! return `None` and the caller parses the whole text again. A property
-//! test checks that the result always equals a full parse.
-
-use rowan::{NodeOrToken, TextRange, TextSize};
+//! Incremental reparsing of Haas programs: the shared reparse of line
+//! blocks (`line_blocks`), refused where an edit could move a tape mark
+//! `%`.
 
 use super::parser;
 use crate::{
-    Parse, SyntaxError, SyntaxKind, SyntaxNode, TextEdit,
-    encoding::BYTE_ORDER_MARK,
-    error::sort_errors,
-    limit::Omitted,
-    runs::{deleted_text, regroup},
+    Parse, SyntaxKind, SyntaxNode, TextEdit,
+    line_blocks::{LineDialect, reparse_line_blocks},
+    runs::deleted_text,
 };
 
 pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Option<Parse> {
-    let root = old.syntax_node();
-    let old_len = root.text_range().end();
-    if edit.delete.end() > old_len || new_text.len() != usize::from(old_len - edit.delete.len()) + edit.insert.len() {
-        return None;
-    }
-    if edit.insert.contains('%') || deleted_text(&root, edit.delete).contains('%') {
-        return None;
-    }
-    let runs: Vec<SyntaxNode> = root.children().filter(|n| n.kind() == SyntaxKind::BLOCK_RUN).collect();
-    let (first_run, last_run) = (runs.first()?, runs.last()?);
-    let body = TextRange::new(first_run.text_range().start(), last_run.text_range().end());
-    let (s, e) = (edit.delete.start(), edit.delete.end());
-    // Text before the blocks (the opening mark), and the start of the
-    // closing mark's line, where text would glue onto the mark.
-    let closing = body.end() < old_len;
-    // A byte-order mark is read only at the very start of the file.
-    let near_mark = usize::from(s) < BYTE_ORDER_MARK.len_utf8();
-    if near_mark || s < body.start() || e > body.end() || (e == body.end() && closing) {
-        return None;
-    }
-    let one = TextSize::from(1);
-    let first = block_at(&root, s.max(body.start() + one) - one)?;
-    let last = if e < body.end() { block_at(&root, e)? } else { block_at(&root, body.end() - one)? };
-    let region_start = first.text_range().start();
-    let old_region_end = last.text_range().end();
-
-    let delta = i64::from(u32::from(TextSize::of(edit.insert.as_str()))) - i64::from(u32::from(edit.delete.len()));
-    let shift = |offset: TextSize| TextSize::from((i64::from(u32::from(offset)) + delta) as u32);
-    let start = usize::from(region_start);
-    let new_end = usize::from(shift(old_region_end));
-    // A line of the region that now starts with `%` would be a tape mark;
-    // a line the edit made end at the body's end may lack its line break.
-    if new_text[start..new_end].contains('%') {
-        return None;
-    }
-    // Without an opening mark, blanking the lines before a `%` line would
-    // make it the opening mark.
-    let opening = root.children().any(|n| n.kind() == SyntaxKind::TAPE_MARK && n.text_range().end() <= body.start());
-    if !opening && new_text[start..new_end].trim().is_empty() {
-        return None;
-    }
-    let (blocks, block_errors) = parser::parse_blocks(new_text, start..new_end, &[first.green(), last.green()]);
-    let stop = (old_region_end < body.end()).then(|| block_at(&root, old_region_end)).flatten();
-    let end_index = last_run.index() + 1;
-    let green = regroup(&root, &first, blocks, stop.as_ref(), new_text, end_index);
-
-    // Every error lies on one line, so in one block: those of the replaced
-    // blocks are recomputed, the later ones move by `delta`.
-    // A zero-width error at the very end of the blocks belongs to the last.
-    let in_region = |at: TextSize| {
-        at >= region_start && (at < old_region_end || (at == old_region_end && old_region_end == body.end()))
+    let dialect = LineDialect {
+        edit_ok: |root: &SyntaxNode| !edit.insert.contains('%') && !deleted_text(root, edit.delete).contains('%'),
+        region_ok: |root: &SyntaxNode, region: &str| {
+            // A line of the region that now starts with `%` would be a tape
+            // mark. Without an opening mark, blanking the lines before a
+            // `%` line would make it the opening mark.
+            let body_start =
+                root.children().find(|n| n.kind() == SyntaxKind::BLOCK_RUN).map(|n| n.text_range().start());
+            let opening = body_start.is_some_and(|start| {
+                root.children().any(|n| n.kind() == SyntaxKind::TAPE_MARK && n.text_range().end() <= start)
+            });
+            !region.contains('%') && (opening || !region.trim().is_empty())
+        },
+        parse_blocks: parser::parse_blocks,
     };
-    let moved = |range: TextRange| {
-        if range.start() >= old_region_end { TextRange::new(shift(range.start()), shift(range.end())) } else { range }
-    };
-    let mut errors: Vec<SyntaxError> = old
-        .errors()
-        .iter()
-        .filter(|error| !in_region(error.range.start()))
-        .map(|error| SyntaxError { range: moved(error.range), ..error.clone() })
-        .collect();
-    errors.extend(block_errors.kept);
-    sort_errors(&mut errors);
-    let mut omitted: Vec<Omitted<_>> = old
-        .omitted()
-        .iter()
-        .filter(|o| !in_region(o.at))
-        .map(|o| {
-            let line_and_at = moved(TextRange::new(o.line, o.at));
-            Omitted { line: line_and_at.start(), at: line_and_at.end(), ..*o }
-        })
-        .collect();
-    omitted.extend(block_errors.omitted);
-    omitted.sort_by_key(|o| (o.at, o.kind));
+    let (green, errors, omitted) =
+        reparse_line_blocks((old.green(), old.errors(), old.omitted()), edit, new_text, dialect)?;
     Some(Parse { green, errors: errors.into(), omitted: omitted.into(), dialect: old.dialect })
-}
-
-/// The block (in its run) that contains the character at `offset`.
-fn block_at(root: &SyntaxNode, offset: TextSize) -> Option<SyntaxNode> {
-    let at = TextRange::at(offset, TextSize::from(1));
-    let run = root.child_or_token_at_range(at)?.into_node().filter(|n| n.kind() == SyntaxKind::BLOCK_RUN)?;
-    match run.child_or_token_at_range(at)? {
-        NodeOrToken::Node(node) if node.kind() == SyntaxKind::BLOCK => Some(node),
-        _ => None,
-    }
 }
