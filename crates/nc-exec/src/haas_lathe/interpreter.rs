@@ -11,8 +11,11 @@
 //!   count from the last position and mix with X and Z in one block
 //!   (lathe manual §5.4 (001:480-555)).
 //! - Coordinates (module `coordinates`): the work offsets G54–G59 and
-//!   G110–G129 of the machine's table, the local shift G52, moves in
-//!   machine coordinates G53 and the reference point returns G28 and G29.
+//!   G110–G129 of the machine's table or as G10 writes them, the local
+//!   shift G52, moves in machine coordinates G53 and the reference point
+//!   returns G28 and G29.
+//! - The skip move G31 as a feed move to its end point: the run has no
+//!   skip input, so the move takes the longest it can.
 //! - Tool-nose radius compensation G41/G42/G40 (module `nose`) with the
 //!   nose radius and tip of the offset T selects, in the passes along the
 //!   contour of G70–G73 too.
@@ -702,6 +705,7 @@ impl<'a> Interpreter<'a> {
         }
         let mut flow = Flow::Next;
         let (mut dwell, mut exact_stop, mut still, mut cycle, mut coordinates) = (false, false, false, None, None);
+        let mut skip = false;
         for code in block.codes(b'G') {
             self.modes.set('G', code);
             match code {
@@ -712,7 +716,8 @@ impl<'a> Interpreter<'a> {
                 4 => dwell = true,
                 9 => exact_stop = true,
                 20 => self.not_run("inch units G20 (the run reads mm)", range),
-                28 | 29 | 52 | 53 => coordinates = Some(code),
+                10 | 28 | 29 | 52 | 53 => coordinates = Some(code),
+                31 => skip = true,
                 81..=89 | 184 => {}
                 95 => self.not_run("live-tool rigid tapping G95", range),
                 101 => self.not_run("mirror image G101", range),
@@ -769,6 +774,8 @@ impl<'a> Interpreter<'a> {
             self.canned(code, place.block, block, range)
         } else if still {
             STILL
+        } else if skip {
+            self.skip_move(block, range)
         } else {
             self.motion(block, range)
         };
@@ -947,6 +954,17 @@ impl<'a> Interpreter<'a> {
             return Moved { motion: Motion::Rapid, path, length, duration: self.rapid_seconds(from, to), feed: None };
         }
         self.feed_move(range, from, to, path, length)
+    }
+
+    /// G31: a straight feed move to the block's end point. The run has no
+    /// skip input, so the move goes all the way: the longest it can take.
+    fn skip_move(&mut self, block: &HaasBlock, range: TextRange) -> Moved {
+        let start = self.position;
+        let Some(end) = self.end_point(block, range, &start) else { return STILL };
+        let (z, x) = (slot(b'Z'), slot(b'X'));
+        let (from, to) = ([start[z], start[x]], [end[z], end[x]]);
+        self.position = end;
+        self.feed_move(range, from, to, Path::Straight, (to[0] - from[0]).hypot(to[1] - from[1]))
     }
 
     /// Reports the corner words of a G01 block, which the run leaves out.

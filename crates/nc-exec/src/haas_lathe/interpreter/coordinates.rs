@@ -33,6 +33,13 @@
 //!   the last G28, then to its own X/Z, U/W counting from the intermediate
 //!   point (Fanuc, External). Without a G28 before it, it goes straight
 //!   there.
+//! - G10 writes work offsets as Haas and Fanuc controls do (External; the
+//!   manual prints only the format, 001:74, OQ-17): `L2 P1`–`P6` the offsets
+//!   G54–G59, `L20 P1`–`P20` G110–G129; X and Z set the offset's value, U
+//!   and W add to it, X a diameter as in the table. The value holds for the
+//!   rest of the run, and at once when the offset is in force. G10's other
+//!   pages (the tool offsets of L1, L10, L11, the shift of L2 P0) are not
+//!   run.
 
 use super::{Interpreter, Moved, STILL};
 use crate::{
@@ -59,6 +66,19 @@ pub(super) struct Coordinates {
     /// The last G28's intermediate point in machine coordinates, per axis
     /// it named (Z, X radius).
     via: [Option<f64>; 2],
+    /// The work offsets G10 wrote, by G code (Z, X radius), over the
+    /// machine's table.
+    written: Vec<(u8, Point)>,
+}
+
+/// The work offset G10 `L` `P` writes, by its G code.
+fn written_offset(page: u32, number: u32) -> Option<u8> {
+    let code = match (page, number) {
+        (2, 1..=6) => 53 + number,
+        (20, 1..=20) => 109 + number,
+        _ => return None,
+    };
+    u8::try_from(code).ok()
 }
 
 /// Machine minus program coordinates (Z, X radius) under the work offset
@@ -95,7 +115,7 @@ impl Interpreter<'_> {
     /// tool stays where it is, its program position changes.
     pub(super) fn update_frame(&mut self) {
         let code = self.modes.get(WORK_OFFSET).and_then(|code| u8::try_from(code).ok()).unwrap_or(54);
-        let [z, x] = work_offset(&self.machine, code);
+        let [z, x] = self.work_offset(code);
         let translation = [z + self.coordinates.local[0], x + self.coordinates.local[1]];
         let before = std::mem::replace(&mut self.coordinates.translation, translation);
         if before == translation {
@@ -104,6 +124,34 @@ impl Interpreter<'_> {
         self.position[slot(b'Z')] += before[0] - translation[0];
         self.position[slot(b'X')] += before[1] - translation[1];
         self.frame = self.frame_of(translation);
+    }
+
+    /// The work offset `G<code>`: as G10 wrote it, else the machine's.
+    fn work_offset(&self, code: u8) -> Point {
+        let written = self.coordinates.written.iter().find(|(written, _)| *written == code);
+        written.map_or_else(|| work_offset(&self.machine, code), |&(_, offset)| offset)
+    }
+
+    /// G10: writes the work offset its L and P name.
+    fn write_offset(&mut self, block: &HaasBlock, range: TextRange) {
+        let whole = |interpreter: &mut Self, letter| {
+            block.word(letter).and_then(|word| interpreter.number(word, range)).map(|value| value as u32)
+        };
+        let (page, number) = (whole(self, b'L'), whole(self, b'P'));
+        let Some(code) = page.zip(number).and_then(|(page, number)| written_offset(page, number)) else {
+            let page = page.map_or_else(String::new, |page| format!(" L{page}"));
+            self.not_run(&format!("G10{page} (only the work offsets of L2 P1-P6 and L20 P1-P20 are written)"), range);
+            return;
+        };
+        let [z, x] = self.work_offset(code);
+        let mut offset: Position = [0.0; 26];
+        (offset[slot(b'Z')], offset[slot(b'X')]) = (z, x);
+        if let Some(end) = self.end_point(block, range, &offset) {
+            let value = [end[slot(b'Z')], end[slot(b'X')]];
+            self.coordinates.written.retain(|(written, _)| *written != code);
+            self.coordinates.written.push((code, value));
+            self.update_frame();
+        }
     }
 
     /// The index of the frame of `translation`, added when new.
@@ -126,9 +174,14 @@ impl Interpreter<'_> {
         machine
     }
 
-    /// A block of G28, G29, G52 or G53: its words are no ordinary move.
+    /// A block of G10, G28, G29, G52 or G53: its words are no ordinary
+    /// move.
     pub(super) fn coordinates(&mut self, code: u32, block: &HaasBlock, range: TextRange) -> Moved {
         match code {
+            10 => {
+                self.write_offset(block, range);
+                STILL
+            }
             52 => {
                 let mut shift: Position = [0.0; 26];
                 (shift[slot(b'Z')], shift[slot(b'X')]) = (self.coordinates.local[0], self.coordinates.local[1]);

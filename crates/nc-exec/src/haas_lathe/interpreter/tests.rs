@@ -355,6 +355,33 @@ fn nose_radius_compensation_offsets_a_profile_by_the_radius_and_shifts_it_to_the
 }
 
 #[test]
+fn g10_writes_work_offsets_and_the_one_in_force_moves_the_program_zero_at_once() {
+    // G10 L2 P2 sets G55 at X-40. (a diameter) Z-300.; W-5. then adds to
+    // G54's Z, which is in force: the program zero moves under the tool.
+    let text = "O1\nG10 L2 P2 X-40. Z-300.\nG55 G00 X0 Z0\nG54 G00 X0 Z0\nG10 L2 P1 W-5.\nG00 X0 Z0\nG10 L20 P3 X10.\nG10 L1 P1 X1.\nM30\n";
+    let trace = run(text, &NoFiles, &lathe_with_offsets(), 100);
+    let machine: Vec<[f64; 2]> = (0..trace.steps.len())
+        .filter(|&i| trace.steps[i].motion == Motion::Rapid)
+        .map(|i| [trace.machine_end(i)[1], trace.machine_end(i)[0]])
+        .collect();
+    assert_eq!(machine, [[-300.0, -20.0], [-200.0, -50.0], [-205.0, -50.0]]);
+    // Only G10's work offsets are written; its tool offsets are not run.
+    let rules: Vec<(RunRule, String)> =
+        trace.findings.iter().map(|f| (f.rule, text[f.range].trim_end().to_owned())).collect();
+    assert_eq!(rules, [(RunRule::NotRunYet, "G10 L1 P1 X1.".to_owned())]);
+}
+
+#[test]
+fn g31_feeds_to_its_end_point() {
+    let text = "O1\nG98 F100.\nG00 X20. Z5.\nG31 W-10.\nM30\n";
+    let trace = run_lathe(text);
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+    let skip = trace.steps.iter().rfind(|step| step.motion != Motion::None).unwrap();
+    assert_eq!((skip.motion, zx(skip)), (Motion::Feed, (-5.0, 10.0)));
+    assert!((skip.duration - 6.0).abs() < 1e-9, "10 mm at 100 mm/min: {}", skip.duration);
+}
+
+#[test]
 fn a_new_work_offset_ends_compensation_and_the_next_start_is_in_its_frame() {
     let machine = MachineConfig { offsets: lathe_with_offsets().offsets, ..lathe_with_nose() };
     let text = "O1\nT101\nG98 F100.\nG00 X20. Z2.\nG42 G01 Z0\nZ-10.\nG55 Z-20.\nM30\n";
