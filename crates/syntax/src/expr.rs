@@ -33,8 +33,8 @@ pub(crate) struct Ahead {
 }
 
 /// The dialect parser, as the expression parser sees it.
-pub(crate) trait ExprInput {
-    fn text(&self) -> &str;
+pub(crate) trait ExprInput<'t> {
+    fn text(&self) -> &'t str;
     /// The position of the next token.
     fn pos(&self) -> usize;
     /// The next token at or after `from` that is not whitespace or a
@@ -72,18 +72,18 @@ pub(crate) struct Grammar {
 
 /// Parses an expression starting at the input's position, or reports a
 /// missing one (`what` names what was expected) and returns `None`.
-pub(crate) fn expr(input: &mut impl ExprInput, grammar: &Grammar, what: &str) -> Option<GreenElement> {
+pub(crate) fn expr<'t>(input: &mut impl ExprInput<'t>, grammar: &Grammar, what: &str) -> Option<GreenElement> {
     expr_bp(input, grammar, 0, 0, what)
 }
 
 /// A value without binary operators: a number, a variable, a bracket, a
 /// function call, or one of those after a sign.
-pub(crate) fn atom(input: &mut impl ExprInput, grammar: &Grammar, what: &str) -> Option<GreenElement> {
+pub(crate) fn atom<'t>(input: &mut impl ExprInput<'t>, grammar: &Grammar, what: &str) -> Option<GreenElement> {
     prefix(input, grammar, 0, what)
 }
 
-fn expr_bp(
-    input: &mut impl ExprInput,
+fn expr_bp<'t>(
+    input: &mut impl ExprInput<'t>,
     grammar: &Grammar,
     min_bp: u8,
     depth: usize,
@@ -99,7 +99,7 @@ fn expr_bp(
 /// the operator loop of the Pratt parser. `operand` parses a right-hand
 /// side at the given binding power; a dialect with its own values (the
 /// Sinumerik parser) shares the loop through it.
-pub(crate) fn binary_tail<I: ExprInput>(
+pub(crate) fn binary_tail<'t, I: ExprInput<'t>>(
     input: &mut I,
     binary: fn(SyntaxKind, &str) -> Option<(u8, u8)>,
     mut lhs: GreenElement,
@@ -126,7 +126,7 @@ pub(crate) fn binary_tail<I: ExprInput>(
     lhs
 }
 
-fn prefix(input: &mut impl ExprInput, grammar: &Grammar, depth: usize, what: &str) -> Option<GreenElement> {
+fn prefix<'t>(input: &mut impl ExprInput<'t>, grammar: &Grammar, depth: usize, what: &str) -> Option<GreenElement> {
     let pos = input.pos();
     let Some(next) = input.significant_at(pos).filter(|next| next.range.0 == pos) else {
         missing(input, what);
@@ -169,7 +169,7 @@ fn prefix(input: &mut impl ExprInput, grammar: &Grammar, depth: usize, what: &st
     }
 }
 
-fn missing(input: &mut impl ExprInput, what: &str) {
+fn missing<'t>(input: &mut impl ExprInput<'t>, what: &str) {
     let pos = input.pos();
     let range = match input.significant_at(pos) {
         Some(next) if next.range.0 == pos && next.kind != NEWLINE => next.range.0..next.range.1,
@@ -178,7 +178,7 @@ fn missing(input: &mut impl ExprInput, what: &str) {
     input.error(E::ExpectedExpression, range, format!("expected {what}"));
 }
 
-fn literal(input: &mut impl ExprInput) -> GreenElement {
+fn literal<'t>(input: &mut impl ExprInput<'t>) -> GreenElement {
     let mut children = Vec::new();
     number(input, &mut children);
     NodeOrToken::Node(green::node(LITERAL, children))
@@ -186,7 +186,7 @@ fn literal(input: &mut impl ExprInput) -> GreenElement {
 
 /// A number token into `children`, with a second one glued to it by a
 /// doubled decimal point (`7.75.`), which is an error.
-pub(crate) fn number(input: &mut impl ExprInput, children: &mut Vec<GreenElement>) {
+pub(crate) fn number<'t>(input: &mut impl ExprInput<'t>, children: &mut Vec<GreenElement>) {
     let start = input.pos();
     children.push(input.bump());
     let end = input.pos();
@@ -213,7 +213,7 @@ pub(crate) fn placeholder(token: &str) -> Option<String> {
 }
 
 /// `#` and the variable number: `#100`, `#[#1+2]`.
-pub(crate) fn var_ref(input: &mut impl ExprInput, grammar: &Grammar, depth: usize) -> GreenElement {
+pub(crate) fn var_ref<'t>(input: &mut impl ExprInput<'t>, grammar: &Grammar, depth: usize) -> GreenElement {
     let start = input.pos();
     let mut children = vec![input.bump()];
     match input.token_kind_at(input.pos()) {
@@ -229,7 +229,7 @@ pub(crate) fn var_ref(input: &mut impl ExprInput, grammar: &Grammar, depth: usiz
 }
 
 /// `[`, an expression, `]`.
-pub(crate) fn bracket(input: &mut impl ExprInput, grammar: &Grammar, depth: usize) -> GreenElement {
+pub(crate) fn bracket<'t>(input: &mut impl ExprInput<'t>, grammar: &Grammar, depth: usize) -> GreenElement {
     let open = input.pos();
     let mut children = vec![input.bump()];
     input.bump_trivia(&mut children);
@@ -246,7 +246,7 @@ pub(crate) fn bracket(input: &mut impl ExprInput, grammar: &Grammar, depth: usiz
     NodeOrToken::Node(green::node(BRACKET_EXPR, children))
 }
 
-fn call(input: &mut impl ExprInput, grammar: &Grammar, depth: usize, arguments: Arguments) -> GreenElement {
+fn call<'t>(input: &mut impl ExprInput<'t>, grammar: &Grammar, depth: usize, arguments: Arguments) -> GreenElement {
     let name_start = input.pos();
     let mut children = vec![input.bump()];
     let name = input.text()[name_start..input.pos()].to_owned();

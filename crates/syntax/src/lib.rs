@@ -19,6 +19,7 @@ mod haas_lathe;
 mod lexing;
 pub mod limit;
 mod line_blocks;
+mod line_cursor;
 mod runs;
 pub mod sinumerik;
 mod syntax_kind;

@@ -19,7 +19,10 @@
 //!   items of their block; loops are matched later, not here, so an edit
 //!   inside a loop reparses one block.
 
-use std::{ops::Range, sync::OnceLock};
+use std::{
+    ops::{Deref, DerefMut, Range},
+    sync::OnceLock,
+};
 
 use rowan::{GreenNode, NodeOrToken};
 
@@ -30,10 +33,12 @@ use crate::{
     encoding::BYTE_ORDER_MARK,
     error::Errors,
     expr::{self, Ahead, Arguments, ExprInput, Grammar},
-    green::{self, GreenElement, GreenFactory},
-    lexing::{MAX_READ_LINE, Token, range, read_end},
-    limit::{LineLimiter, Omitted},
-    line_blocks, visible,
+    green::{self, GreenElement},
+    lexing::{Token, range},
+    limit::Omitted,
+    line_blocks,
+    line_cursor::{Lexer, LineCursor, TokenError},
+    visible,
 };
 
 /// The operators of Haas macro expressions, with the Fanuc precedence:
@@ -94,7 +99,7 @@ fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, 
         }
         parser.move_to(mark, body.start);
         children.push(NodeOrToken::Node(parser.opening_mark()));
-        errors.append(parser.into_errors());
+        errors.append(parser.cursor.into_errors());
     }
     let (runs, block_errors) = line_blocks::parse_in_parts(text, body.clone(), parallel_threshold, parse_blocks);
     children.extend(runs);
@@ -186,97 +191,51 @@ pub(crate) fn parse_blocks(
     while parser.pos < region.end {
         blocks.push(NodeOrToken::Node(parser.block()));
     }
-    (blocks, parser.into_errors())
+    (blocks, parser.cursor.into_errors())
 }
 
 struct Parser<'a> {
-    text: &'a str,
-    pos: usize,
-    /// Where reading stops: `region_end`, or before it where the read part
-    /// of the current line ends (`MAX_READ_LINE`).
-    end: usize,
-    region_end: usize,
-    errors: Vec<SyntaxError>,
-    limiter: LineLimiter<'a, E>,
-    green: GreenFactory<'a>,
+    cursor: LineCursor<'a, HaasLexer>,
+}
+
+impl<'a> Deref for Parser<'a> {
+    type Target = LineCursor<'a, HaasLexer>;
+
+    fn deref(&self) -> &Self::Target {
+        &self.cursor
+    }
+}
+
+impl DerefMut for Parser<'_> {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.cursor
+    }
+}
+
+/// The Haas lathe's tokens; a `(` comment not closed on its line is an
+/// error.
+struct HaasLexer;
+
+impl Lexer for HaasLexer {
+    fn token_at(text: &str, pos: usize) -> Token {
+        lexer::token_at(text, pos)
+    }
+
+    fn unclosed(kind: SyntaxKind, text: &str) -> Option<TokenError> {
+        (kind == COMMENT && text.starts_with('(') && !text.ends_with(')')).then(|| {
+            let message = "comment `(` not closed by `)` on its line; the rest of the line is read as comment";
+            (E::UnclosedComment, 1, message.to_owned())
+        })
+    }
 }
 
 impl<'a> Parser<'a> {
     fn new(text: &'a str, pos: usize, region_end: usize) -> Self {
-        let mut parser = Parser {
-            text,
-            pos,
-            end: region_end,
-            region_end,
-            errors: Vec::new(),
-            limiter: LineLimiter::new(text),
-            green: GreenFactory::new(),
-        };
-        parser.move_to(pos, region_end);
-        parser
-    }
-
-    /// Continues at `pos`, a line start, reading up to `region_end`.
-    fn move_to(&mut self, pos: usize, region_end: usize) {
-        self.pos = pos;
-        self.region_end = region_end;
-        self.end = read_end(self.text, crate::lexing::line_start(self.text, pos), region_end);
-    }
-
-    fn token_at(&self, pos: usize) -> Option<Token> {
-        crate::lexing::bounded_token(self.text, pos, self.end, self.region_end, lexer::token_at)
-    }
-
-    fn peek(&self) -> Option<Token> {
-        self.token_at(self.pos)
-    }
-
-    fn kind_at(&self, pos: usize) -> Option<SyntaxKind> {
-        self.token_at(pos).map(|t| t.kind)
+        Parser { cursor: LineCursor::new(text, pos, region_end) }
     }
 
     fn byte_at(&self, pos: usize) -> u8 {
         self.text.as_bytes()[pos]
-    }
-
-    fn skip_whitespace(&self, mut pos: usize) -> usize {
-        while let Some(Token { kind: WHITESPACE, len }) = self.token_at(pos) {
-            pos += len;
-        }
-        pos
-    }
-
-    fn report(&mut self, kind: E, r: Range<usize>, message: impl Into<String>) {
-        let r = range(r);
-        if self.limiter.keep(r.start(), kind) {
-            self.errors.push(SyntaxError::new(kind, r, message));
-        }
-    }
-
-    fn into_errors(self) -> Errors {
-        Errors { kept: self.errors, omitted: self.limiter.finish() }
-    }
-
-    fn bump(&mut self) -> GreenElement {
-        let token = self.peek().expect("bump past the end");
-        let start = self.pos;
-        let text = &self.text[start..start + token.len];
-        self.pos += token.len;
-        match token.kind {
-            NEWLINE => self.end = read_end(self.text, self.pos, self.region_end),
-            UNREAD => self.report(
-                E::LineTooLong,
-                start..self.pos,
-                format!("line longer than {MAX_READ_LINE} bytes; ncc reads only its first {MAX_READ_LINE} bytes"),
-            ),
-            COMMENT if self.byte_at(start) == b'(' && !text.ends_with(')') => self.report(
-                E::UnclosedComment,
-                start..start + 1,
-                "comment `(` not closed by `)` on its line; the rest of the line is read as comment",
-            ),
-            _ => {}
-        }
-        self.green.token(token.kind, text)
     }
 
     /// Bumps whitespace into `children`.
@@ -286,13 +245,6 @@ impl<'a> Parser<'a> {
         }
     }
 
-    fn error_token(&mut self, kind: E, message: impl Into<String>) -> GreenElement {
-        let start = self.pos;
-        let element = self.bump();
-        self.report(kind, start..self.pos, message);
-        NodeOrToken::Node(green::node(ERROR, [element]))
-    }
-
     /// The opening `%` line: spaces, `%`, comments; other text on it is an
     /// error.
     fn opening_mark(&mut self) -> GreenNode {
@@ -300,9 +252,7 @@ impl<'a> Parser<'a> {
         while let Some(token) = self.peek() {
             let child = match token.kind {
                 WHITESPACE | COMMENT | NEWLINE | PERCENT | UNREAD => self.bump(),
-                _ => {
-                    self.error_token(E::UnexpectedCharacter, "only a comment may follow the tape mark `%` on its line")
-                }
+                _ => self.error_node(E::UnexpectedCharacter, "only a comment may follow the tape mark `%` on its line"),
             };
             children.push(child);
         }
@@ -331,17 +281,15 @@ impl<'a> Parser<'a> {
                 HASH => self.assignment(),
                 IDENT => self.statement(),
                 NUMBER => match expr::placeholder(&self.text[self.pos..self.pos + token.len]) {
-                    Some(message) => self.error_token(E::TemplatePlaceholder, message),
-                    None => self.error_token(E::NumberWithoutAddress, "a number must follow an address letter: `X10.`"),
+                    Some(message) => self.error_node(E::TemplatePlaceholder, message),
+                    None => self.error_node(E::NumberWithoutAddress, "a number must follow an address letter: `X10.`"),
                 },
-                PLUS | MINUS => {
-                    self.error_token(E::SignWithoutAddress, "a sign must follow an address letter: `X-10.`")
-                }
-                EQ => self.error_token(E::MisplacedEquals, "`=` assigns to a variable only: `#1 = 5.`"),
-                PERCENT => self.error_token(E::MisplacedPercent, "a tape mark `%` must be alone on its line"),
+                PLUS | MINUS => self.error_node(E::SignWithoutAddress, "a sign must follow an address letter: `X-10.`"),
+                EQ => self.error_node(E::MisplacedEquals, "`=` assigns to a variable only: `#1 = 5.`"),
+                PERCENT => self.error_node(E::MisplacedPercent, "a tape mark `%` must be alone on its line"),
                 _ => {
                     let shown = visible::quoted(&self.text[self.pos..self.pos + token.len]);
-                    self.error_token(E::UnexpectedCharacter, format!("`{shown}` is not allowed here"))
+                    self.error_node(E::UnexpectedCharacter, format!("`{shown}` is not allowed here"))
                 }
             };
             started = true;
@@ -409,14 +357,14 @@ impl<'a> Parser<'a> {
             let comma = self.bump();
             return self.word(vec![comma]);
         }
-        self.error_token(E::UnexpectedCharacter, "`,` must be followed by a corner word: `,C1.` or `,R1.`")
+        self.error_node(E::UnexpectedCharacter, "`,` must be followed by a corner word: `,C1.` or `,R1.`")
     }
 
     /// A word: address letter, value (after `children`, the comma of a
     /// corner word).
     fn word(&mut self, mut children: Vec<GreenElement>) -> GreenElement {
         if children.is_empty()
-            && let Some(word) = self.simple_word()
+            && let Some(word) = self.cursor.simple_word(b".")
         {
             return word;
         }
@@ -459,25 +407,8 @@ impl<'a> Parser<'a> {
             "unexpected text `{}`: an address letter must be followed by its value; text belongs in a comment `( … )`",
             visible::quoted(text)
         );
-        self.report(E::UnexpectedCharacter, start..self.pos, message);
+        self.report_from(E::UnexpectedCharacter, start, message);
         NodeOrToken::Node(green::node(ERROR, [NodeOrToken::Token(rowan::GreenToken::new(ERROR_TOKEN.into(), text))]))
-    }
-
-    /// The common case, an upper-case letter, an optional sign and a number
-    /// with a digit, served from the word cache.
-    fn simple_word(&mut self) -> Option<GreenElement> {
-        let bytes = &self.text.as_bytes()[..self.end];
-        let start = self.pos;
-        let sign_len = usize::from(matches!(bytes.get(start + 1), Some(b'-' | b'+')));
-        let number_start = start + 1 + sign_len;
-        let len = crate::lexing::number_len(&bytes[number_start..]);
-        let end = number_start + len;
-        let has_digit = bytes[number_start..end].iter().any(u8::is_ascii_digit);
-        if !bytes[start].is_ascii_uppercase() || !has_digit || bytes.get(end) == Some(&b'.') {
-            return None;
-        }
-        self.pos = end;
-        Some(self.green.simple_word(&self.text[start..end], sign_len))
     }
 
     /// `[sign [spaces]] (number | variable | bracket)` into `children`.
@@ -487,7 +418,7 @@ impl<'a> Parser<'a> {
             children.push(self.bump());
             let value_at = self.skip_whitespace(self.pos);
             if !matches!(self.kind_at(value_at), Some(NUMBER | HASH | L_BRACK)) {
-                self.report(E::MissingValue, sign_start..self.pos, "sign without a value after it");
+                self.report_from(E::MissingValue, sign_start, "sign without a value after it");
                 return;
             }
             self.space_in_word(self.pos..value_at);
@@ -516,9 +447,9 @@ impl<'a> Parser<'a> {
             }
             _ => {
                 let shown = visible::quoted(&self.text[start..self.pos]);
-                self.report(
+                self.report_from(
                     E::MalformedStatement,
-                    start..self.pos,
+                    start,
                     format!("`{shown}` on its own does nothing: assign it a value, `{shown} = 1.`"),
                 );
             }
@@ -540,7 +471,7 @@ impl<'a> Parser<'a> {
             "END" => self.loop_end(),
             keyword => {
                 let message = format!("`{keyword}` cannot start a statement");
-                self.error_token(E::MalformedStatement, message)
+                self.error_node(E::MalformedStatement, message)
             }
         }
     }
@@ -644,45 +575,6 @@ impl<'a> Parser<'a> {
             }
             _ => self.malformed(start, keyword_len, missing),
         }
-    }
-}
-
-impl ExprInput for Parser<'_> {
-    fn text(&self) -> &str {
-        self.text
-    }
-
-    fn pos(&self) -> usize {
-        self.pos
-    }
-
-    fn significant_at(&self, mut from: usize) -> Option<Ahead> {
-        loop {
-            let token = self.token_at(from)?;
-            match token.kind {
-                WHITESPACE | COMMENT => from += token.len,
-                NEWLINE | UNREAD => return None,
-                kind => return Some(Ahead { kind, range: (from, from + token.len) }),
-            }
-        }
-    }
-
-    fn token_kind_at(&self, pos: usize) -> Option<SyntaxKind> {
-        self.kind_at(pos)
-    }
-
-    fn bump(&mut self) -> GreenElement {
-        Parser::bump(self)
-    }
-
-    fn bump_trivia(&mut self, into: &mut Vec<GreenElement>) {
-        while let Some(WHITESPACE | COMMENT) = self.kind_at(self.pos) {
-            into.push(Parser::bump(self));
-        }
-    }
-
-    fn error(&mut self, kind: E, range: Range<usize>, message: String) {
-        self.report(kind, range, message);
     }
 }
 

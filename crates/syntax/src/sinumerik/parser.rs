@@ -1,7 +1,7 @@
 //! The Sinumerik parser. The grammar is in the module documentation
 //! (`sinumerik/mod.rs`).
 
-use std::ops::Range;
+use std::ops::{Deref, DerefMut, Range};
 
 use rowan::{GreenNode, NodeOrToken};
 
@@ -12,10 +12,12 @@ use crate::{
     encoding::BYTE_ORDER_MARK,
     error::Errors,
     expr::{self, Ahead, ExprInput, MAX_DEPTH},
-    green::{self, GreenElement, GreenFactory},
-    lexing::{MAX_READ_LINE, Token, range, read_end},
-    limit::{LineLimiter, Omitted},
-    line_blocks, visible,
+    green::{self, GreenElement},
+    lexing::{Token, range},
+    limit::Omitted,
+    line_blocks,
+    line_cursor::{Lexer, LineCursor, TokenError},
+    visible,
 };
 
 /// The types of definitions and formal parameters (004:1484, 1676, 4915;
@@ -105,45 +107,47 @@ pub(crate) fn parse_blocks(
     while parser.pos < region.end {
         blocks.push(NodeOrToken::Node(parser.block()));
     }
-    (blocks, parser.into_errors())
+    (blocks, parser.cursor.into_errors())
 }
 
 struct Parser<'a> {
-    text: &'a str,
-    pos: usize,
-    /// Where reading stops: `region_end`, or before it where the read part
-    /// of the current line ends (`MAX_READ_LINE`).
-    end: usize,
-    region_end: usize,
-    errors: Vec<SyntaxError>,
-    limiter: LineLimiter<'a, E>,
-    green: GreenFactory<'a>,
+    cursor: LineCursor<'a, SinumerikLexer>,
+}
+
+impl<'a> Deref for Parser<'a> {
+    type Target = LineCursor<'a, SinumerikLexer>;
+
+    fn deref(&self) -> &Self::Target {
+        &self.cursor
+    }
+}
+
+impl DerefMut for Parser<'_> {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.cursor
+    }
+}
+
+/// Sinumerik's tokens; a string not closed on its line is an error.
+struct SinumerikLexer;
+
+impl Lexer for SinumerikLexer {
+    fn token_at(text: &str, pos: usize) -> Token {
+        lexer::token_at(text, pos)
+    }
+
+    fn unclosed(kind: SyntaxKind, text: &str) -> Option<TokenError> {
+        (kind == STRING && (text.len() < 2 || !text.ends_with(&text[..1]))).then(|| {
+            let quote = &text[..1];
+            let message = format!("string `{quote}` not closed by `{quote}` on its line; a string cannot span lines");
+            (E::UnclosedString, 1, message)
+        })
+    }
 }
 
 impl<'a> Parser<'a> {
     fn new(text: &'a str, pos: usize, region_end: usize) -> Self {
-        let end = read_end(text, pos, region_end);
-        Parser {
-            text,
-            pos,
-            end,
-            region_end,
-            errors: Vec::new(),
-            limiter: LineLimiter::new(text),
-            green: GreenFactory::new(),
-        }
-    }
-
-    fn token_at(&self, pos: usize) -> Option<Token> {
-        crate::lexing::bounded_token(self.text, pos, self.end, self.region_end, lexer::token_at)
-    }
-
-    fn kind_at(&self, pos: usize) -> Option<SyntaxKind> {
-        self.token_at(pos).map(|t| t.kind)
-    }
-
-    fn peek(&self) -> Option<Token> {
-        self.token_at(self.pos)
+        Parser { cursor: LineCursor::new(text, pos, region_end) }
     }
 
     /// The text of the token at `pos`.
@@ -162,60 +166,10 @@ impl<'a> Parser<'a> {
         self.significant_at(self.pos).map(|next| next.kind)
     }
 
-    fn report(&mut self, kind: E, r: Range<usize>, message: impl Into<String>) {
-        let r = range(r);
-        if self.limiter.keep(r.start(), kind) {
-            self.errors.push(SyntaxError::new(kind, r, message));
-        }
-    }
-
-    fn into_errors(self) -> Errors {
-        Errors { kept: self.errors, omitted: self.limiter.finish() }
-    }
-
-    fn bump(&mut self) -> GreenElement {
-        let token = self.peek().expect("bump past the end");
-        let start = self.pos;
-        let text = &self.text[start..start + token.len];
-        self.pos += token.len;
-        match token.kind {
-            NEWLINE => self.end = read_end(self.text, self.pos, self.region_end),
-            UNREAD => self.report(
-                E::LineTooLong,
-                start..self.pos,
-                format!("line longer than {MAX_READ_LINE} bytes; ncc reads only its first {MAX_READ_LINE} bytes"),
-            ),
-            STRING if text.len() < 2 || !text.ends_with(&text[..1]) => {
-                let quote = &text[..1];
-                self.report(
-                    E::UnclosedString,
-                    start..start + 1,
-                    format!("string `{quote}` not closed by `{quote}` on its line; a string cannot span lines"),
-                );
-            }
-            _ => {}
-        }
-        self.green.token(token.kind, text)
-    }
-
-    /// Bumps whitespace and comments before the next significant token.
-    fn trivia(&mut self, children: &mut Vec<GreenElement>) {
-        while let Some(WHITESPACE | COMMENT) = self.kind_at(self.pos) {
-            children.push(self.bump());
-        }
-    }
-
     /// Bumps the next significant token with the trivia before it.
     fn bump_significant(&mut self, children: &mut Vec<GreenElement>) {
         self.trivia(children);
         children.push(self.bump());
-    }
-
-    fn error_node(&mut self, kind: E, message: impl Into<String>) -> GreenElement {
-        let start = self.pos;
-        let element = self.bump();
-        self.report(kind, start..self.pos, message);
-        NodeOrToken::Node(green::node(ERROR, [element]))
     }
 
     fn node(kind: SyntaxKind, children: Vec<GreenElement>) -> GreenElement {
@@ -346,9 +300,9 @@ impl<'a> Parser<'a> {
                 break;
             }
         }
-        self.report(
+        self.report_from(
             E::ParenthesisComment,
-            start..self.pos,
+            start,
             "Sinumerik reads `( … )` as code, not as a comment; write comments after `;`",
         );
         Self::node(ERROR, children)
@@ -418,18 +372,14 @@ impl<'a> Parser<'a> {
         }
         let shown = visible::quoted(&self.text[start..self.pos]);
         let kind = if self.is_parameter_at(start) { E::ParameterWithoutAssignment } else { E::MalformedStatement };
-        self.report(
-            kind,
-            start..self.pos,
-            format!("`{shown}` on its own does nothing: assign it a value, `{shown}=1`"),
-        );
+        self.report_from(kind, start, format!("`{shown}` on its own does nothing: assign it a value, `{shown}=1`"));
         Self::node(ERROR, children)
     }
 
     /// An address with its value: `X-12.5`, `G1`, `X=R1+5`, `X = 5`, and an
     /// address with its extension, which takes `=` (`A3=1`, `X1=X`).
     fn word(&mut self) -> GreenElement {
-        if let Some(word) = self.simple_word() {
+        if let Some(word) = self.cursor.simple_word(b".=Ee") {
             return word;
         }
         let start = self.pos;
@@ -463,9 +413,9 @@ impl<'a> Parser<'a> {
             children.push(self.bump());
             let number_at = self.skip_whitespace(self.pos);
             if self.kind_at(number_at) != Some(NUMBER) {
-                self.report(
+                self.report_from(
                     E::MissingValue,
-                    sign..self.pos,
+                    sign,
                     "sign without a number after it; an expression needs `=`: `X=-R1`",
                 );
                 return Self::node(WORD, children);
@@ -474,13 +424,6 @@ impl<'a> Parser<'a> {
         }
         expr::number(self, &mut children);
         Self::node(WORD, children)
-    }
-
-    fn skip_whitespace(&self, mut pos: usize) -> usize {
-        while let Some(Token { kind: WHITESPACE, len }) = self.token_at(pos) {
-            pos += len;
-        }
-        pos
     }
 
     fn space_in_word(&mut self, space: Range<usize>, children: &mut Vec<GreenElement>) {
@@ -494,26 +437,6 @@ impl<'a> Parser<'a> {
                 children.push(self.bump());
             }
         }
-    }
-
-    /// The common case, served from the word cache: an upper-case letter,
-    /// an optional sign and a number with a digit, and nothing glued to it
-    /// that would make it another statement (`=`, a second point, an
-    /// exponent).
-    fn simple_word(&mut self) -> Option<GreenElement> {
-        let bytes = &self.text.as_bytes()[..self.end];
-        let start = self.pos;
-        let sign_len = usize::from(matches!(bytes.get(start + 1), Some(b'-' | b'+')));
-        let number_start = start + 1 + sign_len;
-        let len = crate::lexing::number_len(&bytes[number_start..]);
-        let end = number_start + len;
-        let has_digit = bytes[number_start..end].iter().any(u8::is_ascii_digit);
-        let glued = matches!(bytes.get(end), Some(b'.' | b'=' | b'E' | b'e'));
-        if !bytes[start].is_ascii_uppercase() || !has_digit || glued {
-            return None;
-        }
-        self.pos = end;
-        Some(self.green.simple_word(&self.text[start..end], sign_len))
     }
 
     /// A statement that starts with a name: a keyword statement, an
@@ -562,7 +485,7 @@ impl<'a> Parser<'a> {
         let start = self.pos;
         if self.label_follows() {
             let label = self.label();
-            self.report(E::MalformedStatement, start..self.pos, "a label must start its block, after the block number");
+            self.report_from(E::MalformedStatement, start, "a label must start its block, after the block number");
             return label;
         }
         let name_end = start + self.text_at(start).len();
@@ -709,9 +632,9 @@ impl<'a> Parser<'a> {
                 next.kind == IDENT && JUMPS.iter().any(|jump| self.text_at(next.range.0).eq_ignore_ascii_case(jump))
             });
             if !jump {
-                self.report(
+                self.report_from(
                     E::MalformedStatement,
-                    arm_start..self.pos,
+                    arm_start,
                     "a CASE arm must be followed by a jump: `1 GOTOF L1`",
                 );
                 children.push(Self::node(CASE_ARM, arm));
@@ -750,7 +673,7 @@ impl<'a> Parser<'a> {
             None => {
                 let message =
                     format!("`{keyword}` needs a target: a label, a block number `N10` or a string expression");
-                self.report(E::MalformedStatement, start..self.pos, message);
+                self.report_from(E::MalformedStatement, start, message);
             }
         }
         Self::node(GOTO_STMT, children)
@@ -844,9 +767,9 @@ impl<'a> Parser<'a> {
         let start = self.pos;
         let mut children = vec![self.bump()];
         if !matches!(self.significant_kind(), Some(IDENT | LETTER)) {
-            self.report(
+            self.report_from(
                 E::MalformedStatement,
-                start..self.pos,
+                start,
                 "`PROC` must be followed by the program's name: `PROC CONTOUR`",
             );
             return Self::node(PROC_STMT, children);
@@ -874,7 +797,7 @@ impl<'a> Parser<'a> {
         let mut children = vec![self.bump()];
         if !matches!(self.significant_kind(), Some(IDENT | LETTER)) {
             let message = "`EXTERN` must be followed by the subprogram's name and parameter types: `EXTERN CONTOUR(REAL, VAR INT)`";
-            self.report(E::MalformedStatement, start..self.pos, message);
+            self.report_from(E::MalformedStatement, start, message);
             return Self::node(EXTERN_STMT, children);
         }
         self.trivia(&mut children);
@@ -1270,43 +1193,6 @@ impl<'a> Parser<'a> {
             _ => pos..pos,
         };
         self.report(E::ExpectedExpression, range, format!("expected {what}"));
-    }
-}
-
-impl ExprInput for Parser<'_> {
-    fn text(&self) -> &str {
-        self.text
-    }
-
-    fn pos(&self) -> usize {
-        self.pos
-    }
-
-    fn significant_at(&self, mut from: usize) -> Option<Ahead> {
-        loop {
-            let token = self.token_at(from)?;
-            match token.kind {
-                WHITESPACE | COMMENT => from += token.len,
-                NEWLINE | UNREAD => return None,
-                kind => return Some(Ahead { kind, range: (from, from + token.len) }),
-            }
-        }
-    }
-
-    fn token_kind_at(&self, pos: usize) -> Option<SyntaxKind> {
-        self.kind_at(pos)
-    }
-
-    fn bump(&mut self) -> GreenElement {
-        Parser::bump(self)
-    }
-
-    fn bump_trivia(&mut self, into: &mut Vec<GreenElement>) {
-        self.trivia(into);
-    }
-
-    fn error(&mut self, kind: E, range: Range<usize>, message: String) {
-        self.report(kind, range, message);
     }
 }
 
