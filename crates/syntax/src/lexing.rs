@@ -96,6 +96,20 @@ pub(crate) fn bounded_token(
     Some(Token { kind: token.kind, len: token.len.min(end - pos) })
 }
 
+/// The length of the run of characters the language does not know at
+/// `pos`, up to a letter, a digit or a character of `known`: one stray
+/// word of foreign text yields one diagnostic.
+pub(crate) fn unknown_run_len(text: &str, pos: usize, known: &str) -> usize {
+    let mut end = pos;
+    for (offset, ch) in text[pos..].char_indices() {
+        if offset > 0 && (ch.is_ascii_alphanumeric() || known.contains(ch)) {
+            break;
+        }
+        end = pos + offset + ch.len_utf8();
+    }
+    end - pos
+}
+
 /// Every token `lex` finds in `text`, with its text: for the lexers' tests.
 #[cfg(test)]
 pub(crate) fn lex_all(text: &str, lex: fn(&str, usize) -> Token) -> Vec<(SyntaxKind, &str)> {

@@ -74,7 +74,7 @@ pub(crate) fn token_at(text: &str, pos: usize) -> Token {
         b']' => (R_BRACK, 1),
         b',' => (COMMA, 1),
         b'%' => (PERCENT, 1),
-        _ => (ERROR_TOKEN, unknown_run_len(text, pos)),
+        _ => (ERROR_TOKEN, crate::lexing::unknown_run_len(text, pos, KNOWN)),
     };
     Token { kind, len }
 }
@@ -99,18 +99,9 @@ fn comment_len(bytes: &[u8], pos: usize, parenthesis: bool) -> usize {
     }
 }
 
-/// Characters the language does not know are grouped so that one stray
-/// word of foreign text yields one diagnostic.
-fn unknown_run_len(text: &str, pos: usize) -> usize {
-    let mut end = pos;
-    for (offset, ch) in text[pos..].char_indices() {
-        if offset > 0 && (ch.is_ascii_alphanumeric() || " \t\n\r(;+-*/=#[],%.".contains(ch)) {
-            break;
-        }
-        end = pos + offset + ch.len_utf8();
-    }
-    end - pos
-}
+/// What ends a run of characters the language does not know, besides
+/// letters and digits.
+const KNOWN: &str = " \t\n\r(;+-*/=#[],%.";
 
 #[cfg(test)]
 mod tests {

@@ -47,7 +47,7 @@ pub(crate) fn token_at(text: &str, pos: usize) -> Token {
         }
         b'A'..=b'Z' | b'a'..=b'z' => (LETTER, 1),
         b'$' => match system_variable_len(rest) {
-            0 => (ERROR_TOKEN, unknown_run_len(text, pos)),
+            0 => (ERROR_TOKEN, crate::lexing::unknown_run_len(text, pos, KNOWN)),
             len => (IDENT, len),
         },
         // A run of points is one placeholder (`X..`, `...`), which the
@@ -75,7 +75,7 @@ pub(crate) fn token_at(text: &str, pos: usize) -> Token {
         b',' => (COMMA, 1),
         b':' => (COLON, 1),
         b'%' => (PERCENT, 1),
-        _ => (ERROR_TOKEN, unknown_run_len(text, pos)),
+        _ => (ERROR_TOKEN, crate::lexing::unknown_run_len(text, pos, KNOWN)),
     };
     Token { kind, len }
 }
@@ -123,18 +123,9 @@ fn number_with_exponent_len(rest: &[u8]) -> usize {
     len
 }
 
-/// Characters the language does not know are grouped so that one stray
-/// word of foreign text yields one diagnostic.
-fn unknown_run_len(text: &str, pos: usize) -> usize {
-    let mut end = pos;
-    for (offset, ch) in text[pos..].char_indices() {
-        if offset > 0 && (ch.is_ascii_alphanumeric() || " \t\n\r;\"'+-*/=<>()[],:%._$".contains(ch)) {
-            break;
-        }
-        end = pos + offset + ch.len_utf8();
-    }
-    end - pos
-}
+/// What ends a run of characters the language does not know, besides
+/// letters and digits.
+const KNOWN: &str = " \t\n\r;\"'+-*/=<>()[],:%._$";
 
 #[cfg(test)]
 mod tests {
