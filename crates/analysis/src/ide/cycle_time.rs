@@ -1332,25 +1332,8 @@ mod tests {
         fn resumed_estimates_equal_whole_runs(
             edits in proptest::collection::vec((0.0f64..1.0, 0u8..6), 1..4),
         ) {
-            let mut text = long_program(2500);
-            let mut previous = estimate_of(&text, None);
-            for (place, kind) in edits {
-                let line_start = text[..(place * text.len() as f64) as usize].rfind('\n').map_or(0, |i| i + 1);
-                let line_end = text[line_start..].find('\n').map_or(text.len(), |i| line_start + i + 1);
-                let word = text[line_start..line_end].find(" X").map(|i| line_start + i + 2);
-                match (kind, word) {
-                    (0, Some(at)) => text.insert(at, '3'),
-                    (1, Some(at)) => { text.remove(at); }
-                    (2, _) => text.insert_str(line_start, "N5 G01 X1 Y1 F2000\n"),
-                    (3, _) if line_start > 0 => text.insert_str(line_start, "N6 G73 L1000 Q1\n"),
-                    (4, _) if line_start > 0 => text.insert_str(line_start, "N7 G73 L77777 Q1\n"),
-                    _ if line_start > 0 && line_end < text.len() => text.replace_range(line_start..line_end, ""),
-                    _ => {}
-                }
-                let resumed = estimate_of(&text, Some(&previous));
-                assert_alike(&resumed, &estimate_of(&text, None));
-                previous = resumed;
-            }
+            let later = ["N6 G73 L1000 Q1\n", "N7 G73 L77777 Q1\n"];
+            assert_edits_resume_as_whole_runs(long_program(2500), &edits, "N5 G01 X1 Y1 F2000\n", &later, estimate_of);
         }
     }
 
@@ -1365,27 +1348,43 @@ mod tests {
         fn resumed_haas_estimates_equal_whole_runs(
             edits in proptest::collection::vec((0.0f64..1.0, 0u8..8), 1..4),
         ) {
-            let mut text = long_haas_program(2500);
-            let mut previous = haas_estimate_of(&text, None);
-            for (place, kind) in edits {
-                let line_start = text[..(place * text.len() as f64) as usize].rfind('\n').map_or(0, |i| i + 1);
-                let line_end = text[line_start..].find('\n').map_or(text.len(), |i| line_start + i + 1);
-                let word = text[line_start..line_end].find(" X").map(|i| line_start + i + 2);
-                match (kind, word) {
-                    (0, Some(at)) => text.insert(at, '3'),
-                    (1, Some(at)) => { text.remove(at); }
-                    (2, _) => text.insert_str(line_start, "N5 G01 X1. Z1. F2000.\n"),
-                    (3, _) if line_start > 0 => text.insert_str(line_start, "#1 = #1 + 1\nIF [#1 LT 2] GOTO 1000\n"),
-                    (4, _) if line_start > 0 => text.insert_str(line_start, "GOTO 77777\n"),
-                    (5, _) if line_start > 0 => text.insert_str(line_start, "M97 P90000\n"),
-                    (6, _) if line_start > 0 => text.insert_str(line_start, "N1000 G01 X2.\n"),
-                    _ if line_start > 0 && line_end < text.len() => text.replace_range(line_start..line_end, ""),
-                    _ => {}
+            let later = ["#1 = #1 + 1\nIF [#1 LT 2] GOTO 1000\n", "GOTO 77777\n", "M97 P90000\n", "N1000 G01 X2.\n"];
+            let first = "N5 G01 X1. Z1. F2000.\n";
+            assert_edits_resume_as_whole_runs(long_haas_program(2500), &edits, first, &later, haas_estimate_of);
+        }
+    }
+
+    /// Applies `edits` to `text` one by one, at a place (a fraction of the
+    /// text) of a kind: a digit typed into (0) or deleted from (1) an X
+    /// word, the block `first` inserted anywhere (2), a block of `later`
+    /// (3 on) inserted after the first line, else a line removed; after
+    /// each, the estimate resumed from the last equals a whole run's.
+    fn assert_edits_resume_as_whole_runs(
+        mut text: String,
+        edits: &[(f64, u8)],
+        first: &str,
+        later: &[&str],
+        estimate_of: fn(&str, Option<&Estimate>) -> Estimate,
+    ) {
+        let mut previous = estimate_of(&text, None);
+        for &(place, kind) in edits {
+            let line_start = text[..(place * text.len() as f64) as usize].rfind('\n').map_or(0, |i| i + 1);
+            let line_end = text[line_start..].find('\n').map_or(text.len(), |i| line_start + i + 1);
+            let word = text[line_start..line_end].find(" X").map(|i| line_start + i + 2);
+            let block = usize::from(kind).checked_sub(3).and_then(|i| later.get(i));
+            match (kind, word, block) {
+                (0, Some(at), _) => text.insert(at, '3'),
+                (1, Some(at), _) => {
+                    text.remove(at);
                 }
-                let resumed = haas_estimate_of(&text, Some(&previous));
-                assert_alike(&resumed, &haas_estimate_of(&text, None));
-                previous = resumed;
+                (2, _, _) => text.insert_str(line_start, first),
+                (_, _, Some(block)) if line_start > 0 => text.insert_str(line_start, block),
+                _ if line_start > 0 && line_end < text.len() => text.replace_range(line_start..line_end, ""),
+                _ => {}
             }
+            let resumed = estimate_of(&text, Some(&previous));
+            assert_alike(&resumed, &estimate_of(&text, None));
+            previous = resumed;
         }
     }
 
