@@ -288,6 +288,24 @@ impl StepSink for Vec<Step> {
     }
 }
 
+/// Takes steps until it has `room` of them, then is closed.
+#[cfg(test)]
+pub(crate) struct Closing {
+    pub(crate) taken: usize,
+    pub(crate) room: usize,
+}
+
+#[cfg(test)]
+impl StepSink for Closing {
+    fn step(&mut self, _step: Step) {
+        self.taken += 1;
+    }
+
+    fn closed(&self) -> bool {
+        self.taken >= self.room
+    }
+}
+
 /// The steps of a run after its first `before`, and a checkpoint
 /// every `every` blocks (none for 0).
 #[cfg(test)]

@@ -1,29 +1,13 @@
 use std::f64::consts::PI;
 
 use crate::run::{
-    Axes, Called, Checkpoint, Checkpoints, DELIVERY_BATCH, Environment, Motion, NoFiles, Path, Step, StepSink, Stop,
-    Trace, resume_into, round3, run, run_into,
+    Axes, Called, Checkpoint, Checkpoints, Closing, DELIVERY_BATCH, Environment, Motion, NoFiles, Path, Stop, Trace,
+    resume_into, round3, run, run_into,
 };
 use crate::{
     machine::OffsetTable,
     machine::{MachineConfig, TravelLimits},
 };
-
-/// Takes steps until it has `room` of them, then is closed.
-struct Closing {
-    taken: usize,
-    room: usize,
-}
-
-impl StepSink for Closing {
-    fn step(&mut self, _step: Step) {
-        self.taken += 1;
-    }
-
-    fn closed(&self) -> bool {
-        self.taken >= self.room
-    }
-}
 
 #[test]
 fn a_streamed_run_ends_soon_after_its_sink_closes() {

@@ -12,8 +12,8 @@ use crate::{
     machine::{MachineConfig, OffsetTable, ToolEntry, ToolTable},
     run::{NoFiles, resume_into, run, run_into},
     trace::{
-        Called, Checkpoint, Checkpoints, Compensated, DELIVERY_BATCH, Environment, Motion, Path, PathMode, RunRule,
-        Step, StepSink, Stop, Trace,
+        Called, Checkpoint, Checkpoints, Closing, Compensated, DELIVERY_BATCH, Environment, Motion, Path, PathMode,
+        RunRule, Step, StepSink, Stop, Trace,
     },
     transform::Frame,
 };
@@ -689,22 +689,6 @@ fn a_streamed_run_hands_on_the_steps_a_kept_run_keeps_a_batch_at_a_time() {
     // The run held no more than a batch at a time, compensation or not.
     assert!(delivered.sizes.len() > 2, "{:?}", delivered.sizes);
     assert!(delivered.sizes.iter().all(|&size| size <= DELIVERY_BATCH), "{:?}", delivered.sizes);
-}
-
-/// Takes steps until it has `room` of them, then is closed.
-struct Closing {
-    taken: usize,
-    room: usize,
-}
-
-impl StepSink for Closing {
-    fn step(&mut self, _step: Step) {
-        self.taken += 1;
-    }
-
-    fn closed(&self) -> bool {
-        self.taken >= self.room
-    }
 }
 
 #[test]
