@@ -64,6 +64,7 @@ pub mod cnc8x6;
 pub(crate) mod compensation;
 pub(crate) mod envelope;
 pub mod expand;
+pub(crate) mod green;
 pub mod haas_lathe;
 pub mod known;
 pub mod machine;
