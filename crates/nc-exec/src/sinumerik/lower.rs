@@ -19,7 +19,7 @@
 //! `'B101'` are hexadecimal and binary constants; `REPEAT start [end] P=n`
 //! repeats a program section; `M2` ends a main program like `M30`.
 
-use ncc_catalog::{AddressRole, Catalogue, DialectId, Modality};
+use ncc_catalog::{AddressRole, Catalogue, DialectId, KeywordKind, Modality};
 use ncc_syntax::{Decimal, Sign, SyntaxKind, TextRange, TextSize};
 use rowan::{GreenNodeData, GreenTokenData, NodeOrToken};
 
@@ -147,11 +147,20 @@ pub enum StatementKind {
         arms: Vec<CaseArm>,
     },
     Jump(Jump),
-    /// `[WHEN|WHENEVER|EVERY|FROM cond] DO actions`.
+    /// `[ID=n] [WHEN|WHENEVER|EVERY|FROM cond] DO actions`.
     SyncAction {
+        id: Option<SyncId>,
         condition: Option<Expr>,
         actions: Vec<Statement>,
     },
+}
+
+/// The number of a synchronous action: `ID=1`, `IDS=2`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SyncId {
+    /// `ID` or `IDS`.
+    pub keyword: String,
+    pub number: Expr,
 }
 
 /// An address with its value.
@@ -677,7 +686,7 @@ fn lower_statement(catalogue: &Catalogue, node: &GreenNodeData, range: TextRange
                     _ => {}
                 }
             }
-            StatementKind::SyncAction { condition, actions: attach_words(catalogue, actions) }
+            StatementKind::SyncAction { id: None, condition, actions: attach_words(catalogue, actions) }
         }
         _ => return None,
     };
@@ -1093,7 +1102,8 @@ fn lower_jump(catalogue: &Catalogue, node: &GreenNodeData, range: TextRange) -> 
 
 /// What the parser leaves in a block after a statement: a frame takes the
 /// words of the addresses it allows, a program call its repetition count,
-/// `REPEAT` its labels and count.
+/// `REPEAT` its labels and count, and a synchronous action the `ID=n`
+/// before it.
 fn attach_words(catalogue: &Catalogue, statements: Vec<Statement>) -> Vec<Statement> {
     let mut attached: Vec<Statement> = Vec::with_capacity(statements.len());
     for statement in statements {
@@ -1112,6 +1122,14 @@ fn attach_words(catalogue: &Catalogue, statements: Vec<Statement>) -> Vec<Statem
                     && is_count(catalogue, word) =>
             {
                 call.repetitions = word.value.clone();
+                true
+            }
+            (StatementKind::Assign { target, value }, StatementKind::SyncAction { id: None, condition, actions })
+                if is_sync_id(catalogue, target) =>
+            {
+                let id = SyncId { keyword: target.name.clone(), number: value.clone() };
+                previous.kind =
+                    StatementKind::SyncAction { id: Some(id), condition: condition.clone(), actions: actions.clone() };
                 true
             }
             (StatementKind::Command(command), StatementKind::Call(call))
@@ -1160,6 +1178,13 @@ fn takes_word(catalogue: &Catalogue, command: &Command, word: &Word) -> bool {
     catalogue.word_code(&command.name).is_some_and(|code| {
         code.modality == Modality::Block && code.allows.iter().any(|a| a.eq_ignore_ascii_case(&word.address))
     })
+}
+
+/// Whether `target` is the number of a synchronous action (`ID`, `IDS`).
+fn is_sync_id(catalogue: &Catalogue, target: &Place) -> bool {
+    target.kind == PlaceKind::User
+        && target.indices.is_empty()
+        && catalogue.keyword(&target.name).is_some_and(|keyword| keyword.kind == KeywordKind::SynchronousAction)
 }
 
 /// Whether `word` is the repetition count (`P3`).

@@ -164,9 +164,10 @@ fn show_statement(statement: &Statement) -> String {
             format!("case {} of {}", show(selector), arms.join("; "))
         }
         StatementKind::Jump(jump) => show_jump(jump),
-        StatementKind::SyncAction { condition, actions } => {
+        StatementKind::SyncAction { id, condition, actions } => {
+            let id = id.as_ref().map_or(String::new(), |id| format!("{}={} ", id.keyword, show(&id.number)));
             let actions: Vec<String> = actions.iter().map(show_statement).collect();
-            format!("sync {} do {}", condition.as_ref().map_or("-".to_owned(), show), actions.join(" "))
+            format!("sync {id}{} do {}", condition.as_ref().map_or("-".to_owned(), show), actions.join(" "))
         }
         other => format!("{other:?}"),
     }
@@ -314,7 +315,7 @@ fn control_statements_and_jumps() {
             GotoS -
             LABEL1: | M0
             repeat LABEL1..Some("LABEL2") times 2
-            ID := 1 | sync (sys:$AA_IM[X] Gt 10) do sys:$AC_PARAM[0] := 1 M7
+            sync ID=1 (sys:$AA_IM[X] Gt 10) do sys:$AC_PARAM[0] := 1 M7
         "#]],
     );
 }
