@@ -354,3 +354,35 @@ fn resolve_is_what_the_model_lists() {
     assert_eq!(model.jumps_from(1).map(|site| site.resolved).collect::<Vec<_>>(), [Resolved::Block(1)]);
     assert_eq!(model.structures_at(0).count(), 0);
 }
+
+proptest::proptest! {
+    /// Any bytes lower and make a model; every jump the model lists is
+    /// resolved as `resolve` says.
+    #[test]
+    fn any_bytes_make_a_model(bytes in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..200)) {
+        let model = model_of(&String::from_utf8_lossy(&bytes));
+        for site in &model.jumps {
+            proptest::prop_assert_eq!(model.resolve(site.block, &site.jump), site.resolved);
+        }
+    }
+
+    #[test]
+    fn any_structure_soup_makes_a_model(lines in proptest::collection::vec(proptest::sample::select(vec![
+        "IF R1", "ELSE", "ENDIF", "WHILE R1", "ENDWHILE", "FOR R1=1 TO 2", "ENDFOR", "REPEAT", "UNTIL R1",
+        "LOOP", "ENDLOOP", "AB:", "N10", "GOTOF AB", "GOTOB N10", "GOTO AB", "GOTOC N10", "IF R1 GOTOB AB",
+        "CASE R1 OF 1 GOTOF AB DEFAULT GOTOB N10", "PROC P(REAL X)", "DEF INT I[2]", "PROFIL(1,,2)",
+    ]), 0..40)) {
+        let model = model_of(&(lines.join("\n") + "\n"));
+        // Every start and every end is in a structure or listed unmatched.
+        let count = |of: &[&str]| lines.iter().filter(|line| of.contains(line)).count();
+        let problems = |problem| model.unmatched.iter().filter(|u| u.problem == problem).count();
+        let starts = count(&["IF R1", "WHILE R1", "FOR R1=1 TO 2", "REPEAT", "LOOP"]);
+        let ends = count(&["ENDIF", "ENDWHILE", "ENDFOR", "UNTIL R1", "ENDLOOP"]);
+        proptest::prop_assert_eq!(starts, model.structures.len() + problems(Unbalanced::NotClosed));
+        proptest::prop_assert_eq!(ends, model.structures.len() + problems(Unbalanced::NotOpened));
+        for structure in &model.structures {
+            let middle = structure.middle.unwrap_or(structure.start + 1);
+            proptest::prop_assert!(structure.start < middle && middle <= structure.end);
+        }
+    }
+}
