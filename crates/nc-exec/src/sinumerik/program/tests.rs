@@ -81,7 +81,8 @@ fn show_model(model: &SinumerikModel) -> String {
     }
     for call in &model.calls {
         let modal = if call.modal { " modal" } else { "" };
-        writeln!(out, "call {:?} with {} at {}{modal}", call.callee, call.arguments, line(call.block)).unwrap();
+        let callee = call.callee.program_name().map_or_else(|| format!("{:?}", call.callee), str::to_owned);
+        writeln!(out, "call {callee} with {} at {}{modal}", call.arguments, line(call.block)).unwrap();
     }
     out
 }
@@ -133,7 +134,7 @@ fn l19_main_calls_profil_which_declares_five_parameters() {
             N65 at [5]
             N70 at [6]
             N100 at [8]
-            call Program("PROFIL") with 4 at 6
+            call PROFIL with 4 at 6
         "#]],
     );
     check(
@@ -151,58 +152,58 @@ fn l29_jumps_by_label_block_number_and_computed_target() {
     check(
         &listing("l29_blob_souradnice_dole.mpf"),
         expect![[r#"
-        label END at [104]
-        label FINIS at [43]
-        label HRUBOVANI at [32]
-        label PREDBEZNE at [23]
-        N1 at [58]
-        N2 at [66]
-        N3 at [73]
-        N4 at [81]
-        N5 at [87]
-        N101 at [118]
-        N102 at [120]
-        N103 at [122]
-        N1652 at [126]
-        N1653 at [128]
-        N1654 at [130]
-        N1701 at [132]
-        N1702 at [134]
-        N6552 at [138]
-        N6553 at [140]
-        N6554 at [142]
-        If 24..28 else 26 depth 1
-        If 33..42 depth 1
-        If 59..65 else 62 depth 1
-        If 67..71 depth 1
-        If 74..80 else 77 depth 1
-        If 82..86 depth 1
-        If 90..92 depth 1
-        If 95..99 else 97 depth 1
-        If 107..113 depth 1
-        GotoF at 41 -> line 58
-        Goto at 61 -> line 66
-        GotoF at 70 -> Computed
-        GotoF at 72 -> line 87
-        Goto at 76 -> line 81
-        GotoF at 85 -> Computed
-        GotoF at 88 -> line 104
-        GotoF at 102 -> Computed
-        GotoB at 112 -> line 23
-        GotoB at 119 -> Computed
-        GotoB at 121 -> Computed
-        GotoB at 123 -> Computed
-        GotoB at 127 -> Computed
-        GotoB at 129 -> Computed
-        GotoB at 131 -> Computed
-        GotoB at 133 -> Computed
-        GotoB at 135 -> Computed
-        GotoB at 139 -> Computed
-        GotoB at 141 -> Computed
-        GotoB at 143 -> Computed
-        call Cycle("CYCLE800") with 15 at 21
-        call Cycle("CYCLE832") with 3 at 48
-    "#]],
+            label END at [104]
+            label FINIS at [43]
+            label HRUBOVANI at [32]
+            label PREDBEZNE at [23]
+            N1 at [58]
+            N2 at [66]
+            N3 at [73]
+            N4 at [81]
+            N5 at [87]
+            N101 at [118]
+            N102 at [120]
+            N103 at [122]
+            N1652 at [126]
+            N1653 at [128]
+            N1654 at [130]
+            N1701 at [132]
+            N1702 at [134]
+            N6552 at [138]
+            N6553 at [140]
+            N6554 at [142]
+            If 24..28 else 26 depth 1
+            If 33..42 depth 1
+            If 59..65 else 62 depth 1
+            If 67..71 depth 1
+            If 74..80 else 77 depth 1
+            If 82..86 depth 1
+            If 90..92 depth 1
+            If 95..99 else 97 depth 1
+            If 107..113 depth 1
+            GotoF at 41 -> line 58
+            Goto at 61 -> line 66
+            GotoF at 70 -> Computed
+            GotoF at 72 -> line 87
+            Goto at 76 -> line 81
+            GotoF at 85 -> Computed
+            GotoF at 88 -> line 104
+            GotoF at 102 -> Computed
+            GotoB at 112 -> line 23
+            GotoB at 119 -> Computed
+            GotoB at 121 -> Computed
+            GotoB at 123 -> Computed
+            GotoB at 127 -> Computed
+            GotoB at 129 -> Computed
+            GotoB at 131 -> Computed
+            GotoB at 133 -> Computed
+            GotoB at 135 -> Computed
+            GotoB at 139 -> Computed
+            GotoB at 141 -> Computed
+            GotoB at 143 -> Computed
+            call CYCLE800 with 15 at 21
+            call CYCLE832 with 3 at 48
+        "#]],
     );
 }
 
@@ -211,27 +212,27 @@ fn l30_l31_cam_program_and_its_cycle() {
     check(
         &listing("l30_run_vacka.mpf"),
         expect![[r#"
-        proc RUN_VACKA () [] at 3
-        extern VACKA_CYKLUS(Real, Real, Real) at 4
-        def Real POCATECNI_R dims 0 at 5
-        def Real TLOUSTKA dims 0 at 5
-        def Real INKREMENT_UHLU dims 0 at 5
-        def Real UHEL_1 dims 0 at 6
-        def Real RADIUS_1 dims 0 at 6
-        def Real UHEL_2 dims 0 at 6
-        def Real RADIUS_2 dims 0 at 6
-        def Real UHEL_3 dims 0 at 6
-        def Real RADIUS_3 dims 0 at 6
-        def Real UHEL_4 dims 0 at 6
-        def Real RADIUS_4 dims 0 at 6
-        def Real UHEL_5 dims 0 at 6
-        def Real RADIUS_5 dims 0 at 6
-        If 29..32 depth 1
-        If 34..38 depth 1
-        call Cycle("CYCLE800") with 16 at 18
-        call Program("VACKA_CYKLUS") with 3 at 36
-        call Program("_N_GEOMETRIE_VACKA_SPF") with 0 at 39
-    "#]],
+            proc RUN_VACKA () [] at 3
+            extern VACKA_CYKLUS(Real, Real, Real) at 4
+            def Real POCATECNI_R dims 0 at 5
+            def Real TLOUSTKA dims 0 at 5
+            def Real INKREMENT_UHLU dims 0 at 5
+            def Real UHEL_1 dims 0 at 6
+            def Real RADIUS_1 dims 0 at 6
+            def Real UHEL_2 dims 0 at 6
+            def Real RADIUS_2 dims 0 at 6
+            def Real UHEL_3 dims 0 at 6
+            def Real RADIUS_3 dims 0 at 6
+            def Real UHEL_4 dims 0 at 6
+            def Real RADIUS_4 dims 0 at 6
+            def Real UHEL_5 dims 0 at 6
+            def Real RADIUS_5 dims 0 at 6
+            If 29..32 depth 1
+            If 34..38 depth 1
+            call CYCLE800 with 16 at 18
+            call VACKA_CYKLUS with 3 at 36
+            call _N_GEOMETRIE_VACKA_SPF with 0 at 39
+        "#]],
     );
     check(
         &listing("l31_vacka_cyklus.spf"),
