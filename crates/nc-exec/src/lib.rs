@@ -44,12 +44,17 @@
 //!   [`expand::Expand`] interface the command line drives them by.
 //! - [`envelope`]: the CNC8x9 envelope velocity, a streaming look-ahead
 //!   planner of up to 500 blocks with linear or jerk-limited ramps.
+//! - `green`: reading the parsers' green trees, for every dialect's lowering.
 //! - [`known`]: values a static reading may not know.
 //! - [`machine`]: the machine a program runs on (its control, axes, rates,
 //!   limits, constants and tables).
 //! - [`run`]: running a program on its machine into a [`run::Trace`] or a
 //!   sink, on a thread of its own or this one, from a checkpoint or the
 //!   start.
+//! - [`sinumerik`]: what belongs to the Siemens Sinumerik dialect:
+//!   [`sinumerik::lower`] (blocks as plain data, read from the syntax tree
+//!   and the catalogue) and [`sinumerik::program`] (labels, block numbers,
+//!   control structures, declarations, jumps and calls of a file).
 //! - [`trace`]: what a run produces and how it hands it on: steps,
 //!   findings and their rules, the sink and the checkpoints.
 //! - [`tool_path`]: the moves and positions of the tool centre, which
@@ -64,10 +69,12 @@ pub mod cnc8x6;
 pub(crate) mod compensation;
 pub(crate) mod envelope;
 pub mod expand;
+pub(crate) mod green;
 pub mod haas_lathe;
 pub mod known;
 pub mod machine;
 pub mod run;
+pub mod sinumerik;
 pub mod tool_path;
 pub(crate) mod trace;
 pub(crate) mod transform;

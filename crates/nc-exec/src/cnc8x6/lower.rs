@@ -8,8 +8,10 @@
 use std::fmt;
 
 use ncc_catalog::{AddressRole, Dialect};
-use ncc_syntax::{BlockParser, Decimal, NcLanguage, Sign, SyntaxKind, TextRange, TextSize, ast};
+use ncc_syntax::{BlockParser, Decimal, Sign, SyntaxKind, TextRange, TextSize, ast};
 use rowan::{GreenNode, GreenNodeData, NodeOrToken};
+
+use crate::green::{GreenRef, children, kind};
 
 /// One block.
 #[derive(Debug, Default, Clone, PartialEq, Eq, Hash)]
@@ -396,22 +398,6 @@ fn digits_at(bytes: &[u8], at: usize) -> usize {
 /// A parameter number as the tree lowering reads it.
 fn index(digits: &str) -> Option<u32> {
     Decimal::parse(None, digits).and_then(|d| d.scaled(0)).and_then(|v| u32::try_from(v).ok())
-}
-
-fn kind(raw: rowan::SyntaxKind) -> SyntaxKind {
-    <NcLanguage as rowan::Language>::kind_from_raw(raw)
-}
-
-type GreenRef<'a> = NodeOrToken<&'a GreenNodeData, &'a rowan::GreenTokenData>;
-
-/// The children of a green node with their ranges, `start` being the node's.
-fn children(node: &GreenNodeData, start: TextSize) -> impl Iterator<Item = (TextRange, GreenRef<'_>)> {
-    let mut offset = start;
-    node.children().map(move |child| {
-        let range = TextRange::at(offset, child.text_len());
-        offset = range.end();
-        (range, child)
-    })
 }
 
 /// A word: address, then its value.

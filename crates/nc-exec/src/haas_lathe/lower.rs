@@ -8,8 +8,10 @@
 
 use std::fmt;
 
-use ncc_syntax::{Decimal, NcLanguage, Sign, SyntaxKind, TextRange, TextSize};
+use ncc_syntax::{Decimal, Sign, SyntaxKind, TextRange, TextSize};
 use rowan::{GreenNodeData, GreenTokenData, NodeOrToken};
+
+use crate::green::{GreenRef, children, is_trivia, kind, token_of};
 
 /// One block (one line).
 #[derive(Debug, Default, Clone, PartialEq)]
@@ -345,33 +347,6 @@ pub fn block_nodes(file: &GreenNodeData) -> impl Iterator<Item = (TextRange, &Gr
             NodeOrToken::Node(block) if kind(block.kind()) == SyntaxKind::BLOCK => Some((range, block)),
             _ => None,
         })
-}
-
-fn kind(raw: rowan::SyntaxKind) -> SyntaxKind {
-    <NcLanguage as rowan::Language>::kind_from_raw(raw)
-}
-
-type GreenRef<'a> = NodeOrToken<&'a GreenNodeData, &'a GreenTokenData>;
-
-/// The children of a green node with their ranges, `start` being the node's.
-fn children(node: &GreenNodeData, start: TextSize) -> impl Iterator<Item = (TextRange, GreenRef<'_>)> {
-    let mut offset = start;
-    node.children().map(move |child| {
-        let range = TextRange::at(offset, child.text_len());
-        offset = range.end();
-        (range, child)
-    })
-}
-
-fn token_of(child: GreenRef<'_>, wanted: SyntaxKind) -> Option<&GreenTokenData> {
-    match child {
-        NodeOrToken::Token(token) if kind(token.kind()) == wanted => Some(token),
-        _ => None,
-    }
-}
-
-fn is_trivia(child: GreenRef<'_>) -> bool {
-    matches!(kind(child.kind()), SyntaxKind::WHITESPACE | SyntaxKind::COMMENT | SyntaxKind::NEWLINE)
 }
 
 fn lower_comment(token: &GreenTokenData, range: TextRange) -> Comment {

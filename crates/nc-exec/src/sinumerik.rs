@@ -1,0 +1,24 @@
+//! The Siemens Sinumerik dialect's part of the executor: its block IR and
+//! lowering ([`lower`]) and the program model over the lowered blocks
+//! ([`program`]). Nothing runs Sinumerik programs yet.
+//!
+//! What the next steps read from them:
+//!
+//! - The interpreter runs [`lower::SinumerikBlock::statements`] in order:
+//!   words (address, literal or expression, `AC`/`IC`), assignments to R
+//!   parameters, variables, system variables and `G[n]`, commands with
+//!   the words a frame takes, calls with their arguments and repetitions,
+//!   and expressions as trees whose operators the parser already ordered.
+//!   It follows [`program::SinumerikModel`]: where each structure's start,
+//!   ELSE and end lead ([`program::SinumerikModel::structures_at`]), each
+//!   jump's block, the labels and block numbers a computed target
+//!   (`"N"<<R3`) is looked up in with [`program::SinumerikModel::resolve`],
+//!   and the PROC header that binds a call's arguments to the formal
+//!   parameters (omitted ones are zero, 004:1480-1484).
+//! - The checker reads the same model over partly unknown values: the
+//!   unbalanced control structures, jumps without a target, labels and
+//!   block numbers written twice, and calls against the PROC and EXTERN
+//!   signatures by argument count.
+
+pub mod lower;
+pub mod program;

@@ -1,0 +1,297 @@
+//! The program model of one Sinumerik file over its lowered blocks: labels
+//! and block numbers, the control structures matched across blocks, the
+//! PROC header, EXTERN and DEF declarations, every jump with the block it
+//! reaches, and the calls of programs.
+//!
+//! Jumps search as the Siemens manual says (digest §2.5, Siemens
+//! documentation, not in the thesis, which only uses the suffixes that
+//! way): GOTOF forward, GOTOB backward, GOTO forward and then backward, and
+//! GOTOC like GOTO but with no alarm when the target is missing. Forward
+//! means the blocks after the jump's; backward the jump's block and those
+//! before it, so `LOOP1: … GOTOB LOOP1` on one line repeats the line
+//! (assumption). Duplicate labels and block numbers are kept for a rule;
+//! a jump takes the nearest in its direction.
+//!
+//! Control structures pair as a stack: an end closes the innermost open
+//! structure of its kind, and the structures opened inside it and still
+//! open are listed as not closed. The nesting depth is kept for the limit
+//! of 16 levels (004:1464).
+
+use std::collections::BTreeMap;
+
+use super::lower::{Callee, Declared, Extern, Jump, JumpKind, JumpTarget, Proc, SinumerikBlock, StatementKind, Type};
+
+/// The model of one file.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SinumerikModel {
+    /// Every block carrying each label (upper case), in file order.
+    pub labels: BTreeMap<String, Vec<usize>>,
+    /// Every block carrying each block number (`N10` or `:10`), in file
+    /// order.
+    pub block_numbers: BTreeMap<u64, Vec<usize>>,
+    /// The matched structures, in the order they close.
+    pub structures: Vec<Structure>,
+    /// Starts never closed, ends and ELSEs without their start, in the
+    /// order found.
+    pub unmatched: Vec<Unmatched>,
+    /// Every PROC line; the program's own is the first (004:1415-1421).
+    pub procs: Vec<Declaration<Proc>>,
+    pub externs: Vec<Declaration<Extern>>,
+    /// Each name a DEF declares, in order.
+    pub definitions: Vec<Definition>,
+    pub jumps: Vec<JumpSite>,
+    /// The calls of programs and cycles (not of predefined procedures).
+    pub calls: Vec<CallSite>,
+}
+
+/// A declaration with its block.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Declaration<T> {
+    pub block: usize,
+    pub declaration: T,
+}
+
+/// A name declared by DEF.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Definition {
+    pub block: usize,
+    /// `NCK` or `CHAN`.
+    pub scope: Option<String>,
+    pub ty: Type,
+    pub declared: Declared,
+}
+
+/// A control structure matched across blocks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Structure {
+    pub kind: StructureKind,
+    pub start: usize,
+    /// The ELSE block of an IF.
+    pub middle: Option<usize>,
+    pub end: usize,
+    /// 1 for an outermost structure.
+    pub depth: usize,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StructureKind {
+    /// `IF` … [`ELSE` …] `ENDIF`.
+    If,
+    /// `WHILE` … `ENDWHILE`.
+    While,
+    /// `FOR` … `ENDFOR`.
+    For,
+    /// `REPEAT` … `UNTIL`.
+    Repeat,
+    /// `LOOP` … `ENDLOOP`.
+    Loop,
+}
+
+/// A part of a control structure without its partner.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Unmatched {
+    pub block: usize,
+    pub kind: StructureKind,
+    pub problem: Unbalanced,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unbalanced {
+    /// A start without its end.
+    NotClosed,
+    /// An end without its start.
+    NotOpened,
+    /// An ELSE outside an IF, or a second ELSE.
+    StrayElse,
+}
+
+/// A jump and where it leads.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JumpSite {
+    pub block: usize,
+    pub jump: Jump,
+    pub resolved: Resolved,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Resolved {
+    Block(usize),
+    /// `GOTOS`: the program's start.
+    Start,
+    /// A string expression: only a run knows the target.
+    Computed,
+    /// No block in the searched direction has the target; `alarm` is
+    /// false for GOTOC, which then goes on with the next block.
+    NotFound {
+        alarm: bool,
+    },
+    /// The target is missing or malformed; the parser reported it.
+    NoTarget,
+}
+
+/// A call of a program or cycle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CallSite {
+    pub block: usize,
+    pub callee: Callee,
+    /// Positions written, omitted ones included: `PROFIL(,TRUE)` has 2.
+    pub arguments: usize,
+    /// `MCALL`: after every block with a path motion.
+    pub modal: bool,
+}
+
+impl SinumerikModel {
+    pub fn new(blocks: &[SinumerikBlock]) -> SinumerikModel {
+        let mut model = SinumerikModel::default();
+        for (index, block) in blocks.iter().enumerate() {
+            if let Some(label) = &block.label {
+                model.labels.entry(label.name.clone()).or_default().push(index);
+            }
+            if let Some(number) = block.number.and_then(|number| number.value) {
+                model.block_numbers.entry(number).or_default().push(index);
+            }
+        }
+        let mut open: Vec<Open> = Vec::new();
+        for (index, block) in blocks.iter().enumerate() {
+            for statement in &block.statements {
+                model.structure(&mut open, index, &statement.kind);
+                model.declarations_and_calls(index, &statement.kind);
+            }
+        }
+        model.unmatched.extend(open.into_iter().map(|o| Unmatched {
+            block: o.start,
+            kind: o.kind,
+            problem: Unbalanced::NotClosed,
+        }));
+        model
+    }
+
+    /// The PROC header of the program.
+    pub fn header(&self) -> Option<&Declaration<Proc>> {
+        self.procs.first()
+    }
+
+    /// The structures that start, continue or end at `block`.
+    pub fn structures_at(&self, block: usize) -> impl Iterator<Item = &Structure> {
+        self.structures.iter().filter(move |s| s.start == block || s.middle == Some(block) || s.end == block)
+    }
+
+    /// The jumps written in `block`.
+    pub fn jumps_from(&self, block: usize) -> impl Iterator<Item = &JumpSite> {
+        self.jumps.iter().filter(move |site| site.block == block)
+    }
+
+    /// The block a jump from `from` reaches (see the module documentation).
+    pub fn resolve(&self, from: usize, jump: &Jump) -> Resolved {
+        let candidates = match &jump.target {
+            _ if jump.kind == JumpKind::GotoS => return Resolved::Start,
+            None | Some(JumpTarget::BlockNumber(None)) => return Resolved::NoTarget,
+            Some(JumpTarget::Computed(_)) => return Resolved::Computed,
+            Some(JumpTarget::Label(label)) => self.labels.get(label),
+            Some(JumpTarget::BlockNumber(Some(number))) => self.block_numbers.get(number),
+        };
+        let candidates = candidates.map_or(&[][..], Vec::as_slice);
+        let forward = || candidates.iter().copied().find(|&block| block > from);
+        let backward = || candidates.iter().copied().rev().find(|&block| block <= from);
+        let found = match jump.kind {
+            JumpKind::GotoF => forward(),
+            JumpKind::GotoB => backward(),
+            JumpKind::Goto | JumpKind::GotoC | JumpKind::GotoS => forward().or_else(backward),
+        };
+        found.map_or(Resolved::NotFound { alarm: jump.kind != JumpKind::GotoC }, Resolved::Block)
+    }
+
+    fn structure(&mut self, open: &mut Vec<Open>, block: usize, statement: &StatementKind) {
+        let start = |kind| Some(Open { kind, start: block, middle: None });
+        let opened = match statement {
+            StatementKind::If { jump: None, .. } => start(StructureKind::If),
+            StatementKind::While(_) => start(StructureKind::While),
+            StatementKind::For { .. } => start(StructureKind::For),
+            StatementKind::Repeat => start(StructureKind::Repeat),
+            StatementKind::Loop => start(StructureKind::Loop),
+            _ => None,
+        };
+        if let Some(opened) = opened {
+            open.push(opened);
+            return;
+        }
+        let closes = match statement {
+            StatementKind::Else => {
+                match open.last_mut() {
+                    Some(top) if top.kind == StructureKind::If && top.middle.is_none() => top.middle = Some(block),
+                    _ => self.unmatched.push(Unmatched {
+                        block,
+                        kind: StructureKind::If,
+                        problem: Unbalanced::StrayElse,
+                    }),
+                }
+                return;
+            }
+            StatementKind::EndIf => StructureKind::If,
+            StatementKind::EndWhile => StructureKind::While,
+            StatementKind::EndFor => StructureKind::For,
+            StatementKind::Until(_) => StructureKind::Repeat,
+            StatementKind::EndLoop => StructureKind::Loop,
+            _ => return,
+        };
+        let Some(at) = open.iter().rposition(|o| o.kind == closes) else {
+            self.unmatched.push(Unmatched { block, kind: closes, problem: Unbalanced::NotOpened });
+            return;
+        };
+        for inner in open.drain(at + 1..) {
+            self.unmatched.push(Unmatched { block: inner.start, kind: inner.kind, problem: Unbalanced::NotClosed });
+        }
+        if let Some(opened) = open.pop() {
+            let depth = open.len() + 1;
+            self.structures.push(Structure {
+                kind: opened.kind,
+                start: opened.start,
+                middle: opened.middle,
+                end: block,
+                depth,
+            });
+        }
+    }
+
+    fn declarations_and_calls(&mut self, block: usize, statement: &StatementKind) {
+        match statement {
+            StatementKind::Proc(proc) => self.procs.push(Declaration { block, declaration: proc.clone() }),
+            StatementKind::Extern(declaration) => {
+                self.externs.push(Declaration { block, declaration: declaration.clone() });
+            }
+            StatementKind::Def(def) => {
+                self.definitions.extend(def.names.iter().map(|declared| Definition {
+                    block,
+                    scope: def.scope.clone(),
+                    ty: def.ty.clone(),
+                    declared: declared.clone(),
+                }));
+            }
+            StatementKind::Jump(jump) | StatementKind::If { jump: Some(jump), .. } => self.jump(block, jump),
+            StatementKind::Case { arms, .. } => arms.iter().for_each(|arm| self.jump(block, &arm.jump)),
+            StatementKind::Call(call) | StatementKind::ModalCall(Some(call))
+                if !matches!(call.callee, Callee::Predefined(_)) =>
+            {
+                let modal = matches!(statement, StatementKind::ModalCall(_));
+                let arguments = call.arguments.len();
+                self.calls.push(CallSite { block, callee: call.callee.clone(), arguments, modal });
+            }
+            _ => {}
+        }
+    }
+
+    fn jump(&mut self, block: usize, jump: &Jump) {
+        let resolved = self.resolve(block, jump);
+        self.jumps.push(JumpSite { block, jump: jump.clone(), resolved });
+    }
+}
+
+/// A structure still open while the blocks are read.
+struct Open {
+    kind: StructureKind,
+    start: usize,
+    middle: Option<usize>,
+}
+
+#[cfg(test)]
+mod tests;
