@@ -6,7 +6,9 @@
 //! catalogue's function letters say, with a modifier naming their
 //! catalogue group (`g1` plane, `g3` radius compensation, `m2`
 //! spindle, …), so a theme can colour groups apart; parameters are
-//! variables, assigned ones with `declaration`.
+//! variables, assigned ones with `declaration`. Sinumerik's labels are
+//! labels (`declaration` where defined), its calls by name functions, and
+//! its system variables properties: the control's state, as addresses are.
 
 use ncc_analysis::{Dialect, HighlightKind, HighlightRange};
 use ncc_catalog::AddressRole;
@@ -14,8 +16,10 @@ use tower_lsp_server::ls_types as lsp;
 
 use super::convert::LineMap;
 
-const TYPES: [&str; 11] =
-    ["keyword", "macro", "property", "function", "label", "variable", "number", "comment", "operator", "error", "type"];
+const TYPES: [&str; 12] = [
+    "keyword", "macro", "property", "function", "label", "variable", "number", "comment", "operator", "error", "type",
+    "string",
+];
 const DECLARATION: u32 = 1;
 
 fn type_index(name: &str) -> u32 {
@@ -58,6 +62,10 @@ fn classify(kind: HighlightKind, preparatory: Option<u8>) -> (u32, u32) {
         HighlightKind::Keyword => (type_index("keyword"), 0),
         HighlightKind::Operator => (type_index("operator"), 0),
         HighlightKind::Error => (type_index("error"), 0),
+        HighlightKind::String => (type_index("string"), 0),
+        HighlightKind::Label { write } => (type_index("label"), if write { DECLARATION } else { 0 }),
+        HighlightKind::Function => (type_index("function"), 0),
+        HighlightKind::SystemVariable => (type_index("property"), 0),
     }
 }
 
@@ -93,7 +101,12 @@ mod tests {
 
     #[test]
     fn every_kind_has_a_type_and_groups_fit_the_modifier_bits() {
-        let dialect = Dialect::Cnc8x6;
+        for dialect in Dialect::all() {
+            kinds_fit_the_legend(dialect);
+        }
+    }
+
+    fn kinds_fit_the_legend(dialect: Dialect) {
         let legend = legend(dialect);
         let preparatory = dialect.catalogue().preparatory_letter();
         assert!(legend.token_modifiers.len() <= 32, "{} modifiers", legend.token_modifiers.len());
