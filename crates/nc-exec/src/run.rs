@@ -155,3 +155,26 @@ fn not_run(text: &str, machine: &MachineConfig) -> Trace {
         blocks_run: 0,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A Sinumerik program makes no step: its one finding, at its first
+    /// line with text, says the executor does not run it yet.
+    #[test]
+    fn a_program_without_an_interpreter_runs_to_one_finding() {
+        let machine = MachineConfig::of_control(Dialect::Sinumerik);
+        assert_eq!(machine.axes, b"XYZ");
+        let text = "\n  N10 G0 X10 Y20\r\nM30\n";
+        let trace = run(text, &NoFiles, &machine, DEFAULT_STEP_BUDGET);
+        assert!(trace.steps.is_empty() && trace.blocks_run == 0);
+        let [finding] = trace.findings.as_slice() else { panic!("{:?}", trace.findings) };
+        assert_eq!(finding.rule, RunRule::NotRunYet);
+        assert_eq!(&text[finding.range], "N10 G0 X10 Y20");
+        assert_eq!(finding.message, "the executor does not run Siemens Sinumerik programs yet");
+        assert!(!interprets(Dialect::Sinumerik) && interprets(Dialect::HaasLathe));
+        let empty = run("", &NoFiles, &machine, DEFAULT_STEP_BUDGET);
+        assert_eq!(empty.findings[0].range, TextRange::default());
+    }
+}

@@ -258,7 +258,9 @@ impl Walk {
                 SyntaxKind::CALL_STMT => self.call(node, range.start()),
                 SyntaxKind::VAR_DECL => self.declared(node, range.start(), None),
                 SyntaxKind::PARAM => self.declared(node, range.start(), Some(SyntaxKind::TYPE)),
-                SyntaxKind::PROC_STMT | SyntaxKind::EXTERN_STMT => self.procedure(node, range.start()),
+                SyntaxKind::PROC_STMT | SyntaxKind::EXTERN_STMT | SyntaxKind::MACRO_DEF => {
+                    self.procedure(node, range.start())
+                }
                 SyntaxKind::BIN_EXPR | SyntaxKind::PREFIX_EXPR | SyntaxKind::CALL_EXPR => {
                     self.operation(node, range.start())
                 }
@@ -430,7 +432,7 @@ impl Walk {
     fn name(&mut self, node: &GreenNodeData, start: TextSize, write: bool) {
         for (range, item) in children(node, start) {
             match item {
-                NodeOrToken::Token(token) if kind(token.kind()) == SyntaxKind::IDENT => {
+                NodeOrToken::Token(token) if matches!(kind(token.kind()), SyntaxKind::IDENT | SyntaxKind::LETTER) => {
                     let highlight = self.name_kind(token.text(), write);
                     self.push(range, highlight, false);
                 }
@@ -537,15 +539,20 @@ impl Walk {
         }
     }
 
-    /// `PROC NAME(…)`, `EXTERN NAME(…)`: the keyword, the name, then the
-    /// parameters and attributes.
+    /// `PROC NAME(…)`, `EXTERN NAME(…)`, `DEFINE NAME AS …`: the keyword,
+    /// the name, then the parameters and attributes, or the macro's text,
+    /// whose letters are addresses.
     fn procedure(&mut self, node: &GreenNodeData, start: TextSize) {
         let mut idents = 0;
         for (range, item) in children(node, start) {
-            match item {
-                NodeOrToken::Token(_) if kind(item.kind()) == SyntaxKind::IDENT => {
+            match (kind(item.kind()), item) {
+                (SyntaxKind::IDENT, _) => {
                     idents += 1;
                     let highlight = if idents == 2 { HighlightKind::Function } else { HighlightKind::Keyword };
+                    self.push(range, highlight, false);
+                }
+                (SyntaxKind::LETTER, NodeOrToken::Token(letter)) => {
+                    let highlight = letter_kind(self.catalogue, letter.text().as_bytes()[0], None);
                     self.push(range, highlight, false);
                 }
                 _ => self.element(item, range, None, false),

@@ -203,13 +203,18 @@ fn structure(statement: &SyntaxNode) -> Option<Structure> {
 pub(crate) fn completions(db: &dyn Db, file: SourceFile, offset: TextSize) -> Vec<CompletionItem> {
     let text = file.text(db);
     let root = file.parse(db).syntax_node();
-    let Some(block) = blocks(&root).find(|block| block.text_range().contains_inclusive(offset)) else {
+    // A cursor after a line break is on the next line.
+    let holds = |block: &SyntaxNode| {
+        let range = block.text_range();
+        range.contains(offset) || (range.end() == offset && !text[range].ends_with(['\n', '\r']))
+    };
+    let Some(block) = blocks(&root).find(holds) else { return Vec::new() };
+    let start = block.text_range().start();
+    let Some(before) = text.get(std::ops::Range::from(TextRange::new(start, offset.min(block.text_range().end()))))
+    else {
         return Vec::new();
     };
-    let start = block.text_range().start();
-    let before = &text[TextRange::new(start, offset.min(block.text_range().end()))];
-    let before = before.trim_end_matches(['\n', '\r']);
-    if in_comment_or_string(before) {
+    if before.ends_with('\r') || in_comment_or_string(before) {
         return Vec::new();
     }
     let typed = before.len() - before.trim_end_matches(|c: char| c.is_ascii_alphanumeric() || c == '_').len();
