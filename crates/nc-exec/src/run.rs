@@ -40,7 +40,8 @@ pub fn reset_frame(machine: &MachineConfig) -> Frame {
 /// run of any other makes no step, and its only finding says so.
 pub fn interprets(control: Dialect) -> bool {
     match control {
-        Dialect::Cnc8x6 | Dialect::HaasLathe => true,
+        Dialect::Cnc8x6 => true,
+        Dialect::HaasLathe => true,
         Dialect::Sinumerik => false,
     }
 }

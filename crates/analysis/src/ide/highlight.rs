@@ -506,12 +506,12 @@ impl Walk {
 
     fn called(&mut self, name: &str) -> HighlightKind {
         let catalogue = self.catalogue;
-        if let Some(code) = catalogue.word_code(name) {
-            let letter = code.group.as_deref().and_then(|group| group.bytes().next()).unwrap_or(b'G');
+        // A word code's letter is its group's.
+        if let Some(letter) = catalogue.word_code(name).and_then(|code| code.group.as_deref()?.bytes().next()) {
             let group = catalogue.word_modal_group_index(name).and_then(|index| u8::try_from(index).ok());
             return HighlightKind::Code { letter, group };
         }
-        if catalogue.keyword(name).is_some() {
+        if catalogue.word_code(name).is_some() || catalogue.keyword(name).is_some() {
             return HighlightKind::Keyword;
         }
         HighlightKind::Function
