@@ -514,7 +514,8 @@ pub(crate) fn lower(path: &Path, dialect: Option<DialectId>) -> ExitCode {
             }
         }
         Dialect::Sinumerik => {
-            eprintln!("error: {}: the executor does not read Siemens Sinumerik programs yet", path.display());
+            let title = DialectId::from(parse.dialect()).title();
+            eprintln!("error: {}: the executor does not read {title} programs yet", path.display());
             return ExitCode::from(2);
         }
     }

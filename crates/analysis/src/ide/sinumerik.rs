@@ -63,17 +63,20 @@ fn query_of(token: &SyntaxToken) -> Option<(String, TextRange)> {
 
 /// `G642` for a code word, the letter for any other address.
 fn word_query(word: &SyntaxNode) -> Option<String> {
+    let (letter, code) = word_code(word)?;
+    let letter = char::from(letter);
+    Some(code.map_or_else(|| letter.to_string(), |code| format!("{letter}{code}")))
+}
+
+/// A word's (upper-case) letter, and its number when the letter is a
+/// code's and the number a whole one.
+fn word_code(word: &SyntaxNode) -> Option<(u8, Option<u32>)> {
     let mut tokens = word.children_with_tokens().filter_map(|child| child.into_token());
-    let letter = tokens.next().filter(|token| token.kind() == SyntaxKind::LETTER)?;
-    let letter = letter.text().to_ascii_uppercase();
+    let letter = tokens.next().filter(|token| token.kind() == SyntaxKind::LETTER)?.text().as_bytes()[0];
+    let letter = letter.to_ascii_uppercase();
     let number = tokens.find(|token| token.kind() != SyntaxKind::WHITESPACE).filter(|t| t.kind() == SyntaxKind::NUMBER);
-    let code = number.and_then(|number| number.text().parse::<u32>().ok());
-    Some(match code {
-        Some(code) if catalogue().role_of(letter.as_bytes()[0]) == Some(AddressRole::Function) => {
-            format!("{letter}{code}")
-        }
-        _ => letter,
-    })
+    let is_code = catalogue().role_of(letter) == Some(AddressRole::Function);
+    Some((letter, number.and_then(|number| number.text().parse().ok()).filter(|_| is_code)))
 }
 
 /// The file's blocks, in order.
@@ -151,7 +154,7 @@ pub(crate) fn folding_ranges(db: &dyn Db, file: SourceFile) -> Vec<Fold> {
             match structure(&statement) {
                 Some(Structure::Start(end)) => open.push((end, block.text_range().start())),
                 Some(Structure::End(word)) => {
-                    if let Some(at) = open.iter().rposition(|(end, _)| end.eq_ignore_ascii_case(word)) {
+                    if let Some(at) = open.iter().rposition(|(end, _)| *end == word) {
                         let start = open[at].1;
                         open.truncate(at);
                         folds.push(Fold {
@@ -199,7 +202,8 @@ fn structure(statement: &SyntaxNode) -> Option<Structure> {
 
 /// Where a word starts (after a blank or at the line's start): the codes
 /// and addresses, then the keywords and functions; after an operator, a
-/// parenthesis or `=`, the functions. Nothing in a comment or a string.
+/// parenthesis or `=`, the functions. Nothing in a comment, a string or
+/// a system variable's name.
 pub(crate) fn completions(db: &dyn Db, file: SourceFile, offset: TextSize) -> Vec<CompletionItem> {
     let text = file.text(db);
     let root = file.parse(db).syntax_node();
@@ -210,10 +214,8 @@ pub(crate) fn completions(db: &dyn Db, file: SourceFile, offset: TextSize) -> Ve
     };
     let Some(block) = blocks(&root).find(holds) else { return Vec::new() };
     let start = block.text_range().start();
-    let Some(before) = text.get(std::ops::Range::from(TextRange::new(start, offset.min(block.text_range().end()))))
-    else {
-        return Vec::new();
-    };
+    // An offset inside a character (a position no editor sends) has no text before it.
+    let Some(before) = text.get(std::ops::Range::from(TextRange::new(start, offset))) else { return Vec::new() };
     if before.ends_with('\r') || in_comment_or_string(before) {
         return Vec::new();
     }
@@ -270,15 +272,12 @@ fn in_comment_or_string(line: &str) -> bool {
 /// lists read them.
 fn written(block: &SyntaxNode) -> Written {
     let start = block.text_range().start();
-    let catalogue = catalogue();
     let mut written = Written::default();
     for word in block.children().filter(|node| node.kind() == SyntaxKind::WORD) {
-        let Some(letter) = word.first_token().filter(|token| token.kind() == SyntaxKind::LETTER) else { continue };
-        let letter = letter.text().as_bytes()[0].to_ascii_uppercase();
+        let Some((letter, code)) = word_code(&word) else { continue };
         let range = word.text_range() - start;
         written.words.push((letter, range));
-        let number = word_query(&word).and_then(|query| query[1..].parse::<u32>().ok());
-        if let Some(number) = number.filter(|_| catalogue.role_of(letter) == Some(AddressRole::Function)) {
+        if let Some(number) = code {
             written.codes.push((letter, number, range));
         }
     }
