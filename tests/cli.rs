@@ -473,7 +473,7 @@ fn explain_list_prints_the_counts() {
 }
 
 #[test]
-fn explain_reads_the_catalogue_of_a_dialect_whose_programs_it_does_not_read() {
+fn explain_reads_the_sinumerik_catalogue() {
     let output = ncc(&["explain", "--dialect", "sinumerik", "bspline"]);
     assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
     let text = stdout(&output);
@@ -1270,16 +1270,57 @@ fn an_unknown_dialect_is_a_usage_error_that_lists_the_known_ones() {
 }
 
 #[test]
-fn a_named_dialect_this_version_does_not_read_exits_with_2() {
-    let output = ncc(&["check", "--dialect", "sinumerik", "examples"]);
-    assert_eq!(output.status.code(), Some(2));
-    assert_eq!(stderr(&output), "error: ncc does not read Siemens Sinumerik programs yet (dialect `sinumerik`)\n");
+fn a_named_dialect_reads_the_program_whatever_its_name_says() {
     let dir = tempfile::tempdir().unwrap();
     let lathe = dir.path().join("O1000.nc");
     std::fs::write(&lathe, "%\nO1000\nG28\nM30\n%\n").unwrap();
-    // `--dialect` reads it as the named dialect, whatever its name says.
     assert_eq!(ncc(&["check", "--dialect", "cnc8x6", lathe.to_str().unwrap()]).status.code(), Some(1));
+    let output = ncc(&["check", "--dialect", "sinumerik", "--format", "short", lathe.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(1));
+    assert!(stdout(&output).contains("O1000.nc:1:1: error[S015]"), "{}", stdout(&output));
     assert_eq!(ncc(&["explain", "--dialect", "cnc8x6", "G40"]).status.code(), Some(0));
+}
+
+/// A Sinumerik program is checked for its syntax; the executor does not
+/// run it yet, and `run`, `expand` and `plot` say so at its first line and
+/// give no time, program or picture.
+#[test]
+fn sinumerik_programs_are_checked_and_not_run_yet() {
+    let dir = tempfile::tempdir().unwrap();
+    let clean = dir.path().join("PART.MPF");
+    let text = "; a part\nN10 G0 X0 Y0\nDEF REAL DEPTH=5\nIF DEPTH>2 GOTOF DONE\nWHILE R1<10\n  R1=R1+1\nENDWHILE\nDONE: G642 SOFT\nMSG(\"depth \"<<DEPTH)\nM30\n";
+    std::fs::write(&clean, text).unwrap();
+    let clean = clean.to_str().unwrap();
+    let output = ncc(&["check", clean]);
+    assert_eq!(output.status.code(), Some(0), "{}", stdout(&output));
+    assert_eq!(stdout(&output), "All checks passed (1 file checked).\n");
+    let broken = dir.path().join("SUB.SPF");
+    std::fs::write(&broken, "PROC SUB\nR1=(5+2\nMSG(\"open)\nRET\n").unwrap();
+    let output = ncc(&["check", "--format", "short", broken.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(1));
+    let out = stdout(&output);
+    assert!(out.contains("SUB.SPF:2:4: error[S029]: `(` is not closed by `)` on its line"), "{out}");
+    assert!(out.contains("SUB.SPF:3:5: error[S028]"), "{out}");
+    let svg = dir.path().join("part.svg");
+    for args in [
+        &["run", clean][..],
+        &["run", "--format", "json", clean],
+        &["expand", clean],
+        &["plot", clean, "-o", svg.to_str().unwrap()],
+    ] {
+        let output = ncc(args);
+        assert_eq!(output.status.code(), Some(1), "{args:?}");
+        assert_eq!(stdout(&output), "", "{args:?}");
+        let message = "PART.MPF:1: info[E020]: the executor does not run Siemens Sinumerik programs yet\n";
+        assert!(stderr(&output).ends_with(message), "{args:?}: {}", stderr(&output));
+    }
+    assert!(!svg.exists());
+    let output = ncc(&["parse", clean]);
+    assert_eq!(output.status.code(), Some(0));
+    assert!(stdout(&output).contains("LABEL@"), "{}", stdout(&output));
+    let output = ncc(&["lower", clean]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(stderr(&output).contains("the executor does not read Siemens Sinumerik programs yet"));
 }
 
 #[test]
@@ -1298,20 +1339,19 @@ fn directories_are_searched_by_extension_per_dialect_and_ncc_toml_maps_more() {
     };
     let (code, out, err) = checked(dir.path());
     assert_eq!(code, Some(0), "{out}{err}");
-    assert_eq!(out, "All checks passed (2 files checked).\n");
-    assert_eq!(err, "note: 2 files skipped: ncc does not read Siemens Sinumerik programs yet (dialect `sinumerik`)\n");
+    assert_eq!((out.as_str(), err.as_str()), ("All checks passed (4 files checked).\n", ""));
     // The project maps an extension of its own, and takes `.nc` files for
     // CNC8x6 programs.
     write("ncc.toml", "[extensions]\nPRG = \"cnc8x6\"\n\".nc\" = \"cnc8x6\"\n");
     let (code, out, _) = checked(dir.path());
     assert_eq!(code, Some(1), "{out}");
-    assert!(out.ends_with("in 3 files.\n") && out.contains("O1000.nc"), "{out}");
+    assert!(out.ends_with("in 5 files.\n") && out.contains("O1000.nc"), "{out}");
     assert!(!out.contains("b.PRG"), "a clean file has no findings: {out}");
     // A project of one dialect: every program is read as it.
     write("ncc.toml", "dialect = \"sinumerik\"\n");
-    let (code, out, err) = checked(dir.path());
-    assert_eq!((code, out.as_str()), (Some(0), "All checks passed (0 files checked).\n"));
-    assert!(err.contains("note: 4 files skipped: ncc does not read Siemens Sinumerik programs yet"), "{err}");
+    let (code, out, _) = checked(dir.path());
+    assert_eq!(code, Some(1), "{out}");
+    assert!(out.ends_with("in 4 files.\n") && out.contains("a.NCP") && out.contains("O1000.nc"), "{out}");
     write("ncc.toml", "[extensions]\n\"a/b\" = \"cnc8x6\"\n");
     let (code, _, err) = checked(dir.path());
     assert_eq!(code, Some(2));

@@ -659,24 +659,101 @@ fn hover_on_a_block_adds_its_speed_profile() {
     assert_eq!(hover(&mut client, "SIDE"), N20_HOVER);
 }
 
+/// A Sinumerik subprogram with a syntax error on line 8.
+const SINUMERIK: &str = "PROC PART(REAL DEPTH) SAVE
+DEF STRING[20] NAME=\"A\"
+; two comment lines
+; fold together
+G642 SOFT
+START: $P_UIFR[1,X,TR]=5
+IF DEPTH>2 GOTOF START
+R1=(5+
+WHILE R1<10
+  NAME=SUBSTR(NAME<<\"B\",0,1)
+ENDWHILE
+M17
+";
+
 #[test]
-fn a_document_of_a_dialect_this_version_does_not_read_gets_one_finding_saying_so() {
+fn a_sinumerik_document_gets_its_syntax_errors_hover_tokens_and_outline() {
     let (mut client, dir) = session();
-    let doc = document(&dir, "MAIN.MPF", "DEF REAL X0=1\nG0 X=X0\nM30\n");
-    let published = open(&mut client, &doc);
+    let doc = document(&dir, "PART.SPF", SINUMERIK);
+    client.notify("textDocument/didOpen", doc.did_open()).unwrap();
+    let published = settled_diagnostics(&mut client, &doc);
     let diagnostics = published.params()["diagnostics"].as_array().unwrap();
-    assert_eq!(diagnostics.len(), 1, "{}", published.json);
-    assert_eq!(diagnostics[0]["message"], "ncc does not read Siemens Sinumerik programs yet (dialect `sinumerik`)");
-    assert_eq!(diagnostics[0]["severity"], 3);
-    // Every request about it has an empty answer, not an error an editor
-    // would show, and the server goes on serving.
-    let hover = client.call("textDocument/hover", doc.at(doc.position(0))).unwrap();
-    assert_eq!((hover.error_code(), hover.result()), (None, Some(&Value::Null)), "{}", hover.json);
-    let document = json!({ "textDocument": { "uri": doc.uri } });
-    for method in ["textDocument/semanticTokens/full", "textDocument/foldingRange", "textDocument/documentSymbol"] {
-        let answer = client.call(method, document.clone()).unwrap();
-        assert_eq!(answer.error_code(), None, "{method}: {}", answer.json);
+    let found: Vec<(&str, u64)> = diagnostics
+        .iter()
+        .map(|d| (d["code"].as_str().unwrap(), d["range"]["start"]["line"].as_u64().unwrap()))
+        .collect();
+    assert_eq!(found, [("S029", 7), ("S024", 7)], "{}", published.json);
+
+    let hover = |client: &mut Client, at: &str| {
+        let answer = client.call("textDocument/hover", doc.at(doc.position(doc.text().find(at).unwrap()))).unwrap();
+        answer.result().and_then(|r| r["contents"]["value"].as_str()).unwrap_or_default().to_owned()
+    };
+    assert!(hover(&mut client, "G642").starts_with("### G642"), "{}", hover(&mut client, "G642"));
+    assert!(hover(&mut client, "SOFT").starts_with("### SOFT"), "{}", hover(&mut client, "SOFT"));
+    assert!(hover(&mut client, "GOTOF").starts_with("### GOTOF — Jump forward"), "{}", hover(&mut client, "GOTOF"));
+    // Known by its prefix: a variable ncc does not document, never an error.
+    assert!(
+        hover(&mut client, "$P_UIFR").starts_with("### $P_… — a system variable"),
+        "{}",
+        hover(&mut client, "$P_UIFR")
+    );
+    let substr = hover(&mut client, "SUBSTR(");
+    assert!(substr.starts_with("### SUBSTR") && substr.contains("```\nSUBSTR("), "{substr}");
+    // A name of the program's own has nothing in the catalogue.
+    assert_eq!(hover(&mut client, "NAME="), "");
+
+    let tokens = client.call("textDocument/semanticTokens/full", json!({ "textDocument": doc.id() })).unwrap();
+    let data = tokens.result().unwrap()["data"].as_array().unwrap().clone();
+    let types = ["keyword", "macro", "property", "function", "label", "variable", "number", "comment", "operator"];
+    let types: Vec<&str> = types.into_iter().chain(["error", "type", "string"]).collect();
+    let (mut line, mut start) = (0, 0);
+    let mut classified = Vec::new();
+    for token in data.chunks(5) {
+        let number = |i: usize| token[i].as_u64().unwrap() as usize;
+        line += number(0);
+        start = if number(0) == 0 { start + number(1) } else { number(1) };
+        let text: String = doc.text().lines().nth(line).unwrap().chars().skip(start).take(number(2)).collect();
+        classified.push((text, types[number(3)]));
     }
+    for (text, kind) in [
+        ("PROC", "keyword"),
+        ("PART", "function"),
+        ("\"A\"", "string"),
+        ("START:", "label"),
+        ("$P_UIFR", "property"),
+        (">", "operator"),
+        ("START", "label"),
+        ("<<", "operator"),
+        ("(", "operator"),
+        ("NAME", "variable"),
+        ("SUBSTR", "keyword"),
+        ("G642", "keyword"),
+    ] {
+        assert!(classified.contains(&(text.to_owned(), kind)), "{text} as {kind}: {classified:?}");
+    }
+
+    let symbols = client.call("textDocument/documentSymbol", json!({ "textDocument": doc.id() })).unwrap();
+    let symbols = symbols.result().unwrap().as_array().unwrap().clone();
+    assert_eq!(symbols.len(), 1, "{symbols:?}");
+    assert_eq!(symbols[0]["name"], "PART");
+    assert_eq!(symbols[0]["children"][0]["name"], "START");
+
+    let folds = client.call("textDocument/foldingRange", json!({ "textDocument": doc.id() })).unwrap();
+    let folds: Vec<(u64, u64)> = folds
+        .result()
+        .unwrap()
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| (f["startLine"].as_u64().unwrap(), f["endLine"].as_u64().unwrap()))
+        .collect();
+    assert_eq!(folds, [(2, 3), (8, 10)]);
+    // No run, so no time: the code lens of the total stays away.
+    let lenses = client.call("textDocument/codeLens", json!({ "textDocument": doc.id() })).unwrap();
+    assert_eq!(lenses.result(), Some(&json!([])), "{}", lenses.json);
     assert_serving(&mut client, &dir);
 }
 
@@ -686,11 +763,12 @@ fn the_project_decides_a_documents_dialect() {
     std::fs::create_dir(dir.path().join("siemens")).unwrap();
     std::fs::write(dir.path().join("siemens/ncc.toml"), "dialect = \"sinumerik\"\n").unwrap();
     std::fs::write(dir.path().join("ncc.toml"), "[extensions]\nPRG = \"cnc8x6\"\n").unwrap();
-    // Named CNC8x6 by its extension, but in a Sinumerik project.
-    let siemens = document(&dir, "siemens/A.NCP", "%1\nN10 G01 X1\n");
-    let published = open(&mut client, &siemens);
-    let message = "ncc does not read Siemens Sinumerik programs yet (dialect `sinumerik`)";
-    assert_eq!(published.params()["diagnostics"][0]["message"], message);
+    // Named CNC8x6 by its extension, but in a Sinumerik project: `*` is
+    // no Sinumerik.
+    let siemens = document(&dir, "siemens/A.NCP", "%1\nN10 G01 X1\n*\n");
+    client.notify("textDocument/didOpen", siemens.did_open()).unwrap();
+    let published = settled_diagnostics(&mut client, &siemens);
+    assert_eq!(published.params()["diagnostics"][0]["code"], "S001", "{}", published.json);
     // An extension of the project's own: analysed as CNC8x6.
     let mapped = document(&dir, "B.PRG", "%1\nN10 G01 X1\nN20 M30\n*\n");
     client.notify("textDocument/didOpen", mapped.did_open()).unwrap();

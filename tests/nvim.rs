@@ -21,8 +21,32 @@ const LUA_TIMEOUT_MS: u64 = 3000;
 /// One error: the space after the sign of `X-`.
 const PROGRAM: &str = "%1\nN10 G01 X- 5 F100\nN20 M30\n*\n";
 const MACRO: &str = "N10 G79 L9001\nN20 G90 G00 Z2.\nN30 G70\n*\n";
-/// A Sinumerik program, which this version does not read.
-const SINUMERIK: &str = "G0 X10 Z2\nM30\n";
+/// A Sinumerik program with one error: the `(` not closed on line 4.
+const SINUMERIK: &str = "%_N_MAIN_MPF\n; a part\nDEF REAL DEPTH=2.5\nR1=(5+2\n/1 N10 G642 SOFT X=R1 CR=2\n\
+    START: $P_UIFR[1,X,TR]=5\nIF DEPTH>2 GOTOF START\nMSG(\"DONE \"<<DEPTH)\nCYCLE81(10,0,2) M30\n";
+/// Where the syntax file highlights what in `SINUMERIK`.
+const SINUMERIK_HIGHLIGHT: [(usize, &str, &str); 20] = [
+    (0, "%_N_MAIN_MPF", "sinumerikHeader"),
+    (1, "; a part", "sinumerikComment"),
+    (2, "DEF", "sinumerikDeclaration"),
+    (2, "REAL", "sinumerikType"),
+    (2, "2.5", "sinumerikNumber"),
+    (3, "R1", "sinumerikParameter"),
+    (4, "/1", "sinumerikBlockSkip"),
+    (4, "N10", "sinumerikBlockNumber"),
+    (4, "G642", "sinumerikGCode"),
+    (4, "SOFT", "sinumerikWordCode"),
+    (4, "X=", "sinumerikAxis"),
+    (4, "CR", "sinumerikAddress"),
+    (5, "START", "sinumerikLabel"),
+    (5, "$P_UIFR", "sinumerikSystemVariable"),
+    (6, "IF", "sinumerikStatement"),
+    (6, "GOTOF", "sinumerikStatement"),
+    (7, "MSG", "sinumerikFunction"),
+    (7, "\"DONE", "sinumerikString"),
+    (8, "CYCLE81", "sinumerikCycle"),
+    (8, "M30", "sinumerikFlow"),
+];
 /// A Haas lathe program, in a file named by its program number.
 const HAAS: &str = "%\nO01234 (SHAFT)\nN10 G28 U0 W0 (HOME)\n/1 N20 T0101 S1200 M03\n\
     N30 #100 = #[#1+2] * SIN[30.]\nN40 IF [#100 GT 0] GOTO50\nN50 WHILE [#1 LE 3] DO1\n\
@@ -149,20 +173,23 @@ fn neovim_detects_programs_and_shows_diagnostics_hover_and_the_cycle_time() {
         "OLD",
     ]
     .map(|name| programs.join(name));
-    let haas_lines: Vec<&str> = HAAS.lines().collect();
-    let haas_probes: Vec<Value> = HAAS_HIGHLIGHT
-        .iter()
-        .map(|&(line, text, _)| json!({ "line": line, "character": haas_lines[line].find(text).unwrap() }))
-        .collect();
+    let probes_of = |text: &str, highlight: &[(usize, &str, &str)]| -> Vec<Value> {
+        let lines: Vec<&str> = text.lines().collect();
+        highlight
+            .iter()
+            .map(|&(line, text, _)| json!({ "line": line, "character": lines[line].find(text).unwrap() }))
+            .collect()
+    };
     let input = json!({
         "runtime": workspace().join("editors/nvim"),
         "server": env!("CARGO_BIN_EXE_ncc"),
         "config_file": config,
         "macro": programs.join("L9001"),
         "program": programs.join("drill.NCP"),
-        "unread": programs.join("MAIN.MPF"),
+        "sinumerik": programs.join("MAIN.MPF"),
+        "sinumerik_probes": probes_of(SINUMERIK, &SINUMERIK_HIGHLIGHT),
         "haas": programs.join("O01234"),
-        "haas_probes": haas_probes,
+        "haas_probes": probes_of(HAAS, &HAAS_HIGHLIGHT),
         "hover": { "line": 1, "character": line.find("G01").unwrap() },
         "timeout_ms": LUA_TIMEOUT_MS,
         "filetype_probes": probes,
@@ -201,6 +228,9 @@ fn neovim_detects_programs_and_shows_diagnostics_hover_and_the_cycle_time() {
     let groups: Vec<&str> = HAAS_HIGHLIGHT.iter().map(|&(_, _, group)| group).collect();
     assert_eq!(output["haas_highlight"], json!(groups), "{context}");
     assert_eq!(output["haas_commentstring"], "(%s)", "{context}");
+    let groups: Vec<&str> = SINUMERIK_HIGHLIGHT.iter().map(|&(_, _, group)| group).collect();
+    assert_eq!(output["sinumerik_highlight"], json!(groups), "{context}");
+    assert_eq!(output["sinumerik_commentstring"], ";%s", "{context}");
 
     // One server for the project, found by its `ncc.toml`, serves all four
     // files.
@@ -212,7 +242,7 @@ fn neovim_detects_programs_and_shows_diagnostics_hover_and_the_cycle_time() {
     assert_eq!(clients[0]["init_options"], init_options, "{context}");
     assert_eq!(
         clients[0]["buffers"],
-        json!({ "program": true, "macro": true, "unread": true, "haas": true }),
+        json!({ "program": true, "macro": true, "sinumerik": true, "haas": true }),
         "{context}"
     );
 
@@ -225,14 +255,9 @@ fn neovim_detects_programs_and_shows_diagnostics_hover_and_the_cycle_time() {
     });
     assert_eq!(output["diagnostics"], json!([space_after_sign]), "{context}");
 
-    // The server's one note on the program it does not read.
-    let not_read = json!({ "source": "ncc", "severity": "INFO", "line": 0, "character": 0 });
-    assert_eq!(output["unread_diagnostics"], json!([not_read]), "{context}");
-    assert_eq!(
-        output["unread_messages"],
-        json!(["ncc does not read Siemens Sinumerik programs yet (dialect `sinumerik`)"]),
-        "{context}"
-    );
+    // The Sinumerik program's syntax error.
+    let unclosed = json!({ "code": "S029", "source": "ncc", "severity": "ERROR", "line": 3, "character": 3 });
+    assert_eq!(output["sinumerik_diagnostics"], json!([unclosed]), "{context}");
 
     // The predicted total on the header: 5 mm at 100 mm/min, with its
     // ramps and the stop at the end.

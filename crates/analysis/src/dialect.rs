@@ -18,6 +18,8 @@ fn check_rules(dialect: Dialect) -> &'static [&'static [&'static Rule]] {
     match dialect {
         Dialect::Cnc8x6 => cnc8x6::checks::RULES,
         Dialect::HaasLathe => haas_lathe::checks::RULES,
+        // No Sinumerik checks beyond the parser's syntax diagnostics yet.
+        Dialect::Sinumerik => &[],
     }
 }
 
@@ -41,6 +43,7 @@ pub(crate) fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => cnc8x6::checks::local_findings(db, file),
         Dialect::HaasLathe => haas_lathe::checks::local_findings(db, file),
+        Dialect::Sinumerik => Findings::default(),
     }
 }
 
@@ -49,6 +52,10 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> &Findings {
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => cnc8x6::flow::flow_diagnostics(db, file),
         Dialect::HaasLathe => haas_lathe::checks::flow_findings(db, file),
+        Dialect::Sinumerik => {
+            static NONE: Findings = Findings { diagnostics: Vec::new(), omitted: Vec::new() };
+            &NONE
+        }
     }
 }
 
@@ -57,8 +64,8 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> &Findings {
 pub(crate) fn prepare_states(db: &dyn Db, file: SourceFile) {
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => cnc8x6::states::prepare(db, file),
-        // Hover reads nothing prepared about a Haas file.
-        Dialect::HaasLathe => {}
+        // Hover reads nothing prepared about a Haas or Sinumerik file.
+        Dialect::HaasLathe | Dialect::Sinumerik => {}
     }
 }
 
@@ -67,8 +74,8 @@ pub(crate) fn prepare_states(db: &dyn Db, file: SourceFile) {
 pub(crate) fn code_fits_machine(dialect: Dialect, letter: char, number: u32, config: &Config) -> bool {
     match dialect {
         Dialect::Cnc8x6 => cnc8x6::ide::code_fits_machine(letter, number, config),
-        // The machine description names no options of a Haas lathe.
-        Dialect::HaasLathe => true,
+        // The machine description names no options of these controls.
+        Dialect::HaasLathe | Dialect::Sinumerik => true,
     }
 }
 
@@ -78,6 +85,8 @@ pub(crate) fn starts_unit(dialect: Dialect, block: &BlockData, word: &Word) -> b
         Dialect::Cnc8x6 => cnc8x6::ide::starts_unit(block, word),
         // Only `O` starts a program, and it is no word of a block.
         Dialect::HaasLathe => false,
+        // `PROC` starts one, a statement rather than a word.
+        Dialect::Sinumerik => false,
     }
 }
 
@@ -85,6 +94,6 @@ pub(crate) fn starts_unit(dialect: Dialect, block: &BlockData, word: &Word) -> b
 pub(crate) fn unnamed_unit(dialect: Dialect) -> &'static str {
     match dialect {
         Dialect::Cnc8x6 => cnc8x6::ide::UNNAMED_UNIT,
-        Dialect::HaasLathe => "program",
+        Dialect::HaasLathe | Dialect::Sinumerik => "program",
     }
 }

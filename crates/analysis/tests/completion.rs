@@ -311,6 +311,39 @@ proptest! {
         for hint in analysis.inlay_hints(file, Some(TextRange::empty(offset))) {
             prop_assert!(hint.offset <= end);
         }
+        let mut host = AnalysisHost::in_dialect(Dialect::Sinumerik, Config::default());
+        let file = host.add_file("MAIN.MPF", text.as_str());
+        for item in host.analysis().completions(file, offset) {
+            prop_assert!(item.replace.contains_inclusive(offset) && item.replace.end() <= end, "{item:?}");
+        }
+    }
+}
+
+/// The completions of a Sinumerik program with `$0` as the cursor, as
+/// `label (kind)`.
+fn sinumerik_completions(program: &str) -> Vec<String> {
+    let mut host = AnalysisHost::in_dialect(Dialect::Sinumerik, Config::default());
+    let file = host.add_file("MAIN.MPF", program.replace("$0", ""));
+    let offset = TextSize::try_from(program.find("$0").expect("a `$0` cursor")).unwrap();
+    host.analysis().completions(file, offset).iter().map(|item| format!("{} ({:?})", item.label, item.kind)).collect()
+}
+
+/// Where a word starts: codes, addresses, keywords and functions; in an
+/// expression the functions alone; nothing in a comment, a string or a
+/// system variable's name.
+#[test]
+fn sinumerik_completion_offers_the_catalogues_words() {
+    let items = sinumerik_completions("N10 G0 X0\nGOT$0\n");
+    for expected in
+        ["G642 (Code)", "X (Address)", "CR (Address)", "GOTOF (Keyword)", "WHILE (Keyword)", "SIN (Function)"]
+    {
+        assert!(items.iter().any(|item| item == expected), "{expected} in {items:?}");
+    }
+    let items = sinumerik_completions("G1 X=SI$0\n");
+    assert!(items.iter().any(|item| item == "SIN (Function)"), "{items:?}");
+    assert!(items.iter().all(|item| item.ends_with("(Function)")), "{items:?}");
+    for program in ["G1 X0 ; a G$0\n", "MSG(\"G$0\")\n", "R1=$P_$0\n"] {
+        assert_eq!(sinumerik_completions(program), Vec::<String>::new(), "{program}");
     }
 }
 

@@ -711,3 +711,106 @@ fn lathe_hover_shows_the_modal_state_before_the_block() {
     // G96 from the program, G99 and G18 from reset.
     assert!(state.contains("G96") && state.contains("G18") && state.contains("G99"), "{state}");
 }
+
+/// A Sinumerik subprogram with the language's statements.
+const SINUMERIK: &str = "%_N_PART_SPF
+PROC PART(REAL DEPTH, VAR INT COUNT) SAVE
+; two comment lines
+; fold together
+DEF REAL B=5, C[2]
+N10 G17 G642 SOFT X=R1+5 CR=2
+START: $P_UIFR[1,X,TR]=5
+IF DEPTH>=2 GOTOF START
+IF B<>C[1]
+  WHILE R1<10
+    R[R1]=R1 B=B*2
+  ENDWHILE
+ELSE
+  REPEAT
+    MSG(\"N=\"<<B)
+  UNTIL B==5
+ENDIF
+ENDLOOP
+CYCLE81(10,0,2,-5) L140(1)
+M17
+";
+
+#[test]
+fn highlight_a_sinumerik_program() {
+    check_highlight(
+        "PART.SPF",
+        SINUMERIK,
+        expect![[r#"
+            %_N_PART_SPF:Keyword
+            PROC:Keyword PART:Function (:Operator REAL:Keyword DEPTH:write ,:Operator VAR:Keyword INT:Keyword COUNT:write ):Operator SAVE:Keyword
+            ; two comment lines:Comment
+            ; fold together:Comment
+            DEF:Keyword REAL:Keyword B:write =:Operator 5:Number ,:Operator C:write [:Operator 2:Number ]:Operator
+            N10:BlockNumber G17:GG6 G642:GG10 SOFT:GG21 X:Axis =:Operator R1:read +:Operator 5:Number CR:Interpolation =:Operator 2:Number
+            START::Label { write: true } $P_UIFR:SystemVariable [:Operator 1:Number ,:Operator X:Axis ,:Operator TR:read ]:Operator =:Operator 5:Number
+            IF:Keyword DEPTH:read >=:Operator 2:Number GOTOF:Keyword START:Label { write: false }
+            IF:Keyword B:Axis <>:Operator C:Axis [:Operator 1:Number ]:Operator
+            WHILE:Keyword R1:read <:Operator 10:Number
+            R[:write R1:read ]:write =:Operator R1:read B:Axis =:Operator B:Axis *:Operator 2:Number
+            ENDWHILE:Keyword
+            ELSE:Keyword
+            REPEAT:Keyword
+            MSG:Function (:Operator "N=":String <<:Operator B:Axis ):Operator
+            UNTIL:Keyword B:Axis ==:Operator 5:Number
+            ENDIF:Keyword
+            ENDLOOP:Keyword
+            CYCLE81:Function (:Operator 10:Number ,:Operator 0:Number ,:Operator 2:Number ,:Operator -:Operator 5:Number ):Operator L140:Function (:Operator 1:Number ):Operator
+            M17:MM1
+        "#]],
+    );
+}
+
+/// The `PROC` holds the labels after it; the structures fold, an end
+/// without its start (`ENDLOOP`) folds nothing.
+#[test]
+fn symbols_and_folds_of_a_sinumerik_program() {
+    check_symbols(
+        "PART.SPF",
+        SINUMERIK,
+        expect![[r#"
+        Subprogram PART ((REAL DEPTH, VAR INT COUNT) SAVE): `PROC PART(REAL DEPTH, VAR INT COUNT) SAVE` … `M17` select `PART`
+          JumpTarget START: `START: $P_UIFR[1,X,TR]=5` select `START`
+    "#]],
+    );
+    check_folds(
+        "PART.SPF",
+        SINUMERIK,
+        expect![[r#"
+        Comment `; two comment lines` … `; fold together`
+        Region `IF B<>C[1]` … `ENDIF`
+        Region `  WHILE R1<10` … `  ENDWHILE`
+        Region `  REPEAT` … `  UNTIL B==5`"#]],
+    );
+}
+
+/// Every token of the Sinumerik listings the parser reads without an error
+/// is classified as something other than an error.
+#[test]
+fn sinumerik_listings_highlight_without_errors() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../syntax/test_data/sinumerik");
+    let listings = std::fs::read_dir(&dir).unwrap().chain(std::fs::read_dir(dir.join("constructs")).unwrap());
+    let mut read = 0;
+    for path in listings.map(|entry| entry.unwrap().path()) {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if !(name.ends_with(".mpf") || name.ends_with(".spf")) || name.starts_with("error_") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        let (host, ids, _) = setup(&[(&name.to_uppercase(), &text)]);
+        let errors: Vec<&str> = host
+            .analysis()
+            .highlight(ids[0])
+            .iter()
+            .filter(|h| h.kind == HighlightKind::Error)
+            .map(|h| &text[h.range])
+            .collect();
+        assert!(errors.is_empty(), "{name}: {errors:?}");
+        read += 1;
+    }
+    assert!(read >= 15, "{read} listings");
+}

@@ -1,9 +1,9 @@
 //! Fixture programs with the expected diagnostics written inline.
 //!
 //! Every program in `test_data/rules` is analysed in the dialect its file
-//! name gives (`*.ncp`: CNC8x6, `*.nc`: Haas lathe) and its diagnostics are compared with the
+//! name gives (`*.ncp`: CNC8x6, `*.nc`: Haas lathe, `*.mpf`: Sinumerik) and its diagnostics are compared with the
 //! annotations in it. An annotation is a line of the dialect's comment
-//! (CNC8x6: `"`, Haas lathe: `;`) right after the line it describes:
+//! (CNC8x6: `"`, Haas lathe and Sinumerik: `;`) right after the line it describes:
 //!
 //! ```text
 //! N20 G01 X10 Y10
@@ -42,7 +42,7 @@ fn dialect_of(path: &std::path::Path) -> Option<Dialect> {
 fn comment_start(dialect: Dialect) -> &'static str {
     match dialect {
         Dialect::Cnc8x6 => "\"",
-        Dialect::HaasLathe => ";",
+        Dialect::HaasLathe | Dialect::Sinumerik => ";",
     }
 }
 

@@ -210,6 +210,7 @@ fn program_text(dialect: Dialect, moves: &[Move]) -> String {
     match dialect {
         Dialect::Cnc8x6 => progen::write(moves, Syntax::Cnc8x6),
         Dialect::HaasLathe => progen::write(moves, Syntax::HaasLathe),
+        Dialect::Sinumerik => progen::write(moves, Syntax::Sinumerik),
     }
 }
 
@@ -230,6 +231,7 @@ pub(crate) fn code_near(dialect: Dialect, text: &str, offset: usize, rng: &mut L
     match dialect {
         Dialect::Cnc8x6 => progen::g_code_near(text, offset, rng),
         Dialect::HaasLathe => progen::g_code_near(text, offset, rng),
+        Dialect::Sinumerik => progen::g_code_near(text, offset, rng),
     }
 }
 
@@ -238,6 +240,7 @@ enum SyntaxArg {
     Cnc8x6,
     Ngc,
     HaasLathe,
+    Sinumerik,
 }
 
 fn main() -> anyhow::Result<()> {
@@ -281,6 +284,7 @@ fn main() -> anyhow::Result<()> {
                 SyntaxArg::Cnc8x6 => Syntax::Cnc8x6,
                 SyntaxArg::Ngc => Syntax::Ngc,
                 SyntaxArg::HaasLathe => Syntax::HaasLathe,
+                SyntaxArg::Sinumerik => Syntax::Sinumerik,
             };
             let text = progen::write(&progen::surfacing(blocks), syntax);
             std::fs::write(&output, text).with_context(|| format!("writing {}", output.display()))
@@ -317,12 +321,14 @@ fn measure<T>(runs: usize, mut f: impl FnMut() -> T) -> Measurement {
 
 /// What the `gcode` crate reads beside a program of `dialect`: the same
 /// bytes where it reads them (a Haas program is plain ISO code to it), else
-/// the same toolpath in NGC (CNC8x6's header, `"` comments and `*` end are
-/// not G-code it knows); and what the output calls it.
+/// the same toolpath in NGC (CNC8x6's header, `"` comments and `*` end, and
+/// Sinumerik's header and `;` comments are not G-code it knows); and what
+/// the output calls it.
 fn gcode_input(dialect: Dialect, moves: &[Move], program: &str) -> (String, &'static str) {
     match dialect {
         Dialect::Cnc8x6 => (progen::write(moves, Syntax::Ngc), "NGC"),
         Dialect::HaasLathe => (program.to_owned(), "the same bytes"),
+        Dialect::Sinumerik => (progen::write(moves, Syntax::Ngc), "NGC"),
     }
 }
 

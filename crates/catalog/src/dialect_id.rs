@@ -45,7 +45,7 @@ impl DialectId {
         match self {
             DialectId::Cnc8x6 => Some(Dialect::Cnc8x6),
             DialectId::HaasLathe => Some(Dialect::HaasLathe),
-            DialectId::Sinumerik => None,
+            DialectId::Sinumerik => Some(Dialect::Sinumerik),
         }
     }
 
@@ -85,6 +85,7 @@ impl From<Dialect> for DialectId {
         match dialect {
             Dialect::Cnc8x6 => DialectId::Cnc8x6,
             Dialect::HaasLathe => DialectId::HaasLathe,
+            Dialect::Sinumerik => DialectId::Sinumerik,
         }
     }
 }

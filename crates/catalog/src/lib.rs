@@ -29,6 +29,8 @@ pub enum Dialect {
     Cnc8x6,
     /// Haas lathe, classic control (Fanuc-style ISO).
     HaasLathe,
+    /// Siemens Sinumerik.
+    Sinumerik,
 }
 
 impl Dialect {
@@ -42,6 +44,10 @@ impl Dialect {
             Dialect::HaasLathe => {
                 static HAAS_LATHE: OnceLock<Catalogue> = OnceLock::new();
                 HAAS_LATHE.get_or_init(|| Catalogue::load(&HAAS_LATHE_FILES))
+            }
+            Dialect::Sinumerik => {
+                static SINUMERIK: OnceLock<Catalogue> = OnceLock::new();
+                SINUMERIK.get_or_init(|| Catalogue::load(&SINUMERIK_FILES))
             }
         }
     }
@@ -105,21 +111,6 @@ static SINUMERIK_FILES: DataFiles = DataFiles {
         system_variables: data_file!("sinumerik", "system_variables.toml"),
     }),
 };
-
-impl DialectId {
-    /// The catalogue of this dialect, including those this build does not
-    /// read programs of yet (Sinumerik): `ncc explain` and the data tests
-    /// need no more.
-    pub fn catalogue(self) -> &'static Catalogue {
-        match self.implementation() {
-            Some(dialect) => dialect.catalogue(),
-            None => {
-                static SINUMERIK: OnceLock<Catalogue> = OnceLock::new();
-                SINUMERIK.get_or_init(|| Catalogue::load(&SINUMERIK_FILES))
-            }
-        }
-    }
-}
 
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -2,10 +2,10 @@
 //! each kind. The facts of the catalogue are checked in the crate's unit
 //! tests (`src/tests/sinumerik.rs`).
 
-use ncc_catalog::DialectId;
+use ncc_catalog::Dialect;
 
 fn explain(query: &str) -> String {
-    let catalogue = DialectId::Sinumerik.catalogue();
+    let catalogue = Dialect::Sinumerik.catalogue();
     match catalogue.explain(query) {
         Ok(items) => items.iter().map(|item| item.markdown(catalogue)).collect::<Vec<_>>().join("\n"),
         Err(not_found) => format!("not found: {not_found:?}\n"),
@@ -41,7 +41,7 @@ fn explain_snapshots() {
 
 #[test]
 fn unknown_words_get_suggestions() {
-    let catalogue = DialectId::Sinumerik.catalogue();
+    let catalogue = Dialect::Sinumerik.catalogue();
     let not_found = catalogue.explain("GOTOX").unwrap_err();
     assert!(not_found.suggestions.iter().any(|s| s == "GOTOF" || s == "GOTO"), "{not_found:?}");
     let not_found = catalogue.explain("BSPLIN").unwrap_err();

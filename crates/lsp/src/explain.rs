@@ -5,10 +5,9 @@ use std::process::ExitCode;
 use ncc_catalog::{Catalogue, Dialect, DialectId};
 
 /// Explains `query` in `dialect`'s catalogue (the default dialect's when
-/// none is named: a query names no program to take one from). Dialects whose
-/// programs this version does not read have a catalogue too.
-pub(crate) fn run(query: Option<&str>, list: bool, dialect: Option<DialectId>) -> ExitCode {
-    let dialect = dialect.unwrap_or_else(|| Dialect::default().into());
+/// none is named: a query names no program to take one from).
+pub(crate) fn run(query: Option<&str>, list: bool, dialect: Option<Dialect>) -> ExitCode {
+    let dialect = dialect.unwrap_or_default();
     let catalogue = dialect.catalogue();
     if list {
         print!("{}", listing(catalogue));
@@ -25,7 +24,7 @@ pub(crate) fn run(query: Option<&str>, list: bool, dialect: Option<DialectId>) -
             eprintln!(
                 "error: `{}` is not a code, address, parameter, machine constant or operation of {}",
                 not_found.query,
-                dialect.title()
+                DialectId::from(dialect).title()
             );
             if !not_found.suggestions.is_empty() {
                 eprintln!("help: did you mean {}?", not_found.suggestions.join(", "));

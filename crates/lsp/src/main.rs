@@ -180,15 +180,15 @@ enum Command {
 
 fn main() -> ExitCode {
     let Cli { dialect, command } = Cli::parse();
-    // `explain` reads only the catalogue, which every dialect has.
-    let reads_programs = !matches!(command, Command::Explain { .. });
-    if let Some(unread) = dialect.filter(|dialect| reads_programs && dialect.implementation().is_none()) {
+    if let Some(unread) = dialect.filter(|dialect| dialect.implementation().is_none()) {
         eprintln!("error: {}", unread.not_read());
         return ExitCode::from(2);
     }
     match command {
         Command::Check { paths, format } => check::run(&paths, format, dialect),
-        Command::Explain { query, list } => explain::run(query.as_deref(), list, dialect),
+        Command::Explain { query, list } => {
+            explain::run(query.as_deref(), list, dialect.and_then(DialectId::implementation))
+        }
         Command::Rules { query, markdown } => rules::run(query.as_deref(), markdown),
         Command::Lsp { version: true, .. } => {
             println!("ncc {}", env!("CARGO_PKG_VERSION"));

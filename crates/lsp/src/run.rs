@@ -301,6 +301,9 @@ pub(crate) fn run(path: &Path, dialect: Option<DialectId>, format: Format, step_
 }
 
 fn run_program(program: &Program<'_>, path: &Path, format: Format, step_budget: usize) -> ExitCode {
+    if !nc_exec::run::interprets(program.dialect) {
+        return not_run(program, step_budget);
+    }
     let (ran, written) = match format {
         Format::Human => {
             let (ran, tally) = match Ran::tally(program, step_budget, Progress::OnTerminal) {
@@ -351,29 +354,21 @@ fn expand_program(program: &Program<'_>, path: &Path, output: Option<&Path>, ste
         Err(error) => return config_error(error),
     };
     let machine = &config.machine;
-    let (out, target): (Box<dyn io::Write>, String) = match output {
-        Some(output) => match std::fs::File::create(output) {
-            Ok(file) => (Box::new(file), output.display().to_string()),
-            Err(error) => {
-                eprintln!("error: writing {}: {error}", output.display());
-                return ExitCode::from(2);
-            }
-        },
-        None => (Box::new(io::stdout().lock()), "stdout".to_owned()),
-    };
     let name = path.file_name().map_or_else(|| path.display().to_string(), |name| name.to_string_lossy().into_owned());
     let title = format!("EXPANDED FROM {name}");
-    let out = io::BufWriter::new(out);
     // The expansion is written in the program's own dialect.
-    let mut expansion: Box<dyn Expand> = match program.dialect {
+    let (mut expansion, target): (Box<dyn Expand>, String) = match program.dialect {
         Dialect::Cnc8x6 => {
             let number = program_number(program.text).unwrap_or(1);
-            Box::new(cnc8x6::expand::Expansion::new(out, machine, number, &title))
+            let Some((out, target)) = open_output(output) else { return ExitCode::from(2) };
+            (Box::new(cnc8x6::expand::Expansion::new(out, machine, number, &title)), target)
         }
         Dialect::HaasLathe => {
             let number = haas_lathe::program::first_program_number(program.text).unwrap_or(1);
-            Box::new(haas_lathe::expand::Expansion::new(out, machine, number, &title))
+            let Some((out, target)) = open_output(output) else { return ExitCode::from(2) };
+            (Box::new(haas_lathe::expand::Expansion::new(out, machine, number, &title)), target)
         }
+        Dialect::Sinumerik => return not_run(program, step_budget),
     };
     let ran = Ran::run(program, &config, Progress::OnTerminal, |text, library| {
         nc_exec::run::run_into(text, library, machine, step_budget, &mut *expansion)
@@ -402,6 +397,35 @@ fn expand_program(program: &Program<'_>, path: &Path, output: Option<&Path>, ste
     code
 }
 
+/// A program the executor does not run: its run makes no step and says so
+/// in its one finding, which is all the command prints; no time, file or
+/// picture comes out of it, and the exit status says so.
+fn not_run(program: &Program<'_>, step_budget: usize) -> ExitCode {
+    match Ran::of(program, step_budget, Progress::OnTerminal) {
+        Ok(ran) => {
+            ran.print_findings();
+            ExitCode::FAILURE
+        }
+        Err(error) => config_error(error),
+    }
+}
+
+/// Where an expansion goes, buffered, and its name for messages; `None`
+/// after saying why a file cannot be written.
+fn open_output(output: Option<&Path>) -> Option<(io::BufWriter<Box<dyn io::Write>>, String)> {
+    let (out, target): (Box<dyn io::Write>, String) = match output {
+        Some(output) => match std::fs::File::create(output) {
+            Ok(file) => (Box::new(file), output.display().to_string()),
+            Err(error) => {
+                eprintln!("error: writing {}: {error}", output.display());
+                return None;
+            }
+        },
+        None => (Box::new(io::stdout().lock()), "stdout".to_owned()),
+    };
+    Some((io::BufWriter::new(out), target))
+}
+
 /// `ncc plot FILE -o OUT`: the toolpath as an SVG picture of the first
 /// `max_moves` moves, a lathe's in `view`.
 pub(crate) fn plot(
@@ -416,6 +440,9 @@ pub(crate) fn plot(
 }
 
 fn plot_program(program: &Program<'_>, output: &Path, step_budget: usize, max_moves: usize, view: View) -> ExitCode {
+    if !nc_exec::run::interprets(program.dialect) {
+        return not_run(program, step_budget);
+    }
     let (ran, picture) = match Ran::plotted(program, step_budget, max_moves, view, Progress::OnTerminal) {
         Ok(plotted) => plotted,
         Err(error) => return config_error(error),
@@ -485,6 +512,11 @@ pub(crate) fn lower(path: &Path, dialect: Option<DialectId>) -> ExitCode {
                 let line = lines.line_col(range.start(), Columns::Characters).0 + 1;
                 let _ = writeln!(out, "{line:>6}  {}", haas_lathe::lower::HaasBlock::lower(block));
             }
+        }
+        Dialect::Sinumerik => {
+            let title = DialectId::from(parse.dialect()).title();
+            eprintln!("error: {}: the executor does not read {title} programs yet", path.display());
+            return ExitCode::from(2);
         }
     }
     let mut stdout = io::stdout().lock();

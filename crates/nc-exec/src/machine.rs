@@ -118,13 +118,16 @@ impl Default for MachineConfig {
 impl MachineConfig {
     /// The machine a program for `control` runs on when the configuration
     /// describes none: for CNC8x6 the default, a machine with axes XYZUVC;
-    /// for the Haas lathe a two-axis lathe, X (a diameter) and Z.
+    /// for the Haas lathe a two-axis lathe, X (a diameter) and Z; for
+    /// Sinumerik a three-axis mill, XYZ (an assumption: the seed names no
+    /// machine, and a mill is what its listings program).
     pub fn of_control(control: Dialect) -> MachineConfig {
         match control {
             Dialect::Cnc8x6 => MachineConfig::default(),
             Dialect::HaasLathe => {
                 MachineConfig { control, axes: b"XZ".to_vec(), diameter_axis: Some(b'X'), ..MachineConfig::default() }
             }
+            Dialect::Sinumerik => MachineConfig { control, axes: b"XYZ".to_vec(), ..MachineConfig::default() },
         }
     }
 

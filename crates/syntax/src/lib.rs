@@ -21,7 +21,7 @@ pub mod limit;
 mod line_blocks;
 mod line_cursor;
 mod runs;
-pub mod sinumerik;
+mod sinumerik;
 mod syntax_kind;
 pub mod visible;
 
@@ -80,6 +80,7 @@ impl Parse {
         let (green, errors, omitted) = match dialect {
             Dialect::Cnc8x6 => cnc8x6::parse_source_file(text),
             Dialect::HaasLathe => haas_lathe::parse_source_file(text),
+            Dialect::Sinumerik => sinumerik::parse_source_file(text),
         };
         Parse { green, errors: errors.into(), omitted: omitted.into(), dialect }
     }
@@ -91,6 +92,7 @@ impl Parse {
         let reparsed = match self.dialect {
             Dialect::Cnc8x6 => cnc8x6::reparse_blocks(self, edit, new_text),
             Dialect::HaasLathe => haas_lathe::reparse_blocks(self, edit, new_text),
+            Dialect::Sinumerik => sinumerik::reparse_blocks(self, edit, new_text),
         };
         reparsed.unwrap_or_else(|| Parse::new(new_text, self.dialect))
     }
@@ -125,19 +127,14 @@ impl Parse {
 
     /// The tree and the errors as text, for tests and `ncc parse`.
     pub fn debug_dump(&self) -> String {
-        debug_dump(&self.green, &self.errors, &self.omitted)
+        let mut dump = format!("{:#?}", self.syntax_node());
+        for error in self.errors.iter() {
+            dump.push_str(&format!("{error}\n"));
+        }
+        for omitted in self.omitted.iter() {
+            let Omitted { kind, at, count, .. } = omitted;
+            dump.push_str(&format!("{count} more {}[{}] from {at:?} on its line\n", kind.severity(), kind.code()));
+        }
+        dump
     }
-}
-
-/// A tree and its errors as text, for tests and `ncc parse`.
-pub(crate) fn debug_dump(green: &GreenNode, errors: &[SyntaxError], omitted: &[Omitted<SyntaxErrorKind>]) -> String {
-    let mut dump = format!("{:#?}", SyntaxNode::new_root(green.clone()));
-    for error in errors {
-        dump.push_str(&format!("{error}\n"));
-    }
-    for omitted in omitted {
-        let Omitted { kind, at, count, .. } = omitted;
-        dump.push_str(&format!("{count} more {}[{}] from {at:?} on its line\n", kind.severity(), kind.code()));
-    }
-    dump
 }

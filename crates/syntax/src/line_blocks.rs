@@ -80,7 +80,7 @@ fn split_at_lines(text: &str, region: Range<usize>, parts: usize) -> Vec<usize> 
 }
 
 /// A tree with its errors, as [`crate::Parse`] holds them.
-pub type Parts = (GreenNode, Vec<SyntaxError>, Vec<Omitted<SyntaxErrorKind>>);
+pub(crate) type Parts = (GreenNode, Vec<SyntaxError>, Vec<Omitted<SyntaxErrorKind>>);
 
 /// What a dialect decides in a reparse.
 pub(crate) struct LineDialect<E, R, P> {

@@ -11,22 +11,19 @@
 
 use std::{fs, path::PathBuf};
 
-use ncc_syntax::{
-    SyntaxErrorKind, SyntaxKind, SyntaxNode, TextEdit, TextRange, TextSize,
-    sinumerik::{self, Parts},
-};
+use ncc_syntax::{Dialect, Parse, SyntaxErrorKind, SyntaxKind, SyntaxNode, TextEdit, TextRange, TextSize};
 use proptest::prelude::*;
 
-fn parse(text: &str) -> Parts {
-    sinumerik::parse_source_file(text)
+fn parse(text: &str) -> Parse {
+    Parse::new(text, Dialect::Sinumerik)
 }
 
-fn reparse(old: &Parts, edit: &TextEdit, new_text: &str) -> Parts {
-    sinumerik::reparse_blocks((&old.0, &old.1, &old.2), edit, new_text).unwrap_or_else(|| parse(new_text))
+fn reparse(old: &Parse, edit: &TextEdit, new_text: &str) -> Parse {
+    old.reparse(edit, new_text)
 }
 
-fn root(parts: &Parts) -> SyntaxNode {
-    SyntaxNode::new_root(parts.0.clone())
+fn root(parse: &Parse) -> SyntaxNode {
+    parse.syntax_node()
 }
 
 fn files(dir: &str) -> Vec<(PathBuf, String)> {
@@ -51,7 +48,7 @@ fn listings_parse_without_errors() {
     for (path, text) in listings {
         let parts = parse(&text);
         assert_eq!(root(&parts).to_string(), text, "{} does not round-trip", path.display());
-        assert!(parts.1.is_empty(), "{}:\n{}", path.display(), sinumerik::debug_dump(&parts));
+        assert!(parts.errors().is_empty(), "{}:\n{}", path.display(), parts.debug_dump());
     }
 }
 
@@ -64,13 +61,13 @@ fn construct_snapshots() {
         assert_eq!(root(&parts).to_string(), text, "{} does not round-trip", path.display());
         let is_error_fixture = path.file_name().unwrap().to_str().unwrap().starts_with("error_");
         assert_eq!(
-            !parts.1.is_empty(),
+            !parts.errors().is_empty(),
             is_error_fixture,
             "{}: error fixtures are named error_*\n{:?}",
             path.display(),
-            parts.1
+            parts.errors()
         );
-        expect_test::expect_file![path.with_extension("rast")].assert_eq(&sinumerik::debug_dump(&parts));
+        expect_test::expect_file![path.with_extension("rast")].assert_eq(&parts.debug_dump());
     }
 }
 
@@ -114,7 +111,7 @@ fn an_edit_inside_a_loop_reparses_one_block() {
     edit.apply(&mut new_text);
     let new = reparse(&old, &edit, &new_text);
     assert_eq!(new, parse(&new_text));
-    let blocks = |parts: &Parts| -> Vec<*const rowan::GreenNodeData> {
+    let blocks = |parts: &Parse| -> Vec<*const rowan::GreenNodeData> {
         root(parts)
             .descendants()
             .filter(|n| n.kind() == SyntaxKind::BLOCK)
@@ -161,7 +158,7 @@ fn addresses_and_names_split_by_the_two_letter_rule() {
 /// The top node of the first statement of `text`'s first block.
 fn first_statement(text: &str) -> SyntaxNode {
     let parts = parse(text);
-    assert!(parts.1.is_empty(), "{:?}", parts.1);
+    assert!(parts.errors().is_empty(), "{:?}", parts.errors());
     let block = root(&parts).descendants().find(|n| n.kind() == SyntaxKind::BLOCK).unwrap();
     block.children().next().unwrap()
 }
@@ -199,7 +196,7 @@ fn a_long_line_is_read_up_to_the_limit() {
     let root = root(&parts);
     assert_eq!(root.to_string(), text);
     assert!(root.descendants_with_tokens().count() < 3_000);
-    assert!(parts.1.iter().any(|e| e.kind == SyntaxErrorKind::LineTooLong));
+    assert!(parts.errors().iter().any(|e| e.kind == SyntaxErrorKind::LineTooLong));
 }
 
 #[test]
@@ -384,9 +381,9 @@ fn char_boundary(text: &str, at: usize) -> usize {
     (0..=at.min(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap()
 }
 
-fn assert_well_formed(text: &str, parts: &Parts) {
+fn assert_well_formed(text: &str, parts: &Parse) {
     assert_eq!(root(parts).to_string(), text);
-    for error in &parts.1 {
+    for error in parts.errors() {
         let r = std::ops::Range::<usize>::from(error.range);
         assert!(r.end <= text.len() && text.is_char_boundary(r.start) && text.is_char_boundary(r.end), "{error}");
         assert!(!error.message.is_empty());
@@ -410,7 +407,7 @@ proptest! {
     fn valid_programs_parse_without_errors(text in valid_program()) {
         let parts = parse(&text);
         assert_well_formed(&text, &parts);
-        prop_assert!(parts.1.is_empty(), "{}", sinumerik::debug_dump(&parts));
+        prop_assert!(parts.errors().is_empty(), "{}", parts.debug_dump());
     }
 
     #[test]

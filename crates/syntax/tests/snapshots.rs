@@ -51,22 +51,17 @@ fn fixtures_cover_every_syntax_error() {
     for (_, text, dialect) in fixtures() {
         seen.extend(Parse::new(&text, dialect).errors().iter().map(|e| e.kind));
     }
-    // The Haas lathe grammar has its own fixtures, the manual's examples.
-    let haas = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("test_data/haas-lathe");
-    for entry in fs::read_dir(haas).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_some_and(|ext| ext == "nc") {
-            let text = fs::read_to_string(&path).unwrap();
-            seen.extend(Parse::new(&text, Dialect::HaasLathe).errors().iter().map(|e| e.kind));
-        }
-    }
-    // So has Sinumerik, which is no `Dialect` yet.
-    let sinumerik = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("test_data/sinumerik/constructs");
-    for entry in fs::read_dir(sinumerik).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_some_and(|ext| ext == "mpf") {
-            let text = fs::read_to_string(&path).unwrap();
-            seen.extend(ncc_syntax::sinumerik::parse_source_file(&text).1.iter().map(|e| e.kind));
+    // The Haas lathe and Sinumerik grammars have their own fixtures.
+    for (dir, extension, dialect) in [
+        ("test_data/haas-lathe", "nc", Dialect::HaasLathe),
+        ("test_data/sinumerik/constructs", "mpf", Dialect::Sinumerik),
+    ] {
+        for entry in fs::read_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(dir)).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|ext| ext == extension) {
+                let text = fs::read_to_string(&path).unwrap();
+                seen.extend(Parse::new(&text, dialect).errors().iter().map(|e| e.kind));
+            }
         }
     }
     let missing: Vec<_> = ncc_syntax::SyntaxErrorKind::ALL.iter().filter(|k| !seen.contains(k)).collect();

@@ -76,8 +76,8 @@ workspace="$out/workspace"
 cp -r "$repo/examples" "$workspace"
 # One error that ncc check reports.
 printf '%%1\nN10 G01 X- 5 F100\nN20 M30\n*\n' > "$workspace/milling/error.NCP"
-# A program in a dialect the server does not read.
-printf 'G0 X10 Z2\nM30\n' > "$workspace/MAIN.MPF"
+# A Sinumerik program with one syntax error.
+printf 'G0 X10 Z2\nR1=(5+2\nM30\n' > "$workspace/MAIN.MPF"
 # The extension gallery on a closed loopback port: nothing leaves the machine.
 export EXTENSIONS_GALLERY='{"serviceUrl":"http://127.0.0.1:9/gallery","itemUrl":"http://127.0.0.1:9/item"}'
 "$code_server" --user-data-dir "$out/user-data" --extensions-dir "$out/extensions" \

@@ -298,8 +298,8 @@ describe('the packaged extension in code-server', () => {
     );
   });
 
-  test('a Sinumerik program gets the note that ncc does not read it, and no error notification', async () => {
-    const note = 'ncc does not read Siemens Sinumerik programs yet';
+  test('a Sinumerik program gets its syntax error, and no error notification', async () => {
+    const note = '`(` is not closed by `)` on its line';
     await workbench.openFile('MAIN.MPF');
     // The mouse rests on the text, so that the workbench asks for a hover
     // too, besides what it asks for on opening (folding, symbols, tokens).
@@ -319,11 +319,11 @@ describe('the packaged extension in code-server', () => {
         const panel = document.querySelector<HTMLElement>('.markers-panel');
         return panel?.innerText.includes(text) ? panel.innerText : '';
       },
-      'the note in the Problems panel',
+      'the syntax error in the Problems panel',
       note,
     );
     await sleep(3000);
-    await workbench.screenshot('6-not-read');
+    await workbench.screenshot('6-sinumerik');
     await workbench.page.mouse.move(0, 0);
     assert.match(problems, /MAIN\.MPF/);
     // The language's name in the status bar.
@@ -334,7 +334,7 @@ describe('the packaged extension in code-server', () => {
     );
     // The language client's notice of a failed request ("Request
     // textDocument/semanticTokens/full failed. Message: …"): the server
-    // answers every request about MAIN.MPF empty.
+    // answers every request about MAIN.MPF.
     const failures = toasts.filter((toast) => /failed|is not open/.test(toast));
     assert.deepEqual(failures, [], 'no notification about the requests on MAIN.MPF');
   });

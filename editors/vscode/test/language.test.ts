@@ -83,16 +83,40 @@ describe('Haas lathe contribution', () => {
   });
 });
 
-describe('the control ncc does not read yet', () => {
-  test('Sinumerik main programs and subprograms, in either case', () => {
+describe('Sinumerik contribution', () => {
+  const sinumerik = (manifest.contributes.languages as Contribution[]).find((c) => c.id === 'sinumerik');
+
+  test('main programs and subprograms, in either case', () => {
     for (const file of ['MAIN.MPF', 'main.mpf', 'dir/SUB.SPF', 'sub.spf']) {
       assert.equal(languageOf(file), 'sinumerik', file);
     }
   });
 
-  test('has no grammar: no highlighting is claimed for it', () => {
-    const grammars = manifest.contributes.grammars.map((grammar: { language: string }) => grammar.language);
-    assert.ok(!grammars.includes('sinumerik'));
+  test('has a grammar and a configuration that exist', () => {
+    assert.ok(sinumerik?.configuration);
+    assert.ok(existsSync(path.join(root, sinumerik.configuration)));
+    const grammar = manifest.contributes.grammars.find((g: { language: string }) => g.language === 'sinumerik');
+    assert.equal(grammar.scopeName, 'source.sinumerik');
+    assert.ok(existsSync(path.join(root, grammar.path)));
+  });
+
+  test('comments a line with a semicolon; a word is a name, a system variable or a number', () => {
+    const configuration = JSON.parse(readFileSync(path.join(root, sinumerik?.configuration ?? ''), 'utf8'));
+    assert.deepEqual(configuration.comments, { lineComment: ';' });
+    const text = 'N10 G642 X=R1+5.5 $P_UIFR[1] CYCLE800(1) "TEXT" ; NOTE';
+    assert.deepEqual(text.match(wordPattern(configuration)), [
+      'N10',
+      'G642',
+      'X',
+      'R1',
+      '5.5',
+      '$P_UIFR',
+      '1',
+      'CYCLE800',
+      '1',
+      'TEXT',
+      'NOTE',
+    ]);
   });
 });
 

@@ -331,38 +331,29 @@ describe('a session with ncc lsp', () => {
     }
   });
 
-  test('a Sinumerik program gets the note that ncc does not read it yet', async () => {
-    const programs = [{ file: 'MAIN.MPF', dialect: 'sinumerik', title: 'Siemens Sinumerik', text: 'G0 X10 Z2\nM30\n' }];
-    for (const { file, dialect, title, text } of programs) {
-      // The language VS Code gives the file, which the client hands over.
-      const languageId = languageOf(file);
-      assert.equal(languageId, dialect, file);
-      assert.ok(DOCUMENT_SELECTOR.some((selector) => selector.scheme === 'file' && selector.language === languageId));
-      const program = pathToFileURL(path.join(scratch, 'programs', file)).href;
-      await connection.sendNotification(DidOpenTextDocumentNotification.type, {
-        textDocument: { uri: program, languageId, version: 1, text },
-      });
-      const opened = await diagnostics(`the note on ${file}`, (p) => p.uri === program && p.version === 1);
-      assert.deepEqual(opened.diagnostics, [
-        {
-          range: { start: { line: 0, character: 0 }, end: { line: 0, character: 0 } },
-          severity: DiagnosticSeverity.Information,
-          source: 'ncc',
-          message: `ncc does not read ${title} programs yet (dialect \`${dialect}\`)`,
-        },
-      ]);
-
-      // What the editor asks about the program comes back empty, not as an
-      // error the client would show.
-      const hover = await within(
-        `answer to hover on ${file}`,
-        connection.sendRequest(HoverRequest.type, {
-          textDocument: { uri: program },
-          position: { line: 0, character: 0 },
-        }),
-      );
-      assert.equal(hover, null, `hover on ${file}`);
-    }
+  test('a Sinumerik program gets its syntax errors and hover from the catalogue', async () => {
+    const file = 'MAIN.MPF';
+    // The language VS Code gives the file, which the client hands over.
+    const languageId = languageOf(file);
+    assert.equal(languageId, 'sinumerik', file);
+    assert.ok(DOCUMENT_SELECTOR.some((selector) => selector.scheme === 'file' && selector.language === languageId));
+    const program = pathToFileURL(path.join(scratch, 'programs', file)).href;
+    await connection.sendNotification(DidOpenTextDocumentNotification.type, {
+      textDocument: { uri: program, languageId, version: 1, text: 'G0 X10 Z2\nR1=(5+2\nM30\n' },
+    });
+    const opened = await diagnostics(`the findings on ${file}`, (p) => p.uri === program && p.version === 1);
+    assert.deepEqual(
+      opened.diagnostics.map((d) => [d.code, d.range.start]),
+      [['S029', { line: 1, character: 3 }]],
+    );
+    const hover = await within(
+      `answer to hover on ${file}`,
+      connection.sendRequest(HoverRequest.type, {
+        textDocument: { uri: program },
+        position: { line: 0, character: 0 },
+      }),
+    );
+    assert.match(JSON.stringify(hover), /G0 — /, `hover on ${file}`);
   });
 
   test('shutdown and exit end the server with status 0', async () => {

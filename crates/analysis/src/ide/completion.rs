@@ -16,7 +16,7 @@
 use ncc_catalog::{AddressRole, Catalogue, Code, Item};
 use ncc_syntax::{TextRange, TextSize};
 
-use super::{cnc8x6, haas_lathe};
+use super::{cnc8x6, haas_lathe, sinumerik};
 use crate::{
     Dialect,
     db::{Db, Settings, SourceFile},
@@ -78,6 +78,7 @@ pub(crate) fn completions(db: &dyn Db, file: SourceFile, offset: TextSize) -> Ve
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => cnc8x6::completion::completions(db, file, offset),
         Dialect::HaasLathe => haas_lathe::completion::completions(db, file, offset),
+        Dialect::Sinumerik => sinumerik::completions(db, file, offset),
     }
 }
 

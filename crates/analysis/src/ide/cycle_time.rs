@@ -173,12 +173,13 @@ impl Environment for WorkspaceFiles {
 }
 
 /// What a run of `file` needs; `None` for macrocycle and cycle files,
-/// which run only when a program calls them.
+/// which run only when a program calls them, and for a program the
+/// executor does not run (no time rather than a wrong one).
 pub(crate) fn run_input(db: &dyn Db, file: SourceFile) -> Option<RunInput> {
-    if model::file_kind(db, file) != FileKind::Program {
+    let settings = Settings::get(db);
+    if !nc_exec::run::interprets(*settings.dialect(db)) || model::file_kind(db, file) != FileKind::Program {
         return None;
     }
-    let settings = Settings::get(db);
     let mut files = WorkspaceFiles::default();
     for (&number, found) in model::macrocycles(db) {
         if let Some(first) = found.first() {

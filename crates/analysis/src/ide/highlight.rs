@@ -51,8 +51,19 @@ pub enum HighlightKind {
     Comment,
     /// `%`, `*`, the `$PC` of a fixed-cycle file and block skip `/`.
     Keyword,
-    /// `=` of an assignment, the sign before a parameter (`X-R1`).
+    /// `=` of an assignment, the sign before a parameter (`X-R1`); the
+    /// comparisons, `<<`, parentheses and the `:` of frames.
     Operator,
+    /// Sinumerik: a string `"…"`.
+    String,
+    /// Sinumerik: a jump label, where it is defined (`write: true`,
+    /// `LOOP1:`) or named by a jump (`GOTOF LOOP1`).
+    Label { write: bool },
+    /// Sinumerik: a command, cycle or subprogram called by name
+    /// (`CYCLE81`, `TRAORI`, `PROFIL`), and a `PROC`'s name.
+    Function,
+    /// Sinumerik: a system variable, `$P_UIFR`.
+    SystemVariable,
     /// Text the parser could not place (a syntax error covers it).
     Error,
 }
@@ -95,6 +106,21 @@ impl HighlightKind {
             HighlightKind::Error,
         ] {
             add(kind);
+        }
+        // The kinds of a language beyond addresses and codes.
+        if !catalogue.keywords.is_empty() {
+            for address in catalogue.addresses.iter().filter(|address| address.letter.len() > 1) {
+                add(HighlightKind::Address(address.role));
+            }
+            for kind in [
+                HighlightKind::String,
+                HighlightKind::Label { write: true },
+                HighlightKind::Label { write: false },
+                HighlightKind::Function,
+                HighlightKind::SystemVariable,
+            ] {
+                add(kind);
+            }
         }
         kinds
     }
@@ -224,6 +250,17 @@ impl Walk {
                 SyntaxKind::PROGRAM_NUMBER => self.program_number(node, range.start()),
                 SyntaxKind::VAR_REF => self.variable(node, range.start(), false),
                 SyntaxKind::ASSIGN => self.variable_assignment(node, range.start()),
+                SyntaxKind::NAME_REF => self.name(node, range.start(), false),
+                SyntaxKind::INDEX_EXPR => self.indexed(node, range.start(), false),
+                SyntaxKind::LABEL => self.nodes(node, range.start(), Some(HighlightKind::Label { write: true }), true),
+                SyntaxKind::BLOCK_NUMBER => self.nodes(node, range.start(), Some(HighlightKind::BlockNumber), true),
+                SyntaxKind::GOTO_STMT => self.jump(node, range.start()),
+                SyntaxKind::CALL_STMT => self.call(node, range.start()),
+                SyntaxKind::VAR_DECL => self.declared(node, range.start(), None),
+                SyntaxKind::PARAM => self.declared(node, range.start(), Some(SyntaxKind::TYPE)),
+                SyntaxKind::PROC_STMT | SyntaxKind::EXTERN_STMT | SyntaxKind::MACRO_DEF => {
+                    self.procedure(node, range.start())
+                }
                 SyntaxKind::BIN_EXPR | SyntaxKind::PREFIX_EXPR | SyntaxKind::CALL_EXPR => {
                     self.operation(node, range.start())
                 }
@@ -305,6 +342,8 @@ impl Walk {
         for (range, item) in items {
             match (kind(item.kind()), item) {
                 (SyntaxKind::WHITESPACE, _) => {}
+                // Sinumerik's `X=…`.
+                (SyntaxKind::EQ, _) => self.out.push(HighlightRange { range, kind: HighlightKind::Operator }),
                 (SyntaxKind::PARAM_REF, NodeOrToken::Node(node)) => {
                     if let Some(sign) = sign {
                         self.out[sign].kind = HighlightKind::Operator;
@@ -360,14 +399,161 @@ impl Walk {
         }
     }
 
-    /// `#1 = …`: the assigned variable, `=`, then the expression.
+    /// `#1 = …`, `R1=…`, `NAME[1]=…`: the assigned variable, `=`, then
+    /// the expression.
     fn variable_assignment(&mut self, node: &GreenNodeData, start: TextSize) {
         let mut assigned = false;
         for (range, item) in children(node, start) {
             match (kind(item.kind()), item) {
-                (SyntaxKind::VAR_REF, NodeOrToken::Node(target)) if !assigned => {
+                (target_kind, NodeOrToken::Node(target)) if !assigned => {
                     assigned = true;
-                    self.variable(target, range.start(), true);
+                    match target_kind {
+                        SyntaxKind::VAR_REF => self.variable(target, range.start(), true),
+                        SyntaxKind::PARAM_REF => {
+                            self.tokens(target, range.start(), HighlightKind::Parameter { write: true })
+                        }
+                        SyntaxKind::NAME_REF => self.name(target, range.start(), true),
+                        SyntaxKind::INDEX_EXPR => self.indexed(target, range.start(), true),
+                        _ => self.element(item, range, None, false),
+                    }
+                }
+                _ => self.element(item, range, None, false),
+            }
+        }
+    }
+
+    /// Every token of `node` as one item of `kind`.
+    fn tokens(&mut self, node: &GreenNodeData, start: TextSize, kind: HighlightKind) {
+        self.nodes(node, start, Some(kind), true);
+    }
+
+    /// A name used as a value or assigned: a system variable, a keyword
+    /// (`TRUE`), an address (`X`, `CR`), else a variable.
+    fn name(&mut self, node: &GreenNodeData, start: TextSize, write: bool) {
+        for (range, item) in children(node, start) {
+            match item {
+                NodeOrToken::Token(token) if matches!(kind(token.kind()), SyntaxKind::IDENT | SyntaxKind::LETTER) => {
+                    let highlight = self.name_kind(token.text(), write);
+                    self.push(range, highlight, false);
+                }
+                _ => self.element(item, range, None, false),
+            }
+        }
+    }
+
+    fn name_kind(&self, name: &str, write: bool) -> HighlightKind {
+        if name.starts_with('$') {
+            return HighlightKind::SystemVariable;
+        }
+        if self.catalogue.keyword(name).is_some() {
+            return HighlightKind::Keyword;
+        }
+        match self.catalogue.address(name) {
+            Some(address) if address.letter.len() > 1 => HighlightKind::Address(address.role),
+            Some(address) => letter_kind(self.catalogue, address.letter.as_bytes()[0], None),
+            None => HighlightKind::Parameter { write },
+        }
+    }
+
+    /// `A[1,2]`, `$P_UIFR[1,X,TR]`: the name, then the indices.
+    fn indexed(&mut self, node: &GreenNodeData, start: TextSize, write: bool) {
+        let mut named = false;
+        for (range, item) in children(node, start) {
+            match item {
+                NodeOrToken::Token(token)
+                    if !named && matches!(kind(token.kind()), SyntaxKind::IDENT | SyntaxKind::LETTER) =>
+                {
+                    named = true;
+                    let highlight = self.name_kind(token.text(), write);
+                    self.push(range, highlight, false);
+                }
+                NodeOrToken::Node(name) if !named && kind(name.kind()) == SyntaxKind::NAME_REF => {
+                    named = true;
+                    self.name(name, range.start(), write);
+                }
+                _ => self.element(item, range, None, false),
+            }
+        }
+    }
+
+    /// `GOTOF LABEL1`: the keyword, then the label its target names.
+    fn jump(&mut self, node: &GreenNodeData, start: TextSize) {
+        for (range, item) in children(node, start) {
+            match item {
+                NodeOrToken::Node(target) if kind(target.kind()) == SyntaxKind::NAME_REF => {
+                    self.tokens(target, range.start(), HighlightKind::Label { write: false });
+                }
+                _ => self.element(item, range, None, false),
+            }
+        }
+    }
+
+    /// A call by name: a code written as a word (`SOFT`, in its group), a
+    /// keyword (`MCALL`), or a command, cycle or subprogram; `L140` and
+    /// `M6` with arguments are subprograms.
+    fn call(&mut self, node: &GreenNodeData, start: TextSize) {
+        for (range, item) in children(node, start) {
+            match (kind(item.kind()), item) {
+                (SyntaxKind::IDENT, NodeOrToken::Token(token)) => {
+                    let highlight = self.called(token.text());
+                    self.push(range, highlight, false);
+                }
+                (SyntaxKind::LETTER | SyntaxKind::NUMBER, _) => self.push(range, HighlightKind::Function, true),
+                _ => self.element(item, range, None, false),
+            }
+        }
+    }
+
+    fn called(&mut self, name: &str) -> HighlightKind {
+        let catalogue = self.catalogue;
+        // A word code's letter is its group's.
+        if let Some(letter) = catalogue.word_code(name).and_then(|code| code.group.as_deref()?.bytes().next()) {
+            let group = catalogue.word_modal_group_index(name).and_then(|index| u8::try_from(index).ok());
+            return HighlightKind::Code { letter, group };
+        }
+        if catalogue.word_code(name).is_some() || catalogue.keyword(name).is_some() {
+            return HighlightKind::Keyword;
+        }
+        HighlightKind::Function
+    }
+
+    /// A declared variable or formal parameter: its name (the first name,
+    /// or the first after `after`) is assigned; the rest as it is.
+    fn declared(&mut self, node: &GreenNodeData, start: TextSize, after: Option<SyntaxKind>) {
+        let mut waiting = after.is_some();
+        let mut named = false;
+        for (range, item) in children(node, start) {
+            let item_kind = kind(item.kind());
+            match item {
+                NodeOrToken::Token(_)
+                    if !waiting && !named && matches!(item_kind, SyntaxKind::IDENT | SyntaxKind::LETTER) =>
+                {
+                    named = true;
+                    self.push(range, HighlightKind::Parameter { write: true }, false);
+                }
+                _ => {
+                    waiting &= Some(item_kind) != after;
+                    self.element(item, range, None, false);
+                }
+            }
+        }
+    }
+
+    /// `PROC NAME(…)`, `EXTERN NAME(…)`, `DEFINE NAME AS …`: the keyword,
+    /// the name, then the parameters and attributes, or the macro's text,
+    /// whose letters are addresses.
+    fn procedure(&mut self, node: &GreenNodeData, start: TextSize) {
+        let mut idents = 0;
+        for (range, item) in children(node, start) {
+            match (kind(item.kind()), item) {
+                (SyntaxKind::IDENT, _) => {
+                    idents += 1;
+                    let highlight = if idents == 2 { HighlightKind::Function } else { HighlightKind::Keyword };
+                    self.push(range, highlight, false);
+                }
+                (SyntaxKind::LETTER, NodeOrToken::Token(letter)) => {
+                    let highlight = letter_kind(self.catalogue, letter.text().as_bytes()[0], None);
+                    self.push(range, highlight, false);
                 }
                 _ => self.element(item, range, None, false),
             }
@@ -447,7 +633,21 @@ fn token_kind_of(token: SyntaxKind) -> Option<HighlightKind> {
         SyntaxKind::COMMENT | SyntaxKind::PREAMBLE | SyntaxKind::TRAILER | SyntaxKind::UNREAD => HighlightKind::Comment,
         SyntaxKind::NUMBER | SyntaxKind::PLUS | SyntaxKind::MINUS => HighlightKind::Number,
         SyntaxKind::PERCENT | SyntaxKind::STAR | SyntaxKind::SLASH => HighlightKind::Keyword,
-        SyntaxKind::EQ | SyntaxKind::L_BRACK | SyntaxKind::R_BRACK | SyntaxKind::COMMA => HighlightKind::Operator,
+        SyntaxKind::EQ
+        | SyntaxKind::L_BRACK
+        | SyntaxKind::R_BRACK
+        | SyntaxKind::COMMA
+        | SyntaxKind::L_PAREN
+        | SyntaxKind::R_PAREN
+        | SyntaxKind::COLON
+        | SyntaxKind::EQ_EQ
+        | SyntaxKind::NEQ
+        | SyntaxKind::LT
+        | SyntaxKind::LT_EQ
+        | SyntaxKind::GT
+        | SyntaxKind::GT_EQ
+        | SyntaxKind::CONCAT => HighlightKind::Operator,
+        SyntaxKind::STRING => HighlightKind::String,
         // `GOTO`, `WHILE`, `DO1`, `END1`.
         SyntaxKind::IDENT => HighlightKind::Keyword,
         // Letters outside words occur only in error nodes.

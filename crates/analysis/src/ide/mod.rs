@@ -15,6 +15,7 @@ mod haas_lathe;
 pub(crate) mod highlight;
 pub(crate) mod inlay;
 pub(crate) mod references;
+mod sinumerik;
 pub(crate) mod symbols;
 
 use ncc_catalog::{AddressRole, Item};
@@ -52,6 +53,7 @@ pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<H
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => hover_in_unit(db, file, offset),
         Dialect::HaasLathe => haas_lathe::hover(db, file, offset),
+        Dialect::Sinumerik => sinumerik::hover(db, file, offset),
     }
 }
 
@@ -60,6 +62,9 @@ pub(crate) fn goto_definition(db: &dyn Db, file: SourceFile, offset: TextSize) -
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => definition_in_unit(db, file, offset),
         Dialect::HaasLathe => haas_lathe::goto_definition(db, file, offset),
+        // Labels and subprograms are resolved by the program model, which
+        // Sinumerik does not have yet.
+        Dialect::Sinumerik => Vec::new(),
     }
 }
 
@@ -73,6 +78,7 @@ pub(crate) fn references(
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => references::references(db, file, offset, include_declaration),
         Dialect::HaasLathe => haas_lathe::references(db, file, offset, include_declaration),
+        Dialect::Sinumerik => Vec::new(),
     }
 }
 
@@ -81,6 +87,7 @@ pub(crate) fn document_symbols(db: &dyn Db, file: SourceFile) -> Vec<symbols::Do
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => symbols::document_symbols(db, file),
         Dialect::HaasLathe => haas_lathe::document_symbols(db, file),
+        Dialect::Sinumerik => sinumerik::document_symbols(db, file),
     }
 }
 
@@ -89,6 +96,7 @@ pub(crate) fn folding_ranges(db: &dyn Db, file: SourceFile) -> Vec<folding::Fold
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => folding::folding_ranges(db, file),
         Dialect::HaasLathe => haas_lathe::folding_ranges(db, file),
+        Dialect::Sinumerik => sinumerik::folding_ranges(db, file),
     }
 }
 
@@ -96,8 +104,9 @@ pub(crate) fn folding_ranges(db: &dyn Db, file: SourceFile) -> Vec<folding::Fold
 pub(crate) fn format(db: &dyn Db, file: SourceFile) -> Vec<TextEdit> {
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => format::format(file.text(db), file.parse(db)),
-        // No style is defined for Haas programs yet: formatting changes nothing.
-        Dialect::HaasLathe => Vec::new(),
+        // No style is defined for Haas or Sinumerik programs yet:
+        // formatting changes nothing.
+        Dialect::HaasLathe | Dialect::Sinumerik => Vec::new(),
     }
 }
 
@@ -107,7 +116,7 @@ pub(crate) fn inlay_hints(db: &dyn Db, file: SourceFile, range: Option<TextRange
         Dialect::Cnc8x6 => inlay::inlay_hints(db, file, range),
         // Parameter values are CNC8x6's; the cycle time's hints come from
         // the run, for every dialect.
-        Dialect::HaasLathe => Vec::new(),
+        Dialect::HaasLathe | Dialect::Sinumerik => Vec::new(),
     }
 }
 
@@ -118,7 +127,7 @@ pub(crate) fn states_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Vec<
         Dialect::Cnc8x6 => {
             block_index_at(db, file, offset).map(|index| flow::states_before(db, file, index)).unwrap_or_default()
         }
-        Dialect::HaasLathe => Vec::new(),
+        Dialect::HaasLathe | Dialect::Sinumerik => Vec::new(),
     }
 }
 

@@ -22,6 +22,9 @@ pub enum Syntax {
     /// toolpath in the lathe's ZX plane, Y written as Z and the surface's
     /// height left out, so that arcs in XY become arcs by I/K in ZX.
     HaasLathe,
+    /// Siemens Sinumerik: a `%_N_…_MPF` header, `N` on every block,
+    /// `;comments`, `M30`.
+    Sinumerik,
 }
 
 /// One step of the toolpath.
@@ -126,12 +129,14 @@ pub fn write(moves: &[Move], syntax: Syntax) -> String {
     match syntax {
         Syntax::Cnc8x6 => out.push_str("%1 \"SURFACING\"\n"),
         Syntax::HaasLathe => out.push_str("O1 (SURFACING)\n"),
+        Syntax::Sinumerik => out.push_str("%_N_SURFACING_MPF\n"),
         Syntax::Ngc => {}
     }
     let lathe = syntax == Syntax::HaasLathe;
     for m in moves {
         let block_start = out.len();
-        if syntax == Syntax::Cnc8x6 && !matches!(m, Move::Comment(_)) {
+        let numbered = matches!(syntax, Syntax::Cnc8x6 | Syntax::Sinumerik);
+        if numbered && !matches!(m, Move::Comment(_)) {
             n += 1;
             let _ = write!(out, "N{n} ");
         }
@@ -180,6 +185,9 @@ pub fn write(moves: &[Move], syntax: Syntax) -> String {
                 }
                 Syntax::Ngc | Syntax::HaasLathe => {
                     let _ = write!(out, "({text})");
+                }
+                Syntax::Sinumerik => {
+                    let _ = write!(out, "; {text}");
                 }
             },
             Move::End => out.push_str(if syntax == Syntax::Ngc { "M2" } else { "M30" }),

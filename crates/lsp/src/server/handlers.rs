@@ -9,9 +9,6 @@ use tower_lsp_server::ls_types as lsp;
 use super::{Snapshot, convert, semantic};
 
 pub(crate) fn capabilities() -> lsp::ServerCapabilities {
-    // Declared at initialize, before any program is open: the default
-    // dialect's letters and groups.
-    let dialect = Dialect::default();
     lsp::ServerCapabilities {
         position_encoding: Some(lsp::PositionEncodingKind::UTF16),
         text_document_sync: Some(lsp::TextDocumentSyncCapability::Options(lsp::TextDocumentSyncOptions {
@@ -37,7 +34,7 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
         folding_range_provider: Some(lsp::FoldingRangeProviderCapability::Simple(true)),
         semantic_tokens_provider: Some(lsp::SemanticTokensServerCapabilities::SemanticTokensOptions(
             lsp::SemanticTokensOptions {
-                legend: semantic::legend(dialect),
+                legend: semantic::legend(),
                 full: Some(lsp::SemanticTokensFullOptions::Bool(true)),
                 range: Some(true),
                 ..Default::default()

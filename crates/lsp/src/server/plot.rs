@@ -149,10 +149,15 @@ fn plot(job: Job) -> jsonrpc::Result<Value> {
             stopped: finding.stopped,
         })
         .collect();
-    let stop = ran.stop().map(|stop| {
-        let place = if stop.in_program { String::new() } else { format!("{} ", stop.file) };
-        format!("the run stopped at {place}line {}: {}", stop.line, stop.message)
-    });
+    let stop = match ran.stop() {
+        Some(stop) => {
+            let place = if stop.in_program { String::new() } else { format!("{} ", stop.file) };
+            Some(format!("the run stopped at {place}line {}: {}", stop.line, stop.message))
+        }
+        // Nothing to draw: the run's one finding says why.
+        None if !nc_exec::run::interprets(program.dialect) => ran.findings().next().map(|f| f.message.to_owned()),
+        None => None,
+    };
     let plotted = Plotted { svg: picture.svg, total_time_s: picture.total_time, findings, view: picture.view };
     let plotted = serde_json::to_value(plotted).map_err(|_| jsonrpc::Error::internal_error())?;
     match stop {

@@ -87,40 +87,23 @@
 mod lexer;
 mod parser;
 
-use rowan::GreenNode;
-
-pub use crate::line_blocks::Parts;
 use crate::{
-    SyntaxError, SyntaxErrorKind, SyntaxNode, TextEdit,
-    limit::Omitted,
+    Parse, SyntaxNode, TextEdit,
     line_blocks::{self, LineDialect},
 };
 
-/// Parses a whole program: the tree (every byte of the text), the syntax
-/// errors sorted by position, and the counts of those left out per line.
-pub fn parse_source_file(text: &str) -> Parts {
-    parser::parse_source_file(text)
-}
+pub(crate) use parser::parse_source_file;
 
 /// Parses `new_text`, the result of applying `edit` to the text of `old`,
 /// reusing every line the edit cannot have changed; `None` when the whole
-/// text must be parsed again. The result equals
-/// `parse_source_file(new_text)`.
-pub fn reparse_blocks(
-    old: (&GreenNode, &[SyntaxError], &[Omitted<SyntaxErrorKind>]),
-    edit: &TextEdit,
-    new_text: &str,
-) -> Option<Parts> {
+/// text must be parsed again. No edit is refused: nothing spans lines.
+pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Option<Parse> {
     let dialect = LineDialect {
         edit_ok: |_: &SyntaxNode| true,
         region_ok: |_: &SyntaxNode, _: &str| true,
         parse_blocks: parser::parse_blocks,
     };
-    line_blocks::reparse_line_blocks(old, edit, new_text, dialect)
-}
-
-/// The tree and the errors as text, for tests and `ncc parse`.
-pub fn debug_dump(parts: &Parts) -> String {
-    let (green, errors, omitted) = parts;
-    crate::debug_dump(green, errors, omitted)
+    let (green, errors, omitted) =
+        line_blocks::reparse_line_blocks((old.green(), old.errors(), old.omitted()), edit, new_text, dialect)?;
+    Some(Parse { green, errors: errors.into(), omitted: omitted.into(), dialect: old.dialect })
 }

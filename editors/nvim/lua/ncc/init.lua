@@ -5,8 +5,7 @@ local M = {}
 
 -- One filetype per control, named as ncc names its dialects. The server
 -- picks each file's dialect itself, from its name and its project's
--- ncc.toml, and of a program in a dialect it does not read yet it says so
--- in one diagnostic.
+-- ncc.toml.
 local filetypes = { "cnc8x6", "haas-lathe", "sinumerik" }
 
 local uv = vim.uv or vim.loop
