@@ -7,7 +7,7 @@
 //! a panic; `ERROR` nodes, which the parser reported, are left out.
 //!
 //! The tree leaves to this step what only the catalogue knows
-//! (`ncc_syntax::sinumerik`): whether `NAME=…` writes a multi-letter
+//! (the Sinumerik grammar of `ncc_syntax`): whether `NAME=…` writes a multi-letter
 //! address (`CR=10`) or a variable, and whether a bare name is a command
 //! (`TRAORI`, `BSPLINE`, `STOPRE`), a cycle (`CYCLE800`), a predefined
 //! procedure (`MSG`, `WRITE`) or a program. A block-only code that takes
@@ -19,7 +19,7 @@
 //! `'B101'` are hexadecimal and binary constants; `REPEAT start [end] P=n`
 //! repeats a program section; `M2` ends a main program like `M30`.
 
-use ncc_catalog::{AddressRole, Catalogue, DialectId, KeywordKind, Modality};
+use ncc_catalog::{AddressRole, Catalogue, Dialect, KeywordKind, Modality};
 use ncc_syntax::{Decimal, Sign, SyntaxKind, TextRange, TextSize};
 use rowan::{GreenNodeData, GreenTokenData, NodeOrToken};
 
@@ -502,7 +502,7 @@ const END_CODES: [(u64, ProgramEnd); 3] =
 impl SinumerikBlock {
     /// Lowers a `BLOCK` green node of the Sinumerik parser.
     pub fn lower(block: &GreenNodeData) -> SinumerikBlock {
-        let catalogue = DialectId::Sinumerik.catalogue();
+        let catalogue = Dialect::Sinumerik.catalogue();
         let mut data = SinumerikBlock { len: block.text_len(), ..SinumerikBlock::default() };
         let mut statements = Vec::new();
         for (range, child) in children(block, TextSize::from(0)) {

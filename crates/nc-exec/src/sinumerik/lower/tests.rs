@@ -1,12 +1,12 @@
 use expect_test::{Expect, expect};
-use ncc_syntax::sinumerik::parse_source_file;
+use ncc_syntax::Parse;
 use proptest::prelude::*;
 
 use super::*;
 
 pub(crate) fn lower_text(text: &str) -> Vec<SinumerikBlock> {
-    let (tree, _, _) = parse_source_file(text);
-    block_nodes(&tree).map(|(_, block)| SinumerikBlock::lower(block)).collect()
+    let parse = Parse::new(text, Dialect::Sinumerik);
+    block_nodes(parse.green()).map(|(_, block)| SinumerikBlock::lower(block)).collect()
 }
 
 /// A compact rendering: every operation in parentheses, places with their
