@@ -50,6 +50,9 @@
 //! - [`run`]: running a program on its machine into a [`run::Trace`] or a
 //!   sink, on a thread of its own or this one, from a checkpoint or the
 //!   start.
+//! - [`spline`]: rational B-spline curves (NURBS) over any axes, built
+//!   from the data a control programs them by: points, derivatives,
+//!   curvature, length, polylines within a chord tolerance.
 //! - [`trace`]: what a run produces and how it hands it on: steps,
 //!   findings and their rules, the sink and the checkpoints.
 //! - [`tool_path`]: the moves and positions of the tool centre, which
@@ -68,6 +71,7 @@ pub mod haas_lathe;
 pub mod known;
 pub mod machine;
 pub mod run;
+pub mod spline;
 pub mod tool_path;
 pub(crate) mod trace;
 pub(crate) mod transform;
