@@ -17,9 +17,10 @@
 //!
 //! - The curve starts at the start position (the current one) and ends at
 //!   the last programmed point: the knot vector is clamped (the first and
-//!   last degree + 1 knots equal). Siemens documents the start point and
-//!   the control points, not the knot vector; clamping is the standard
-//!   convention that makes the curve begin and end there (assumption).
+//!   last degree + 1 knots equal). Siemens documents that the programmed
+//!   points are control points the curve passes near, not the knot
+//!   vector; clamping is the standard convention that makes the curve
+//!   begin and end at its end points (assumption).
 //! - Degree: SD, 3 when not programmed (Siemens documentation). With fewer
 //!   points than degree + 1 the degree is lowered to the points less one,
 //!   the highest a clamped curve through them can have (assumption): two
@@ -30,19 +31,20 @@
 //!   everywhere ([`SplineError::Weight`]).
 //! - Knot spacing: Siemens documents that the control computes it unless
 //!   PL gives the parameter interval lengths, in path units, and not how.
-//!   Here each point's parameter interval is its PL or, when not
-//!   programmed, its distance from the point before (chord length, the
-//!   usual choice and the spec's; assumption). The inner knots are the
+//!   Here a point's PL is the interval from the point before to it, and a
+//!   point without PL takes its distance from the point before (chord
+//!   length, the usual choice; assumption). The inner knots are the
 //!   averages of degree successive point parameters (Piegl & Tiller eq.
 //!   9.8, their choice for curves fitted through points), the count a
 //!   clamped curve needs whatever the degree: equal intervals h give inner
 //!   knots h apart and end spans (degree + 1)·h/2 long. The parameter runs
 //!   in path units from 0 to the sum of the intervals.
 //! - A point at the position of the point before it adds no motion and is
-//!   dropped, its weight replacing the earlier one's (assumption): the
-//!   programs that repeat the start position as the first control point
-//!   then make the same curve as those that do not, instead of one that
-//!   stands still at its start with a cusp of infinite curvature there.
+//!   dropped, its weight (when programmed) replacing the earlier one's
+//!   (assumption): programs that repeat the start position as the first
+//!   control point then make the same curve as those that do not, instead
+//!   of one that stands still at its start with a cusp of infinite
+//!   curvature there.
 
 use nalgebra::SVector;
 use smallvec::{SmallVec, smallvec};
@@ -115,7 +117,8 @@ pub enum SplineError {
     Position { point: usize },
     /// A weight is not a positive finite number.
     Weight { point: usize, weight: f64 },
-    /// A parameter interval is not a positive finite number.
+    /// A parameter interval is not a positive finite number, or the
+    /// intervals add up beyond the floating-point range.
     Interval { point: usize, length: f64 },
     /// There are not as many weights as points.
     WeightCount { points: usize, weights: usize },
@@ -179,7 +182,7 @@ impl<const D: usize> Spline<D> {
         if let Some(point) = points.iter().position(|point| !point.iter().all(|x| x.is_finite())) {
             return Err(SplineError::Position { point });
         }
-        if let Some(point) = weights.iter().position(|&weight| !valid_length(weight)) {
+        if let Some(point) = weights.iter().position(|&weight| !positive_finite(weight)) {
             return Err(SplineError::Weight { point, weight: weights[point] });
         }
         let last = points.len();
@@ -216,15 +219,16 @@ impl<const D: usize> Spline<D> {
         let mut points = vec![SVector::from(start)];
         let mut weights = vec![1.0];
         let mut intervals = Vec::new();
+        let mut total = 0.0;
         for (index, control) in programmed.iter().enumerate() {
             if !control.position.iter().all(|x| x.is_finite()) {
                 return Err(SplineError::Position { point: index });
             }
             let weight = control.weight.unwrap_or(1.0);
-            if !valid_length(weight) {
+            if !positive_finite(weight) {
                 return Err(SplineError::Weight { point: index, weight });
             }
-            if let Some(length) = control.interval.filter(|&length| !valid_length(length)) {
+            if let Some(length) = control.interval.filter(|&length| !positive_finite(length)) {
                 return Err(SplineError::Interval { point: index, length });
             }
             let position = SVector::from(control.position);
@@ -234,12 +238,19 @@ impl<const D: usize> Spline<D> {
                 return Err(SplineError::Position { point: index });
             }
             if chord <= COINCIDENT * position.amax().max(before.amax()).max(1.0) {
-                *weights.last_mut().expect("the start is a point") = weight;
+                if control.weight.is_some() {
+                    *weights.last_mut().expect("the start is a point") = weight;
+                }
                 continue;
+            }
+            let interval = control.interval.unwrap_or(chord);
+            total += interval;
+            if !total.is_finite() {
+                return Err(SplineError::Interval { point: index, length: interval });
             }
             points.push(position);
             weights.push(weight);
-            intervals.push(control.interval.unwrap_or(chord));
+            intervals.push(interval);
         }
         let degree = degree.unwrap_or(3).min(points.len() - 1);
         let knots = averaged_knots(&intervals, degree);
@@ -463,7 +474,7 @@ impl<const D: usize> Spline<D> {
     }
 }
 
-fn valid_length(value: f64) -> bool {
+fn positive_finite(value: f64) -> bool {
     value.is_finite() && value > 0.0
 }
 

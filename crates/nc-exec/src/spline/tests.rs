@@ -187,6 +187,10 @@ fn repeating_the_start_position_makes_the_same_curve() {
     let weighted: Vec<_> =
         std::iter::once(ControlPoint { position: start, weight: Some(2.0), interval: None }).chain(points).collect();
     assert_eq!(Spline::programmed(start, &weighted, None).unwrap().weights()[0], 2.0);
+    // A repeat without a weight keeps the one programmed before.
+    let heavy = ControlPoint { weight: Some(3.0), ..points[0] };
+    let twice = Spline::programmed(start, &[heavy, points[0], points[1]], None).unwrap();
+    assert_eq!(twice.weights(), [1.0, 3.0, 1.0]);
     assert!(without.spans().iter().all(|span| span.max_curvature.is_finite()));
 }
 
@@ -215,6 +219,10 @@ fn bad_data_is_an_error_naming_its_point() {
     assert_eq!(build(&[at, weighted(-1.0)]), Err(SplineError::Weight { point: 1, weight: -1.0 }));
     assert!(matches!(build(&[weighted(f64::NAN)]), Err(SplineError::Weight { point: 0, .. })));
     assert_eq!(build(&[at, interval(0.0)]), Err(SplineError::Interval { point: 1, length: 0.0 }));
+    assert_eq!(
+        build(&[ControlPoint { interval: Some(f64::MAX), ..at }, interval(f64::MAX)]),
+        Err(SplineError::Interval { point: 1, length: f64::MAX })
+    );
     assert_eq!(build(&[at, ControlPoint::at([f64::NAN, 0.0])]), Err(SplineError::Position { point: 1 }));
     assert_eq!(Spline::programmed([f64::INFINITY, 0.0], &[at], None), Err(SplineError::Start));
     assert_eq!(build(&[ControlPoint::at([f64::MAX, 0.0]), at]), Err(SplineError::Position { point: 0 }));
