@@ -55,6 +55,9 @@
 //!   [`sinumerik::lower`] (blocks as plain data, read from the syntax tree
 //!   and the catalogue) and [`sinumerik::program`] (labels, block numbers,
 //!   control structures, declarations, jumps and calls of a file).
+//! - [`spline`]: rational B-spline curves (NURBS) over any axes, built
+//!   from the data a control programs them by: points, derivatives,
+//!   curvature, length, polylines within a chord tolerance.
 //! - [`trace`]: what a run produces and how it hands it on: steps,
 //!   findings and their rules, the sink and the checkpoints.
 //! - [`tool_path`]: the moves and positions of the tool centre, which
@@ -75,6 +78,7 @@ pub mod known;
 pub mod machine;
 pub mod run;
 pub mod sinumerik;
+pub mod spline;
 pub mod tool_path;
 pub(crate) mod trace;
 pub(crate) mod transform;
