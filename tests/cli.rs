@@ -1320,7 +1320,7 @@ fn sinumerik_programs_are_checked_and_not_run_yet() {
     assert!(stdout(&output).contains("LABEL@"), "{}", stdout(&output));
     let output = ncc(&["lower", clean]);
     assert_eq!(output.status.code(), Some(2));
-    assert!(stderr(&output).contains("the executor does not read Siemens Sinumerik programs yet"));
+    assert!(stderr(&output).contains("`ncc lower` does not print Siemens Sinumerik blocks yet"));
 }
 
 #[test]

@@ -15,7 +15,7 @@ use std::{
     process::Command,
 };
 
-use ncc_analysis::{AnalysisHost, Config, CycleTimeHints, DialectId, TextSize};
+use ncc_analysis::{AnalysisHost, Config, CycleTimeHints, Dialect, TextSize};
 use ncc_catalog::macrocycle_number;
 use ncc_syntax::encoding;
 
@@ -45,7 +45,7 @@ fn corpus() -> Vec<PathBuf> {
                 let path = entry.unwrap().path();
                 if path.is_dir() {
                     stack.push(path);
-                } else if DialectId::by_default_for(&path).is_some() {
+                } else if Dialect::by_default_for(&path).is_some() {
                     programs.push(path.strip_prefix(&root).unwrap().to_owned());
                 }
             }
@@ -126,11 +126,7 @@ fn analysis_outputs(out: &mut String, program: &Path) {
     let path = root.join(program);
     let text = read(&path).unwrap();
     // Every file of the corpus has a dialect by its name.
-    let dialect = DialectId::by_default_for(&path).expect("the corpus holds programs only");
-    let Some(dialect) = dialect.implementation() else {
-        writeln!(out, "== analysis: {}", dialect.not_read()).unwrap();
-        return;
-    };
+    let dialect = Dialect::by_default_for(&path).expect("the corpus holds programs only");
     let mut host = AnalysisHost::in_dialect(dialect, config_for(&path));
     for other in neighbours(&path) {
         let name = other.strip_prefix(&root).unwrap().display().to_string();

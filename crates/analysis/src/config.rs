@@ -66,7 +66,6 @@ use nc_exec::{
     cnc8x6::tables::{self, Finding},
     haas_lathe::offsets,
 };
-use ncc_catalog::DialectId;
 use ncc_syntax::{Dialect, Severity};
 use serde::Deserialize;
 
@@ -113,35 +112,35 @@ pub struct Config {
 #[derive(Debug, Clone, PartialEq, Eq, Hash, Default)]
 pub struct Dialects {
     /// The dialect of every program, when the project names one.
-    pub dialect: Option<DialectId>,
+    pub dialect: Option<Dialect>,
     /// Dialects by file extension (without the dot, any case), before the
     /// defaults.
-    pub extensions: BTreeMap<String, DialectId>,
+    pub extensions: BTreeMap<String, Dialect>,
 }
 
 impl Dialects {
     /// The dialect the name of the file at `path` gives: its extension as
     /// `[extensions]` maps it, else by default; `None` for a file that is
     /// no program by its name.
-    pub fn by_name(&self, path: &Path) -> Option<DialectId> {
+    pub fn by_name(&self, path: &Path) -> Option<Dialect> {
         let mapped = || {
             let extension = path.extension()?.to_str()?;
             self.extensions.iter().find(|(known, _)| known.eq_ignore_ascii_case(extension)).map(|(_, &dialect)| dialect)
         };
-        mapped().or_else(|| DialectId::by_default_for(path))
+        mapped().or_else(|| Dialect::by_default_for(path))
     }
 
     /// The dialect of a file found in a directory, `None` when it is no
     /// program by its name: `forced` (`--dialect`), else the project's,
     /// else the one its name gives.
-    pub fn of_found(&self, path: &Path, forced: Option<DialectId>) -> Option<DialectId> {
+    pub fn of_found(&self, path: &Path, forced: Option<Dialect>) -> Option<Dialect> {
         self.by_name(path).map(|by_name| forced.or(self.dialect).unwrap_or(by_name))
     }
 
     /// The dialect of a program given by name: as a found one's, and
     /// CNC8x6 for a name that says nothing.
-    pub fn of_given(&self, path: &Path, forced: Option<DialectId>) -> DialectId {
-        forced.or(self.dialect).or_else(|| self.by_name(path)).unwrap_or(DialectId::Cnc8x6)
+    pub fn of_given(&self, path: &Path, forced: Option<Dialect>) -> Dialect {
+        forced.or(self.dialect).or_else(|| self.by_name(path)).unwrap_or_default()
     }
 }
 
@@ -162,9 +161,9 @@ impl Default for ReportConfig {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields, rename_all = "kebab-case")]
 struct ConfigFile {
-    dialect: Option<DialectId>,
+    dialect: Option<Dialect>,
     #[serde(default)]
-    extensions: BTreeMap<String, DialectId>,
+    extensions: BTreeMap<String, Dialect>,
     #[serde(default)]
     rules: BTreeMap<String, Level>,
     #[serde(default)]
@@ -493,7 +492,7 @@ impl Config {
             report: file.report,
             // The machine's control is the project's dialect when this
             // build reads it; the machine's keys are read in its terms.
-            machine: MachineConfig::of_control(file.dialect.and_then(DialectId::implementation).unwrap_or_default()),
+            machine: MachineConfig::of_control(file.dialect.unwrap_or_default()),
         };
         if let Some(unknown) = config.rules.keys().find(|key| crate::Rule::find(key).is_none()) {
             return Err(format!("{origin}: [rules] names no rule `{unknown}` (see `ncc rules`)"));

@@ -27,8 +27,9 @@ impl Rule {
     /// Every rule: the parser's syntax diagnostics, every dialect's checks,
     /// the report limits, then the executor's.
     pub fn all() -> impl Iterator<Item = &'static Rule> {
-        let checks =
-            Dialect::all().flat_map(|dialect| check_rules(dialect).iter().flat_map(|rules| rules.iter().copied()));
+        let checks = Dialect::ALL
+            .into_iter()
+            .flat_map(|dialect| check_rules(dialect).iter().flat_map(|rules| rules.iter().copied()));
         diagnostic::syntax_rules().chain(checks).chain(findings::RULES.iter().copied()).chain(diagnostic::run_rules())
     }
 

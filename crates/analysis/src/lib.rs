@@ -23,7 +23,6 @@ use std::sync::Arc;
 pub(crate) use nc_exec::cnc8x6::lower;
 /// What the flow walk may not know.
 pub use nc_exec::known::Known;
-pub use ncc_catalog::DialectId;
 use ncc_syntax::Parse;
 pub use ncc_syntax::{Dialect, Severity, TextEdit, TextRange, TextSize};
 pub use salsa::Cancelled;

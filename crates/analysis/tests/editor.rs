@@ -6,8 +6,8 @@ mod strategies;
 
 use expect_test::{Expect, expect};
 use ncc_analysis::{
-    Analysis, AnalysisHost, Config, Dialect, DialectId, DocumentSymbol, FileId, HighlightKind, RootDatabase, TextEdit,
-    TextRange, TextSize,
+    Analysis, AnalysisHost, Config, Dialect, DocumentSymbol, FileId, HighlightKind, RootDatabase, TextEdit, TextRange,
+    TextSize,
 };
 use proptest::prelude::*;
 use strategies::{block_program, crowded_lines, overlong_lines, program_text};
@@ -58,11 +58,8 @@ N3 G70
 /// one of them has `$0`.
 /// A host in the dialect the first file's name gives, with the files.
 fn setup(files: &[(&str, &str)]) -> (AnalysisHost, Vec<FileId>, Option<(FileId, TextSize)>) {
-    let dialect = files
-        .first()
-        .and_then(|(path, _)| DialectId::by_default_for(std::path::Path::new(path)))
-        .and_then(DialectId::implementation)
-        .unwrap_or_default();
+    let dialect =
+        files.first().and_then(|(path, _)| Dialect::by_default_for(std::path::Path::new(path))).unwrap_or_default();
     let mut host = AnalysisHost::in_dialect(dialect, Config::default());
     let mut cursor = None;
     let mut ids = Vec::new();

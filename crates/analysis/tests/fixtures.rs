@@ -22,7 +22,7 @@
 use std::{fmt::Write, fs, path::PathBuf};
 
 use nc_exec::run::{Called, Environment};
-use ncc_analysis::{AnalysisHost, Config, Diagnostic, Dialect, DialectId, Rule, TextRange};
+use ncc_analysis::{AnalysisHost, Config, Diagnostic, Dialect, Rule, TextRange};
 
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
 struct Expected {
@@ -35,7 +35,7 @@ struct Expected {
 /// The dialect a fixture's program is in, by its file name; `None` for
 /// files of no dialect this build reads.
 fn dialect_of(path: &std::path::Path) -> Option<Dialect> {
-    DialectId::by_default_for(path).and_then(DialectId::implementation)
+    Dialect::by_default_for(path)
 }
 
 /// What starts a line comment in `dialect`, where annotations are written.

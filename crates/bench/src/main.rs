@@ -22,14 +22,14 @@ use std::{
 
 use anyhow::Context;
 use clap::{Parser, Subcommand, ValueEnum};
-use ncc_analysis::DialectId;
+use ncc_analysis::Dialect;
 use ncc_bench::{
     cnc8x6::progen::{self, Move, Syntax},
     edits::{self, Lcg},
     lsp_client::{self, Client, Document},
     rs274,
 };
-use ncc_syntax::{Dialect, Parse};
+use ncc_syntax::Parse;
 use serde_json::{Value, json};
 
 /// mimalloc, counting the bytes in use and their peak.
@@ -190,19 +190,8 @@ enum Command {
 #[derive(clap::Args)]
 struct DialectArg {
     /// The dialect's name.
-    #[arg(long = "dialect", value_name = "NAME", default_value_t = DialectId::from(Dialect::default()))]
-    id: DialectId,
-}
-
-impl DialectArg {
-    /// The dialect's implementation; for a dialect this build does not
-    /// read, the message and exit status 2.
-    fn implementation(&self) -> Dialect {
-        self.id.implementation().unwrap_or_else(|| {
-            eprintln!("error: {}", self.id.not_read());
-            std::process::exit(2)
-        })
-    }
+    #[arg(long = "dialect", value_name = "NAME", default_value_t = Dialect::default())]
+    id: Dialect,
 }
 
 /// The toolpath `moves` as a program of `dialect`.
@@ -221,7 +210,7 @@ fn generated_program(dialect: Dialect, blocks: usize) -> String {
 
 /// The name of the generated program's file: the dialect's extension.
 fn program_file_name(dialect: Dialect) -> String {
-    let extension = DialectId::from(dialect).default_extensions().first().copied().unwrap_or_default();
+    let extension = dialect.default_extensions().first().copied().unwrap_or_default();
     format!("surface.{extension}")
 }
 
@@ -245,26 +234,26 @@ enum SyntaxArg {
 
 fn main() -> anyhow::Result<()> {
     match Cli::parse().command {
-        Command::Parse { dialect, blocks, runs } => parse_benchmark(dialect.implementation(), blocks, runs.max(1)),
-        Command::Reparse { dialect, blocks, edits } => reparse_benchmark(dialect.implementation(), blocks, edits),
-        Command::Check { dialect, blocks } => check_benchmark(dialect.implementation(), blocks),
+        Command::Parse { dialect, blocks, runs } => parse_benchmark(dialect.id, blocks, runs.max(1)),
+        Command::Reparse { dialect, blocks, edits } => reparse_benchmark(dialect.id, blocks, edits),
+        Command::Check { dialect, blocks } => check_benchmark(dialect.id, blocks),
         Command::Lsp { server, dialect, blocks, edits, json } => {
-            let dialect = dialect.implementation();
+            let dialect = dialect.id;
             lsp_benchmark(&server.map_or_else(ncc_beside_bench, Ok)?, dialect, blocks, edits, json)
         }
         Command::LspMemory { server, dialect, blocks, edits, sample_every, pause_every, json } => {
-            let dialect = dialect.implementation();
+            let dialect = dialect.id;
             lsp_memory::run(
                 &server.map_or_else(ncc_beside_bench, Ok)?,
                 &lsp_memory::Options { dialect, blocks, edits, sample_every, pause_every, json },
             )
         }
         Command::Exec { ncc, dialect, blocks, runs, json } => {
-            let dialect = dialect.implementation();
+            let dialect = dialect.id;
             exec_benchmark(&ncc.map_or_else(ncc_beside_bench, Ok)?, dialect, blocks, runs.max(1), json)
         }
         Command::ParseFile { path, dialect, threads, gcode } => {
-            let dialect = dialect.implementation();
+            let dialect = dialect.id;
             let text = std::fs::read_to_string(&path)?;
             let start = Instant::now();
             if gcode {
@@ -351,7 +340,7 @@ fn parse_benchmark(dialect: Dialect, blocks: usize, runs: usize) -> anyhow::Resu
     let single = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     println!(
         "parse benchmark: {blocks} blocks; {} {:.1} MB, gcode reads {peer_input}, {:.1} MB; best of {runs} runs",
-        DialectId::from(dialect).title(),
+        dialect.title(),
         cnc.len() as f64 / 1e6,
         ngc.len() as f64 / 1e6
     );

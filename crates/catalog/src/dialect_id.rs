@@ -1,4 +1,4 @@
-//! The controls ncc knows by name, and which files are whose by default.
+//! The controls' languages by name, and which files are whose by default.
 //!
 //! One contract for the command line (`--dialect`), `ncc.toml` (`dialect`,
 //! `[extensions]`) and the language server: a program's dialect is the one
@@ -8,125 +8,84 @@ use std::{fmt, path::Path, str::FromStr};
 
 use crate::Dialect;
 
-/// A control language by its name, whether or not this build reads it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum DialectId {
-    /// MEFI CNC836 / CNC846 / CNC856.
-    Cnc8x6,
-    /// A Haas lathe, classic control (Fanuc-style ISO).
-    HaasLathe,
-    /// Siemens Sinumerik.
-    Sinumerik,
-}
-
-impl DialectId {
-    pub const ALL: [DialectId; 3] = [DialectId::Cnc8x6, DialectId::HaasLathe, DialectId::Sinumerik];
+impl Dialect {
+    /// Every dialect, in the registry's order: what tests and benchmarks
+    /// that hold for every dialect go over.
+    pub const ALL: [Dialect; 3] = [Dialect::Cnc8x6, Dialect::HaasLathe, Dialect::Sinumerik];
 
     /// The name users write.
     pub fn name(self) -> &'static str {
         match self {
-            DialectId::Cnc8x6 => "cnc8x6",
-            DialectId::HaasLathe => "haas-lathe",
-            DialectId::Sinumerik => "sinumerik",
+            Dialect::Cnc8x6 => "cnc8x6",
+            Dialect::HaasLathe => "haas-lathe",
+            Dialect::Sinumerik => "sinumerik",
         }
     }
 
     /// The control's name as people know it.
     pub fn title(self) -> &'static str {
         match self {
-            DialectId::Cnc8x6 => "CNC8x6",
-            DialectId::HaasLathe => "Haas lathe",
-            DialectId::Sinumerik => "Siemens Sinumerik",
-        }
-    }
-
-    /// The dialect's implementation, when this build has one.
-    pub fn implementation(self) -> Option<Dialect> {
-        match self {
-            DialectId::Cnc8x6 => Some(Dialect::Cnc8x6),
-            DialectId::HaasLathe => Some(Dialect::HaasLathe),
-            DialectId::Sinumerik => Some(Dialect::Sinumerik),
+            Dialect::Cnc8x6 => "CNC8x6",
+            Dialect::HaasLathe => "Haas lathe",
+            Dialect::Sinumerik => "Siemens Sinumerik",
         }
     }
 
     /// The file extensions of the dialect's programs, by default.
     pub fn default_extensions(self) -> &'static [&'static str] {
         match self {
-            DialectId::Cnc8x6 => &["NCP"],
-            DialectId::HaasLathe => &["nc", "tap"],
-            DialectId::Sinumerik => &["MPF", "SPF"],
+            Dialect::Cnc8x6 => &["NCP"],
+            Dialect::HaasLathe => &["nc", "tap"],
+            Dialect::Sinumerik => &["MPF", "SPF"],
         }
     }
 
     /// The dialect a file's name gives by default: its extension (any case),
     /// a CNC8x6 macrocycle file name `L<number>`, or a Haas program file
     /// `O<number>` without an extension, as the control stores programs.
-    pub fn by_default_for(path: &Path) -> Option<DialectId> {
+    pub fn by_default_for(path: &Path) -> Option<Dialect> {
         let by_extension = path.extension().and_then(|extension| {
             let extension = extension.to_str()?;
-            DialectId::ALL
+            Dialect::ALL
                 .into_iter()
                 .find(|dialect| dialect.default_extensions().iter().any(|known| known.eq_ignore_ascii_case(extension)))
         });
         let bare = || path.extension().is_none().then_some(path);
         by_extension
-            .or_else(|| macrocycle_number(path).map(|_| DialectId::Cnc8x6))
-            .or_else(|| bare().and_then(program_file_number).map(|_| DialectId::HaasLathe))
-    }
-
-    /// The message for a program of a dialect this build does not read.
-    pub fn not_read(self) -> String {
-        format!("ncc does not read {} programs yet (dialect `{}`)", self.title(), self.name())
+            .or_else(|| macrocycle_number(path).map(|_| Dialect::Cnc8x6))
+            .or_else(|| bare().and_then(program_file_number).map(|_| Dialect::HaasLathe))
     }
 }
 
-impl From<Dialect> for DialectId {
-    fn from(dialect: Dialect) -> DialectId {
-        match dialect {
-            Dialect::Cnc8x6 => DialectId::Cnc8x6,
-            Dialect::HaasLathe => DialectId::HaasLathe,
-            Dialect::Sinumerik => DialectId::Sinumerik,
-        }
-    }
-}
-
-impl Dialect {
-    /// Every dialect this build reads, in the registry's order: what tests
-    /// and benchmarks that hold for every dialect go over.
-    pub fn all() -> impl Iterator<Item = Dialect> {
-        DialectId::ALL.into_iter().filter_map(DialectId::implementation)
-    }
-}
-
-impl fmt::Display for DialectId {
+impl fmt::Display for Dialect {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
     }
 }
 
-/// A dialect name that is none of [`DialectId::ALL`].
+/// A dialect name that is none of [`Dialect::ALL`].
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct UnknownDialect(pub String);
 
 impl fmt::Display for UnknownDialect {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let names: Vec<&str> = DialectId::ALL.iter().map(|dialect| dialect.name()).collect();
+        let names: Vec<&str> = Dialect::ALL.iter().map(|dialect| dialect.name()).collect();
         write!(f, "unknown dialect `{}` (known: {})", self.0, names.join(", "))
     }
 }
 
 impl std::error::Error for UnknownDialect {}
 
-impl FromStr for DialectId {
+impl FromStr for Dialect {
     type Err = UnknownDialect;
 
-    fn from_str(name: &str) -> Result<DialectId, UnknownDialect> {
-        DialectId::ALL.into_iter().find(|dialect| dialect.name() == name).ok_or_else(|| UnknownDialect(name.to_owned()))
+    fn from_str(name: &str) -> Result<Dialect, UnknownDialect> {
+        Dialect::ALL.into_iter().find(|dialect| dialect.name() == name).ok_or_else(|| UnknownDialect(name.to_owned()))
     }
 }
 
-impl<'de> serde::Deserialize<'de> for DialectId {
-    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<DialectId, D::Error> {
+impl<'de> serde::Deserialize<'de> for Dialect {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Dialect, D::Error> {
         let name = String::deserialize(deserializer)?;
         name.parse().map_err(serde::de::Error::custom)
     }
@@ -155,11 +114,11 @@ mod tests {
 
     #[test]
     fn names_read_back() {
-        for dialect in DialectId::ALL {
+        for dialect in Dialect::ALL {
             assert_eq!(dialect.name().parse(), Ok(dialect));
         }
         assert_eq!(
-            "fanuc".parse::<DialectId>().unwrap_err().to_string(),
+            "fanuc".parse::<Dialect>().unwrap_err().to_string(),
             "unknown dialect `fanuc` (known: cnc8x6, haas-lathe, sinumerik)"
         );
     }
@@ -167,25 +126,25 @@ mod tests {
     #[test]
     fn file_names_give_a_dialect_by_default() {
         let cases = [
-            ("a.NCP", Some(DialectId::Cnc8x6)),
-            ("b.ncp", Some(DialectId::Cnc8x6)),
-            ("L9001", Some(DialectId::Cnc8x6)),
-            ("dir/L12.NCP", Some(DialectId::Cnc8x6)),
-            ("O1234.nc", Some(DialectId::HaasLathe)),
-            ("O1234.NC", Some(DialectId::HaasLathe)),
-            ("part.tap", Some(DialectId::HaasLathe)),
-            ("O01234", Some(DialectId::HaasLathe)),
-            ("dir/O1", Some(DialectId::HaasLathe)),
+            ("a.NCP", Some(Dialect::Cnc8x6)),
+            ("b.ncp", Some(Dialect::Cnc8x6)),
+            ("L9001", Some(Dialect::Cnc8x6)),
+            ("dir/L12.NCP", Some(Dialect::Cnc8x6)),
+            ("O1234.nc", Some(Dialect::HaasLathe)),
+            ("O1234.NC", Some(Dialect::HaasLathe)),
+            ("part.tap", Some(Dialect::HaasLathe)),
+            ("O01234", Some(Dialect::HaasLathe)),
+            ("dir/O1", Some(Dialect::HaasLathe)),
             ("O123456", None),
             ("Oil", None),
-            ("MAIN.MPF", Some(DialectId::Sinumerik)),
-            ("cycle.spf", Some(DialectId::Sinumerik)),
+            ("MAIN.MPF", Some(Dialect::Sinumerik)),
+            ("cycle.spf", Some(Dialect::Sinumerik)),
             ("README.md", None),
             ("Lx1", None),
             ("NCP", None),
         ];
         for (name, dialect) in cases {
-            assert_eq!(DialectId::by_default_for(Path::new(name)), dialect, "{name}");
+            assert_eq!(Dialect::by_default_for(Path::new(name)), dialect, "{name}");
         }
     }
 }

@@ -15,14 +15,14 @@ pub mod schema;
 use std::{collections::HashMap, ops::RangeInclusive, sync::OnceLock};
 
 pub use crate::{
-    dialect_id::{DialectId, UnknownDialect, macrocycle_number, program_file_number},
+    dialect_id::{UnknownDialect, macrocycle_number, program_file_number},
     explain::{Item, NotFound},
     schema::*,
 };
 
 /// The programming language of a control. Matches on it are exhaustive on
 /// purpose: adding a dialect makes the compiler list every place to extend.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
 pub enum Dialect {
     /// MEFI CNC836 / CNC846 / CNC856.
     #[default]

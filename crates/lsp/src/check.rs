@@ -8,7 +8,7 @@ use std::{
 };
 
 use indicatif::{ParallelProgressIterator, ProgressBar, ProgressStyle};
-use ncc_analysis::{AnalysisHost, Config, Dialect, DialectId, Dialects, Severity};
+use ncc_analysis::{AnalysisHost, Config, Dialect, Dialects, Severity};
 pub(crate) use ncc_catalog::macrocycle_number;
 use ncc_syntax::{encoding, visible};
 use rayon::prelude::*;
@@ -75,7 +75,7 @@ fn special_kind(kind: std::fs::FileType) -> &'static str {
 }
 
 /// A workspace: the `ncc.toml` of a project, and a dialect.
-type Workspace = (Option<PathBuf>, DialectId);
+type Workspace = (Option<PathBuf>, Dialect);
 
 /// Below this many files a run is quick enough not to need a progress bar.
 const PROGRESS_BAR_MIN_FILES: usize = 200;
@@ -132,18 +132,16 @@ impl Projects {
     }
 }
 
-/// The implementation of the dialect of a program given by name (see
-/// [`Dialects::of_given`]), or why there is none.
-pub(crate) fn dialect_for(projects: &mut Projects, path: &Path, forced: Option<DialectId>) -> Result<Dialect, String> {
-    let dialect = projects.dialects(Some(path)).of_given(path, forced);
-    dialect.implementation().ok_or_else(|| format!("{}: {}", shown_path(path), dialect.not_read()))
+/// The dialect of a program given by name (see [`Dialects::of_given`]).
+pub(crate) fn dialect_for(projects: &mut Projects, path: &Path, forced: Option<Dialect>) -> Dialect {
+    projects.dialects(Some(path)).of_given(path, forced)
 }
 
-pub(crate) fn run(paths: &[PathBuf], format: Format, forced: Option<DialectId>) -> ExitCode {
+pub(crate) fn run(paths: &[PathBuf], format: Format, forced: Option<Dialect>) -> ExitCode {
     let mut projects = Projects::default();
-    let Found { files, mut failures, not_read } = collect_files(paths, &mut projects, forced);
+    let Found { files, mut failures } = collect_files(paths, &mut projects, forced);
     let progress = progress_bar(files.len());
-    let read: Vec<Result<(PathBuf, DialectId, String), String>> = files
+    let read: Vec<Result<(PathBuf, Dialect, String), String>> = files
         .par_iter()
         .map(|(path, dialect)| {
             read_program(path)
@@ -165,8 +163,6 @@ pub(crate) fn run(paths: &[PathBuf], format: Format, forced: Option<DialectId>) 
     let mut checked = Vec::new();
     let mut sources = HashMap::new();
     for ((config_path, dialect), programs) in workspaces {
-        // Only dialects with an implementation are collected.
-        let Some(dialect) = dialect.implementation() else { continue };
         let config = match projects.config(config_path.as_deref()) {
             Ok(config) => config.clone(),
             Err(message) => {
@@ -218,10 +214,6 @@ pub(crate) fn run(paths: &[PathBuf], format: Format, forced: Option<DialectId>) 
     }
     for failure in &failures {
         eprintln!("error: {}", visible::escaped(failure));
-    }
-    for (dialect, count) in not_read {
-        let files = if count == 1 { "file" } else { "files" };
-        eprintln!("note: {count} {files} skipped: {}", dialect.not_read());
     }
     exit_code(&checked, &failures)
 }
@@ -281,21 +273,17 @@ pub(crate) fn macrocycles_beside(programs: &[(PathBuf, String)]) -> Vec<(PathBuf
 /// What [`collect_files`] found.
 pub(crate) struct Found {
     /// The programs to read, sorted, with their dialect.
-    pub files: Vec<(PathBuf, DialectId)>,
+    pub files: Vec<(PathBuf, Dialect)>,
     /// Why paths cannot be looked at.
     pub failures: Vec<String>,
-    /// Programs found in directories whose dialect this build does not
-    /// read, counted by dialect.
-    pub not_read: BTreeMap<DialectId, usize>,
 }
 
 /// The programs to check: explicit files as given, and in directories the
 /// files that are programs of a dialect by their project's configuration or
-/// their name. An explicit file of a dialect this build does not read is a
-/// failure; found ones are counted. Reading a file that is not a regular
-/// one fails later, saying what it is.
-pub(crate) fn collect_files(paths: &[PathBuf], projects: &mut Projects, forced: Option<DialectId>) -> Found {
-    let mut found = Found { files: Vec::new(), failures: Vec::new(), not_read: BTreeMap::new() };
+/// their name. Reading a file that is not a regular one fails later, saying
+/// what it is.
+pub(crate) fn collect_files(paths: &[PathBuf], projects: &mut Projects, forced: Option<Dialect>) -> Found {
+    let mut found = Found { files: Vec::new(), failures: Vec::new() };
     for path in paths {
         let metadata = match std::fs::metadata(path) {
             Ok(metadata) => metadata,
@@ -305,22 +293,14 @@ pub(crate) fn collect_files(paths: &[PathBuf], projects: &mut Projects, forced: 
             }
         };
         if !metadata.is_dir() {
-            let dialect = projects.dialects(Some(path)).of_given(path, forced);
-            match dialect.implementation() {
-                Some(_) => found.files.push((path.clone(), dialect)),
-                None => found.failures.push(format!("{}: {}", path.display(), dialect.not_read())),
-            }
+            found.files.push((path.clone(), projects.dialects(Some(path)).of_given(path, forced)));
             continue;
         }
         for entry in ignore::WalkBuilder::new(path).build() {
             match entry {
                 Ok(entry) if entry.file_type().is_some_and(|t| t.is_file()) => {
-                    match projects.dialects(Some(entry.path())).of_found(entry.path(), forced) {
-                        Some(dialect) if dialect.implementation().is_some() => {
-                            found.files.push((entry.into_path(), dialect))
-                        }
-                        Some(dialect) => *found.not_read.entry(dialect).or_default() += 1,
-                        None => {}
+                    if let Some(dialect) = projects.dialects(Some(entry.path())).of_found(entry.path(), forced) {
+                        found.files.push((entry.into_path(), dialect));
                     }
                 }
                 Ok(_) => {}

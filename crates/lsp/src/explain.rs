@@ -2,7 +2,7 @@
 
 use std::process::ExitCode;
 
-use ncc_catalog::{Catalogue, Dialect, DialectId};
+use ncc_catalog::{Catalogue, Dialect};
 
 /// Explains `query` in `dialect`'s catalogue (the default dialect's when
 /// none is named: a query names no program to take one from).
@@ -24,7 +24,7 @@ pub(crate) fn run(query: Option<&str>, list: bool, dialect: Option<Dialect>) -> 
             eprintln!(
                 "error: `{}` is not a code, address, parameter, machine constant or operation of {}",
                 not_found.query,
-                DialectId::from(dialect).title()
+                dialect.title()
             );
             if !not_found.suggestions.is_empty() {
                 eprintln!("help: did you mean {}?", not_found.suggestions.join(", "));

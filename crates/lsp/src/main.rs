@@ -14,7 +14,7 @@ mod server;
 use std::{path::PathBuf, process::ExitCode};
 
 use clap::{Parser, Subcommand};
-use ncc_analysis::DialectId;
+use ncc_analysis::Dialect;
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
@@ -45,7 +45,7 @@ struct Cli {
     /// The dialect of every program read, whatever its name and project
     /// say: cnc8x6, haas-lathe or sinumerik.
     #[arg(long, global = true, value_name = "NAME")]
-    dialect: Option<DialectId>,
+    dialect: Option<Dialect>,
     #[command(subcommand)]
     command: Command,
 }
@@ -58,8 +58,7 @@ enum Command {
     /// macrocycle files `L<number>`, `*.MPF`, `*.SPF`, `*.nc` and `*.tap`;
     /// see `[extensions]` in ncc.toml), honouring `.gitignore`. Exit status:
     /// 0 when no error or warning was found, 1 when one was, 2 when a path
-    /// or an `ncc.toml` could not be read or a program named on the command
-    /// line is in a dialect this version does not read.
+    /// or an `ncc.toml` could not be read.
     Check {
         /// Files or directories to check.
         #[arg(default_value = ".")]
@@ -180,15 +179,9 @@ enum Command {
 
 fn main() -> ExitCode {
     let Cli { dialect, command } = Cli::parse();
-    if let Some(unread) = dialect.filter(|dialect| dialect.implementation().is_none()) {
-        eprintln!("error: {}", unread.not_read());
-        return ExitCode::from(2);
-    }
     match command {
         Command::Check { paths, format } => check::run(&paths, format, dialect),
-        Command::Explain { query, list } => {
-            explain::run(query.as_deref(), list, dialect.and_then(DialectId::implementation))
-        }
+        Command::Explain { query, list } => explain::run(query.as_deref(), list, dialect),
         Command::Rules { query, markdown } => rules::run(query.as_deref(), markdown),
         Command::Lsp { version: true, .. } => {
             println!("ncc {}", env!("CARGO_PKG_VERSION"));

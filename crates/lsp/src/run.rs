@@ -24,7 +24,7 @@ use nc_exec::{
     run::{Axes, Called, Environment, Message, MessageDisplay, Motion, Step, Stop, Totals, Trace, expected_blocks},
     velocity::{self, Dynamics, Timer, Timing, TimingSink},
 };
-use ncc_analysis::{Config, Dialect, DialectId, Rule, Severity, Suppressions, WorkspaceFiles, clock};
+use ncc_analysis::{Config, Dialect, Rule, Severity, Suppressions, WorkspaceFiles, clock};
 use ncc_syntax::{BlockParser, Parse, TextSize, ast::AstNode, visible};
 use serde::Serialize;
 
@@ -86,14 +86,10 @@ fn read(path: &Path) -> Result<String, ExitCode> {
 }
 
 /// Runs `command` on the program at `path` with the `ncc.toml` found for
-/// it; a program that cannot be read, or is in a dialect this version does
-/// not read, is exit status 2.
-fn on_program(path: &Path, dialect: Option<DialectId>, command: impl FnOnce(&Program<'_>) -> ExitCode) -> ExitCode {
+/// it; a program that cannot be read is exit status 2.
+fn on_program(path: &Path, dialect: Option<Dialect>, command: impl FnOnce(&Program<'_>) -> ExitCode) -> ExitCode {
     let mut projects = check::Projects::default();
-    let dialect = match check::dialect_for(&mut projects, path, dialect) {
-        Ok(dialect) => dialect,
-        Err(error) => return config_error(error),
-    };
+    let dialect = check::dialect_for(&mut projects, path, dialect);
     let text = match read(path) {
         Ok(text) => text,
         Err(code) => return code,
@@ -296,7 +292,7 @@ pub(crate) enum Progress {
     Hidden,
 }
 
-pub(crate) fn run(path: &Path, dialect: Option<DialectId>, format: Format, step_budget: usize) -> ExitCode {
+pub(crate) fn run(path: &Path, dialect: Option<Dialect>, format: Format, step_budget: usize) -> ExitCode {
     on_program(path, dialect, |program| run_program(program, path, format, step_budget))
 }
 
@@ -344,7 +340,7 @@ fn run_program(program: &Program<'_>, path: &Path, format: Format, step_budget: 
 /// to `output` or stdout, each block as its move comes: a run of any length
 /// expands in the same memory. A move the program cannot express stops the
 /// writing; the output file is then removed.
-pub(crate) fn expand(path: &Path, dialect: Option<DialectId>, output: Option<&Path>, step_budget: usize) -> ExitCode {
+pub(crate) fn expand(path: &Path, dialect: Option<Dialect>, output: Option<&Path>, step_budget: usize) -> ExitCode {
     on_program(path, dialect, |program| expand_program(program, path, output, step_budget))
 }
 
@@ -430,7 +426,7 @@ fn open_output(output: Option<&Path>) -> Option<(io::BufWriter<Box<dyn io::Write
 /// `max_moves` moves, a lathe's in `view`.
 pub(crate) fn plot(
     path: &Path,
-    dialect: Option<DialectId>,
+    dialect: Option<Dialect>,
     output: &Path,
     step_budget: usize,
     max_moves: usize,
@@ -474,15 +470,15 @@ impl crate::plot::Lines for Ran {
 
 /// The program at `path` parsed in its dialect; the error is the exit code
 /// after the message is printed.
-fn parsed(path: &Path, dialect: Option<DialectId>) -> Result<(String, Parse), ExitCode> {
-    let dialect = check::dialect_for(&mut check::Projects::default(), path, dialect).map_err(config_error)?;
+fn parsed(path: &Path, dialect: Option<Dialect>) -> Result<(String, Parse), ExitCode> {
+    let dialect = check::dialect_for(&mut check::Projects::default(), path, dialect);
     let text = read(path)?;
     let parse = Parse::new(&text, dialect);
     Ok((text, parse))
 }
 
 /// `ncc parse FILE`: the lossless syntax tree.
-pub(crate) fn parse(path: &Path, dialect: Option<DialectId>) -> ExitCode {
+pub(crate) fn parse(path: &Path, dialect: Option<Dialect>) -> ExitCode {
     match parsed(path, dialect) {
         Ok((_, parse)) => {
             print!("{}", parse.debug_dump());
@@ -493,7 +489,7 @@ pub(crate) fn parse(path: &Path, dialect: Option<DialectId>) -> ExitCode {
 }
 
 /// `ncc lower FILE`: each block as the executor reads it, after its line.
-pub(crate) fn lower(path: &Path, dialect: Option<DialectId>) -> ExitCode {
+pub(crate) fn lower(path: &Path, dialect: Option<Dialect>) -> ExitCode {
     let (text, parse) = match parsed(path, dialect) {
         Ok(parsed) => parsed,
         Err(code) => return code,
@@ -514,8 +510,8 @@ pub(crate) fn lower(path: &Path, dialect: Option<DialectId>) -> ExitCode {
             }
         }
         Dialect::Sinumerik => {
-            let title = DialectId::from(parse.dialect()).title();
-            eprintln!("error: {}: the executor does not read {title} programs yet", path.display());
+            let title = parse.dialect().title();
+            eprintln!("error: {}: `ncc lower` does not print {title} blocks yet", path.display());
             return ExitCode::from(2);
         }
     }

@@ -9,7 +9,7 @@
 
 use std::{sync::mpsc, thread::Scope};
 
-use ncc_catalog::{Dialect, DialectId};
+use ncc_catalog::Dialect;
 use ncc_syntax::{TextRange, TextSize};
 
 use crate::{cnc8x6, haas_lathe, machine::MachineConfig, transform::Frame, velocity::Dynamics};
@@ -140,7 +140,7 @@ fn not_run(text: &str, machine: &MachineConfig) -> Trace {
     let start = text.len() - text.trim_start().len();
     let end = text[start..].find(['\r', '\n']).map_or(text.len(), |length| start + length);
     let range = TextRange::new(TextSize::new(start as u32), TextSize::new(end as u32));
-    let message = format!("the executor does not run {} programs yet", DialectId::from(machine.control).title());
+    let message = format!("the executor does not run {} programs yet", machine.control.title());
     Trace {
         axes: machine.step_axes().to_vec(),
         diameter_axis: machine.diameter_axis,

@@ -30,7 +30,7 @@ proptest! {
 
     #[test]
     fn any_string_round_trips(text in any::<String>()) {
-        for dialect in Dialect::all() {
+        for dialect in Dialect::ALL.into_iter() {
             assert_well_formed(&text, &Parse::new(&text, dialect));
         }
     }
@@ -65,7 +65,7 @@ proptest! {
 
     #[test]
     fn program_like_text_round_trips(text in prop_oneof![program_text(), crowded_lines(), overlong_lines()]) {
-        for dialect in Dialect::all() {
+        for dialect in Dialect::ALL.into_iter() {
             assert_well_formed(&text, &Parse::new(&text, dialect));
         }
     }
@@ -103,7 +103,7 @@ proptest! {
         );
         let mut new_text = text.clone();
         edit.apply(&mut new_text);
-        for dialect in Dialect::all() {
+        for dialect in Dialect::ALL.into_iter() {
             let incremental = Parse::new(&text, dialect).reparse(&edit, &new_text);
             prop_assert_eq!(incremental, Parse::new(&new_text, dialect));
         }

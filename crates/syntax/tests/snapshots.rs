@@ -5,11 +5,10 @@
 
 use std::{fs, path::PathBuf};
 
-use ncc_catalog::DialectId;
 use ncc_syntax::{Dialect, Parse, TextEdit, TextRange, TextSize};
 
 fn dialect_of(path: &std::path::Path) -> Option<Dialect> {
-    DialectId::by_default_for(path).and_then(DialectId::implementation)
+    Dialect::by_default_for(path)
 }
 
 /// The fixtures with their text and dialect.

@@ -54,7 +54,8 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
 /// codes', the call targets' (`L`; `P`, `Q`) and the parameters' (`R`, `#`).
 fn trigger_characters() -> Vec<String> {
     let roles = [AddressRole::Function, AddressRole::Label, AddressRole::Parameter];
-    let mut letters: Vec<String> = Dialect::all()
+    let mut letters: Vec<String> = Dialect::ALL
+        .into_iter()
         .flat_map(|dialect| dialect.catalogue().addresses.iter())
         .filter(|address| roles.contains(&address.role))
         .map(|address| address.letter.clone())

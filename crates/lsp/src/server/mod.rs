@@ -24,7 +24,7 @@ mod semantic;
 mod workspace;
 
 use std::{
-    collections::{HashMap, HashSet},
+    collections::HashMap,
     path::PathBuf,
     process::ExitCode,
     sync::{
@@ -33,9 +33,7 @@ use std::{
     },
 };
 
-use ncc_analysis::{
-    Analysis, Cancelled, CycleTimeHints, Diagnostic, Dialect, DialectId, FileId, Findings, TextRange, TextSize,
-};
+use ncc_analysis::{Analysis, Cancelled, CycleTimeHints, Diagnostic, Dialect, FileId, Findings, TextRange, TextSize};
 use tokio::sync::mpsc;
 use tower_lsp_server::{
     Client, LanguageServer, LspService,
@@ -61,7 +59,7 @@ pub(crate) enum LogLevel {
 }
 
 /// Serves the protocol; `dialect`, when given, is every document's.
-pub(crate) fn run(log_level: LogLevel, dialect: Option<DialectId>) -> ExitCode {
+pub(crate) fn run(log_level: LogLevel, dialect: Option<Dialect>) -> ExitCode {
     let level = match log_level {
         LogLevel::Error => tracing::Level::ERROR,
         LogLevel::Warn => tracing::Level::WARN,
@@ -132,9 +130,6 @@ struct Document {
 struct State {
     workspaces: Workspaces,
     documents: HashMap<Uri, Document>,
-    /// Open documents in a dialect this build does not read: their one
-    /// diagnostic says so, and every request about them has an empty answer.
-    unread: HashSet<Uri>,
     /// `ncc.cycleTime.inlayHints`.
     cycle_hints: CycleTimeHints,
     refresh: cycle_time::Refresh,
@@ -181,7 +176,7 @@ struct Snapshot {
 }
 
 impl Server {
-    fn new(client: Client, shut_down: Arc<AtomicBool>, dialect: Option<DialectId>) -> Server {
+    fn new(client: Client, shut_down: Arc<AtomicBool>, dialect: Option<Dialect>) -> Server {
         let (publisher, publications) = mpsc::unbounded_channel();
         tokio::spawn(publish(client.clone(), publications));
         let state = Arc::new(Mutex::new(State { workspaces: Workspaces::new(dialect), ..State::default() }));
@@ -195,33 +190,28 @@ impl Server {
         lock(&self.state)
     }
 
-    /// A snapshot of `uri`'s document; `None` for one in a dialect this
-    /// build does not read.
-    fn snapshot(&self, uri: &Uri) -> jsonrpc::Result<Option<Snapshot>> {
+    /// A snapshot of `uri`'s document.
+    fn snapshot(&self, uri: &Uri) -> jsonrpc::Result<Snapshot> {
         let state = self.state();
-        if state.unread.contains(uri) {
-            return Ok(None);
-        }
         let document =
             state.documents.get(uri).ok_or_else(|| invalid_params(format!("{} is not open", uri.as_str())))?;
-        Ok(Some(Snapshot {
+        Ok(Snapshot {
             analysis: state.workspaces.get(document.workspace).analysis(),
             file: document.file,
             map: document.map.clone(),
             uri: uri.clone(),
             cycle: cycle_time::View::of(&document.cycle),
             cycle_hints: state.cycle_hints,
-        }))
+        })
     }
 
-    /// Runs `query` on a snapshot of `uri`'s document on the blocking pool;
-    /// a document in a dialect this build does not read has nothing to say.
-    async fn query<T: Send + Default + 'static>(
+    /// Runs `query` on a snapshot of `uri`'s document on the blocking pool.
+    async fn query<T: Send + 'static>(
         &self,
         uri: &Uri,
         query: impl FnOnce(&Snapshot) -> T + Send + 'static,
     ) -> jsonrpc::Result<T> {
-        let Some(snapshot) = self.snapshot(uri)? else { return Ok(T::default()) };
+        let snapshot = self.snapshot(uri)?;
         let task =
             tokio::task::spawn_blocking(move || Cancelled::catch(std::panic::AssertUnwindSafe(|| query(&snapshot))));
         match task.await {
@@ -442,22 +432,8 @@ impl LanguageServer for Server {
         let document = params.text_document;
         let errors = {
             let mut state = self.state();
-            let (workspace, dialect, file, errors) = match state.workspaces.open(&document.uri, document.text) {
-                Opened::Analysed { index, dialect, file, errors } => (index, dialect, file, errors),
-                Opened::NotRead(dialect) => {
-                    state.unread.insert(document.uri.clone());
-                    drop(state);
-                    // One finding at the start says why nothing else is said.
-                    let diagnostic = lsp::Diagnostic {
-                        severity: Some(lsp::DiagnosticSeverity::INFORMATION),
-                        source: Some("ncc".to_owned()),
-                        message: dialect.not_read(),
-                        ..lsp::Diagnostic::default()
-                    };
-                    let _ = self.publisher.send((document.uri, vec![diagnostic], document.version));
-                    return;
-                }
-            };
+            let Opened { index: workspace, dialect, file, errors } =
+                state.workspaces.open(&document.uri, document.text);
             let map = LineMap::new(state.workspaces.get(workspace).analysis().text(file));
             let (flow, cycle) = Default::default();
             let version = document.version;
@@ -480,9 +456,7 @@ impl LanguageServer for Server {
             let mut guard = self.state();
             let state = &mut *guard;
             let Some(document) = state.documents.get_mut(&uri) else {
-                if !state.unread.contains(&uri) {
-                    tracing::warn!("change of {} which is not open", uri.as_str());
-                }
+                tracing::warn!("change of {} which is not open", uri.as_str());
                 return;
             };
             let host = state.workspaces.host_mut(document.workspace);
@@ -515,7 +489,6 @@ impl LanguageServer for Server {
         let uri = params.text_document.uri;
         {
             let mut state = self.state();
-            state.unread.remove(&uri);
             if let Some(document) = state.documents.remove(&uri) {
                 state.workspaces.close(document.workspace, &uri, document.file);
             }

@@ -110,7 +110,7 @@ mod tests {
 
     #[test]
     fn every_kind_has_a_type_and_groups_fit_the_modifier_bits() {
-        for dialect in Dialect::all() {
+        for dialect in Dialect::ALL.into_iter() {
             kinds_fit_the_legend(dialect);
         }
     }

@@ -7,7 +7,7 @@ use std::{
     path::{Path, PathBuf},
 };
 
-use ncc_analysis::{AnalysisHost, Config, Dialect, DialectId, FileId, NavigationTarget};
+use ncc_analysis::{AnalysisHost, Config, Dialect, FileId, NavigationTarget};
 use tower_lsp_server::ls_types::{self as lsp, Uri};
 
 use super::convert::LineMap;
@@ -16,7 +16,7 @@ use crate::check;
 #[derive(Debug, Default)]
 pub(crate) struct Workspaces {
     /// The dialect of every document, when the server was started with one.
-    forced_dialect: Option<DialectId>,
+    forced_dialect: Option<Dialect>,
     /// Each project's configuration, read once, or the one the client named
     /// for every document.
     projects: check::Projects,
@@ -44,17 +44,17 @@ fn document_path(uri: &Uri) -> (String, Option<PathBuf>) {
     }
 }
 
-/// What opening a document gave.
-pub(crate) enum Opened {
-    /// The document is analysed in `dialect` as `file` of workspace
-    /// `index`; `errors` are about files read on the way.
-    Analysed { index: usize, dialect: Dialect, file: FileId, errors: Vec<String> },
-    /// The document is in a dialect this version does not read.
-    NotRead(DialectId),
+/// What opening a document gave: it is analysed in `dialect` as `file` of
+/// workspace `index`; `errors` are about files read on the way.
+pub(crate) struct Opened {
+    pub index: usize,
+    pub dialect: Dialect,
+    pub file: FileId,
+    pub errors: Vec<String>,
 }
 
 impl Workspaces {
-    pub fn new(forced_dialect: Option<DialectId>) -> Workspaces {
+    pub fn new(forced_dialect: Option<Dialect>) -> Workspaces {
         Workspaces { forced_dialect, ..Workspaces::default() }
     }
 
@@ -78,7 +78,7 @@ impl Workspaces {
     /// The `ncc.toml` that applies to the program at `path` and its
     /// dialect (a document that is no file, `untitled:`, has the default
     /// one).
-    fn project_of(&mut self, path: Option<&Path>) -> (Option<PathBuf>, DialectId) {
+    fn project_of(&mut self, path: Option<&Path>) -> (Option<PathBuf>, Dialect) {
         let dialect = self.projects.dialects(path).of_given(path.unwrap_or(Path::new("")), self.forced_dialect);
         (self.projects.config_path(path), dialect)
     }
@@ -104,11 +104,9 @@ impl Workspaces {
         self.list.len() - 1
     }
 
-    /// Adds a file read from disk unless its workspace has it, or its
-    /// dialect is one this version does not read.
+    /// Adds a file read from disk unless its workspace has it.
     fn add_from_disk(&mut self, path: &Path, errors: &mut Vec<String>) {
         let (config_path, dialect) = self.project_of(Some(path));
-        let Some(dialect) = dialect.implementation() else { return };
         let index = self.workspace_for(config_path, dialect, errors);
         let workspace = &mut self.list[index];
         let name = path.display().to_string();
@@ -144,10 +142,7 @@ impl Workspaces {
         let (name, path) = document_path(uri);
         let mut errors = Vec::new();
         let (config_path, dialect) = self.project_of(path.as_deref());
-        let Some(implementation) = dialect.implementation() else {
-            return Opened::NotRead(dialect);
-        };
-        let index = self.workspace_for(config_path, implementation, &mut errors);
+        let index = self.workspace_for(config_path, dialect, &mut errors);
         if let Some(path) = &path {
             let beside = check::macrocycles_beside(&[(path.clone(), String::new())]);
             for (macrocycle, _) in beside {
@@ -167,7 +162,7 @@ impl Workspaces {
             }
         };
         workspace.uris.insert(file, uri.clone());
-        Opened::Analysed { index, dialect: implementation, file, errors }
+        Opened { index, dialect, file, errors }
     }
 
     /// Closes a document: the file on disk takes its place again, or the
