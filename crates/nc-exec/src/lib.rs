@@ -47,6 +47,8 @@
 //! - [`known`]: values a static reading may not know.
 //! - [`machine`]: the machine a program runs on (its control, axes, rates,
 //!   limits, constants and tables).
+//! - `ramp`: how fast the path speed may change (acceleration and jerk:
+//!   linear ramps or S-curves), for both velocity planners.
 //! - [`run`]: running a program on its machine into a [`run::Trace`] or a
 //!   sink, on a thread of its own or this one, from a checkpoint or the
 //!   start.
@@ -67,6 +69,7 @@ pub mod expand;
 pub mod haas_lathe;
 pub mod known;
 pub mod machine;
+pub(crate) mod ramp;
 pub mod run;
 pub mod tool_path;
 pub(crate) mod trace;

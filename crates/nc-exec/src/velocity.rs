@@ -4,8 +4,21 @@
 //! [`Dynamics`] (for CNC8x6, `cnc8x6::dynamics`) and the [`Terms`] its
 //! reasons are told in.
 //!
-//! Every move ramps linearly (trapezoids). A junction between two moves is
-//! smooth or a stop ([`stop_reason`]):
+//! Every move ramps linearly (trapezoids), or, where the control limits
+//! the jerk ([`Dynamics::jerk`]) and the step asks for it
+//! ([`Step::jerk_limited`]), along S-curves: the acceleration rises and
+//! falls at the jerk limit, so that a change of speed by Δv takes
+//! 2·sqrt(Δv/J) where it stays below the acceleration A (Δv ≤ A²/J) and
+//! Δv/A + A/J where it reaches it, over the mean speed times that time
+//! (the closed forms are in `ramp`). Every ramp the model computes takes
+//! the move's profile: the time and distance to change speed, the speed a
+//! move can still stop from within itself, the peak a short move reaches
+//! (found by bisection under a jerk limit, where the distance is no longer
+//! a quadratic in the speed) and so the profile a step reports. A rest to
+//! rest move of length L at feed F with F > A²/J takes F/A + A/J + L/F
+//! when it reaches F; with no jerk limit, F/A + L/F.
+//!
+//! A junction between two moves is smooth or a stop ([`stop_reason`]):
 //!
 //! * smooth only between two working-feed moves where the second is
 //!   programmed for a continuous path and the control joins such moves
@@ -48,6 +61,7 @@ pub use crate::envelope::Profile;
 use crate::{
     envelope::{Envelope, EnvelopeMove, Limit, MoveKind, Planned, Planner},
     machine::MachineConfig,
+    ramp::Ramp,
     trace::{Axes, Checkpoint, MAX_AXES, Motion, Path, PathMode, Step, StepSink, Trace, shift_count, shift_range},
 };
 
@@ -113,6 +127,10 @@ pub struct Dynamics {
     /// How fast the spindle changes its speed, in rpm/s; infinite where it
     /// is taken to follow at once.
     pub spindle_acceleration: f64,
+    /// The jerk limit of the ramps in mm/s³ for the steps that ask for it
+    /// ([`Step::jerk_limited`]); `None` ramps linearly (no jerk limit).
+    /// The envelope planner takes its ramps from its own sets instead.
+    pub jerk: Option<f64>,
     /// A look-ahead planner over many moves, for controls that have one: it
     /// plans the moves instead of the one-block look-ahead.
     pub envelope: Option<Envelope>,
@@ -400,7 +418,7 @@ struct Move {
     /// The programmed speed, and the speed the move may run at.
     programmed: f64,
     cruise: f64,
-    acceleration: f64,
+    ramp: Ramp,
     /// Runs without ramps (threads).
     no_ramps: bool,
     kind: Kind,
@@ -1009,13 +1027,14 @@ fn move_of(step: &Step, start: &Axes, axes: &[u8], dynamics: &Dynamics) -> Move 
         (Kind::Feed, PathMode::Continuous) if dynamics.joining != Joining::Off => dynamics.continuity_acceleration,
         _ => dynamics.feed_acceleration,
     };
+    let ramp = Ramp::new(acceleration, dynamics.jerk.filter(|_| step.jerk_limited));
     let beyond_three_axes = (3..MAX_AXES).any(|i| (step.end[i] - start[i]).abs() > 0.0);
     Move {
         length: step.length,
         programmed,
         cruise,
-        acceleration,
-        no_ramps: kind == Kind::Thread || acceleration <= 0.0,
+        ramp,
+        no_ramps: kind == Kind::Thread || !ramp.limited(),
         kind,
         path_mode: step.path_mode,
         beyond_three_axes,
@@ -1065,7 +1084,7 @@ fn stop_reason(this: &Move, next: &Move, dynamics: &Dynamics) -> Option<Reason> 
 /// The highest speed at which `this` can be entered (from `entry`'s side:
 /// the speed it can still reach or stop from) within its length.
 fn stopping_speed(this: &Move, from: f64) -> f64 {
-    if this.no_ramps { f64::INFINITY } else { (from * from + 2.0 * this.acceleration * this.length).sqrt() }
+    if this.no_ramps { f64::INFINITY } else { this.ramp.reachable(from, this.length) }
 }
 
 /// The wait after `this` stops before `next` starts: the in-position
@@ -1096,21 +1115,25 @@ fn profile(this: &Move, entry: f64, exit: f64, fallback: f64) -> Profile {
 }
 
 /// The highest speed of `this` between `entry` and `exit` (mm/s): its
-/// cruise speed, or the top of the triangle when it is too short for it.
+/// cruise speed, or the top of the ramps when it is too short for it.
 fn peak_speed(this: &Move, entry: f64, exit: f64) -> f64 {
     if this.no_ramps {
         return this.cruise;
     }
-    ((2.0 * this.acceleration * this.length + entry * entry + exit * exit) / 2.0).sqrt().min(this.cruise)
+    this.ramp.peak(entry, exit, this.length, this.cruise)
 }
 
 /// Seconds to run `this` from `entry` to `exit` (mm/s), at most at its
-/// cruise speed, with linear ramps.
+/// cruise speed.
 fn run_time(this: &Move, entry: f64, exit: f64) -> f64 {
     if this.no_ramps {
         return this.length / this.cruise;
     }
-    let (a, length, cruise) = (this.acceleration, this.length, this.cruise);
+    if this.ramp.jerk_limited() {
+        return this.ramp.duration(entry, peak_speed(this, entry, exit), exit, this.length);
+    }
+    // Linear ramps: the trapezoid or, too short for the cruise, the triangle.
+    let (a, length, cruise) = (this.ramp.acceleration, this.length, this.cruise);
     let ramps = (cruise * cruise - entry * entry + cruise * cruise - exit * exit) / (2.0 * a);
     if ramps <= length {
         (cruise - entry) / a + (cruise - exit) / a + (length - ramps) / cruise
@@ -1131,7 +1154,7 @@ fn lost_time(this: &Move, next: &Move, entry: f64, exit: f64, smooth: f64, after
 
 #[cfg(test)]
 mod tests {
-    use super::{Joining, Reason, Timing, corner_speed, time};
+    use super::{Dynamics, Joining, Reason, Timing, corner_speed, time};
     use crate::{
         cnc8x6::dynamics,
         machine::MachineConfig,
@@ -1145,6 +1168,22 @@ mod tests {
         let trace = run(text, &NoFiles, &machine, 1000);
         assert!(trace.findings.is_empty(), "{:?}", trace.findings);
         time(&trace, &dynamics::dynamics(&machine))
+    }
+
+    /// Times `text` with ramps limited to `jerk` mm/s³ in the steps
+    /// `soft` picks, as a control's SOFT marks them.
+    fn soft(text: &str, jerk: f64, soft: impl Fn(usize) -> bool) -> Timing {
+        let machine = MachineConfig::default();
+        let mut trace = run(text, &NoFiles, &machine, 1000);
+        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+        trace.steps.iter_mut().enumerate().for_each(|(i, step)| step.jerk_limited = soft(i));
+        time(&trace, &Dynamics { jerk: Some(jerk), ..dynamics::dynamics(&machine) })
+    }
+
+    /// The speed (mm/s) from which ramps of `a` and `j` stop within `length`
+    /// mm where they reach `a` (length > 2a³/j²): length = v/2 · (v/a + a/j).
+    fn s_curve_stopping_speed(length: f64, a: f64, j: f64) -> f64 {
+        ((a.powi(4) / (j * j) + 8.0 * a * length).sqrt() - a * a / j) / 2.0
     }
 
     fn close(actual: f64, expected: f64) {
@@ -1419,5 +1458,62 @@ mod tests {
         assert_eq!(reasons[..2], [(0, Reason::Rapid), (1, Reason::Rapid)]);
         // 90 mm at the default 10 m/min rapid with R237 ramps.
         close(timing.profiles[1].duration, rest_to_rest(90.0, 10_000.0 / 60.0, 1000.0) + 0.010);
+    }
+
+    #[test]
+    fn a_jerk_limited_move_from_rest_to_rest_takes_the_s_curves_time() {
+        let (a, f, j) = (1000.0, 100.0, 20_000.0);
+        let line =
+            |length: f64, jerk: f64| soft(&format!("%1\nN1 G01 X{length} F6000\nN2 M30\n"), jerk, |_| true).profiles[0];
+        // 100 mm reach the feed, and the acceleration A on the way (A²/J =
+        // 50 mm/s < F): F/A + A/J + L/F, with the 20 ms pause.
+        let long = line(100.0, j);
+        assert_eq!((long.entry, long.peak, long.exit), (0.0, 6000.0, 0.0));
+        close(long.duration, f / a + a / j + 100.0 / f + 0.020);
+        // J = 5000 mm/s³ never reaches A (A²/J = 200 mm/s > F): 2·sqrt(F/J) + L/F.
+        close(line(100.0, 5000.0).duration, 2.0 * (f / 5000.0).sqrt() + 100.0 / f + 0.020);
+        // 8 mm are too short for the feed: each half ramps through A to v.
+        let short = line(8.0, j);
+        let v = s_curve_stopping_speed(4.0, a, j);
+        close(short.peak, v * 60.0);
+        close(short.duration, 2.0 * (v / a + a / j) + 0.020);
+        // 1 mm is too short for A (A³/J² = 2.5 mm per ramp):
+        // v = ((L/2)²·J)^⅓ and t = 4·(L/(2J))^⅓.
+        let tiny = line(1.0, j);
+        close(tiny.peak, (0.25 * j).cbrt() * 60.0);
+        close(tiny.duration, 4.0 * (1.0 / (2.0 * j)).cbrt() + 0.020);
+    }
+
+    #[test]
+    fn a_joined_move_can_stop_within_itself_under_the_jerk_limit() {
+        // As without a jerk limit, the 8 mm block after a fast one limits
+        // the junction; the S-curve stops within 8 mm at R236 = 400 mm/s²
+        // and J = 4000 mm/s³ from 62.5 mm/s, not the linear 80 mm/s.
+        let (a, j) = (400.0, 4000.0);
+        let timing = soft("%1\nN1 G23 G01 X100 F6000\nN2 X108\nN3 X200\nN4 M30\n", j, |_| true);
+        let v = s_curve_stopping_speed(8.0, a, j);
+        assert!(v < 80.0 && v > 62.0, "{v}");
+        assert_eq!((timing.breaks[0].step, timing.breaks[0].reason.reason), (0, Reason::LookAhead));
+        close(timing.breaks[0].at, v * 60.0);
+        close(timing.profiles[0].exit, v * 60.0);
+        close(timing.profiles[1].entry, v * 60.0);
+        // The first block, 100 mm from rest: up to the feed through A,
+        // down to v below it (Δv < A²/J = 40 mm/s).
+        let up = 100.0 / a + a / j;
+        let down = 2.0 * ((100.0 - v) / j).sqrt();
+        let cruise = 100.0 - 50.0 * up - (100.0 + v) / 2.0 * down;
+        close(timing.profiles[0].duration, up + down + cruise / 100.0);
+    }
+
+    #[test]
+    fn soft_and_brisk_switch_block_by_block() {
+        // Two lines with a stop between them (G98): the first limits its
+        // jerk, the second ramps linearly.
+        let text = "%1\nN1 G01 X100 F6000\nN2 X200\nN3 M30\n";
+        let timing = soft(text, 20_000.0, |i| i == 0);
+        close(timing.profiles[0].duration, 0.1 + 0.05 + 1.0 + 0.020);
+        close(timing.profiles[1].duration, rest_to_rest(100.0, 100.0, 1000.0) + 0.020);
+        // A jerk limit no step asks for changes nothing.
+        assert_eq!(soft(text, 20_000.0, |_| false), timed(text));
     }
 }
