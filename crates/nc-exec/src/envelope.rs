@@ -597,7 +597,7 @@ impl Planner {
         if !ramp.limited() {
             return (cruise, length / cruise);
         }
-        let distance = |peak: f64| ramp.change(entry, peak).1 + ramp.change(peak, exit).1;
+        let distance = |peak: f64| ramp.span(entry, peak, exit).1;
         let time = |peak: f64| ramp.duration(entry, peak, exit, length);
         if distance(low) > length * (1.0 + 1e-9) + 1e-12 {
             return section(slot, through, cruise);

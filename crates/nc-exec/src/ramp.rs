@@ -75,7 +75,7 @@ impl Ramp {
     }
 
     /// Seconds and mm to rise from `entry` to `peak` and fall to `exit`.
-    fn span(&self, entry: f64, peak: f64, exit: f64) -> (f64, f64) {
+    pub fn span(&self, entry: f64, peak: f64, exit: f64) -> (f64, f64) {
         let (up, down) = (self.change(entry, peak), self.change(peak, exit));
         (up.0 + down.0, up.1 + down.1)
     }

@@ -1181,7 +1181,7 @@ mod tests {
     }
 
     /// The speed (mm/s) from which ramps of `a` and `j` stop within `length`
-    /// mm where they reach `a` (length > 2a³/j²): length = v/2 · (v/a + a/j).
+    /// mm where they reach `a` (length > a³/j²): length = v/2 · (v/a + a/j).
     fn s_curve_stopping_speed(length: f64, a: f64, j: f64) -> f64 {
         ((a.powi(4) / (j * j) + 8.0 * a * length).sqrt() - a * a / j) / 2.0
     }
