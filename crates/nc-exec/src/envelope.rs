@@ -20,7 +20,7 @@
 
 use std::collections::VecDeque;
 
-use crate::trace::shift_count;
+use crate::{ramp::Ramp, trace::shift_count};
 
 /// A move's speed through it, in mm/min: at its start, its highest, and at
 /// its end; with its duration in seconds.
@@ -50,16 +50,6 @@ pub(crate) const P_PER_JERK: f64 = 32.768;
 pub enum ProfileKind {
     Linear,
     Parabolic,
-}
-
-/// How fast speed may change: acceleration in mm/s² and jerk in mm/s³. An
-/// infinite jerk is the linear profile; an acceleration that is not a
-/// positive finite number means no ramps at all (threads, and a machine
-/// whose configuration gives zero).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Ramp {
-    pub acceleration: f64,
-    pub jerk: f64,
 }
 
 /// One dynamic set (R406–R429), or the constants that stand for it when the
@@ -261,37 +251,9 @@ impl Planner {
     }
 }
 
+/// A section's ramps, besides a move's own ([`Ramp::change`]: the
+/// manual's S-curve, 04 §1.10).
 impl Ramp {
-    /// No ramps: speed changes at once.
-    const NONE: Ramp = Ramp { acceleration: f64::INFINITY, jerk: f64::INFINITY };
-
-    fn limited(&self) -> bool {
-        self.acceleration.is_finite() && self.acceleration > 0.0
-    }
-
-    fn jerk_limited(&self) -> bool {
-        self.jerk.is_finite() && self.jerk > 0.0
-    }
-
-    /// Seconds and mm for one move to change speed between `from` and `to`,
-    /// starting and ending without acceleration: a trapezoid's ramp, or the
-    /// S-curve's t = 2·sqrt(Δv/J) up to Δv = A²/J and Δv/A + A/J beyond
-    /// (04 §1.10). Both are symmetric: the distance is the mean speed × t.
-    fn change(&self, from: f64, to: f64) -> (f64, f64) {
-        if !self.limited() {
-            return (0.0, 0.0);
-        }
-        let (a, j, dv) = (self.acceleration, self.jerk, (to - from).abs());
-        let time = if !self.jerk_limited() {
-            dv / a
-        } else if dv <= a * a / j {
-            2.0 * (dv / j).sqrt()
-        } else {
-            dv / a + a / j
-        };
-        (time, (from + to) / 2.0 * time)
-    }
-
     /// The highest speed reached from `from` over `distance` mm (or the
     /// highest from which `from` is reached), starting without acceleration:
     /// the jerk raises it to A, then A holds. This is a section's ramp over
@@ -635,36 +597,12 @@ impl Planner {
         if !ramp.limited() {
             return (cruise, length / cruise);
         }
-        let span = |peak: f64| {
-            let (up, down) = (ramp.change(entry, peak), ramp.change(peak, exit));
-            (up.0 + down.0, up.1 + down.1)
-        };
-        let time = |peak: f64| {
-            let (ramps, distance) = span(peak);
-            if peak > 0.0 { ramps + (length - distance).max(0.0) / peak } else { ramps }
-        };
-        if span(low).1 > length * (1.0 + 1e-9) + 1e-12 {
+        let distance = |peak: f64| ramp.span(entry, peak, exit).1;
+        let time = |peak: f64| ramp.duration(entry, peak, exit, length);
+        if distance(low) > length * (1.0 + 1e-9) + 1e-12 {
             return section(slot, through, cruise);
         }
-        let peak = if span(cruise).1 <= length {
-            cruise
-        } else if !ramp.jerk_limited() {
-            ((2.0 * ramp.acceleration * length + entry * entry + exit * exit) / 2.0).sqrt().max(low).min(cruise)
-        } else {
-            let (mut below, mut above) = (low, cruise);
-            for _ in 0..100 {
-                let middle = (below + above) / 2.0;
-                if span(middle).1 <= length {
-                    below = middle
-                } else {
-                    above = middle
-                }
-                if above - below <= above * 1e-13 {
-                    break;
-                }
-            }
-            below
-        };
+        let peak = if distance(cruise) <= length { cruise } else { ramp.peak(entry, exit, length, cruise).max(low) };
         let rise = time(peak);
         // R395: rising within the move is not worth it when the move at its
         // junction speeds is short (linear, 04 §1.9.3) or gains little

@@ -48,6 +48,8 @@
 //! - [`known`]: values a static reading may not know.
 //! - [`machine`]: the machine a program runs on (its control, axes, rates,
 //!   limits, constants and tables).
+//! - `ramp`: how fast the path speed may change (acceleration and jerk:
+//!   linear ramps or S-curves), for both velocity planners.
 //! - [`run`]: running a program on its machine into a [`run::Trace`] or a
 //!   sink, on a thread of its own or this one, from a checkpoint or the
 //!   start.
@@ -76,6 +78,7 @@ pub(crate) mod green;
 pub mod haas_lathe;
 pub mod known;
 pub mod machine;
+pub(crate) mod ramp;
 pub mod run;
 pub mod sinumerik;
 pub mod spline;

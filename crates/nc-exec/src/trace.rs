@@ -123,6 +123,10 @@ pub struct Step {
     /// G01 line without M, S, T, D or F and not under G91, which machine
     /// constant R383 merges, 04 §1.9.4).
     pub mergeable: bool,
+    /// The control limits the jerk of the move's ramps to its policy's
+    /// (the velocity model's `Dynamics::jerk`; Sinumerik: SOFT against
+    /// BRISK), so that a program switches block by block.
+    pub jerk_limited: bool,
     /// The spindle's commanded speed in rpm (negative under M04, 0 where
     /// it stands or the control's model does not follow it) as the step
     /// starts and as it ends; they differ on a cut under constant cutting

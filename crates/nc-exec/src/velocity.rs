@@ -4,8 +4,21 @@
 //! [`Dynamics`] (for CNC8x6, `cnc8x6::dynamics`) and the [`Terms`] its
 //! reasons are told in.
 //!
-//! Every move ramps linearly (trapezoids). A junction between two moves is
-//! smooth or a stop ([`stop_reason`]):
+//! Every move ramps linearly (trapezoids), or, where the control limits
+//! the jerk ([`Dynamics::jerk`]) and the step asks for it
+//! ([`Step::jerk_limited`]), along S-curves: the acceleration rises and
+//! falls at the jerk limit, so that a change of speed by Δv takes
+//! 2·sqrt(Δv/J) where it stays below the acceleration A (Δv ≤ A²/J) and
+//! Δv/A + A/J where it reaches it, over the mean speed times that time
+//! (the closed forms are in `ramp`). Every ramp the model computes takes
+//! the move's profile: the time and distance to change speed, the speed a
+//! move can still stop from within itself, the peak a short move reaches
+//! (found by bisection under a jerk limit, where the distance is no longer
+//! a quadratic in the speed) and so the profile a step reports. A rest to
+//! rest move of length L at feed F with F > A²/J takes F/A + A/J + L/F
+//! when it reaches F; with no jerk limit, F/A + L/F.
+//!
+//! A junction between two moves is smooth or a stop ([`stop_reason`]):
 //!
 //! * smooth only between two working-feed moves where the second is
 //!   programmed for a continuous path and the control joins such moves
@@ -48,6 +61,7 @@ pub use crate::envelope::Profile;
 use crate::{
     envelope::{Envelope, EnvelopeMove, Limit, MoveKind, Planned, Planner},
     machine::MachineConfig,
+    ramp::Ramp,
     trace::{Axes, Checkpoint, MAX_AXES, Motion, Path, PathMode, Step, StepSink, Trace, shift_count, shift_range},
 };
 
@@ -113,6 +127,10 @@ pub struct Dynamics {
     /// How fast the spindle changes its speed, in rpm/s; infinite where it
     /// is taken to follow at once.
     pub spindle_acceleration: f64,
+    /// The jerk limit of the ramps in mm/s³ for the steps that ask for it
+    /// ([`Step::jerk_limited`]); `None` ramps linearly (no jerk limit).
+    /// The envelope planner takes its ramps from its own sets instead.
+    pub jerk: Option<f64>,
     /// A look-ahead planner over many moves, for controls that have one: it
     /// plans the moves instead of the one-block look-ahead.
     pub envelope: Option<Envelope>,
@@ -400,7 +418,7 @@ struct Move {
     /// The programmed speed, and the speed the move may run at.
     programmed: f64,
     cruise: f64,
-    acceleration: f64,
+    ramp: Ramp,
     /// Runs without ramps (threads).
     no_ramps: bool,
     kind: Kind,
@@ -1009,13 +1027,14 @@ fn move_of(step: &Step, start: &Axes, axes: &[u8], dynamics: &Dynamics) -> Move 
         (Kind::Feed, PathMode::Continuous) if dynamics.joining != Joining::Off => dynamics.continuity_acceleration,
         _ => dynamics.feed_acceleration,
     };
+    let ramp = Ramp::new(acceleration, dynamics.jerk.filter(|_| step.jerk_limited));
     let beyond_three_axes = (3..MAX_AXES).any(|i| (step.end[i] - start[i]).abs() > 0.0);
     Move {
         length: step.length,
         programmed,
         cruise,
-        acceleration,
-        no_ramps: kind == Kind::Thread || acceleration <= 0.0,
+        ramp,
+        no_ramps: kind == Kind::Thread || !ramp.limited(),
         kind,
         path_mode: step.path_mode,
         beyond_three_axes,
@@ -1065,7 +1084,7 @@ fn stop_reason(this: &Move, next: &Move, dynamics: &Dynamics) -> Option<Reason> 
 /// The highest speed at which `this` can be entered (from `entry`'s side:
 /// the speed it can still reach or stop from) within its length.
 fn stopping_speed(this: &Move, from: f64) -> f64 {
-    if this.no_ramps { f64::INFINITY } else { (from * from + 2.0 * this.acceleration * this.length).sqrt() }
+    if this.no_ramps { f64::INFINITY } else { this.ramp.reachable(from, this.length) }
 }
 
 /// The wait after `this` stops before `next` starts: the in-position
@@ -1096,21 +1115,25 @@ fn profile(this: &Move, entry: f64, exit: f64, fallback: f64) -> Profile {
 }
 
 /// The highest speed of `this` between `entry` and `exit` (mm/s): its
-/// cruise speed, or the top of the triangle when it is too short for it.
+/// cruise speed, or the top of the ramps when it is too short for it.
 fn peak_speed(this: &Move, entry: f64, exit: f64) -> f64 {
     if this.no_ramps {
         return this.cruise;
     }
-    ((2.0 * this.acceleration * this.length + entry * entry + exit * exit) / 2.0).sqrt().min(this.cruise)
+    this.ramp.peak(entry, exit, this.length, this.cruise)
 }
 
 /// Seconds to run `this` from `entry` to `exit` (mm/s), at most at its
-/// cruise speed, with linear ramps.
+/// cruise speed.
 fn run_time(this: &Move, entry: f64, exit: f64) -> f64 {
     if this.no_ramps {
         return this.length / this.cruise;
     }
-    let (a, length, cruise) = (this.acceleration, this.length, this.cruise);
+    if this.ramp.jerk_limited() {
+        return this.ramp.duration(entry, peak_speed(this, entry, exit), exit, this.length);
+    }
+    // Linear ramps: the trapezoid or, too short for the cruise, the triangle.
+    let (a, length, cruise) = (this.ramp.acceleration, this.length, this.cruise);
     let ramps = (cruise * cruise - entry * entry + cruise * cruise - exit * exit) / (2.0 * a);
     if ramps <= length {
         (cruise - entry) / a + (cruise - exit) / a + (length - ramps) / cruise
@@ -1130,294 +1153,4 @@ fn lost_time(this: &Move, next: &Move, entry: f64, exit: f64, smooth: f64, after
 }
 
 #[cfg(test)]
-mod tests {
-    use super::{Joining, Reason, Timing, corner_speed, time};
-    use crate::{
-        cnc8x6::dynamics,
-        machine::MachineConfig,
-        run::{NoFiles, run},
-    };
-
-    /// The default machine: R97 = 2, R39 = 60°, R52 = 1000, R236 = 400 and
-    /// R237 = 1000 mm/s², a 20 ms pause under G98 and a 10 ms settle.
-    fn timed(text: &str) -> Timing {
-        let machine = MachineConfig::default();
-        let trace = run(text, &NoFiles, &machine, 1000);
-        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
-        time(&trace, &dynamics::dynamics(&machine))
-    }
-
-    fn close(actual: f64, expected: f64) {
-        assert!((actual - expected).abs() <= expected.abs() * 1e-9 + 1e-12, "{actual} != {expected}");
-    }
-
-    /// A move of `length` mm from rest to rest at `speed` mm/s with `a` mm/s².
-    fn rest_to_rest(length: f64, speed: f64, a: f64) -> f64 {
-        2.0 * speed / a + (length - speed * speed / a) / speed
-    }
-
-    #[test]
-    fn unset_constants_take_the_models_assumptions() {
-        let dynamics = dynamics::dynamics(&MachineConfig::default());
-        assert_eq!((dynamics.joining, dynamics.tolerance_angle), (Joining::Automatic, 60.0));
-        let accelerations = (dynamics.feed_acceleration, dynamics.continuity_acceleration, dynamics.rapid_acceleration);
-        assert_eq!(accelerations, (1000.0, 400.0, 1000.0));
-    }
-
-    #[test]
-    fn the_corner_speed_keeps_the_blend_within_the_tolerance() {
-        let (x, y) = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
-        // 90°: r = ε·cos 45° / (1 − cos 45°) = ε (1 + √2).
-        close(corner_speed(x, y, 0.1, 1000.0), (1000.0 * 0.1 * (1.0 + 2.0f64.sqrt())).sqrt());
-        assert_eq!(corner_speed(x, x, 0.1, 1000.0), f64::INFINITY);
-        assert_eq!(corner_speed(x, [-1.0, 0.0, 0.0], 0.1, 1000.0), 0.0);
-        assert_eq!(corner_speed(x, [-1.0, 0.0, 0.0], f64::INFINITY, 1000.0), f64::INFINITY);
-    }
-
-    #[test]
-    fn one_long_line_ramps_up_and_down() {
-        // 100 mm at 100 mm/s: 5 mm of ramp at each end at 1000 mm/s².
-        let timing = timed("%1\nN1 G01 X100 F6000\nN2 M30\n");
-        let line = timing.profiles[0];
-        assert_eq!((line.entry, line.peak, line.exit), (0.0, 6000.0, 0.0));
-        close(line.duration, rest_to_rest(100.0, 100.0, 1000.0) + 0.020);
-        close(timing.total_time(), 1.1 + 0.020);
-        let reasons: Vec<Reason> = timing.breaks.iter().map(|b| b.reason.reason).collect();
-        assert_eq!(reasons, [Reason::NonMotion]);
-        // The stop costs the ramp down, against going on at 100 mm/s.
-        close(timing.breaks[0].lost, 100.0 / 1000.0 / 2.0 + 0.020);
-        // Too short to reach the feed: a triangle.
-        let short = timed("%1\nN1 G01 X1 F6000\nN2 M30\n").profiles[0];
-        close(short.peak, (1000.0f64 * 1.0).sqrt() * 60.0);
-        close(short.duration, 2.0 * (1000.0f64).sqrt() / 1000.0 + 0.020);
-    }
-
-    #[test]
-    fn a_collinear_g23_chain_runs_through_at_the_feed() {
-        let timing = timed("%1\nN1 G23 G01 X10 F600\nN2 X20\nN3 X30\nN4 M30\n");
-        let speeds: Vec<(f64, f64)> = timing.profiles[..3].iter().map(|p| (p.entry, p.exit)).collect();
-        assert_eq!(speeds, [(0.0, 600.0), (600.0, 600.0), (600.0, 0.0)]);
-        // Under continuity the ramps take R236: 10 mm/s at 400 mm/s².
-        close(timing.total_time(), 3.0 + 10.0 / 400.0 + 0.010);
-        assert_eq!(timing.breaks.len(), 1);
-    }
-
-    #[test]
-    fn a_corner_below_r39_joins_and_one_above_stops() {
-        // 53.13° (3-4-5) and 63.43° (1-2) turns from the X axis.
-        let below = timed("%1\nN1 G23 G01 X10 F600\nN2 X13 Y4\nN3 M30\n");
-        assert_eq!(below.breaks.len(), 1);
-        close(below.total_time(), 15.0 / 10.0 + 10.0 / 400.0 + 0.010);
-        let above = timed("%1\nN1 G23 G01 X10 F600\nN2 X11 Y2\nN3 M30\n");
-        let Reason::Corner { angle, limit } = above.breaks[0].reason.reason else { panic!("{:?}", above.breaks) };
-        close(angle, 2.0f64.atan().to_degrees());
-        assert_eq!(limit, 60.0);
-        let second = 5.0f64.sqrt();
-        let expected = rest_to_rest(10.0, 10.0, 400.0) + 0.010 + rest_to_rest(second, 10.0, 400.0) + 0.010;
-        close(above.total_time(), expected);
-        // Against a smooth join at 10 mm/s the corner costs a ramp down and
-        // up (10/400 s) and the settle.
-        close(above.breaks[0].lost, 10.0 / 400.0 + 0.010);
-    }
-
-    #[test]
-    fn g98_g24_and_g23_on_the_same_path() {
-        let path = |code: &str| timed(&format!("%1\nN1 {code} G01 X10 F600\nN2 X20\nN3 M30\n")).total_time();
-        // G98: R52 ramps and a 20 ms pause after each line; G24: the same
-        // ramps and a 10 ms settle; G23: one smooth run with R236 ramps.
-        close(path("G98"), 2.0 * rest_to_rest(10.0, 10.0, 1000.0) + 2.0 * 0.020);
-        close(path("G24"), 2.0 * rest_to_rest(10.0, 10.0, 1000.0) + 2.0 * 0.010);
-        close(path("G23"), 2.0 + 10.0 / 400.0 + 0.010);
-    }
-
-    #[test]
-    fn an_arc_runs_at_its_chord_limit() {
-        // Radius 1 mm: a 1 µm chord error per 10 ms allows sqrt(8 r e)/Ts.
-        let timing = timed("%1\nN1 G02 X2 Y0 I1 J0 F1000\nN2 M30\n");
-        let limit = (8.0f64 * 0.001).sqrt() / 0.01;
-        close(timing.profiles[0].peak, limit * 60.0);
-        let arc = timing.breaks.iter().find(|b| matches!(b.reason.reason, Reason::ArcLimit { .. })).unwrap();
-        assert_eq!(arc.reason.reason, Reason::ArcLimit { radius: 1.0 });
-        close(arc.at, limit * 60.0);
-        close(arc.before, 1000.0);
-        let length = std::f64::consts::PI;
-        close(timing.profiles[0].duration, rest_to_rest(length, limit, 1000.0) + 0.020);
-    }
-
-    #[test]
-    fn dwell_keeps_its_time_and_breaks_the_path() {
-        let timing = timed("%1\nN1 G23 G01 X10 F600\nN2 G04 Q150\nN3 X20\nN4 M30\n");
-        close(timing.profiles[1].duration, 1.5);
-        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason.reason)).collect();
-        assert_eq!(reasons, [(0, Reason::NonMotion), (2, Reason::NonMotion)]);
-    }
-
-    #[test]
-    fn a_short_block_after_a_fast_one_limits_the_junction() {
-        // The control brakes one block ahead: the 0.5 mm block must be able
-        // to stop within itself, sqrt(2 * 400 * 0.5) = 20 mm/s.
-        let timing = timed("%1\nN1 G23 G01 X100 F3000\nN2 X100.5 F3000\nN3 X200\nN4 M30\n");
-        let reasons: Vec<Reason> = timing.breaks.iter().map(|b| b.reason.reason).collect();
-        assert_eq!(reasons[0], Reason::ShortBlock { duration: 0.5 / 50.0, limit: 0.060 });
-        // 8 mm take 80 ms at 100 mm/s, but stop within themselves only
-        // from sqrt(2 * 400 * 8) = 80 mm/s.
-        let timing = timed("%1\nN1 G23 G01 X100 F6000\nN2 X108\nN3 X200\nN4 M30\n");
-        assert_eq!((timing.breaks[0].step, timing.breaks[0].reason.reason), (0, Reason::LookAhead));
-        close(timing.breaks[0].at, 4800.0);
-        close(timing.profiles[1].entry, 4800.0);
-        // Long enough blocks, one slow: the fast one ends at the slow speed.
-        let timing = timed("%1\nN1 G23 G01 X100 F3000\nN2 X110 F600\nN3 M30\n");
-        assert_eq!(timing.profiles[0].exit, 600.0);
-        assert_eq!(timing.profiles[1].entry, 600.0);
-    }
-
-    /// A CNC8x9 with the envelope velocity and the linear profile (R338
-    /// decade 2 = 1).
-    fn enveloped(text: &str) -> Timing {
-        let machine = MachineConfig { constants: [(338, 10)].into(), ..MachineConfig::default() };
-        let dynamics = dynamics::dynamics(&machine);
-        assert!(dynamics.envelope.is_some());
-        let trace = run(text, &NoFiles, &machine, 1000);
-        assert!(trace.findings.is_empty(), "{:?}", trace.findings);
-        time(&trace, &dynamics)
-    }
-
-    #[test]
-    fn the_envelope_runs_a_chain_of_short_blocks_at_the_feed() {
-        // 100 blocks of 1 mm at 100 mm/s: 10 ms each, far below the CNC8x6's
-        // 60 ms, but the envelope plans across them as one 100 mm line
-        // ramping at R236 = 400 mm/s², with the 10 ms settle at the end.
-        let mut text = String::from("%1\nN1 G23 G01 X1 F6000\n");
-        for i in 2..=100 {
-            text.push_str(&format!("N{i} X{i}\n"));
-        }
-        text.push_str("N101 M30\n");
-        let timing = enveloped(&text);
-        let expected = rest_to_rest(100.0, 100.0, 400.0) + 0.010;
-        assert!((timing.total_time() - expected).abs() < expected * 1e-3, "{} != {expected}", timing.total_time());
-        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason.reason)).collect();
-        assert_eq!(reasons, [(99, Reason::NonMotion)]);
-        // The CNC8x6 stops after every block.
-        assert!(timed(&text).total_time() > 3.0 * expected);
-    }
-
-    #[test]
-    fn the_envelope_merges_a_tiny_line_by_r383_unless_it_may_not() {
-        // A 3 µm line inside a 100 mm one at 100 mm/s: merged, the path is
-        // one line; on its own it would take the 4 ms minimum duration
-        // (0.75 mm/s), braking from and ramping back to the feed.
-        let program = |middle: &str| format!("%1\nN1 G23 G01 X50 F6000\nN2 {middle}\nN3 X100\nN4 M30\n");
-        let merged = enveloped(&program("X50.003")).total_time();
-        let expected = rest_to_rest(100.0, 100.0, 400.0) + 0.010;
-        assert!((merged - expected).abs() < expected * 1e-3, "{merged} != {expected}");
-        // Braking to a near stop and back costs about v/A against passing.
-        let ramps = 100.0 / 400.0;
-        // A technology function keeps it a block of its own.
-        let with_speed = enveloped(&program("X50.003 S1000")).total_time();
-        assert!(with_speed > merged + 0.9 * ramps, "{with_speed} vs {merged}");
-        // A minus sign blocks R383.
-        let machine = MachineConfig { constants: [(338, 10), (383, -5)].into(), ..MachineConfig::default() };
-        let trace = run(&program("X50.003"), &NoFiles, &machine, 1000);
-        let blocked = time(&trace, &dynamics::dynamics(&machine)).total_time();
-        assert!(blocked > merged + 0.9 * ramps, "{blocked} vs {merged}");
-    }
-
-    #[test]
-    fn g23_i_selects_the_dynamic_set_of_the_parabolic_envelope() {
-        // Sets on (R406, R412), parabolic profile: set 1 ramps at R408 =
-        // 600 mm/s², set 2 at R414 = 100 mm/s², with the same P.
-        let constants = [(338, 20), (406, 1), (407, 50_000), (408, 600), (412, 1), (413, 50_000), (414, 100)];
-        let machine = MachineConfig { constants: constants.into(), ..MachineConfig::default() };
-        let timed = |set: u8| {
-            let text = format!("%1\nN1 G23 I{set} G01 X100 F6000\nN2 M30\n");
-            let trace = run(&text, &NoFiles, &machine, 1000);
-            assert!(trace.findings.is_empty(), "{:?}", trace.findings);
-            time(&trace, &dynamics::dynamics(&machine)).total_time()
-        };
-        let (first, second) = (timed(1), timed(2));
-        // J = P / 32.768. Set 2 reaches A: v/A + A/J + L/v (04 §2.2); set 1
-        // reaches 100 mm/s before A = 600 mm/s² (A²/J > v): 2·sqrt(v/J) + L/v.
-        let jerk: f64 = 50_000.0 / 32.768;
-        let (one, two) = (2.0 * (100.0 / jerk).sqrt() + 1.0 + 0.010, 100.0 / 100.0 + 100.0 / jerk + 1.0 + 0.010);
-        assert!((first - one).abs() < one * 1e-3, "{first} != {one}");
-        assert!((second - two).abs() < two * 1e-3, "{second} != {two}");
-    }
-
-    #[test]
-    fn the_envelope_slows_a_corner_by_the_accuracy_criterion() {
-        // 45° below R39: R384 = 8 µm at Ts = 2 ms allows
-        // 0.008 / (0.002 tan 22.5°) mm/s, below R385's 10000 · 0.002 /
-        // (2 sin 22.5°).
-        let timing = enveloped("%1\nN1 G23 G01 X100 F6000\nN2 X200 Y100\nN3 M30\n");
-        let corner = timing.breaks[0];
-        assert_eq!(corner.step, 0);
-        let Reason::Accuracy { angle } = corner.reason.reason else { panic!("{:?}", corner.reason) };
-        assert!((angle - 45.0).abs() < 1e-9);
-        let limit = 0.008 / (0.002 * 22.5f64.to_radians().tan()) * 60.0;
-        assert!((corner.at - limit).abs() < limit * 1e-3, "{} != {limit}", corner.at);
-        assert!((timing.profiles[1].entry - corner.at).abs() < 1e-9);
-        // The drop costs both moves' ramps against passing at 100 mm/s.
-        let (v, a) = (limit / 60.0, 400.0);
-        let ramps = 2.0 * ((100.0 - v) / a - (100.0 * 100.0 - v * v) / (2.0 * a) / 100.0);
-        assert!((corner.lost - ramps).abs() < ramps * 1e-3, "{} != {ramps}", corner.lost);
-    }
-
-    #[test]
-    fn a_move_still_ramping_up_into_a_junction_is_no_break() {
-        // 8 mm from rest under G23 reach sqrt(2 * 400 * 8) = 80 mm/s of the
-        // 100 programmed, and the long next move takes that speed over.
-        let timing = timed("%1\nN1 G23 G01 X8 F6000\nN2 X200\nN3 M30\n");
-        close(timing.profiles[0].exit, 4800.0);
-        close(timing.profiles[1].entry, 4800.0);
-        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason.reason)).collect();
-        assert_eq!(reasons, [(1, Reason::NonMotion)]);
-    }
-
-    #[test]
-    fn a_thread_block_without_motion_is_a_non_motion_block() {
-        // X10 again: a G33 block that does not move.
-        let timing = timed("%1\nN1 M03 S500\nN2 G23 G01 X10 F600\nN3 G33 X10 K1\nN4 G01 X20\nN5 M30\n");
-        let reasons: Vec<(usize, &str)> = timing.breaks.iter().map(|b| (b.step, b.reason.code())).collect();
-        assert_eq!(reasons, [(1, "non-motion"), (3, "non-motion")]);
-    }
-
-    #[test]
-    fn a_g24_block_too_short_to_send_the_next_pauses_as_under_g98() {
-        // 1 mm at 100 mm/s takes 10 ms, under the 30 ms G24 needs.
-        let timing = timed("%1\nN1 G24 G01 X1 F6000\nN2 X101\nN3 M30\n");
-        let first = 2.0 * (1000.0f64).sqrt() / 1000.0;
-        close(timing.profiles[0].duration, first + 0.020);
-        close(timing.profiles[1].duration, rest_to_rest(100.0, 100.0, 1000.0) + 0.010);
-    }
-
-    #[test]
-    fn m_functions_and_tool_changes_take_the_machines_times() {
-        let machine = MachineConfig { m_function_ms: 200, tool_change_ms: 6000, ..MachineConfig::default() };
-        // M06 is the tool change; M03 and M08 two M functions; M30 ends.
-        let trace = run("%1\nN1 T1 M06\nN2 M03 M08 S1000\nN3 M30\n", &NoFiles, &machine, 100);
-        let timing = time(&trace, &dynamics::dynamics(&machine));
-        let durations: Vec<f64> = timing.profiles.iter().map(|profile| profile.duration).collect();
-        assert_eq!(durations, [6.0, 0.4, 0.0]);
-    }
-
-    #[test]
-    fn a_subprogram_called_q_times_and_a_jump_loop() {
-        // Each run of the 10 mm move ends at the non-motion G70 or G73
-        // block: from rest to rest at R236, then the settle.
-        let one_run = rest_to_rest(10.0, 10.0, 400.0) + 0.010;
-        let called = timed("%1\nN1 G23 G01 F600 G71 L1 Q3\nN2 M30\nN3 G79 L1\nN4 G91 X10\nN5 G70\n");
-        close(called.total_time(), 3.0 * one_run);
-        let looped = timed("%1\nN1 G23 G91 G01 F600\nN2 X10\nN3 G73 L2 Q2\nN4 M30\n");
-        close(looped.total_time(), 3.0 * one_run);
-        assert_eq!(looped.breaks.len(), 3);
-    }
-
-    #[test]
-    fn rapid_moves_stop_at_both_ends() {
-        let timing = timed("%1\nN1 G23 G01 X10 F600\nN2 G00 X100\nN3 G01 X110\nN4 M30\n");
-        let reasons: Vec<(usize, Reason)> = timing.breaks.iter().map(|b| (b.step, b.reason.reason)).collect();
-        assert_eq!(reasons[..2], [(0, Reason::Rapid), (1, Reason::Rapid)]);
-        // 90 mm at the default 10 m/min rapid with R237 ramps.
-        close(timing.profiles[1].duration, rest_to_rest(90.0, 10_000.0 / 60.0, 1000.0) + 0.010);
-    }
-}
+mod tests;

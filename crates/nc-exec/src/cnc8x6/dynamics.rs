@@ -9,8 +9,9 @@ use std::fmt;
 
 use crate::{
     compensation::Settings,
-    envelope::{DynamicSet, Envelope, MAX_DEPTH, P_PER_JERK, ProfileKind, Ramp},
+    envelope::{DynamicSet, Envelope, MAX_DEPTH, P_PER_JERK, ProfileKind},
     machine::MachineConfig,
+    ramp::Ramp,
     trace::PathMode,
     velocity::{Dynamics, Joining, MachineTimes, Reason, Terms},
 };
@@ -78,6 +79,8 @@ fn one_block_look_ahead(machine: &MachineConfig) -> Dynamics {
         chord_error: CHORD_ERROR,
         // The manual gives no spindle run-up: the spindle is taken to follow.
         spindle_acceleration: f64::INFINITY,
+        // Linear ramps; the envelope's sets bring their own jerk.
+        jerk: None,
         envelope: None,
         terms: &TERMS,
     }

@@ -69,6 +69,8 @@ pub fn dynamics(machine: &MachineConfig) -> Dynamics {
         tick: ASSUMED_TICK,
         chord_error: ASSUMED_CHORD_ERROR,
         spindle_acceleration: configured(machine.spindle_acceleration, ASSUMED_SPINDLE_ACCELERATION),
+        // The manual names no jerk limit: linear ramps.
+        jerk: None,
         envelope: None,
         terms: &TERMS,
     }

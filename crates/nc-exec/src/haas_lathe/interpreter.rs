@@ -835,6 +835,7 @@ impl<'a> Interpreter<'a> {
             tool_change: facts.tool_change,
             dynamic_set: 1,
             mergeable: false,
+            jerk_limited: false,
             // Each step's own, from where it starts and ends: below.
             spindle: [0.0; 2],
             corner_tolerance: self.corner_tolerance as f32,

@@ -854,8 +854,10 @@ impl Runner {
             tool_change,
             dynamic_set: self.dynamic_set,
             mergeable,
-            // The CNC8x6 model follows no spindle run-up and joins corners
-            // by R39, not by a tolerance.
+            // The CNC8x6 model follows no spindle run-up and no jerk limit
+            // (the envelope's sets have their own), and joins corners by
+            // R39, not by a tolerance.
+            jerk_limited: false,
             spindle: [0.0; 2],
             corner_tolerance: f32::INFINITY,
         };

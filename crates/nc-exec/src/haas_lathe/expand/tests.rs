@@ -113,6 +113,7 @@ fn step(motion: Motion, path: Path, x: f64, z: f64, feed: Option<f64>) -> Step {
         tool_change: false,
         dynamic_set: 1,
         mergeable: false,
+        jerk_limited: false,
         spindle: [0.0; 2],
         corner_tolerance: super::super::dynamics::corner_rounding(&lathe()) as f32,
     }
