@@ -33,3 +33,21 @@ pub(crate) fn token_of(child: GreenRef<'_>, wanted: SyntaxKind) -> Option<&Green
 pub(crate) fn is_trivia(child: GreenRef<'_>) -> bool {
     matches!(kind(child.kind()), SyntaxKind::WHITESPACE | SyntaxKind::COMMENT | SyntaxKind::NEWLINE)
 }
+
+/// Block skip `/` or `/n` at a block's start, as the line dialects write it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Skip {
+    /// The digit of `/1` … `/9`; `None` for `/`.
+    pub level: Option<u8>,
+    pub range: TextRange,
+}
+
+impl Skip {
+    /// Lowers a `BLOCK_SKIP` node at `range`.
+    pub(crate) fn lower(node: &GreenNodeData, range: TextRange) -> Skip {
+        let level = children(node, range.start())
+            .find_map(|(_, c)| token_of(c, SyntaxKind::NUMBER))
+            .and_then(|t| t.text().parse().ok());
+        Skip { level, range }
+    }
+}

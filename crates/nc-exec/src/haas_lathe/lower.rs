@@ -11,6 +11,7 @@ use std::fmt;
 use ncc_syntax::{Decimal, Sign, SyntaxKind, TextRange, TextSize};
 use rowan::{GreenNodeData, GreenTokenData, NodeOrToken};
 
+pub use crate::green::Skip;
 use crate::green::{GreenRef, children, is_trivia, kind, token_of};
 
 /// One block (one line).
@@ -40,14 +41,6 @@ pub struct HaasBlock {
 pub struct Number {
     /// `None` when not a whole number (`N1.5`) or missing.
     pub value: Option<u64>,
-    pub range: TextRange,
-}
-
-/// Block delete.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Skip {
-    /// The digit of `/1` … `/9`.
-    pub level: Option<u8>,
     pub range: TextRange,
 }
 
@@ -286,12 +279,7 @@ impl HaasBlock {
                             .and_then(|v| u32::try_from(v).ok());
                         data.program = Some(ProgramStart { number, title: None, range });
                     }
-                    SyntaxKind::BLOCK_SKIP => {
-                        let level = children(node, range.start())
-                            .find_map(|(_, c)| token_of(c, SyntaxKind::NUMBER))
-                            .and_then(|t| t.text().parse().ok());
-                        data.skip = Some(Skip { level, range });
-                    }
+                    SyntaxKind::BLOCK_SKIP => data.skip = Some(Skip::lower(node, range)),
                     _ => data.statements.extend(lower_statement(node, range)),
                 },
             }

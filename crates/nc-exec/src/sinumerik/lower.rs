@@ -23,6 +23,7 @@ use ncc_catalog::{AddressRole, Catalogue, Dialect, KeywordKind, Modality};
 use ncc_syntax::{Decimal, Sign, SyntaxKind, TextRange, TextSize};
 use rowan::{GreenNodeData, GreenTokenData, NodeOrToken};
 
+pub use crate::green::Skip;
 use crate::green::{GreenRef, children, is_trivia, kind, token_of};
 
 /// One block (one line).
@@ -40,13 +41,6 @@ pub struct SinumerikBlock {
     pub comments: Vec<Comment>,
     /// The block's length in bytes, line break included.
     pub len: TextSize,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Skip {
-    /// The digit of `/1` … `/9`; `None` for `/`.
-    pub level: Option<u8>,
-    pub range: TextRange,
 }
 
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -513,12 +507,7 @@ impl SinumerikBlock {
                 }
                 NodeOrToken::Token(_) => {}
                 NodeOrToken::Node(node) => match kind(node.kind()) {
-                    SyntaxKind::BLOCK_SKIP => {
-                        let level = children(node, range.start())
-                            .find_map(|(_, c)| token_of(c, SyntaxKind::NUMBER))
-                            .and_then(|t| t.text().parse().ok());
-                        data.skip = Some(Skip { level, range });
-                    }
+                    SyntaxKind::BLOCK_SKIP => data.skip = Some(Skip::lower(node, range)),
                     SyntaxKind::HEADER => {
                         let name = children(node, range.start())
                             .skip(1)
