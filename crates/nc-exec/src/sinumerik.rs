@@ -1,6 +1,7 @@
 //! The Siemens Sinumerik dialect's part of the executor: its block IR and
 //! lowering ([`lower`]) and the program model over the lowered blocks
-//! ([`program`]). Nothing runs Sinumerik programs yet.
+//! ([`program`]), and the pieces the interpreter will call: the
+//! programmable frame ([`frames`]). Nothing runs Sinumerik programs yet.
 //!
 //! What the next steps read from them:
 //!
@@ -20,5 +21,6 @@
 //!   block numbers written twice, and calls against the PROC and EXTERN
 //!   signatures by argument count.
 
+pub mod frames;
 pub mod lower;
 pub mod program;
