@@ -56,8 +56,10 @@
 //! - [`sinumerik`]: what belongs to the Siemens Sinumerik dialect:
 //!   [`sinumerik::lower`] (blocks as plain data, read from the syntax tree
 //!   and the catalogue), [`sinumerik::program`] (labels, block numbers,
-//!   control structures, declarations, jumps and calls of a file) and
-//!   [`sinumerik::frames`] (the programmable frame TRANS … AMIRROR).
+//!   control structures, declarations, jumps and calls of a file),
+//!   [`sinumerik::frames`] (the programmable frame TRANS … AMIRROR) and
+//!   [`sinumerik::cycles`] (the drilling cycles CYCLE81–CYCLE89 as moves,
+//!   the swivel CYCLE800 as a frame).
 //! - [`spline`]: rational B-spline curves (NURBS) over any axes, built
 //!   from the data a control programs them by: points, derivatives,
 //!   curvature, length, polylines within a chord tolerance.

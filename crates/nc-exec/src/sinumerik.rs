@@ -1,7 +1,8 @@
 //! The Siemens Sinumerik dialect's part of the executor: its block IR and
 //! lowering ([`lower`]) and the program model over the lowered blocks
 //! ([`program`]), and the pieces the interpreter will call: the
-//! programmable frame ([`frames`]). Nothing runs Sinumerik programs yet.
+//! programmable frame ([`frames`]) and the drilling and swivel cycles
+//! ([`cycles`]). Nothing runs Sinumerik programs yet.
 //!
 //! What the next steps read from them:
 //!
@@ -21,6 +22,7 @@
 //!   block numbers written twice, and calls against the PROC and EXTERN
 //!   signatures by argument count.
 
+pub mod cycles;
 pub mod frames;
 pub mod lower;
 pub mod program;

@@ -212,53 +212,49 @@ impl ProgrammableFrame {
     /// refused command leaves the frame as it was.
     pub fn apply(&mut self, command: FrameCommand, words: &[(&str, f64)], plane: Plane) -> Result<(), FrameError> {
         let values = axis_values(command, words, plane)?;
-        let (component, inverse) = match command.kind {
+        if !command.additive {
+            *self = ProgrammableFrame::default();
+        }
+        self.compose(command.kind, values);
+        Ok(())
+    }
+
+    /// Adds the component `kind` of the values of X, Y and Z (`None` for an
+    /// axis not written) on top of the frame, as an additive command does.
+    /// The values must be finite, and a scale's not zero.
+    pub(super) fn compose(&mut self, kind: FrameKind, values: [Option<f64>; 3]) {
+        let (component, inverse) = match kind {
             FrameKind::Translation => {
                 let shift = Vector3::from(values.map(|value| value.unwrap_or(0.0)));
-                (
-                    Affine { linear: Matrix3::identity(), translation: shift },
-                    Affine { linear: Matrix3::identity(), translation: -shift },
-                )
+                let along = |translation| Affine { linear: Matrix3::identity(), translation };
+                (along(shift), along(-shift))
             }
             FrameKind::Rotation => {
                 let [x, y, z] = values.map(|value| value.unwrap_or(0.0).to_radians());
                 // Rz·Ry·Rx: about Z first, then the turned Y, then X.
                 let rotation = Rotation3::from_euler_angles(x, y, z);
+                self.rotation *= rotation;
                 (Affine::linear(*rotation.matrix()), Affine::linear(*rotation.inverse().matrix()))
             }
-            FrameKind::Scale => {
-                let factors = Vector3::from(values.map(|value| value.unwrap_or(1.0)));
-                (
-                    Affine::linear(Matrix3::from_diagonal(&factors)),
-                    Affine::linear(Matrix3::from_diagonal(&factors.map(|f| 1.0 / f))),
-                )
-            }
-            FrameKind::Mirror => {
-                let signs = Vector3::from(values.map(|value| if value.is_some() { -1.0 } else { 1.0 }));
-                let mirror = Affine::linear(Matrix3::from_diagonal(&signs));
-                (mirror, mirror)
-            }
-        };
-        if !command.additive {
-            *self = ProgrammableFrame::default();
-        }
-        self.to_base = self.to_base.after(&component);
-        self.to_program = inverse.after(&self.to_program);
-        match command.kind {
-            FrameKind::Translation => {}
-            FrameKind::Rotation => self.rotation *= Rotation3::from_matrix_unchecked(component.linear),
             FrameKind::Scale => {
                 for (scales, value) in self.scales.iter_mut().zip(values) {
                     scales.extend(value);
                 }
+                let factors = Vector3::from(values.map(|value| value.unwrap_or(1.0)));
+                let inverse = factors.map(|factor| 1.0 / factor);
+                (Affine::linear(Matrix3::from_diagonal(&factors)), Affine::linear(Matrix3::from_diagonal(&inverse)))
             }
             FrameKind::Mirror => {
                 for (mirrored, value) in self.mirrored.iter_mut().zip(values) {
                     *mirrored ^= value.is_some();
                 }
+                let signs = Vector3::from(values.map(|value| if value.is_some() { -1.0 } else { 1.0 }));
+                let mirror = Affine::linear(Matrix3::from_diagonal(&signs));
+                (mirror, mirror)
             }
-        }
-        Ok(())
+        };
+        self.to_base = self.to_base.after(&component);
+        self.to_program = inverse.after(&self.to_program);
     }
 
     /// A point in program coordinates, in base coordinates.
