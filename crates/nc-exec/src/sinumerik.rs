@@ -1,8 +1,9 @@
 //! The Siemens Sinumerik dialect's part of the executor: its block IR and
 //! lowering ([`lower`]) and the program model over the lowered blocks
 //! ([`program`]), and the pieces the interpreter will call: the
-//! programmable frame ([`frames`]) and the drilling and swivel cycles
-//! ([`cycles`]). Nothing runs Sinumerik programs yet.
+//! programmable frame ([`frames`]), the drilling and swivel cycles
+//! ([`cycles`]) and the velocity policy with the continuous-path modes
+//! ([`dynamics`]). Nothing runs Sinumerik programs yet.
 //!
 //! What the next steps read from them:
 //!
@@ -23,6 +24,7 @@
 //!   signatures by argument count.
 
 pub mod cycles;
+pub mod dynamics;
 pub mod frames;
 pub mod lower;
 pub mod program;
