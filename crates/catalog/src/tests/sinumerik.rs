@@ -272,6 +272,7 @@ const FURTHER_WORDS: &[&str] = &[
     "CYCLE87",
     "CYCLE88",
     "CYCLE89",
+    "CYCLE840",
     "CIP",
     "CT",
     "G4",

@@ -1,5 +1,5 @@
-//! Sinumerik's drilling cycles CYCLE81–CYCLE89 as moves, and the swivel
-//! cycle CYCLE800 as a frame.
+//! Sinumerik's drilling cycles CYCLE81–CYCLE89 and CYCLE840 as moves, and
+//! the swivel cycle CYCLE800 as a frame.
 //!
 //! ```text
 //! let hole = Hole { position: [10.0, 20.0, 50.0], plane: Plane::XY, feed: 300.0, spindle: 1000.0 };
@@ -47,8 +47,11 @@
 //!   spindle and the program, and after the operator's start go out at
 //!   rapid and restart the spindle in SDIR. CYCLE86–CYCLE88 also start the
 //!   spindle in SDIR before they drill;
-//! - CYCLE840 (tapping with a compensating chuck) is not in the catalogue,
-//!   so it is not run here.
+//! - CYCLE840 (tapping in a compensating chuck) taps along AXN's axis (0:
+//!   the plane's tool axis): with an encoder (ENC=0) at the pitch as
+//!   CYCLE84 does, at the spindle speed in force; without (ENC=1) at the
+//!   feed F, reversing the spindle at the bottom. The return turns as SDR
+//!   says (0: reversed), and SDAC sets the spindle after it;
 //!
 //! CYCLE800 ([`swivel`]) turns the working plane: it translates to the
 //! reference point (_X0, _Y0, _Z0), turns by _A, _B, _C and translates to
@@ -247,6 +250,8 @@ enum Drilling {
     DeepHole,
     /// CYCLE84, rigid.
     Tap,
+    /// CYCLE840, in a compensating chuck.
+    FloatingTap,
     /// CYCLE85: in and out at feeds of its own.
     Bore,
     /// CYCLE86: out at rapid, lifted off the wall.
@@ -263,6 +268,7 @@ impl Drilling {
             "CYCLE81" | "CYCLE82" => Drilling::Drill,
             "CYCLE83" => Drilling::DeepHole,
             "CYCLE84" => Drilling::Tap,
+            "CYCLE840" => Drilling::FloatingTap,
             "CYCLE85" => Drilling::Bore,
             "CYCLE86" => Drilling::BoreLiftingOff,
             "CYCLE87" | "CYCLE88" => Drilling::BoreForTheOperator,
@@ -272,7 +278,7 @@ impl Drilling {
     }
 }
 
-/// The moves of the drilling cycle `name` (CYCLE81–CYCLE89) called with
+/// The moves of the drilling cycle `name` (CYCLE81–CYCLE89, CYCLE840) called with
 /// `arguments` at `hole`.
 pub fn drilling(name: &str, arguments: &[Option<f64>], hole: &Hole) -> Result<Vec<CycleMove>, CycleError> {
     let arguments = Arguments::of(name, arguments)?;
@@ -284,7 +290,14 @@ pub fn drilling(name: &str, arguments: &[Option<f64>], hole: &Hole) -> Result<Ve
         });
     };
     let planes = Planes::of(&arguments)?;
-    let axis = hole.plane.axes()[2];
+    let axis = match kind {
+        Drilling::FloatingTap => match arguments.value("AXN") {
+            0.0 => hole.plane.axes()[2],
+            axis @ (1.0 | 2.0 | 3.0) => axis as usize - 1,
+            other => return arguments.refuse("AXN", format!("is {other}, not 1, 2 or 3 (X, Y, Z) or 0 (the plane's)")),
+        },
+        _ => hole.plane.axes()[2],
+    };
     let at = |height: f64| {
         let mut point = hole.position;
         point[axis] = height;
@@ -321,6 +334,41 @@ pub fn drilling(name: &str, arguments: &[Option<f64>], hole: &Hole) -> Result<Ve
             moves.push(CycleMove::Tap { to: bottom, lead: lead.abs(), rpm: into });
             dwell(&arguments, "DTB", &mut moves)?;
             moves.push(CycleMove::Tap { to: top, lead: lead.abs(), rpm: out });
+        }
+        Drilling::FloatingTap => {
+            let (into, moving) = match arguments.value("ENC") {
+                0.0 => {
+                    let lead = pitch(&arguments)?;
+                    (hole.spindle.abs() * lead.signum(), Some(lead.abs()))
+                }
+                1.0 => (hole.spindle, None),
+                other => return arguments.refuse("ENC", format!("is {other}, not 0 (with an encoder) or 1 (without)")),
+            };
+            if into == 0.0 {
+                return Err(CycleError {
+                    cycle: arguments.cycle.to_owned(),
+                    argument: None,
+                    problem: "needs the spindle turning".into(),
+                });
+            }
+            let out = match arguments.value("SDR") {
+                0.0 => -into,
+                3.0 | 4.0 => arguments.direction("SDR", into)?,
+                other => return arguments.refuse("SDR", format!("is {other}, not 0 (reversed), 3 (M3) or 4 (M4)")),
+            };
+            match moving {
+                Some(lead) => {
+                    moves.push(CycleMove::Tap { to: bottom, lead, rpm: into });
+                    dwell(&arguments, "DTB", &mut moves)?;
+                    moves.push(CycleMove::Tap { to: top, lead, rpm: out });
+                }
+                None => {
+                    let feed = feed()?;
+                    moves.push(CycleMove::Feed { to: bottom, feed });
+                    dwell(&arguments, "DTB", &mut moves)?;
+                    moves.extend([CycleMove::Spindle(SpindleAction::Turn(out)), CycleMove::Feed { to: top, feed }]);
+                }
+            }
         }
         Drilling::Bore => {
             let rate = |name| match arguments.value(name) {
@@ -367,7 +415,7 @@ pub fn drilling(name: &str, arguments: &[Option<f64>], hole: &Hole) -> Result<Ve
         }
     }
     moves.push(CycleMove::Rapid(at(planes.retraction)));
-    if kind == Drilling::Tap {
+    if matches!(kind, Drilling::Tap | Drilling::FloatingTap) {
         let after = match arguments.value("SDAC") {
             3.0 => SpindleAction::Turn(hole.spindle.abs()),
             4.0 => SpindleAction::Turn(-hole.spindle.abs()),

@@ -147,6 +147,50 @@ fn cycle84_taps_in_at_the_pitch_and_out_reversed() {
 }
 
 #[test]
+fn cycle840_taps_at_the_pitch_with_an_encoder_and_at_the_feed_without() {
+    // The catalogue's example: M8 with an encoder, the spindle reversed for
+    // the return, M3 after.
+    let example = [10.0, 0.0, 2.0, -20.0].map(Some).into_iter().chain([None]);
+    let example: Vec<_> = example.chain([0.0, 0.0, 3.0, 0.0, 8.0].map(Some)).collect();
+    assert_eq!(
+        call("CYCLE840", &example),
+        [
+            Rapid(at(2.0)),
+            Tap { to: at(-20.0), lead: 1.25, rpm: 1000.0 },
+            Tap { to: at(2.0), lead: 1.25, rpm: -1000.0 },
+            Rapid(at(10.0)),
+            Spindle(Turn(1000.0)),
+        ]
+    );
+    // Without an encoder at F, out in M4 as SDR says, M5 after.
+    let floating = [10.0, 0.0, 2.0, -20.0, 0.0, 0.0, 4.0, 5.0, 1.0].map(Some);
+    let moves = call("CYCLE840", &floating);
+    assert_eq!(
+        moves,
+        [
+            Rapid(at(2.0)),
+            Feed { to: at(-20.0), feed: 300.0 },
+            Spindle(Turn(-1000.0)),
+            Feed { to: at(2.0), feed: 300.0 },
+            Rapid(at(10.0)),
+            Spindle(Stop),
+        ]
+    );
+    close(feed_length(&moves), 44.0);
+    // AXN 1 taps along X, whatever the plane.
+    let mut along_x = floating.to_vec();
+    along_x.extend([None, None, Some(1.0)]);
+    assert_eq!(call("CYCLE840", &along_x)[1], Feed { to: [-20.0, 20.0, 50.0], feed: 300.0 });
+    for (at, value, name) in [(8, 2.0, "ENC"), (6, 5.0, "SDR"), (11, 4.0, "AXN")] {
+        let mut wrong = along_x.clone();
+        wrong[at] = Some(value);
+        assert_eq!(refused("CYCLE840", &wrong).argument, Some((at, name)));
+    }
+    let still = Hole { spindle: 0.0, ..HOLE };
+    assert_eq!(drilling("CYCLE840", &floating, &still).unwrap_err().to_string(), "CYCLE840: needs the spindle turning");
+}
+
+#[test]
 fn boring_cycles_feed_in_and_out_as_each_says() {
     let bore = [10.0, 0.0, 2.0, -20.0].map(Some);
     let with =
