@@ -317,7 +317,7 @@ impl ProgrammableFrame {
 /// rotation in the plane as one about its tool axis.
 fn axis_values(command: FrameCommand, words: &[(&str, f64)], plane: Plane) -> Result<[Option<f64>; 3], FrameError> {
     let mut values = [None; 3];
-    let mut in_plane = None;
+    let mut in_plane = false;
     for (index, &(address, value)) in words.iter().enumerate() {
         let error = |kind| Err(FrameError { word: index, kind });
         let address = address.to_ascii_uppercase();
@@ -328,14 +328,14 @@ fn axis_values(command: FrameCommand, words: &[(&str, f64)], plane: Plane) -> Re
             if command.kind != FrameKind::Rotation || values.iter().any(Option::is_some) {
                 return error(FrameErrorKind::PlaneRotation);
             }
-            in_plane = Some(index);
+            in_plane = true;
             values[plane.axes()[2]] = Some(value);
             continue;
         }
         let Some(axis) = AXES.iter().position(|&name| name == address) else {
             return error(FrameErrorKind::NotAFrameAxis(address));
         };
-        if in_plane.is_some() {
+        if in_plane {
             return error(FrameErrorKind::PlaneRotation);
         }
         if values[axis].is_some() {
