@@ -970,7 +970,13 @@ fn renamed(path: &str, text: &str, needle: &str, new_name: &str) -> Result<Strin
 
 /// The lines a rename changed, as they read after it (without indent).
 fn changed_lines(before: &str, after: &str) -> String {
-    before.lines().zip(after.lines()).filter(|(b, a)| b != a).map(|(_, a)| a.trim_start()).collect::<Vec<_>>().join("\n")
+    before
+        .lines()
+        .zip(after.lines())
+        .filter(|(b, a)| b != a)
+        .map(|(_, a)| a.trim_start())
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 #[test]

@@ -90,9 +90,11 @@ fn word_code(word: &SyntaxNode) -> Option<(u8, Option<u32>)> {
     Some((letter, number.and_then(|number| number.text().parse().ok()).filter(|_| is_code)))
 }
 
-/// The file's blocks, in order.
+/// The file's blocks, in order: the children of its block runs, as the
+/// lowering reads them.
 fn blocks(root: &SyntaxNode) -> impl Iterator<Item = SyntaxNode> {
-    root.descendants().filter(|node| node.kind() == SyntaxKind::BLOCK)
+    let runs = root.children().filter(|node| node.kind() == SyntaxKind::BLOCK_RUN);
+    runs.flat_map(|run| run.children()).filter(|node| node.kind() == SyntaxKind::BLOCK)
 }
 
 /// A block's line without its line break and trailing blanks.

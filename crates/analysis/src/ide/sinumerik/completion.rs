@@ -4,20 +4,17 @@
 //! parameters as a snippet.
 
 use ncc_catalog::Item;
-use ncc_syntax::{Dialect, TextRange};
+use ncc_syntax::{Dialect, SyntaxKind, TextRange};
 
 use super::{
-    catalogue,
-    navigation::{Symbol, occurrences, program_key},
+    blocks, catalogue,
+    navigation::{declared, name_run, program_key},
     outline::declared_type,
     signature::proc_signature,
 };
 use crate::{
     db::{Db, Settings, SourceFile},
-    ide::{
-        completion::{CompletionItem, CompletionKind, Site},
-        references::ReferenceKind,
-    },
+    ide::completion::{CompletionItem, CompletionKind, Site},
     sinumerik::model::file_model,
 };
 
@@ -44,19 +41,23 @@ pub(super) fn system_variables(site: &Site<'_>, replace: TextRange) -> Vec<Compl
     variables.chain(prefixes).collect()
 }
 
-/// The labels of the file, once each, as written.
+/// The labels of the file, once each, as written. Read from the tree, as
+/// the variables are: completion asks at every keystroke, and nothing of
+/// the rest of the file is needed.
 pub(super) fn labels(db: &dyn Db, file: SourceFile, site: &Site<'_>, replace: TextRange) -> Vec<CompletionItem> {
     let text = file.text(db);
-    let mut seen: Vec<&Symbol> = Vec::new();
+    let root = file.parse(db).syntax_node();
+    let mut seen: Vec<String> = Vec::new();
     let mut items = Vec::new();
-    for label in occurrences(db, file).iter().filter(|o| matches!(o.symbol, Symbol::Label(_))) {
-        if label.kind != ReferenceKind::Definition || seen.contains(&&label.symbol) {
+    for label in blocks(&root).flat_map(|block| block.children()).filter(|node| node.kind() == SyntaxKind::LABEL) {
+        let Some((name, range)) = name_run(label.children_with_tokens()) else { continue };
+        if seen.contains(&name) {
             continue;
         }
-        seen.push(&label.symbol);
-        let line = text[..usize::from(label.range.start())].matches('\n').count() + 1;
+        seen.push(name);
+        let line = text[..usize::from(range.start())].matches('\n').count() + 1;
         items.push(site.item(
-            text[label.range].to_owned(),
+            text[range].to_owned(),
             CompletionKind::Label,
             format!("label, line {line}"),
             None,
@@ -71,15 +72,19 @@ pub(super) fn labels(db: &dyn Db, file: SourceFile, site: &Site<'_>, replace: Te
 pub(super) fn variables(db: &dyn Db, file: SourceFile, site: &Site<'_>, replace: TextRange) -> Vec<CompletionItem> {
     let text = file.text(db);
     let root = file.parse(db).syntax_node();
-    let mut seen: Vec<&Symbol> = Vec::new();
+    let declarations = blocks(&root)
+        .flat_map(|block| block.children())
+        .filter(|statement| matches!(statement.kind(), SyntaxKind::DEF_STMT | SyntaxKind::PROC_STMT))
+        .flat_map(|statement| statement.children());
+    let mut seen: Vec<String> = Vec::new();
     let mut items = Vec::new();
-    for declared in occurrences(db, file).iter().filter(|o| o.kind == ReferenceKind::Definition) {
-        if !matches!(declared.symbol, Symbol::Variable(_)) || seen.contains(&&declared.symbol) {
+    for (name, range) in declarations.filter_map(|node| declared(&node)) {
+        if seen.contains(&name) {
             continue;
         }
-        seen.push(&declared.symbol);
-        let detail = declared_type(text, &root, declared.range).unwrap_or_default();
-        items.push(site.item(text[declared.range].to_owned(), CompletionKind::Variable, detail, None, replace));
+        seen.push(name);
+        let detail = declared_type(text, &root, range).unwrap_or_default();
+        items.push(site.item(text[range].to_owned(), CompletionKind::Variable, detail, None, replace));
     }
     items
 }

@@ -104,12 +104,8 @@ fn occurrence(model: &FileModel, index: usize, node: &SyntaxNode) -> Option<Occu
             }
             (Symbol::Variable(name), range, access(node))
         }
-        SyntaxKind::VAR_DECL => {
-            let (name, range) = name_run(elements())?;
-            (Symbol::Variable(name), range, ReferenceKind::Definition)
-        }
-        SyntaxKind::PARAM if parent == Some(SyntaxKind::PROC_STMT) => {
-            let (name, range) = name_run(elements().skip_while(|e| e.kind() != SyntaxKind::TYPE).skip(1))?;
+        SyntaxKind::VAR_DECL | SyntaxKind::PARAM => {
+            let (name, range) = declared(node)?;
             (Symbol::Variable(name), range, ReferenceKind::Definition)
         }
         SyntaxKind::PARAM_REF => {
@@ -147,9 +143,21 @@ fn occurrence(model: &FileModel, index: usize, node: &SyntaxNode) -> Option<Occu
     Some(Occurrence { symbol, range, kind, block: index })
 }
 
+/// The name a DEF's `VAR_DECL` or a PROC's parameter declares.
+pub(super) fn declared(node: &SyntaxNode) -> Option<(String, TextRange)> {
+    let elements = node.children_with_tokens();
+    match node.kind() {
+        SyntaxKind::VAR_DECL => name_run(elements),
+        SyntaxKind::PARAM if node.parent().is_some_and(|parent| parent.kind() == SyntaxKind::PROC_STMT) => {
+            name_run(elements.skip_while(|e| e.kind() != SyntaxKind::TYPE).skip(1))
+        }
+        _ => None,
+    }
+}
+
 /// The name that starts the elements (after blanks), upper case: an
 /// identifier, or a letter with its digits (`L1`, `R_1`).
-fn name_run(elements: impl Iterator<Item = SyntaxElement>) -> Option<(String, TextRange)> {
+pub(super) fn name_run(elements: impl Iterator<Item = SyntaxElement>) -> Option<(String, TextRange)> {
     let is_name = |e: &SyntaxElement| matches!(e.kind(), SyntaxKind::IDENT | SyntaxKind::LETTER | SyntaxKind::NUMBER);
     let mut tokens = elements.skip_while(|e| e.kind().is_trivia()).take_while(is_name).filter_map(|e| e.into_token());
     let first = tokens.next()?;
