@@ -13,7 +13,8 @@
 //! workspace by its file's name, `NAME.SPF`, `NAME.MPF`, `_N_NAME_SPF` or
 //! `_N_NAME_MPF`, in any case (004:1444-1456); a name written without DEF
 //! and unknown to the catalogue (a global variable) has references but no
-//! definition here.
+//! definition here; a `REPEAT` section's label is looked for before the
+//! `REPEAT`, then after it.
 
 use nc_exec::sinumerik::{
     lower::{Callee, Jump, JumpKind, JumpTarget, StatementKind},
@@ -280,8 +281,7 @@ fn jump_target(model: &FileModel, at: &Occurrence) -> Option<usize> {
     let resolved = match model.model.jumps_from(at.block).find(|site| site.jump.range.contains_range(relative)) {
         Some(site) => site.resolved,
         None => {
-            // A `REPEAT` section: its labels come before it (Siemens
-            // documentation), else after.
+            // A `REPEAT` section's label: before it, else after.
             let Symbol::Label(label) = &at.symbol else { return None };
             let jump = |kind| Jump { kind, target: Some(JumpTarget::Label(label.clone())), range: relative };
             match model.model.resolve(at.block, &jump(JumpKind::GotoB)) {
@@ -332,14 +332,31 @@ const MAX_NAME: usize = 31;
 
 /// The name at `offset` that rename would change, or why there is none.
 pub(crate) fn prepare_rename(db: &dyn Db, file: SourceFile, offset: TextSize) -> Result<TextRange, String> {
+    renamed_at(db, file, offset).map(|at| at.range)
+}
+
+/// The edits that rename the thing at `offset` to `new_name` in the file,
+/// or why they cannot.
+pub(crate) fn rename(db: &dyn Db, file: SourceFile, offset: TextSize, new_name: &str) -> Result<Vec<TextEdit>, String> {
+    let at = renamed_at(db, file, offset)?;
+    check_new_name(db, file, &at.symbol, new_name)?;
+    Ok(occurrences(db, file)
+        .iter()
+        .filter(|o| o.symbol == at.symbol)
+        .map(|o| TextEdit::replace(o.range, new_name))
+        .collect())
+}
+
+/// The name at `offset` if rename can change it: a label, or a variable
+/// or parameter the file declares.
+fn renamed_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Result<&Occurrence, String> {
     let at = occurrence_at(db, file, offset).ok_or_else(|| {
         "Nothing to rename here: user variables, PROC parameters and labels can be renamed".to_owned()
     })?;
-    let text = file.text(db);
-    let written = &text[at.range];
+    let written = &file.text(db)[at.range];
     match &at.symbol {
-        Symbol::Label(_) => Ok(at.range),
-        Symbol::Variable(name) if is_declared(file_model(db, file), name) => Ok(at.range),
+        Symbol::Label(_) => Ok(at),
+        Symbol::Variable(name) if is_declared(file_model(db, file), name) => Ok(at),
         Symbol::Variable(_) => Err(format!(
             "`{written}` is not declared in this file (no DEF or PROC parameter): it cannot be renamed here"
         )),
@@ -347,19 +364,6 @@ pub(crate) fn prepare_rename(db: &dyn Db, file: SourceFile, offset: TextSize) ->
         Symbol::Parameter(_) => Err(format!("`{written}` is an R parameter: its number cannot be renamed")),
         Symbol::Program(_) => Err(format!("`{written}` is a program: it is renamed with its file")),
     }
-}
-
-/// The edits that rename the thing at `offset` to `new_name` in the file,
-/// or why they cannot.
-pub(crate) fn rename(db: &dyn Db, file: SourceFile, offset: TextSize, new_name: &str) -> Result<Vec<TextEdit>, String> {
-    prepare_rename(db, file, offset)?;
-    let at = occurrence_at(db, file, offset).expect("prepare_rename found a name");
-    check_new_name(db, file, &at.symbol, new_name)?;
-    Ok(occurrences(db, file)
-        .iter()
-        .filter(|o| o.symbol == at.symbol)
-        .map(|o| TextEdit::replace(o.range, new_name))
-        .collect())
 }
 
 /// Refuses a name the control would not take (two letters, then letters,
