@@ -739,7 +739,8 @@ fn a_sinumerik_document_gets_its_syntax_errors_hover_tokens_and_outline() {
     let symbols = symbols.result().unwrap().as_array().unwrap().clone();
     assert_eq!(symbols.len(), 1, "{symbols:?}");
     assert_eq!(symbols[0]["name"], "PART");
-    assert_eq!(symbols[0]["children"][0]["name"], "START");
+    let children: Vec<&Value> = symbols[0]["children"].as_array().unwrap().iter().map(|c| &c["name"]).collect();
+    assert_eq!(children, ["NAME", "START", "WHILE R1<10"], "{symbols:?}");
 
     let folds = client.call("textDocument/foldingRange", json!({ "textDocument": doc.id() })).unwrap();
     let folds: Vec<(u64, u64)> = folds
@@ -801,4 +802,58 @@ fn the_plot_command_runs_called_files_as_edited() {
     client.notify("textDocument/didChange", macrocycle.change(x + 1..x + 3, "30")).unwrap();
     let edited = total(&mut client);
     assert!((edited - on_disk - 2.0).abs() < 0.01, "{on_disk} s before the edit, {edited} s after");
+}
+
+/// Go to definition, rename and signature help in a Sinumerik program that
+/// calls a subprogram of the workspace.
+#[test]
+fn sinumerik_definition_rename_and_signature_help() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("PROFIL.SPF"), "PROC PROFIL(REAL C, BOOL H, REAL X)\nG1 X=X\nRET\n").unwrap();
+    let mut client = server();
+    let initialized = client.initialize(dir.path(), None).unwrap();
+    let capabilities = &initialized.result().unwrap()["capabilities"];
+    assert_eq!(capabilities["renameProvider"], json!({ "prepareProvider": true }), "{capabilities}");
+    assert_eq!(capabilities["signatureHelpProvider"]["triggerCharacters"], json!(["(", ","]), "{capabilities}");
+    let text = "DEF INT DELKA\nDELKA=5 ; DELKA\nPROFIL(,TRUE,DELKA)\nM30\n";
+    let doc = document(&dir, "MAIN.MPF", text);
+    open(&mut client, &doc);
+    let at = |needle: &str| doc.at(doc.position(text.find(needle).unwrap()));
+    let range = |line: u32, start: u32, end: u32| json!({ "start": { "line": line, "character": start }, "end": { "line": line, "character": end } });
+
+    let answer = client.call("textDocument/definition", at("PROFIL(")).unwrap();
+    let links = answer.result().unwrap_or_else(|| panic!("{}", answer.json));
+    assert!(links[0]["targetUri"].as_str().is_some_and(|uri| uri.ends_with("/PROFIL.SPF")), "{links}");
+    assert_eq!(links[0]["targetSelectionRange"], range(0, 5, 11), "{links}");
+
+    let answer = client.call("textDocument/prepareRename", at("DELKA=")).unwrap();
+    assert_eq!(answer.result(), Some(&range(1, 0, 5)), "{}", answer.json);
+    let mut params = at("DELKA=");
+    params["newName"] = json!("LENGTH");
+    let answer = client.call("textDocument/rename", params.clone()).unwrap();
+    let edits = &answer.result().unwrap_or_else(|| panic!("{}", answer.json))["changes"][&doc.uri];
+    let edited: Vec<(&Value, &Value)> =
+        edits.as_array().unwrap().iter().map(|e| (&e["range"], &e["newText"])).collect();
+    // The comment keeps its word.
+    let renamed = json!("LENGTH");
+    assert_eq!(edited, [(&range(0, 8, 13), &renamed), (&range(1, 0, 5), &renamed), (&range(2, 13, 18), &renamed)]);
+    params["newName"] = json!("1X");
+    let refused = client.call("textDocument/rename", params).unwrap();
+    assert_eq!(refused.error_code(), Some(-32803), "{}", refused.json);
+    assert!(
+        refused.json["error"]["message"].as_str().is_some_and(|m| m.contains("not a valid name")),
+        "{}",
+        refused.json
+    );
+    let refused = client.call("textDocument/prepareRename", at("M30")).unwrap();
+    assert_eq!(refused.error_code(), Some(-32803), "{}", refused.json);
+
+    let answer = client.call("textDocument/signatureHelp", at("DELKA)")).unwrap();
+    let help = answer.result().unwrap_or_else(|| panic!("{}", answer.json));
+    assert_eq!(help["signatures"][0]["label"], "PROFIL(REAL C, BOOL H, REAL X)", "{help}");
+    assert_eq!(help["activeParameter"], 2, "{help}");
+    assert_eq!(help["signatures"][0]["parameters"][2]["label"], json!([23, 29]), "{help}");
+    let outside = client.call("textDocument/signatureHelp", at("M30")).unwrap();
+    assert_eq!(outside.result(), Some(&Value::Null), "{}", outside.json);
+    assert_serving(&mut client, &dir);
 }

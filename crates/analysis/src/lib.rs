@@ -15,6 +15,7 @@ mod dialect;
 mod findings;
 mod haas_lathe;
 mod ide;
+mod sinumerik;
 mod suppress;
 
 use std::sync::Arc;
@@ -46,7 +47,7 @@ pub use crate::{
     db::{RootDatabase, SourceFile},
     diagnostic::{Diagnostic, Fix, Related, Rule},
     findings::{Findings, OmittedFindings},
-    ide::{HoverResult, NavigationTarget},
+    ide::{HoverResult, NavigationTarget, SignatureHelp, SignatureParameter},
     suppress::Suppressions,
 };
 
@@ -268,6 +269,25 @@ impl Analysis {
     /// The highlighting of the blocks (and header, end) that overlap `range`.
     pub fn highlight_range(&self, file: FileId, range: TextRange) -> Vec<HighlightRange> {
         ide::highlight::highlight(&self.db, file, Some(range))
+    }
+
+    /// The name at `offset` that [`Analysis::rename`] would change, or why
+    /// none can be renamed there.
+    pub fn prepare_rename(&self, file: FileId, offset: TextSize) -> Result<TextRange, String> {
+        ide::prepare_rename(&self.db, file, offset)
+    }
+
+    /// The edits of `file` that give the name at `offset` the name
+    /// `new_name` wherever it is written, or why they cannot (the name is
+    /// not one the control takes, or is taken).
+    pub fn rename(&self, file: FileId, offset: TextSize, new_name: &str) -> Result<Vec<TextEdit>, String> {
+        ide::rename(&self.db, file, offset, new_name)
+    }
+
+    /// The signature of the call whose parentheses hold `offset`, with the
+    /// parameter there.
+    pub fn signature_help(&self, file: FileId, offset: TextSize) -> Option<SignatureHelp> {
+        ide::signature_help(&self.db, file, offset)
     }
 
     /// The definition (with `include_declaration`) and the uses of the

@@ -329,8 +329,7 @@ fn sinumerik_completions(program: &str) -> Vec<String> {
 }
 
 /// Where a word starts: codes, addresses, keywords and functions; in an
-/// expression the functions alone; nothing in a comment, a string or a
-/// system variable's name.
+/// expression the functions alone; nothing in a comment or a string.
 #[test]
 fn sinumerik_completion_offers_the_catalogues_words() {
     let items = sinumerik_completions("N10 G0 X0\nGOT$0\n");
@@ -342,9 +341,84 @@ fn sinumerik_completion_offers_the_catalogues_words() {
     let items = sinumerik_completions("G1 X=SI$0\n");
     assert!(items.iter().any(|item| item == "SIN (Function)"), "{items:?}");
     assert!(items.iter().all(|item| item.ends_with("(Function)")), "{items:?}");
-    for program in ["G1 X0 ; a G$0\n", "MSG(\"G$0\")\n", "R1=$P_$0\n"] {
+    for program in ["G1 X0 ; a G$0\n", "MSG(\"G$0\")\n"] {
         assert_eq!(sinumerik_completions(program), Vec::<String>::new(), "{program}");
     }
+}
+
+/// The completions in a workspace of `files`, the cursor at `$0` in the
+/// first, as `label (kind): detail`, and the inserted text when it is not
+/// the label.
+fn sinumerik_workspace_completions(files: &[(&str, &str)]) -> Vec<String> {
+    let mut host = AnalysisHost::in_dialect(Dialect::Sinumerik, Config::default());
+    let (path, program) = files[0];
+    let file = host.add_file(path, program.replace("$0", ""));
+    for (path, text) in &files[1..] {
+        host.add_file(*path, *text);
+    }
+    let offset = TextSize::try_from(program.find("$0").expect("a `$0` cursor")).unwrap();
+    let text = host.analysis().text(file);
+    host.analysis()
+        .completions(file, offset)
+        .iter()
+        .map(|item| {
+            assert_eq!(&text[item.replace], &program[usize::from(item.replace.start())..offset.into()]);
+            let inserted =
+                if item.insert_text == item.label { String::new() } else { format!(" → {}", item.insert_text) };
+            format!("{} ({:?}): {}{inserted}", item.label, item.kind, item.detail)
+        })
+        .collect()
+}
+
+const CAM: &str = "PROC CAM(REAL RADIUS, VAR INT COUNT) SAVE
+DEF STRING[50] FILE_NAME=\"CAM\"
+DEF REAL ANGLE, STEPS[3]
+START: ANGLE=0
+END_CAM: M17
+";
+
+/// After `$` the catalogue's system variables and prefixes; after a jump
+/// the file's labels alone; the file's variables and parameters with
+/// their types wherever a value goes; where a word starts the programs of
+/// the workspace, with their parameters to fill.
+#[test]
+fn sinumerik_completion_offers_the_files_names() {
+    let items = sinumerik_workspace_completions(&[("MAIN.MPF", "R1=$P_$0\n")]);
+    assert!(items.iter().any(|item| item.starts_with("$P_F (Variable): ")), "{items:?}");
+    assert!(items.iter().any(|item| item.starts_with("$AA_ (Variable): ")), "{items:?}");
+    assert!(items.iter().all(|item| item.starts_with('$')), "{items:?}");
+
+    let with_cam = |program: &str| {
+        let program = CAM.replace("END_CAM: M17\n", &format!("{program}\nEND_CAM: M17\n"));
+        sinumerik_workspace_completions(&[("CAM.SPF", &program)])
+    };
+    expect![[r#"
+        START (Label): label, line 4
+        END_CAM (Label): label, line 6"#]]
+    .assert_eq(&with_cam("IF ANGLE>1 GOTOB S$0").join("\n"));
+    let items = with_cam("ANGLE=RA$0");
+    let names: Vec<&String> = items.iter().filter(|item| item.contains("(Variable)")).collect();
+    expect![[r#"
+        [
+            "RADIUS (Variable): REAL",
+            "COUNT (Variable): VAR INT",
+            "FILE_NAME (Variable): STRING[50]",
+            "ANGLE (Variable): REAL",
+            "STEPS (Variable): REAL",
+        ]
+    "#]]
+    .assert_debug_eq(&names);
+
+    let files = [("MAIN.MPF", "G0 X0\nCA$0\n"), ("CAM.SPF", CAM), ("_N_PLAIN_SPF", "PROC PLAIN\nM17\n")];
+    let items = sinumerik_workspace_completions(&files);
+    let programs: Vec<&String> = items.iter().filter(|item| item.contains("(Program)")).collect();
+    expect![[r#"
+        [
+            "CAM (Program): CAM(REAL RADIUS, VAR INT COUNT) → CAM(${1:RADIUS}, ${2:COUNT})",
+            "PLAIN (Program): PLAIN()",
+        ]
+    "#]]
+    .assert_debug_eq(&programs);
 }
 
 /// A Haas lathe program with contours, calls, a jump and macro variables;

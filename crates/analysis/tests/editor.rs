@@ -695,7 +695,6 @@ fn every_lathe_example_answers_everywhere() {
             let _ = analysis.hover(file, offset);
             let _ = analysis.goto_definition(file, offset);
             let _ = analysis.references(file, offset, true);
-            let _ = analysis.completions(file, offset);
         }
     }
 }
@@ -770,9 +769,14 @@ fn symbols_and_folds_of_a_sinumerik_program() {
         "PART.SPF",
         SINUMERIK,
         expect![[r#"
-        Subprogram PART ((REAL DEPTH, VAR INT COUNT) SAVE): `PROC PART(REAL DEPTH, VAR INT COUNT) SAVE` … `M17` select `PART`
-          JumpTarget START: `START: $P_UIFR[1,X,TR]=5` select `START`
-    "#]],
+            Subprogram PART ((REAL DEPTH, VAR INT COUNT) SAVE): `PROC PART(REAL DEPTH, VAR INT COUNT) SAVE` … `M17` select `PART`
+              Variable B (REAL): `B=5` select `B`
+              Variable C (REAL): `C[2]` select `C`
+              JumpTarget START: `START: $P_UIFR[1,X,TR]=5` select `START`
+              Structure IF B<>C[1]: `IF B<>C[1]` … `ENDIF` select `IF`
+                Structure WHILE R1<10: `  WHILE R1<10` … `  ENDWHILE` select `WHILE`
+                Structure REPEAT: `  REPEAT` … `  UNTIL B==5` select `REPEAT`
+        "#]],
     );
     check_folds(
         "PART.SPF",
@@ -810,4 +814,437 @@ fn sinumerik_listings_highlight_without_errors() {
         read += 1;
     }
     assert!(read >= 15, "{read} listings");
+}
+
+/// The seed listings: L19's main program and subprogram, L29 with its
+/// computed jumps, L30 and the cycle L31 it calls.
+const L19_MAIN: &str = include_str!("../../syntax/test_data/sinumerik/l19_profil_main.mpf");
+const L19_SUB: &str = include_str!("../../syntax/test_data/sinumerik/l19_profil_sub.spf");
+const L29: &str = include_str!("../../syntax/test_data/sinumerik/l29_blob_souradnice_dole.mpf");
+const L30: &str = include_str!("../../syntax/test_data/sinumerik/l30_run_vacka.mpf");
+const L31: &str = include_str!("../../syntax/test_data/sinumerik/l31_vacka_cyklus.spf");
+
+/// A workspace of `files` with the cursor before `needle` in the first.
+fn with_cursor(files: &[(&str, &str)], needle: &str) -> Vec<(String, String)> {
+    let mut files: Vec<(String, String)> = files.iter().map(|(p, t)| (p.to_string(), t.to_string())).collect();
+    files[0].1 = at(&files[0].1, needle);
+    files
+}
+
+fn borrowed(files: &[(String, String)]) -> Vec<(&str, &str)> {
+    files.iter().map(|(p, t)| (p.as_str(), t.as_str())).collect()
+}
+
+/// Where go to definition leads from before `needle` in the first file, as
+/// `path:line: focus`.
+fn definitions(files: &[(&str, &str)], needle: &str) -> Vec<String> {
+    let files = with_cursor(files, needle);
+    let (host, _, cursor) = setup(&borrowed(&files));
+    let (file, offset) = cursor.unwrap();
+    let analysis = host.analysis();
+    analysis
+        .goto_definition(file, offset)
+        .iter()
+        .map(|target| {
+            let text = analysis.text(target.file);
+            assert!(target.range.contains_range(target.focus), "{target:?}");
+            let line = text[..usize::from(target.focus.start())].matches('\n').count() + 1;
+            format!("{}:{line}: {}", analysis.path(target.file), show(&text, target.focus))
+        })
+        .collect()
+}
+
+fn references_at(files: &[(&str, &str)], needle: &str) -> String {
+    references(&borrowed(&with_cursor(files, needle)), true)
+}
+
+#[test]
+fn sinumerik_definitions_of_calls_variables_and_parameters_across_files() {
+    let files = [("MAIN.MPF", L19_MAIN), ("PROFIL.SPF", L19_SUB)];
+    assert_eq!(definitions(&files, "PROFIL ("), ["PROFIL.SPF:4: `PROFIL`"]);
+    assert_eq!(definitions(&files, "DELKA) ;"), ["MAIN.MPF:4: `DELKA`"]);
+    assert_eq!(definitions(&files, "DELKA=5.0"), ["MAIN.MPF:4: `DELKA`"]);
+    // In the subprogram: the formal parameters, not the axes X1 and Y1.
+    let files = [("PROFIL.SPF", L19_SUB), ("MAIN.MPF", L19_MAIN)];
+    assert_eq!(definitions(&files, "X Y1"), ["PROFIL.SPF:4: `X`"]);
+    assert_eq!(definitions(&files, "X1="), Vec::<String>::new());
+    check_references(
+        &borrowed(&with_cursor(&files, "PROFIL (")),
+        true,
+        expect![[r#"
+            PROFIL.SPF:4:7: PROFIL Definition
+            MAIN.MPF:6:6: PROFIL Call"#]],
+    );
+    // L30 declares the cycle L31 is and calls it; the program it writes is
+    // called by its control name `_N_…_SPF`.
+    let files = [
+        ("RUN_VACKA.MPF", L30),
+        ("VACKA_CYKLUS.SPF", L31),
+        ("_N_GEOMETRIE_VACKA_SPF", "; written by VACKA_CYKLUS\nG0 X0\nM17\n"),
+    ];
+    assert_eq!(definitions(&files, "VACKA_CYKLUS("), ["VACKA_CYKLUS.SPF:3: `VACKA_CYKLUS`"]);
+    assert_eq!(definitions(&files, "VACKA_CYKLUS(POC"), ["VACKA_CYKLUS.SPF:3: `VACKA_CYKLUS`"]);
+    assert_eq!(definitions(&files, "_N_GEOMETRIE_VACKA_SPF\n"), ["_N_GEOMETRIE_VACKA_SPF:1: ``"]);
+    check_references(
+        &borrowed(&with_cursor(&files, "VACKA_CYKLUS(POC")),
+        true,
+        expect![[r#"
+            VACKA_CYKLUS.SPF:3:6: VACKA_CYKLUS Definition
+            RUN_VACKA.MPF:4:8: VACKA_CYKLUS Declaration
+            RUN_VACKA.MPF:36:5: VACKA_CYKLUS Call"#]],
+    );
+}
+
+/// L29 jumps to block numbers and labels and computes the target of some:
+/// those have no definition before a run.
+#[test]
+fn sinumerik_jumps_of_l29_lead_to_their_blocks() {
+    let files = [("BLOB.MPF", L29)];
+    assert_eq!(definitions(&files, "N5\nN3"), ["BLOB.MPF:87: `N5`"]);
+    assert_eq!(definitions(&files, "N2\nELSE"), ["BLOB.MPF:66: `N2`"]);
+    assert_eq!(definitions(&files, "PREDBEZNE\nENDIF"), ["BLOB.MPF:23: `PREDBEZNE`"]);
+    assert_eq!(definitions(&files, "END\nR10="), ["BLOB.MPF:104: `END`"]);
+    assert_eq!(definitions(&files, "\"N\"<<R3"), Vec::<String>::new());
+    // An R parameter's definitions are its assignments.
+    expect![[r#"
+        BLOB.MPF:68: `R3`
+        BLOB.MPF:83: `R3`"#]]
+    .assert_eq(&definitions(&files, "R3\nENDIF").join("\n"));
+    expect![[r#"
+        BLOB.MPF:68:3: R3 Write
+        BLOB.MPF:70:14: R3 Read
+        BLOB.MPF:83:3: R3 Write
+        BLOB.MPF:85:14: R3 Read"#]]
+    .assert_eq(&references_at(&files, "R3=100"));
+    expect![[r#"
+        BLOB.MPF:66:1: N2 Definition
+        BLOB.MPF:61:8: N2 Jump"#]]
+    .assert_eq(&references_at(&files, "N2 "));
+}
+
+/// L31: labels reached forward and backward, CASE jumps to block numbers,
+/// and a FOR variable written in three cases.
+#[test]
+fn sinumerik_labels_case_targets_and_variables_of_l31() {
+    let files = [("VACKA_CYKLUS.SPF", L31)];
+    assert_eq!(definitions(&files, "KRUH\n  WRITE"), ["VACKA_CYKLUS.SPF:87: `KRUH`"]);
+    assert_eq!(definitions(&files, "COUNTER\n;"), ["VACKA_CYKLUS.SPF:83: `COUNTER`"]);
+    assert_eq!(definitions(&files, "N24 10"), ["VACKA_CYKLUS.SPF:27: `N24`"]);
+    assert_eq!(definitions(&files, "INKREMENT_UHLU\n"), ["VACKA_CYKLUS.SPF:3: `INKREMENT_UHLU`"]);
+    expect![[r#"
+        VACKA_CYKLUS.SPF:4:64: VAR_i Definition
+        VACKA_CYKLUS.SPF:60:5: var_i Write
+        VACKA_CYKLUS.SPF:63:35: VAR_I Read
+        VACKA_CYKLUS.SPF:65:15: var_i Read
+        VACKA_CYKLUS.SPF:66:34: var_i Read
+        VACKA_CYKLUS.SPF:67:21: var_i Read
+        VACKA_CYKLUS.SPF:67:39: var_i Read
+        VACKA_CYKLUS.SPF:67:60: var_i Read
+        VACKA_CYKLUS.SPF:69:15: var_i Read
+        VACKA_CYKLUS.SPF:69:34: var_i Read
+        VACKA_CYKLUS.SPF:71:58: var_i Read
+        VACKA_CYKLUS.SPF:84:18: var_i Read"#]]
+    .assert_eq(&references_at(&files, "var_i = 0"));
+    expect![[r#"
+        VACKA_CYKLUS.SPF:98:1: END Definition
+        VACKA_CYKLUS.SPF:65:35: END Jump"#]]
+    .assert_eq(&references_at(&files, "END:"));
+}
+
+/// The text after renaming what is before `needle` to `new_name`, or why not.
+fn renamed(path: &str, text: &str, needle: &str, new_name: &str) -> Result<String, String> {
+    let files = with_cursor(&[(path, text)], needle);
+    let (host, ids, cursor) = setup(&borrowed(&files));
+    let analysis = host.analysis();
+    let offset = cursor.unwrap().1;
+    let prepared = analysis.prepare_rename(ids[0], offset)?;
+    assert!(prepared.contains_inclusive(offset), "{prepared:?} at {offset:?}");
+    let mut edits = analysis.rename(ids[0], offset, new_name)?;
+    edits.sort_by_key(|edit| std::cmp::Reverse(edit.delete.start()));
+    let mut text = analysis.text(ids[0]).to_string();
+    for edit in edits {
+        edit.apply(&mut text);
+    }
+    Ok(text)
+}
+
+/// The lines a rename changed, as they read after it (without indent).
+fn changed_lines(before: &str, after: &str) -> String {
+    before
+        .lines()
+        .zip(after.lines())
+        .filter(|(b, a)| b != a)
+        .map(|(_, a)| a.trim_start())
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn sinumerik_rename_changes_the_name_and_nothing_else() {
+    let after = renamed("VACKA_CYKLUS.SPF", L31, "VAR_I<<", "IDX_I").unwrap();
+    expect![[r#"
+        DEF REAL AKT_R, AKT_UHEL, AKT_X, AKT_Y, KONECNY_UHEL, DELTA_R, IDX_I
+        FOR IDX_I = 0 TO 20
+        WRITE(ERROR,DEBURGER,"VAR_I= "<<IDX_I<<"")
+        IF VAC_POLE[IDX_I+2,0]==0 GOTOF END
+        KONECNY_UHEL=AKT_UHEL+VAC_POLE[IDX_I+1,0]
+        DELTA_R=(VAC_POLE[IDX_I,1]-VAC_POLE[IDX_I+1,1])/VAC_POLE[IDX_I+1,0]*INKREMENT_UHLU
+        IF VAC_POLE[IDX_I,1]==VAC_POLE[IDX_I+1,1] GOTOF KRUH
+        WRITE(ERROR,DEBURGER,"VAC_POLE[var_i+1,0]= "<<VAC_POLE[IDX_I+1,0]<<"")
+        AKT_R=VAC_POLE[IDX_I+1,1]"#]]
+    .assert_eq(&changed_lines(L31, &after));
+    let after = renamed("VACKA_CYKLUS.SPF", L31, "END\n  KONECNY", "KONEC").unwrap();
+    expect![[r#"
+        IF VAC_POLE[var_i+2,0]==0 GOTOF KONEC
+        KONEC:"#]]
+    .assert_eq(&changed_lines(L31, &after));
+    // A PROC's formal parameter, in the subprogram.
+    let after = renamed("PROFIL.SPF", L19_SUB, "X Y1", "XPOS").unwrap();
+    expect![[r#"
+         PROC PROFIL (REAL C, BOOL H, REAL XPOS, INT Y, REAL Z) ; Formální parametry by nabyly hodnotu: C=0, protože nebyl předán, H=TRUE, X=2.14, Y=DELKA=5.0 , Z=0, protože také nebyl zadán
+         N30 X1=XPOS Y1=Y ; Najetí osou X1 na pozici 2.14 a osou Y1 na 5.0"#]]
+    .assert_eq(&changed_lines(L19_SUB, &after));
+}
+
+#[test]
+fn sinumerik_rename_refuses_names_the_control_would_not_take() {
+    let refusal = |needle: &str, new_name: &str| renamed("VACKA_CYKLUS.SPF", L31, needle, new_name).unwrap_err();
+    let refusals: Vec<String> = [
+        ("AKT_X=", "1X"),
+        ("AKT_X=", "X"),
+        ("AKT_X=", "A1"),
+        ("AKT_X=", "NAME-2"),
+        ("AKT_X=", "ABCDEFGHIJKLMNOPQRSTUVWXYZ_ABCDE"),
+        ("AKT_X=", "SIN"),
+        ("AKT_X=", "cr"),
+        ("AKT_X=", "GOTOF"),
+        ("AKT_X=", "CYCLE800"),
+        ("AKT_X=", "AKT_Y"),
+        ("AKT_X=", "kruh"),
+        ("KRUH:", "VACKA_CYKLUS"),
+        ("R=AKT_R", "VAC_POLE"),
+        ("VAC_POLE[0,1]", "TABLE"),
+        ("BSPLINE", "TABLE"),
+        ("$A_DAY", "TABLE"),
+        ("N21 M", "TABLE"),
+        ("VACKA_CYKLUS (", "TABLE"),
+        (";pohyb", "TABLE"),
+    ]
+    .into_iter()
+    .map(|(needle, new_name)| format!("{needle:?} → {new_name}: {}", refusal(needle, new_name)))
+    .collect();
+    expect![[r#"
+        "AKT_X=" → 1X: `1X` is not a valid name: two letters first, then letters, digits or `_`, at most 31 characters
+        "AKT_X=" → X: `X` is not a valid name: two letters first, then letters, digits or `_`, at most 31 characters
+        "AKT_X=" → A1: `A1` is not a valid name: two letters first, then letters, digits or `_`, at most 31 characters
+        "AKT_X=" → NAME-2: `NAME-2` is not a valid name: two letters first, then letters, digits or `_`, at most 31 characters
+        "AKT_X=" → ABCDEFGHIJKLMNOPQRSTUVWXYZ_ABCDE: `ABCDEFGHIJKLMNOPQRSTUVWXYZ_ABCDE` is not a valid name: two letters first, then letters, digits or `_`, at most 31 characters
+        "AKT_X=" → SIN: `SIN` is a predefined function of the control
+        "AKT_X=" → cr: `cr` is an address of the control
+        "AKT_X=" → GOTOF: `GOTOF` is a keyword of the control
+        "AKT_X=" → CYCLE800: `CYCLE800` is a cycle of the control
+        "AKT_X=" → AKT_Y: `AKT_Y` is already a name in this file (`AKT_Y` on line 4)
+        "AKT_X=" → kruh: `kruh` is already a name in this file (`KRUH` on line 69)
+        "KRUH:" → VACKA_CYKLUS: `VACKA_CYKLUS` is already a name in this file (`VACKA_CYKLUS` on line 3)
+        "R=AKT_R" → VAC_POLE: `VAC_POLE` is already a name in this file (`VAC_POLE` on line 11)
+        "VAC_POLE[0,1]" → TABLE: `VAC_POLE` is not declared in this file (no DEF or PROC parameter): it cannot be renamed here
+        "BSPLINE" → TABLE: Nothing to rename here: user variables, PROC parameters and labels can be renamed
+        "$A_DAY" → TABLE: Nothing to rename here: user variables, PROC parameters and labels can be renamed
+        "N21 M" → TABLE: `N21` is a block number: renumber the block instead
+        "VACKA_CYKLUS (" → TABLE: `VACKA_CYKLUS` is a program: it is renamed with its file
+        ";pohyb" → TABLE: Nothing to rename here: user variables, PROC parameters and labels can be renamed"#]].assert_eq(&refusals.join("\n"));
+    // The same name in another case is the same name.
+    assert!(renamed("VACKA_CYKLUS.SPF", L31, "AKT_X=", "Akt_X").is_ok());
+    assert_eq!(
+        renamed("BLOB.MPF", L29, "R3=100", "TABLE"),
+        Err("`R3` is an R parameter: its number cannot be renamed".to_owned())
+    );
+}
+
+/// A Sinumerik subprogram with seven names the rename test picks from (two
+/// PROC parameters, three variables, two labels), each also in a comment
+/// and a string, which rename leaves alone.
+fn naming_program(names: &[String]) -> String {
+    let [a, b, c, d, e, l1, l2] = names else { panic!("seven names") };
+    format!(
+        "PROC WORK(REAL {a}, INT {b})
+DEF REAL {c}={a}*2, {d}[3]
+DEF INT {e}
+{l1}: {c}={c}+{b} R1={d}[0]
+IF {c}>10 GOTOF {l2}
+FOR {e} = 0 TO {b}
+  {d}[{e}]={a}+{e}
+ENDFOR
+REPEAT {l1} P=2
+GOTOB {l1}
+{l2}: WRITE(R2,\"LOG\",\"C=\"<<{c})
+MSG(\"{a} {b} {c} {d} {e} {l1} {l2}\")
+; {a} {b} {c} {d} {e} {l1} {l2}
+M17
+"
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// Renaming a name and renaming it back gives the original text, and
+    /// comments and strings keep the old name.
+    #[test]
+    fn sinumerik_rename_and_back_gives_the_original(
+        bases in prop::collection::vec(("[A-Z]{2}[A-Z_]{0,5}", prop::bool::ANY), 7),
+        picked in 0usize..7,
+        new_base in "[A-Z]{2}[A-Z_]{0,5}",
+    ) {
+        // Distinct names, none a prefix of another: a digit only at the end.
+        let names: Vec<String> = bases
+            .iter()
+            .enumerate()
+            .map(|(i, (base, lower))| {
+                let name = format!("{base}Z{i}");
+                if *lower { name.to_lowercase() } else { name }
+            })
+            .collect();
+        let text = naming_program(&names);
+        let old = &names[picked];
+        let new = format!("{new_base}Z9");
+        let mut host = AnalysisHost::in_dialect(Dialect::Sinumerik, Config::default());
+        let file = host.add_file("WORK.SPF", text.as_str());
+        let offset = TextSize::try_from(text.find(old.as_str()).unwrap()).unwrap();
+        let rename = |host: &AnalysisHost, to: &str| {
+            let analysis = host.analysis();
+            let mut edits = analysis.rename(file, offset, to).unwrap_or_else(|why| panic!("{why}\n{}", analysis.text(file)));
+            edits.sort_by_key(|edit| std::cmp::Reverse(edit.delete.start()));
+            let mut renamed = analysis.text(file).to_string();
+            for edit in &edits {
+                edit.apply(&mut renamed);
+            }
+            renamed
+        };
+        let renamed = rename(&host, &new);
+        let untouched = |line: &&str| line.starts_with(';') || line.starts_with("MSG(");
+        prop_assert_eq!(text.lines().filter(untouched).collect::<Vec<_>>(), renamed.lines().filter(untouched).collect::<Vec<_>>());
+        prop_assert!(!renamed.lines().filter(|line| !untouched(line)).any(|line| line.contains(old.as_str())), "{}", renamed);
+        host.set_text(file, renamed);
+        prop_assert_eq!(rename(&host, old), text);
+    }
+}
+
+/// L31's outline: the PROC holds its variables, labels and structures,
+/// the structures what lies inside them.
+#[test]
+fn sinumerik_outline_nests_structures_labels_and_variables() {
+    check_symbols(
+        "VACKA_CYKLUS.SPF",
+        L31,
+        expect![[r#"
+        Subprogram VACKA_CYKLUS ((REAL POCATECNI_R, REAL TLOUSTKA, REAL INKREMENT_UHLU) SAVE): `PROC VACKA_CYKLUS (REAL POCATECNI_R, REAL TLOUSTKA, REAL INKREMENT_UHLU) SAVE` … `M17` select `VACKA_CYKLUS`
+          Variable AKT_R (REAL): `AKT_R` select `AKT_R`
+          Variable AKT_UHEL (REAL): `AKT_UHEL` select `AKT_UHEL`
+          Variable AKT_X (REAL): `AKT_X` select `AKT_X`
+          Variable AKT_Y (REAL): `AKT_Y` select `AKT_Y`
+          Variable KONECNY_UHEL (REAL): `KONECNY_UHEL` select `KONECNY_UHEL`
+          Variable DELTA_R (REAL): `DELTA_R` select `DELTA_R`
+          Variable VAR_i (REAL): `VAR_i` select `VAR_i`
+          Variable DEBURGER (STRING[50]): `DEBURGER="/_N_MPF_DIR/_N_VACKA_DIR/_N_DEBURGER_SPF"` select `DEBURGER`
+          Variable PROGRAM (STRING[50]): `PROGRAM="/_N_MPF_DIR/_N_VACKA_DIR/_N_GEOMETRIE_VACKA_SPF"` select `PROGRAM`
+          Variable ERROR (INT): `ERROR` select `ERROR`
+          Structure IF(ISFILE(PROGRAM)): `IF(ISFILE(PROGRAM))` … `ENDIF` select `IF`
+          Structure IF ERROR: `IF ERROR` … `ENDIF` select `IF`
+            Structure CASE ERROR OF: `    CASE ERROR OF 1 GOTOF N21 2 GOTOF N22 3 GOTOF N23 4 GOTOF N24 10 GOTOF N25 11 GOTOF N26 12 GOTOF N27 13 GOTOF N28 20 GOTOF N29` select `CASE ERROR OF`
+          Structure FOR var_i = 0 TO 20: `FOR var_i = 0 TO 20` … `ENDFOR` select `FOR`
+            JumpTarget TEST_POKRACOVANI: `  TEST_POKRACOVANI:` select `TEST_POKRACOVANI`
+            Structure WHILE AKT_UHEL < KONECNY_UHEL: `  WHILE AKT_UHEL < KONECNY_UHEL` … `  ENDWHILE` select `WHILE`
+            JumpTarget COUNTER: `  COUNTER:` select `COUNTER`
+          JumpTarget KRUH: `KRUH:` select `KRUH`
+          JumpTarget END: `END:` select `END`
+    "#]],
+    );
+}
+
+/// The signature help before `needle` in the first file, the active
+/// parameter in `⟨…⟩`.
+fn signature(files: &[(&str, &str)], needle: &str) -> String {
+    let files = with_cursor(files, needle);
+    let (host, _, cursor) = setup(&borrowed(&files));
+    let (file, offset) = cursor.unwrap();
+    let Some(help) = host.analysis().signature_help(file, offset) else { return "none".to_owned() };
+    let mut label = help.label.clone();
+    if let Some(active) = help.active_parameter.map(|index| help.parameters[index].range) {
+        label = format!("{}⟨{}⟩{}", &label[..active.start().into()], &label[active], &label[active.end().into()..]);
+    }
+    let documentation = help.active_parameter.and_then(|index| help.parameters[index].documentation.clone());
+    format!("{label}{}", documentation.map(|d| format!(" — {d}")).unwrap_or_default())
+}
+
+/// Inside a call's parentheses: a PROC of the workspace, the EXTERN
+/// declaration when the PROC's file is not there, a cycle's and a
+/// function's catalogue signature.
+#[test]
+fn sinumerik_signature_help_of_procs_cycles_and_functions() {
+    let l19 = [("MAIN.MPF", L19_MAIN), ("PROFIL.SPF", L19_SUB)];
+    let l30 = [("RUN_VACKA.MPF", L30), ("VACKA_CYKLUS.SPF", L31)];
+    let found: Vec<String> = [
+        (&l19[..], ",TRUE"),
+        (&l19[..], "2.14,"),
+        (&l19[..], "DELKA)"),
+        (&l19[..], ") ; V"),
+        (&l19[..1], "DELKA)"),
+        (&l30[..], "TLOUSTKA, INKREMENT_UHLU)\n"),
+        (&l30[..1], "TLOUSTKA, INKREMENT_UHLU)\n"),
+        (&l30[..], "\"0\",100000"),
+        (&l30[..], "0,-30,0"),
+        (&l30[..], "RADIUS_5)"),
+        (&l30[..], "\"_N_GEOMETRIE"),
+    ]
+    .into_iter()
+    .map(|(files, needle)| format!("{needle:?}: {}", signature(files, needle)))
+    .collect();
+    expect![[r#"
+        ",TRUE": PROFIL(⟨REAL C⟩, BOOL H, REAL X, INT Y, REAL Z)
+        "2.14,": PROFIL(REAL C, BOOL H, ⟨REAL X⟩, INT Y, REAL Z)
+        "DELKA)": PROFIL(REAL C, BOOL H, REAL X, ⟨INT Y⟩, REAL Z)
+        ") ; V": PROFIL(REAL C, BOOL H, REAL X, ⟨INT Y⟩, REAL Z)
+        "DELKA)": none
+        "TLOUSTKA, INKREMENT_UHLU)\n": VACKA_CYKLUS(REAL POCATECNI_R, ⟨REAL TLOUSTKA⟩, REAL INKREMENT_UHLU)
+        "TLOUSTKA, INKREMENT_UHLU)\n": VACKA_CYKLUS(REAL, ⟨REAL⟩, REAL)
+        "\"0\",100000": CYCLE800(INT _FR, ⟨STRING[32] _TC⟩, INT _ST, INT _MODE, REAL _X0, REAL _Y0, REAL _Z0, REAL _A, REAL _B, REAL _C, REAL _X1, REAL _Y1, REAL _Z1, INT _DIR, REAL _FR_I, INT _DMODE) — Name of the swivel data record (`"0"`, `"TC1"` in the thesis's calls); the thesis's reading: a string naming the record (inferred).
+        "0,-30,0": WORKPIECE([STRING _1], STRING _2[, INT _3], STRING form, ⟨REAL… values⟩) — Reference and dimensions of the blank; `0,0,-60,0,0,0,140,30` for the thesis's box.
+        "RADIUS_5)": SET(⟨REAL… values⟩) → array values — The values, in order.
+        "\"_N_GEOMETRIE": ISFILE(⟨STRING file⟩) → BOOL — Path or name of the file."#]].assert_eq(&found.join("\n"));
+}
+
+/// Every editor question at every offset of the Sinumerik listings and
+/// syntax fixtures answers without a panic, with ranges in the text.
+#[test]
+fn every_sinumerik_listing_answers_everywhere() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../syntax/test_data/sinumerik");
+    let listings = std::fs::read_dir(&dir).unwrap().chain(std::fs::read_dir(dir.join("constructs")).unwrap());
+    for path in listings.map(|entry| entry.unwrap().path()) {
+        let name = path.file_name().unwrap().to_string_lossy().to_uppercase();
+        if !(name.ends_with(".MPF") || name.ends_with(".SPF")) {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        let (host, ids, _) = setup(&[(&name, &text), ("PROFIL.SPF", L19_SUB)]);
+        let analysis = host.analysis();
+        let file = ids[0];
+        let within = |range: TextRange| usize::from(range.end()) <= text.len();
+        assert!(analysis.document_symbols(file).iter().all(|s| within(s.range)), "{name}");
+        for offset in (0..=text.len()).filter(|&i| text.is_char_boundary(i)) {
+            let offset = TextSize::try_from(offset).unwrap();
+            for target in analysis.goto_definition(file, offset).iter().filter(|t| t.file == file) {
+                assert!(within(target.range) && target.range.contains_range(target.focus), "{name}: {target:?}");
+            }
+            assert!(analysis.references(file, offset, true).iter().all(|r| r.file != file || within(r.range)));
+            if let Ok(range) = analysis.prepare_rename(file, offset) {
+                assert!(range.contains_inclusive(offset), "{name} at {offset:?}");
+                let edits = analysis.rename(file, offset, "RENAMED").unwrap();
+                assert!(edits.iter().all(|edit| within(edit.delete)), "{name}");
+            }
+            if let Some(help) = analysis.signature_help(file, offset) {
+                assert!(help.parameters.iter().all(|p| usize::from(p.range.end()) <= help.label.len()), "{help:?}");
+            }
+        }
+    }
 }

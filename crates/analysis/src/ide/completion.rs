@@ -34,6 +34,9 @@ pub struct CompletionItem {
     /// Markdown: the catalogue's hover text, a target's block.
     pub documentation: Option<String>,
     pub insert_text: String,
+    /// Whether `insert_text` is a snippet, with `${1:name}` placeholders
+    /// for the editor to fill.
+    pub snippet: bool,
     /// The text the item replaces: what has been typed of the word.
     pub replace: TextRange,
 }
@@ -59,6 +62,11 @@ pub enum CompletionKind {
     Keyword,
     /// A Haas macro function: `SIN`, `SQRT`.
     Function,
+    /// A Sinumerik user variable (`DEF`, a PROC parameter) or system
+    /// variable (`$P_F`).
+    Variable,
+    /// A Sinumerik label, after a jump.
+    Label,
 }
 
 /// What the lists of codes and addresses read of the block under the
@@ -106,7 +114,8 @@ impl<'a> Site<'a> {
         documentation: Option<String>,
         replace: TextRange,
     ) -> CompletionItem {
-        CompletionItem { insert_text: label.clone(), label, kind, detail, documentation, replace: replace + self.start }
+        let replace = replace + self.start;
+        CompletionItem { insert_text: label.clone(), label, kind, detail, documentation, snippet: false, replace }
     }
 
     /// Where a new word starts (`typed`, its letter if written): the

@@ -48,6 +48,27 @@ pub struct NavigationTarget {
     pub focus: TextRange,
 }
 
+/// A called procedure's or function's signature, for the call the cursor
+/// is in.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SignatureHelp {
+    /// `PROFIL(REAL C, BOOL H, REAL X)`.
+    pub label: String,
+    /// Markdown.
+    pub documentation: Option<String>,
+    pub parameters: Vec<SignatureParameter>,
+    /// The parameter the cursor is in; `None` past the last.
+    pub active_parameter: Option<usize>,
+}
+
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SignatureParameter {
+    /// Where the parameter stands in the signature's label.
+    pub range: TextRange,
+    /// Markdown.
+    pub documentation: Option<String>,
+}
+
 /// What the thing at `offset` is.
 pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<HoverResult> {
     match file.parse(db).dialect() {
@@ -62,9 +83,7 @@ pub(crate) fn goto_definition(db: &dyn Db, file: SourceFile, offset: TextSize) -
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => definition_in_unit(db, file, offset),
         Dialect::HaasLathe => haas_lathe::goto_definition(db, file, offset),
-        // Labels and subprograms are resolved by the program model, which
-        // Sinumerik does not have yet.
-        Dialect::Sinumerik => Vec::new(),
+        Dialect::Sinumerik => sinumerik::goto_definition(db, file, offset),
     }
 }
 
@@ -78,7 +97,34 @@ pub(crate) fn references(
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => references::references(db, file, offset, include_declaration),
         Dialect::HaasLathe => haas_lathe::references(db, file, offset, include_declaration),
-        Dialect::Sinumerik => Vec::new(),
+        Dialect::Sinumerik => sinumerik::references(db, file, offset, include_declaration),
+    }
+}
+
+/// The name at `offset` that a rename changes, or why none can be.
+pub(crate) fn prepare_rename(db: &dyn Db, file: SourceFile, offset: TextSize) -> Result<TextRange, String> {
+    let dialect = file.parse(db).dialect();
+    match dialect {
+        Dialect::Sinumerik => sinumerik::prepare_rename(db, file, offset),
+        Dialect::HaasLathe | Dialect::Cnc8x6 => Err(format!("{} programs have no names to rename", dialect.title())),
+    }
+}
+
+/// The edits that give the thing at `offset` the name `new_name`, or why
+/// they cannot.
+pub(crate) fn rename(db: &dyn Db, file: SourceFile, offset: TextSize, new_name: &str) -> Result<Vec<TextEdit>, String> {
+    match file.parse(db).dialect() {
+        Dialect::Sinumerik => sinumerik::rename(db, file, offset, new_name),
+        Dialect::HaasLathe | Dialect::Cnc8x6 => prepare_rename(db, file, offset).map(|_| Vec::new()),
+    }
+}
+
+/// The signature of the call the cursor is in.
+pub(crate) fn signature_help(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<SignatureHelp> {
+    match file.parse(db).dialect() {
+        Dialect::Sinumerik => sinumerik::signature_help(db, file, offset),
+        // Their calls take no arguments in parentheses.
+        Dialect::HaasLathe | Dialect::Cnc8x6 => None,
     }
 }
 

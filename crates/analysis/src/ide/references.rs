@@ -41,8 +41,10 @@ pub enum ReferenceKind {
     Write,
     /// `G71 L<n>` or `G72 L<n>`.
     Call,
-    /// `G73 L<n>`.
+    /// `G73 L<n>`; a Sinumerik `GOTOF` to a label or block number.
     Jump,
+    /// A Sinumerik `EXTERN` line: a program declared for its calls.
+    Declaration,
 }
 
 /// The references of the thing at `offset`: the definition first, then the

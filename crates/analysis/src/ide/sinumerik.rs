@@ -1,17 +1,28 @@
-//! The editor's answers for a Sinumerik file, read from the tree alone
-//! (there is no program model for Sinumerik yet): hover from the
-//! catalogue, the outline (the `PROC` header and the labels), folding of
-//! control structures and comment runs, and completion of the catalogue's
-//! codes, addresses, keywords and functions where a word starts.
+//! The editor's answers for a Sinumerik file: hover from the catalogue,
+//! folding of control structures and comment runs, and completion of the
+//! catalogue's codes, addresses, keywords and functions, read from the
+//! tree; go to definition, references and rename ([`navigation`]), the
+//! outline ([`outline`]), signature help ([`signature`]) and the file's
+//! own names in completion ([`completion`]), read from the tree and the
+//! program model (`crate::sinumerik::model`).
+
+mod completion;
+mod navigation;
+mod outline;
+mod signature;
 
 use ncc_catalog::{AddressRole, Catalogue, Item};
 use ncc_syntax::{Dialect, SyntaxKind, SyntaxNode, SyntaxToken, TextRange, TextSize};
 
+pub(crate) use self::{
+    navigation::{goto_definition, prepare_rename, references, rename},
+    outline::document_symbols,
+    signature::signature_help,
+};
 use super::{
     HoverResult,
     completion::{CompletionItem, CompletionKind, Site, Written},
     folding::{Fold, FoldKind, with_comment_runs},
-    symbols::{DocumentSymbol, SymbolKind},
 };
 use crate::db::{Db, SourceFile};
 
@@ -79,66 +90,17 @@ fn word_code(word: &SyntaxNode) -> Option<(u8, Option<u32>)> {
     Some((letter, number.and_then(|number| number.text().parse().ok()).filter(|_| is_code)))
 }
 
-/// The file's blocks, in order.
+/// The file's blocks, in order: the children of its block runs, as the
+/// lowering reads them.
 fn blocks(root: &SyntaxNode) -> impl Iterator<Item = SyntaxNode> {
-    root.descendants().filter(|node| node.kind() == SyntaxKind::BLOCK)
+    let runs = root.children().filter(|node| node.kind() == SyntaxKind::BLOCK_RUN);
+    runs.flat_map(|run| run.children()).filter(|node| node.kind() == SyntaxKind::BLOCK)
 }
 
 /// A block's line without its line break and trailing blanks.
 fn line_range(text: &str, block: &SyntaxNode) -> TextRange {
     let range = block.text_range();
     TextRange::at(range.start(), TextSize::of(text[range].trim_end()))
-}
-
-/// The first name of a node: a label's, a `PROC`'s after the keyword.
-fn name_token(node: &SyntaxNode, skip: usize) -> Option<SyntaxToken> {
-    node.children_with_tokens()
-        .filter_map(|child| child.into_token())
-        .filter(|token| token.kind() == SyntaxKind::IDENT)
-        .nth(skip)
-}
-
-/// The `PROC` header, holding the labels after it, and the labels before
-/// it (or all of them in a program without one).
-pub(crate) fn document_symbols(db: &dyn Db, file: SourceFile) -> Vec<DocumentSymbol> {
-    let text = file.text(db);
-    let root = file.parse(db).syntax_node();
-    let mut symbols = Vec::new();
-    let mut procedure: Option<DocumentSymbol> = None;
-    for block in blocks(&root) {
-        for statement in block.children() {
-            match statement.kind() {
-                SyntaxKind::LABEL => {
-                    let Some(name) = name_token(&statement, 0) else { continue };
-                    let label = DocumentSymbol {
-                        name: name.text().to_owned(),
-                        kind: SymbolKind::JumpTarget,
-                        detail: None,
-                        range: line_range(text, &block),
-                        selection_range: name.text_range(),
-                        children: Vec::new(),
-                    };
-                    procedure.as_mut().map_or(&mut symbols, |procedure| &mut procedure.children).push(label);
-                }
-                SyntaxKind::PROC_STMT if procedure.is_none() => {
-                    let Some(name) = name_token(&statement, 1) else { continue };
-                    let after_name = TextRange::new(name.text_range().end(), statement.text_range().end());
-                    let signature = text[after_name].trim();
-                    procedure = Some(DocumentSymbol {
-                        name: name.text().to_owned(),
-                        kind: SymbolKind::Subprogram,
-                        detail: (!signature.is_empty()).then(|| signature.to_owned()),
-                        range: TextRange::new(block.text_range().start(), TextSize::of(text.trim_end())),
-                        selection_range: name.text_range(),
-                        children: Vec::new(),
-                    });
-                }
-                _ => {}
-            }
-        }
-    }
-    symbols.extend(procedure);
-    symbols
 }
 
 /// The block structures `IF`…`ENDIF`, `WHILE`…`ENDWHILE`, `FOR`…`ENDFOR`,
@@ -224,9 +186,18 @@ pub(crate) fn completions(db: &dyn Db, file: SourceFile, offset: TextSize) -> Ve
     let replace = TextRange::new(TextSize::of(&before[..word_start]), TextSize::of(before));
     let catalogue = catalogue();
     let site = Site::new(db, Dialect::Sinumerik, start, written(&block));
-    let mut items = Vec::new();
     let preceding = before[..word_start].chars().next_back();
-    if preceding.is_none_or(|c| c == ' ' || c == '\t') {
+    if preceding == Some('$') {
+        let with_dollar = TextRange::new(replace.start() - TextSize::of('$'), replace.end());
+        return completion::system_variables(&site, with_dollar);
+    }
+    let words: Vec<&str> = before[..word_start].split_whitespace().collect();
+    if words.last().is_some_and(|word| completion::takes_label(word)) {
+        return completion::labels(db, file, &site, replace);
+    }
+    let mut items = Vec::new();
+    let word_starts = preceding.is_none_or(|c| c == ' ' || c == '\t');
+    if word_starts {
         let typed_word = (typed > 0).then_some(replace);
         items = site.new_word(typed_word, replace);
         for keyword in &catalogue.keywords {
@@ -239,9 +210,8 @@ pub(crate) fn completions(db: &dyn Db, file: SourceFile, offset: TextSize) -> Ve
                 replace,
             ));
         }
-    } else if preceding == Some('$') {
-        return Vec::new();
     }
+    items.extend(completion::variables(db, file, &site, replace));
     for function in &catalogue.functions {
         let documentation = Item::Function(function).markdown(catalogue);
         items.push(site.item(
@@ -251,6 +221,9 @@ pub(crate) fn completions(db: &dyn Db, file: SourceFile, offset: TextSize) -> Ve
             Some(documentation),
             replace,
         ));
+    }
+    if word_starts {
+        items.extend(completion::programs(db, file, &site, replace));
     }
     items
 }

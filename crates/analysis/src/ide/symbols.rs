@@ -49,6 +49,11 @@ pub enum SymbolKind {
     /// A tool change (Haas: a `T` word), where a lathe program's operations
     /// begin.
     Tool,
+    /// A control structure (Sinumerik `IF` … `ENDIF`, `CASE`), holding
+    /// what is inside it.
+    Structure,
+    /// A declared variable (Sinumerik `DEF`).
+    Variable,
 }
 
 pub(crate) fn document_symbols(db: &dyn Db, file: SourceFile) -> Vec<DocumentSymbol> {

@@ -29,6 +29,14 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
         inlay_hint_provider: Some(lsp::OneOf::Left(true)),
         code_lens_provider: Some(lsp::CodeLensOptions { resolve_provider: Some(false) }),
         references_provider: Some(lsp::OneOf::Left(true)),
+        rename_provider: Some(lsp::OneOf::Right(lsp::RenameOptions {
+            prepare_provider: Some(true),
+            work_done_progress_options: Default::default(),
+        })),
+        signature_help_provider: Some(lsp::SignatureHelpOptions {
+            trigger_characters: Some(vec!["(".to_owned(), ",".to_owned()]),
+            ..Default::default()
+        }),
         document_highlight_provider: Some(lsp::OneOf::Left(true)),
         document_symbol_provider: Some(lsp::OneOf::Left(true)),
         folding_range_provider: Some(lsp::FoldingRangeProviderCapability::Simple(true)),
@@ -89,6 +97,48 @@ pub(crate) fn definition(s: &Snapshot, position: lsp::Position) -> Vec<Navigatio
     s.analysis.goto_definition(s.file, s.map.offset(position))
 }
 
+/// The range of the name a rename changes, or why none can be renamed.
+pub(crate) fn prepare_rename(s: &Snapshot, position: lsp::Position) -> Result<lsp::PrepareRenameResponse, String> {
+    let range = s.analysis.prepare_rename(s.file, s.map.offset(position))?;
+    Ok(lsp::PrepareRenameResponse::Range(s.map.range(range)))
+}
+
+/// The document's edits that rename the name at `position`.
+pub(crate) fn rename(s: &Snapshot, position: lsp::Position, new_name: &str) -> Result<lsp::WorkspaceEdit, String> {
+    let edits = s.analysis.rename(s.file, s.map.offset(position), new_name)?;
+    let edits = edits.iter().map(|edit| s.map.text_edit(edit)).collect();
+    Ok(lsp::WorkspaceEdit { changes: Some(HashMap::from([(s.uri.clone(), edits)])), ..Default::default() })
+}
+
+/// The signature of the call at `position`; parameters by their place in
+/// the label, in UTF-16 units.
+pub(crate) fn signature_help(s: &Snapshot, position: lsp::Position) -> Option<lsp::SignatureHelp> {
+    let help = s.analysis.signature_help(s.file, s.map.offset(position))?;
+    let units = |end: ncc_analysis::TextSize| help.label[..usize::from(end)].encode_utf16().count() as u32;
+    let parameters = help
+        .parameters
+        .iter()
+        .map(|parameter| lsp::ParameterInformation {
+            label: lsp::ParameterLabel::LabelOffsets([units(parameter.range.start()), units(parameter.range.end())]),
+            documentation: parameter
+                .documentation
+                .clone()
+                .map(|text| lsp::Documentation::MarkupContent(convert::markdown(text))),
+        })
+        .collect();
+    let active = help.active_parameter.and_then(|index| u32::try_from(index).ok());
+    Some(lsp::SignatureHelp {
+        signatures: vec![lsp::SignatureInformation {
+            label: help.label.clone(),
+            documentation: help.documentation.map(|text| lsp::Documentation::MarkupContent(convert::markdown(text))),
+            parameters: Some(parameters),
+            active_parameter: active,
+        }],
+        active_signature: Some(0),
+        active_parameter: active,
+    })
+}
+
 /// The quick fixes of the diagnostics that touch `range`.
 pub(crate) fn code_actions(s: &Snapshot, range: lsp::Range) -> lsp::CodeActionResponse {
     let range = s.map.range_offsets(range);
@@ -131,8 +181,8 @@ pub(crate) fn completion(s: &Snapshot, position: lsp::Position) -> Vec<lsp::Comp
                 | CompletionKind::Macrocycle
                 | CompletionKind::Program
                 | CompletionKind::Function => lsp::CompletionItemKind::FUNCTION,
-                CompletionKind::Block => lsp::CompletionItemKind::REFERENCE,
-                CompletionKind::Parameter => lsp::CompletionItemKind::VARIABLE,
+                CompletionKind::Block | CompletionKind::Label => lsp::CompletionItemKind::REFERENCE,
+                CompletionKind::Parameter | CompletionKind::Variable => lsp::CompletionItemKind::VARIABLE,
             }),
             detail: Some(item.detail),
             documentation: item.documentation.map(|text| lsp::Documentation::MarkupContent(convert::markdown(text))),
@@ -142,6 +192,7 @@ pub(crate) fn completion(s: &Snapshot, position: lsp::Position) -> Vec<lsp::Comp
                 range: s.map.range(item.replace),
                 new_text: item.insert_text,
             })),
+            insert_text_format: item.snippet.then_some(lsp::InsertTextFormat::SNIPPET),
             label: item.label,
             ..Default::default()
         })
@@ -216,6 +267,8 @@ pub(crate) fn document_symbols(s: &Snapshot) -> Vec<lsp::DocumentSymbol> {
                 SymbolKind::Subprogram | SymbolKind::Macrocycle | SymbolKind::CycleBody => lsp::SymbolKind::FUNCTION,
                 SymbolKind::JumpTarget => lsp::SymbolKind::KEY,
                 SymbolKind::Tool => lsp::SymbolKind::EVENT,
+                SymbolKind::Structure => lsp::SymbolKind::NAMESPACE,
+                SymbolKind::Variable => lsp::SymbolKind::VARIABLE,
             },
             tags: None,
             deprecated: None,

@@ -353,6 +353,13 @@ fn invalid_params(message: String) -> jsonrpc::Error {
     jsonrpc::Error { code: ErrorCode::InvalidParams, message: message.into(), data: None }
 }
 
+/// A request the server understood but refuses, with the reason for the
+/// user (a rename to a name the control would not take): LSP's
+/// `RequestFailed`, which the JSON-RPC crate does not name.
+fn request_failed(message: String) -> jsonrpc::Error {
+    jsonrpc::Error { code: ErrorCode::ServerError(-32803), message: message.into(), data: None }
+}
+
 /// The server's configuration from the client.
 #[derive(Debug, Default, serde::Deserialize)]
 #[serde(rename_all = "camelCase")]
@@ -563,6 +570,28 @@ impl LanguageServer for Server {
             .filter_map(|reference| addresses.location(reference.file, reference.range))
             .collect();
         Ok(Some(locations))
+    }
+
+    async fn prepare_rename(
+        &self,
+        params: lsp::TextDocumentPositionParams,
+    ) -> jsonrpc::Result<Option<lsp::PrepareRenameResponse>> {
+        let position = params.position;
+        let answer = self.query(&params.text_document.uri, move |s| handlers::prepare_rename(s, position)).await?;
+        answer.map(Some).map_err(request_failed)
+    }
+
+    async fn rename(&self, params: lsp::RenameParams) -> jsonrpc::Result<Option<lsp::WorkspaceEdit>> {
+        let position = params.text_document_position;
+        let new_name = params.new_name;
+        let answer =
+            self.query(&position.text_document.uri, move |s| handlers::rename(s, position.position, &new_name)).await?;
+        answer.map(Some).map_err(request_failed)
+    }
+
+    async fn signature_help(&self, params: lsp::SignatureHelpParams) -> jsonrpc::Result<Option<lsp::SignatureHelp>> {
+        let position = params.text_document_position_params;
+        self.query(&position.text_document.uri, move |s| handlers::signature_help(s, position.position)).await
     }
 
     async fn document_highlight(
