@@ -20,5 +20,6 @@
 //!   block numbers written twice, and calls against the PROC and EXTERN
 //!   signatures by argument count.
 
+pub mod eval;
 pub mod lower;
 pub mod program;
