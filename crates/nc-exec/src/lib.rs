@@ -55,8 +55,12 @@
 //!   start.
 //! - [`sinumerik`]: what belongs to the Siemens Sinumerik dialect:
 //!   [`sinumerik::lower`] (blocks as plain data, read from the syntax tree
-//!   and the catalogue) and [`sinumerik::program`] (labels, block numbers,
-//!   control structures, declarations, jumps and calls of a file).
+//!   and the catalogue), [`sinumerik::program`] (labels, block numbers,
+//!   control structures, declarations, jumps and calls of a file),
+//!   [`sinumerik::eval`] (typed values, variables and expressions) and
+//!   `sinumerik::interpreter` (the control flow, calls, files, motion,
+//!   splines and time of a program, which [`run`] runs on a Sinumerik
+//!   machine).
 //! - [`spline`]: rational B-spline curves (NURBS) over any axes, built
 //!   from the data a control programs them by: points, derivatives,
 //!   curvature, length, polylines within a chord tolerance.

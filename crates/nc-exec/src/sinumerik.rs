@@ -1,8 +1,9 @@
 //! The Siemens Sinumerik dialect's part of the executor: its block IR and
-//! lowering ([`lower`]) and the program model over the lowered blocks
-//! ([`program`]). Nothing runs Sinumerik programs yet.
+//! lowering ([`lower`]), the program model over the lowered blocks
+//! ([`program`]), values and expressions ([`eval`]) and the interpreter
+//! that runs a program (`interpreter`, through [`crate::run`]).
 //!
-//! What the next steps read from them:
+//! What reads them:
 //!
 //! - The interpreter runs [`lower::SinumerikBlock::statements`] in order:
 //!   words (address, literal or expression, `AC`/`IC`), assignments to R
@@ -21,5 +22,6 @@
 //!   signatures by argument count.
 
 pub mod eval;
+pub(crate) mod interpreter;
 pub mod lower;
 pub mod program;

@@ -364,11 +364,23 @@ impl Store {
     }
 
     /// Declares `name` in the innermost scope (a DEF, or a formal
-    /// parameter by value), every element zero.
-    fn declare(&mut self, name: &str, ty: BaseType, length: Option<usize>, dimensions: Vec<usize>) -> Slot {
+    /// parameter by value), or as global user data, every element zero.
+    fn declare(
+        &mut self,
+        name: &str,
+        ty: BaseType,
+        length: Option<usize>,
+        dimensions: Vec<usize>,
+        global: bool,
+    ) -> Slot {
         let size = dimensions.iter().product::<usize>().max(1);
-        let values = vec![Value::zero(&ty); size];
-        self.locals.push(Variable { ty, length, dimensions, values });
+        let variable = Variable { values: vec![Value::zero(&ty); size], ty, length, dimensions };
+        if global {
+            self.globals.push(variable);
+            self.global_names.insert(name.to_owned(), self.globals.len() - 1);
+            return Slot { cell: Cell::Global(self.globals.len() - 1), element: None };
+        }
+        self.locals.push(variable);
         let slot = Slot { cell: Cell::Local(self.locals.len() - 1), element: None };
         if let Some(scope) = self.scopes.last_mut() {
             scope.names.insert(name.to_owned(), slot);
@@ -636,8 +648,10 @@ impl Eval<'_> {
         Ok(())
     }
 
-    /// Runs a DEF line's declaration of `declared` in the innermost scope.
-    pub fn define(&mut self, ty: &Type, declared: &Declared) -> Result<()> {
+    /// Runs a DEF line's declaration of `declared` in the innermost scope,
+    /// or as global user data (a GUD definition file's `DEF NCK`, `DEF
+    /// CHAN`).
+    pub fn define(&mut self, ty: &Type, declared: &Declared, global: bool) -> Result<()> {
         let range = declared.range;
         let length = match &ty.length {
             Some(expr) => Some(self.size(expr)?),
@@ -654,7 +668,7 @@ impl Eval<'_> {
         if matches!(ty.base, BaseType::Frame | BaseType::Unknown) {
             return Err(not_modelled(range, "FRAME variables"));
         }
-        let slot = self.store.declare(&declared.name, ty.base.clone(), length, dimensions);
+        let slot = self.store.declare(&declared.name, ty.base.clone(), length, dimensions, global);
         if let Some(initial) = &declared.initial {
             let place = Place { kind: PlaceKind::User, name: declared.name.clone(), indices: Vec::new() };
             match Fill::of(initial) {
@@ -678,7 +692,7 @@ impl Eval<'_> {
             BaseType::Unknown => BaseType::Real,
             ref base => base.clone(),
         };
-        let slot = self.store.declare(name, base, length, Vec::new());
+        let slot = self.store.declare(name, base, length, Vec::new(), false);
         match value {
             Some(value) => self.store.write(slot, value, range),
             None => Ok(()),
@@ -831,6 +845,11 @@ fn binary(op: BinaryOp, lhs: Value, rhs: Value, range: TextRange) -> Result<Valu
         }
         BinaryOp::Chain => return Err(not_modelled(range, "frame chaining with `:`")),
     })
+}
+
+/// Whether two values are equal, as `==` compares them.
+pub fn equal(lhs: &Value, rhs: &Value, range: TextRange) -> Result<bool> {
+    compare(lhs, rhs, range).map(std::cmp::Ordering::is_eq)
 }
 
 /// The order of two values: strings and axes by their text, anything

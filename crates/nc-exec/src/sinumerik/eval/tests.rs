@@ -47,7 +47,7 @@ fn run(text: &str, store: &mut Store, context: &mut Fixed) -> Result<()> {
             match &statement.kind {
                 StatementKind::Def(def) => {
                     for declared in &def.names {
-                        eval.define(&def.ty, declared)?;
+                        eval.define(&def.ty, declared, def.scope.is_some())?;
                     }
                 }
                 StatementKind::Assign { target, value } => eval.assign(target, value, statement.range)?,
