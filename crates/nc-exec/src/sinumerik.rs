@@ -1,7 +1,8 @@
 //! The Siemens Sinumerik dialect's part of the executor: its block IR and
 //! lowering ([`lower`]), the program model over the lowered blocks
-//! ([`program`]), values and expressions ([`eval`]) and the interpreter
-//! that runs a program (`interpreter`, through [`crate::run`]).
+//! ([`program`]), values and expressions ([`eval`]), the interpreter
+//! that runs a program (`interpreter`, through [`crate::run`]) and the
+//! run written back as plain blocks ([`expand`]).
 //!
 //! What reads them:
 //!
@@ -22,6 +23,7 @@
 //!   signatures by argument count.
 
 pub mod eval;
+pub mod expand;
 pub(crate) mod interpreter;
 pub mod lower;
 pub mod program;

@@ -6,7 +6,8 @@
 //! [`Spline::programmed`] from the position before the first BSPLINE
 //! block, and each block's step becomes the straight pieces of the curve
 //! within [`CHORD_TOLERANCE`] of it that belong to its knot interval, the
-//! pieces joined end to end. A block of the curve without a piece (its
+//! pieces joined end to end: the first with the block's path mode and
+//! functions, the others continuous, the last with the block's stop. A block of the curve without a piece (its
 //! point repeats the one before) ends where the curve is; so does any
 //! block run while the curve was open.
 
@@ -15,7 +16,7 @@ use ncc_syntax::TextRange;
 use super::{Interpreter, Moved, Words};
 use crate::{
     spline::{ControlPoint, Spline, SplineError},
-    trace::{Axes, Finding, MAX_AXES, Motion, Path, Position, RunRule, Step},
+    trace::{Axes, Finding, MAX_AXES, Motion, Path, PathMode, Position, RunRule, Step},
     transform::over_axes,
 };
 
@@ -110,9 +111,20 @@ impl Interpreter<'_> {
                 continue;
             };
             let rate = pending.points[index].rate;
-            for &(end, length) in &pieces[index] {
+            let last = pieces[index].len() - 1;
+            for (piece, &(end, length)) in pieces[index].iter().enumerate() {
                 let duration = rate.map_or(0.0, |rate| length / rate * 60.0);
-                replaced.push(Step { end, length, duration, feed: rate, ..step.clone() });
+                let mut made = Step { end, length, duration, feed: rate, ..step.clone() };
+                // Inside its block the curve runs on: only the block's
+                // first piece joins as the block's mode says, and the last
+                // stops where the block does.
+                if piece > 0 {
+                    (made.path_mode, made.m_functions, made.tool_change) = (PathMode::Continuous, 0, false);
+                }
+                if piece < last {
+                    made.stop = None;
+                }
+                replaced.push(made);
                 at = end;
             }
         }
