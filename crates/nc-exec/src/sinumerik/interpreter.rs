@@ -44,8 +44,8 @@
 //! - Each step's path mode from G60/G9 (exact stop) and G64/G641–G645
 //!   (continuous), its jerk limit from SOFT against BRISK, and its corner
 //!   tolerance: ADIS (ADISPOS for G0) under G641, 0 when not programmed;
-//!   the machine's corner rounding under G642–G645; infinite otherwise
-//!   (no tolerance bounds the corner).
+//!   infinite otherwise (no tolerance the run knows bounds the corner: the
+//!   tolerances of G642–G645 are machine data it does not read).
 //! - WRITE, READ, DELETE and ISFILE on the run's own files (module
 //!   `files`).
 //!
@@ -57,7 +57,9 @@
 //! what [`super::eval`] does not model. System variables the run has no
 //! value for read 0 with a finding once per name.
 //!
-//! Assumptions besides those above: block skip is off; the settable frames
+//! Assumptions besides those above: a program run by itself whose first
+//! line is a PROC has its parameters, `VAR` ones too, as variables of
+//! their type at zero, as if called with all left out; block skip is off; the settable frames
 //! G54 … are zero; a subprogram that reaches its end without M17 or RET
 //! returns; a main program ends at its end without a finding; `$AC_TIME`
 //! (the time since the block started) is 0 where a program reads it, and
@@ -74,7 +76,7 @@ use ncc_syntax::{Parse, TextRange, TextSize};
 use super::{
     eval::{Context, ErrorKind, Eval, EvalError, Store, Value, equal},
     lower::{
-        Command, Dimension, Expr, ExprKind, Jump, JumpKind, JumpTarget, Place, PlaceKind, SinumerikBlock,
+        Call, Command, Dimension, Expr, ExprKind, Jump, JumpKind, JumpTarget, Place, PlaceKind, SinumerikBlock,
         StatementKind, Word, WordValue, block_nodes,
     },
     program::{Resolved, SinumerikModel, StructureKind},
@@ -363,8 +365,8 @@ struct Interpreter<'a> {
     store: Store,
     state: State<'a>,
     calls: Vec<calls::Frame>,
-    /// MCALL's program and arguments, with the file it was written in.
-    modal_call: Option<calls::ModalCall>,
+    /// MCALL's program and arguments.
+    modal_call: Option<Call>,
     spline: Option<bspline::Pending>,
     steps: Undelivered,
     executed: usize,
@@ -435,6 +437,7 @@ impl<'a> Interpreter<'a> {
     /// Runs the program from its first block for at most `budget` blocks.
     fn run(&mut self, budget: usize, mut sink: Option<&mut (dyn StepSink + '_)>) {
         self.define_globals();
+        self.bind_own_parameters();
         let mut at = At { source: 0, block: 0 };
         loop {
             let unit = Rc::clone(&self.units[at.source]);
@@ -442,7 +445,7 @@ impl<'a> Interpreter<'a> {
             if at.block >= unit.blocks.len() {
                 // The end of the file: a subprogram returns, the main
                 // program ends.
-                match self.return_from(at) {
+                match self.return_from() {
                     Some(back) => {
                         at = back;
                         continue;
@@ -469,7 +472,7 @@ impl<'a> Interpreter<'a> {
                 Flow::Next => Some(At { block: at.block + 1, ..at }),
                 Flow::Jump(block) => Some(At { block, ..at }),
                 Flow::Go(to) => Some(to),
-                Flow::Return | Flow::End => self.return_from(at),
+                Flow::Return | Flow::End => self.return_from(),
                 Flow::Stop => None,
             };
             let Some(next) = next else { break };
@@ -530,7 +533,7 @@ impl<'a> Interpreter<'a> {
                 StatementKind::Command(command) => self.command(command, &mut words, range),
                 StatementKind::Call(called) => call = Some((called.clone(), range)),
                 StatementKind::ModalCall(modal) => {
-                    self.modal_call = modal.clone().map(|call| calls::ModalCall { call, source: at.source, range });
+                    self.modal_call = modal.clone();
                 }
                 StatementKind::Return { arguments } => {
                     if !arguments.is_empty() {
@@ -590,12 +593,11 @@ impl<'a> Interpreter<'a> {
                 break;
             }
         }
-        let start = self.state.position;
         let (moved, stop, end, facts) = self.codes_and_motion(&words, whole);
         if self.state.stopped {
             return Flow::Stop;
         }
-        self.record(at, whole, &start, moved.clone(), facts, stop);
+        self.record(at, whole, moved.clone(), facts, stop);
         if end {
             self.end_spline();
             return Flow::End;
@@ -686,8 +688,18 @@ impl<'a> Interpreter<'a> {
             }
             return;
         }
+        let numbered_axis = |name: &str| {
+            name.len() > 1
+                && b"XYZABCUVW".contains(&name.as_bytes()[0])
+                && name[1..].bytes().all(|b| b.is_ascii_digit())
+        };
         let Some(role) = catalogue.address(address).map(|a| a.role) else {
-            self.state.not_run(&format!("the address {address}"), word.range);
+            let what = if numbered_axis(address) {
+                format!("axis {address} (the machine has none)")
+            } else {
+                format!("the address {address}")
+            };
+            self.state.not_run(&what, word.range);
             return;
         };
         let Some((value, dimension)) = self.word_number(word) else { return };
@@ -1034,16 +1046,12 @@ impl<'a> Interpreter<'a> {
     }
 
     /// Adds the block's step.
-    fn record(&mut self, at: At, range: TextRange, start: &Position, moved: Moved, facts: Facts, stop: Option<Stop>) {
-        let _ = start;
+    fn record(&mut self, at: At, range: TextRange, moved: Moved, facts: Facts, stop: Option<Stop>) {
         let modes = &self.state.modes;
         let exact = facts.exact || modes.is(PATH_MODE, "G60");
         let corner_tolerance = match modes.get(PATH_MODE) {
             Some("G641") if moved.motion == Motion::Rapid => self.state.adispos as f32,
             Some("G641") => self.state.adis as f32,
-            Some("G642" | "G643" | "G644" | "G645") => {
-                self.state.machine.corner_rounding_um.map_or(f32::INFINITY, |um| um as f32 / 1000.0)
-            }
             _ => f32::INFINITY,
         };
         let rpm = match modes.get(SPINDLE) {

@@ -47,15 +47,6 @@ enum Bound {
     Alias { name: String, slot: Slot },
 }
 
-/// MCALL's call.
-#[derive(Debug, Clone)]
-pub(super) struct ModalCall {
-    pub(super) call: Call,
-    /// The file it was written in.
-    pub(super) source: usize,
-    pub(super) range: TextRange,
-}
-
 /// The name of a program as the control names its file: `PROFIL` and
 /// `_N_PROFIL_SPF` both name `PROFIL`, the latter an SPF.
 fn program_name(name: &str) -> (String, Option<&'static str>) {
@@ -118,16 +109,16 @@ impl Interpreter<'_> {
         self.enter(at, &name, &call.arguments, runs as u64 - 1, false, range)
     }
 
-    /// MCALL's program after a block with a path motion.
-    pub(super) fn modal(&mut self, at: At, modal: &ModalCall, range: TextRange) -> Flow {
-        let _ = (modal.source, modal.range);
-        match &modal.call.callee {
+    /// MCALL's program after a block with a path motion, its arguments
+    /// evaluated anew at each call.
+    pub(super) fn modal(&mut self, at: At, modal: &Call, range: TextRange) -> Flow {
+        match &modal.callee {
             Callee::Cycle(name) => {
-                self.cycle(name, &modal.call.arguments, range);
+                self.cycle(name, &modal.arguments, range);
                 Flow::Next
             }
             callee => match callee.program_name() {
-                Some(name) => self.enter(at, name, &modal.call.arguments, 0, true, range),
+                Some(name) => self.enter(at, name, &modal.arguments, 0, true, range),
                 None => {
                     self.state.not_run("this modal call", range);
                     Flow::Next
@@ -216,6 +207,19 @@ impl Interpreter<'_> {
         Flow::Go(At { source, block: 0 })
     }
 
+    /// The parameters of the PROC line of the program being run by
+    /// itself: zero, as if a call left them all out.
+    pub(super) fn bind_own_parameters(&mut self) {
+        let unit = Rc::clone(&self.units[0]);
+        let Some(header) = unit.model.header() else { return };
+        self.state.block_start = unit.ranges[header.block].start();
+        for parameter in &header.declaration.parameters {
+            let Some(name) = &parameter.name else { continue };
+            let result = self.eval().bind_value(name, &parameter.ty, None, parameter.range);
+            self.check(result);
+        }
+    }
+
     /// Opens the scope of a call's run with its parameters bound; false
     /// after reporting a value that does not fit its parameter.
     fn open_scope(&mut self, frame: &Frame, range: TextRange) -> bool {
@@ -274,10 +278,9 @@ impl Interpreter<'_> {
         self.units.len() - 1
     }
 
-    /// The block after the called program returns from the block at
-    /// `at` (RET, M17, its end); `None` at the main program's end.
-    pub(super) fn return_from(&mut self, at: At) -> Option<At> {
-        let _ = at;
+    /// The block after the called program returns (RET, M17, its end);
+    /// `None` at the main program's end.
+    pub(super) fn return_from(&mut self) -> Option<At> {
         self.end_spline();
         while self.calls.last().is_some_and(|frame| frame.bound.is_none()) {
             self.calls.pop();

@@ -53,7 +53,8 @@ fn moves(trace: &Trace) -> Vec<&Step> {
 
 #[test]
 fn a_for_loop_makes_one_move_a_pass_to_the_computed_end() {
-    let text = "DEF INT COUNT\nG0 X0 Y0 Z0\nF1000\nFOR COUNT = 1 TO 5\n  G1 X=COUNT*10 Y=COUNT\nENDFOR\nM30\n";
+    let text =
+        "DEF INT COUNT, LAST=5\nG0 X0 Y0 Z0\nF1000\nFOR COUNT = 1 TO LAST\n  G1 X=COUNT*10 Y=COUNT\nENDFOR\nM30\n";
     let trace = run(text);
     assert_eq!(findings(&trace, text), []);
     let made = moves(&trace);
@@ -475,4 +476,36 @@ proptest! {
         let trace = run_in(&text, &Beside::with(&[("_N_SUB_SPF", "PROC SUB(INT N)\nSUB(N+1)\n")]), &machine(), 3000, None, None);
         prop_assert!(trace.blocks_run <= 3000);
     }
+}
+
+#[test]
+fn a_subprogram_run_by_itself_has_its_parameters_at_zero() {
+    let text = "PROC SIDE(REAL D, VAR INT N) SAVE\nN=N+1\nG0 X=D+1 Y=N Z=$P_SUBPAR[1]\nM17\n";
+    let trace = run(text);
+    assert_eq!(findings(&trace, text), []);
+    assert_eq!(end(&trace), [1.0, 1.0, 0.0]);
+}
+
+#[test]
+fn modal_calls_and_repeated_sections_run_where_the_control_runs_them() {
+    let main = "\
+MCALL MARK(R1)
+G0 X1
+R1=R1+1
+G0 X2
+MCALL
+G0 X3
+START: R3=R3+1
+R4=R4+10
+FINISH: R5=R5+100
+REPEAT START FINISH P=3
+G0 Y=R2 Z=R3+R4+R5
+M30
+";
+    let mark = "PROC MARK(REAL WHAT)\nR2=R2+WHAT+1\nM17\n";
+    let trace = run_with(main, &Beside::with(&[("_N_MARK_SPF", mark)]));
+    assert_eq!(findings(&trace, main), []);
+    // MARK after the two moves under MCALL: (0+1) + (1+1); the section
+    // once on the way and three times repeated.
+    assert_eq!(end(&trace), [3.0, 3.0, 4.0 + 40.0 + 400.0]);
 }
