@@ -1,7 +1,7 @@
 //! The Siemens Sinumerik dialect's part of the executor: its block IR and
 //! lowering ([`lower`]), the program model over the lowered blocks
 //! ([`program`]), values and expressions ([`eval`]), the interpreter
-//! that runs a program (`interpreter`, through [`crate::run`]) and the
+//! that runs a program (`interpreter`, which the run driver picks) and the
 //! run written back as plain blocks ([`expand`]).
 //!
 //! What reads them:
