@@ -57,6 +57,13 @@
 //! what [`super::eval`] does not model. System variables the run has no
 //! value for read 0 with a finding once per name.
 //!
+//! A block makes a step when it has a word the machine acts on (an axis,
+//! a code, F, S, T, M, …), moves, dwells or stops; one that only
+//! computes, branches or calls makes none: the control prepares it ahead,
+//! and the path does not wait for it (assumption; the seed warns that
+//! slow preparation can starve a fast path, 004:2537-2557, which the run
+//! does not model).
+//!
 //! Assumptions besides those above: a program run by itself whose first
 //! line is a PROC has its parameters, `VAR` ones too, as variables of
 //! their type at zero, as if called with all left out; block skip is off; the settable frames
@@ -214,6 +221,36 @@ struct Words {
     weight: Option<f64>,
     interval: Option<f64>,
     auxiliary: u8,
+}
+
+impl Words {
+    /// Whether the block wrote no word the machine acts on.
+    fn is_empty(&self) -> bool {
+        let Words {
+            axes,
+            centre,
+            radius,
+            opening,
+            feed,
+            speed,
+            tool,
+            m,
+            codes,
+            adis,
+            adispos,
+            degree,
+            weight,
+            interval,
+            auxiliary,
+        } = self;
+        axes.is_empty()
+            && centre.iter().all(Option::is_none)
+            && [radius, opening, feed, speed, adis, adispos, degree, weight, interval].iter().all(|word| word.is_none())
+            && tool.is_none()
+            && m.is_empty()
+            && codes.is_empty()
+            && *auxiliary == 0
+    }
 }
 
 /// A block's move, before it becomes a step.
@@ -597,7 +634,11 @@ impl<'a> Interpreter<'a> {
         if self.state.stopped {
             return Flow::Stop;
         }
-        self.record(at, whole, moved.clone(), facts, stop);
+        // A block that only computes, branches or calls is prepared ahead:
+        // the machine sees nothing of it.
+        if !words.is_empty() || moved.motion != Motion::None || stop.is_some() {
+            self.record(at, whole, moved.clone(), facts, stop);
+        }
         if end {
             self.end_spline();
             return Flow::End;

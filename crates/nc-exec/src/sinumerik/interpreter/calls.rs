@@ -149,6 +149,10 @@ impl Interpreter<'_> {
             return Flow::Stop;
         }
         let unit = Rc::clone(&self.units[source]);
+        if unit.blocks.is_empty() {
+            // An empty file does nothing, however often it runs.
+            return Flow::Next;
+        }
         let header = unit.model.header().map(|proc| &proc.declaration);
         let parameters = header.map_or(&[][..], |proc| &proc.parameters[..]);
         if arguments.len() > parameters.len() {
