@@ -523,9 +523,8 @@ impl<'a> Interpreter<'a> {
                 }
             }
         }
-        if !self.state.stopped {
-            self.end_spline();
-        }
+        // A curve the run stopped in still ends where its points lead.
+        self.end_spline();
     }
 
     /// Hands `sink` the steps no later block can change: all at the
@@ -941,6 +940,8 @@ impl<'a> Interpreter<'a> {
             self.state.position = end;
             return self.spline_point(words, range, &start, &end);
         }
+        // `G[1]=…` left the spline without a code of the block.
+        self.end_spline();
         let (path, length, end) = match motion {
             "G0" | "G1" => (Path::Straight, distance(&start, &end), end),
             "G2" | "G3" => match self.arc(words, range, &start, end, motion == "G3") {

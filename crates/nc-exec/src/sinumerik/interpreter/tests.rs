@@ -332,6 +332,13 @@ fn a_rational_bspline_is_the_quarter_circle() {
     assert_eq!(end(&trace), [0.0, 20.0, 0.0]);
     let lines = trace.steps.iter().filter(|step| step.motion == Motion::Feed).count();
     assert_eq!(lines, curve.len() + 1);
+    // Left by `G[1]=2` (G1): the line after the curve keeps its own end.
+    let text = "F1000\nBSPLINE X10 Y10\nX20 Y0\nG[1]=2\nX0 Y20\n";
+    let trace = run(text);
+    assert_eq!(trace.findings, []);
+    let last = trace.steps.last().unwrap();
+    assert_eq!((&text[last.range], [last.end[0], last.end[1]]), ("X0 Y20\n", [0.0, 20.0]));
+    assert!((last.length - 20.0 * 2f64.sqrt()).abs() < 1e-9);
 }
 
 #[test]
