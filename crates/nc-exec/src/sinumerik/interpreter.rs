@@ -3,11 +3,11 @@
 //! control runs them.
 //!
 //! What runs:
-//! - Values and variables through [`super::eval`]: global user data
-//!   from the GUD definition files beside the program (`UGUD.DEF`, …),
-//!   assignments, DEF,
-//!   `G[n]=k`, and a word `NAME=…` whose name is a defined variable (a
-//!   formal parameter `X` of `PROC PROFIL (…, REAL X, …)`) assigns it.
+//! - Values and variables through [`super::eval`]: global user data from
+//!   the GUD definition files beside the program (`UGUD.DEF`, …),
+//!   assignments, DEF, `G[n]=k`, and a word `NAME=…` whose name is a
+//!   defined variable and no axis of the machine (a formal parameter `C`
+//!   of `PROC PROFIL (REAL C, …)`) assigns it.
 //! - Control structures by [`SinumerikModel`]: IF/ELSE/ENDIF, WHILE,
 //!   FOR (`FOR v = a TO b`, inclusive, step 1, the end evaluated at every
 //!   pass), REPEAT/UNTIL, LOOP/ENDLOOP, CASE … OF … DEFAULT, and
@@ -66,14 +66,15 @@
 //!
 //! Assumptions besides those above: a program run by itself whose first
 //! line is a PROC has its parameters, `VAR` ones too, as variables of
-//! their type at zero, as if called with all left out; block skip is off; the settable frames
-//! G54 … are zero; a subprogram that reaches its end without M17 or RET
-//! returns; a main program ends at its end without a finding; `$AC_TIME`
-//! (the time since the block started) is 0 where a program reads it, and
-//! the run has no clock (`$A_YEAR` … read 0, reported once);
-//! `$AA_IM`, `$AA_IW` are the programmed position; a named tool has no
-//! number (`$P_TOOLNO` is 0) and is not listed in the trace's tools. The
-//! run takes no checkpoints: a Sinumerik run always starts at the top.
+//! their type at zero, as if called with all left out; block skip is off;
+//! the settable frames G54 … are zero; a subprogram that reaches its end
+//! without M17 or RET returns; a main program ends at its end without a
+//! finding; `$AC_TIME` (the time since the block started) is 0 where a
+//! program reads it, and the run has no clock (`$A_YEAR` … read 0,
+//! reported once); `$AA_IM`, `$AA_IW` are the programmed position; a named
+//! tool has no number (`$P_TOOLNO` is 0) and is not listed in the trace's
+//! tools. The run takes no checkpoints: a Sinumerik run always starts at
+//! the top.
 
 use std::{collections::HashSet, rc::Rc};
 
@@ -802,15 +803,13 @@ impl<'a> Interpreter<'a> {
 
     /// A frame command (TRANS, ATRANS, ROT, SCALE, MIRROR and their
     /// additive forms): where the frames are joined to the run.
-    fn frame(&mut self, command: &Command, range: TextRange) {
-        let _ = command;
+    fn frame(&mut self, _command: &Command, range: TextRange) {
         self.state.not_run("programmable frames (TRANS, ROT, SCALE, MIRROR)", range);
     }
 
     /// A call of a control's cycle (CYCLE800, CYCLE832, …): where the
     /// cycles are joined to the run.
-    fn cycle(&mut self, name: &str, arguments: &[Option<Expr>], range: TextRange) {
-        let _ = arguments;
+    fn cycle(&mut self, name: &str, _arguments: &[Option<Expr>], range: TextRange) {
         self.state.not_run(&format!("the cycle {name}"), range);
     }
 
