@@ -23,7 +23,7 @@ fn stdout(output: &Output) -> String {
 fn bundled_examples_pass() {
     let output = ncc(&["check", "examples"]);
     assert_eq!(output.status.code(), Some(0), "{}", stdout(&output));
-    assert_eq!(stdout(&output), "All checks passed (5 files checked).\n");
+    assert_eq!(stdout(&output), "All checks passed (8 files checked).\n");
 }
 
 #[test]
@@ -1281,15 +1281,16 @@ fn a_named_dialect_reads_the_program_whatever_its_name_says() {
     assert_eq!(ncc(&["explain", "--dialect", "cnc8x6", "G40"]).status.code(), Some(0));
 }
 
-/// A Sinumerik program is checked for its syntax; the executor does not
-/// run it yet, and `run`, `expand` and `plot` say so at its first line and
-/// give no time, program or picture.
+/// A Sinumerik program is checked for its syntax and runs: `run` times
+/// it with the subprogram beside it, `expand` writes its moves as plain
+/// blocks, `plot` draws it, and the files it writes go below `--write-dir`.
 #[test]
-fn sinumerik_programs_are_checked_and_not_run_yet() {
+fn sinumerik_programs_are_checked_and_run() {
     let dir = tempfile::tempdir().unwrap();
     let clean = dir.path().join("PART.MPF");
-    let text = "; a part\nN10 G0 X0 Y0\nDEF REAL DEPTH=5\nIF DEPTH>2 GOTOF DONE\nWHILE R1<10\n  R1=R1+1\nENDWHILE\nDONE: G642 SOFT\nMSG(\"depth \"<<DEPTH)\nM30\n";
+    let text = "; a part\nN10 G0 X0 Y0\nDEF REAL DEPTH=5\nIF DEPTH>2 GOTOF DONE\nWHILE R1<10\n  R1=R1+1\nENDWHILE\nDONE: G642 SOFT\nMSG(\"depth \"<<DEPTH)\nSIDE(DEPTH)\nWRITE(R2,\"/_N_MPF_DIR/_N_OUT_DIR/_N_LOG_SPF\",\"X\"<<DEPTH)\nM30\n";
     std::fs::write(&clean, text).unwrap();
+    std::fs::write(dir.path().join("SIDE.SPF"), "PROC SIDE(REAL D)\nG1 X=D*2 Y=D F600\nM17\n").unwrap();
     let clean = clean.to_str().unwrap();
     let output = ncc(&["check", clean]);
     assert_eq!(output.status.code(), Some(0), "{}", stdout(&output));
@@ -1301,20 +1302,31 @@ fn sinumerik_programs_are_checked_and_not_run_yet() {
     let out = stdout(&output);
     assert!(out.contains("SUB.SPF:2:4: error[S029]: `(` is not closed by `)` on its line"), "{out}");
     assert!(out.contains("SUB.SPF:3:5: error[S028]"), "{out}");
+    let written = dir.path().join("out");
+    let output = ncc(&["run", "--write-dir", written.to_str().unwrap(), clean]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    let out = stdout(&output);
+    assert!(out.contains("(0:00:01.118 at the programmed feeds)") && out.contains("11.180 mm"), "{out}");
+    assert!(out.contains("end position X10.000 Y5.000 Z0.000"), "{out}");
+    let log = written.join("MPF").join("OUT").join("LOG.SPF");
+    assert_eq!(std::fs::read_to_string(&log).unwrap(), "X5\n");
+    assert!(stderr(&output).ends_with(&format!("wrote {}\n", log.display())), "{}", stderr(&output));
+    let output = ncc(&["expand", clean]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    assert_eq!(
+        stdout(&output),
+        "; EXPANDED FROM PART.MPF\nG17 G71 G90 G94 G60 BRISK\nG0 X0 Y0 Z0\nG64 SOFT G1 X10 Y5 F600\nM30\n"
+    );
     let svg = dir.path().join("part.svg");
-    for args in [
-        &["run", clean][..],
-        &["run", "--format", "json", clean],
-        &["expand", clean],
-        &["plot", clean, "-o", svg.to_str().unwrap()],
-    ] {
-        let output = ncc(args);
-        assert_eq!(output.status.code(), Some(1), "{args:?}");
-        assert_eq!(stdout(&output), "", "{args:?}");
-        let message = "PART.MPF:1: info[E020]: the executor does not run Siemens Sinumerik programs yet\n";
-        assert!(stderr(&output).ends_with(message), "{args:?}: {}", stderr(&output));
-    }
-    assert!(!svg.exists());
+    let output = ncc(&["plot", clean, "-o", svg.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    assert!(std::fs::read_to_string(&svg).unwrap().starts_with("<svg"));
+    // A written path that would leave the directory is refused.
+    let leaving = dir.path().join("LEAVE.MPF");
+    std::fs::write(&leaving, "WRITE(R1,\"/ETC/X\",\"x\")\nM30\n").unwrap();
+    let output = ncc(&["run", "--write-dir", written.to_str().unwrap(), leaving.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(stderr(&output).contains("the program wrote /ETC/X, a path that would leave"), "{}", stderr(&output));
     let output = ncc(&["parse", clean]);
     assert_eq!(output.status.code(), Some(0));
     assert!(stdout(&output).contains("LABEL@"), "{}", stdout(&output));

@@ -3,7 +3,8 @@
 //! fails here and shows where; a deliberate one is taken over with
 //! `UPDATE_GOLDEN=1 cargo test -p ncc --test golden` and reviewed in the diff.
 //!
-//! Per program: `ncc check --format json`, `ncc run --format json`,
+//! Per program: `ncc check --format json`, `ncc run --format json` (and
+//! the files the program wrote),
 //! `ncc expand` and `ncc plot` as the command line gives them, then the
 //! analysis answers an editor shows: hover at the start of every word of the
 //! first lines, the inlay hints, and the cycle-time estimate (headline, hints
@@ -82,7 +83,16 @@ fn cli_outputs(out: &mut String, program: &Path, scratch: &Path) {
     let file = program.to_str().unwrap();
     command(out, "check --format json", &["check", "--format", "json", file]);
     let budget = RUN_BUDGET.to_string();
-    command(out, "run --format json", &["run", "--format", "json", "--step-budget", &budget, file]);
+    let written = scratch.join("written");
+    let _ = std::fs::remove_dir_all(&written);
+    let write_dir = written.to_str().unwrap();
+    let run = ["run", "--format", "json", "--step-budget", &budget, "--write-dir", write_dir, file];
+    command(out, "run --format json", &run);
+    for (path, text) in files_below(&written) {
+        writeln!(out, "== written {path}").unwrap();
+        out.push_str(&text);
+    }
+    *out = out.replace(write_dir, "<written>");
     command(out, "expand", &["expand", "--step-budget", &budget, file]);
     let svg = scratch.join("plot.svg");
     let _ = std::fs::remove_file(&svg);
@@ -94,6 +104,26 @@ fn cli_outputs(out: &mut String, program: &Path, scratch: &Path) {
             out.push('\n');
         }
     }
+}
+
+/// The files below `directory` with their text, by their path from it
+/// (`/`-separated), sorted.
+fn files_below(top: &Path) -> Vec<(String, String)> {
+    let mut files = Vec::new();
+    let mut stack = vec![top.to_owned()];
+    while let Some(directory) = stack.pop() {
+        for entry in std::fs::read_dir(&directory).into_iter().flatten() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                let relative = path.strip_prefix(top).unwrap();
+                files.push((relative.to_string_lossy().replace('\\', "/"), read(&path).unwrap()));
+            }
+        }
+    }
+    files.sort();
+    files
 }
 
 /// The configuration the program is analysed with: a rule fixture's own
@@ -108,13 +138,17 @@ fn config_for(path: &Path) -> Config {
     }
 }
 
-/// Macrocycle files beside `path`, as `ncc check` adds them.
+/// Macrocycle files beside `path`, as `ncc check` adds them, and beside
+/// a Sinumerik program the Sinumerik files it may call by name.
 fn neighbours(path: &Path) -> Vec<PathBuf> {
     let mut found: Vec<PathBuf> = std::fs::read_dir(path.parent().unwrap())
         .unwrap()
         .map(|entry| entry.unwrap().path())
         .filter(|other| {
-            other != path && other.is_file() && macrocycle_number(other).is_some() && other.extension().is_none()
+            let macrocycle = macrocycle_number(other).is_some() && other.extension().is_none();
+            // A Sinumerik program calls the programs beside it by name.
+            let sinumerik = |file: &Path| Dialect::by_default_for(file) == Some(Dialect::Sinumerik);
+            other != path && other.is_file() && (macrocycle || (sinumerik(path) && sinumerik(other)))
         })
         .collect();
     found.sort();

@@ -172,6 +172,8 @@ impl Environment for FixtureFiles<'_> {
             Called::Number(number) => self.named(&format!("L{number}")),
             Called::Name(name) => self.named(name),
             Called::Program(number) => self.named(&format!("O{number}")),
+            Called::ControlFile(name) => self.0.iter().find(|(path, _)| ncc_catalog::is_control_file(path, name)),
+            Called::Written(_) => None,
         };
         found.map(|(_, text)| text.clone())
     }
@@ -196,6 +198,10 @@ fn run_check(fixture: &PathBuf) -> Result<Vec<&'static str>, String> {
         Some(Called::Program(number)) => {
             files.iter().position(|(path, _)| path.ends_with(format!("O{number}"))).unwrap()
         }
+        Some(Called::ControlFile(name)) => {
+            files.iter().position(|(path, _)| ncc_catalog::is_control_file(path, name)).unwrap()
+        }
+        Some(Called::Written(path)) => panic!("a fixture wrote {path}, which has no annotations"),
     };
     let mut report = String::new();
     for (index, (path, text)) in

@@ -108,9 +108,33 @@ pub fn program_file_number(path: &Path) -> Option<u32> {
     digits.parse().ok()
 }
 
+/// Whether the file at `path` is the one a Sinumerik control names
+/// `control_name` (`_N_PROFIL_SPF`): named so, or `PROFIL.SPF`, in any
+/// case (004:1452-1454).
+pub fn is_control_file(path: &Path, control_name: &str) -> bool {
+    let Some(name) = path.file_name().and_then(|name| name.to_str()) else { return false };
+    if name.eq_ignore_ascii_case(control_name) {
+        return true;
+    }
+    let inner = control_name.get(3..).filter(|_| control_name.get(..3).is_some_and(|p| p.eq_ignore_ascii_case("_N_")));
+    let Some((stem, extension)) = inner.and_then(|inner| inner.rsplit_once('_')) else { return false };
+    name.rsplit_once('.').is_some_and(|(file_stem, file_extension)| {
+        file_stem.eq_ignore_ascii_case(stem) && file_extension.eq_ignore_ascii_case(extension)
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn control_files_are_found_by_either_name() {
+        let file = |name: &str| is_control_file(Path::new(name), "_N_PROFIL_SPF");
+        assert!(file("dir/PROFIL.SPF") && file("profil.spf") && file("_N_PROFIL_SPF") && file("x/_n_profil_spf"));
+        assert!(!file("PROFIL.MPF") && !file("PROFIL") && !file("XPROFIL.SPF"));
+        assert!(is_control_file(Path::new("UGUD.DEF"), "_N_UGUD_DEF"));
+        assert!(!is_control_file(Path::new("A.SPF"), "PROFIL"));
+    }
 
     #[test]
     fn names_read_back() {

@@ -15,7 +15,7 @@ pub mod schema;
 use std::{collections::HashMap, ops::RangeInclusive, sync::OnceLock};
 
 pub use crate::{
-    dialect_id::{UnknownDialect, macrocycle_number, program_file_number},
+    dialect_id::{UnknownDialect, is_control_file, macrocycle_number, program_file_number},
     explain::{Item, NotFound},
     schema::*,
 };

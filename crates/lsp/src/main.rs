@@ -124,6 +124,11 @@ enum Command {
         /// ends, runaway calls).
         #[arg(long, default_value_t = nc_exec::run::DEFAULT_STEP_BUDGET)]
         step_budget: usize,
+        /// Where the files the program writes go (Sinumerik WRITE): the
+        /// control's path below this directory, created when the program
+        /// writes one (`/_N_MPF_DIR/_N_PART_SPF` is `MPF/PART.SPF`).
+        #[arg(long, default_value = "ncc-written")]
+        write_dir: PathBuf,
     },
     /// Draw the toolpath as an SVG picture: XY (ZX on a lathe), feed moves
     /// coloured by the speed of the velocity model, rapid moves dashed, the
@@ -188,7 +193,9 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Command::Lsp { log_level, .. } => server::run(log_level, dialect),
-        Command::Run { file, format, step_budget } => run::run(&file, dialect, format, step_budget),
+        Command::Run { file, format, step_budget, write_dir } => {
+            run::run(&file, dialect, format, step_budget, &write_dir)
+        }
         Command::Expand { file, output, step_budget } => run::expand(&file, dialect, output.as_deref(), step_budget),
         Command::Lower { file } => run::lower(&file, dialect),
         Command::Plot { file, output, step_budget, max_moves, view } => {

@@ -21,7 +21,11 @@ use nc_exec::{
     cnc8x6::{self, lower::BlockData},
     expand::{Expand, ExpandError},
     haas_lathe,
-    run::{Axes, Called, Environment, Message, MessageDisplay, Motion, Step, Stop, Totals, Trace, expected_blocks},
+    run::{
+        Axes, Called, Environment, Message, MessageDisplay, Motion, Step, Stop, Totals, Trace, WrittenFile,
+        expected_blocks,
+    },
+    sinumerik,
     velocity::{self, Dynamics, Timer, Timing, TimingSink},
 };
 use ncc_analysis::{Config, Dialect, Rule, Severity, Suppressions, WorkspaceFiles, clock};
@@ -292,11 +296,17 @@ pub(crate) enum Progress {
     Hidden,
 }
 
-pub(crate) fn run(path: &Path, dialect: Option<Dialect>, format: Format, step_budget: usize) -> ExitCode {
-    on_program(path, dialect, |program| run_program(program, path, format, step_budget))
+pub(crate) fn run(
+    path: &Path,
+    dialect: Option<Dialect>,
+    format: Format,
+    step_budget: usize,
+    write_dir: &Path,
+) -> ExitCode {
+    on_program(path, dialect, |program| run_program(program, path, format, step_budget, write_dir))
 }
 
-fn run_program(program: &Program<'_>, path: &Path, format: Format, step_budget: usize) -> ExitCode {
+fn run_program(program: &Program<'_>, path: &Path, format: Format, step_budget: usize, write_dir: &Path) -> ExitCode {
     if !nc_exec::run::interprets(program.dialect) {
         return not_run(program, step_budget);
     }
@@ -333,7 +343,59 @@ fn run_program(program: &Program<'_>, path: &Path, format: Format, step_budget: 
         eprintln!("error: writing the output: {error}");
         return ExitCode::from(2);
     }
+    if let Err(error) = write_files(&ran.trace.written, write_dir) {
+        eprintln!("error: {error}");
+        return ExitCode::from(2);
+    }
     ran.exit_code()
+}
+
+/// Writes the files the run wrote below `directory`, each at the path
+/// [`written_path`] gives; creates it only when there is one.
+fn write_files(files: &[WrittenFile], directory: &Path) -> Result<(), String> {
+    for file in files {
+        let Some(relative) = written_path(&file.path) else {
+            return Err(format!("the program wrote {}, a path that would leave {}", file.path, directory.display()));
+        };
+        let path = directory.join(relative);
+        let written =
+            path.parent().map_or(Ok(()), std::fs::create_dir_all).and_then(|()| std::fs::write(&path, &file.text));
+        written.map_err(|error| format!("writing {}: {error}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// Where a file the control names `path` goes below the directory the
+/// written files go to: `_N_X_DIR` is the directory `X`, `_N_NAME_EXT` the
+/// file `NAME.EXT`, other names stay; `None` for a path that would leave
+/// the directory (`..`, an absolute one once the control's directories
+/// are mapped, a drive or a backslash).
+fn written_path(path: &str) -> Option<PathBuf> {
+    let mut relative = PathBuf::new();
+    let parts: Vec<&str> = path.split('/').collect();
+    for (index, part) in parts.iter().enumerate() {
+        // A leading `/` is the control's root, for the control's
+        // directories only.
+        if part.is_empty()
+            && index == 0
+            && parts.get(1).is_some_and(|next| next.starts_with("_N_") && next.ends_with("_DIR"))
+        {
+            continue;
+        }
+        let unsafe_part = part.is_empty() || *part == "." || *part == ".." || part.contains(['\\', ':']);
+        if unsafe_part {
+            return None;
+        }
+        let inner = part.strip_prefix("_N_").filter(|inner| !inner.is_empty());
+        let mapped = match inner.and_then(|inner| inner.rsplit_once('_')) {
+            Some((name, "DIR")) if index + 1 < parts.len() => name.to_owned(),
+            Some((name, extension)) if index + 1 == parts.len() && !name.is_empty() => format!("{name}.{extension}"),
+            _ => (*part).to_owned(),
+        };
+        relative.push(mapped);
+    }
+    (!relative.as_os_str().is_empty()).then_some(relative)
 }
 
 /// `ncc expand`: the run written back as a program of plain motion blocks,
@@ -364,7 +426,10 @@ fn expand_program(program: &Program<'_>, path: &Path, output: Option<&Path>, ste
             let Some((out, target)) = open_output(output) else { return ExitCode::from(2) };
             (Box::new(haas_lathe::expand::Expansion::new(out, machine, number, &title)), target)
         }
-        Dialect::Sinumerik => return not_run(program, step_budget),
+        Dialect::Sinumerik => {
+            let Some((out, target)) = open_output(output) else { return ExitCode::from(2) };
+            (Box::new(sinumerik::expand::Expansion::new(out, machine, &title)), target)
+        }
     };
     let ran = Ran::run(program, &config, Progress::OnTerminal, |text, library| {
         nc_exec::run::run_into(text, library, machine, step_budget, &mut *expansion)
@@ -1031,8 +1096,16 @@ impl<'a> Library<'a> {
             lines: TextIndex::new(text),
             suppressions: Suppressions::of_text(text, dialect),
         };
-        let files = trace.files.iter().filter_map(|called| read.iter().find(|(c, _, _)| c == called));
-        let files = files.map(|(_, path, text)| source(path.display().to_string(), text));
+        let files = trace.files.iter().map(|called| match called {
+            Called::Written(path) => {
+                let written = trace.written.iter().find(|file| file.path == *path);
+                source(path.clone(), written.map_or("", |file| file.text.as_str()))
+            }
+            _ => match read.iter().find(|(c, _, _)| c == called) {
+                Some((_, path, text)) => source(path.display().to_string(), text),
+                None => source(String::new(), ""),
+            },
+        });
         std::iter::once(source(name.to_owned(), text)).chain(files).collect()
     }
 }
@@ -1054,6 +1127,12 @@ impl Environment for Library<'_> {
                 let named = |path: &Path| ncc_catalog::program_file_number(path) == Some(number);
                 self.read(called, named, |files| files.program_file(number))
             }
+            Called::ControlFile(name) => {
+                let named = |path: &Path| ncc_catalog::is_control_file(path, name);
+                self.read(called, named, |files| files.control_file(name))
+            }
+            // The run keeps what it wrote itself.
+            Called::Written(_) => None,
         }
     }
 
@@ -1088,5 +1167,24 @@ impl Source {
     /// `path:line`, for people.
     fn place(&self, offset: TextSize) -> String {
         format!("{}:{}", visible::escaped(&self.name), self.line(offset))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn written_paths_map_the_controls_names_and_stay_inside() {
+        let mapped = |path: &str| written_path(path).map(|path| path.to_string_lossy().replace('\\', "/"));
+        assert_eq!(
+            mapped("/_N_MPF_DIR/_N_VACKA_DIR/_N_GEOMETRIE_VACKA_SPF").as_deref(),
+            Some("MPF/VACKA/GEOMETRIE_VACKA.SPF")
+        );
+        assert_eq!(mapped("_N_PART_MPF").as_deref(), Some("PART.MPF"));
+        assert_eq!(mapped("NOTES.TXT").as_deref(), Some("NOTES.TXT"));
+        for leaving in ["/ETC/PASSWD", "/_N_MPF_DIR/../X", "..", "A/./B", "C:X", "A\\B", "", "/_N_MPF_DIR/"] {
+            assert_eq!(mapped(leaving), None, "{leaving}");
+        }
     }
 }

@@ -55,6 +55,24 @@ impl CircleArc {
     }
 }
 
+/// The centre of the arc of `radius` from `from` to `to`: on the side that
+/// makes it at most a half circle, the other side for a negative radius
+/// (Haas lathe manual §5.8 (001:658-660); Sinumerik's CR alike). `None` when the ends lie farther
+/// apart than the diameter beyond `tolerance`.
+pub fn centre_by_radius(from: [f64; 2], to: [f64; 2], radius: f64, ccw: bool, tolerance: f64) -> Option<[f64; 2]> {
+    let chord = [to[0] - from[0], to[1] - from[1]];
+    let half = chord[0].hypot(chord[1]) / 2.0;
+    if half == 0.0 || half > radius.abs() + tolerance {
+        return None;
+    }
+    let height = (radius * radius - half * half).max(0.0).sqrt();
+    // The centre of a short counter-clockwise arc lies left of the chord.
+    let side = if ccw == (radius > 0.0) { 1.0 } else { -1.0 };
+    let left = [-chord[1] / (2.0 * half), chord[0] / (2.0 * half)];
+    let middle = [(from[0] + to[0]) / 2.0, (from[1] + to[1]) / 2.0];
+    Some([middle[0] + side * height * left[0], middle[1] + side * height * left[1]])
+}
+
 #[cfg(test)]
 mod tests {
     use std::f64::consts::{FRAC_PI_2, PI, TAU};

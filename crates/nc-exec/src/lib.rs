@@ -57,10 +57,14 @@
 //!   [`sinumerik::lower`] (blocks as plain data, read from the syntax tree
 //!   and the catalogue), [`sinumerik::program`] (labels, block numbers,
 //!   control structures, declarations, jumps and calls of a file),
+//!   [`sinumerik::eval`] (typed values, variables and expressions),
 //!   [`sinumerik::frames`] (the programmable frame TRANS … AMIRROR),
 //!   [`sinumerik::cycles`] (the drilling cycles CYCLE81–CYCLE89 as moves,
-//!   the swivel CYCLE800 as a frame) and [`sinumerik::dynamics`] (its
-//!   velocity policy, and the modes G60, G64x, SOFT and BRISK a run keeps).
+//!   the swivel CYCLE800 as a frame), [`sinumerik::dynamics`] (its
+//!   velocity policy, and the modes G60, G64x, SOFT and BRISK a run keeps)
+//!   and `sinumerik::interpreter` (the control flow, calls, files, motion,
+//!   frames, cycles, splines and time of a program, which [`run`] runs on a
+//!   Sinumerik machine).
 //! - [`spline`]: rational B-spline curves (NURBS) over any axes, built
 //!   from the data a control programs them by: points, derivatives,
 //!   curvature, length, polylines within a chord tolerance.

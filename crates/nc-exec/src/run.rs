@@ -1,8 +1,8 @@
 //! Running a program: the driver that runs it on its machine by the
 //! interpreter of the machine's control (CNC8x6:
 //! [`crate::cnc8x6::interpreter`], Haas lathe:
-//! [`crate::haas_lathe::interpreter`]; Sinumerik has none yet, see
-//! [`not_run`]), to a trace or into a sink, on a thread
+//! [`crate::haas_lathe::interpreter`], Sinumerik:
+//! `crate::sinumerik::interpreter`), to a trace or into a sink, on a thread
 //! of its own or this one, with checkpoints to resume from; the control's
 //! velocity policy that times the steps; and the trace's vocabulary
 //! ([`crate::trace`]), which the interpreters write.
@@ -10,9 +10,8 @@
 use std::{sync::mpsc, thread::Scope};
 
 use ncc_catalog::Dialect;
-use ncc_syntax::{TextRange, TextSize};
 
-use crate::{cnc8x6, haas_lathe, machine::MachineConfig, transform::Frame, velocity::Dynamics};
+use crate::{cnc8x6, haas_lathe, machine::MachineConfig, sinumerik, transform::Frame, velocity::Dynamics};
 
 pub use crate::trace::*;
 
@@ -27,12 +26,13 @@ pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget:
 
 /// The frame in which a run on `machine` starts ([`Trace::reset_frame`]):
 /// CNC8x6, the zero offset G53 of its tables after the priority block;
-/// Haas lathe, the work offset G54; Sinumerik, which does not run yet, none.
+/// Haas lathe, the work offset G54; Sinumerik, none (its settable frames
+/// are zero).
 pub fn reset_frame(machine: &MachineConfig) -> Frame {
     match machine.control {
         Dialect::Cnc8x6 => cnc8x6::interpreter::reset_frame(machine),
         Dialect::HaasLathe => haas_lathe::interpreter::reset_frame(machine),
-        Dialect::Sinumerik => Frame::default(),
+        Dialect::Sinumerik => sinumerik::interpreter::reset_frame(machine),
     }
 }
 
@@ -42,7 +42,7 @@ pub fn interprets(control: Dialect) -> bool {
     match control {
         Dialect::Cnc8x6 => true,
         Dialect::HaasLathe => true,
-        Dialect::Sinumerik => false,
+        Dialect::Sinumerik => true,
     }
 }
 
@@ -129,53 +129,6 @@ fn run_in<'a, 's>(
     match machine.control {
         Dialect::Cnc8x6 => cnc8x6::interpreter::run_in(scope, text, files, machine, budget, sink, checkpoint),
         Dialect::HaasLathe => haas_lathe::interpreter::run_in(text, files, machine, budget, sink, checkpoint),
-        Dialect::Sinumerik => not_run(text, machine),
-    }
-}
-
-/// The run of a program in a language the executor has no interpreter for
-/// yet (Sinumerik): no step, and one finding at the first line with text
-/// that says so, so that no time is given for it rather than a wrong one.
-fn not_run(text: &str, machine: &MachineConfig) -> Trace {
-    let start = text.len() - text.trim_start().len();
-    let end = text[start..].find(['\r', '\n']).map_or(text.len(), |length| start + length);
-    let range = TextRange::new(TextSize::new(start as u32), TextSize::new(end as u32));
-    let message = format!("the executor does not run {} programs yet", machine.control.title());
-    Trace {
-        axes: machine.step_axes().to_vec(),
-        diameter_axis: machine.diameter_axis,
-        frames: Vec::new(),
-        reset_frame: reset_frame(machine),
-        tool_centre: Vec::new(),
-        compensated: Vec::new(),
-        messages: Vec::new(),
-        steps: Vec::new(),
-        findings: vec![Finding { rule: RunRule::NotRunYet, source: 0, range, message }],
-        tools: Vec::new(),
-        files: Vec::new(),
-        blocks_run: 0,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A Sinumerik program makes no step: its one finding, at its first
-    /// line with text, says the executor does not run it yet.
-    #[test]
-    fn a_program_without_an_interpreter_runs_to_one_finding() {
-        let machine = MachineConfig::of_control(Dialect::Sinumerik);
-        assert_eq!(machine.axes, b"XYZ");
-        let text = "\n  N10 G0 X10 Y20\r\nM30\n";
-        let trace = run(text, &NoFiles, &machine, DEFAULT_STEP_BUDGET);
-        assert!(trace.steps.is_empty() && trace.blocks_run == 0);
-        let [finding] = trace.findings.as_slice() else { panic!("{:?}", trace.findings) };
-        assert_eq!(finding.rule, RunRule::NotRunYet);
-        assert_eq!(&text[finding.range], "N10 G0 X10 Y20");
-        assert_eq!(finding.message, "the executor does not run Siemens Sinumerik programs yet");
-        assert!(!interprets(Dialect::Sinumerik) && interprets(Dialect::HaasLathe));
-        let empty = run("", &NoFiles, &machine, DEFAULT_STEP_BUDGET);
-        assert_eq!(empty.findings[0].range, TextRange::default());
+        Dialect::Sinumerik => sinumerik::interpreter::run_in(text, files, machine, budget, sink, checkpoint),
     }
 }

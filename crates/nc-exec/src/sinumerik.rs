@@ -1,11 +1,12 @@
 //! The Siemens Sinumerik dialect's part of the executor: its block IR and
-//! lowering ([`lower`]) and the program model over the lowered blocks
-//! ([`program`]), and the pieces the interpreter will call: the
-//! programmable frame ([`frames`]), the drilling and swivel cycles
-//! ([`cycles`]) and the velocity policy with the continuous-path modes
-//! ([`dynamics`]). Nothing runs Sinumerik programs yet.
+//! lowering ([`lower`]), the program model over the lowered blocks
+//! ([`program`]), values and expressions ([`eval`]), the programmable
+//! frame ([`frames`]), the drilling and swivel cycles ([`cycles`]), the
+//! velocity policy with the continuous-path modes ([`dynamics`]), the
+//! interpreter that runs a program (`interpreter`, which the run driver
+//! picks) and the run written back as plain blocks ([`expand`]).
 //!
-//! What the next steps read from them:
+//! What reads them:
 //!
 //! - The interpreter runs [`lower::SinumerikBlock::statements`] in order:
 //!   words (address, literal or expression, `AC`/`IC`), assignments to R
@@ -25,6 +26,9 @@
 
 pub mod cycles;
 pub mod dynamics;
+pub mod eval;
+pub mod expand;
 pub mod frames;
+pub(crate) mod interpreter;
 pub mod lower;
 pub mod program;

@@ -272,6 +272,18 @@ pub struct Trace {
     /// Blocks the run executed, the ones before a checkpoint it resumed
     /// from included (the step budget counts them).
     pub blocks_run: usize,
+    /// The files the program wrote (Sinumerik: WRITE), with their final
+    /// text, for whoever runs it to keep where it chooses.
+    pub written: Vec<WrittenFile>,
+}
+
+/// A file a run wrote.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct WrittenFile {
+    /// As the program named it, in upper case: the control's path
+    /// (`/_N_MPF_DIR/_N_VACKA_DIR/_N_GEOMETRIE_VACKA_SPF`) or a bare name.
+    pub path: String,
+    pub text: String,
 }
 
 impl Trace {
@@ -342,4 +354,10 @@ pub enum Called {
     /// calls program `O1234`, in a file named after it, `O1234` or
     /// `O01234` with or without an extension).
     Program(u32),
+    /// A program by the control's name for its file (Sinumerik:
+    /// `_N_PROFIL_SPF`, in a file `PROFIL.SPF` or `_N_PROFIL_SPF` beside
+    /// the program, any case).
+    ControlFile(String),
+    /// A program the run wrote itself ([`Trace::written`]), by its path.
+    Written(String),
 }

@@ -10,7 +10,7 @@
 //! The run needs no database: [`RunInput`] takes what it reads from a
 //! snapshot, so a long run never holds one (an edit would wait for it).
 
-use std::{fmt::Write as _, ops::ControlFlow, sync::Arc};
+use std::{fmt::Write as _, ops::ControlFlow, path::Path, sync::Arc};
 
 use nc_exec::{
     run::{Called, Checkpoint, Environment, Motion, Step, Totals, shift_count, shift_offset, shift_range},
@@ -140,6 +140,10 @@ pub struct WorkspaceFiles {
     /// The files named as the machine's cycle file, by their name without
     /// directory and extension, with their path.
     by_stem: Vec<(String, String, Arc<String>)>,
+    /// Sinumerik: the other files of the workspace, which a program calls
+    /// by the control's name (`_N_PROFIL_SPF` is `PROFIL.SPF`): path and
+    /// text.
+    control_files: Vec<(String, Arc<String>)>,
 }
 
 impl WorkspaceFiles {
@@ -159,6 +163,13 @@ impl WorkspaceFiles {
         let found = self.by_stem.iter().find(|(s, _, _)| s.eq_ignore_ascii_case(stem));
         found.map(|(_, path, text)| (path.as_str(), text.as_str()))
     }
+
+    /// The path and text of the Sinumerik file the control names `name`
+    /// (`_N_PROFIL_SPF`).
+    pub fn control_file(&self, name: &str) -> Option<(&str, &str)> {
+        let found = self.control_files.iter().find(|(path, _)| ncc_catalog::is_control_file(Path::new(path), name));
+        found.map(|(path, text)| (path.as_str(), text.as_str()))
+    }
 }
 
 impl Environment for WorkspaceFiles {
@@ -167,6 +178,8 @@ impl Environment for WorkspaceFiles {
             &Called::Number(number) => self.macrocycle_file(number),
             Called::Name(name) => self.cycle_file_named(name),
             &Called::Program(number) => self.program_file(number),
+            Called::ControlFile(name) => self.control_file(name),
+            Called::Written(_) => None,
         };
         found.map(|(_, text)| text.to_owned())
     }
@@ -189,10 +202,14 @@ pub(crate) fn run_input(db: &dyn Db, file: SourceFile) -> Option<RunInput> {
     let machine = &settings.config(db).machine;
     if *settings.dialect(db) == ncc_syntax::Dialect::HaasLathe {
         for &other in settings.files(db) {
-            if let Some(number) = ncc_catalog::program_file_number(std::path::Path::new(other.path(db))) {
+            if let Some(number) = ncc_catalog::program_file_number(Path::new(other.path(db))) {
                 files.programs.entry(number).or_insert_with(|| (other.path(db).clone(), other.text(db).clone()));
             }
         }
+    }
+    if *settings.dialect(db) == ncc_syntax::Dialect::Sinumerik {
+        let others = settings.files(db).iter().filter(|&&other| other != file);
+        files.control_files = others.map(|other| (other.path(db).clone(), other.text(db).clone())).collect();
     }
     // Only the cycle file the machine names: an edit of another program
     // leaves this one's estimate as it is.
@@ -1196,6 +1213,7 @@ mod tests {
             .collect(),
             by_stem: Vec::new(),
             programs: FxHashMap::default(),
+            control_files: Vec::new(),
         };
         let machine = MachineConfig::default();
         let text = Arc::new(text);

@@ -305,6 +305,7 @@ pub(crate) fn run_in<'a, 's>(
         tools: runner.tools,
         files: called,
         blocks_run: executed,
+        written: Vec::new(),
     }
 }
 

@@ -122,7 +122,7 @@ use super::{
     program::{Contour, Program, ProgramModel},
 };
 use crate::{
-    arc::{CircleArc, OffCircle, circle_through},
+    arc::{CircleArc, OffCircle, centre_by_radius, circle_through},
     compensation::{Side, ToolElement},
     known::Known,
     machine::MachineConfig,
@@ -177,6 +177,7 @@ pub(crate) fn run_in(
         tools: interpreter.tools,
         files: interpreter.called,
         blocks_run: interpreter.executed,
+        written: Vec::new(),
     }
 }
 
@@ -1299,24 +1300,6 @@ fn turning_minutes(length: f64, [from, to]: [f64; 2], k: f64, limit: f64) -> f64
     } else {
         length * (integral(to) - integral(from)) / (to - from)
     }
-}
-
-/// The centre of the arc of `radius` from `from` to `to`: on the side that
-/// makes it at most a half circle, the other side for a negative radius
-/// (lathe manual §5.8 (001:658-660)). `None` when the ends lie farther
-/// apart than the diameter beyond `tolerance`.
-fn centre_by_radius(from: [f64; 2], to: [f64; 2], radius: f64, ccw: bool, tolerance: f64) -> Option<[f64; 2]> {
-    let chord = [to[0] - from[0], to[1] - from[1]];
-    let half = chord[0].hypot(chord[1]) / 2.0;
-    if half == 0.0 || half > radius.abs() + tolerance {
-        return None;
-    }
-    let height = (radius * radius - half * half).max(0.0).sqrt();
-    // The centre of a short counter-clockwise arc lies left of the chord.
-    let side = if ccw == (radius > 0.0) { 1.0 } else { -1.0 };
-    let left = [-chord[1] / (2.0 * half), chord[0] / (2.0 * half)];
-    let middle = [(from[0] + to[0]) / 2.0, (from[1] + to[1]) / 2.0];
-    Some([middle[0] + side * height * left[0], middle[1] + side * height * left[1]])
 }
 
 mod calls;

@@ -1035,8 +1035,9 @@ fn lower_for(catalogue: &Catalogue, node: &GreenNodeData, range: TextRange) -> S
                     start = Some(value);
                 }
             }
+            // The variable without `= start`; a name after TO is the end.
             NodeOrToken::Node(target)
-                if matches!(kind(target.kind()), SyntaxKind::NAME_REF | SyntaxKind::PARAM_REF) =>
+                if start.is_none() && matches!(kind(target.kind()), SyntaxKind::NAME_REF | SyntaxKind::PARAM_REF) =>
             {
                 variable = place(catalogue, target, r);
             }

@@ -1,0 +1,38 @@
+use super::*;
+use crate::{
+    run::run_into,
+    trace::{DEFAULT_STEP_BUDGET, NoFiles},
+};
+use ncc_catalog::Dialect;
+
+fn expand(text: &str) -> String {
+    let machine = MachineConfig::of_control(Dialect::Sinumerik);
+    let mut expansion = Box::new(Expansion::new(Vec::new(), &machine, "EXPANDED FROM T.MPF"));
+    let trace = run_into(text, &NoFiles, &machine, DEFAULT_STEP_BUDGET, &mut *expansion);
+    assert_eq!(trace.findings, []);
+    let out = std::mem::take(&mut expansion.out);
+    expansion.finish().expect("written");
+    String::from_utf8(out).expect("text")
+}
+
+#[test]
+fn loops_and_arcs_become_plain_blocks() {
+    let text = "DEF INT PASS\nG0 X10 Y0\nFOR PASS=1 TO 2\nG1 Z=-PASS F100\nENDFOR\nG64 SOFT G3 X0 Y10 CR=10\nG18 G2 Z0 X2 K2 I0\nG4 F1.5\nM0\nM30\n";
+    let written = expand(text);
+    let expected = "; EXPANDED FROM T.MPF\nG17 G71 G90 G94 G60 BRISK\nG0 X10 Y0 Z0\nG1 Z-1 F100\nG1 Z-2\nG64 SOFT G3 X0 Y10 I-10 J0\nG18 G2 X2 Z0 K2 I0\nG4 F1.5\nM0\n";
+    assert_eq!(written, expected);
+    assert_eq!((decimal(-3000), decimal(12_500), decimal(1)), ("-3".to_owned(), "12.5".to_owned(), "0.001".to_owned()));
+}
+
+#[test]
+fn the_expansion_runs_the_same_moves() {
+    let text = "G0 X5 Y5\nF500\nG2 X15 Y5 CR=5\nBSPLINE X20 Y10\nX25 Y5\nG1 X0 Y0\nM30\n";
+    let machine = MachineConfig::of_control(Dialect::Sinumerik);
+    let original = crate::run::run(text, &NoFiles, &machine, DEFAULT_STEP_BUDGET);
+    let expanded = expand(text);
+    let again = crate::run::run(&expanded, &NoFiles, &machine, DEFAULT_STEP_BUDGET);
+    assert_eq!(again.findings, []);
+    let length = |trace: &crate::trace::Trace| trace.steps.iter().map(|step| step.length).sum::<f64>();
+    assert!((length(&original) - length(&again)).abs() < 1e-3, "{expanded}");
+    assert_eq!(original.end_position(), again.end_position());
+}

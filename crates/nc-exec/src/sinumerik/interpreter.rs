@@ -1,0 +1,1288 @@
+//! The Sinumerik interpreter: the modal state, variables, control flow,
+//! calls, motion and time of a program, block by block, in the order the
+//! control runs them.
+//!
+//! What runs:
+//! - Values and variables through [`super::eval`]: global user data from
+//!   the GUD definition files beside the program (`UGUD.DEF`, …),
+//!   assignments, DEF, `G[n]=k`, and a word `NAME=…` whose name is a
+//!   defined variable and no axis of the machine (a formal parameter `C`
+//!   of `PROC PROFIL (REAL C, …)`) assigns it.
+//! - Control structures by [`SinumerikModel`]: IF/ELSE/ENDIF, WHILE,
+//!   FOR (`FOR v = a TO b`, inclusive, step 1, the end evaluated at every
+//!   pass), REPEAT/UNTIL, LOOP/ENDLOOP, CASE … OF … DEFAULT, and
+//!   GOTO/GOTOF/GOTOB/GOTOC/GOTOS with a label, block number or computed
+//!   target (`GOTOF "N"<<R3`: a string `N<digits>` names a block number,
+//!   any other a label, searched in the jump's direction). Structures keep
+//!   no stack: an ENDFOR always steps its FOR's variable and an ENDWHILE
+//!   always goes back to its WHILE, so a jump out of a structure leaves it
+//!   and a jump into a body (the cam cycle's `GOTOB COUNTER`, 004:5091,
+//!   5145-5165) runs on from there as the loop (assumption; the step budget
+//!   ends any run that does not end).
+//! - Calls (module `calls`): programs by name (`PROFIL`,
+//!   `_N_GEOMETRIE_VACKA_SPF`, `L140`, `PCALL path`, `CALL "name"`), found
+//!   first among the files the run wrote, then by the [`Environment`] as
+//!   `_N_NAME_MPF` before `_N_NAME_SPF` (004:1454-1462), their PROC
+//!   parameters bound by value or `VAR` by reference (omitted ones zero,
+//!   004:1480), `$P_SUBPAR`, `P` repetitions, SAVE (the caller's modal G
+//!   codes come back), RET and M17 (and M2/M30 in a subprogram, Siemens
+//!   documentation) return, MCALL after every block with a path motion,
+//!   `REPEAT label [label] P=n` sections; 16 program levels at most
+//!   (004:1464), the main program being the first.
+//! - Motion: G0 (each axis at its rapid rate, the slowest deciding; the
+//!   dogleg of 004:841-847 is timed so but drawn straight), G1, G2/G3 by
+//!   centre I/J/K (incremental from the start unless `=AC(…)`), radius CR
+//!   (negative above 180°) or opening angle AR with a centre or an end
+//!   point, in the plane of G17/G18/G19 (a helix when the third axis
+//!   moves); G90/G91 and `AC()`/`IC()` per word; G70/G700 inch and
+//!   G71/G710 mm (G700 and G710 take the feed in the same unit); F in
+//!   mm/min (G94) or mm per revolution (G95, at S); BSPLINE (module
+//!   `bspline`).
+//! - S, M3/M4/M5, T (a number, or `T="name"`), M6, G4 dwell (F seconds
+//!   or S spindle revolutions, in a block of its own), M0/M1 stops, M2/M30
+//!   end; MSG evaluates its text, which the trace has no place for.
+//! - Each step's path mode from G60/G9 (exact stop) and G64/G641–G645
+//!   (continuous), its jerk limit from SOFT against BRISK, and its corner
+//!   tolerance: ADIS (ADISPOS for G0) under G641, 0 when not programmed;
+//!   infinite otherwise (no tolerance the run knows bounds the corner: the
+//!   tolerances of G642–G645 are machine data it does not read).
+//! - WRITE, READ, DELETE and ISFILE on the run's own files (module
+//!   `files`).
+//!
+//! Reported once each as not run, moving nothing: frames (TRANS, ROT, …)
+//! and the control's cycles until their modules are joined here
+//! ([`Interpreter::frame`], [`Interpreter::cycle`]), axes the machine does
+//! not have and orientation words, transformations (TRAORI), radius
+//! compensation G41/G42, inverse-time feed G93, synchronous actions and
+//! what [`super::eval`] does not model. System variables the run has no
+//! value for read 0 with a finding once per name.
+//!
+//! A block makes a step when it has a word the machine acts on (an axis,
+//! a code, F, S, T, M, …), moves, dwells or stops; one that only
+//! computes, branches or calls makes none: the control prepares it ahead,
+//! and the path does not wait for it (assumption; the seed warns that
+//! slow preparation can starve a fast path, 004:2537-2557, which the run
+//! does not model).
+//!
+//! Assumptions besides those above: a program run by itself whose first
+//! line is a PROC has its parameters, `VAR` ones too, as variables of
+//! their type at zero, as if called with all left out; block skip is off;
+//! the settable frames G54 … are zero; a subprogram that reaches its end
+//! without M17 or RET returns; a main program ends at its end without a
+//! finding; `$AC_TIME` (the time since the block started) is 0 where a
+//! program reads it, and the run has no clock (`$A_YEAR` … read 0,
+//! reported once); `$AA_IM`, `$AA_IW` are the programmed position; a named
+//! tool has no number (`$P_TOOLNO` is 0) and is not listed in the trace's
+//! tools. The run takes no checkpoints: a Sinumerik run always starts at
+//! the top.
+
+use std::{collections::HashSet, rc::Rc};
+
+use ncc_catalog::{AddressRole, Code, Dialect, KeywordKind};
+use ncc_syntax::{Parse, TextRange, TextSize};
+
+use super::{
+    eval::{Context, ErrorKind, Eval, EvalError, Store, Value, equal},
+    lower::{
+        Call, Command, Dimension, Expr, ExprKind, Jump, JumpKind, JumpTarget, Place, PlaceKind, SinumerikBlock,
+        StatementKind, Word, WordValue, block_nodes,
+    },
+    program::{Resolved, SinumerikModel, StructureKind},
+};
+use crate::{
+    arc::{OffCircle, centre_by_radius, circle_through},
+    machine::MachineConfig,
+    trace::{
+        Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, PROGRESS_INTERVAL, Path, PathMode, Position,
+        RunRule, Step, StepSink, Stop, Trace, Undelivered, slot,
+    },
+    transform::{Frame, over_axes},
+};
+
+mod bspline;
+mod calls;
+mod files;
+mod modes;
+
+use modes::Modes;
+
+/// The catalogue's groups the interpreter reads.
+const MOTION: &str = "G1";
+const PLANE: &str = "G6";
+const PATH_MODE: &str = "G10";
+const UNITS: &str = "G13";
+const DIMENSIONS: &str = "G14";
+const FEED_MODE: &str = "G15";
+const ACCELERATION: &str = "G21";
+const SPINDLE: &str = "M2";
+
+/// Millimetres in an inch.
+const INCH: f64 = 25.4;
+
+/// The frame a Sinumerik run starts in: none, the settable frames being
+/// zero.
+pub(crate) fn reset_frame(_machine: &MachineConfig) -> Frame {
+    Frame::default()
+}
+
+/// Runs `text` on `machine` for at most `budget` blocks, reading the
+/// programs it calls through `files`, handing the steps to `sink` as they
+/// are final when there is one. A checkpoint is never taken, so none is
+/// resumed from.
+pub(crate) fn run_in(
+    text: &str,
+    files: &dyn Environment,
+    machine: &MachineConfig,
+    budget: usize,
+    mut sink: Option<&mut dyn StepSink>,
+    _checkpoint: Option<&Checkpoint>,
+) -> Trace {
+    let mut interpreter = Interpreter::new(machine, files, text);
+    interpreter.run(budget, sink.as_deref_mut());
+    if let Some(sink) = sink {
+        interpreter.deliver(sink, true);
+    }
+    let Interpreter { steps, state, called, executed, .. } = interpreter;
+    Trace {
+        axes: machine.step_axes().to_vec(),
+        diameter_axis: machine.diameter_axis,
+        frames: vec![reset_frame(machine)],
+        reset_frame: reset_frame(machine),
+        tool_centre: Vec::new(),
+        compensated: Vec::new(),
+        messages: Vec::new(),
+        steps: steps.steps,
+        findings: state.findings,
+        tools: state.tools,
+        files: called,
+        blocks_run: executed,
+        written: state.files.into_written(),
+    }
+}
+
+/// One file of a run, lowered: the program's (source 0), or one a call
+/// read.
+struct Unit {
+    blocks: Vec<SinumerikBlock>,
+    /// Each block's range in the file.
+    ranges: Vec<TextRange>,
+    model: SinumerikModel,
+}
+
+impl Unit {
+    fn read(text: &str) -> Unit {
+        let parse = Parse::new(text, Dialect::Sinumerik);
+        let (ranges, blocks): (Vec<TextRange>, Vec<SinumerikBlock>) =
+            block_nodes(parse.green()).map(|(range, block)| (range, SinumerikBlock::lower(block))).unzip();
+        let model = SinumerikModel::new(&blocks);
+        Unit { blocks, ranges, model }
+    }
+}
+
+/// A block of a run: its file (as [`Step::source`]) and index there.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct At {
+    source: usize,
+    block: usize,
+}
+
+/// Which block runs after one.
+enum Flow {
+    Next,
+    /// A block of the same file.
+    Jump(usize),
+    /// Into a call, or back from one.
+    Go(At),
+    /// Back from the program being run: `RET`, `M17`.
+    Return,
+    /// M2 or M30: the end of a main program, a return from a subprogram.
+    End,
+    /// The run stops (an error).
+    Stop,
+}
+
+/// The words of a block, their values read.
+#[derive(Debug, Default)]
+struct Words {
+    /// Axis letters with their values and dimensions.
+    axes: Vec<(u8, f64, Option<Dimension>)>,
+    /// I, J, K.
+    centre: [Option<(f64, Option<Dimension>)>; 3],
+    radius: Option<f64>,
+    opening: Option<f64>,
+    feed: Option<f64>,
+    speed: Option<f64>,
+    tool: Option<Value>,
+    m: Vec<u32>,
+    /// The codes written, in order (G numbers and words like `SOFT`).
+    codes: Vec<&'static Code>,
+    adis: Option<f64>,
+    adispos: Option<f64>,
+    degree: Option<f64>,
+    weight: Option<f64>,
+    interval: Option<f64>,
+    auxiliary: u8,
+}
+
+impl Words {
+    /// Whether the block wrote no word the machine acts on.
+    fn is_empty(&self) -> bool {
+        let Words {
+            axes,
+            centre,
+            radius,
+            opening,
+            feed,
+            speed,
+            tool,
+            m,
+            codes,
+            adis,
+            adispos,
+            degree,
+            weight,
+            interval,
+            auxiliary,
+        } = self;
+        axes.is_empty()
+            && centre.iter().all(Option::is_none)
+            && [radius, opening, feed, speed, adis, adispos, degree, weight, interval].iter().all(|word| word.is_none())
+            && tool.is_none()
+            && m.is_empty()
+            && codes.is_empty()
+            && *auxiliary == 0
+    }
+}
+
+/// A block's move, before it becomes a step.
+#[derive(Clone, PartialEq)]
+struct Moved {
+    motion: Motion,
+    path: Path,
+    length: f64,
+    duration: f64,
+    feed: Option<f64>,
+}
+
+const STILL: Moved = Moved { motion: Motion::None, path: Path::Straight, length: 0.0, duration: 0.0, feed: None };
+
+/// What the expressions see of the run, and what it reports: the modal
+/// state, position, feed and spindle, the files, the findings.
+struct State<'a> {
+    machine: &'a MachineConfig,
+    modes: Modes,
+    /// Program coordinates in mm.
+    position: Position,
+    /// F as written, in mm/min or mm/rev by the feed mode (inch under
+    /// G700).
+    feed: Option<f64>,
+    /// S in rpm.
+    speed: f64,
+    /// The tool T selected last: a number, or 0 for a named one.
+    tool: u32,
+    tools: Vec<u32>,
+    /// ADIS and ADISPOS in mm.
+    adis: f64,
+    adispos: f64,
+    files: files::Files,
+    findings: Vec<Finding>,
+    /// Keys of what was reported once.
+    reported: HashSet<String>,
+    /// The file and the start of the block being run: expressions and
+    /// statements have ranges inside their block.
+    source: usize,
+    block_start: TextSize,
+    stopped: bool,
+}
+
+impl State<'_> {
+    /// A finding at `range`, inside the block being run.
+    fn finding(&mut self, rule: RunRule, range: TextRange, message: &str) {
+        self.stopped |= rule.stops();
+        let range = range + self.block_start;
+        self.findings.push(Finding { rule, source: self.source, range, message: message.to_owned() });
+    }
+
+    fn report_once(&mut self, rule: RunRule, key: &str, range: TextRange, message: &str) {
+        if self.reported.insert(key.to_owned()) {
+            self.finding(rule, range, message);
+        }
+    }
+
+    fn not_run(&mut self, what: &str, range: TextRange) {
+        let message = format!("the executor does not run {what} yet: the time leaves it out");
+        self.report_once(RunRule::NotRunYet, what, range, &message);
+    }
+
+    /// The value of axis `name` in program coordinates.
+    fn axis_value(&self, name: &str) -> Option<f64> {
+        let &[letter] = name.as_bytes() else { return None };
+        self.machine.axes.contains(&letter).then(|| self.position[slot(letter)])
+    }
+}
+
+impl Context for State<'_> {
+    fn system(&mut self, name: &str, indices: &[Value], range: TextRange) -> Result<Value, EvalError> {
+        let index = |at: usize| indices.get(at).and_then(|value| value.int(range).ok());
+        let value = match name {
+            "$P_F" => Value::Real(self.feed.unwrap_or(0.0)),
+            "$P_S" => Value::Real(self.speed),
+            "$P_SDIR" => Value::Int(self.modes.get(SPINDLE).and_then(|code| code[1..].parse().ok()).unwrap_or(5)),
+            "$AC_MSNUM" => Value::Int(1),
+            "$P_GG" => {
+                let group = index(0).map(|group| format!("G{group}"));
+                let code = group.and_then(|group| self.modes.code(&group));
+                Value::Int(code.and_then(|code| code.index).map_or(0, i64::from))
+            }
+            "$AA_IM" | "$AA_IW" => match indices.first() {
+                Some(Value::Axis(axis) | Value::Str(axis)) => match self.axis_value(axis) {
+                    Some(value) => Value::Real(value),
+                    None => return Err(failed(range, format!("the machine has no axis {axis}"))),
+                },
+                _ => return Err(failed(range, format!("{name} needs an axis: {name}[X]"))),
+            },
+            "$P_TOOLNO" | "$P_TOOLP" => Value::Int(i64::from(self.tool)),
+            "$P_ISTEST" => Value::Bool(false),
+            "$AC_TIME" => Value::Real(0.0),
+            "$MN_MM_NUM_R_PARAM" | "$MC_MM_NUM_R_PARAM" => {
+                Value::Int(i64::from(Dialect::Sinumerik.catalogue().parameters.count))
+            }
+            "$A_YEAR" | "$A_MONTH" | "$A_DAY" | "$A_HOUR" | "$A_MINUTE" | "$A_SECOND" => {
+                let message = "the run has no clock: the date and time variables ($A_YEAR … $A_SECOND) read 0";
+                self.report_once(RunRule::ParameterUnknown, "clock", range, message);
+                Value::Int(0)
+            }
+            _ => {
+                let message = format!("the run has no value for the system variable {name}: it reads 0");
+                self.report_once(RunRule::ParameterUnknown, name, range, &message);
+                Value::Int(0)
+            }
+        };
+        Ok(value)
+    }
+
+    fn write_system(&mut self, name: &str, _: &[Value], _: Value, range: TextRange) -> Result<(), EvalError> {
+        self.not_run(&format!("writes of the system variable {name}"), range);
+        Ok(())
+    }
+
+    fn set_group(&mut self, group: i64, index: i64, range: TextRange) -> Result<(), EvalError> {
+        let code = u32::try_from(index)
+            .ok()
+            .and_then(|index| Dialect::Sinumerik.catalogue().code_at(&format!("G{group}"), index));
+        match code {
+            Some(code) => {
+                self.modes.set(code);
+                Ok(())
+            }
+            None => Err(failed(range, format!("G group {group} has no code {index} the executor knows"))),
+        }
+    }
+
+    fn is_file(&self, path: &str) -> bool {
+        self.files.exists(path)
+    }
+
+    fn undefined_array(&mut self, name: &str, range: TextRange) {
+        let message = format!(
+            "{name} is not defined in the program (a GUD whose definition is not in the project): taken as a REAL array of 100 elements a dimension"
+        );
+        self.report_once(RunRule::ParameterUnknown, name, range, &message);
+    }
+}
+
+fn failed(range: TextRange, message: String) -> EvalError {
+    EvalError { kind: ErrorKind::Failed, message, range }
+}
+
+struct Interpreter<'a> {
+    files: &'a dyn Environment,
+    units: Vec<Rc<Unit>>,
+    /// The files read besides the program, source k being `called[k - 1]`.
+    called: Vec<Called>,
+    store: Store,
+    state: State<'a>,
+    calls: Vec<calls::Frame>,
+    /// MCALL's program and arguments.
+    modal_call: Option<Call>,
+    spline: Option<bspline::Pending>,
+    steps: Undelivered,
+    executed: usize,
+}
+
+impl<'a> Interpreter<'a> {
+    fn new(machine: &'a MachineConfig, files: &'a dyn Environment, text: &str) -> Self {
+        let state = State {
+            machine,
+            modes: Modes::at_reset(),
+            position: [0.0; 26],
+            feed: None,
+            speed: 0.0,
+            tool: 0,
+            tools: Vec::new(),
+            adis: 0.0,
+            adispos: 0.0,
+            files: files::Files::default(),
+            findings: Vec::new(),
+            reported: HashSet::new(),
+            source: 0,
+            block_start: TextSize::default(),
+            stopped: false,
+        };
+        Interpreter {
+            files,
+            units: vec![Rc::new(Unit::read(text))],
+            called: Vec::new(),
+            store: Store::new(),
+            state,
+            calls: Vec::new(),
+            modal_call: None,
+            spline: None,
+            steps: Undelivered::default(),
+            executed: 0,
+        }
+    }
+
+    fn eval(&mut self) -> Eval<'_> {
+        Eval { store: &mut self.store, context: &mut self.state }
+    }
+
+    /// Declares the global user data of the definition files the
+    /// environment has (Siemens's `_N_SGUD_DEF`, `_N_MGUD_DEF`,
+    /// `_N_UGUD_DEF`, `_N_GUD4_DEF` … `_N_GUD9_DEF`): their DEF lines.
+    fn define_globals(&mut self) {
+        let names = ["SGUD", "MGUD", "UGUD", "GUD4", "GUD5", "GUD6", "GUD7", "GUD8", "GUD9"];
+        for name in names {
+            let called = Called::ControlFile(format!("_N_{name}_DEF"));
+            let Some(text) = self.files.file(&called) else { continue };
+            let source = self.unit_of(called, &text);
+            let unit = Rc::clone(&self.units[source]);
+            self.state.source = source;
+            for (block, range) in unit.blocks.iter().zip(&unit.ranges) {
+                self.state.block_start = range.start();
+                for statement in &block.statements {
+                    if let StatementKind::Def(def) = &statement.kind {
+                        for declared in &def.names {
+                            let result = self.eval().define(&def.ty, declared, true);
+                            self.check(result);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Runs the program from its first block for at most `budget` blocks.
+    fn run(&mut self, budget: usize, mut sink: Option<&mut (dyn StepSink + '_)>) {
+        self.define_globals();
+        self.bind_own_parameters();
+        let mut at = At { source: 0, block: 0 };
+        loop {
+            let unit = Rc::clone(&self.units[at.source]);
+            self.state.source = at.source;
+            if at.block >= unit.blocks.len() {
+                // The end of the file: a subprogram returns, the main
+                // program ends.
+                match self.return_from() {
+                    Some(back) => {
+                        at = back;
+                        continue;
+                    }
+                    None => break,
+                }
+            }
+            self.state.block_start = unit.ranges[at.block].start();
+            if self.executed >= budget {
+                let message = format!("the run went past its budget of {budget} blocks");
+                let range = TextRange::up_to(unit.blocks[at.block].len);
+                self.state.finding(RunRule::StepBudget, range, &message);
+                break;
+            }
+            self.executed += 1;
+            if self.executed.is_multiple_of(PROGRESS_INTERVAL) {
+                self.files.progress(self.executed);
+            }
+            let flow = self.block(at, &unit);
+            if self.state.stopped {
+                break;
+            }
+            let next = match flow {
+                Flow::Next => Some(At { block: at.block + 1, ..at }),
+                Flow::Jump(block) => Some(At { block, ..at }),
+                Flow::Go(to) => Some(to),
+                Flow::Return | Flow::End => self.return_from(),
+                Flow::Stop => None,
+            };
+            let Some(next) = next else { break };
+            at = self.section_end(at, next);
+            if let Some(sink) = sink.as_deref_mut()
+                && self.steps.steps.len() >= DELIVERY_BATCH
+            {
+                self.deliver(sink, false);
+                if sink.closed() {
+                    return;
+                }
+            }
+        }
+        // A curve the run stopped in still ends where its points lead.
+        self.end_spline();
+    }
+
+    /// Hands `sink` the steps no later block can change: all at the
+    /// `end`, else those before an open spline's.
+    fn deliver(&mut self, sink: &mut dyn StepSink, end: bool) {
+        let open = self.spline.as_ref().filter(|_| !end).map(bspline::Pending::first_step);
+        self.steps.deliver(sink, open, &[reset_frame(self.state.machine)], &[], &mut []);
+    }
+
+    /// Runs the block at `at` of `unit`: its statements in order, then its
+    /// codes and motion, then its call, jump or end.
+    fn block(&mut self, at: At, unit: &Unit) -> Flow {
+        let block = &unit.blocks[at.block];
+        if block.statements.is_empty() {
+            return Flow::Next;
+        }
+        let whole = TextRange::up_to(block.len);
+        let mut words = Words::default();
+        let mut flow = Flow::Next;
+        let mut call = None;
+        for statement in &block.statements {
+            let range = statement.range;
+            match &statement.kind {
+                StatementKind::Word(word) => self.word(word, &mut words),
+                StatementKind::Assign { target, value }
+                    if target.kind == PlaceKind::User
+                        && !self.store.is_defined(&target.name)
+                        && Dialect::Sinumerik.catalogue().keyword(&target.name).is_some() =>
+                {
+                    self.state.not_run(&target.name, range);
+                }
+                StatementKind::Assign { target, value } => {
+                    let result = self.eval().assign(target, value, range);
+                    self.check(result);
+                }
+                StatementKind::Def(def) => {
+                    for declared in &def.names {
+                        let result = self.eval().define(&def.ty, declared, def.scope.is_some());
+                        self.check(result);
+                    }
+                }
+                StatementKind::Command(command) => self.command(command, &mut words, range),
+                StatementKind::Call(called) => call = Some((called.clone(), range)),
+                StatementKind::ModalCall(modal) => {
+                    self.modal_call = modal.clone();
+                }
+                StatementKind::Return { arguments } => {
+                    if !arguments.is_empty() {
+                        self.state.not_run("RET with a return target", range);
+                    }
+                    flow = Flow::Return;
+                }
+                StatementKind::Proc(_) | StatementKind::Extern(_) => {}
+                StatementKind::Define { .. } => self.state.not_run("DEFINE … AS macros", range),
+                StatementKind::SyncAction { .. } => self.state.not_run("synchronous actions", range),
+                StatementKind::Jump(jump) => flow = self.jump(at.block, jump, unit),
+                StatementKind::If { condition, jump } => {
+                    let holds = self.truth(condition);
+                    flow = match (holds, jump) {
+                        (None, _) => Flow::Stop,
+                        (Some(true), Some(jump)) => self.jump(at.block, jump, unit),
+                        (Some(false), Some(_)) | (Some(true), None) => Flow::Next,
+                        (Some(false), None) => self.structure_exit(at.block, StructureKind::If, unit, range),
+                    };
+                }
+                StatementKind::Else => flow = self.structure_exit(at.block, StructureKind::If, unit, range),
+                StatementKind::While(condition) => {
+                    flow = match self.truth(condition) {
+                        None => Flow::Stop,
+                        Some(true) => Flow::Next,
+                        Some(false) => self.structure_exit(at.block, StructureKind::While, unit, range),
+                    };
+                }
+                StatementKind::EndWhile => flow = self.structure_back(at.block, StructureKind::While, unit, range, 0),
+                StatementKind::For { variable, start, end } => {
+                    let result = self.eval().assign(variable, start, range);
+                    flow = match self.check(result).and_then(|()| self.for_continues(variable, end)) {
+                        None => Flow::Stop,
+                        Some(true) => Flow::Next,
+                        Some(false) => self.structure_exit(at.block, StructureKind::For, unit, range),
+                    };
+                }
+                StatementKind::EndFor => flow = self.end_for(at.block, unit, range),
+                StatementKind::Repeat | StatementKind::Loop | StatementKind::EndIf => {}
+                StatementKind::Until(condition) => {
+                    flow = match self.truth(condition) {
+                        None => Flow::Stop,
+                        Some(true) => Flow::Next,
+                        Some(false) => self.structure_back(at.block, StructureKind::Repeat, unit, range, 1),
+                    };
+                }
+                StatementKind::EndLoop => flow = self.structure_back(at.block, StructureKind::Loop, unit, range, 1),
+                StatementKind::RepeatSection { start, end, count } => {
+                    flow = self.repeat_section(at, unit, start, end.as_deref(), count.as_ref(), range);
+                }
+                StatementKind::Case { selector, arms } => flow = self.case(at.block, selector, arms, unit),
+            }
+            if self.state.stopped {
+                return Flow::Stop;
+            }
+            if !matches!(flow, Flow::Next) {
+                break;
+            }
+        }
+        let (moved, stop, end, facts) = self.codes_and_motion(&words, whole);
+        if self.state.stopped {
+            return Flow::Stop;
+        }
+        // A block that only computes, branches or calls is prepared ahead:
+        // the machine sees nothing of it.
+        if !words.is_empty() || moved.motion != Motion::None || stop.is_some() {
+            self.record(at, whole, moved.clone(), facts, stop);
+        }
+        if end {
+            self.end_spline();
+            return Flow::End;
+        }
+        if words.m.contains(&17) {
+            self.end_spline();
+            return Flow::Return;
+        }
+        if let Some((called, range)) = call {
+            return self.call(at, &called, range);
+        }
+        if matches!(flow, Flow::Next)
+            && matches!(moved.motion, Motion::Rapid | Motion::Feed)
+            && let Some(modal) = self.modal_call.clone()
+            && !self.calls.iter().any(|frame| frame.modal)
+        {
+            return self.modal(at, &modal, whole);
+        }
+        flow
+    }
+
+    /// Reports an evaluation's error; `Some` when there was none.
+    fn check<T>(&mut self, result: Result<T, EvalError>) -> Option<T> {
+        match result {
+            Ok(value) => Some(value),
+            Err(error) => {
+                self.eval_failed(error);
+                None
+            }
+        }
+    }
+
+    fn eval_failed(&mut self, error: EvalError) {
+        match error.kind {
+            ErrorKind::Failed => {
+                let message = format!("{}: the control stops", error.message);
+                self.state.finding(RunRule::ArithmeticFailed, error.range, &message);
+            }
+            ErrorKind::NotModelled => self.state.not_run(&error.message, error.range),
+        }
+    }
+
+    /// A condition's truth; `None` after reporting why it has none.
+    fn truth(&mut self, condition: &Expr) -> Option<bool> {
+        let result = self.eval().truth(condition);
+        let truth = self.check(result);
+        if truth.is_none() && !self.state.stopped {
+            // Not modelled: the run cannot tell which way it goes.
+            let message = "a condition the run cannot evaluate: it cannot tell which way the program goes";
+            self.state.finding(RunRule::ControlWordUnknown, condition.range, message);
+        }
+        truth
+    }
+
+    /// A word's number and dimension; `None` when it has none (reported).
+    fn word_number(&mut self, word: &Word) -> Option<(f64, Option<Dimension>)> {
+        match word.value.as_ref() {
+            Some(WordValue::Literal(number)) => Some((number.value(), None)),
+            Some(WordValue::Expr { expr, dimension }) => {
+                let result = self.eval().number(expr);
+                self.check(result).map(|value| (value, *dimension))
+            }
+            None => None,
+        }
+    }
+
+    /// Reads a word into `words`, or assigns it when its address is a
+    /// variable's name.
+    fn word(&mut self, word: &Word, words: &mut Words) {
+        let catalogue = Dialect::Sinumerik.catalogue();
+        let address = word.address.as_str();
+        let machine_axis = matches!(address.as_bytes(), &[letter] if self.state.machine.axes.contains(&letter));
+        if let Some(WordValue::Expr { expr, dimension: None }) = &word.value
+            && !machine_axis
+            && self.store.is_defined(address)
+        {
+            let target = Place { kind: PlaceKind::User, name: address.to_owned(), indices: Vec::new() };
+            let result = self.eval().assign(&target, expr, word.range);
+            self.check(result);
+            return;
+        }
+        if address == "T" {
+            if let Some(WordValue::Expr { expr, .. }) = &word.value {
+                let result = self.eval().value(expr);
+                words.tool = self.check(result);
+            } else if let Some((value, _)) = self.word_number(word) {
+                words.tool = Some(Value::Real(value));
+            }
+            return;
+        }
+        let numbered_axis = |name: &str| {
+            name.len() > 1
+                && b"XYZABCUVW".contains(&name.as_bytes()[0])
+                && name[1..].bytes().all(|b| b.is_ascii_digit())
+        };
+        let Some(role) = catalogue.address(address).map(|a| a.role) else {
+            let what = if numbered_axis(address) {
+                format!("axis {address} (the machine has none)")
+            } else {
+                format!("the address {address}")
+            };
+            self.state.not_run(&what, word.range);
+            return;
+        };
+        let Some((value, dimension)) = self.word_number(word) else { return };
+        let whole = || (value >= 0.0 && value.fract() == 0.0 && value < f64::from(u32::MAX)).then_some(value as u32);
+        match (role, address) {
+            (AddressRole::Function, "G") => match whole().and_then(|number| catalogue.code('G', number)) {
+                Some(code) => words.codes.push(code),
+                None => self.state.not_run(&format!("G{value}"), word.range),
+            },
+            (AddressRole::Function, _) => match whole() {
+                Some(number) => words.m.push(number),
+                None => self.state.not_run(&format!("M{value}"), word.range),
+            },
+            (AddressRole::Axis, _) => match address.as_bytes() {
+                &[letter] if self.state.machine.axes.contains(&letter) => words.axes.push((letter, value, dimension)),
+                _ => self.state.not_run(&format!("axis {address} (the machine has none)"), word.range),
+            },
+            (AddressRole::Interpolation, "I" | "J" | "K") => {
+                words.centre[usize::from(address.as_bytes()[0] - b'I')] = Some((value, dimension));
+            }
+            (AddressRole::Interpolation, "CR") => words.radius = Some(value),
+            (AddressRole::Interpolation, "AR") => words.opening = Some(value),
+            (AddressRole::Feed, _) => words.feed = Some(value),
+            (AddressRole::Speed, _) => words.speed = Some(value),
+            (AddressRole::Tolerance, "ADIS") => words.adis = Some(value),
+            (AddressRole::Tolerance, "ADISPOS") => words.adispos = Some(value),
+            (AddressRole::Spline, "SD") => words.degree = Some(value),
+            (AddressRole::Spline, "PW") => words.weight = Some(value),
+            (AddressRole::Spline, "PL") => words.interval = Some(value),
+            (AddressRole::Auxiliary, _) => words.auxiliary = words.auxiliary.saturating_add(1),
+            // Tool offsets select lengths the run does not model; the
+            // count belongs to a call, tolerances of orientation to what
+            // is reported below.
+            (AddressRole::Offset | AddressRole::Count | AddressRole::Tolerance, _) => {}
+            (AddressRole::Orientation, _) => self.state.not_run("tool orientation (A2, A3, LEAD, …)", word.range),
+            _ => self.state.not_run(&format!("the address {address}"), word.range),
+        }
+    }
+
+    /// A code or keyword written as a name.
+    fn command(&mut self, command: &Command, words: &mut Words, range: TextRange) {
+        let catalogue = Dialect::Sinumerik.catalogue();
+        if let Some(code) = catalogue.word_code(&command.name) {
+            if code.group.as_deref() == Some("G3") {
+                self.frame(command, range);
+            } else {
+                words.codes.push(code);
+            }
+            return;
+        }
+        match catalogue.keyword(&command.name).map(|keyword| keyword.kind) {
+            Some(KeywordKind::Transformation) if command.name.ends_with("OF") => {}
+            Some(KeywordKind::Transformation) => {
+                self.state.not_run(&format!("the transformation {}", command.name), range);
+            }
+            Some(KeywordKind::Statement) => {}
+            _ => self.state.not_run(&command.name, range),
+        }
+    }
+
+    /// A frame command (TRANS, ATRANS, ROT, SCALE, MIRROR and their
+    /// additive forms): where the frames are joined to the run.
+    fn frame(&mut self, _command: &Command, range: TextRange) {
+        self.state.not_run("programmable frames (TRANS, ROT, SCALE, MIRROR)", range);
+    }
+
+    /// A call of a control's cycle (CYCLE800, CYCLE832, …): where the
+    /// cycles are joined to the run.
+    fn cycle(&mut self, name: &str, _arguments: &[Option<Expr>], range: TextRange) {
+        self.state.not_run(&format!("the cycle {name}"), range);
+    }
+
+    /// The block's codes, feed, spindle, tool and motion: its move, its
+    /// stop, whether it ends the program, and what its step records.
+    fn codes_and_motion(&mut self, words: &Words, range: TextRange) -> (Moved, Option<Stop>, bool, Facts) {
+        let mut facts = Facts::default();
+        let mut dwell = false;
+        for &code in &words.codes {
+            match code.code.as_str() {
+                "G4" => dwell = true,
+                "G9" => facts.exact = true,
+                "G41" | "G42" => self.state.not_run("tool radius compensation G41/G42", range),
+                "G93" => self.state.not_run("inverse-time feed G93", range),
+                "G74" | "G75" => self.state.not_run("reference point approach G74/G75", range),
+                _ => {}
+            }
+            let ends_spline = code.group.as_deref() == Some(MOTION) && code.code != "BSPLINE";
+            if ends_spline {
+                self.end_spline();
+            }
+            self.state.modes.set(code);
+        }
+        let mut stop = None;
+        let mut end = false;
+        for &m in &words.m {
+            match m {
+                0 => stop = Some(Stop::Program),
+                1 => stop = Some(Stop::Optional),
+                2 | 30 => end = true,
+                17 => {}
+                6 => facts.tool_change = true,
+                3..=5 => {
+                    if let Some(code) = Dialect::Sinumerik.catalogue().code('M', m) {
+                        self.state.modes.set(code);
+                    }
+                }
+                _ => facts.m_functions = facts.m_functions.saturating_add(1),
+            }
+        }
+        facts.m_functions = facts.m_functions.saturating_add(words.auxiliary);
+        if let Some(adis) = words.adis {
+            self.state.adis = self.length(adis);
+        }
+        if let Some(adispos) = words.adispos {
+            self.state.adispos = self.length(adispos);
+        }
+        if let Some(tool) = &words.tool {
+            self.select_tool(tool);
+        }
+        if dwell {
+            return (self.dwell(words, range), stop, end, facts);
+        }
+        if let Some(feed) = words.feed {
+            self.state.feed = Some(feed);
+        }
+        if let Some(speed) = words.speed {
+            self.state.speed = speed;
+        }
+        let moved = self.motion(words, range);
+        (moved, stop, end, facts)
+    }
+
+    fn select_tool(&mut self, tool: &Value) {
+        self.state.tool = match tool {
+            Value::Str(_) => 0,
+            number => number.int(TextRange::default()).ok().and_then(|n| u32::try_from(n).ok()).unwrap_or(0),
+        };
+        if self.state.tool != 0 && !self.state.tools.contains(&self.state.tool) {
+            self.state.tools.push(self.state.tool);
+        }
+    }
+
+    /// G4: F seconds, or S revolutions of the spindle.
+    fn dwell(&mut self, words: &Words, range: TextRange) -> Moved {
+        let duration = match (words.feed, words.speed) {
+            (Some(seconds), _) => seconds,
+            (None, Some(revolutions)) if self.state.speed > 0.0 => revolutions * 60.0 / self.state.speed,
+            (None, Some(_)) => {
+                let message = "a dwell of spindle revolutions with the spindle at S0: it never ends";
+                self.state.finding(RunRule::MotionWithoutFeed, range, message);
+                0.0
+            }
+            (None, None) => {
+                self.state.finding(RunRule::ValueRefused, range, "G4 needs its time: F seconds or S revolutions");
+                0.0
+            }
+        };
+        Moved { motion: Motion::Dwell, duration: duration.max(0.0), ..STILL }
+    }
+
+    /// A length as written, in mm: inch under G70 and G700.
+    fn length(&self, value: f64) -> f64 {
+        match self.state.modes.get(UNITS) {
+            Some("G70" | "G700") => value * INCH,
+            _ => value,
+        }
+    }
+
+    /// Where the block's axis words lead; `None` when it has none.
+    fn end_point(&self, words: &Words) -> Option<Position> {
+        if words.axes.is_empty() {
+            return None;
+        }
+        let incremental = self.state.modes.is(DIMENSIONS, "G91");
+        let mut end = self.state.position;
+        for &(letter, value, dimension) in &words.axes {
+            let value = if is_linear(letter) { self.length(value) } else { value };
+            let relative = dimension.map_or(incremental, |d| d == Dimension::Incremental);
+            let at = &mut end[slot(letter)];
+            *at = if relative { *at + value } else { value };
+        }
+        Some(end)
+    }
+
+    /// The block's move in the motion mode in force.
+    fn motion(&mut self, words: &Words, range: TextRange) -> Moved {
+        let start = self.state.position;
+        let arc_by_angle = words.opening.is_some() && words.centre.iter().any(Option::is_some);
+        let end = match self.end_point(words) {
+            Some(end) => end,
+            None if arc_by_angle && matches!(self.state.modes.get(MOTION), Some("G2" | "G3")) => start,
+            None => return STILL,
+        };
+        let motion = self.state.modes.get(MOTION).unwrap_or("G1");
+        if motion == "BSPLINE" {
+            self.state.position = end;
+            return self.spline_point(words, range, &start, &end);
+        }
+        // `G[1]=…` left the spline without a code of the block.
+        self.end_spline();
+        let (path, length, end) = match motion {
+            "G0" | "G1" => (Path::Straight, distance(&start, &end), end),
+            "G2" | "G3" => match self.arc(words, range, &start, end, motion == "G3") {
+                Some(arc) => arc,
+                None => return STILL,
+            },
+            other => {
+                self.state.not_run(&format!("the motion {other}"), range);
+                return STILL;
+            }
+        };
+        self.state.position = end;
+        if motion == "G0" {
+            let minutes = self
+                .state
+                .machine
+                .axes
+                .iter()
+                .map(|&axis| {
+                    (end[slot(axis)] - start[slot(axis)]).abs() / f64::from(self.state.machine.axis_rapid_rate(axis))
+                })
+                .fold(0.0, f64::max);
+            return Moved { motion: Motion::Rapid, path, length, duration: minutes * 60.0, feed: None };
+        }
+        self.feed_move(range, path, length)
+    }
+
+    /// A feed move of `length` mm along `path`.
+    fn feed_move(&mut self, range: TextRange, path: Path, length: f64) -> Moved {
+        let minutes = self.feed_rate(range).map(|rate| length / rate);
+        let (duration, feed) = match minutes {
+            Some(minutes) => {
+                (minutes * 60.0, Some(length / minutes).filter(|f| f.is_finite()).or(self.feed_rate_quiet()))
+            }
+            None => (0.0, None),
+        };
+        Moved { motion: Motion::Feed, path, length, duration, feed }
+    }
+
+    /// The path feed in mm/min; `None` after reporting why the axes cannot
+    /// move.
+    fn feed_rate(&mut self, range: TextRange) -> Option<f64> {
+        let rate = self.feed_rate_quiet();
+        if rate.is_none() {
+            let message = match self.state.modes.get(FEED_MODE) {
+                Some("G95") => "feed per revolution (G95) with no F or the spindle stopped: the axes cannot move",
+                _ => "no feed F programmed before this motion: G1, G2, G3 and splines need one",
+            };
+            self.state.finding(RunRule::MotionWithoutFeed, range, message);
+        }
+        rate
+    }
+
+    fn feed_rate_quiet(&self) -> Option<f64> {
+        let feed = self.state.feed.filter(|&feed| feed > 0.0)?;
+        let feed = if self.state.modes.is(UNITS, "G700") { feed * INCH } else { feed };
+        let spindle_on = matches!(self.state.modes.get(SPINDLE), Some("M3" | "M4"));
+        match self.state.modes.get(FEED_MODE) {
+            Some("G95") => (spindle_on && self.state.speed > 0.0).then_some(feed * self.state.speed),
+            _ => Some(feed),
+        }
+    }
+
+    /// The arc of G2 (`ccw` false) or G3 from `start` to `end` in the
+    /// plane in force: its path, length and end; `None` after reporting.
+    fn arc(
+        &mut self,
+        words: &Words,
+        range: TextRange,
+        start: &Position,
+        mut end: Position,
+        ccw: bool,
+    ) -> Option<(Path, f64, Position)> {
+        let (a, b, normal) = match self.state.modes.get(PLANE) {
+            Some("G18") => (b'Z', b'X', b'Y'),
+            Some("G19") => (b'Y', b'Z', b'X'),
+            _ => (b'X', b'Y', b'Z'),
+        };
+        let from = [start[slot(a)], start[slot(b)]];
+        let centre_word = |letter: u8| words.centre[usize::from(letter - b'X')];
+        let centre = match (centre_word(a), centre_word(b)) {
+            (None, None) => None,
+            (i, j) => {
+                let absolute = |word: Option<(f64, Option<Dimension>)>, at: f64| match word {
+                    Some((value, Some(Dimension::Absolute))) => self.length(value),
+                    Some((value, _)) => at + self.length(value),
+                    None => at,
+                };
+                Some([absolute(i, from[0]), absolute(j, from[1])])
+            }
+        };
+        let tolerance = self.state.machine.arc_tolerance();
+        let to_point = |end: &Position| [end[slot(a)], end[slot(b)]];
+        let centre = match (centre, words.radius, words.opening) {
+            (Some(centre), _, Some(angle)) if words.axes.is_empty() => {
+                // The end lies the opening angle round the centre.
+                let turn = if ccw { angle } else { -angle }.to_radians();
+                let (sin, cos) = turn.sin_cos();
+                let (dx, dy) = (from[0] - centre[0], from[1] - centre[1]);
+                end[slot(a)] = centre[0] + dx * cos - dy * sin;
+                end[slot(b)] = centre[1] + dx * sin + dy * cos;
+                centre
+            }
+            (Some(centre), _, _) => centre,
+            (None, radius, opening) => {
+                let to = to_point(&end);
+                let radius = match (radius, opening) {
+                    (Some(radius), _) => Some(self.length(radius)),
+                    (None, Some(angle)) if angle > 0.0 && angle < 360.0 => {
+                        let half = (to[0] - from[0]).hypot(to[1] - from[1]) / 2.0;
+                        let radius = half / (angle / 2.0).to_radians().sin();
+                        Some(if angle > 180.0 { -radius } else { radius })
+                    }
+                    _ => None,
+                };
+                let Some(radius) = radius else {
+                    let message = "a circle needs its centre (I, J, K), radius CR or opening angle AR";
+                    self.state.finding(RunRule::ArcOffCircle, range, message);
+                    return None;
+                };
+                match centre_by_radius(from, to, radius, ccw, tolerance) {
+                    Some(centre) => centre,
+                    None => {
+                        let message = format!("no arc of radius {} mm joins the start and the end point", radius.abs());
+                        self.state.finding(RunRule::ArcOffCircle, range, &message);
+                        return None;
+                    }
+                }
+            }
+        };
+        let arc = match circle_through(from, to_point(&end), centre, ccw, tolerance) {
+            Ok(arc) => arc,
+            Err(OffCircle { start_radius, end_radius }) => {
+                let message = format!(
+                    "the end point does not lie on the circle: {end_radius:.3} mm from the centre, the start {start_radius:.3} mm, more than the tolerance {tolerance} mm apart"
+                );
+                self.state.finding(RunRule::ArcOffCircle, range, &message);
+                return None;
+            }
+        };
+        let rise = end[slot(normal)] - start[slot(normal)];
+        let path = Path::Arc { plane: (a, b), centre, clockwise: !ccw };
+        Some((path, arc.length().hypot(rise), end))
+    }
+
+    /// Adds the block's step.
+    fn record(&mut self, at: At, range: TextRange, moved: Moved, facts: Facts, stop: Option<Stop>) {
+        let modes = &self.state.modes;
+        let exact = facts.exact || modes.is(PATH_MODE, "G60");
+        let corner_tolerance = match modes.get(PATH_MODE) {
+            Some("G641") if moved.motion == Motion::Rapid => self.state.adispos as f32,
+            Some("G641") => self.state.adis as f32,
+            _ => f32::INFINITY,
+        };
+        let rpm = match modes.get(SPINDLE) {
+            Some("M3") => self.state.speed as f32,
+            Some("M4") => -self.state.speed as f32,
+            _ => 0.0,
+        };
+        let step = Step {
+            source: at.source,
+            range: range + self.state.block_start,
+            motion: moved.motion,
+            path: moved.path,
+            duration: moved.duration,
+            length: moved.length,
+            feed: moved.feed,
+            end: over_axes(&self.state.position, self.state.machine.step_axes()),
+            frame: 0,
+            stop,
+            path_mode: if exact { PathMode::ExactStop } else { PathMode::Continuous },
+            m_functions: facts.m_functions,
+            tool_change: facts.tool_change,
+            dynamic_set: 1,
+            mergeable: false,
+            jerk_limited: modes.is(ACCELERATION, "SOFT"),
+            spindle: [rpm; 2],
+            corner_tolerance,
+        };
+        self.steps.push(step);
+    }
+
+    /// The end of the structure of `kind` that `block` starts or
+    /// continues (ELSE): the block to go on with.
+    fn structure_exit(&mut self, block: usize, kind: StructureKind, unit: &Unit, range: TextRange) -> Flow {
+        let structure =
+            unit.model.structures_at(block).find(|s| s.kind == kind && (s.start == block || s.middle == Some(block)));
+        match structure {
+            // A false IF goes on after its ELSE; ELSE and a false IF
+            // without one at the ENDIF.
+            Some(s) if kind == StructureKind::If && s.start == block => Flow::Jump(s.middle.map_or(s.end, |m| m + 1)),
+            Some(s) if kind == StructureKind::If => Flow::Jump(s.end),
+            Some(s) => Flow::Jump(s.end + 1),
+            None => self.unmatched(kind, range),
+        }
+    }
+
+    /// Back to the start of the structure of `kind` that `block` ends,
+    /// `past` blocks after it.
+    fn structure_back(
+        &mut self,
+        block: usize,
+        kind: StructureKind,
+        unit: &Unit,
+        range: TextRange,
+        past: usize,
+    ) -> Flow {
+        match unit.model.structures_at(block).find(|s| s.kind == kind && s.end == block) {
+            Some(s) => Flow::Jump(s.start + past),
+            None => self.unmatched(kind, range),
+        }
+    }
+
+    fn unmatched(&mut self, kind: StructureKind, range: TextRange) -> Flow {
+        let name = match kind {
+            StructureKind::If => "IF … ENDIF",
+            StructureKind::While => "WHILE … ENDWHILE",
+            StructureKind::For => "FOR … ENDFOR",
+            StructureKind::Repeat => "REPEAT … UNTIL",
+            StructureKind::Loop => "LOOP … ENDLOOP",
+        };
+        let message = format!("{name} is not closed or not opened: the control stops");
+        self.state.finding(RunRule::CallTargetMissing, range, &message);
+        Flow::Stop
+    }
+
+    /// Whether a FOR's variable is still at most its end.
+    fn for_continues(&mut self, variable: &Place, end: &Expr) -> Option<bool> {
+        let current = ExprKind::Name(variable.clone());
+        let current = Expr { kind: current, range: end.range };
+        let result = (|| {
+            let mut eval = self.eval();
+            Ok::<_, EvalError>(eval.number(&current)? <= eval.number(end)?)
+        })();
+        self.check(result)
+    }
+
+    /// ENDFOR: the variable steps by 1 and the body runs again while it is
+    /// at most the end.
+    fn end_for(&mut self, block: usize, unit: &Unit, range: TextRange) -> Flow {
+        let Some(structure) = unit.model.structures_at(block).find(|s| s.kind == StructureKind::For && s.end == block)
+        else {
+            return self.unmatched(StructureKind::For, range);
+        };
+        let header = unit.blocks[structure.start].statements.iter().find_map(|statement| match &statement.kind {
+            StatementKind::For { variable, end, .. } => Some((variable, end)),
+            _ => None,
+        });
+        let Some((variable, end)) = header else { return self.unmatched(StructureKind::For, range) };
+        let current = Expr { kind: ExprKind::Name(variable.clone()), range };
+        let result = (|| {
+            let mut eval = self.eval();
+            let next = eval.value(&current)?.number(range)? + 1.0;
+            eval.write(variable, Value::Real(next), range)
+        })();
+        match self.check(result).and_then(|()| self.for_continues(variable, end)) {
+            None => Flow::Stop,
+            Some(true) => Flow::Jump(structure.start + 1),
+            Some(false) => Flow::Next,
+        }
+    }
+
+    /// CASE: the first arm whose value equals the selector's, else
+    /// DEFAULT, else the next block.
+    fn case(&mut self, block: usize, selector: &Expr, arms: &[super::lower::CaseArm], unit: &Unit) -> Flow {
+        let result = self.eval().value(selector);
+        let Some(value) = self.check(result) else { return Flow::Stop };
+        for arm in arms {
+            let matched = match &arm.value {
+                None => true,
+                Some(expr) => {
+                    let result = self.eval().value(expr).and_then(|arm_value| equal(&value, &arm_value, expr.range));
+                    match self.check(result) {
+                        Some(matched) => matched,
+                        None => return Flow::Stop,
+                    }
+                }
+            };
+            if matched {
+                return self.jump(block, &arm.jump, unit);
+            }
+        }
+        Flow::Next
+    }
+
+    /// Where a jump from `block` leads.
+    fn jump(&mut self, block: usize, jump: &Jump, unit: &Unit) -> Flow {
+        let mut computed_name = None;
+        let resolved = match &jump.target {
+            Some(JumpTarget::Computed(expr)) => {
+                let result = self.eval().value(expr);
+                let Some(name) = self.check(result) else { return Flow::Stop };
+                let name = name.text().trim().to_ascii_uppercase();
+                let number = name.strip_prefix('N').or_else(|| name.strip_prefix(':'));
+                let target =
+                    match number.filter(|digits| !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())) {
+                        Some(digits) => JumpTarget::BlockNumber(digits.parse().ok()),
+                        None => JumpTarget::Label(name.clone()),
+                    };
+                let computed = Jump { kind: jump.kind, target: Some(target), range: jump.range };
+                computed_name = Some(name);
+                unit.model.resolve(block, &computed)
+            }
+            _ => unit.model.resolve(block, jump),
+        };
+        match resolved {
+            Resolved::Block(target) => Flow::Jump(target),
+            Resolved::Start => Flow::Jump(0),
+            Resolved::NotFound { alarm: false } => Flow::Next,
+            Resolved::NotFound { alarm: true } | Resolved::Computed | Resolved::NoTarget => {
+                let direction = match jump.kind {
+                    JumpKind::GotoF => " after it",
+                    JumpKind::GotoB => " before it",
+                    _ => "",
+                };
+                let target = computed_name.map_or_else(String::new, |name| format!(" {name}"));
+                let message = format!("the jump's target{target} is not in the program{direction}: the control stops");
+                self.state.finding(RunRule::CallTargetMissing, jump.range, &message);
+                Flow::Stop
+            }
+        }
+    }
+}
+
+/// What a block's step records besides its move.
+#[derive(Debug, Default)]
+struct Facts {
+    /// G9.
+    exact: bool,
+    m_functions: u8,
+    tool_change: bool,
+}
+
+/// Whether `axis` is a linear axis, whose values are lengths.
+fn is_linear(axis: u8) -> bool {
+    matches!(axis, b'X' | b'Y' | b'Z' | b'U' | b'V' | b'W')
+}
+
+/// The length of a straight move over the linear axes.
+fn distance(from: &Position, to: &Position) -> f64 {
+    b"XYZUVW".iter().map(|&axis| (to[slot(axis)] - from[slot(axis)]).powi(2)).sum::<f64>().sqrt()
+}
+
+#[cfg(test)]
+mod tests;

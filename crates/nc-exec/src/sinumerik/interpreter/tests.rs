@@ -1,0 +1,524 @@
+use std::collections::BTreeMap;
+
+use proptest::prelude::*;
+
+use super::*;
+use crate::trace::{DEFAULT_STEP_BUDGET, NoFiles, WrittenFile};
+
+/// Files beside the program by the control's name (`_N_PROFIL_SPF`).
+#[derive(Default)]
+struct Beside(BTreeMap<String, String>);
+
+impl Beside {
+    fn with(files: &[(&str, &str)]) -> Beside {
+        Beside(files.iter().map(|(name, text)| ((*name).to_owned(), (*text).to_owned())).collect())
+    }
+}
+
+impl Environment for Beside {
+    fn file(&self, called: &Called) -> Option<String> {
+        match called {
+            Called::ControlFile(name) => self.0.get(name).cloned(),
+            _ => None,
+        }
+    }
+}
+
+fn machine() -> MachineConfig {
+    MachineConfig::of_control(Dialect::Sinumerik)
+}
+
+fn run_with(text: &str, files: &dyn Environment) -> Trace {
+    run_in(text, files, &machine(), DEFAULT_STEP_BUDGET, None, None)
+}
+
+fn run(text: &str) -> Trace {
+    run_with(text, &NoFiles)
+}
+
+/// The findings as (rule, text of their range).
+fn findings<'t>(trace: &Trace, text: &'t str) -> Vec<(RunRule, &'t str)> {
+    trace.findings.iter().map(|finding| (finding.rule, &text[finding.range])).collect()
+}
+
+/// The end of the last step as (X, Y, Z).
+fn end(trace: &Trace) -> [f64; 3] {
+    let position = trace.end_position();
+    [position[slot(b'X')], position[slot(b'Y')], position[slot(b'Z')]]
+}
+
+fn moves(trace: &Trace) -> Vec<&Step> {
+    trace.steps.iter().filter(|step| matches!(step.motion, Motion::Rapid | Motion::Feed)).collect()
+}
+
+#[test]
+fn a_for_loop_makes_one_move_a_pass_to_the_computed_end() {
+    let text =
+        "DEF INT COUNT, LAST=5\nG0 X0 Y0 Z0\nF1000\nFOR COUNT = 1 TO LAST\n  G1 X=COUNT*10 Y=COUNT\nENDFOR\nM30\n";
+    let trace = run(text);
+    assert_eq!(findings(&trace, text), []);
+    let made = moves(&trace);
+    assert_eq!(made.len(), 6, "the rapid and five passes");
+    assert!(
+        made[1..].iter().all(|step| step.motion == Motion::Feed && &text[step.range] == "  G1 X=COUNT*10 Y=COUNT\n")
+    );
+    assert_eq!(end(&trace), [50.0, 5.0, 0.0]);
+    let length: f64 = made.iter().map(|step| step.length).sum();
+    assert!((length - 5.0 * 101f64.sqrt()).abs() < 1e-9, "{length}");
+    let time: f64 = made[1..].iter().map(|step| step.duration).sum();
+    assert!((time - length / 1000.0 * 60.0).abs() < 1e-9);
+    // A loop whose end is below its start runs no pass.
+    let none = run("DEF INT COUNT\nF100\nFOR COUNT = 3 TO 2\nG1 X1\nENDFOR\n");
+    assert!(moves(&none).is_empty() && none.findings.is_empty());
+}
+
+#[test]
+fn structures_branch_and_loop() {
+    let text = "\
+R1=0 R2=0
+WHILE R1<3
+  R1=R1+1
+ENDWHILE
+REPEAT
+  R2=R2+2
+UNTIL R2>=6
+IF R1==3
+  R3=1
+ELSE
+  R3=2
+ENDIF
+IF R1<>3
+  R4=1
+ELSE
+  R4=2
+ENDIF
+LOOP
+  R5=R5+1
+  IF R5==4 GOTOF OUT
+ENDLOOP
+OUT: CASE R4 OF 1 GOTOF ONE 2 GOTOF TWO DEFAULT GOTOF ONE
+ONE: R6=1
+TWO: G0 X=R1 Y=R2 Z=R3*10+R4+R5/10+R6
+M30
+";
+    let trace = run(text);
+    assert_eq!(findings(&trace, text), []);
+    assert_eq!(end(&trace), [3.0, 6.0, 12.4]);
+}
+
+#[test]
+fn computed_jumps_go_to_the_block_number_the_string_names() {
+    // As L29: coordinates after M30, reached by GOTOF "N"<<R3 and left by
+    // GOTOB "N"<<R9 (004:4629-4633, 4737-4791).
+    let text = "\
+R10=0
+N1 R10=R10+1
+R3=1000+R10 R9=2
+GOTOF \"N\"<<R3
+N2 IF R10<3 GOTOB N1
+M30
+N1001 G0 X1
+GOTOB \"N\"<<R9
+N1002 G0 X2 Y2
+GOTOB \"N\"<<R9
+N1003 G0 X3 Y3 Z3
+GOTOB \"N\"<<R9
+";
+    let trace = run(text);
+    assert_eq!(findings(&trace, text), []);
+    let ends: Vec<[f64; 3]> = moves(&trace).iter().map(|step| [step.end[0], step.end[1], step.end[2]]).collect();
+    assert_eq!(ends, [[1.0, 0.0, 0.0], [2.0, 2.0, 0.0], [3.0, 3.0, 3.0]]);
+    let missing = "R3=7\nGOTOF \"L\"<<R3\nN7 M30\n";
+    let trace = run(missing);
+    assert_eq!(findings(&trace, missing), [(RunRule::CallTargetMissing, "GOTOF \"L\"<<R3")]);
+}
+
+#[test]
+fn a_jump_into_a_for_body_runs_on_as_the_loop() {
+    // The cam cycle's shape: out of the body to a label after ENDFOR and
+    // back into the body (004:5091, 5133-5165).
+    let text = "\
+DEF INT I_1
+DEF INT VISITS
+FOR I_1 = 0 TO 3
+  IF I_1==1 GOTOF OUTSIDE
+  BACK:
+  VISITS=VISITS+1
+ENDFOR
+GOTOF DONE
+OUTSIDE:
+  R1=R1+1
+GOTOB BACK
+DONE: G0 X=VISITS Y=R1 Z=I_1
+";
+    let trace = run(text);
+    assert_eq!(findings(&trace, text), []);
+    assert_eq!(end(&trace), [4.0, 1.0, 4.0]);
+}
+
+#[test]
+fn a_loop_without_end_stops_at_the_budget() {
+    let text = "LOOP\nG91 G1 X1 F1000\nENDLOOP\n";
+    let trace = run_in(text, &NoFiles, &machine(), 1000, None, None);
+    let [finding] = trace.findings.as_slice() else { panic!("{:?}", trace.findings) };
+    assert_eq!(finding.rule, RunRule::StepBudget);
+    assert_eq!(trace.blocks_run, 1000);
+}
+
+#[test]
+fn calls_bind_parameters_by_value_and_by_reference() {
+    let main = "\
+DEF REAL TOTAL=1
+DEF INT COUNT
+DEF REAL TABLE[3]
+ADD(5, TOTAL, COUNT, TABLE[2]) P2
+G0 X=TOTAL Y=COUNT Z=TABLE[2]
+M30
+";
+    let add = "\
+PROC ADD(REAL STEP, VAR REAL SUM, VAR INT CALLS, VAR REAL CELL) SAVE
+DEF REAL LOCAL=STEP*2
+G91
+SUM=SUM+STEP
+CALLS=CALLS+1
+CELL=CELL+LOCAL
+INNER(CALLS)
+M17
+";
+    let inner = "PROC INNER(VAR INT N)\nN=N*10\nRET\n";
+    let files = Beside::with(&[("_N_ADD_SPF", add), ("_N_INNER_SPF", inner)]);
+    let trace = run_with(main, &files);
+    assert_eq!(trace.findings, []);
+    // Twice: TOTAL 1+5+5, COUNT (0+1)*10 then (10+1)*10, TABLE[2] 10+10.
+    assert_eq!(end(&trace), [11.0, 110.0, 20.0]);
+    // SAVE brought G90 back: the move was absolute.
+    assert_eq!(
+        trace.files,
+        [Called::ControlFile("_N_ADD_SPF".to_owned()), Called::ControlFile("_N_INNER_SPF".to_owned())]
+    );
+    let sources: Vec<usize> = trace.steps.iter().map(|step| step.source).collect();
+    // Of ADD's blocks the machine sees G91 and M17, twice; the others
+    // only compute.
+    assert_eq!(sources.iter().filter(|&&source| source == 1).count(), 2 * 2);
+}
+
+#[test]
+fn l19_passes_omitted_parameters_as_zero() {
+    let main = include_str!("../../../../syntax/test_data/sinumerik/l19_profil_main.mpf");
+    let sub = include_str!("../../../../syntax/test_data/sinumerik/l19_profil_sub.spf");
+    // X1 and Y1 of the seed's machine are X and Y of this one.
+    let sub = sub.replace("X1=X Y1=Y", "G0 X=X Y=Y Z=C+Z+$P_SUBPAR[1]+$P_SUBPAR[4]*10");
+    let trace = run_with(main, &Beside::with(&[("_N_PROFIL_SPF", &sub)]));
+    assert_eq!(trace.findings, []);
+    assert_eq!(end(&trace), [2.14, 5.0, 10.0]);
+}
+
+#[test]
+fn a_missing_program_and_runaway_recursion_stop_the_run() {
+    let text = "NOWHERE\nM30\n";
+    let trace = run(text);
+    assert_eq!(findings(&trace, text), [(RunRule::CallTargetMissing, "NOWHERE")]);
+    let selfish = "PROC AGAIN\nAGAIN\nM17\n";
+    let trace = run_with("AGAIN\n", &Beside::with(&[("_N_AGAIN_SPF", selfish)]));
+    let rules: Vec<RunRule> = trace.findings.iter().map(|finding| finding.rule).collect();
+    assert_eq!(rules, [RunRule::CallDepth]);
+    assert_eq!(trace.findings[0].source, 1);
+    // An empty program called a trillion times takes no time to run.
+    let trace = run_with("EMPTY P999999999999\nG0 X1\n", &Beside::with(&[("_N_EMPTY_SPF", "")]));
+    assert_eq!((trace.findings.as_slice(), end(&trace)), (&[][..], [1.0, 0.0, 0.0]));
+}
+
+#[test]
+fn motion_follows_the_modes() {
+    let text = "\
+G0 X10 Y0 Z0
+G17 G3 X0 Y10 I-10 J0 F600
+G2 X10 Y0 CR=-10
+G91 G1 X=IC(5) Y=AC(0) Z-1
+G90 G18 G2 Z-11 X0 CR=10
+G70 G1 X1
+G4 F2.5
+M30
+";
+    let trace = run(text);
+    assert_eq!(findings(&trace, text), []);
+    let steps = &trace.steps;
+    let quarter = 10.0 * std::f64::consts::FRAC_PI_2;
+    assert!((steps[1].length - quarter).abs() < 1e-9);
+    assert_eq!(steps[1].path, Path::Arc { plane: (b'X', b'Y'), centre: [0.0, 0.0], clockwise: false });
+    assert!((steps[1].duration - quarter / 600.0 * 60.0).abs() < 1e-9);
+    assert!((steps[2].length - 3.0 * quarter).abs() < 1e-9, "CR<0: the long way");
+    assert_eq!([steps[3].end[0], steps[3].end[1], steps[3].end[2]], [15.0, 0.0, -1.0]);
+    assert!(matches!(steps[4].path, Path::Arc { plane: (b'Z', b'X'), clockwise: true, .. }));
+    assert_eq!(steps[5].end[0], 25.4);
+    assert_eq!((steps[6].motion, steps[6].duration), (Motion::Dwell, 2.5));
+    // The rapid move: the slowest axis decides.
+    let rapid = run("G0 X100 Y50\n");
+    let rate = f64::from(machine().axis_rapid_rate(b'X').min(machine().axis_rapid_rate(b'Y')));
+    assert!(rapid.steps[0].duration >= 50.0 / rate * 60.0 - 1e-9);
+}
+
+#[test]
+fn steps_record_the_path_modes() {
+    let text = "F100\nG1 X1\nG64 SOFT X2\nG641 ADIS=0.5 X3\nG9 X4\nBRISK G60 X5\n";
+    let trace = run(text);
+    let modes: Vec<(PathMode, bool, f32)> =
+        trace.steps[1..].iter().map(|step| (step.path_mode, step.jerk_limited, step.corner_tolerance)).collect();
+    let inf = f32::INFINITY;
+    assert_eq!(
+        modes,
+        [
+            (PathMode::ExactStop, false, inf),
+            (PathMode::Continuous, true, inf),
+            (PathMode::Continuous, true, 0.5),
+            (PathMode::ExactStop, true, 0.5),
+            (PathMode::ExactStop, false, inf),
+        ]
+    );
+}
+
+#[test]
+fn unmodelled_words_are_reported_once_and_the_run_goes_on() {
+    let text = "TRANS X10\nTRANS Y5\nCYCLE800(1,\"0\")\nG0 X1 A2=5 B3=1\nG0 X2 A2=6\nR1=$A_DAY+$A_DAY\nTRAORI\nM30\n";
+    let trace = run(text);
+    assert_eq!(
+        findings(&trace, text),
+        [
+            (RunRule::NotRunYet, "TRANS X10"),
+            (RunRule::NotRunYet, "CYCLE800(1,\"0\")"),
+            (RunRule::NotRunYet, "A2=5"),
+            (RunRule::ParameterUnknown, "$A_DAY"),
+            (RunRule::NotRunYet, "TRAORI"),
+        ]
+    );
+    assert_eq!(end(&trace), [2.0, 0.0, 0.0]);
+}
+
+#[test]
+fn arithmetic_errors_stop_with_their_place() {
+    let text = "R1=0\nR2=5/R1\nG0 X1\n";
+    let trace = run(text);
+    assert_eq!(findings(&trace, text), [(RunRule::ArithmeticFailed, "5/R1")]);
+    assert!(moves(&trace).is_empty());
+}
+
+#[test]
+fn a_rational_bspline_is_the_quarter_circle() {
+    // The quarter circle of radius 10 as a rational quadratic: the middle
+    // point weighs cos 45°.
+    let text = format!(
+        "G0 X10 Y0\nF1000\nBSPLINE SD=2 X10 Y10 PW={}\nX0 Y10\nG1 X0 Y20\nM30\n",
+        std::f64::consts::FRAC_1_SQRT_2
+    );
+    let trace = run(&text);
+    assert_eq!(trace.findings, []);
+    let curve: Vec<&Step> = trace
+        .steps
+        .iter()
+        .filter(|step| text[step.range].starts_with("BSPLINE") || &text[step.range] == "X0 Y10\n")
+        .collect();
+    let length: f64 = curve.iter().map(|step| step.length).sum();
+    let quarter = 5.0 * std::f64::consts::PI;
+    assert!((length - quarter).abs() < quarter * 1e-3, "{length}");
+    assert!(curve.len() > 20, "pieces within 1 µm: {}", curve.len());
+    for step in &curve {
+        let radius = step.end[0].hypot(step.end[1]);
+        assert!((radius - 10.0).abs() < 1e-9, "on the circle: {radius}");
+        assert!((step.duration - step.length / 1000.0 * 60.0).abs() < 1e-12);
+    }
+    // Both blocks have pieces, joined: each starts where the one before ends.
+    assert!(curve.iter().any(|step| text[step.range].starts_with("BSPLINE")));
+    assert_eq!(curve.last().map(|step| [step.end[0], step.end[1]]), Some([0.0, 10.0]));
+    assert_eq!(end(&trace), [0.0, 20.0, 0.0]);
+    let lines = trace.steps.iter().filter(|step| step.motion == Motion::Feed).count();
+    assert_eq!(lines, curve.len() + 1);
+    // Left by `G[1]=2` (G1): the line after the curve keeps its own end.
+    let text = "F1000\nBSPLINE X10 Y10\nX20 Y0\nG[1]=2\nX0 Y20\n";
+    let trace = run(text);
+    assert_eq!(trace.findings, []);
+    let last = trace.steps.last().unwrap();
+    assert_eq!((&text[last.range], [last.end[0], last.end[1]]), ("X0 Y20\n", [0.0, 20.0]));
+    assert!((last.length - 20.0 * 2f64.sqrt()).abs() < 1e-9);
+}
+
+#[test]
+fn written_files_can_be_called_later_in_the_run() {
+    let text = "\
+DEF INT ERROR
+DEF STRING[60] PROGRAM=\"/_N_MPF_DIR/_N_PARTS_DIR/_N_MADE_SPF\"
+IF NOT ISFILE(\"_N_MADE_SPF\")
+  WRITE(ERROR,PROGRAM,\"G0 X\"<<4*2.5<<\" Y\"<<1/4)
+  WRITE(ERROR,PROGRAM,\"M17\")
+ENDIF
+MADE
+DELETE(ERROR,\"_N_OTHER_SPF\")
+G0 Z=ERROR
+M30
+";
+    let trace = run(text);
+    assert_eq!(findings(&trace, text), []);
+    assert_eq!(end(&trace), [10.0, 0.25, 3.0]);
+    assert_eq!(
+        trace.written,
+        [WrittenFile {
+            path: "/_N_MPF_DIR/_N_PARTS_DIR/_N_MADE_SPF".to_owned(),
+            text: "G0 X10 Y0.25\nM17\n".to_owned()
+        }]
+    );
+    assert_eq!(trace.files, [Called::Written("/_N_MPF_DIR/_N_PARTS_DIR/_N_MADE_SPF".to_owned())]);
+}
+
+fn seed(name: &str) -> &'static str {
+    match name {
+        "l24" => include_str!("../../../../syntax/test_data/sinumerik/l24_igs_splines_output.spf"),
+        "l25" => include_str!("../../../../syntax/test_data/sinumerik/l25_podpis_janskacel.mpf"),
+        "l26" => include_str!("../../../../syntax/test_data/sinumerik/l26_krivky_y_const.spf"),
+        "l27" => include_str!("../../../../syntax/test_data/sinumerik/l27_krivky_x_const_a_rot.spf"),
+        "l28" => include_str!("../../../../syntax/test_data/sinumerik/l28_krivky_y_const_hrub.spf"),
+        "l29" => include_str!("../../../../syntax/test_data/sinumerik/l29_blob_souradnice_dole.mpf"),
+        "l30" => include_str!("../../../../syntax/test_data/sinumerik/l30_run_vacka.mpf"),
+        "l31" => include_str!("../../../../syntax/test_data/sinumerik/l31_vacka_cyklus.spf"),
+        _ => unreachable!("{name}"),
+    }
+}
+
+/// L29 with the coordinate blocks the seed elides: block `N<100i+j>` for
+/// every point of the 65 × 54 grid its R4 and R5 give.
+fn l29_complete() -> String {
+    let mut text = seed("l29").to_owned();
+    for i in 1..=65 {
+        for j in 1..=54 {
+            let number = 100 * i + j;
+            if !text.contains(&format!("\nN{number} ")) {
+                let (x, y) = (-50.0 + f64::from(i - 1) * 100.0 / 64.0, 50.0 - f64::from(j - 1) * 100.0 / 53.0);
+                text.push_str(&format!("N{number} X{x:.8} Y{y:.8} Z-30\n  GOTOB \"N\"<<R9\n"));
+            }
+        }
+    }
+    text
+}
+
+#[test]
+fn the_seed_listings_run_to_their_end() {
+    let l29 = l29_complete();
+    for name in ["l24", "l25", "l26", "l27", "l28", "l29"] {
+        let text = if name == "l29" { l29.as_str() } else { seed(name) };
+        let trace = run(text);
+        let stops: Vec<&Finding> = trace.findings.iter().filter(|finding| finding.stops()).collect();
+        assert_eq!(stops, Vec::<&Finding>::new(), "{name}");
+        assert!(trace.steps.iter().any(|step| step.motion == Motion::Feed), "{name}");
+        // Only what the run leaves out, and L28's first move, which the
+        // seed writes before any F.
+        for finding in &trace.findings {
+            let expected = matches!(finding.rule, RunRule::NotRunYet)
+                || (name == "l28"
+                    && finding.rule == RunRule::MotionWithoutFeed
+                    && &text[finding.range] == "X-60 Y60\n");
+            assert!(expected, "{name}: {finding:?}");
+        }
+    }
+}
+
+#[test]
+fn the_cam_program_writes_its_geometry_and_runs_it() {
+    // The GUD the seed leaves out (004:3112-3114): a row per angle and
+    // radius.
+    let gud = "DEF NCK REAL VAC_POLE[30,2]\n";
+    let files = Beside::with(&[("_N_VACKA_CYKLUS_SPF", seed("l31")), ("_N_UGUD_DEF", gud)]);
+    let trace = run_with(seed("l30"), &files);
+    let rules: Vec<(RunRule, &str)> =
+        trace.findings.iter().map(|finding| (finding.rule, finding.message.split(':').next().unwrap_or(""))).collect();
+    assert_eq!(
+        rules,
+        [
+            (RunRule::NotRunYet, "the executor does not run the cycle CYCLE800 yet"),
+            (RunRule::NotRunYet, "the executor does not run axis A (the machine has none) yet"),
+            (RunRule::NotRunYet, "the executor does not run axis C (the machine has none) yet"),
+            (RunRule::ParameterUnknown, "the run has no clock"),
+        ]
+    );
+    let path = "/_N_MPF_DIR/_N_VACKA_DIR/_N_GEOMETRIE_VACKA_SPF";
+    let [geometry, debug] = trace.written.as_slice() else { panic!("{:?}", trace.written) };
+    assert_eq!(debug.path, "/_N_MPF_DIR/_N_VACKA_DIR/_N_DEBURGER_SPF");
+    assert_eq!(geometry.path, path);
+    let lines: Vec<&str> = geometry.text.lines().collect();
+    assert_eq!(lines[0], ";Date: 0.0.2000  Time: 0:0:0");
+    assert_eq!(lines[1..5], ["G[06]=1    ; G17/G18/G19", "G90 G94", ";NASTROJ a M6", "F2000"]);
+    assert_eq!(lines[5], "S2000 M5", "the spindle never started");
+    assert_eq!(lines[11..14], ["G0 X0 Y15", "G1 Z-3", "Y10"]);
+    assert_eq!(lines[lines.len() - 5..], ["G0 Z200", "X200 Y200 A0 C0", "SUPA FFWOF", "M5 M9", "M17"]);
+    // The first 12° at a constant radius are one arc, then a point a
+    // degree over the 35°, 175° and 25° where the radius changes; the
+    // cycle looks two rows ahead (`VAC_POLE[var_i+2,0]==0`), so the last
+    // row's 113° is never written.
+    let points = lines.iter().filter(|line| line.starts_with("X=") || line.starts_with("G2 ")).count();
+    assert_eq!(points, 1 + 35 + 175 + 25);
+    // The run called what it wrote: its moves are the file's blocks.
+    assert_eq!(trace.files.last(), Some(&Called::Written(path.to_owned())));
+    let source = trace.files.len();
+    let mut blocks: Vec<TextRange> = trace
+        .steps
+        .iter()
+        .filter(|step| step.source == source && step.motion == Motion::Feed)
+        .map(|step| step.range)
+        .collect();
+    blocks.dedup();
+    // G1 Z-3, Y10, the arc and the control points of the BSPLINE that
+    // `G[01]=7` selects.
+    assert_eq!(blocks.len(), 3 + 235);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn any_bytes_run_without_panic_within_the_budget(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
+        let text = String::from_utf8_lossy(&bytes);
+        let trace = run_in(&text, &NoFiles, &machine(), 2000, None, None);
+        prop_assert!(trace.blocks_run <= 2000);
+    }
+
+    #[test]
+    fn statement_soup_runs_without_panic(parts in proptest::collection::vec(prop::sample::select(vec![
+        "R1=R1+1", "GOTOB N1", "GOTOF N2", "N1", "N2", "IF R1>3", "ENDIF", "ELSE", "WHILE R1<5", "ENDWHILE",
+        "FOR R2=1 TO 3", "ENDFOR", "LOOP", "ENDLOOP", "REPEAT", "UNTIL R1>2", "G2 X1 Y1 CR=0.1", "BSPLINE X1 PW=0",
+        "G1 X=R1 F100", "SUB(1)", "EMPTY P999999999999", "M17", "RET", "DEF INT A[2]", "A[5]=1", "M30", "G0 X=1/R3", "\n", "\n", "\n",
+    ]), 0..60)) {
+        let text = parts.join(" ");
+        let files = Beside::with(&[("_N_SUB_SPF", "PROC SUB(INT N)\nSUB(N+1)\n"), ("_N_EMPTY_SPF", "")]);
+        let trace = run_in(&text, &files, &machine(), 3000, None, None);
+        prop_assert!(trace.blocks_run <= 3000);
+    }
+}
+
+#[test]
+fn a_subprogram_run_by_itself_has_its_parameters_at_zero() {
+    let text = "PROC SIDE(REAL D, VAR INT N) SAVE\nN=N+1\nG0 X=D+1 Y=N Z=$P_SUBPAR[1]\nM17\n";
+    let trace = run(text);
+    assert_eq!(findings(&trace, text), []);
+    assert_eq!(end(&trace), [1.0, 1.0, 0.0]);
+}
+
+#[test]
+fn modal_calls_and_repeated_sections_run_where_the_control_runs_them() {
+    let main = "\
+MCALL MARK(R1)
+G0 X1
+R1=R1+1
+G0 X2
+MCALL
+G0 X3
+START: R3=R3+1
+R4=R4+10
+FINISH: R5=R5+100
+REPEAT START FINISH P=3
+G0 Y=R2 Z=R3+R4+R5
+M30
+";
+    let mark = "PROC MARK(REAL WHAT)\nR2=R2+WHAT+1\nM17\n";
+    let trace = run_with(main, &Beside::with(&[("_N_MARK_SPF", mark)]));
+    assert_eq!(findings(&trace, main), []);
+    // MARK after the two moves under MCALL: (0+1) + (1+1); the section
+    // once on the way and three times repeated.
+    assert_eq!(end(&trace), [3.0, 3.0, 4.0 + 40.0 + 400.0]);
+}
