@@ -52,9 +52,7 @@ pub fn dynamics(machine: &MachineConfig) -> Dynamics {
     match machine.control {
         Dialect::Cnc8x6 => cnc8x6::dynamics::dynamics(machine),
         Dialect::HaasLathe => haas_lathe::dynamics::dynamics(machine),
-        // Sinumerik has no policy yet, and its runs make no step to time:
-        // the Haas policy, read from the same machine description, stands in.
-        Dialect::Sinumerik => haas_lathe::dynamics::dynamics(machine),
+        Dialect::Sinumerik => sinumerik::dynamics::dynamics(machine),
     }
 }
 

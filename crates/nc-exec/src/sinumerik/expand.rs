@@ -16,10 +16,10 @@
 //!   machine is known to be. The feed is what ran: under G95 F times the
 //!   spindle speed.
 //! - Dwells are `G4 F` in seconds, stops M0/M1 where the run had them;
-//!   G60 and G64 where the blocks change between exact stop and
-//!   continuous path, SOFT and BRISK where the jerk limit changes, and
-//!   `G641 ADIS=` where the corner tolerance is a finite one, in the block
-//!   of a move.
+//!   SOFT and BRISK where the jerk limit changes, in the block of a move;
+//!   G60, or G642 with the corner tolerance as `CTOL=`, where the way the
+//!   path passes into the next move changes, in the block before it (the
+//!   expansion writes a block once the next one has come).
 //! - Tools, the spindle and other M functions are not written: the
 //!   expansion is the path and its time.
 
@@ -46,8 +46,11 @@ pub struct Expansion<W: Write> {
     plane: (u8, u8),
     exact_stop: bool,
     jerk_limited: bool,
-    /// The corner tolerance written, in µm; `None` under G64 and G60.
+    /// The corner tolerance written, in µm; `None` under G60.
     corner: Option<i64>,
+    /// The words of the block written last: how the path passes from it
+    /// into the next one is that step's to say.
+    pending: Option<Vec<String>>,
     failure: Option<ExpandError>,
 }
 
@@ -65,6 +68,7 @@ impl<W: Write> Expansion<W> {
             exact_stop: true,
             jerk_limited: false,
             corner: None,
+            pending: None,
             failure: None,
         };
         let title: String = title.chars().filter(|c| !c.is_control()).collect();
@@ -125,8 +129,9 @@ impl<W: Write> Expansion<W> {
         if matches!(step.motion, Motion::Rapid | Motion::Feed) {
             self.at = Some(to);
         }
-        if !words.is_empty() {
-            self.modes(step, &mut words);
+        if !words.is_empty() && step.jerk_limited != self.jerk_limited {
+            self.jerk_limited = step.jerk_limited;
+            words.insert(0, if step.jerk_limited { "SOFT" } else { "BRISK" }.to_owned());
         }
         match step.stop {
             Some(Stop::Program) => words.push("M0".to_owned()),
@@ -136,28 +141,36 @@ impl<W: Write> Expansion<W> {
         if words.is_empty() {
             return Ok(());
         }
+        let joining = self.joining(step);
+        self.flush(joining)?;
+        self.pending = Some(words);
+        Ok(())
+    }
+
+    /// Writes the block before, with the mode that passes from it into
+    /// the next (`joining`).
+    fn flush(&mut self, joining: Option<String>) -> io::Result<()> {
+        let Some(mut words) = self.pending.take() else { return Ok(()) };
+        words.splice(0..0, joining);
         writeln!(self.out, "{}", words.join(" "))
     }
 
-    /// The path modes of `step` where they change, before its words.
-    fn modes(&mut self, step: &Step, words: &mut Vec<String>) {
-        let mut modes = Vec::new();
+    /// The path mode that passes into `step` as it ran, where it changes:
+    /// G60 for an exact stop, else G642 with the corner tolerance as CTOL,
+    /// which the policy takes as it is.
+    fn joining(&mut self, step: &Step) -> Option<String> {
         let exact_stop = step.path_mode == PathMode::ExactStop;
         let corner = (!exact_stop && step.corner_tolerance.is_finite())
             .then(|| (f64::from(step.corner_tolerance) * 1000.0).round() as i64);
-        if exact_stop != self.exact_stop || corner != self.corner {
-            match (exact_stop, corner) {
-                (true, _) => modes.push("G60".to_owned()),
-                (false, Some(corner)) => modes.push(format!("G641 ADIS={}", decimal(corner))),
-                (false, None) => modes.push("G64".to_owned()),
-            }
-            (self.exact_stop, self.corner) = (exact_stop, corner);
+        if (exact_stop, corner) == (self.exact_stop, self.corner) {
+            return None;
         }
-        if step.jerk_limited != self.jerk_limited {
-            self.jerk_limited = step.jerk_limited;
-            modes.push(if step.jerk_limited { "SOFT" } else { "BRISK" }.to_owned());
-        }
-        words.splice(0..0, modes);
+        (self.exact_stop, self.corner) = (exact_stop, corner);
+        Some(match corner {
+            _ if exact_stop => "G60".to_owned(),
+            Some(corner) => format!("G642 CTOL={}", decimal(corner)),
+            None => "G64".to_owned(),
+        })
     }
 
     /// The words of the axes `moved` marks, to their place in `to`.
@@ -221,6 +234,7 @@ impl<W: Write> Expand for Expansion<W> {
         if let Some(failure) = self.failure.take() {
             return Err(failure);
         }
+        self.flush(None)?;
         self.out.write_all(b"M30\n")?;
         self.out.flush()?;
         Ok(())

@@ -82,7 +82,10 @@ use ncc_catalog::{AddressRole, Code, Dialect, KeywordKind};
 use ncc_syntax::{Parse, TextRange, TextSize};
 
 use super::{
+    cycles::{self, CycleMove, Hole, SpindleAction},
+    dynamics::PathControl,
     eval::{Context, ErrorKind, Eval, EvalError, Store, Value, equal},
+    frames::{FrameCommand, FrameKind, Plane, ProgrammableFrame},
     lower::{
         Call, Command, Dimension, Expr, ExprKind, Jump, JumpKind, JumpTarget, Place, PlaceKind, SinumerikBlock,
         StatementKind, Word, WordValue, block_nodes,
@@ -93,8 +96,8 @@ use crate::{
     arc::{OffCircle, centre_by_radius, circle_through},
     machine::MachineConfig,
     trace::{
-        Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, PROGRESS_INTERVAL, Path, PathMode, Position,
-        RunRule, Step, StepSink, Stop, Trace, Undelivered, slot,
+        Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, PROGRESS_INTERVAL, Path, Position, RunRule,
+        Step, StepSink, Stop, Trace, Undelivered, slot,
     },
     transform::{Frame, over_axes},
 };
@@ -115,6 +118,9 @@ const DIMENSIONS: &str = "G14";
 const FEED_MODE: &str = "G15";
 const ACCELERATION: &str = "G21";
 const SPINDLE: &str = "M2";
+
+/// The axes the programmable frame maps, in its order.
+const XYZ: [u8; 3] = [b'X', b'Y', b'Z'];
 
 /// Millimetres in an inch.
 const INCH: f64 = 25.4;
@@ -216,8 +222,8 @@ struct Words {
     m: Vec<u32>,
     /// The codes written, in order (G numbers and words like `SOFT`).
     codes: Vec<&'static Code>,
-    adis: Option<f64>,
-    adispos: Option<f64>,
+    /// ADIS, ADISPOS and CTOL in mm, for the path modes.
+    path: Vec<(&'static str, f64)>,
     degree: Option<f64>,
     weight: Option<f64>,
     interval: Option<f64>,
@@ -237,8 +243,7 @@ impl Words {
             tool,
             m,
             codes,
-            adis,
-            adispos,
+            path,
             degree,
             weight,
             interval,
@@ -246,7 +251,8 @@ impl Words {
         } = self;
         axes.is_empty()
             && centre.iter().all(Option::is_none)
-            && [radius, opening, feed, speed, adis, adispos, degree, weight, interval].iter().all(|word| word.is_none())
+            && [radius, opening, feed, speed, degree, weight, interval].iter().all(|word| word.is_none())
+            && path.is_empty()
             && tool.is_none()
             && m.is_empty()
             && codes.is_empty()
@@ -281,9 +287,12 @@ struct State<'a> {
     /// The tool T selected last: a number, or 0 for a named one.
     tool: u32,
     tools: Vec<u32>,
-    /// ADIS and ADISPOS in mm.
-    adis: f64,
-    adispos: f64,
+    /// The path modes G60, G64x, SOFT, BRISK with ADIS, ADISPOS and CTOL,
+    /// kept in step with the groups of `modes` as each step is recorded.
+    path: PathControl,
+    /// The programmable frame: program coordinates to base ones (the
+    /// settable frame's, which are zero).
+    frame: ProgrammableFrame,
     files: files::Files,
     findings: Vec<Finding>,
     /// Keys of what was reported once.
@@ -296,6 +305,28 @@ struct State<'a> {
 }
 
 impl State<'_> {
+    /// A position in program coordinates in base ones, through the
+    /// programmable frame (X, Y and Z; other axes as they are).
+    fn to_base(&self, position: &Position) -> Position {
+        self.frame_xyz(position, |frame, point| frame.to_base(point))
+    }
+
+    fn to_program(&self, position: &Position) -> Position {
+        self.frame_xyz(position, |frame, point| frame.to_program(point))
+    }
+
+    fn frame_xyz(&self, position: &Position, map: impl Fn(&ProgrammableFrame, [f64; 3]) -> [f64; 3]) -> Position {
+        if self.frame.is_identity() {
+            return *position;
+        }
+        let mut mapped = *position;
+        let xyz = XYZ.map(|letter| position[slot(letter)]);
+        for (letter, value) in XYZ.into_iter().zip(map(&self.frame, xyz)) {
+            mapped[slot(letter)] = value;
+        }
+        mapped
+    }
+
     /// A finding at `range`, inside the block being run.
     fn finding(&mut self, rule: RunRule, range: TextRange, message: &str) {
         self.stopped |= rule.stops();
@@ -420,8 +451,8 @@ impl<'a> Interpreter<'a> {
             speed: 0.0,
             tool: 0,
             tools: Vec::new(),
-            adis: 0.0,
-            adispos: 0.0,
+            path: PathControl::default(),
+            frame: ProgrammableFrame::default(),
             files: files::Files::default(),
             findings: Vec::new(),
             reported: HashSet::new(),
@@ -641,10 +672,12 @@ impl<'a> Interpreter<'a> {
         }
         if end {
             self.end_spline();
+            self.state.path.subprogram_end();
             return Flow::End;
         }
         if words.m.contains(&17) {
             self.end_spline();
+            self.state.path.subprogram_end();
             return Flow::Return;
         }
         if let Some((called, range)) = call {
@@ -765,8 +798,9 @@ impl<'a> Interpreter<'a> {
             (AddressRole::Interpolation, "AR") => words.opening = Some(value),
             (AddressRole::Feed, _) => words.feed = Some(value),
             (AddressRole::Speed, _) => words.speed = Some(value),
-            (AddressRole::Tolerance, "ADIS") => words.adis = Some(value),
-            (AddressRole::Tolerance, "ADISPOS") => words.adispos = Some(value),
+            (AddressRole::Tolerance, "ADIS") => words.path.push(("ADIS", value)),
+            (AddressRole::Tolerance, "ADISPOS") => words.path.push(("ADISPOS", value)),
+            (AddressRole::Tolerance, "CTOL") => words.path.push(("CTOL", value)),
             (AddressRole::Spline, "SD") => words.degree = Some(value),
             (AddressRole::Spline, "PW") => words.weight = Some(value),
             (AddressRole::Spline, "PL") => words.interval = Some(value),
@@ -802,15 +836,139 @@ impl<'a> Interpreter<'a> {
     }
 
     /// A frame command (TRANS, ATRANS, ROT, SCALE, MIRROR and their
-    /// additive forms): where the frames are joined to the run.
-    fn frame(&mut self, _command: &Command, range: TextRange) {
-        self.state.not_run("programmable frames (TRANS, ROT, SCALE, MIRROR)", range);
+    /// additive forms): the tool stays where it is, its program
+    /// coordinates are those of the new frame.
+    fn frame(&mut self, command: &Command, range: TextRange) {
+        let Some(frame_command) = FrameCommand::from_name(&command.name) else {
+            return self.state.not_run(&command.name, range);
+        };
+        let mut values = Vec::with_capacity(command.words.len());
+        for word in &command.words {
+            let Some((value, _)) = self.word_number(word) else { return };
+            let value = match frame_command.kind {
+                FrameKind::Translation => self.length(value),
+                FrameKind::Rotation | FrameKind::Scale | FrameKind::Mirror => value,
+            };
+            values.push((word.address.as_str(), value));
+        }
+        let plane = self.plane();
+        let base = self.state.to_base(&self.state.position);
+        match self.state.frame.apply(frame_command, &values, plane) {
+            Ok(()) => self.state.position = self.state.to_program(&base),
+            Err(error) => {
+                let range = command.words.get(error.word).map_or(range, |word| word.range);
+                self.state.finding(RunRule::ValueRefused, range, &error.to_string());
+            }
+        }
     }
 
-    /// A call of a control's cycle (CYCLE800, CYCLE832, …): where the
-    /// cycles are joined to the run.
-    fn cycle(&mut self, name: &str, _arguments: &[Option<Expr>], range: TextRange) {
-        self.state.not_run(&format!("the cycle {name}"), range);
+    /// The working plane of G17, G18, G19.
+    fn plane(&self) -> Plane {
+        self.state.modes.get(PLANE).and_then(Plane::from_code).unwrap_or_default()
+    }
+
+    /// A call of a control's cycle: the drilling cycles as moves of the
+    /// block that calls them, CYCLE800 as the frame it swivels to; others
+    /// (CYCLE832, …) are reported as not run.
+    fn cycle(&mut self, at: At, name: &str, arguments: &[Option<Expr>], range: TextRange) {
+        let drilling = matches!(
+            name,
+            "CYCLE81"
+                | "CYCLE82"
+                | "CYCLE83"
+                | "CYCLE84"
+                | "CYCLE840"
+                | "CYCLE85"
+                | "CYCLE86"
+                | "CYCLE87"
+                | "CYCLE88"
+                | "CYCLE89"
+        );
+        if !drilling && name != "CYCLE800" {
+            return self.state.not_run(&format!("the cycle {name}"), range);
+        }
+        let mut values = Vec::with_capacity(arguments.len());
+        for argument in arguments {
+            let value = match argument {
+                // A string (CYCLE800's swivel data record) is not read.
+                Some(expr) if matches!(expr.kind, ExprKind::String(_)) => None,
+                Some(expr) => {
+                    let result = self.eval().number(expr);
+                    let Some(value) = self.check(result) else { return };
+                    Some(value)
+                }
+                None => None,
+            };
+            values.push(value);
+        }
+        let result = if drilling {
+            let hole = Hole {
+                position: XYZ.map(|letter| self.state.position[slot(letter)]),
+                plane: self.plane(),
+                feed: self.feed_rate_quiet().unwrap_or(0.0),
+                spindle: self.signed_rpm(),
+            };
+            cycles::drilling(name, &values, &hole).map(|moves| self.cycle_moves(at, &moves, range))
+        } else {
+            cycles::swivel(&values).map(|swivel| {
+                let base = self.state.to_base(&self.state.position);
+                swivel.apply_to(&mut self.state.frame);
+                self.state.position = self.state.to_program(&base);
+            })
+        };
+        if let Err(error) = result {
+            self.state.finding(RunRule::CycleFailed, range, &error.to_string());
+        }
+    }
+
+    /// A drilling cycle's moves as steps of the block at `at`.
+    fn cycle_moves(&mut self, at: At, moves: &[CycleMove], range: TextRange) {
+        for cycle_move in moves {
+            let start = self.state.to_base(&self.state.position);
+            let mut to_point = |to: &[f64; 3]| {
+                for (letter, value) in XYZ.into_iter().zip(to) {
+                    self.state.position[slot(letter)] = *value;
+                }
+                let end = self.state.to_base(&self.state.position);
+                (distance(&start, &end), end)
+            };
+            let (moved, stop) = match *cycle_move {
+                CycleMove::Rapid(to) => {
+                    let (length, end) = to_point(&to);
+                    (self.rapid(&start, &end, length), None)
+                }
+                CycleMove::Feed { to, feed } => {
+                    let (length, _) = to_point(&to);
+                    let duration = if feed > 0.0 { length / feed * 60.0 } else { 0.0 };
+                    let moved =
+                        Moved { motion: Motion::Feed, path: Path::Straight, length, duration, feed: Some(feed) };
+                    (moved, None)
+                }
+                CycleMove::Tap { to, lead, rpm } => {
+                    let (length, _) = to_point(&to);
+                    let feed = lead.abs() * rpm.abs();
+                    let duration = if feed > 0.0 { length / feed * 60.0 } else { 0.0 };
+                    let path = Path::Thread { lead: lead.abs(), speed: rpm.abs() };
+                    (Moved { motion: Motion::Feed, path, length, duration, feed: Some(feed) }, None)
+                }
+                CycleMove::Dwell(seconds) => (Moved { motion: Motion::Dwell, duration: seconds, ..STILL }, None),
+                CycleMove::Spindle(action) => {
+                    let code = match action {
+                        SpindleAction::Turn(rpm) => {
+                            self.state.speed = rpm.abs();
+                            if rpm < 0.0 { "M4" } else { "M3" }
+                        }
+                        SpindleAction::Stop | SpindleAction::Orient(_) => "M5",
+                    };
+                    if let Some(code) = Dialect::Sinumerik.catalogue().code_named(code) {
+                        self.state.modes.set(code);
+                    }
+                    continue;
+                }
+                CycleMove::ProgramStop => (STILL, Some(Stop::Program)),
+            };
+            self.record(at, range, moved, Facts::default(), stop);
+        }
     }
 
     /// The block's codes, feed, spindle, tool and motion: its move, its
@@ -851,11 +1009,10 @@ impl<'a> Interpreter<'a> {
             }
         }
         facts.m_functions = facts.m_functions.saturating_add(words.auxiliary);
-        if let Some(adis) = words.adis {
-            self.state.adis = self.length(adis);
-        }
-        if let Some(adispos) = words.adispos {
-            self.state.adispos = self.length(adispos);
+        for &(address, value) in &words.path {
+            if let Err(error) = self.state.path.address(address, self.length(value)) {
+                self.state.finding(RunRule::ValueRefused, range, &error.to_string());
+            }
         }
         if let Some(tool) = &words.tool {
             self.select_tool(tool);
@@ -871,6 +1028,15 @@ impl<'a> Interpreter<'a> {
         }
         let moved = self.motion(words, range);
         (moved, stop, end, facts)
+    }
+
+    /// The spindle's commanded rpm, negative under M4, 0 when it stands.
+    fn signed_rpm(&self) -> f64 {
+        match self.state.modes.get(SPINDLE) {
+            Some("M3") => self.state.speed,
+            Some("M4") => -self.state.speed,
+            _ => 0.0,
+        }
     }
 
     fn select_tool(&mut self, tool: &Value) {
@@ -937,14 +1103,17 @@ impl<'a> Interpreter<'a> {
         let motion = self.state.modes.get(MOTION).unwrap_or("G1");
         if motion == "BSPLINE" {
             self.state.position = end;
+            // A frame is affine: the curve of the mapped control points is
+            // the mapped curve.
+            let (start, end) = (self.state.to_base(&start), self.state.to_base(&end));
             return self.spline_point(words, range, &start, &end);
         }
         // `G[1]=…` left the spline without a code of the block.
         self.end_spline();
-        let (path, length, end) = match motion {
-            "G0" | "G1" => (Path::Straight, distance(&start, &end), end),
+        let (path, end) = match motion {
+            "G0" | "G1" => (Path::Straight, end),
             "G2" | "G3" => match self.arc(words, range, &start, end, motion == "G3") {
-                Some(arc) => arc,
+                Some((path, end)) => (self.arc_in_base(path, &start, range), end),
                 None => return STILL,
             },
             other => {
@@ -953,19 +1122,50 @@ impl<'a> Interpreter<'a> {
             }
         };
         self.state.position = end;
+        let (start, end) = (self.state.to_base(&start), self.state.to_base(&end));
+        let length = path_length(&path, &start, &end, self.state.machine.arc_tolerance());
         if motion == "G0" {
-            let minutes = self
-                .state
-                .machine
-                .axes
-                .iter()
-                .map(|&axis| {
-                    (end[slot(axis)] - start[slot(axis)]).abs() / f64::from(self.state.machine.axis_rapid_rate(axis))
-                })
-                .fold(0.0, f64::max);
-            return Moved { motion: Motion::Rapid, path, length, duration: minutes * 60.0, feed: None };
+            return self.rapid(&start, &end, length);
         }
         self.feed_move(range, path, length)
+    }
+
+    /// A rapid move between base positions: each axis at its own rate, the
+    /// slowest deciding.
+    fn rapid(&self, start: &Position, end: &Position, length: f64) -> Moved {
+        let machine = self.state.machine;
+        let minutes = machine
+            .axes
+            .iter()
+            .map(|&axis| (end[slot(axis)] - start[slot(axis)]).abs() / f64::from(machine.axis_rapid_rate(axis)))
+            .fold(0.0, f64::max);
+        Moved { motion: Motion::Rapid, path: Path::Straight, length, duration: minutes * 60.0, feed: None }
+    }
+
+    /// The path of an arc programmed from `start` to `end` as the frame
+    /// puts it in base coordinates: its centre moved and its sense turned
+    /// over by mirrors; a straight move, reported, where the frame makes
+    /// the circle an ellipse or turns it out of its plane.
+    fn arc_in_base(&mut self, path: Path, start: &Position, range: TextRange) -> Path {
+        let Path::Arc { plane: (a, b), centre, clockwise } = path else { return path };
+        if self.state.frame.is_identity() {
+            return path;
+        }
+        let plane = Plane::from_code(self.state.modes.get(PLANE).unwrap_or("G17")).unwrap_or_default();
+        if !self.state.frame.keeps_plane(plane) {
+            let what = "an arc in a frame that makes its circle an ellipse or turns it out of its plane (run straight)";
+            self.state.not_run(what, range);
+            return Path::Straight;
+        }
+        let mut centre_point = *start;
+        centre_point[slot(a)] = centre[0];
+        centre_point[slot(b)] = centre[1];
+        let moved = self.state.to_base(&centre_point);
+        Path::Arc {
+            plane: (a, b),
+            centre: [moved[slot(a)], moved[slot(b)]],
+            clockwise: clockwise != self.state.frame.turns_arcs_over(plane),
+        }
     }
 
     /// A feed move of `length` mm along `path`.
@@ -1005,7 +1205,7 @@ impl<'a> Interpreter<'a> {
     }
 
     /// The arc of G2 (`ccw` false) or G3 from `start` to `end` in the
-    /// plane in force: its path, length and end; `None` after reporting.
+    /// plane in force: its path and end; `None` after reporting.
     fn arc(
         &mut self,
         words: &Words,
@@ -1013,11 +1213,11 @@ impl<'a> Interpreter<'a> {
         start: &Position,
         mut end: Position,
         ccw: bool,
-    ) -> Option<(Path, f64, Position)> {
-        let (a, b, normal) = match self.state.modes.get(PLANE) {
-            Some("G18") => (b'Z', b'X', b'Y'),
-            Some("G19") => (b'Y', b'Z', b'X'),
-            _ => (b'X', b'Y', b'Z'),
+    ) -> Option<(Path, Position)> {
+        let (a, b) = match self.state.modes.get(PLANE) {
+            Some("G18") => (b'Z', b'X'),
+            Some("G19") => (b'Y', b'Z'),
+            _ => (b'X', b'Y'),
         };
         let from = [start[slot(a)], start[slot(b)]];
         let centre_word = |letter: u8| words.centre[usize::from(letter - b'X')];
@@ -1071,35 +1271,31 @@ impl<'a> Interpreter<'a> {
                 }
             }
         };
-        let arc = match circle_through(from, to_point(&end), centre, ccw, tolerance) {
-            Ok(arc) => arc,
-            Err(OffCircle { start_radius, end_radius }) => {
-                let message = format!(
-                    "the end point does not lie on the circle: {end_radius:.3} mm from the centre, the start {start_radius:.3} mm, more than the tolerance {tolerance} mm apart"
-                );
-                self.state.finding(RunRule::ArcOffCircle, range, &message);
-                return None;
-            }
-        };
-        let rise = end[slot(normal)] - start[slot(normal)];
+        if let Err(OffCircle { start_radius, end_radius }) =
+            circle_through(from, to_point(&end), centre, ccw, tolerance)
+        {
+            let message = format!(
+                "the end point does not lie on the circle: {end_radius:.3} mm from the centre, the start {start_radius:.3} mm, more than the tolerance {tolerance} mm apart"
+            );
+            self.state.finding(RunRule::ArcOffCircle, range, &message);
+            return None;
+        }
         let path = Path::Arc { plane: (a, b), centre, clockwise: !ccw };
-        Some((path, arc.length().hypot(rise), end))
+        Some((path, end))
     }
 
     /// Adds the block's step.
     fn record(&mut self, at: At, range: TextRange, moved: Moved, facts: Facts, stop: Option<Stop>) {
         let modes = &self.state.modes;
-        let exact = facts.exact || modes.is(PATH_MODE, "G60");
-        let corner_tolerance = match modes.get(PATH_MODE) {
-            Some("G641") if moved.motion == Motion::Rapid => self.state.adispos as f32,
-            Some("G641") => self.state.adis as f32,
-            _ => f32::INFINITY,
-        };
-        let rpm = match modes.get(SPINDLE) {
-            Some("M3") => self.state.speed as f32,
-            Some("M4") => -self.state.speed as f32,
-            _ => 0.0,
-        };
+        // `G[10]=…` and SAVE change the groups without a code of the block:
+        // the path modes follow the groups.
+        for group in [PATH_MODE, ACCELERATION] {
+            if let Some(code) = modes.get(group) {
+                self.state.path.code(code);
+            }
+        }
+        let path = self.state.path.step(facts.exact, moved.motion == Motion::Rapid);
+        let rpm = self.signed_rpm() as f32;
         let step = Step {
             source: at.source,
             range: range + self.state.block_start,
@@ -1108,17 +1304,17 @@ impl<'a> Interpreter<'a> {
             duration: moved.duration,
             length: moved.length,
             feed: moved.feed,
-            end: over_axes(&self.state.position, self.state.machine.step_axes()),
+            end: over_axes(&self.state.to_base(&self.state.position), self.state.machine.step_axes()),
             frame: 0,
             stop,
-            path_mode: if exact { PathMode::ExactStop } else { PathMode::Continuous },
+            path_mode: path.path_mode,
             m_functions: facts.m_functions,
             tool_change: facts.tool_change,
             dynamic_set: 1,
             mergeable: false,
-            jerk_limited: modes.is(ACCELERATION, "SOFT"),
+            jerk_limited: path.jerk_limited,
             spindle: [rpm; 2],
-            corner_tolerance,
+            corner_tolerance: path.corner_tolerance,
         };
         self.steps.push(step);
     }
@@ -1280,6 +1476,19 @@ fn is_linear(axis: u8) -> bool {
 }
 
 /// The length of a straight move over the linear axes.
+/// The length of `path` from `start` to `end` (base coordinates): a
+/// helix's is its arc's and its rise's.
+fn path_length(path: &Path, start: &Position, end: &Position, tolerance: f64) -> f64 {
+    let Path::Arc { plane: (a, b), centre, clockwise } = *path else { return distance(start, end) };
+    let normal = XYZ.into_iter().find(|&letter| letter != a && letter != b).unwrap_or(b'Z');
+    let point = |position: &Position| [position[slot(a)], position[slot(b)]];
+    let rise = end[slot(normal)] - start[slot(normal)];
+    match circle_through(point(start), point(end), centre, !clockwise, tolerance) {
+        Ok(arc) => arc.length().hypot(rise),
+        Err(_) => distance(start, end),
+    }
+}
+
 fn distance(from: &Position, to: &Position) -> f64 {
     b"XYZUVW".iter().map(|&axis| (to[slot(axis)] - from[slot(axis)]).powi(2)).sum::<f64>().sqrt()
 }

@@ -67,7 +67,7 @@ impl Interpreter<'_> {
         let name = match &call.callee {
             Callee::Predefined(name) => return self.predefined(name, &call.arguments, range),
             Callee::Cycle(name) => {
-                self.cycle(name, &call.arguments, range);
+                self.cycle(at, name, &call.arguments, range);
                 return Flow::Next;
             }
             Callee::Program(name) | Callee::Path(name) => name.clone(),
@@ -114,7 +114,7 @@ impl Interpreter<'_> {
     pub(super) fn modal(&mut self, at: At, modal: &Call, range: TextRange) -> Flow {
         match &modal.callee {
             Callee::Cycle(name) => {
-                self.cycle(name, &modal.arguments, range);
+                self.cycle(at, name, &modal.arguments, range);
                 Flow::Next
             }
             callee => match callee.program_name() {

@@ -3,7 +3,7 @@ use std::collections::BTreeMap;
 use proptest::prelude::*;
 
 use super::*;
-use crate::trace::{DEFAULT_STEP_BUDGET, NoFiles, WrittenFile};
+use crate::trace::{DEFAULT_STEP_BUDGET, NoFiles, PathMode, WrittenFile};
 
 /// Files beside the program by the control's name (`_N_PROFIL_SPF`).
 #[derive(Default)]
@@ -258,34 +258,37 @@ M30
     assert!(rapid.steps[0].duration >= 50.0 / rate * 60.0 - 1e-9);
 }
 
+/// Each step records how the path passes into it, by the modes in force
+/// in the block before it (the velocity policy's `PathControl`): G60 and
+/// G9 stop at the end of their block, G64 and G641 join within their
+/// tolerances, SOFT limits the jerk of the block's own ramps.
 #[test]
 fn steps_record_the_path_modes() {
     let text = "F100\nG1 X1\nG64 SOFT X2\nG641 ADIS=0.5 X3\nG9 X4\nBRISK G60 X5\n";
     let trace = run(text);
     let modes: Vec<(PathMode, bool, f32)> =
         trace.steps[1..].iter().map(|step| (step.path_mode, step.jerk_limited, step.corner_tolerance)).collect();
-    let inf = f32::INFINITY;
+    let (inf, g64, adis) = (f32::INFINITY, 0.01, (0.5 * std::f64::consts::FRAC_PI_8.tan()) as f32);
     assert_eq!(
         modes,
         [
             (PathMode::ExactStop, false, inf),
-            (PathMode::Continuous, true, inf),
-            (PathMode::Continuous, true, 0.5),
-            (PathMode::ExactStop, true, 0.5),
-            (PathMode::ExactStop, false, inf),
+            (PathMode::ExactStop, true, inf),
+            (PathMode::Continuous, true, g64),
+            (PathMode::Continuous, true, adis),
+            (PathMode::ExactStop, false, adis),
         ]
     );
 }
 
 #[test]
 fn unmodelled_words_are_reported_once_and_the_run_goes_on() {
-    let text = "TRANS X10\nTRANS Y5\nCYCLE800(1,\"0\")\nG0 X1 A2=5 B3=1\nG0 X2 A2=6\nR1=$A_DAY+$A_DAY\nTRAORI\nM30\n";
+    let text = "CYCLE832(0.01,_FINISH,1)\nCYCLE832(0.1)\nG0 X1 A2=5 B3=1\nG0 X2 A2=6\nR1=$A_DAY+$A_DAY\nTRAORI\nM30\n";
     let trace = run(text);
     assert_eq!(
         findings(&trace, text),
         [
-            (RunRule::NotRunYet, "TRANS X10"),
-            (RunRule::NotRunYet, "CYCLE800(1,\"0\")"),
+            (RunRule::NotRunYet, "CYCLE832(0.01,_FINISH,1)"),
             (RunRule::NotRunYet, "A2=5"),
             (RunRule::ParameterUnknown, "$A_DAY"),
             (RunRule::NotRunYet, "TRAORI"),
@@ -431,7 +434,6 @@ fn the_cam_program_writes_its_geometry_and_runs_it() {
     assert_eq!(
         rules,
         [
-            (RunRule::NotRunYet, "the executor does not run the cycle CYCLE800 yet"),
             (RunRule::NotRunYet, "the executor does not run axis A (the machine has none) yet"),
             (RunRule::NotRunYet, "the executor does not run axis C (the machine has none) yet"),
             (RunRule::ParameterUnknown, "the run has no clock"),
@@ -521,4 +523,59 @@ M30
     // MARK after the two moves under MCALL: (0+1) + (1+1); the section
     // once on the way and three times repeated.
     assert_eq!(end(&trace), [3.0, 3.0, 4.0 + 40.0 + 400.0]);
+}
+
+/// The end of every move, X, Y and Z, to the micrometre.
+fn ends(trace: &Trace) -> Vec<[f64; 3]> {
+    let moves = trace.steps.iter().filter(|step| matches!(step.motion, Motion::Rapid | Motion::Feed));
+    moves.map(|step| [0, 1, 2].map(|axis| (step.end[axis] * 1000.0).round() / 1000.0)).collect()
+}
+
+/// Frames move the path as they compose: an ATRANS after an ASCALE is
+/// scaled, a rotation turns the moves and their arcs, a mirror turns an
+/// arc over; the tool stays where it is when a frame changes.
+#[test]
+fn frames_compose_as_the_control_composes_them() {
+    let text = "G0 X0 Y0 Z0\nASCALE X2 Y2 Z2\nATRANS X5\nG0 X1 Y1\nTRANS X10\nAROT Z90\nG1 X5 Y0 F100\nTRANS\nMIRROR X0\nG0 X10 Y0\nG2 X0 Y10 CR=10\nTRANS\nG0 X0 Y0\nM30\n";
+    let trace = run(text);
+    assert_eq!(findings(&trace, text), []);
+    // ASCALE 2 then ATRANS X5: (1, 1) is (2·(1+5), 2·1).
+    // TRANS X10 AROT Z90: X5 is 5 along the turned X, so (10, 5).
+    // MIRROR X: (10, 0) is (-10, 0); the short G2 from there to (0, 10)
+    // turns about (10, 10), which is (-10, 10) mirrored, and over to G3.
+    assert_eq!(
+        ends(&trace),
+        [[0.0, 0.0, 0.0], [12.0, 2.0, 0.0], [10.0, 5.0, 0.0], [-10.0, 0.0, 0.0], [0.0, 10.0, 0.0], [0.0, 0.0, 0.0]]
+    );
+    let arc = trace.steps.iter().find(|step| matches!(step.path, Path::Arc { .. })).expect("the arc");
+    assert!(
+        matches!(arc.path, Path::Arc { clockwise: false, centre, .. } if centre == [-10.0, 10.0]),
+        "{:?}",
+        arc.path
+    );
+    assert!((arc.length - 10.0 * std::f64::consts::FRAC_PI_2).abs() < 1e-9);
+    // A scale lengthens the moves: 2 mm programmed is 4 mm run.
+    let scaled = run("G0 X0 Y0 Z0\nSCALE X2 Y2\nG1 X2 F60\nM30\n");
+    let cut = scaled.steps.iter().find(|step| step.motion == Motion::Feed).expect("the cut");
+    assert_eq!((cut.length, cut.duration), (4.0, 4.0));
+}
+
+/// CYCLE800 turns the plane it drills in; a modal drilling cycle runs at
+/// every position after MCALL until MCALL alone ends it.
+#[test]
+fn cycles_drill_at_each_position_and_swivel_the_plane() {
+    let text = "G17 G0 X0 Y0 Z50\nF200 S1000 M3\nMCALL CYCLE81(10,0,2,-20)\nX10 Y10\nX20\nMCALL\nX30\nM30\n";
+    let trace = run(text);
+    assert_eq!(findings(&trace, text), []);
+    let holes: Vec<[f64; 3]> = ends(&trace).into_iter().filter(|end| end[2] == -20.0).collect();
+    assert_eq!(holes, [[10.0, 10.0, -20.0], [20.0, 10.0, -20.0]]);
+    // In at the feed from the safety distance 2 mm above RFP 0: 22 mm at
+    // 200 mm/min for each hole.
+    let drilled: f64 = trace.steps.iter().filter(|step| step.motion == Motion::Feed).map(|step| step.length).sum();
+    assert!((drilled - 44.0).abs() < 1e-9, "{drilled}");
+    assert_eq!(ends(&trace).last(), Some(&[30.0, 10.0, 10.0]));
+    // Turned by 90° about Z, X10 runs along the base's Y.
+    let swivelled = run("G0 X0 Y0 Z0\nCYCLE800(0,\"TC1\",0,57,0,0,0,0,0,90)\nG0 X10\nM30\n");
+    assert_eq!(findings(&swivelled, ""), []);
+    assert_eq!(ends(&swivelled).last(), Some(&[0.0, 10.0, 0.0]));
 }
