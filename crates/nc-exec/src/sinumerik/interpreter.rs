@@ -41,17 +41,25 @@
 //! - S, M3/M4/M5, T (a number, or `T="name"`), M6, G4 dwell (F seconds
 //!   or S spindle revolutions, in a block of its own), M0/M1 stops, M2/M30
 //!   end; MSG evaluates its text, which the trace has no place for.
-//! - Each step's path mode from G60/G9 (exact stop) and G64/G641–G645
-//!   (continuous), its jerk limit from SOFT against BRISK, and its corner
-//!   tolerance: ADIS (ADISPOS for G0) under G641, 0 when not programmed;
-//!   infinite otherwise (no tolerance the run knows bounds the corner: the
-//!   tolerances of G642–G645 are machine data it does not read).
+//! - Each step's path mode, corner tolerance and jerk limit from the
+//!   velocity policy's [`PathControl`] (G60/G9, G64, G641 with ADIS and
+//!   ADISPOS, G642–G645 with CTOL, SOFT/BRISK, M17 and M30 ending the
+//!   continuous path), kept in step with the groups of the modal state.
+//! - The programmable frame ([`ProgrammableFrame`]: TRANS, ATRANS, ROT,
+//!   AROT, SCALE, ASCALE, MIRROR, AMIRROR, and CYCLE800's swivel): steps
+//!   are in base coordinates, the frame's image of the program's; a frame
+//!   change leaves the tool where it is. An arc stays an arc where the
+//!   frame keeps its plane (its centre moved, its sense turned over by a
+//!   mirror); where the frame makes it an ellipse or turns it out of the
+//!   plane it runs straight, reported as not run.
+//! - The drilling cycles CYCLE81–CYCLE89 and CYCLE840 ([`cycles`]) as
+//!   moves of the block that calls them, at the tool's position in the
+//!   plane, under MCALL after every block with a path motion.
 //! - WRITE, READ, DELETE and ISFILE on the run's own files (module
 //!   `files`).
 //!
-//! Reported once each as not run, moving nothing: frames (TRANS, ROT, …)
-//! and the control's cycles until their modules are joined here
-//! ([`Interpreter::frame`], [`Interpreter::cycle`]), axes the machine does
+//! Reported once each as not run, moving nothing: the control's other
+//! cycles (CYCLE832, …), axes the machine does
 //! not have and orientation words, transformations (TRAORI), radius
 //! compensation G41/G42, inverse-time feed G93, synchronous actions and
 //! what [`super::eval`] does not model. System variables the run has no
