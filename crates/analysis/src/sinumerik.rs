@@ -1,0 +1,5 @@
+//! The Siemens Sinumerik dialect's part of the analysis: the file's blocks,
+//! lowered per chunk, the program model over them, and the rules.
+
+pub(crate) mod checks;
+pub(crate) mod model;
