@@ -1281,14 +1281,14 @@ fn a_named_dialect_reads_the_program_whatever_its_name_says() {
     assert_eq!(ncc(&["explain", "--dialect", "cnc8x6", "G40"]).status.code(), Some(0));
 }
 
-/// A Sinumerik program is checked for its syntax; the executor does not
+/// A Sinumerik program is checked for its syntax and rules; the executor does not
 /// run it yet, and `run`, `expand` and `plot` say so at its first line and
 /// give no time, program or picture.
 #[test]
 fn sinumerik_programs_are_checked_and_not_run_yet() {
     let dir = tempfile::tempdir().unwrap();
     let clean = dir.path().join("PART.MPF");
-    let text = "; a part\nN10 G0 X0 Y0\nDEF REAL DEPTH=5\nIF DEPTH>2 GOTOF DONE\nWHILE R1<10\n  R1=R1+1\nENDWHILE\nDONE: G642 SOFT\nMSG(\"depth \"<<DEPTH)\nM30\n";
+    let text = "; a part\nDEF REAL DEPTH=5\nN10 G0 X0 Y0\nIF DEPTH>2 GOTOF DONE\nWHILE R1<10\n  R1=R1+1\nENDWHILE\nDONE: G642 SOFT\nMSG(\"depth \"<<DEPTH)\nM30\n";
     std::fs::write(&clean, text).unwrap();
     let clean = clean.to_str().unwrap();
     let output = ncc(&["check", clean]);

@@ -36,7 +36,7 @@ declare_rules! {
     NESTING_TOO_DEEP = "K042", "nesting-too-deep", Error, "Control structures nested deeper than 16 levels.";
     PROC_NOT_FIRST = "K043", "proc-not-first", Error, "A PROC line that is not the program's first statement.";
     DEFINITION_AFTER_STATEMENT = "K044", "definition-after-statement", Error, "A DEF or EXTERN after the program's first statement that declares nothing.";
-    RET_WITH_SAVE = "K047", "ret-with-save", Warning, "RET in a subprogram whose PROC line has SAVE.";
+    RET_WITH_SAVE = "K047", "ret-with-save", Warning, "RET in a subprogram whose PROC line has SAVE, which the thesis says cannot be combined (Siemens's own cycles do combine them).", opt_in;
     JUMP_TARGET_NOT_FOUND = "K059", "jump-target-not-found", Error, "A jump to a label or block number the program does not have.";
     JUMP_INTO_STRUCTURE = "K060", "jump-into-structure", Warning, "A jump from outside into the body of an IF, WHILE, FOR, REPEAT or LOOP.";
     TRANSFORMATION_AT_END = "K068", "transformation-at-end", Warning, "The program ends with TRAORI still on (no TRAFOOF after it).";
@@ -332,13 +332,14 @@ impl<'a> Enclosing<'a> {
     }
 }
 
-/// Rules 68 and 69: the switches still on at each block that ends the
-/// program after them.
+/// Rules 68 and 69: the switches still on at the last block that ends
+/// the program.
 fn modes_at_end(catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnostic>) {
     let mut transformation: Option<(String, TextRange)> = None;
     let groups: Vec<Option<&str>> =
         MODES_OFF_AT_END.iter().map(|word| catalogue.word_code(word).and_then(|c| c.group.as_deref())).collect();
     let mut modes: Vec<Option<TextRange>> = vec![None; MODES_OFF_AT_END.len()];
+    let mut at_end = None;
     for (index, block) in file.blocks().enumerate() {
         for statement in &block.statements {
             let StatementKind::Command(command) = &statement.kind else { continue };
@@ -353,19 +354,20 @@ fn modes_at_end(catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnosti
                 }
             }
         }
-        if block.program_end().is_none() {
-            continue;
+        if block.program_end().is_some() {
+            let end = file.in_file(index, block.statements.last().map_or_else(TextRange::default, |s| s.range));
+            at_end = Some((end, transformation.clone(), modes.clone()));
         }
-        let end = file.in_file(index, block.statements.last().map_or_else(TextRange::default, |s| s.range));
-        if let Some((name, on)) = &transformation {
-            let message = format!("the program ends with {name} still on: write {TRANSFORMATION_OFF} before the end");
-            out.push(Diagnostic::new(&TRANSFORMATION_AT_END, end, message).with_related(None, *on, name.clone()));
-        }
-        for (word, on) in MODES_OFF_AT_END.iter().zip(&modes) {
-            if let Some(on) = on {
-                let message = format!("the program ends with {word} still on");
-                out.push(Diagnostic::new(&MODE_AT_END, end, message).with_related(None, *on, word.to_string()));
-            }
+    }
+    let Some((end, transformation, modes)) = at_end else { return };
+    if let Some((name, on)) = transformation {
+        let message = format!("the program ends with {name} still on: write {TRANSFORMATION_OFF} before the end");
+        out.push(Diagnostic::new(&TRANSFORMATION_AT_END, end, message).with_related(None, on, name));
+    }
+    for (word, on) in MODES_OFF_AT_END.iter().zip(modes) {
+        if let Some(on) = on {
+            let message = format!("the program ends with {word} still on");
+            out.push(Diagnostic::new(&MODE_AT_END, end, message).with_related(None, on, word.to_string()));
         }
     }
 }
