@@ -266,26 +266,23 @@ fn jumps(file: &FileModel, out: &mut Vec<Diagnostic>) {
 /// direction it is the wrong keyword, else the target is missing.
 fn not_found(file: &FileModel, block: usize, jump: &Jump, range: TextRange, out: &mut Vec<Diagnostic>) {
     let target = target_text(jump);
+    // The keyword written, where it searches, and the one that would find
+    // the target.
     let turned = match jump.kind {
-        JumpKind::GotoF => Some((JumpKind::GotoB, "GOTOB", "behind")),
-        JumpKind::GotoB => Some((JumpKind::GotoF, "GOTOF", "ahead of")),
+        JumpKind::GotoF => Some(("GOTOF", "forward", JumpKind::GotoB, "GOTOB", "behind")),
+        JumpKind::GotoB => Some(("GOTOB", "backward", JumpKind::GotoF, "GOTOF", "ahead of")),
         _ => None,
     };
-    if let Some((kind, keyword, place)) = turned {
-        let other = Jump { kind, ..jump.clone() };
-        if let Resolved::Block(found) = file.model.resolve(block, &other) {
-            let written = if kind == JumpKind::GotoB { "GOTOF" } else { "GOTOB" };
-            let message = format!(
-                "{written} searches {} only, and {target} is {place} the jump: write {keyword}",
-                if written == "GOTOF" { "forward" } else { "backward" }
-            );
-            let keyword_range = TextRange::at(range.start(), TextSize::of(written));
-            let diagnostic = Diagnostic::new(&JUMP_WRONG_DIRECTION, range, message)
-                .with_related(None, file.in_file(found, TextRange::default()), target.clone())
-                .with_fix(format!("Write {keyword}"), vec![TextEdit::replace(keyword_range, keyword)]);
-            out.push(diagnostic);
-            return;
-        }
+    if let Some((written, searches, kind, keyword, place)) = turned
+        && let Resolved::Block(found) = file.model.resolve(block, &Jump { kind, ..jump.clone() })
+    {
+        let message = format!("{written} searches {searches} only, and {target} is {place} the jump: write {keyword}");
+        let keyword_range = TextRange::at(range.start(), TextSize::of(written));
+        let diagnostic = Diagnostic::new(&JUMP_WRONG_DIRECTION, range, message)
+            .with_related(None, file.in_file(found, TextRange::default()), target.clone())
+            .with_fix(format!("Write {keyword}"), vec![TextEdit::replace(keyword_range, keyword)]);
+        out.push(diagnostic);
+        return;
     }
     let message = format!("the program has no {target} to jump to: the control stops with an alarm here");
     out.push(Diagnostic::new(&JUMP_TARGET_NOT_FOUND, range, message));

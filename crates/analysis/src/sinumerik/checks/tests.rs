@@ -78,8 +78,8 @@ type File = (&'static str, &'static str);
 type Finding = (&'static str, usize);
 
 /// What the listings of the thesis get, by rule and line (from 1): each
-/// finding is true of the program as the seed gives it (see the report of
-/// each rule's message).
+/// finding is true of the program as written (L28's `GOTO N30` names a
+/// block of the passes the seed leaves out).
 #[test]
 fn the_seed_listings_get_only_true_findings() {
     let listings: [(&[File], &[Finding]); 8] = [

@@ -79,12 +79,9 @@ fn call_exprs<'a>(call: &'a Call, f: &mut impl FnMut(&'a Expr)) {
     if let Some(WordValue::Expr { expr, .. }) = &call.repetitions {
         f(expr);
     }
-    if let Callee::Indirect { program, section } = &call.callee {
+    // A section's start and end are labels of the called program, no values.
+    if let Callee::Indirect { program, .. } = &call.callee {
         f(program);
-        if let Some((start, end)) = section {
-            f(start);
-            end.iter().for_each(f);
-        }
     }
 }
 
