@@ -50,7 +50,10 @@ pub(crate) fn check(file: &FileModel, text: &str, config: &Config) -> Vec<Diagno
     let catalogue = Dialect::Sinumerik.catalogue();
     let occurrences = occurrences(file, text);
     let mut declared: HashSet<&str> = file.model.labels.keys().map(String::as_str).collect();
-    declared.extend(occurrences.iter().filter(|o| o.used == Use::Declared).map(|o| o.name));
+    declared.extend(file.model.definitions.iter().map(|d| d.declared.name.as_str()));
+    for proc in &file.model.procs {
+        declared.extend(proc.declaration.parameters.iter().filter_map(|p| p.name.as_deref()));
+    }
     for block in file.blocks() {
         for statement in &block.statements {
             if let StatementKind::Define { name, .. } = &statement.kind {
@@ -59,10 +62,11 @@ pub(crate) fn check(file: &FileModel, text: &str, config: &Config) -> Vec<Diagno
         }
     }
     let mut out = Vec::new();
-    let mut reported: HashSet<&str> = HashSet::new();
+    // Each name is looked up once: the catalogue's lists are searched.
+    let mut decided: HashSet<&str> = HashSet::new();
     for occurrence in occurrences.iter().filter(|o| o.used != Use::Declared) {
         let name = occurrence.name;
-        if declared.contains(name) || known(catalogue, config, name) || !reported.insert(name) {
+        if declared.contains(name) || !decided.insert(name) || known(catalogue, config, name) {
             continue;
         }
         let message = format!(

@@ -11,7 +11,7 @@
 //! comparison with a whole number written as such (`R6==2`), the usual
 //! switch test, whose exactness no one doubts.
 
-use std::collections::HashMap;
+use std::{cell::RefCell, collections::HashMap};
 
 use nc_exec::sinumerik::{
     lower::{BaseType, BinaryOp, Callee, Expr, ExprKind, Parameter, Place, PlaceKind, Proc, Statement, StatementKind, Type, UnaryOp,
@@ -135,7 +135,7 @@ pub(crate) fn check(file: &FileModel, signatures: &Signatures<'_>) -> Vec<Diagno
     for definition in &file.model.definitions {
         variables.insert(&definition.declared.name, &definition.ty);
     }
-    let types = Types { catalogue, variables };
+    let types = Types { catalogue, variables, known: RefCell::default() };
     let mut out = Vec::new();
     for (index, block) in file.blocks().enumerate() {
         let offset = file.ranges[index].start();
@@ -165,6 +165,9 @@ type Signature = (Option<String>, TextRange, String);
 struct Types<'a> {
     catalogue: &'a Catalogue,
     variables: HashMap<&'a str, &'a Type>,
+    /// The types of the system variables and functions used, looked up
+    /// once each: the catalogue's lists are searched.
+    known: RefCell<HashMap<String, Ty>>,
 }
 
 /// Whether `expr` is a whole number written without a point.
@@ -181,11 +184,21 @@ impl Types<'_> {
             PlaceKind::Parameter => Ty::Real,
             PlaceKind::GroupCode => Ty::Int,
             PlaceKind::User => self.variables.get(place.name.as_str()).map_or(Ty::Unknown, |ty| Ty::of(&ty.base)),
-            PlaceKind::System => match self.catalogue.system_variable(&place.name) {
+            PlaceKind::System => self.known(&place.name, |catalogue, name| match catalogue.system_variable(name) {
                 Some(SystemVariableInfo::Documented(variable)) => Ty::named(&variable.ty),
                 _ => Ty::Unknown,
-            },
+            }),
         }
+    }
+
+    /// The type the catalogue gives `name`, by `look_up` the first time.
+    fn known(&self, name: &str, look_up: impl FnOnce(&Catalogue, &str) -> Ty) -> Ty {
+        if let Some(&ty) = self.known.borrow().get(name) {
+            return ty;
+        }
+        let ty = look_up(self.catalogue, name);
+        self.known.borrow_mut().insert(name.to_owned(), ty);
+        ty
     }
 
     /// The length of a STRING[n] variable.
@@ -217,7 +230,9 @@ impl Types<'_> {
                 for argument in arguments.iter().flatten() {
                     self.infer(argument, out);
                 }
-                self.catalogue.function(name).and_then(|f| f.returns.as_deref()).map_or(Ty::Unknown, Ty::named)
+                self.known(name, |catalogue, name| {
+                    catalogue.function(name).and_then(|f| f.returns.as_deref()).map_or(Ty::Unknown, Ty::named)
+                })
             }
             ExprKind::List(values) => {
                 for value in values.iter().flatten() {
