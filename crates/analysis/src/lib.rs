@@ -14,8 +14,8 @@ mod diagnostic;
 mod dialect;
 mod findings;
 mod haas_lathe;
-mod sinumerik;
 mod ide;
+mod sinumerik;
 mod suppress;
 
 use std::sync::Arc;

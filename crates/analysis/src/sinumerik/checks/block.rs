@@ -2,9 +2,7 @@
 //! 7, 49, 50, 55, 56, 57, 80 and the comparison priority). They run per
 //! chunk of blocks, so an edit checks again only the chunk it touched.
 
-use nc_exec::sinumerik::lower::{
-    BinaryOp, Callee, Expr, ExprKind, PlaceKind, SinumerikBlock, StatementKind,
-};
+use nc_exec::sinumerik::lower::{BinaryOp, Callee, Expr, ExprKind, PlaceKind, SinumerikBlock, StatementKind};
 use ncc_catalog::{Catalogue, Dialect};
 use ncc_syntax::{TextEdit, TextRange, TextSize};
 
@@ -157,7 +155,8 @@ fn statements(catalogue: &Catalogue, block: &SinumerikBlock, out: &mut Vec<Diagn
         if let ExprKind::String(text) = &expr.kind
             && let Some(at) = text.find('\0')
         {
-            let message = format!("the string holds a NUL character after {at} bytes: the control ends the string there");
+            let message =
+                format!("the string holds a NUL character after {at} bytes: the control ends the string there");
             out.push(Diagnostic::new(&NUL_IN_STRING, expr.range, message));
         }
     });
@@ -177,10 +176,7 @@ fn group_number(catalogue: &Catalogue, indices: &[Expr], value: &Expr, range: Te
         return;
     }
     let instead = g1.index.map_or_else(String::new, |n| format!(" (that is G[{group}]={n})"));
-    let message = format!(
-        "G[{group}]=1 selects {}, the group's first code, not {}{instead}",
-        selected.code, g1.code
-    );
+    let message = format!("G[{group}]=1 selects {}, the group's first code, not {}{instead}", selected.code, g1.code);
     out.push(Diagnostic::new(&GROUP_NUMBER_NOT_CODE, range, message));
 }
 
@@ -302,13 +298,7 @@ enum Item<'a> {
 /// The operands and operators of the chain at `expr`, and the first
 /// operand of a comparison that is an unparenthesised logical operation or
 /// `<<`.
-fn flatten<'a>(
-    text: &str,
-    expr: &'a Expr,
-    root: bool,
-    items: &mut Vec<Item<'a>>,
-    problem: &mut Option<&'a Expr>,
-) {
+fn flatten<'a>(text: &str, expr: &'a Expr, root: bool, items: &mut Vec<Item<'a>>, problem: &mut Option<&'a Expr>) {
     let ExprKind::Binary(op, lhs, rhs) = &expr.kind else {
         items.push(Item::Operand(expr));
         return;
@@ -332,7 +322,9 @@ fn flatten<'a>(
 /// Parentheses around each run of operands joined by comparisons, where
 /// logical operators join the runs; none when an operand is a `<<`.
 fn parenthesise_comparisons(text: &str, items: &[Item<'_>]) -> Vec<TextEdit> {
-    let concat = items.iter().any(|item| matches!(item, Item::Operand(e) if matches!(e.kind, ExprKind::Binary(BinaryOp::Concat, ..))));
+    let concat = items
+        .iter()
+        .any(|item| matches!(item, Item::Operand(e) if matches!(e.kind, ExprKind::Binary(BinaryOp::Concat, ..))));
     if concat {
         return Vec::new();
     }

@@ -206,7 +206,9 @@ fn unused_labels(file: &FileModel, out: &mut Vec<Diagnostic>) {
     for block in file.blocks() {
         for statement in &block.statements {
             match &statement.kind {
-                StatementKind::RepeatSection { start, end, .. } => named.extend(std::iter::once(start).chain(end).map(String::as_str)),
+                StatementKind::RepeatSection { start, end, .. } => {
+                    named.extend(std::iter::once(start).chain(end).map(String::as_str))
+                }
                 StatementKind::Call(call) if matches!(call.callee, Callee::Indirect { section: Some(_), .. }) => return,
                 _ => {}
             }

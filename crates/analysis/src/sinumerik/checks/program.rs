@@ -10,16 +10,16 @@
 //! - Rule 60 counts a structure's body as the blocks between its start and
 //!   its end: a jump to the end block or to the start is no jump into it.
 //! - Rules 68 and 69 read the switches in file order, the last one
-//!   deciding, and report at each block that ends the program after it.
+//!   deciding, and report at the last block that ends the program.
+//! - Rule 47 is opt-in: the digest doubts it (§8), and Siemens's own
+//!   cycles end with RET under SAVE.
 //! - Rule 76 takes points within [`SAME_POINT_MM`] for the same point.
 //! - Rule 77 calls a G1 move short below [`SHORT_MOVE_MM`] and a run long
 //!   from [`LONG_RUN`] such moves on; a move whose end or start is not
 //!   known from numbers written ends the run.
 
 use nc_exec::sinumerik::{
-    lower::{
-        Dimension, Jump, JumpKind, JumpTarget, SinumerikBlock, StatementKind, Word, WordValue,
-    },
+    lower::{Dimension, Jump, JumpKind, JumpTarget, SinumerikBlock, StatementKind, Word, WordValue},
     program::{Resolved, Structure, StructureKind, Unbalanced},
 };
 use ncc_catalog::{AddressRole, Catalogue, Dialect, KeywordKind};
@@ -41,7 +41,7 @@ declare_rules! {
     JUMP_INTO_STRUCTURE = "K060", "jump-into-structure", Warning, "A jump from outside into the body of an IF, WHILE, FOR, REPEAT or LOOP.";
     TRANSFORMATION_AT_END = "K068", "transformation-at-end", Warning, "The program ends with TRAORI still on (no TRAFOOF after it).";
     MODE_AT_END = "K069", "mode-at-end", Info, "The program ends with TOROT or FFWON still on (no TOROTOF or FFWOF after it).";
-    SPLINE_FIRST_POINT = "K076", "spline-first-point", Warning, "The first point after BSPLINE is not the current position, which the thesis's programs repeat there.";
+    SPLINE_FIRST_POINT = "K076", "spline-first-point", Warning, "The first point after BSPLINE 1 µm or more from the current position, which the thesis's programs repeat there.";
     SHORT_MOVE_RUN = "K077", "short-move-run", Hint, "20 or more G1 moves in a row shorter than 1 mm without a compressor or spline: the axes' velocities step at every block.";
     UNBALANCED_STRUCTURE = "K104", "unbalanced-structure", Error, "A control structure without its end, an end without its start, or an ELSE outside an IF.";
     JUMP_WRONG_DIRECTION = "K105", "jump-wrong-direction", Error, "GOTOF to a target only behind the jump, or GOTOB to one only ahead of it.";
@@ -130,7 +130,10 @@ fn name_problem(catalogue: &Catalogue, name: &str) -> Option<String> {
 
 /// Whether a statement declares rather than acts.
 fn declares(kind: &StatementKind) -> bool {
-    matches!(kind, StatementKind::Def(_) | StatementKind::Proc(_) | StatementKind::Extern(_) | StatementKind::Define { .. })
+    matches!(
+        kind,
+        StatementKind::Def(_) | StatementKind::Proc(_) | StatementKind::Extern(_) | StatementKind::Define { .. }
+    )
 }
 
 /// Rules 43, 44 and 47.
@@ -152,13 +155,11 @@ fn declarations(file: &FileModel, out: &mut Vec<Diagnostic>) {
                         let message = format!(
                             "{keyword} after a statement that declares nothing: definitions come first in a program"
                         );
-                        out.push(
-                            Diagnostic::new(&DEFINITION_AFTER_STATEMENT, range, message).with_related(
-                                None,
-                                first,
-                                "the first statement",
-                            ),
-                        );
+                        out.push(Diagnostic::new(&DEFINITION_AFTER_STATEMENT, range, message).with_related(
+                            None,
+                            first,
+                            "the first statement",
+                        ));
                     }
                 }
                 StatementKind::Return { .. } if save => {

@@ -14,7 +14,9 @@
 use std::{cell::RefCell, collections::HashMap};
 
 use nc_exec::sinumerik::{
-    lower::{BaseType, BinaryOp, Callee, Expr, ExprKind, Parameter, Place, PlaceKind, Proc, Statement, StatementKind, Type, UnaryOp,
+    lower::{
+        BaseType, BinaryOp, Callee, Expr, ExprKind, Parameter, Place, PlaceKind, Proc, Statement, StatementKind, Type,
+        UnaryOp,
     },
     program::Declaration,
 };
@@ -32,7 +34,7 @@ declare_rules! {
     CALL_DOES_NOT_FIT = "K046", "call-does-not-fit", Error, "A call with more arguments than the program's parameters, a value for a VAR parameter, or an argument of a type the parameter cannot take.";
     REAL_LITERAL_TO_INT = "K063", "real-literal-to-int", Info, "A number with a fraction or decimal point assigned to an INT variable, which rounds it.";
     STRING_TOO_LONG = "K064", "string-too-long", Error, "A string literal longer than the STRING[n] variable it is assigned to.";
-    REAL_EQUALITY = "K066", "real-equality", Hint, "`==` or `<>` on REAL values, which the control compares with a relative tolerance.";
+    REAL_EQUALITY = "K066", "real-equality", Hint, "`==` or `<>` on REAL values, which the control compares with a relative tolerance (not against a whole number written as such, `R6==2`).";
     TYPE_MISMATCH = "K106", "type-mismatch", Error, "A value of a type its place cannot take: a STRING in arithmetic or assigned to a number, a number assigned to a STRING.";
 }
 
@@ -117,9 +119,7 @@ pub(crate) type Signatures<'a> = HashMap<&'a str, (&'a str, &'a FileModel, &'a D
 /// The name a call gives a program, as its PROC line writes it:
 /// `_N_NAME_SPF` is NAME.
 pub(crate) fn program_name(name: &str) -> &str {
-    name.strip_prefix("_N_")
-        .and_then(|n| n.strip_suffix("_SPF").or_else(|| n.strip_suffix("_MPF")))
-        .unwrap_or(name)
+    name.strip_prefix("_N_").and_then(|n| n.strip_suffix("_SPF").or_else(|| n.strip_suffix("_MPF"))).unwrap_or(name)
 }
 
 pub(crate) fn check(file: &FileModel, signatures: &Signatures<'_>) -> Vec<Diagnostic> {
@@ -260,7 +260,13 @@ impl Types<'_> {
         }
     }
 
-    fn binary(&self, op: BinaryOp, (lhs, left): (&Expr, Ty), (rhs, right): (&Expr, Ty), out: &mut Vec<Diagnostic>) -> Ty {
+    fn binary(
+        &self,
+        op: BinaryOp,
+        (lhs, left): (&Expr, Ty),
+        (rhs, right): (&Expr, Ty),
+        out: &mut Vec<Diagnostic>,
+    ) -> Ty {
         match op {
             BinaryOp::Add | BinaryOp::Sub | BinaryOp::Mul | BinaryOp::Div | BinaryOp::IntDiv | BinaryOp::Mod => {
                 let left_ok = self.arithmetic(lhs, left, out);
@@ -286,8 +292,13 @@ impl Types<'_> {
             BinaryOp::Chain => Ty::Frame,
             BinaryOp::Eq | BinaryOp::Ne | BinaryOp::Lt | BinaryOp::Le | BinaryOp::Gt | BinaryOp::Ge => {
                 if left.cannot_become(right) && right.cannot_become(left) {
-                    let message = format!("a {} is compared with a {}: they cannot be compared", left.name(), right.name());
-                    out.push(Diagnostic::new(&TYPE_MISMATCH, TextRange::new(lhs.range.start(), rhs.range.end()), message));
+                    let message =
+                        format!("a {} is compared with a {}: they cannot be compared", left.name(), right.name());
+                    out.push(Diagnostic::new(
+                        &TYPE_MISMATCH,
+                        TextRange::new(lhs.range.start(), rhs.range.end()),
+                        message,
+                    ));
                 } else if matches!(op, BinaryOp::Eq | BinaryOp::Ne)
                     && (left == Ty::Real || right == Ty::Real)
                     && [left, right].iter().all(|ty| matches!(ty, Ty::Int | Ty::Real))
@@ -295,7 +306,11 @@ impl Types<'_> {
                     && !whole_literal(rhs)
                 {
                     let message = "REAL values compare equal within a relative tolerance on Sinumerik, not exactly: a difference test (`ABS(A-B)<1E-6`) says what is meant";
-                    out.push(Diagnostic::new(&REAL_EQUALITY, TextRange::new(lhs.range.start(), rhs.range.end()), message));
+                    out.push(Diagnostic::new(
+                        &REAL_EQUALITY,
+                        TextRange::new(lhs.range.start(), rhs.range.end()),
+                        message,
+                    ));
                 }
                 Ty::Bool
             }
