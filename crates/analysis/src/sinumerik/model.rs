@@ -20,7 +20,7 @@ pub(crate) fn chunk_blocks<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Arc<
     Arc::new(chunk.blocks(db).map(SinumerikBlock::lower).collect())
 }
 
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub(crate) struct FileModel {
     /// Each block's range in the file.
     pub ranges: Vec<TextRange>,
@@ -29,6 +29,18 @@ pub(crate) struct FileModel {
     /// The index of each chunk's first block.
     firsts: Vec<usize>,
     pub model: SinumerikModel,
+}
+
+/// Chunks an edit did not touch are the same chunks: compared by address,
+/// an edit compares the blocks of the chunk it touched only.
+impl PartialEq for FileModel {
+    fn eq(&self, other: &Self) -> bool {
+        self.ranges == other.ranges
+            && self.firsts == other.firsts
+            && self.chunks.len() == other.chunks.len()
+            && self.chunks.iter().zip(&other.chunks).all(|(a, b)| Arc::ptr_eq(a, b) || a == b)
+            && self.model == other.model
+    }
 }
 
 impl FileModel {

@@ -377,7 +377,7 @@ const PATH_AXES: [&str; 3] = ["X", "Y", "Z"];
 struct Motion<'a> {
     catalogue: &'a Catalogue,
     /// The code in force of the motion group (G1, BSPLINE, …).
-    motion: String,
+    motion: &'a str,
     incremental: bool,
     compressor: bool,
     position: [Option<f64>; 3],
@@ -392,7 +392,7 @@ impl Motion<'_> {
     fn check(catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnostic>) {
         let mut motion = Motion {
             catalogue,
-            motion: String::new(),
+            motion: "",
             incremental: false,
             compressor: false,
             position: [None; 3],
@@ -431,7 +431,7 @@ impl Motion<'_> {
                 if code.code == SPLINE && self.motion != SPLINE {
                     self.spline_start = Some(file.in_file(index, statement.range));
                 }
-                self.motion = code.code.clone();
+                self.motion = &code.code;
             } else if group.is_some() && group == compressor_group {
                 self.compressor = code.index != Some(1);
             } else if code.code == "G90" || code.code == "G91" {
