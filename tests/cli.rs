@@ -1281,14 +1281,27 @@ fn a_named_dialect_reads_the_program_whatever_its_name_says() {
     assert_eq!(ncc(&["explain", "--dialect", "cnc8x6", "G40"]).status.code(), Some(0));
 }
 
-/// A Sinumerik program is checked for its syntax and runs: `run` times
-/// it with the subprogram beside it, `expand` writes its moves as plain
-/// blocks, `plot` draws it, and the files it writes go below `--write-dir`.
+/// A Sinumerik program is checked for its syntax and rules and runs: `run`
+/// times it with the subprogram beside it, `expand` writes its moves as
+/// plain blocks, `plot` draws it, and the files it writes go below
+/// `--write-dir`.
 #[test]
 fn sinumerik_programs_are_checked_and_run() {
     let dir = tempfile::tempdir().unwrap();
     let clean = dir.path().join("PART.MPF");
-    let text = "; a part\nN10 G0 X0 Y0\nDEF REAL DEPTH=5\nIF DEPTH>2 GOTOF DONE\nWHILE R1<10\n  R1=R1+1\nENDWHILE\nDONE: G642 SOFT\nMSG(\"depth \"<<DEPTH)\nSIDE(DEPTH)\nWRITE(R2,\"/_N_MPF_DIR/_N_OUT_DIR/_N_LOG_SPF\",\"X\"<<DEPTH)\nM30\n";
+    let text = "; a part
+DEF REAL DEPTH=5
+N10 G0 X0 Y0
+IF DEPTH>2 GOTOF DONE
+WHILE R1<10
+  R1=R1+1
+ENDWHILE
+DONE: G642 SOFT
+MSG(\"depth \"<<DEPTH)
+SIDE(DEPTH)
+WRITE(R2,\"/_N_MPF_DIR/_N_OUT_DIR/_N_LOG_SPF\",\"X\"<<DEPTH)
+M30
+";
     std::fs::write(&clean, text).unwrap();
     std::fs::write(dir.path().join("SIDE.SPF"), "PROC SIDE(REAL D)\nG1 X=D*2 Y=D F600\nM17\n").unwrap();
     let clean = clean.to_str().unwrap();

@@ -659,8 +659,8 @@ fn hover_on_a_block_adds_its_speed_profile() {
     assert_eq!(hover(&mut client, "SIDE"), N20_HOVER);
 }
 
-/// A Sinumerik subprogram with a syntax error on line 8, where its run
-/// stops.
+/// A Sinumerik subprogram with a jump the wrong way on line 7 and a
+/// syntax error on line 8, where its run stops.
 const SINUMERIK: &str = "PROC PART(REAL DEPTH) SAVE
 DEF STRING[20] NAME=\"A\"
 ; two comment lines
@@ -686,7 +686,15 @@ fn a_sinumerik_document_gets_its_syntax_errors_hover_tokens_and_outline() {
         .iter()
         .map(|d| (d["code"].as_str().unwrap(), d["range"]["start"]["line"].as_u64().unwrap()))
         .collect();
-    assert_eq!(found, [("S029", 7), ("S024", 7)], "{}", published.json);
+    assert_eq!(found, [("K105", 6), ("S029", 7), ("S024", 7)], "{}", published.json);
+    let at = json!({ "line": 6, "character": 11 });
+    let actions = client
+        .call(
+            "textDocument/codeAction",
+            json!({ "textDocument": doc.id(), "range": { "start": at, "end": at }, "context": { "diagnostics": [] } }),
+        )
+        .unwrap();
+    assert!(actions.json.to_string().contains("Write GOTOB"), "{}", actions.json);
 
     let hover = |client: &mut Client, at: &str| {
         let answer = client.call("textDocument/hover", doc.at(doc.position(doc.text().find(at).unwrap()))).unwrap();

@@ -15,6 +15,10 @@
 //! [report]
 //! max-findings = 1000          # a file's findings shown at most
 //!
+//! [sinumerik]
+//! globals = ["VAC_POLE"]       # names declared outside the file (GUD, macros)
+//! r-parameters = 100           # $MN_MM_NUM_R_PARAM: R0 to R99
+//!
 //! [machine]
 //! file = "machines/mill.toml"             # a machine file; the keys below override it
 //! axes = ["X", "Y", "Z", "U", "V", "C"]   # letters of axes 1-6
@@ -105,6 +109,7 @@ pub struct Config {
     pub rules: BTreeMap<String, Level>,
     pub report: ReportConfig,
     pub machine: MachineConfig,
+    pub sinumerik: SinumerikConfig,
 }
 
 /// Which dialect a program is in: `dialect` and `[extensions]` in
@@ -158,6 +163,26 @@ impl Default for ReportConfig {
     }
 }
 
+/// The `[sinumerik]` section of `ncc.toml`: what a Sinumerik program may
+/// use without declaring it.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Default, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "kebab-case", default)]
+pub struct SinumerikConfig {
+    /// Names declared outside the files (global user data, definitions of
+    /// the machine builder), in any case.
+    pub globals: Vec<String>,
+    /// How many R parameters the control has (`$MN_MM_NUM_R_PARAM`);
+    /// `None`: the catalogue's count.
+    pub r_parameters: Option<u32>,
+}
+
+impl SinumerikConfig {
+    /// Whether `name` (upper case) is declared outside the files.
+    pub fn is_global(&self, name: &str) -> bool {
+        self.globals.iter().any(|global| global.eq_ignore_ascii_case(name))
+    }
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields, rename_all = "kebab-case")]
 struct ConfigFile {
@@ -168,6 +193,8 @@ struct ConfigFile {
     rules: BTreeMap<String, Level>,
     #[serde(default)]
     report: ReportConfig,
+    #[serde(default)]
+    sinumerik: SinumerikConfig,
     #[serde(default)]
     machine: Option<MachineFile>,
 }
@@ -490,6 +517,7 @@ impl Config {
             dialects: Dialects { dialect: file.dialect, extensions },
             rules: file.rules,
             report: file.report,
+            sinumerik: file.sinumerik,
             // The machine's control is the project's dialect when this
             // build reads it; the machine's keys are read in its terms.
             machine: MachineConfig::of_control(file.dialect.unwrap_or_default()),

@@ -11,6 +11,7 @@ use crate::{
     findings::Findings,
     haas_lathe,
     lower::{BlockData, Word},
+    sinumerik,
 };
 
 /// The rules of the dialect's checks, by check module.
@@ -18,8 +19,7 @@ fn check_rules(dialect: Dialect) -> &'static [&'static [&'static Rule]] {
     match dialect {
         Dialect::Cnc8x6 => cnc8x6::checks::RULES,
         Dialect::HaasLathe => haas_lathe::checks::RULES,
-        // No Sinumerik checks beyond the parser's syntax diagnostics yet.
-        Dialect::Sinumerik => &[],
+        Dialect::Sinumerik => sinumerik::checks::RULES,
     }
 }
 
@@ -44,7 +44,7 @@ pub(crate) fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => cnc8x6::checks::local_findings(db, file),
         Dialect::HaasLathe => haas_lathe::checks::local_findings(db, file),
-        Dialect::Sinumerik => Findings::default(),
+        Dialect::Sinumerik => sinumerik::checks::local_findings(db, file),
     }
 }
 
@@ -53,10 +53,7 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> &Findings {
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => cnc8x6::flow::flow_diagnostics(db, file),
         Dialect::HaasLathe => haas_lathe::checks::flow_findings(db, file),
-        Dialect::Sinumerik => {
-            static NONE: Findings = Findings { diagnostics: Vec::new(), omitted: Vec::new() };
-            &NONE
-        }
+        Dialect::Sinumerik => sinumerik::checks::flow_findings(db, file),
     }
 }
 

@@ -1,4 +1,6 @@
-//! The Sinumerik dialect's part of the analysis: the file's blocks and
-//! program model, read once per edit, for what the editor features ask.
+//! The Siemens Sinumerik dialect's part of the analysis: the file's blocks,
+//! lowered per chunk, the program model over them, and the rules; the
+//! editor features read the same model.
 
+pub(crate) mod checks;
 pub(crate) mod model;

@@ -743,7 +743,7 @@ fn highlight_a_sinumerik_program() {
             ; fold together:Comment
             DEF:Keyword REAL:Keyword B:write =:Operator 5:Number ,:Operator C:write [:Operator 2:Number ]:Operator
             N10:BlockNumber G17:GG6 G642:GG10 SOFT:GG21 X:Axis =:Operator R1:read +:Operator 5:Number CR:Interpolation =:Operator 2:Number
-            START::Label { write: true } $P_UIFR:SystemVariable [:Operator 1:Number ,:Operator X:Axis ,:Operator TR:read ]:Operator =:Operator 5:Number
+            START::Label { write: true } $P_UIFR:SystemVariable [:Operator 1:Number ,:Operator X:Axis ,:Operator TR:Keyword ]:Operator =:Operator 5:Number
             IF:Keyword DEPTH:read >=:Operator 2:Number GOTOF:Keyword START:Label { write: false }
             IF:Keyword B:Axis <>:Operator C:Axis [:Operator 1:Number ]:Operator
             WHILE:Keyword R1:read <:Operator 10:Number

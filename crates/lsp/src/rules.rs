@@ -59,6 +59,7 @@ const KINDS: &[(&str, &str)] = &[
     ("X", "Transformations"),
     ("D", "Dynamics and continuity"),
     ("L", "Haas lathe (`L` + the rule's number in the lathe manual's list; L101 on: the project's own)"),
+    ("K", "Siemens Sinumerik (`K` + the rule's number in the digest's §6; K101 on: the project's own)"),
     ("Z", "Report limits"),
     ("E", "Execution (`ncc run`, `ncc expand`, `ncc plot`)"),
 ];

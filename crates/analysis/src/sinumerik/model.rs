@@ -1,24 +1,60 @@
-//! A Sinumerik file as the analysis sees it: its blocks lowered, where each
-//! stands, and the program model (labels, block numbers, structures, PROC,
-//! EXTERN and DEF declarations, jumps, calls).
+//! A Sinumerik file as the rules and the editor see it: its blocks lowered, where each
+//! stands, and the program model (labels, structures, declarations, jumps,
+//! calls).
+//!
+//! Blocks are lowered per chunk ([`chunk_blocks`]): after an edit only the
+//! chunk the edit touched is lowered again, and the file model shares the
+//! other chunks' blocks. The program model is rebuilt from them, one pass
+//! over the blocks.
 
-use nc_exec::sinumerik::{
-    lower::{SinumerikBlock, block_nodes},
-    program::SinumerikModel,
-};
+use std::sync::Arc;
+
+use nc_exec::sinumerik::{lower::SinumerikBlock, program::SinumerikModel};
 use ncc_syntax::{TextRange, TextSize};
 
-use crate::db::{Db, SourceFile};
+use crate::db::{BlockChunk, Db, SourceFile, file_chunks};
 
-#[derive(Debug, Clone, PartialEq)]
+/// The lowered blocks of a chunk, in order.
+#[salsa::tracked(returns(ref))]
+pub(crate) fn chunk_blocks<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Arc<Vec<SinumerikBlock>> {
+    Arc::new(chunk.blocks(db).map(SinumerikBlock::lower).collect())
+}
+
+#[derive(Debug, Clone)]
 pub(crate) struct FileModel {
     /// Each block's range in the file.
     pub ranges: Vec<TextRange>,
-    pub blocks: Vec<SinumerikBlock>,
+    /// The chunks' blocks, in order.
+    chunks: Vec<Arc<Vec<SinumerikBlock>>>,
+    /// The index of each chunk's first block.
+    firsts: Vec<usize>,
     pub model: SinumerikModel,
 }
 
+/// Chunks an edit did not touch are the same chunks: compared by address,
+/// an edit compares the blocks of the chunk it touched only.
+impl PartialEq for FileModel {
+    fn eq(&self, other: &Self) -> bool {
+        self.ranges == other.ranges
+            && self.firsts == other.firsts
+            && self.chunks.len() == other.chunks.len()
+            && self.chunks.iter().zip(&other.chunks).all(|(a, b)| Arc::ptr_eq(a, b) || a == b)
+            && self.model == other.model
+    }
+}
+
 impl FileModel {
+    /// Block `index`.
+    pub fn block(&self, index: usize) -> &SinumerikBlock {
+        let chunk = self.firsts.partition_point(|&first| first <= index) - 1;
+        &self.chunks[chunk][index - self.firsts[chunk]]
+    }
+
+    /// Every block, in order.
+    pub fn blocks(&self) -> impl Iterator<Item = &SinumerikBlock> + Clone {
+        self.chunks.iter().flat_map(|chunk| chunk.iter())
+    }
+
     /// A range of block `index` (block-relative) in the file.
     pub fn in_file(&self, index: usize, range: TextRange) -> TextRange {
         range + self.ranges[index].start()
@@ -33,9 +69,19 @@ impl FileModel {
 /// The file's model, rebuilt when its text changes.
 #[salsa::tracked(returns(ref))]
 pub(crate) fn file_model(db: &dyn Db, file: SourceFile) -> FileModel {
-    let parse = file.parse(db);
-    let (ranges, blocks): (Vec<TextRange>, Vec<SinumerikBlock>) =
-        block_nodes(parse.green()).map(|(range, block)| (range, SinumerikBlock::lower(block))).unzip();
-    let model = SinumerikModel::new(&blocks);
-    FileModel { ranges, blocks, model }
+    let mut ranges = Vec::new();
+    let mut chunks = Vec::new();
+    let mut firsts = Vec::new();
+    for chunk in file_chunks(db, file) {
+        let blocks = chunk_blocks(db, chunk.chunk);
+        firsts.push(chunk.first);
+        let mut offset = chunk.offset;
+        for block in blocks.iter() {
+            ranges.push(TextRange::at(offset, block.len));
+            offset += block.len;
+        }
+        chunks.push(blocks.clone());
+    }
+    let model = SinumerikModel::new(chunks.iter().flat_map(|chunk| chunk.iter()));
+    FileModel { ranges, chunks, firsts, model }
 }

@@ -141,9 +141,16 @@ pub struct CallSite {
 }
 
 impl SinumerikModel {
-    pub fn new(blocks: &[SinumerikBlock]) -> SinumerikModel {
+    /// The model of the blocks in file order; they are read twice, so a
+    /// file kept in pieces needs no copy.
+    pub fn new<'a, I>(blocks: I) -> SinumerikModel
+    where
+        I: IntoIterator<Item = &'a SinumerikBlock>,
+        I::IntoIter: Clone,
+    {
+        let blocks = blocks.into_iter();
         let mut model = SinumerikModel::default();
-        for (index, block) in blocks.iter().enumerate() {
+        for (index, block) in blocks.clone().enumerate() {
             if let Some(label) = &block.label {
                 model.labels.entry(label.name.clone()).or_default().push(index);
             }
@@ -152,7 +159,7 @@ impl SinumerikModel {
             }
         }
         let mut open: Vec<Open> = Vec::new();
-        for (index, block) in blocks.iter().enumerate() {
+        for (index, block) in blocks.enumerate() {
             for statement in &block.statements {
                 model.structure(&mut open, index, &statement.kind);
                 model.declarations_and_calls(index, &statement.kind);

@@ -125,7 +125,7 @@ fn occurrence(model: &FileModel, index: usize, node: &SyntaxNode) -> Option<Occu
         SyntaxKind::CALL_STMT => {
             let (name, range) = name_run(elements())?;
             let relative = node.text_range() - model.ranges[index].start();
-            let statement = model.blocks[index].statements.iter().find(|s| s.range.contains_range(relative))?;
+            let statement = model.block(index).statements.iter().find(|s| s.range.contains_range(relative))?;
             match &statement.kind {
                 StatementKind::RepeatSection { start, end, .. } if *start == name || end.as_ref() == Some(&name) => {
                     (Symbol::Label(name), range, ReferenceKind::Jump)

@@ -38,9 +38,8 @@ fn the_expansion_runs_the_same_moves() {
     let joins = |trace: &crate::trace::Trace| -> Vec<_> {
         let moves = trace.steps.iter().filter(|step| matches!(step.motion, Motion::Rapid | Motion::Feed));
         // An exact stop bounds its corner by no tolerance.
-        let corner = |step: &crate::trace::Step| {
-            (step.path_mode == PathMode::Continuous).then(|| (step.corner_tolerance * 1000.0).round())
-        };
+        let corner =
+            |step: &Step| (step.path_mode == PathMode::Continuous).then(|| (step.corner_tolerance * 1000.0).round());
         moves.map(|step| (step.path_mode, step.jerk_limited, corner(step))).collect()
     };
     assert_eq!(joins(&original), joins(&again), "{expanded}");

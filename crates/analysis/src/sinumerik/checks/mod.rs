@@ -1,0 +1,90 @@
+//! The Sinumerik rules (digest §6), coded `K` + the rule's number there;
+//! rules the digest does not list are numbered from K101.
+//!
+//! Rules that read one block ([`block`]) run per chunk of blocks, cached
+//! by salsa, so an edit checks again only the chunk it touched; the rules
+//! on the whole program ([`program`], [`names`], [`types`]) are one pass
+//! each over the file model and come with the flow findings.
+//!
+//! Not checked here:
+//! - rules 1, 2, 10, 11, 12 and 14 are the parser's (`space-in-word`,
+//!   `unexpected-character`, `parenthesis-comment`, the block skip's place,
+//!   `unclosed-string`, `template-placeholder`);
+//! - rules 3, 5, 6, 8, 9 are ISO conventions or off for Sinumerik;
+//! - rules 15–38 and 70–75, 78, 79, 81 follow the path, the tool or the
+//!   stock, which only a run knows; 41 and 48 need the calls' nesting at
+//!   run time; 51–54 and 58 depend on generated programs, the machine's
+//!   tool management or the control's version; 65 on the meaning of
+//!   comments; 67 on the order of blocks in the run; 40 on files with
+//!   both an MPF and an SPF, which the workspace does not tell apart;
+//! - computed jump targets (`GOTOF "N"<<R3`) are the run's.
+
+pub(crate) mod block;
+pub(crate) mod names;
+pub(crate) mod program;
+pub(crate) mod types;
+pub(crate) mod visit;
+
+use crate::{
+    Diagnostic, Rule,
+    db::{BlockChunk, Db, Settings, SourceFile, file_chunks},
+    findings::{self, Findings},
+    sinumerik::model::{chunk_blocks, file_model},
+};
+
+/// The rules of every check module.
+pub(crate) static RULES: &[&[&Rule]] = &[block::RULES, program::RULES, names::RULES, types::RULES];
+
+/// The findings of a file's single blocks, chunk by chunk.
+pub(crate) fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
+    let mut diagnostics = Vec::new();
+    for chunk in file_chunks(db, file) {
+        diagnostics.extend(chunk_findings(db, chunk.chunk).iter().map(|d| d.clone().shifted(chunk.offset)));
+    }
+    Findings { diagnostics, omitted: Vec::new() }
+}
+
+/// The findings of the single blocks of a chunk; ranges relative to the
+/// chunk's start.
+#[salsa::tracked(returns(ref))]
+fn chunk_findings<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<Diagnostic> {
+    let config = Settings::get(db).config(db);
+    let text = chunk.green(db).0.to_string();
+    let mut start = 0;
+    let mut diagnostics = Vec::new();
+    for block in chunk_blocks(db, chunk).iter() {
+        let end = start + usize::from(block.len);
+        let mut found: Vec<Diagnostic> = block::check(block, &text[start..end], config)
+            .into_iter()
+            .map(|d| d.shifted((start as u32).into()))
+            .collect();
+        findings::sort_diagnostics(&mut found);
+        diagnostics.extend(found);
+        start = end;
+    }
+    diagnostics
+}
+
+/// The findings of the rules on the whole program.
+#[salsa::tracked(returns(ref))]
+pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
+    let model = file_model(db, file);
+    let settings = Settings::get(db);
+    let config = settings.config(db);
+    let text = file.text(db).as_str();
+    let mut signatures = types::Signatures::new();
+    for other in settings.files(db) {
+        let other_model = file_model(db, *other);
+        if let Some(proc) = other_model.model.header() {
+            signatures.entry(proc.declaration.name.as_str()).or_insert((other.path(db).as_str(), other_model, proc));
+        }
+    }
+    let mut diagnostics = program::check(model);
+    diagnostics.extend(names::check(model, text, config));
+    diagnostics.extend(types::check(model, &signatures));
+    findings::sort_diagnostics(&mut diagnostics);
+    Findings { diagnostics, omitted: Vec::new() }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,491 @@
+//! Rules on the program as a whole, over the program model (digest §6
+//! rules 39, 42, 43, 44, 47, 59, 60, 68, 69, 76, 77, and the balance of the
+//! control structures and the direction of jumps). Each is one pass over
+//! the blocks or the model's lists.
+//!
+//! Assumptions, where the digest is silent:
+//! - A program name is checked where the program writes it (its PROC line,
+//!   its `%_N_…_MPF` header), not in the file's name on the host;
+//!   numbered programs (`L140`) are named by their number.
+//! - Rule 60 counts a structure's body as the blocks between its start and
+//!   its end: a jump to the end block or to the start is no jump into it.
+//! - Rules 68 and 69 read the switches in file order, the last one
+//!   deciding, and report at the last block that ends the program.
+//! - Rule 47 is opt-in: the digest doubts it (§8), and Siemens's own
+//!   cycles end with RET under SAVE.
+//! - Rule 76 takes points within [`SAME_POINT_MM`] for the same point.
+//! - Rule 77 calls a G1 move short below [`SHORT_MOVE_MM`] and a run long
+//!   from [`LONG_RUN`] such moves on; a move whose end or start is not
+//!   known from numbers written ends the run.
+
+use nc_exec::sinumerik::{
+    lower::{Dimension, Jump, JumpKind, JumpTarget, SinumerikBlock, StatementKind, Word, WordValue},
+    program::{Resolved, Structure, StructureKind, Unbalanced},
+};
+use ncc_catalog::{AddressRole, Catalogue, Dialect, KeywordKind};
+use ncc_syntax::{TextEdit, TextRange, TextSize};
+
+use crate::{
+    Diagnostic,
+    diagnostic::declare_rules,
+    sinumerik::{checks::visit::number, model::FileModel},
+};
+
+declare_rules! {
+    INVALID_PROGRAM_NAME = "K039", "invalid-program-name", Error, "A program name (PROC, `%_N_…_MPF`) that does not start with two letters, holds other characters than letters, digits and `_`, or is longer than 31 characters.";
+    NESTING_TOO_DEEP = "K042", "nesting-too-deep", Error, "Control structures nested deeper than 16 levels.";
+    PROC_NOT_FIRST = "K043", "proc-not-first", Error, "A PROC line that is not the program's first statement.";
+    DEFINITION_AFTER_STATEMENT = "K044", "definition-after-statement", Error, "A DEF or EXTERN after the program's first statement that declares nothing.";
+    RET_WITH_SAVE = "K047", "ret-with-save", Warning, "RET in a subprogram whose PROC line has SAVE, which the thesis says cannot be combined (Siemens's own cycles do combine them).", opt_in;
+    JUMP_TARGET_NOT_FOUND = "K059", "jump-target-not-found", Error, "A jump to a label or block number the program does not have.";
+    JUMP_INTO_STRUCTURE = "K060", "jump-into-structure", Warning, "A jump from outside into the body of an IF, WHILE, FOR, REPEAT or LOOP.";
+    TRANSFORMATION_AT_END = "K068", "transformation-at-end", Warning, "The program ends with TRAORI still on (no TRAFOOF after it).";
+    MODE_AT_END = "K069", "mode-at-end", Info, "The program ends with TOROT or FFWON still on (no TOROTOF or FFWOF after it).";
+    SPLINE_FIRST_POINT = "K076", "spline-first-point", Warning, "The first point after BSPLINE 1 µm or more from the current position, which the thesis's programs repeat there.";
+    SHORT_MOVE_RUN = "K077", "short-move-run", Hint, "20 or more G1 moves in a row shorter than 1 mm without a compressor or spline: the axes' velocities step at every block.";
+    UNBALANCED_STRUCTURE = "K104", "unbalanced-structure", Error, "A control structure without its end, an end without its start, or an ELSE outside an IF.";
+    JUMP_WRONG_DIRECTION = "K105", "jump-wrong-direction", Error, "GOTOF to a target only behind the jump, or GOTOB to one only ahead of it.";
+}
+
+/// The deepest nesting of control structures (004:1464).
+const MAX_DEPTH: usize = 16;
+
+/// The longest program name (004:1446-1450).
+const MAX_NAME_CHARS: usize = 31;
+
+/// A G1 move shorter than this, in mm, is short (rule 77).
+const SHORT_MOVE_MM: f64 = 1.0;
+
+/// Points closer than this, in mm, are the same (rule 76): the thesis's
+/// CAM output repeats the current point to a few tenths of a µm.
+const SAME_POINT_MM: f64 = 0.001;
+
+/// This many short G1 moves in a row are a long run (rule 77).
+const LONG_RUN: usize = 20;
+
+/// The word that switches TRAORI off; the other transformations' too.
+const TRANSFORMATION_OFF: &str = "TRAFOOF";
+
+/// The modes rule 69 wants off at the end: each the code of its group
+/// that switches it on.
+const MODES_OFF_AT_END: [&str; 2] = ["TOROT", "FFWON"];
+
+/// The words of the compressors' group and of the splines (rule 77).
+const COMPRESSOR: &str = "COMPCAD";
+const SPLINE: &str = "BSPLINE";
+
+pub(crate) fn check(file: &FileModel) -> Vec<Diagnostic> {
+    let catalogue = Dialect::Sinumerik.catalogue();
+    let mut out = Vec::new();
+    names(catalogue, file, &mut out);
+    declarations(file, &mut out);
+    structures(file, &mut out);
+    jumps(file, &mut out);
+    modes_at_end(catalogue, file, &mut out);
+    Motion::check(catalogue, file, &mut out);
+    out
+}
+
+/// Rule 39: the names the program gives itself.
+fn names(catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnostic>) {
+    for (index, block) in file.blocks().enumerate() {
+        if let Some(header) = &block.header {
+            let name = header.name.strip_prefix("_N_").and_then(|n| n.strip_suffix("_MPF").or(n.strip_suffix("_SPF")));
+            if let Some(problem) = name.and_then(|name| name_problem(catalogue, name)) {
+                out.push(Diagnostic::new(&INVALID_PROGRAM_NAME, file.in_file(index, header.range), problem));
+            }
+        }
+        for statement in &block.statements {
+            if let StatementKind::Proc(proc) = &statement.kind
+                && let Some(problem) = name_problem(catalogue, &proc.name)
+            {
+                out.push(Diagnostic::new(&INVALID_PROGRAM_NAME, file.in_file(index, statement.range), problem));
+            }
+        }
+    }
+}
+
+/// What is wrong with a program name, if anything.
+fn name_problem(catalogue: &Catalogue, name: &str) -> Option<String> {
+    let numbered = name.split_at_checked(1).is_some_and(|(letter, digits)| {
+        catalogue.address(letter).is_some_and(|a| a.role == AddressRole::Label)
+            && !digits.is_empty()
+            && digits.bytes().all(|b| b.is_ascii_digit())
+    });
+    if numbered || name.is_empty() {
+        return None;
+    }
+    let chars = name.chars().count();
+    if chars > MAX_NAME_CHARS {
+        return Some(format!("the program name {name} has {chars} characters: at most {MAX_NAME_CHARS}"));
+    }
+    if !name.chars().take(2).all(|c| c.is_ascii_alphabetic()) {
+        return Some(format!("the program name {name} must start with two letters"));
+    }
+    if let Some(bad) = name.chars().find(|c| !(c.is_ascii_alphanumeric() || *c == '_')) {
+        return Some(format!("the program name {name} holds `{bad}`: only letters, digits and `_` may follow"));
+    }
+    None
+}
+
+/// Whether a statement declares rather than acts.
+fn declares(kind: &StatementKind) -> bool {
+    matches!(
+        kind,
+        StatementKind::Def(_) | StatementKind::Proc(_) | StatementKind::Extern(_) | StatementKind::Define { .. }
+    )
+}
+
+/// Rules 43, 44 and 47.
+fn declarations(file: &FileModel, out: &mut Vec<Diagnostic>) {
+    let mut first_statement = true;
+    let mut acted: Option<(usize, TextRange)> = None;
+    let save = file.model.header().is_some_and(|proc| proc.declaration.attributes.iter().any(|a| a == "SAVE"));
+    for (index, block) in file.blocks().enumerate() {
+        for statement in &block.statements {
+            let range = file.in_file(index, statement.range);
+            match &statement.kind {
+                StatementKind::Proc(_) if !first_statement => {
+                    let message = "PROC must be the program's first statement: the control reads the PROC line before anything else";
+                    out.push(Diagnostic::new(&PROC_NOT_FIRST, range, message));
+                }
+                StatementKind::Def(_) | StatementKind::Extern(_) => {
+                    if let Some((_, first)) = acted {
+                        let keyword = if matches!(statement.kind, StatementKind::Def(_)) { "DEF" } else { "EXTERN" };
+                        let message = format!(
+                            "{keyword} after a statement that declares nothing: definitions come first in a program"
+                        );
+                        out.push(Diagnostic::new(&DEFINITION_AFTER_STATEMENT, range, message).with_related(
+                            None,
+                            first,
+                            "the first statement",
+                        ));
+                    }
+                }
+                StatementKind::Return { .. } if save => {
+                    let message = "RET in a subprogram with SAVE: RET keeps the continuous-path mode across the return while SAVE restores the caller's modal G functions, and the two cannot be combined; end the subprogram with M17";
+                    out.push(Diagnostic::new(&RET_WITH_SAVE, range, message));
+                }
+                _ => {}
+            }
+            if acted.is_none() && !declares(&statement.kind) {
+                acted = Some((index, range));
+            }
+            first_statement = false;
+        }
+    }
+}
+
+fn structure_name(kind: StructureKind) -> (&'static str, &'static str) {
+    match kind {
+        StructureKind::If => ("IF", "ENDIF"),
+        StructureKind::While => ("WHILE", "ENDWHILE"),
+        StructureKind::For => ("FOR", "ENDFOR"),
+        StructureKind::Repeat => ("REPEAT", "UNTIL"),
+        StructureKind::Loop => ("LOOP", "ENDLOOP"),
+    }
+}
+
+/// The range of the statement of block `index` that opens, continues or
+/// closes a structure, else the block's.
+fn structure_range(file: &FileModel, index: usize) -> TextRange {
+    let statement = file.block(index).statements.iter().find(|s| {
+        matches!(
+            s.kind,
+            StatementKind::If { jump: None, .. }
+                | StatementKind::Else
+                | StatementKind::EndIf
+                | StatementKind::While(_)
+                | StatementKind::EndWhile
+                | StatementKind::For { .. }
+                | StatementKind::EndFor
+                | StatementKind::Repeat
+                | StatementKind::Until(_)
+                | StatementKind::Loop
+                | StatementKind::EndLoop
+        )
+    });
+    file.in_file(index, statement.map_or_else(TextRange::default, |s| s.range))
+}
+
+/// Rule 42 and the balance of the structures.
+fn structures(file: &FileModel, out: &mut Vec<Diagnostic>) {
+    if let Some(deep) = file.model.structures.iter().filter(|s| s.depth > MAX_DEPTH).min_by_key(|s| s.start) {
+        let message = format!(
+            "{} is nested {} levels deep: the control allows {MAX_DEPTH}",
+            structure_name(deep.kind).0,
+            deep.depth
+        );
+        out.push(Diagnostic::new(&NESTING_TOO_DEEP, structure_range(file, deep.start), message));
+    }
+    for unmatched in &file.model.unmatched {
+        let (start, end) = structure_name(unmatched.kind);
+        let message = match unmatched.problem {
+            Unbalanced::NotClosed => format!("{start} without its {end}"),
+            Unbalanced::NotOpened => format!("{end} without its {start}"),
+            Unbalanced::StrayElse => "ELSE outside an IF, or a second ELSE of one IF".to_owned(),
+        };
+        out.push(Diagnostic::new(&UNBALANCED_STRUCTURE, structure_range(file, unmatched.block), message));
+    }
+}
+
+fn target_text(jump: &Jump) -> String {
+    match &jump.target {
+        Some(JumpTarget::Label(label)) => label.clone(),
+        Some(JumpTarget::BlockNumber(Some(number))) => format!("N{number}"),
+        _ => String::new(),
+    }
+}
+
+/// Rules 59 and 60 and the direction of jumps.
+fn jumps(file: &FileModel, out: &mut Vec<Diagnostic>) {
+    let enclosing = Enclosing::new(file);
+    for site in &file.model.jumps {
+        let range = file.in_file(site.block, site.jump.range);
+        match site.resolved {
+            Resolved::NotFound { alarm: true } => not_found(file, site.block, &site.jump, range, out),
+            Resolved::Block(target) => {
+                if let Some(structure) = enclosing.entered(target, site.block) {
+                    let (start, _) = structure_name(structure.kind);
+                    let message = format!(
+                        "the jump to {} enters a {start} from outside it: the control has not set the structure up, so its end is reached without its start",
+                        target_text(&site.jump)
+                    );
+                    out.push(Diagnostic::new(&JUMP_INTO_STRUCTURE, range, message).with_related(
+                        None,
+                        structure_range(file, structure.start),
+                        format!("the {start}"),
+                    ));
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+/// A jump whose target is not in the direction it searches: in the other
+/// direction it is the wrong keyword, else the target is missing.
+fn not_found(file: &FileModel, block: usize, jump: &Jump, range: TextRange, out: &mut Vec<Diagnostic>) {
+    let target = target_text(jump);
+    // The keyword written, where it searches, and the one that would find
+    // the target.
+    let turned = match jump.kind {
+        JumpKind::GotoF => Some(("GOTOF", "forward", JumpKind::GotoB, "GOTOB", "behind")),
+        JumpKind::GotoB => Some(("GOTOB", "backward", JumpKind::GotoF, "GOTOF", "ahead of")),
+        _ => None,
+    };
+    if let Some((written, searches, kind, keyword, place)) = turned
+        && let Resolved::Block(found) = file.model.resolve(block, &Jump { kind, ..jump.clone() })
+    {
+        let message = format!("{written} searches {searches} only, and {target} is {place} the jump: write {keyword}");
+        let keyword_range = TextRange::at(range.start(), TextSize::of(written));
+        let diagnostic = Diagnostic::new(&JUMP_WRONG_DIRECTION, range, message)
+            .with_related(None, file.in_file(found, TextRange::default()), target.clone())
+            .with_fix(format!("Write {keyword}"), vec![TextEdit::replace(keyword_range, keyword)]);
+        out.push(diagnostic);
+        return;
+    }
+    let message = format!("the program has no {target} to jump to: the control stops with an alarm here");
+    out.push(Diagnostic::new(&JUMP_TARGET_NOT_FOUND, range, message));
+}
+
+/// The innermost structure whose body holds each block, and each
+/// structure's enclosing one: the structures nest, so a block's are a
+/// chain.
+struct Enclosing<'a> {
+    structures: Vec<&'a Structure>,
+    /// By block: the index in `structures` of the innermost one.
+    innermost: Vec<Option<usize>>,
+    parent: Vec<Option<usize>>,
+}
+
+impl<'a> Enclosing<'a> {
+    fn new(file: &'a FileModel) -> Enclosing<'a> {
+        let mut structures: Vec<&Structure> = file.model.structures.iter().collect();
+        structures.sort_by_key(|s| s.depth);
+        let mut innermost = vec![None; file.ranges.len()];
+        let mut parent = vec![None; structures.len()];
+        for (index, structure) in structures.iter().enumerate() {
+            parent[index] = innermost[structure.start];
+            for slot in &mut innermost[structure.start + 1..structure.end] {
+                *slot = Some(index);
+            }
+        }
+        Enclosing { structures, innermost, parent }
+    }
+
+    /// The outermost structure whose body holds `target` and not `from`.
+    fn entered(&self, target: usize, from: usize) -> Option<&'a Structure> {
+        let mut entered = None;
+        let mut at = self.innermost[target];
+        while let Some(index) = at {
+            let structure = self.structures[index];
+            if (structure.start..=structure.end).contains(&from) {
+                break;
+            }
+            entered = Some(structure);
+            at = self.parent[index];
+        }
+        entered
+    }
+}
+
+/// Rules 68 and 69: the switches still on at the last block that ends
+/// the program.
+fn modes_at_end(catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnostic>) {
+    let mut transformation: Option<(String, TextRange)> = None;
+    let groups: Vec<Option<&str>> =
+        MODES_OFF_AT_END.iter().map(|word| catalogue.word_code(word).and_then(|c| c.group.as_deref())).collect();
+    let mut modes: Vec<Option<TextRange>> = vec![None; MODES_OFF_AT_END.len()];
+    let mut at_end = None;
+    for (index, block) in file.blocks().enumerate() {
+        for statement in &block.statements {
+            let StatementKind::Command(command) = &statement.kind else { continue };
+            let range = file.in_file(index, statement.range);
+            if catalogue.keyword(&command.name).is_some_and(|k| k.kind == KeywordKind::Transformation) {
+                transformation = (command.name != TRANSFORMATION_OFF).then(|| (command.name.clone(), range));
+            }
+            let Some(code) = catalogue.word_code(&command.name) else { continue };
+            for (slot, (word, group)) in modes.iter_mut().zip(MODES_OFF_AT_END.iter().zip(&groups)) {
+                if code.group.as_deref().is_some_and(|g| Some(g) == *group) {
+                    *slot = (code.code == *word).then_some(range);
+                }
+            }
+        }
+        if block.program_end().is_some() {
+            let end = file.in_file(index, block.statements.last().map_or_else(TextRange::default, |s| s.range));
+            at_end = Some((end, transformation.clone(), modes.clone()));
+        }
+    }
+    let Some((end, transformation, modes)) = at_end else { return };
+    if let Some((name, on)) = transformation {
+        let message = format!("the program ends with {name} still on: write {TRANSFORMATION_OFF} before the end");
+        out.push(Diagnostic::new(&TRANSFORMATION_AT_END, end, message).with_related(None, on, name));
+    }
+    for (word, on) in MODES_OFF_AT_END.iter().zip(modes) {
+        if let Some(on) = on {
+            let message = format!("the program ends with {word} still on");
+            out.push(Diagnostic::new(&MODE_AT_END, end, message).with_related(None, on, word.to_string()));
+        }
+    }
+}
+
+/// The path axes rules 76 and 77 follow.
+const PATH_AXES: [&str; 3] = ["X", "Y", "Z"];
+
+/// The motion state rules 76 and 77 follow in file order.
+struct Motion<'a> {
+    catalogue: &'a Catalogue,
+    /// The code in force of the motion group (G1, BSPLINE, …).
+    motion: &'a str,
+    incremental: bool,
+    compressor: bool,
+    position: [Option<f64>; 3],
+    /// The BSPLINE whose first point is still to come.
+    spline_start: Option<TextRange>,
+    /// The short G1 moves in a row, and where the run starts.
+    run: usize,
+    run_start: Option<TextRange>,
+}
+
+impl Motion<'_> {
+    fn check(catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnostic>) {
+        let mut motion = Motion {
+            catalogue,
+            motion: "",
+            incremental: false,
+            compressor: false,
+            position: [None; 3],
+            spline_start: None,
+            run: 0,
+            run_start: None,
+        };
+        let motion_group = catalogue.word_code(SPLINE).and_then(|c| c.group.clone());
+        let compressor_group = catalogue.word_code(COMPRESSOR).and_then(|c| c.group.clone());
+        for (index, block) in file.blocks().enumerate() {
+            motion.codes(file, index, block, motion_group.as_deref(), compressor_group.as_deref());
+            motion.moves(file, index, block, out);
+        }
+    }
+
+    fn codes(
+        &mut self,
+        file: &FileModel,
+        index: usize,
+        block: &SinumerikBlock,
+        motion_group: Option<&str>,
+        compressor_group: Option<&str>,
+    ) {
+        for statement in &block.statements {
+            let code = match &statement.kind {
+                StatementKind::Word(word) if word.address == "G" => {
+                    let Some(number) = word.value.as_ref().and_then(number).and_then(|n| n.whole()) else { continue };
+                    u32::try_from(number).ok().and_then(|number| self.catalogue.code('G', number))
+                }
+                StatementKind::Command(command) => self.catalogue.word_code(&command.name),
+                _ => None,
+            };
+            let Some(code) = code else { continue };
+            let group = code.group.as_deref();
+            if group.is_some() && group == motion_group {
+                if code.code == SPLINE && self.motion != SPLINE {
+                    self.spline_start = Some(file.in_file(index, statement.range));
+                }
+                self.motion = &code.code;
+            } else if group.is_some() && group == compressor_group {
+                self.compressor = code.index != Some(1);
+            } else if code.code == "G90" || code.code == "G91" {
+                self.incremental = code.code == "G91";
+            }
+        }
+    }
+
+    fn moves(&mut self, file: &FileModel, index: usize, block: &SinumerikBlock, out: &mut Vec<Diagnostic>) {
+        let mut next = self.position;
+        let mut first_word: Option<&Word> = None;
+        for word in block.words() {
+            let Some(axis) = PATH_AXES.iter().position(|a| *a == word.address) else { continue };
+            first_word.get_or_insert(word);
+            let incremental = match &word.value {
+                Some(WordValue::Expr { dimension: Some(dimension), .. }) => *dimension == Dimension::Incremental,
+                _ => self.incremental,
+            };
+            next[axis] = match word.value.as_ref().and_then(number) {
+                Some(number) if incremental => self.position[axis].map(|p| p + number.value()),
+                Some(number) => Some(number.value()),
+                None => None,
+            };
+        }
+        let Some(word) = first_word else { return };
+        let range = file.in_file(index, word.range);
+        if let Some(spline) = self.spline_start.take() {
+            let differs = (0..3).any(|axis| match (self.position[axis], next[axis]) {
+                (Some(from), Some(to)) => (from - to).abs() > SAME_POINT_MM,
+                _ => false,
+            });
+            if differs && self.motion == SPLINE {
+                let message = "the spline's first point is not where the tool stands: the thesis's programs repeat the current position as the first point, so the spline starts there";
+                out.push(Diagnostic::new(&SPLINE_FIRST_POINT, range, message).with_related(None, spline, SPLINE));
+            }
+        }
+        let length = (0..3).try_fold(0.0, |sum, axis| match (self.position[axis], next[axis]) {
+            (Some(from), Some(to)) => Some(sum + (to - from) * (to - from)),
+            _ => None,
+        });
+        let short = self.motion == "G1" && !self.compressor && length.is_some_and(|l| l.sqrt() < SHORT_MOVE_MM);
+        if short {
+            self.run += 1;
+            let start = *self.run_start.get_or_insert(range);
+            if self.run == LONG_RUN {
+                let message = format!(
+                    "{LONG_RUN} G1 moves in a row shorter than {SHORT_MOVE_MM} mm without a compressor or spline: the axes' velocities step at every block; COMPCAD or a spline smooths the path"
+                );
+                out.push(Diagnostic::new(&SHORT_MOVE_RUN, start, message));
+            }
+        } else {
+            self.run = 0;
+            self.run_start = None;
+        }
+        self.position = next;
+    }
+}
