@@ -215,7 +215,7 @@ pub fn random_line(len: usize, seed: u64) -> String {
 }
 
 /// The offset of a random character of the first G word at or after a
-/// random line within ten lines of `offset`.
+/// random line within ten lines of `offset` (generated comments hold none).
 pub fn g_code_near(text: &str, offset: usize, rng: &mut Lcg) -> Option<usize> {
     let mut start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
     let (up, down) = match rng.below(21) {
@@ -230,14 +230,12 @@ pub fn g_code_near(text: &str, offset: usize, rng: &mut Lcg) -> Option<usize> {
     }
     let mut line_start = start;
     for line in text[start..].split_inclusive('\n') {
-        if line.starts_with('N') {
-            let mut word_start = line_start;
-            for word in line.trim_end().split(' ') {
-                if word.len() > 1 && word.starts_with('G') && word.as_bytes()[1].is_ascii_digit() {
-                    return Some(word_start + rng.below(word.len()));
-                }
-                word_start += word.len() + 1;
+        let mut word_start = line_start;
+        for word in line.trim_end().split(' ') {
+            if word.len() > 1 && word.starts_with('G') && word.as_bytes()[1].is_ascii_digit() {
+                return Some(word_start + rng.below(word.len()));
             }
+            word_start += word.len() + 1;
         }
         line_start += line.len();
     }
