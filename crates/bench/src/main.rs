@@ -504,6 +504,9 @@ fn check_benchmark(dialect: Dialect, blocks: usize) -> anyhow::Result<()> {
 const EDIT_GOAL: Duration = Duration::from_millis(16);
 const HOVER_GOAL: Duration = Duration::from_millis(2);
 const CYCLE_TIME_GOAL: Duration = Duration::from_millis(50);
+/// Edits without a new time, and none with one, after which the cycle-time
+/// latency is given up.
+const UNFOLLOWED_EDITS: usize = 10;
 /// The pause after the edits, and the hovers at random places after it.
 const IDLE: Duration = Duration::from_secs(3);
 const IDLE_HOVERS: usize = 100;
@@ -712,7 +715,7 @@ fn lsp_benchmark(server: &Path, dialect: Dialect, blocks: usize, edits: usize, a
             "edit_to_diagnostics": diagnostics.json(),
             "hover": hovers.json(),
             "hover_after_pause": idle_hovers.json(),
-            "edit_to_cycle_time_hint": cycle_times.as_ref().map(|(times, _)| times.json()),
+            "edit_to_cycle_time_hint": cycle_times.as_ref().filter(|(times, _)| !times.samples.is_empty()).map(|(times, _)| times.json()),
             "edits_without_a_new_time": cycle_times.as_ref().map(|(_, unchanged)| unchanged),
             "thread_wake_up": machine.json(),
             "cpu_time_stolen": stolen,
@@ -728,6 +731,9 @@ fn lsp_benchmark(server: &Path, dialect: Dialect, blocks: usize, edits: usize, a
         hovers.print();
         idle_hovers.print();
         match &cycle_times {
+            Some((times, _)) if times.samples.is_empty() => {
+                println!("  edit → cycle-time hint none of the first {UNFOLLOWED_EDITS} coordinate edits changed its line's time");
+            }
             Some((times, unchanged)) => {
                 times.print();
                 if *unchanged > 0 {
@@ -758,7 +764,8 @@ fn lsp_benchmark(server: &Path, dialect: Dialect, blocks: usize, edits: usize, a
 /// refresh the hints when an estimate is ready; each refresh is answered
 /// by asking for the hints of the edited line. An edit whose line shows
 /// the same time (or none) a second after the last refresh is counted
-/// apart, not timed.
+/// apart, not timed. When the first edits all leave their time as it was,
+/// the hints do not follow edits, and the rest are not waited for.
 fn cycle_time_latencies(
     client: &mut Client,
     doc: &mut Document,
@@ -768,6 +775,9 @@ fn cycle_time_latencies(
     let mut latencies = Latencies::new("edit → cycle-time hint", CYCLE_TIME_GOAL, edits);
     let mut unchanged = 0;
     for _ in 0..edits {
+        if latencies.samples.is_empty() && unchanged == UNFOLLOWED_EDITS {
+            break;
+        }
         let at = coordinate_digits(doc.text(), rng).context("no coordinate to edit")?;
         let line = doc.text()[..at].rfind('\n').map_or(0, |i| i + 1);
         let line_end = doc.text()[at..].find('\n').map_or(doc.text().len(), |i| at + i);
@@ -802,7 +812,6 @@ fn cycle_time_latencies(
             wait = Duration::from_secs(1);
         }
     }
-    anyhow::ensure!(!latencies.samples.is_empty(), "no edit changed a block's time hint");
     Ok((latencies, unchanged))
 }
 

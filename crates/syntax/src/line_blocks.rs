@@ -73,7 +73,9 @@ fn parse_blocks<'a, P: LineParser<'a>>(
     for block in replaced {
         parser.green.share_words_of(block);
     }
-    let mut blocks = Vec::new();
+    // A block a line: sized once, a part's list is not copied as it grows.
+    let lines = memchr::memchr_iter(b'\n', &text.as_bytes()[region.clone()]).count() + 1;
+    let mut blocks = Vec::with_capacity(lines);
     while parser.pos < region.end {
         blocks.push(NodeOrToken::Node(parser.block()));
     }
