@@ -732,7 +732,9 @@ fn lsp_benchmark(server: &Path, dialect: Dialect, blocks: usize, edits: usize, a
         idle_hovers.print();
         match &cycle_times {
             Some((times, _)) if times.samples.is_empty() => {
-                println!("  edit → cycle-time hint none of the first {UNFOLLOWED_EDITS} coordinate edits changed its line's time");
+                println!(
+                    "  edit → cycle-time hint none of the first {UNFOLLOWED_EDITS} coordinate edits changed its line's time"
+                );
             }
             Some((times, unchanged)) => {
                 times.print();
@@ -740,7 +742,9 @@ fn lsp_benchmark(server: &Path, dialect: Dialect, blocks: usize, edits: usize, a
                     println!("  {unchanged} of {edits} coordinate edits left their line's time as it was");
                 }
             }
-            None => println!("  edit → cycle-time hint not measured: ncc does not run {} programs yet", dialect.title()),
+            None => {
+                println!("  edit → cycle-time hint not measured: ncc does not run {} programs yet", dialect.title())
+            }
         }
         machine.print();
         if let Some(stolen) = stolen {

@@ -141,7 +141,7 @@ impl<'a, L: Lexer> LineCursor<'a, L> {
                 }
             }
         }
-        self.green.token(token.kind, text)
+        self.green.shared_token(token.kind, text)
     }
 
     /// An empty list for a block's children, with the capacity the last
