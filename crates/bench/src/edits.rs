@@ -2,22 +2,8 @@
 
 use std::ops::Range;
 
-/// A fixed linear congruential sequence: the same numbers on every run and
-/// every platform, so benchmarks and tests repeat exactly.
-#[derive(Debug, Clone)]
-pub struct Lcg(u64);
-
-impl Lcg {
-    pub fn new(seed: u64) -> Lcg {
-        Lcg(seed)
-    }
-
-    /// A number in `0..bound`; `bound` must not be 0.
-    pub fn below(&mut self, bound: usize) -> usize {
-        self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-        (self.0 >> 33) as usize % bound
-    }
-}
+use crate::cnc8x6::progen::is_motion_block;
+pub use crate::lcg::Lcg;
 
 /// Replace the bytes of `range` with `insert`.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -30,15 +16,6 @@ pub struct Edit {
 /// N, F, S) keep theirs, so that the program keeps its meaning and stays
 /// roughly valid: a digit more or less in a coordinate moves one point.
 const COORDINATES: &[u8] = b"XYZIJK";
-
-/// The motion codes of generated programs, in every dialect's spelling.
-const MOTIONS: [&str; 8] = ["G0", "G00", "G1", "G01", "G2", "G02", "G3", "G03"];
-
-/// Whether `line` is a motion block: one of its words is a motion code.
-/// Block numbers do not tell (Haas programs have none).
-pub fn is_motion_block(line: &str) -> bool {
-    line.split(' ').any(|word| MOTIONS.contains(&word))
-}
 
 /// A single-character edit in a random motion block of a generated program
 /// of any dialect: a digit typed into a coordinate (40%), a digit deleted

@@ -8,6 +8,7 @@
 
 pub mod cnc8x6;
 pub mod edits;
+mod lcg;
 pub mod lsp_client;
 pub mod rs274;
 pub mod sinumerik;

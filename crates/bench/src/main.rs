@@ -377,7 +377,7 @@ fn parse_benchmark(dialect: Dialect, blocks: usize, runs: usize) -> anyhow::Resu
         ncc_one.peak_bytes as f64 / gcode_rs.peak_bytes as f64,
         ncc_all.peak_bytes as f64 / gcode_rs.peak_bytes as f64
     );
-    if dialect != Dialect::Cnc8x6 {
+    if dialect != progen::REFERENCE {
         print_ratios_to_cnc8x6(dialect, blocks, runs)?;
     }
     Ok(())
@@ -391,7 +391,8 @@ const PER_BYTE_GOAL: f64 = 1.3;
 fn other_programs(dialect: Dialect, blocks: usize) -> Vec<(&'static str, String)> {
     match dialect {
         Dialect::Sinumerik => vec![("parametric program", sinumerik::parametric(blocks))],
-        Dialect::Cnc8x6 | Dialect::HaasLathe => Vec::new(),
+        Dialect::Cnc8x6 => Vec::new(),
+        Dialect::HaasLathe => Vec::new(),
     }
 }
 
@@ -407,7 +408,7 @@ fn print_ratios_to_cnc8x6(dialect: Dialect, blocks: usize, runs: usize) -> anyho
         [one, all].map(|m| text.len() as f64 / m.best.as_secs_f64())
     };
     let sample = 10_000;
-    let cnc_block_len = program_text(Dialect::Cnc8x6, &progen::surfacing(sample)).len() as f64 / sample as f64;
+    let cnc_block_len = program_text(progen::REFERENCE, &progen::surfacing(sample)).len() as f64 / sample as f64;
     println!(
         "  {} per byte against CNC8x6 CAM output of the same size (1.00x as fast, goal >= {:.2}x on 1 thread):",
         dialect.title(),
@@ -417,8 +418,8 @@ fn print_ratios_to_cnc8x6(dialect: Dialect, blocks: usize, runs: usize) -> anyho
     programs.extend(other_programs(dialect, blocks));
     for (name, text) in programs {
         anyhow::ensure!(Parse::new(&text, dialect).errors().is_empty(), "ncc found errors in the {name}");
-        let cnc = program_text(Dialect::Cnc8x6, &progen::surfacing((text.len() as f64 / cnc_block_len) as usize));
-        let [cnc_one, cnc_all] = bytes_per_s(&cnc, Dialect::Cnc8x6);
+        let cnc = program_text(progen::REFERENCE, &progen::surfacing((text.len() as f64 / cnc_block_len) as usize));
+        let [cnc_one, cnc_all] = bytes_per_s(&cnc, progen::REFERENCE);
         let [one, all] = bytes_per_s(&text, dialect);
         println!(
             "    {name:<20} {:>6.1} MB  {:.2}x (1 thread), {:.2}x ({threads} threads)",
@@ -853,7 +854,7 @@ fn coordinate_digits(text: &str, rng: &mut Lcg) -> Option<usize> {
         let line = &text[start..end];
         let next = text.get(end + 1..).and_then(|rest| rest.lines().next()).unwrap_or_default();
         let arc = |line: &str| line.split(' ').any(|word| word.starts_with(['I', 'J', 'K']));
-        if !line.split(' ').any(|word| word == "G1") || arc(next) {
+        if !progen::is_linear_move(line) || arc(next) {
             continue;
         }
         let mut word_start = start;

@@ -9,7 +9,7 @@
 
 use std::fmt::Write;
 
-use crate::edits::Lcg;
+use crate::lcg::Lcg;
 
 /// The syntax to write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -199,6 +199,25 @@ pub fn write(moves: &[Move], syntax: Syntax) -> String {
         out.push_str("*\n");
     }
     out
+}
+
+/// The dialect whose CAM output other dialects' parse throughput is
+/// compared with.
+pub const REFERENCE: ncc_syntax::Dialect = ncc_syntax::Dialect::Cnc8x6;
+
+/// The motion codes of generated programs, in every syntax's spelling.
+const MOTIONS: [&str; 8] = ["G0", "G00", "G1", "G01", "G2", "G02", "G3", "G03"];
+
+/// Whether `line` of a generated program is a motion block: one of its
+/// words is a motion code. Block numbers do not tell (Haas programs have
+/// none).
+pub fn is_motion_block(line: &str) -> bool {
+    line.split(' ').any(|word| MOTIONS.contains(&word))
+}
+
+/// Whether `line` of a generated program is a straight move at feed.
+pub fn is_linear_move(line: &str) -> bool {
+    line.split(' ').any(|word| word == "G1")
 }
 
 /// Counts the blocks of a generated program (comment lines excluded).
