@@ -2,22 +2,8 @@
 
 use std::ops::Range;
 
-/// A fixed linear congruential sequence: the same numbers on every run and
-/// every platform, so benchmarks and tests repeat exactly.
-#[derive(Debug, Clone)]
-pub struct Lcg(u64);
-
-impl Lcg {
-    pub fn new(seed: u64) -> Lcg {
-        Lcg(seed)
-    }
-
-    /// A number in `0..bound`; `bound` must not be 0.
-    pub fn below(&mut self, bound: usize) -> usize {
-        self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-        (self.0 >> 33) as usize % bound
-    }
-}
+use crate::cnc8x6::progen::is_motion_block;
+pub use crate::lcg::Lcg;
 
 /// Replace the bytes of `range` with `insert`.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -29,12 +15,12 @@ pub struct Edit {
 /// Coordinate words, whose digits are typed and deleted. Other words (G, M,
 /// N, F, S) keep theirs, so that the program keeps its meaning and stays
 /// roughly valid: a digit more or less in a coordinate moves one point.
-const COORDINATES: &[u8] = b"XYZIJ";
+const COORDINATES: &[u8] = b"XYZIJK";
 
-/// A single-character edit in a random block of a CNC8x6 program: a digit
-/// typed into a coordinate (40%), a digit deleted from a coordinate that
-/// has more than one (30%), or a space typed between two words (30%).
-/// `None` if no block of `text` offers such a place.
+/// A single-character edit in a random motion block of a generated program
+/// of any dialect: a digit typed into a coordinate (40%), a digit deleted
+/// from a coordinate that has more than one (30%), or a space typed between
+/// two words (30%). `None` if no block of `text` offers such a place.
 pub fn typing_edit(text: &str, rng: &mut Lcg) -> Option<Edit> {
     // Nearly every line of a generated program qualifies; a text with no
     // block line gives up after a bounded number of tries.
@@ -46,19 +32,17 @@ pub fn typing_edit(text: &str, rng: &mut Lcg) -> Option<Edit> {
         let start = text[..at].rfind('\n').map_or(0, |i| i + 1);
         let end = text[start..].find('\n').map_or(text.len(), |i| start + i);
         let line = &text[start..end];
-        // A block line: `N<number> ` and its words.
-        if !line.starts_with('N') {
+        if !is_motion_block(line) {
             continue;
         }
-        let Some(words_start) = line.find(' ') else { continue };
         let kind = rng.below(10);
         let mut places = Vec::new();
-        let mut word_start = words_start;
-        for word in line[words_start..].split(' ') {
+        let mut word_start = 0;
+        for word in line.split(' ') {
             let coordinate = word.as_bytes().first().is_some_and(|b| COORDINATES.contains(b));
             let digits = word.bytes().filter(u8::is_ascii_digit).count();
             if kind >= 7 {
-                if !word.is_empty() && word_start > words_start {
+                if !word.is_empty() && word_start > 0 {
                     places.push(word_start);
                 }
             } else if coordinate && (kind < 4 || digits > 1) {
@@ -86,14 +70,21 @@ mod tests {
 
     #[test]
     fn edits_touch_only_coordinates_and_spaces_between_words() {
-        let mut text = progen::write(&progen::surfacing(2000), Syntax::Cnc8x6);
+        for syntax in [Syntax::Cnc8x6, Syntax::HaasLathe, Syntax::Sinumerik] {
+            edits_touch_only_coordinates_and_spaces(progen::write(&progen::surfacing(2000), syntax));
+        }
+    }
+
+    fn edits_touch_only_coordinates_and_spaces(mut text: String) {
         let mut rng = Lcg::new(7);
         let (mut typed, mut deleted, mut spaces) = (0, 0, 0);
         for _ in 0..300 {
             let edit = typing_edit(&text, &mut rng).unwrap();
             let line_start = text[..edit.range.start].rfind('\n').unwrap() + 1;
+            let line_end = text[line_start..].find('\n').unwrap() + line_start;
+            assert!(is_motion_block(&text[line_start..line_end]), "{:?}", &text[line_start..line_end]);
             let before = &text[line_start..edit.range.start];
-            assert!(before.starts_with('N') && before.contains(' '), "{before:?}");
+            assert!(before.contains(' '), "{before:?}");
             match (edit.range.len(), edit.insert.as_str()) {
                 (0, " ") => {
                     spaces += 1;
@@ -121,6 +112,7 @@ mod tests {
     #[test]
     fn text_without_blocks_gives_no_edit() {
         assert_eq!(typing_edit("%1\n\"COMMENT\"\n*\n", &mut Lcg::new(1)), None);
+        assert_eq!(typing_edit("O1 (G1 X1)\nN1 M30\n", &mut Lcg::new(1)), None);
         assert_eq!(typing_edit("", &mut Lcg::new(1)), None);
     }
 }

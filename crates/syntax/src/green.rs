@@ -42,6 +42,11 @@ pub(crate) struct GreenFactory<'a> {
     short_words: FxHashMap<u64, GreenNode>,
     /// Keyed by the text parsed, or by a copy for a word of another tree.
     long_words: FxHashMap<Cow<'a, str>, GreenNode>,
+    /// Other tokens of up to eight bytes by kind, length (any byte, zero
+    /// too, may be in them) and packed bytes: the names, numbers and
+    /// operators of expressions recur all over a program, and a shared
+    /// token saves an allocation each time.
+    short_tokens: FxHashMap<(rowan::SyntaxKind, usize, u64), GreenToken>,
 }
 
 impl<'a> GreenFactory<'a> {
@@ -63,13 +68,33 @@ impl<'a> GreenFactory<'a> {
             star: new(STAR, "*"),
             short_words: FxHashMap::default(),
             long_words: FxHashMap::default(),
+            short_tokens: FxHashMap::default(),
         }
     }
 
     /// A green token for `text`, shared when its text is one of the fixed ones.
     pub(crate) fn token(&self, kind: SyntaxKind, text: &str) -> GreenElement {
+        self.fixed_token(kind, text).unwrap_or_else(|| NodeOrToken::Token(GreenToken::new(kind.into(), text)))
+    }
+
+    /// Like [`Self::token`], but a token of up to eight bytes is shared with
+    /// every other of its kind and text.
+    pub(crate) fn shared_token(&mut self, kind: SyntaxKind, text: &str) -> GreenElement {
+        if let Some(fixed) = self.fixed_token(kind, text) {
+            return fixed;
+        }
+        let Some(key) = short_key(text) else { return NodeOrToken::Token(GreenToken::new(kind.into(), text)) };
+        let shared = self
+            .short_tokens
+            .entry((kind.into(), text.len(), key))
+            .or_insert_with(|| GreenToken::new(kind.into(), text));
+        NodeOrToken::Token(shared.clone())
+    }
+
+    /// The shared token of `kind` and `text` when its text is a fixed one.
+    fn fixed_token(&self, kind: SyntaxKind, text: &str) -> Option<GreenElement> {
         let shared = match (kind, text.as_bytes()) {
-            (LETTER, [letter]) => return self.letter(*letter),
+            (LETTER, [letter]) => return Some(self.letter(*letter)),
             (WHITESPACE, b" ") => &self.space,
             (NEWLINE, b"\n") => &self.lf,
             (NEWLINE, b"\r\n") => &self.crlf,
@@ -80,9 +105,9 @@ impl<'a> GreenFactory<'a> {
             (SLASH, _) => &self.slash,
             (PERCENT, _) => &self.percent,
             (STAR, _) => &self.star,
-            _ => return NodeOrToken::Token(GreenToken::new(kind.into(), text)),
+            _ => return None,
         };
-        NodeOrToken::Token(shared.clone())
+        Some(NodeOrToken::Token(shared.clone()))
     }
 
     pub(crate) fn space(&self) -> GreenElement {
@@ -188,4 +213,23 @@ fn simple_word_text(word: &GreenNodeData) -> Option<String> {
         && next.kind() == NUMBER.into()
         && tokens.next().is_none();
     simple.then(|| [Some(letter), sign, Some(next)].into_iter().flatten().map(|token| token.text()).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shared_tokens_are_those_of_their_kind_and_text() {
+        let mut green = GreenFactory::new();
+        let text = |element: GreenElement| element.into_token().unwrap().text().to_owned();
+        let address = |element: &GreenElement| std::ptr::from_ref::<rowan::GreenTokenData>(element.as_token().unwrap());
+        let first = green.shared_token(IDENT, "DEPTH");
+        assert_eq!(address(&first), address(&green.shared_token(IDENT, "DEPTH")));
+        assert_ne!(first, green.shared_token(NUMBER, "DEPTH"));
+        // Zero bytes pad the key: the length tells `A` from `A\0`.
+        assert_eq!(text(green.shared_token(ERROR_TOKEN, "A\0")), "A\0");
+        assert_eq!(text(green.shared_token(ERROR_TOKEN, "A")), "A");
+        assert_eq!(text(green.shared_token(STRING, "\"LONGER TEXT\"")), "\"LONGER TEXT\"");
+    }
 }

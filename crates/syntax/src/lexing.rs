@@ -80,7 +80,7 @@ pub(crate) fn bounded_token(
     pos: usize,
     read_end: usize,
     region_end: usize,
-    lex: fn(&str, usize) -> Token,
+    lex: impl Fn(&str, usize) -> Token,
 ) -> Option<Token> {
     if pos >= region_end {
         return None;

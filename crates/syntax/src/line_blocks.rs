@@ -24,6 +24,7 @@ use crate::{
     error::{Errors, sort_errors},
     green::GreenElement,
     limit::Omitted,
+    line_cursor::LineParser,
     runs::{RunBuilder, regroup},
 };
 
@@ -31,23 +32,19 @@ use crate::{
 pub(crate) const PARALLEL_THRESHOLD: usize = 1 << 20;
 
 /// The blocks of `body` (which starts at a line start) grouped into runs,
-/// parsed by `parse_blocks` in parts on all cores when the body is at least
+/// parsed by `P` in parts on all cores when the body is at least
 /// `parallel_threshold` long, and their errors.
-pub(crate) fn parse_in_parts<P>(
-    text: &str,
+pub(crate) fn parse_in_parts<'a, P: LineParser<'a>>(
+    text: &'a str,
     body: Range<usize>,
     parallel_threshold: usize,
-    parse_blocks: P,
-) -> (Vec<GreenElement>, Errors)
-where
-    P: Fn(&str, Range<usize>, &[&GreenNodeData]) -> (Vec<GreenElement>, Errors) + Sync,
-{
+) -> (Vec<GreenElement>, Errors) {
     let bounds = if body.len() < parallel_threshold {
         vec![body.start, body.end]
     } else {
         split_at_lines(text, body.clone(), rayon::current_num_threads() * 4)
     };
-    let parse_part = |i: usize| parse_blocks(text, bounds[i]..bounds[i + 1], &[]);
+    let parse_part = |i: usize| parse_blocks::<P>(text, bounds[i]..bounds[i + 1], &[]);
     let parts: Vec<_> = if bounds.len() > 2 {
         use rayon::prelude::*;
         (0..bounds.len() - 1).into_par_iter().map(parse_part).collect()
@@ -63,6 +60,26 @@ where
         errors.append(block_errors);
     }
     (runs.finish(), errors)
+}
+
+/// Parses the blocks (lines) of `region`, which starts at a line start.
+/// `replaced` are blocks of an older tree whose words the new blocks share.
+fn parse_blocks<'a, P: LineParser<'a>>(
+    text: &'a str,
+    region: Range<usize>,
+    replaced: &[&GreenNodeData],
+) -> (Vec<GreenElement>, Errors) {
+    let mut parser = P::new(text, region.start, region.end);
+    for block in replaced {
+        parser.green.share_words_of(block);
+    }
+    // A block a line: sized once, a part's list is not copied as it grows.
+    let lines = memchr::memchr_iter(b'\n', &text.as_bytes()[region.clone()]).count() + 1;
+    let mut blocks = Vec::with_capacity(lines);
+    while parser.pos < region.end {
+        blocks.push(NodeOrToken::Node(parser.block()));
+    }
+    (blocks, parser.take_errors())
 }
 
 /// About `parts` parts of `region`, each starting at a line start.
@@ -83,27 +100,25 @@ fn split_at_lines(text: &str, region: Range<usize>, parts: usize) -> Vec<usize> 
 pub(crate) type Parts = (GreenNode, Vec<SyntaxError>, Vec<Omitted<SyntaxErrorKind>>);
 
 /// What a dialect decides in a reparse.
-pub(crate) struct LineDialect<E, R, P> {
+pub(crate) struct LineDialect<E, R> {
     /// Whether the edit may be applied to the old tree at all (its range
     /// is known to lie in the old text).
     pub(crate) edit_ok: E,
     /// Whether the new text of the reparsed lines may be parsed as blocks.
     pub(crate) region_ok: R,
-    /// Parses the blocks of a region that starts at a line start; the
-    /// slice holds old blocks whose words the new ones may share.
-    pub(crate) parse_blocks: P,
 }
 
-pub(crate) fn reparse_line_blocks<E, R, P>(
+/// The reparse of `old` after `edit`, the blocks parsed by `P`.
+pub(crate) fn reparse_line_blocks<'a, P, E, R>(
     old: (&GreenNode, &[SyntaxError], &[Omitted<SyntaxErrorKind>]),
     edit: &TextEdit,
-    new_text: &str,
-    dialect: LineDialect<E, R, P>,
+    new_text: &'a str,
+    dialect: LineDialect<E, R>,
 ) -> Option<Parts>
 where
+    P: LineParser<'a>,
     E: FnOnce(&SyntaxNode) -> bool,
     R: FnOnce(&SyntaxNode, &str) -> bool,
-    P: FnOnce(&str, Range<usize>, &[&GreenNodeData]) -> (Vec<GreenElement>, Errors),
 {
     let (old_green, old_errors, old_omitted) = old;
     let root = SyntaxNode::new_root(old_green.clone());
@@ -139,7 +154,7 @@ where
     if !(dialect.region_ok)(&root, &new_text[start..new_end]) {
         return None;
     }
-    let (blocks, block_errors) = (dialect.parse_blocks)(new_text, start..new_end, &[first.green(), last.green()]);
+    let (blocks, block_errors) = parse_blocks::<P>(new_text, start..new_end, &[first.green(), last.green()]);
     let stop = (old_region_end < body.end()).then(|| block_at(&root, old_region_end)).flatten();
     let end_index = last_run.index() + 1;
     let green = regroup(&root, &first, blocks, stop.as_ref(), new_text, end_index);

@@ -9,7 +9,7 @@ use std::{
     ops::{DerefMut, Range},
 };
 
-use rowan::NodeOrToken;
+use rowan::{GreenNode, NodeOrToken};
 
 use crate::{
     SyntaxError, SyntaxErrorKind as E,
@@ -34,6 +34,16 @@ pub(crate) trait Lexer {
     fn unclosed(kind: SyntaxKind, text: &str) -> Option<TokenError>;
 }
 
+/// A dialect's parser of line blocks, which the shared drivers of
+/// `line_blocks` run over a region.
+pub(crate) trait LineParser<'a>: DerefMut<Target = LineCursor<'a, Self::Lexer>> {
+    type Lexer: Lexer;
+    /// A parser at `pos`, a line start, that reads up to `region_end`.
+    fn new(text: &'a str, pos: usize, region_end: usize) -> Self;
+    /// The block (the line, with its line break) at the position.
+    fn block(&mut self) -> GreenNode;
+}
+
 pub(crate) struct LineCursor<'a, L> {
     pub(crate) text: &'a str,
     pub(crate) pos: usize,
@@ -44,6 +54,8 @@ pub(crate) struct LineCursor<'a, L> {
     errors: Vec<SyntaxError>,
     limiter: LineLimiter<'a, E>,
     pub(crate) green: GreenFactory<'a>,
+    /// The allocation of the last block's children, which the next reuses.
+    block_children: Vec<GreenElement>,
     lexer: PhantomData<L>,
 }
 
@@ -57,6 +69,7 @@ impl<'a, L: Lexer> LineCursor<'a, L> {
             errors: Vec::new(),
             limiter: LineLimiter::new(text),
             green: GreenFactory::new(),
+            block_children: Vec::new(),
             lexer: PhantomData,
         };
         cursor.move_to(pos, region_end);
@@ -102,8 +115,10 @@ impl<'a, L: Lexer> LineCursor<'a, L> {
         self.report(kind, start..self.pos, message);
     }
 
-    pub(crate) fn into_errors(self) -> Errors {
-        Errors { kept: self.errors, omitted: self.limiter.finish() }
+    /// The errors reported so far; the cursor starts a fresh list.
+    pub(crate) fn take_errors(&mut self) -> Errors {
+        let limiter = std::mem::replace(&mut self.limiter, LineLimiter::new(self.text));
+        Errors { kept: std::mem::take(&mut self.errors), omitted: limiter.finish() }
     }
 
     /// Consumes the next token, reporting the line past its read part and
@@ -126,7 +141,39 @@ impl<'a, L: Lexer> LineCursor<'a, L> {
                 }
             }
         }
-        self.green.token(token.kind, text)
+        self.green.shared_token(token.kind, text)
+    }
+
+    /// An empty list for a block's children, with the capacity the last
+    /// block's had: most blocks need no allocation of their own.
+    pub(crate) fn take_block_children(&mut self) -> Vec<GreenElement> {
+        std::mem::take(&mut self.block_children)
+    }
+
+    /// The `BLOCK` node of `children` (from [`Self::take_block_children`]).
+    pub(crate) fn block_node(&mut self, mut children: Vec<GreenElement>) -> GreenNode {
+        let block = green::node(BLOCK, children.drain(..));
+        self.block_children = children;
+        block
+    }
+
+    /// A lone space or a line feed, the commonest tokens, consumed without
+    /// lexing: the element `bump` gives for them. `None`, reading nothing,
+    /// for anything else.
+    pub(crate) fn plain_trivia(&mut self) -> Option<GreenElement> {
+        let bytes = &self.text.as_bytes()[..self.end];
+        match bytes.get(self.pos)? {
+            b' ' if !matches!(bytes.get(self.pos + 1), Some(b' ' | b'\t')) => {
+                self.pos += 1;
+                Some(self.green.space())
+            }
+            b'\n' => {
+                self.pos += 1;
+                self.end = read_end(self.text, self.pos, self.region_end);
+                Some(self.green.newline())
+            }
+            _ => None,
+        }
     }
 
     /// The common word, served from the word cache: an upper-case letter,

@@ -6,9 +6,14 @@
 //! manual §10, cleaned as §10 and §5.3 describe; [`CLEANED`] records what
 //! was stripped from each. Run with `UPDATE_EXPECT=1` to accept new output.
 
+mod line_dialects;
+
 use std::{fs, path::PathBuf};
 
-use ncc_syntax::{Dialect, Parse, Severity, SyntaxKind, TextEdit, TextRange, TextSize};
+use line_dialects::{
+    assert_every_edit_reparses_like_a_full_parse, assert_only_one_block_rebuilt, assert_well_formed, glued, insertion,
+};
+use ncc_syntax::{Dialect, Parse, Severity, SyntaxKind};
 use proptest::prelude::*;
 
 /// What was removed from the manual's text to make each example a program
@@ -80,39 +85,14 @@ fn snapshots() {
 /// position, reparses to the same result as a full parse.
 #[test]
 fn fixture_edits_reparse_like_full_parses() {
+    let inserts = ["N", "(", ")", "\n", "\r", " ", "#", "[", "5", "%", ";", "IF"];
     for (path, text) in fixtures() {
-        let old = parse(&text);
-        let boundaries: Vec<usize> = (0..=text.len()).filter(|&i| text.is_char_boundary(i)).collect();
-        let mut edits = Vec::new();
-        for pair in boundaries.windows(2) {
-            edits.push(TextEdit::replace(range(pair[0], pair[1]), ""));
-        }
-        for &at in &boundaries {
-            for insert in ["N", "(", ")", "\n", "\r", " ", "#", "[", "5", "%", ";", "IF"] {
-                edits.push(TextEdit::replace(range(at, at), insert));
-            }
-        }
-        for edit in edits {
-            let mut new_text = text.clone();
-            edit.apply(&mut new_text);
-            assert_eq!(old.reparse(&edit, &new_text), parse(&new_text), "{}: {edit:?}", path.display());
-        }
+        assert_every_edit_reparses_like_a_full_parse(Dialect::HaasLathe, &path.display().to_string(), &text, &inserts);
     }
 }
 
-fn range(start: usize, end: usize) -> TextRange {
-    TextRange::new(TextSize::from(start as u32), TextSize::from(end as u32))
-}
-
-/// The significant tokens of `text`, as (kind, text).
 fn tokens(text: &str) -> Vec<(SyntaxKind, String)> {
-    parse(text)
-        .syntax_node()
-        .descendants_with_tokens()
-        .filter_map(|e| e.into_token())
-        .filter(|t| !matches!(t.kind(), SyntaxKind::WHITESPACE | SyntaxKind::NEWLINE))
-        .map(|t| (t.kind(), t.text().to_owned()))
-        .collect()
+    line_dialects::tokens(Dialect::HaasLathe, text)
 }
 
 #[test]
@@ -194,66 +174,51 @@ fn deep_nesting_is_bounded() {
     }
 }
 
-/// Fragments of Haas programs, glued at random.
-fn haas_text() -> impl Strategy<Value = String> {
-    let fragment = prop_oneof![
-        Just("G01 "),
-        Just("X-12.5"),
-        Just("Z.5"),
-        Just("#1"),
-        Just("#[#2+1]"),
-        Just("="),
-        Just(" "),
-        Just("\n"),
-        Just("\r\n"),
-        Just("\r"),
-        Just("("),
-        Just(")"),
-        Just("(P1)"),
-        Just(";c"),
-        Just("%"),
-        Just("O1234"),
-        Just("N10 "),
-        Just("/"),
-        Just("/1"),
-        Just("IF [#1 EQ 2] GOTO 10"),
-        Just("THEN"),
-        Just("GOTO"),
-        Just("WHILE [#1 LT 3] DO1"),
-        Just("END1"),
-        Just("DO"),
-        Just("SIN[30.]"),
-        Just("ATAN[1]/[2]"),
-        Just("["),
-        Just("]"),
-        Just("*"),
-        Just("MOD"),
-        Just(",C1."),
-        Just(","),
-        Just("7.75."),
-        Just("Z- 30."),
-        Just("X 5"),
-        Just("é"),
-        Just("\u{feff}"),
-        Just("AND"),
-        Just("-"),
-        Just("+"),
-        Just("G65 P9010 A1. B2."),
-    ];
-    prop::collection::vec(fragment, 0..60).prop_map(|parts| parts.concat())
-}
-
-fn char_boundary(text: &str, at: usize) -> usize {
-    (0..=at.min(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap()
-}
-
-fn assert_well_formed(text: &str, parse: &Parse) {
-    assert_eq!(parse.syntax_node().to_string(), text);
-    for error in parse.errors() {
-        let r = std::ops::Range::<usize>::from(error.range);
-        assert!(r.end <= text.len() && text.is_char_boundary(r.start) && text.is_char_boundary(r.end), "{error}");
-    }
-}
+/// Fragments of Haas programs, valid or not.
+const FRAGMENTS: &[&str] = &[
+    "G01 ",
+    "X-12.5",
+    "Z.5",
+    "#1",
+    "#[#2+1]",
+    "=",
+    " ",
+    "\n",
+    "\r\n",
+    "\r",
+    "(",
+    ")",
+    "(P1)",
+    ";c",
+    "%",
+    "O1234",
+    "N10 ",
+    "/",
+    "/1",
+    "IF [#1 EQ 2] GOTO 10",
+    "THEN",
+    "GOTO",
+    "WHILE [#1 LT 3] DO1",
+    "END1",
+    "DO",
+    "SIN[30.]",
+    "ATAN[1]/[2]",
+    "[",
+    "]",
+    "*",
+    "MOD",
+    ",C1.",
+    ",",
+    "7.75.",
+    "Z- 30.",
+    "X 5",
+    "é",
+    "\u{feff}",
+    "AND",
+    "-",
+    "+",
+    "G65 P9010 A1. B2.",
+];
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(1000))]
@@ -264,24 +229,28 @@ proptest! {
     }
 
     #[test]
-    fn haas_like_text_round_trips(text in haas_text()) {
+    fn haas_like_text_round_trips(text in glued(FRAGMENTS)) {
         assert_well_formed(&text, &parse(&text));
     }
 
     #[test]
     fn reparse_equals_full_parse(
-        text in prop_oneof![haas_text(), any::<String>()],
+        text in prop_oneof![glued(FRAGMENTS), any::<String>()],
         start in 0usize..2000,
         len in 0usize..12,
-        insert in haas_text().prop_map(|t| t.chars().take(8).collect::<String>()),
+        insert in insertion(FRAGMENTS),
     ) {
-        let start = char_boundary(&text, start % (text.len() + 1));
-        let end = char_boundary(&text, start + len);
-        let edit = TextEdit::replace(range(start, end), insert);
-        let mut new_text = text.clone();
-        edit.apply(&mut new_text);
-        let old = parse(&text);
-        prop_assert_eq!(old.reparse(&edit, &new_text), parse(&new_text));
+        line_dialects::reparse_equals_full_parse(Dialect::HaasLathe, &text, start, len, insert)?;
+    }
+}
+
+/// The cases the property tests once failed on.
+#[test]
+fn reparses_that_once_failed() {
+    for (text, start, len, insert) in
+        [("G01 O1234G01 GOTO", 0, 0, "G01 O123"), ("\u{113c2}🌀A0", 132, 0, "\u{feff}O1234O1")]
+    {
+        line_dialects::reparse_equals_full_parse(Dialect::HaasLathe, text, start, len, insert.to_owned()).unwrap();
     }
 }
 
@@ -290,24 +259,6 @@ proptest! {
 #[test]
 fn an_edit_inside_a_loop_reparses_one_block() {
     let text = "O1\n#1 = 0\nWHILE [#1 LT 10] DO1\nG01 X[#1 * 2.] F0.1\n#1 = #1 + 1\nEND1\nM30\n";
-    let old = parse(text);
     let at = text.find("X[#1 * 2.]").unwrap() + 8;
-    let edit = TextEdit::replace(range(at, at + 1), "3");
-    let mut new_text = text.to_owned();
-    edit.apply(&mut new_text);
-    let new = old.reparse(&edit, &new_text);
-    assert_eq!(new, parse(&new_text));
-    let blocks = |parse: &Parse| -> Vec<*const rowan::GreenNodeData> {
-        parse
-            .syntax_node()
-            .descendants()
-            .filter(|n| n.kind() == SyntaxKind::BLOCK)
-            .map(|n| std::ptr::from_ref::<rowan::GreenNodeData>(n.green()))
-            .collect()
-    };
-    let (old_blocks, new_blocks) = (blocks(&old), blocks(&new));
-    assert_eq!(old_blocks.len(), 7);
-    for i in 0..7 {
-        assert_eq!(old_blocks[i] == new_blocks[i], i != 3, "block {i}");
-    }
+    assert_only_one_block_rebuilt(Dialect::HaasLathe, text, at, "3", 7, 3);
 }

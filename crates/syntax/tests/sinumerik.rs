@@ -9,17 +9,18 @@
 //! `test_data/sinumerik/constructs/*` are small programs with their trees
 //! in `.rast` files (run with `UPDATE_EXPECT=1` to accept new output).
 
+mod line_dialects;
+
 use std::{fs, path::PathBuf};
 
-use ncc_syntax::{Dialect, Parse, SyntaxErrorKind, SyntaxKind, SyntaxNode, TextEdit, TextRange, TextSize};
+use line_dialects::{
+    assert_every_edit_reparses_like_a_full_parse, assert_only_one_block_rebuilt, assert_well_formed, glued, insertion,
+};
+use ncc_syntax::{Dialect, Parse, SyntaxErrorKind, SyntaxKind, SyntaxNode};
 use proptest::prelude::*;
 
 fn parse(text: &str) -> Parse {
     Parse::new(text, Dialect::Sinumerik)
-}
-
-fn reparse(old: &Parse, edit: &TextEdit, new_text: &str) -> Parse {
-    old.reparse(edit, new_text)
 }
 
 fn root(parse: &Parse) -> SyntaxNode {
@@ -71,31 +72,13 @@ fn construct_snapshots() {
     }
 }
 
-fn range(start: usize, end: usize) -> TextRange {
-    TextRange::new(TextSize::from(start as u32), TextSize::from(end as u32))
-}
-
 /// Deleting each character, and inserting a few interesting ones at each
 /// position, reparses to the same result as a full parse.
 #[test]
 fn fixture_edits_reparse_like_full_parses() {
+    let inserts = ["N", "(", ")", "\n", "\r", " ", "\"", "[", "5", "%", ";", ":", "IF"];
     for (path, text) in files("constructs").into_iter().chain(files("").into_iter().take(2)) {
-        let old = parse(&text);
-        let boundaries: Vec<usize> = (0..=text.len()).filter(|&i| text.is_char_boundary(i)).collect();
-        let mut edits = Vec::new();
-        for pair in boundaries.windows(2) {
-            edits.push(TextEdit::replace(range(pair[0], pair[1]), ""));
-        }
-        for &at in &boundaries {
-            for insert in ["N", "(", ")", "\n", "\r", " ", "\"", "[", "5", "%", ";", ":", "IF"] {
-                edits.push(TextEdit::replace(range(at, at), insert));
-            }
-        }
-        for edit in edits {
-            let mut new_text = text.clone();
-            edit.apply(&mut new_text);
-            assert_eq!(reparse(&old, &edit, &new_text), parse(&new_text), "{}: {edit:?}", path.display());
-        }
+        assert_every_edit_reparses_like_a_full_parse(Dialect::Sinumerik, &path.display().to_string(), &text, &inserts);
     }
 }
 
@@ -104,35 +87,12 @@ fn fixture_edits_reparse_like_full_parses() {
 #[test]
 fn an_edit_inside_a_loop_reparses_one_block() {
     let text = "R1=0\nWHILE R1<10\nG1 X=R1*2 F100\nR1=R1+1\nENDWHILE\nM30\n";
-    let old = parse(text);
     let at = text.find("R1*2").unwrap() + 3;
-    let edit = TextEdit::replace(range(at, at + 1), "3");
-    let mut new_text = text.to_owned();
-    edit.apply(&mut new_text);
-    let new = reparse(&old, &edit, &new_text);
-    assert_eq!(new, parse(&new_text));
-    let blocks = |parts: &Parse| -> Vec<*const rowan::GreenNodeData> {
-        root(parts)
-            .descendants()
-            .filter(|n| n.kind() == SyntaxKind::BLOCK)
-            .map(|n| std::ptr::from_ref::<rowan::GreenNodeData>(n.green()))
-            .collect()
-    };
-    let (old_blocks, new_blocks) = (blocks(&old), blocks(&new));
-    assert_eq!(old_blocks.len(), 6);
-    for i in 0..6 {
-        assert_eq!(old_blocks[i] == new_blocks[i], i != 2, "block {i}");
-    }
+    assert_only_one_block_rebuilt(Dialect::Sinumerik, text, at, "3", 6, 2);
 }
 
-/// The significant tokens of `text`, as (kind, text).
 fn tokens(text: &str) -> Vec<(SyntaxKind, String)> {
-    root(&parse(text))
-        .descendants_with_tokens()
-        .filter_map(|e| e.into_token())
-        .filter(|t| !matches!(t.kind(), SyntaxKind::WHITESPACE | SyntaxKind::NEWLINE))
-        .map(|t| (t.kind(), t.text().to_owned()))
-        .collect()
+    line_dialects::tokens(Dialect::Sinumerik, text)
 }
 
 #[test]
@@ -212,67 +172,64 @@ fn deep_nesting_is_bounded() {
     }
 }
 
-/// Fragments of Sinumerik programs, valid or not, glued at random.
-fn sinumerik_text() -> impl Strategy<Value = String> {
-    let fragment = prop_oneof![
-        Just("G01 "),
-        Just("X-12.5"),
-        Just("X=R1+5 "),
-        Just("R1"),
-        Just("R[R2+1]"),
-        Just("="),
-        Just(" "),
-        Just("\n"),
-        Just("\r\n"),
-        Just("\r"),
-        Just("("),
-        Just(")"),
-        Just("["),
-        Just("]"),
-        Just(","),
-        Just(":"),
-        Just(";c"),
-        Just("\""),
-        Just("\"TEXT\""),
-        Just("%_N_A_MPF"),
-        Just("N10 "),
-        Just(":20 "),
-        Just("/"),
-        Just("/1"),
-        Just("LABEL:"),
-        Just("IF R1==2 GOTOF LABEL"),
-        Just("ELSE"),
-        Just("ENDIF"),
-        Just("WHILE "),
-        Just("ENDWHILE"),
-        Just("FOR I=1 TO 3"),
-        Just("CASE R1 OF 1 GOTOF L1 DEFAULT GOTOB N10"),
-        Just("DEF STRING[20] S=\"x\""),
-        Just("DEF INT A[2,3]"),
-        Just("PROC P(VAR REAL X[2]) SAVE"),
-        Just("EXTERN P(REAL)"),
-        Just("MSG(\"a\"<<R1)"),
-        Just("SIN(30)"),
-        Just("$AA_IM[X]"),
-        Just("CYCLE81(,1,2)"),
-        Just("<<"),
-        Just("<>"),
-        Just("AND"),
-        Just("NOT"),
-        Just("*"),
-        Just("-"),
-        Just("+"),
-        Just("7.75."),
-        Just(".."),
-        Just("1EX3"),
-        Just("é"),
-        Just("\u{feff}"),
-        Just("#"),
-        Just("'"),
-        Just("WHEN R1>1 DO M7"),
-    ];
-    prop::collection::vec(fragment, 0..60).prop_map(|parts| parts.concat())
-}
+/// Fragments of Sinumerik programs, valid or not.
+const FRAGMENTS: &[&str] = &[
+    "G01 ",
+    "X-12.5",
+    "X=R1+5 ",
+    "R1",
+    "R[R2+1]",
+    "=",
+    " ",
+    "\n",
+    "\r\n",
+    "\r",
+    "(",
+    ")",
+    "[",
+    "]",
+    ",",
+    ":",
+    ";c",
+    "\"",
+    "\"TEXT\"",
+    "%_N_A_MPF",
+    "N10 ",
+    ":20 ",
+    "/",
+    "/1",
+    "LABEL:",
+    "IF R1==2 GOTOF LABEL",
+    "ELSE",
+    "ENDIF",
+    "WHILE ",
+    "ENDWHILE",
+    "FOR I=1 TO 3",
+    "CASE R1 OF 1 GOTOF L1 DEFAULT GOTOB N10",
+    "DEF STRING[20] S=\"x\"",
+    "DEF INT A[2,3]",
+    "PROC P(VAR REAL X[2]) SAVE",
+    "EXTERN P(REAL)",
+    "MSG(\"a\"<<R1)",
+    "SIN(30)",
+    "$AA_IM[X]",
+    "CYCLE81(,1,2)",
+    "<<",
+    "<>",
+    "AND",
+    "NOT",
+    "*",
+    "-",
+    "+",
+    "7.75.",
+    "..",
+    "1EX3",
+    "é",
+    "\u{feff}",
+    "#",
+    "'",
+    "WHEN R1>1 DO M7",
+];
 
 /// Statements that are valid wherever they stand in a block.
 fn valid_statement() -> impl Strategy<Value = String> {
@@ -377,19 +334,6 @@ fn valid_program() -> impl Strategy<Value = String> {
         .prop_map(|(proc_line, blocks)| proc_line.unwrap_or_default() + &blocks.concat())
 }
 
-fn char_boundary(text: &str, at: usize) -> usize {
-    (0..=at.min(text.len())).rev().find(|&i| text.is_char_boundary(i)).unwrap()
-}
-
-fn assert_well_formed(text: &str, parts: &Parse) {
-    assert_eq!(root(parts).to_string(), text);
-    for error in parts.errors() {
-        let r = std::ops::Range::<usize>::from(error.range);
-        assert!(r.end <= text.len() && text.is_char_boundary(r.start) && text.is_char_boundary(r.end), "{error}");
-        assert!(!error.message.is_empty());
-    }
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(1000))]
 
@@ -399,7 +343,7 @@ proptest! {
     }
 
     #[test]
-    fn sinumerik_like_text_round_trips(text in sinumerik_text()) {
+    fn sinumerik_like_text_round_trips(text in glued(FRAGMENTS)) {
         assert_well_formed(&text, &parse(&text));
     }
 
@@ -412,16 +356,11 @@ proptest! {
 
     #[test]
     fn reparse_equals_full_parse(
-        text in prop_oneof![sinumerik_text(), valid_program(), any::<String>()],
+        text in prop_oneof![glued(FRAGMENTS), valid_program(), any::<String>()],
         start in 0usize..2000,
         len in 0usize..12,
-        insert in sinumerik_text().prop_map(|t| t.chars().take(8).collect::<String>()),
+        insert in insertion(FRAGMENTS),
     ) {
-        let start = char_boundary(&text, start % (text.len() + 1));
-        let end = char_boundary(&text, start + len);
-        let edit = TextEdit::replace(range(start, end), insert);
-        let mut new_text = text.clone();
-        edit.apply(&mut new_text);
-        prop_assert_eq!(reparse(&parse(&text), &edit, &new_text), parse(&new_text));
+        line_dialects::reparse_equals_full_parse(Dialect::Sinumerik, &text, start, len, insert)?;
     }
 }

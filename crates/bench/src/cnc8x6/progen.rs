@@ -9,7 +9,7 @@
 
 use std::fmt::Write;
 
-use crate::edits::Lcg;
+use crate::lcg::Lcg;
 
 /// The syntax to write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -201,6 +201,25 @@ pub fn write(moves: &[Move], syntax: Syntax) -> String {
     out
 }
 
+/// The dialect whose CAM output other dialects' parse throughput is
+/// compared with.
+pub const REFERENCE: ncc_syntax::Dialect = ncc_syntax::Dialect::Cnc8x6;
+
+/// The motion codes of generated programs, in every syntax's spelling.
+const MOTIONS: [&str; 8] = ["G0", "G00", "G1", "G01", "G2", "G02", "G3", "G03"];
+
+/// Whether `line` of a generated program is a motion block: one of its
+/// words is a motion code. Block numbers do not tell (Haas programs have
+/// none).
+pub fn is_motion_block(line: &str) -> bool {
+    line.split(' ').any(|word| MOTIONS.contains(&word))
+}
+
+/// Whether `line` of a generated program is a straight move at feed.
+pub fn is_linear_move(line: &str) -> bool {
+    line.split(' ').any(|word| word == "G1")
+}
+
 /// Counts the blocks of a generated program (comment lines excluded).
 pub fn block_count(moves: &[Move]) -> usize {
     moves.iter().filter(|m| !matches!(m, Move::Comment(_))).count()
@@ -215,7 +234,7 @@ pub fn random_line(len: usize, seed: u64) -> String {
 }
 
 /// The offset of a random character of the first G word at or after a
-/// random line within ten lines of `offset`.
+/// random line within ten lines of `offset` (generated comments hold none).
 pub fn g_code_near(text: &str, offset: usize, rng: &mut Lcg) -> Option<usize> {
     let mut start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
     let (up, down) = match rng.below(21) {
@@ -230,14 +249,12 @@ pub fn g_code_near(text: &str, offset: usize, rng: &mut Lcg) -> Option<usize> {
     }
     let mut line_start = start;
     for line in text[start..].split_inclusive('\n') {
-        if line.starts_with('N') {
-            let mut word_start = line_start;
-            for word in line.trim_end().split(' ') {
-                if word.len() > 1 && word.starts_with('G') && word.as_bytes()[1].is_ascii_digit() {
-                    return Some(word_start + rng.below(word.len()));
-                }
-                word_start += word.len() + 1;
+        let mut word_start = line_start;
+        for word in line.trim_end().split(' ') {
+            if word.len() > 1 && word.starts_with('G') && word.as_bytes()[1].is_ascii_digit() {
+                return Some(word_start + rng.below(word.len()));
             }
+            word_start += word.len() + 1;
         }
         line_start += line.len();
     }

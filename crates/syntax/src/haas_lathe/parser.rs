@@ -37,7 +37,7 @@ use crate::{
     lexing::{Token, range},
     limit::Omitted,
     line_blocks,
-    line_cursor::{Lexer, LineCursor, TokenError},
+    line_cursor::{Lexer, LineCursor, LineParser, TokenError},
     visible,
 };
 
@@ -99,9 +99,9 @@ fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, 
         }
         parser.move_to(mark, body.start);
         children.push(NodeOrToken::Node(parser.opening_mark()));
-        errors.append(parser.cursor.into_errors());
+        errors.append(parser.take_errors());
     }
-    let (runs, block_errors) = line_blocks::parse_in_parts(text, body.clone(), parallel_threshold, parse_blocks);
+    let (runs, block_errors) = line_blocks::parse_in_parts::<Parser<'_>>(text, body.clone(), parallel_threshold);
     children.extend(runs);
     errors.append(block_errors);
     if body.end < text.len() {
@@ -176,25 +176,7 @@ fn closing_mark(text: &str, at: usize) -> GreenNode {
     green::node(TAPE_MARK, children)
 }
 
-/// Parses the blocks (lines) of `region`, which starts at a line start.
-/// `replaced` are blocks of an older tree whose words the new blocks share.
-pub(crate) fn parse_blocks(
-    text: &str,
-    region: Range<usize>,
-    replaced: &[&rowan::GreenNodeData],
-) -> (Vec<GreenElement>, Errors) {
-    let mut parser = Parser::new(text, region.start, region.end);
-    for block in replaced {
-        parser.green.share_words_of(block);
-    }
-    let mut blocks = Vec::new();
-    while parser.pos < region.end {
-        blocks.push(NodeOrToken::Node(parser.block()));
-    }
-    (blocks, parser.cursor.into_errors())
-}
-
-struct Parser<'a> {
+pub(super) struct Parser<'a> {
     cursor: LineCursor<'a, HaasLexer>,
 }
 
@@ -214,7 +196,7 @@ impl DerefMut for Parser<'_> {
 
 /// The Haas lathe's tokens; a `(` comment not closed on its line is an
 /// error.
-struct HaasLexer;
+pub(super) struct HaasLexer;
 
 impl Lexer for HaasLexer {
     fn token_at(text: &str, pos: usize) -> Token {
@@ -229,41 +211,34 @@ impl Lexer for HaasLexer {
     }
 }
 
-impl<'a> Parser<'a> {
+impl<'a> LineParser<'a> for Parser<'a> {
+    type Lexer = HaasLexer;
+
     fn new(text: &'a str, pos: usize, region_end: usize) -> Self {
         Parser { cursor: LineCursor::new(text, pos, region_end) }
     }
 
-    fn byte_at(&self, pos: usize) -> u8 {
-        self.text.as_bytes()[pos]
-    }
-
-    /// Bumps whitespace into `children`.
-    fn bump_whitespace(&mut self, children: &mut Vec<GreenElement>) {
-        while self.kind_at(self.pos) == Some(WHITESPACE) {
-            children.push(self.bump());
-        }
-    }
-
-    /// The opening `%` line: spaces, `%`, comments; other text on it is an
-    /// error.
-    fn opening_mark(&mut self) -> GreenNode {
-        let mut children = Vec::new();
-        while let Some(token) = self.peek() {
-            let child = match token.kind {
-                WHITESPACE | COMMENT | NEWLINE | PERCENT | UNREAD => self.bump(),
-                _ => self.error_node(E::UnexpectedCharacter, "only a comment may follow the tape mark `%` on its line"),
-            };
-            children.push(child);
-        }
-        green::node(TAPE_MARK, children)
-    }
-
     /// One line.
     fn block(&mut self) -> GreenNode {
-        let mut children = Vec::new();
+        let mut children = self.take_block_children();
         let mut started = false;
-        while let Some(token) = self.peek() {
+        loop {
+            // Fast paths for what CAM output is made of; each builds exactly
+            // the tree the general path below would.
+            if let Some(trivia) = self.plain_trivia() {
+                let newline = trivia.kind() == NEWLINE.into();
+                children.push(trivia);
+                if newline {
+                    break;
+                }
+                continue;
+            }
+            if let Some(word) = self.plain_word() {
+                started = true;
+                children.push(word);
+                continue;
+            }
+            let Some(token) = self.peek() else { break };
             let child = match token.kind {
                 NEWLINE => {
                     children.push(self.bump());
@@ -295,7 +270,43 @@ impl<'a> Parser<'a> {
             started = true;
             children.push(child);
         }
-        green::node(BLOCK, children)
+        self.block_node(children)
+    }
+}
+
+impl<'a> Parser<'a> {
+    fn byte_at(&self, pos: usize) -> u8 {
+        self.text.as_bytes()[pos]
+    }
+
+    /// Bumps whitespace into `children`.
+    fn bump_whitespace(&mut self, children: &mut Vec<GreenElement>) {
+        while self.kind_at(self.pos) == Some(WHITESPACE) {
+            children.push(self.bump());
+        }
+    }
+
+    /// The opening `%` line: spaces, `%`, comments; other text on it is an
+    /// error.
+    fn opening_mark(&mut self) -> GreenNode {
+        let mut children = Vec::new();
+        while let Some(token) = self.peek() {
+            let child = match token.kind {
+                WHITESPACE | COMMENT | NEWLINE | PERCENT | UNREAD => self.bump(),
+                _ => self.error_node(E::UnexpectedCharacter, "only a comment may follow the tape mark `%` on its line"),
+            };
+            children.push(child);
+        }
+        green::node(TAPE_MARK, children)
+    }
+
+    /// An address word such as `X-12.5` or `G01`, read without lexing: what
+    /// `word` makes of it. Not `O`, which starts a program number.
+    fn plain_word(&mut self) -> Option<GreenElement> {
+        match self.text.as_bytes()[..self.end].get(self.pos)? {
+            b'O' => None,
+            _ => self.cursor.simple_word(b"."),
+        }
     }
 
     /// `/`, and a digit 1 to 9 directly after it.

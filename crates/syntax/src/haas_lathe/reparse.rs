@@ -23,9 +23,12 @@ pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Op
             });
             !region.contains('%') && (opening || !region.trim().is_empty())
         },
-        parse_blocks: parser::parse_blocks,
     };
-    let (green, errors, omitted) =
-        reparse_line_blocks((old.green(), old.errors(), old.omitted()), edit, new_text, dialect)?;
+    let (green, errors, omitted) = reparse_line_blocks::<parser::Parser<'_>, _, _>(
+        (old.green(), old.errors(), old.omitted()),
+        edit,
+        new_text,
+        dialect,
+    )?;
     Some(Parse { green, errors: errors.into(), omitted: omitted.into(), dialect: old.dialect })
 }

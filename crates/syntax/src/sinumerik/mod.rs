@@ -98,12 +98,12 @@ pub(crate) use parser::parse_source_file;
 /// reusing every line the edit cannot have changed; `None` when the whole
 /// text must be parsed again. No edit is refused: nothing spans lines.
 pub(crate) fn reparse_blocks(old: &Parse, edit: &TextEdit, new_text: &str) -> Option<Parse> {
-    let dialect = LineDialect {
-        edit_ok: |_: &SyntaxNode| true,
-        region_ok: |_: &SyntaxNode, _: &str| true,
-        parse_blocks: parser::parse_blocks,
-    };
-    let (green, errors, omitted) =
-        line_blocks::reparse_line_blocks((old.green(), old.errors(), old.omitted()), edit, new_text, dialect)?;
+    let dialect = LineDialect { edit_ok: |_: &SyntaxNode| true, region_ok: |_: &SyntaxNode, _: &str| true };
+    let (green, errors, omitted) = line_blocks::reparse_line_blocks::<parser::Parser<'_>, _, _>(
+        (old.green(), old.errors(), old.omitted()),
+        edit,
+        new_text,
+        dialect,
+    )?;
     Some(Parse { green, errors: errors.into(), omitted: omitted.into(), dialect: old.dialect })
 }

@@ -16,7 +16,7 @@ use crate::{
     lexing::{Token, range},
     limit::Omitted,
     line_blocks,
-    line_cursor::{Lexer, LineCursor, TokenError},
+    line_cursor::{Lexer, LineCursor, LineParser, TokenError},
     visible,
 };
 
@@ -85,32 +85,14 @@ fn parse_source_file_with(text: &str, parallel_threshold: usize) -> (GreenNode, 
             "the file starts with a byte-order mark: it was saved as Unicode text, but the control reads plain text; save it as plain text",
         ));
     }
-    let (runs, block_errors) = line_blocks::parse_in_parts(text, start..text.len(), parallel_threshold, parse_blocks);
+    let (runs, block_errors) = line_blocks::parse_in_parts::<Parser<'_>>(text, start..text.len(), parallel_threshold);
     children.extend(runs);
     errors.append(block_errors);
     let (errors, omitted) = errors.finish(text);
     (green::node(SOURCE_FILE, children), errors, omitted)
 }
 
-/// Parses the blocks (lines) of `region`, which starts at a line start.
-/// `replaced` are blocks of an older tree whose words the new blocks share.
-pub(crate) fn parse_blocks(
-    text: &str,
-    region: Range<usize>,
-    replaced: &[&rowan::GreenNodeData],
-) -> (Vec<GreenElement>, Errors) {
-    let mut parser = Parser::new(text, region.start, region.end);
-    for block in replaced {
-        parser.green.share_words_of(block);
-    }
-    let mut blocks = Vec::new();
-    while parser.pos < region.end {
-        blocks.push(NodeOrToken::Node(parser.block()));
-    }
-    (blocks, parser.cursor.into_errors())
-}
-
-struct Parser<'a> {
+pub(super) struct Parser<'a> {
     cursor: LineCursor<'a, SinumerikLexer>,
 }
 
@@ -129,7 +111,7 @@ impl DerefMut for Parser<'_> {
 }
 
 /// Sinumerik's tokens; a string not closed on its line is an error.
-struct SinumerikLexer;
+pub(super) struct SinumerikLexer;
 
 impl Lexer for SinumerikLexer {
     fn token_at(text: &str, pos: usize) -> Token {
@@ -145,11 +127,46 @@ impl Lexer for SinumerikLexer {
     }
 }
 
-impl<'a> Parser<'a> {
+impl<'a> LineParser<'a> for Parser<'a> {
+    type Lexer = SinumerikLexer;
+
     fn new(text: &'a str, pos: usize, region_end: usize) -> Self {
         Parser { cursor: LineCursor::new(text, pos, region_end) }
     }
 
+    /// One line: `[/n] [%header | N10 | :10] [LABEL:] statement* [;comment]`.
+    fn block(&mut self) -> GreenNode {
+        let mut children = self.take_block_children();
+        if let Some(number) = self.plain_block_number() {
+            children.push(number);
+        } else {
+            self.trivia(&mut children);
+            if self.kind_at(self.pos) == Some(SLASH) {
+                children.push(self.block_skip());
+                self.trivia(&mut children);
+            }
+            match self.kind_at(self.pos) {
+                Some(PERCENT) => children.push(self.header()),
+                Some(COLON) if self.kind_at(self.pos + 1) == Some(NUMBER) => children.push(self.block_number()),
+                Some(LETTER)
+                    if self.text.as_bytes()[self.pos].eq_ignore_ascii_case(&b'N')
+                        && self.kind_at(self.pos + 1) == Some(NUMBER) =>
+                {
+                    children.push(self.block_number());
+                }
+                _ => {}
+            }
+        }
+        self.trivia(&mut children);
+        if self.kind_at(self.pos) == Some(IDENT) && self.label_follows() {
+            children.push(self.label());
+        }
+        self.statements(&mut children);
+        self.block_node(children)
+    }
+}
+
+impl<'a> Parser<'a> {
     /// The text of the token at `pos`.
     fn text_at(&self, pos: usize) -> &'a str {
         let len = self.token_at(pos).map_or(0, |t| t.len);
@@ -176,36 +193,24 @@ impl<'a> Parser<'a> {
         NodeOrToken::Node(green::node(kind, children))
     }
 
-    /// One line: `[/n] [%header | N10 | :10] [LABEL:] statement* [;comment]`.
-    fn block(&mut self) -> GreenNode {
-        let mut children = Vec::new();
-        self.trivia(&mut children);
-        if self.kind_at(self.pos) == Some(SLASH) {
-            children.push(self.block_skip());
-            self.trivia(&mut children);
-        }
-        match self.kind_at(self.pos) {
-            Some(PERCENT) => children.push(self.header()),
-            Some(COLON) if self.kind_at(self.pos + 1) == Some(NUMBER) => children.push(self.block_number()),
-            Some(LETTER)
-                if self.text.as_bytes()[self.pos].eq_ignore_ascii_case(&b'N')
-                    && self.kind_at(self.pos + 1) == Some(NUMBER) =>
-            {
-                children.push(self.block_number());
-            }
-            _ => {}
-        }
-        self.trivia(&mut children);
-        if self.kind_at(self.pos) == Some(IDENT) && self.label_follows() {
-            children.push(self.label());
-        }
-        self.statements(&mut children);
-        green::node(BLOCK, children)
-    }
-
     /// Statements up to the end of the line, with its line break.
     fn statements(&mut self, children: &mut Vec<GreenElement>) {
-        while let Some(token) = self.peek() {
+        loop {
+            // Fast paths for what CAM output is made of; each builds exactly
+            // the tree the general path below would.
+            if let Some(trivia) = self.plain_trivia() {
+                let newline = trivia.kind() == NEWLINE.into();
+                children.push(trivia);
+                if newline {
+                    return;
+                }
+                continue;
+            }
+            if let Some(word) = self.plain_word() {
+                children.push(word);
+                continue;
+            }
+            let Some(token) = self.peek() else { return };
             match token.kind {
                 NEWLINE => {
                     children.push(self.bump());
@@ -215,6 +220,37 @@ impl<'a> Parser<'a> {
                 _ => children.push(self.statement()),
             }
         }
+    }
+
+    /// `N` and digits at the line start, the block number of nearly every
+    /// block, read without lexing; `None`, reading nothing, for any other
+    /// text (a number with a point or an exponent takes the general path).
+    fn plain_block_number(&mut self) -> Option<GreenElement> {
+        let bytes = &self.text.as_bytes()[..self.end];
+        let start = self.pos;
+        let letter = *bytes.get(start)?;
+        let digits = bytes[start + 1..].iter().take_while(|b| b.is_ascii_digit()).count();
+        let plain = letter.eq_ignore_ascii_case(&b'N')
+            && digits > 0
+            && !matches!(bytes.get(start + 1 + digits), Some(b'.' | b'E' | b'e'));
+        if !plain {
+            return None;
+        }
+        self.pos = start + 1 + digits;
+        let number = self.green.token(NUMBER, &self.text[start + 1..self.pos]);
+        Some(NodeOrToken::Node(green::node(BLOCK_NUMBER, [self.green.letter(letter), number])))
+    }
+
+    /// An address word such as `X-12.5` or `G1`, read without lexing: what
+    /// `statement` makes of it. Not `R`, which starts a parameter, nor an
+    /// `L` or `M` number with arguments (`L140(1)`, a call).
+    fn plain_word(&mut self) -> Option<GreenElement> {
+        let glued: &[u8] = match self.text.as_bytes()[..self.end].get(self.pos)? {
+            b'R' => return None,
+            b'L' | b'M' => b".=Ee(",
+            _ => b".=Ee",
+        };
+        self.cursor.simple_word(glued)
     }
 
     /// `/`, and a level digit directly after it.
