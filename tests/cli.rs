@@ -1328,7 +1328,7 @@ M30
     assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
     assert_eq!(
         stdout(&output),
-        "; EXPANDED FROM PART.MPF\nG17 G71 G90 G94 G60 BRISK\nG0 X0 Y0 Z0\nG64 SOFT G1 X10 Y5 F600\nM30\n"
+        "; EXPANDED FROM PART.MPF\nG17 G71 G90 G94 G60 BRISK\nG642 CTOL=0.1 G0 X0 Y0 Z0\nSOFT G1 X10 Y5 F600\nM30\n"
     );
     let svg = dir.path().join("part.svg");
     let output = ncc(&["plot", clean, "-o", svg.to_str().unwrap()]);
