@@ -45,14 +45,15 @@
 //!   velocity policy's [`PathControl`] (G60/G9, G64, G641 with ADIS and
 //!   ADISPOS, G642–G645 with CTOL, SOFT/BRISK, M17 and M30 ending the
 //!   continuous path), kept in step with the groups of the modal state.
-//! - The programmable frame ([`ProgrammableFrame`]: TRANS, ATRANS, ROT,
+//! - The programmable frame ([`ProgrammableFrame`], module
+//!   `frames_and_cycles`: TRANS, ATRANS, ROT,
 //!   AROT, SCALE, ASCALE, MIRROR, AMIRROR, and CYCLE800's swivel): steps
 //!   are in base coordinates, the frame's image of the program's; a frame
 //!   change leaves the tool where it is. An arc stays an arc where the
 //!   frame keeps its plane (its centre moved, its sense turned over by a
 //!   mirror); where the frame makes it an ellipse or turns it out of the
 //!   plane it runs straight, reported as not run.
-//! - The drilling cycles CYCLE81–CYCLE89 and CYCLE840 ([`cycles`]) as
+//! - The drilling cycles CYCLE81–CYCLE89 and CYCLE840 ([`super::cycles`]) as
 //!   moves of the block that calls them, at the tool's position in the
 //!   plane, under MCALL after every block with a path motion.
 //! - WRITE, READ, DELETE and ISFILE on the run's own files (module
@@ -90,10 +91,9 @@ use ncc_catalog::{AddressRole, Code, Dialect, KeywordKind};
 use ncc_syntax::{Parse, TextRange, TextSize};
 
 use super::{
-    cycles::{self, CycleMove, Hole, SpindleAction},
     dynamics::PathControl,
     eval::{Context, ErrorKind, Eval, EvalError, Store, Value, equal},
-    frames::{FrameCommand, FrameKind, Plane, ProgrammableFrame},
+    frames::ProgrammableFrame,
     lower::{
         Call, Command, Dimension, Expr, ExprKind, Jump, JumpKind, JumpTarget, Place, PlaceKind, SinumerikBlock,
         StatementKind, Word, WordValue, block_nodes,
@@ -113,6 +113,7 @@ use crate::{
 mod bspline;
 mod calls;
 mod files;
+mod frames_and_cycles;
 mod modes;
 
 use modes::Modes;
@@ -843,142 +844,6 @@ impl<'a> Interpreter<'a> {
         }
     }
 
-    /// A frame command (TRANS, ATRANS, ROT, SCALE, MIRROR and their
-    /// additive forms): the tool stays where it is, its program
-    /// coordinates are those of the new frame.
-    fn frame(&mut self, command: &Command, range: TextRange) {
-        let Some(frame_command) = FrameCommand::from_name(&command.name) else {
-            return self.state.not_run(&command.name, range);
-        };
-        let mut values = Vec::with_capacity(command.words.len());
-        for word in &command.words {
-            let Some((value, _)) = self.word_number(word) else { return };
-            let value = match frame_command.kind {
-                FrameKind::Translation => self.length(value),
-                FrameKind::Rotation | FrameKind::Scale | FrameKind::Mirror => value,
-            };
-            values.push((word.address.as_str(), value));
-        }
-        let plane = self.plane();
-        let base = self.state.to_base(&self.state.position);
-        match self.state.frame.apply(frame_command, &values, plane) {
-            Ok(()) => self.state.position = self.state.to_program(&base),
-            Err(error) => {
-                let range = command.words.get(error.word).map_or(range, |word| word.range);
-                self.state.finding(RunRule::ValueRefused, range, &error.to_string());
-            }
-        }
-    }
-
-    /// The working plane of G17, G18, G19.
-    fn plane(&self) -> Plane {
-        self.state.modes.get(PLANE).and_then(Plane::from_code).unwrap_or_default()
-    }
-
-    /// A call of a control's cycle: the drilling cycles as moves of the
-    /// block that calls them, CYCLE800 as the frame it swivels to; others
-    /// (CYCLE832, …) are reported as not run.
-    fn cycle(&mut self, at: At, name: &str, arguments: &[Option<Expr>], range: TextRange) {
-        let drilling = matches!(
-            name,
-            "CYCLE81"
-                | "CYCLE82"
-                | "CYCLE83"
-                | "CYCLE84"
-                | "CYCLE840"
-                | "CYCLE85"
-                | "CYCLE86"
-                | "CYCLE87"
-                | "CYCLE88"
-                | "CYCLE89"
-        );
-        if !drilling && name != "CYCLE800" {
-            return self.state.not_run(&format!("the cycle {name}"), range);
-        }
-        let mut values = Vec::with_capacity(arguments.len());
-        for argument in arguments {
-            let value = match argument {
-                // A string (CYCLE800's swivel data record) is not read.
-                Some(expr) if matches!(expr.kind, ExprKind::String(_)) => None,
-                Some(expr) => {
-                    let result = self.eval().number(expr);
-                    let Some(value) = self.check(result) else { return };
-                    Some(value)
-                }
-                None => None,
-            };
-            values.push(value);
-        }
-        let result = if drilling {
-            let hole = Hole {
-                position: XYZ.map(|letter| self.state.position[slot(letter)]),
-                plane: self.plane(),
-                feed: self.feed_rate_quiet().unwrap_or(0.0),
-                spindle: self.signed_rpm(),
-            };
-            cycles::drilling(name, &values, &hole).map(|moves| self.cycle_moves(at, &moves, range))
-        } else {
-            cycles::swivel(&values).map(|swivel| {
-                let base = self.state.to_base(&self.state.position);
-                swivel.apply_to(&mut self.state.frame);
-                self.state.position = self.state.to_program(&base);
-            })
-        };
-        if let Err(error) = result {
-            self.state.finding(RunRule::CycleFailed, range, &error.to_string());
-        }
-    }
-
-    /// A drilling cycle's moves as steps of the block at `at`.
-    fn cycle_moves(&mut self, at: At, moves: &[CycleMove], range: TextRange) {
-        for cycle_move in moves {
-            let start = self.state.to_base(&self.state.position);
-            let mut to_point = |to: &[f64; 3]| {
-                for (letter, value) in XYZ.into_iter().zip(to) {
-                    self.state.position[slot(letter)] = *value;
-                }
-                let end = self.state.to_base(&self.state.position);
-                (distance(&start, &end), end)
-            };
-            let (moved, stop) = match *cycle_move {
-                CycleMove::Rapid(to) => {
-                    let (length, end) = to_point(&to);
-                    (self.rapid(&start, &end, length), None)
-                }
-                CycleMove::Feed { to, feed } => {
-                    let (length, _) = to_point(&to);
-                    let duration = if feed > 0.0 { length / feed * 60.0 } else { 0.0 };
-                    let moved =
-                        Moved { motion: Motion::Feed, path: Path::Straight, length, duration, feed: Some(feed) };
-                    (moved, None)
-                }
-                CycleMove::Tap { to, lead, rpm } => {
-                    let (length, _) = to_point(&to);
-                    let feed = lead.abs() * rpm.abs();
-                    let duration = if feed > 0.0 { length / feed * 60.0 } else { 0.0 };
-                    let path = Path::Thread { lead: lead.abs(), speed: rpm.abs() };
-                    (Moved { motion: Motion::Feed, path, length, duration, feed: Some(feed) }, None)
-                }
-                CycleMove::Dwell(seconds) => (Moved { motion: Motion::Dwell, duration: seconds, ..STILL }, None),
-                CycleMove::Spindle(action) => {
-                    let code = match action {
-                        SpindleAction::Turn(rpm) => {
-                            self.state.speed = rpm.abs();
-                            if rpm < 0.0 { "M4" } else { "M3" }
-                        }
-                        SpindleAction::Stop | SpindleAction::Orient(_) => "M5",
-                    };
-                    if let Some(code) = Dialect::Sinumerik.catalogue().code_named(code) {
-                        self.state.modes.set(code);
-                    }
-                    continue;
-                }
-                CycleMove::ProgramStop => (STILL, Some(Stop::Program)),
-            };
-            self.record(at, range, moved, Facts::default(), stop);
-        }
-    }
-
     /// The block's codes, feed, spindle, tool and motion: its move, its
     /// stop, whether it ends the program, and what its step records.
     fn codes_and_motion(&mut self, words: &Words, range: TextRange) -> (Moved, Option<Stop>, bool, Facts) {
@@ -1148,32 +1013,6 @@ impl<'a> Interpreter<'a> {
             .map(|&axis| (end[slot(axis)] - start[slot(axis)]).abs() / f64::from(machine.axis_rapid_rate(axis)))
             .fold(0.0, f64::max);
         Moved { motion: Motion::Rapid, path: Path::Straight, length, duration: minutes * 60.0, feed: None }
-    }
-
-    /// The path of an arc programmed from `start` to `end` as the frame
-    /// puts it in base coordinates: its centre moved and its sense turned
-    /// over by mirrors; a straight move, reported, where the frame makes
-    /// the circle an ellipse or turns it out of its plane.
-    fn arc_in_base(&mut self, path: Path, start: &Position, range: TextRange) -> Path {
-        let Path::Arc { plane: (a, b), centre, clockwise } = path else { return path };
-        if self.state.frame.is_identity() {
-            return path;
-        }
-        let plane = Plane::from_code(self.state.modes.get(PLANE).unwrap_or("G17")).unwrap_or_default();
-        if !self.state.frame.keeps_plane(plane) {
-            let what = "an arc in a frame that makes its circle an ellipse or turns it out of its plane (run straight)";
-            self.state.not_run(what, range);
-            return Path::Straight;
-        }
-        let mut centre_point = *start;
-        centre_point[slot(a)] = centre[0];
-        centre_point[slot(b)] = centre[1];
-        let moved = self.state.to_base(&centre_point);
-        Path::Arc {
-            plane: (a, b),
-            centre: [moved[slot(a)], moved[slot(b)]],
-            clockwise: clockwise != self.state.frame.turns_arcs_over(plane),
-        }
     }
 
     /// A feed move of `length` mm along `path`.
