@@ -163,7 +163,48 @@ impl MachineTimes {
     }
 }
 
+/// The figures a control's policy assumes where the machine description
+/// gives none, for [`Dynamics::joined_within_tolerance`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Assumed {
+    /// Feed and rapid ramps, mm/s².
+    pub acceleration: f64,
+    /// rpm/s.
+    pub spindle_acceleration: f64,
+    /// The interpolator tick (s) and chord error (mm) that bound arcs.
+    pub tick: f64,
+    pub chord_error: f64,
+    /// mm/s³ where the control limits the jerk.
+    pub jerk: Option<f64>,
+}
+
 impl Dynamics {
+    /// The policy of a control that joins every junction its program's
+    /// modes join and bounds each corner's speed by the step's corner
+    /// tolerance, with the ramps of the machine description, else
+    /// `assumed`.
+    pub fn joined_within_tolerance(machine: &MachineConfig, assumed: Assumed, terms: &'static Terms) -> Dynamics {
+        let configured = |value: Option<u32>, assumed| value.map_or(assumed, f64::from);
+        let feed_acceleration = configured(machine.feed_acceleration, assumed.acceleration);
+        Dynamics {
+            joining: Joining::Programmed,
+            tolerance_angle: 180.0,
+            tolerance_cosine: -1.0,
+            feed_acceleration,
+            continuity_acceleration: feed_acceleration,
+            rapid_acceleration: configured(machine.rapid_acceleration, assumed.acceleration),
+            times: MachineTimes::of(machine),
+            min_continuity: 0.0,
+            min_tight_joining: 0.0,
+            tick: assumed.tick,
+            chord_error: assumed.chord_error,
+            spindle_acceleration: configured(machine.spindle_acceleration, assumed.spindle_acceleration),
+            jerk: assumed.jerk,
+            envelope: None,
+            terms,
+        }
+    }
+
     /// `reason`, to be told in the control's terms.
     pub fn state(&self, reason: Reason) -> Stated {
         Stated { reason, terms: self.terms }

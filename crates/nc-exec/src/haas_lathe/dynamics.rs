@@ -40,7 +40,7 @@ use std::fmt;
 
 use crate::{
     machine::MachineConfig,
-    velocity::{Dynamics, Joining, MachineTimes, Reason, Terms},
+    velocity::{Assumed, Dynamics, Reason, Terms},
 };
 
 const ASSUMED_ACCELERATION: f64 = 1000.0;
@@ -53,27 +53,15 @@ const ASSUMED_LEVELS: [f64; 3] = [0.2, 0.05, 0.01];
 
 /// The velocity model's parameters for a Haas lathe `machine`.
 pub fn dynamics(machine: &MachineConfig) -> Dynamics {
-    let configured = |value: Option<u32>, assumed| value.map_or(assumed, f64::from);
-    let feed_acceleration = configured(machine.feed_acceleration, ASSUMED_ACCELERATION);
-    Dynamics {
-        // Every corner is joined; the corner tolerance bounds its speed.
-        joining: Joining::Programmed,
-        tolerance_angle: 180.0,
-        tolerance_cosine: -1.0,
-        feed_acceleration,
-        continuity_acceleration: feed_acceleration,
-        rapid_acceleration: configured(machine.rapid_acceleration, ASSUMED_ACCELERATION),
-        times: MachineTimes::of(machine),
-        min_continuity: 0.0,
-        min_tight_joining: 0.0,
+    let assumed = Assumed {
+        acceleration: ASSUMED_ACCELERATION,
+        spindle_acceleration: ASSUMED_SPINDLE_ACCELERATION,
         tick: ASSUMED_TICK,
         chord_error: ASSUMED_CHORD_ERROR,
-        spindle_acceleration: configured(machine.spindle_acceleration, ASSUMED_SPINDLE_ACCELERATION),
         // The manual names no jerk limit: linear ramps.
         jerk: None,
-        envelope: None,
-        terms: &TERMS,
-    }
+    };
+    Dynamics::joined_within_tolerance(machine, assumed, &TERMS)
 }
 
 /// Setting 85, the corner tolerance in mm without G187 or after a G187

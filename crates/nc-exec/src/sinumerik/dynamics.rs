@@ -53,7 +53,7 @@ use ncc_catalog::Dialect;
 use crate::{
     machine::MachineConfig,
     trace::PathMode,
-    velocity::{Dynamics, Joining, MachineTimes, Reason, Terms},
+    velocity::{Assumed, Dynamics, Reason, Terms},
 };
 
 const ASSUMED_ACCELERATION: f64 = 1000.0;
@@ -68,27 +68,14 @@ const ASSUMED_CONTOUR_TOLERANCE: f64 = 0.1;
 
 /// The velocity model's parameters for a Sinumerik `machine`.
 pub fn dynamics(machine: &MachineConfig) -> Dynamics {
-    let configured = |value: Option<u32>, assumed| value.map_or(assumed, f64::from);
-    let feed_acceleration = configured(machine.feed_acceleration, ASSUMED_ACCELERATION);
-    Dynamics {
-        // Every junction the modes join is joined; its tolerance bounds
-        // the corner's speed.
-        joining: Joining::Programmed,
-        tolerance_angle: 180.0,
-        tolerance_cosine: -1.0,
-        feed_acceleration,
-        continuity_acceleration: feed_acceleration,
-        rapid_acceleration: configured(machine.rapid_acceleration, ASSUMED_ACCELERATION),
-        times: MachineTimes::of(machine),
-        min_continuity: 0.0,
-        min_tight_joining: 0.0,
+    let assumed = Assumed {
+        acceleration: ASSUMED_ACCELERATION,
+        spindle_acceleration: ASSUMED_SPINDLE_ACCELERATION,
         tick: ASSUMED_TICK,
         chord_error: ASSUMED_CHORD_ERROR,
-        spindle_acceleration: configured(machine.spindle_acceleration, ASSUMED_SPINDLE_ACCELERATION),
         jerk: Some(ASSUMED_JERK),
-        envelope: None,
-        terms: &TERMS,
-    }
+    };
+    Dynamics::joined_within_tolerance(machine, assumed, &TERMS)
 }
 
 /// The continuous-path mode of group 10.
