@@ -3,8 +3,10 @@
 //! evaluation of the lowered expression trees, whose operator order the
 //! parser already settled.
 //!
-//! The variables ([`Store`]): the R parameters (the catalogue's count,
-//! `R5`, `R[expr]`), the names DEF declares with their type and array
+//! The variables ([`Store`]): the R parameters (`R5`, `R[expr]`; how
+//! many a control has is machine data, `$MN_MM_NUM_R_PARAM`, which the
+//! run does not know, and real programs use R999: every index below
+//! [`R_PARAMETER_LIMIT`] runs, the store growing to the highest written), the names DEF declares with their type and array
 //! dimensions, in scopes (a subprogram's DEFs are its own; a `VAR`
 //! formal parameter aliases the caller's variable or array element), and
 //! global user data (GUD), which the run creates when a program uses a
@@ -302,6 +304,10 @@ pub struct Store {
     scopes: Vec<Scope>,
 }
 
+/// One past the highest R parameter a run takes: a bound on the memory a
+/// computed index can claim, far above any machine's count (assumption).
+pub const R_PARAMETER_LIMIT: usize = 65_536;
+
 impl Default for Store {
     fn default() -> Self {
         Store::new()
@@ -309,8 +315,8 @@ impl Default for Store {
 }
 
 impl Store {
-    /// The R parameters of the catalogue's count, all 0, and the main
-    /// program's empty scope.
+    /// The R parameters of the catalogue's standard count, all 0, and the
+    /// main program's empty scope.
     pub fn new() -> Store {
         let count = Dialect::Sinumerik.catalogue().parameters.count as usize;
         Store {
@@ -511,11 +517,13 @@ impl Eval<'_> {
     fn parameter_index(&mut self, place: &Place, range: TextRange) -> Result<usize> {
         let Some(index) = place.indices.first() else { return Err(failed(range, "an R parameter needs its number")) };
         let number = self.value(index)?.int(index.range)?;
-        let count = self.store.parameters.len();
-        usize::try_from(number)
-            .ok()
-            .filter(|&n| n < count)
-            .ok_or_else(|| failed(range, format!("there is no R parameter R{number}: R0 to R{}", count - 1)))
+        let index = usize::try_from(number).ok().filter(|&n| n < R_PARAMETER_LIMIT).ok_or_else(|| {
+            failed(range, format!("there is no R parameter R{number}: R0 to R{}", R_PARAMETER_LIMIT - 1))
+        })?;
+        if index >= self.store.parameters.len() {
+            self.store.parameters.resize(index + 1, 0.0);
+        }
+        Ok(index)
     }
 
     /// The variable or element `place` names (a user variable).
@@ -621,10 +629,12 @@ impl Eval<'_> {
             .collect::<Result<_>>()?;
         if target.kind == PlaceKind::Parameter {
             let first = self.parameter_index(target, range)?;
-            let count = self.store.parameters.len();
-            let wanted = if repeat { count - first } else { values.len() };
-            if first + wanted > count {
+            let wanted = if repeat { self.store.parameters.len() - first } else { values.len() };
+            if first + wanted > R_PARAMETER_LIMIT {
                 return Err(failed(range, "the values go past the last R parameter"));
+            }
+            if first + wanted > self.store.parameters.len() {
+                self.store.parameters.resize(first + wanted, 0.0);
             }
             for offset in 0..wanted {
                 self.store.parameters[first + offset] = values[if repeat { 0 } else { offset }].number(range)?;

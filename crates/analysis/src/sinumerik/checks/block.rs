@@ -15,7 +15,7 @@ use crate::{
 declare_rules! {
     BLOCK_TOO_LONG = "K004", "block-too-long", Error, "A block longer than the 512 characters the control reads.";
     SAME_GROUP_IN_BLOCK = "K007", "same-group-in-block", Error, "Two codes of one modal group in a block (`G0 G1`, `G90 G91`, `BSPLINE G1`).";
-    R_PARAMETER_OUT_OF_RANGE = "K049", "r-parameter-out-of-range", Error, "An R parameter beyond the control's count (R0–R99 unless `[sinumerik] r-parameters` says otherwise).";
+    R_PARAMETER_OUT_OF_RANGE = "K049", "r-parameter-out-of-range", Error, "An R parameter beyond the control's count, where `[sinumerik] r-parameters` gives it (machine data $MN_MM_NUM_R_PARAM).";
     GROUP_NUMBER_NOT_CODE = "K050", "group-number-not-code", Warning, "`G[n]=1` where the group's first code is not G1: `G[1]=1` selects G0.";
     SYNC_ACTION_SHARES_BLOCK = "K055", "sync-action-shares-block", Error, "A synchronous action (`ID=1 WHENEVER … DO …`) with other statements in its block.";
     NUL_IN_STRING = "K056", "nul-in-string", Info, "A string with a NUL character, where the control cuts it off.";
@@ -37,7 +37,7 @@ pub(crate) fn check(block: &SinumerikBlock, text: &str, config: &Config) -> Vec<
     let mut out = Vec::new();
     length(text, &mut out);
     groups(catalogue, block, &mut out);
-    r_parameters(catalogue, block, config, &mut out);
+    r_parameters(block, config, &mut out);
     statements(catalogue, block, &mut out);
     spline_words(block, &mut out);
     for statement in &block.statements {
@@ -95,8 +95,9 @@ fn groups(catalogue: &Catalogue, block: &SinumerikBlock, out: &mut Vec<Diagnosti
 }
 
 /// Rule 49: every R parameter with a literal number, read or written.
-fn r_parameters(catalogue: &Catalogue, block: &SinumerikBlock, config: &Config, out: &mut Vec<Diagnostic>) {
-    let count = config.sinumerik.r_parameters.unwrap_or(catalogue.parameters.count);
+fn r_parameters(block: &SinumerikBlock, config: &Config, out: &mut Vec<Diagnostic>) {
+    // The count is machine data: without it, any index may be the control's.
+    let Some(count) = config.sinumerik.r_parameters else { return };
     let mut check = |kind: PlaceKind, indices: &[Expr]| {
         let [Expr { kind: ExprKind::Number(number), range }] = indices else { return };
         if kind != PlaceKind::Parameter {

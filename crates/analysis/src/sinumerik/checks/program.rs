@@ -32,7 +32,7 @@ use crate::{
 };
 
 declare_rules! {
-    INVALID_PROGRAM_NAME = "K039", "invalid-program-name", Error, "A program name (PROC, `%_N_…_MPF`) that does not start with two letters, holds other characters than letters, digits and `_`, or is longer than 31 characters.";
+    INVALID_PROGRAM_NAME = "K039", "invalid-program-name", Error, "A program name (PROC, `%_N_…_MPF`) that does not start with two letters or underscores, holds other characters than letters, digits and `_`, or is longer than 31 characters.";
     NESTING_TOO_DEEP = "K042", "nesting-too-deep", Error, "Control structures nested deeper than 16 levels.";
     PROC_NOT_FIRST = "K043", "proc-not-first", Error, "A PROC line that is not the program's first statement.";
     DEFINITION_AFTER_STATEMENT = "K044", "definition-after-statement", Error, "A DEF or EXTERN after the program's first statement that declares nothing.";
@@ -119,8 +119,10 @@ fn name_problem(catalogue: &Catalogue, name: &str) -> Option<String> {
     if chars > MAX_NAME_CHARS {
         return Some(format!("the program name {name} has {chars} characters: at most {MAX_NAME_CHARS}"));
     }
-    if !name.chars().take(2).all(|c| c.is_ascii_alphabetic()) {
-        return Some(format!("the program name {name} must start with two letters"));
+    // The thesis says two letters (004:1446); Siemens's own cycles start
+    // `L_…` and `_…`, which its documentation allows: letters or `_`.
+    if !name.chars().take(2).all(|c| c.is_ascii_alphabetic() || c == '_') {
+        return Some(format!("the program name {name} must start with two letters or underscores"));
     }
     if let Some(bad) = name.chars().find(|c| !(c.is_ascii_alphanumeric() || *c == '_')) {
         return Some(format!("the program name {name} holds `{bad}`: only letters, digits and `_` may follow"));

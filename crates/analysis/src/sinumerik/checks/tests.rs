@@ -52,8 +52,9 @@ fn an_edit_lowers_and_checks_only_its_chunk() {
         text.push_str(&format!("N{n} G1 X{n}.5 Y=DEPTH F200\n"));
     }
     text.push_str("M17\n");
-    let mut host =
-        AnalysisHost::with_database(RootDatabase::with_execution_log(), Dialect::Sinumerik, Config::default());
+    let mut config = Config::default();
+    config.sinumerik.r_parameters = Some(100);
+    let mut host = AnalysisHost::with_database(RootDatabase::with_execution_log(), Dialect::Sinumerik, config);
     let file = host.add_file("LONG.SPF", text.as_str());
     assert!(host.analysis().diagnostics(file).is_empty(), "{:#?}", host.analysis().diagnostics(file));
     let first = host.db().take_executions();

@@ -169,8 +169,12 @@ fn real_equality_is_relative() {
 fn parameters_take_computed_indices_and_stay_in_range() {
     assert_eq!(value_after("R2=3\nR[R2+1]=7\n", "R4*2").unwrap(), Value::Real(14.0));
     assert_eq!(value_after("R99=1\n", "R99").unwrap(), Value::Real(1.0));
-    let outside = value_after("R[100]=1\n", "R1").expect_err("R100");
-    assert_eq!(outside.message, "there is no R parameter R100: R0 to R99");
+    // Machines have more than the standard 100: R999 runs.
+    assert_eq!(value_after("R999=4\n", "R999+R998").unwrap(), Value::Real(4.0));
+    assert_eq!(value_after("R[500]=SET(1,2)\n", "R501").unwrap(), Value::Real(2.0));
+    let outside = value_after("R[65536]=1\n", "R1").expect_err("R65536");
+    assert_eq!(outside.message, "there is no R parameter R65536: R0 to R65535");
+    assert!(value_after("R[-1]=1\n", "R1").is_err());
 }
 
 #[test]
