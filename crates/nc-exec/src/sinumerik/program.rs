@@ -158,14 +158,14 @@ impl SinumerikModel {
                 model.block_numbers.entry(number).or_default().push(index);
             }
         }
-        let mut open: Vec<Open> = Vec::new();
+        let mut open = Opened::default();
         for (index, block) in blocks.enumerate() {
             for statement in &block.statements {
                 model.structure(&mut open, index, &statement.kind);
                 model.declarations_and_calls(index, &statement.kind);
             }
         }
-        model.unmatched.extend(open.into_iter().map(|o| Unmatched {
+        model.unmatched.extend(open.structures.into_iter().map(|o| Unmatched {
             block: o.start,
             kind: o.kind,
             problem: Unbalanced::NotClosed,
@@ -208,7 +208,34 @@ impl SinumerikModel {
         found.map_or(Resolved::NotFound { alarm: jump.kind != JumpKind::GotoC }, Resolved::Block)
     }
 
-    fn structure(&mut self, open: &mut Vec<Open>, block: usize, statement: &StatementKind) {
+    fn structure(&mut self, state: &mut Opened, block: usize, statement: &StatementKind) {
+        // Controls' own cycles close a one-line conditional jump with an
+        // ENDIF: the next structure statement after it, if an ENDIF, pairs
+        // with it (the control runs the pair as the jump alone).
+        match statement {
+            StatementKind::If { jump: Some(_), .. } => {
+                state.jump_if = Some(block);
+                return;
+            }
+            StatementKind::EndIf if let Some(start) = state.jump_if.take() => {
+                let depth = state.structures.len() + 1;
+                self.structures.push(Structure { kind: StructureKind::If, start, middle: None, end: block, depth });
+                return;
+            }
+            StatementKind::If { .. }
+            | StatementKind::Else
+            | StatementKind::EndIf
+            | StatementKind::While(_)
+            | StatementKind::EndWhile
+            | StatementKind::For { .. }
+            | StatementKind::EndFor
+            | StatementKind::Repeat
+            | StatementKind::Until(_)
+            | StatementKind::Loop
+            | StatementKind::EndLoop => state.jump_if = None,
+            _ => return,
+        }
+        let open = &mut state.structures;
         let start = |kind| Some(Open { kind, start: block, middle: None });
         let opened = match statement {
             StatementKind::If { jump: None, .. } => start(StructureKind::If),
@@ -298,6 +325,14 @@ struct Open {
     kind: StructureKind,
     start: usize,
     middle: Option<usize>,
+}
+
+/// The structures open while the model is built, and a one-line
+/// conditional jump with no structure statement after it yet.
+#[derive(Default)]
+struct Opened {
+    structures: Vec<Open>,
+    jump_if: Option<usize>,
 }
 
 #[cfg(test)]

@@ -310,6 +310,36 @@ fn unbalanced_structures_are_listed() {
     );
 }
 
+/// Siemens's own cycles close a one-line conditional jump with ENDIF,
+/// words and comments between them; the documented form without ENDIF
+/// stays a jump of its own, inside a block IF too.
+#[test]
+fn an_endif_after_a_one_line_jump_closes_it() {
+    check(
+        "IF R1==1 GOTOF END\n\
+         ENDIF\n\
+         IF R1==2 GOTOF END\n\
+         H41=5 ; a comment\n\
+         ENDIF\n\
+         IF R2\n\
+         IF R1==3 GOTOF END\n\
+         WHILE R3<2\n\
+         ENDWHILE\n\
+         ENDIF\n\
+         END:\n",
+        expect![[r#"
+            label END at [11]
+            If 1..2 depth 1
+            If 3..5 depth 1
+            While 8..9 depth 2
+            If 6..10 depth 1
+            GotoF at 1 -> line 11
+            GotoF at 3 -> line 11
+            GotoF at 7 -> line 11
+        "#]],
+    );
+}
+
 #[test]
 fn jumps_search_in_their_direction() {
     check(
@@ -377,7 +407,9 @@ proptest::proptest! {
         // Every start and every end is in a structure or listed unmatched.
         let count = |of: &[&str]| lines.iter().filter(|line| of.contains(line)).count();
         let problems = |problem| model.unmatched.iter().filter(|u| u.problem == problem).count();
-        let starts = count(&["IF R1", "WHILE R1", "FOR R1=1 TO 2", "REPEAT", "LOOP"]);
+        // A one-line jump starts a structure where an ENDIF closes it.
+        let closed_jumps = model.structures.iter().filter(|s| lines[s.start] == "IF R1 GOTOB AB").count();
+        let starts = count(&["IF R1", "WHILE R1", "FOR R1=1 TO 2", "REPEAT", "LOOP"]) + closed_jumps;
         let ends = count(&["ENDIF", "ENDWHILE", "ENDFOR", "UNTIL R1", "ENDLOOP"]);
         proptest::prop_assert_eq!(starts, model.structures.len() + problems(Unbalanced::NotClosed));
         proptest::prop_assert_eq!(ends, model.structures.len() + problems(Unbalanced::NotOpened));
