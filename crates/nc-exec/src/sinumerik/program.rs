@@ -210,14 +210,18 @@ impl SinumerikModel {
 
     fn structure(&mut self, state: &mut Opened, block: usize, statement: &StatementKind) {
         // Controls' own cycles close a one-line conditional jump with an
-        // ENDIF: the next structure statement after it, if an ENDIF, pairs
-        // with it (the control runs the pair as the jump alone).
+        // ENDIF: the next structure statement after it, if an ENDIF that no
+        // open IF takes, pairs with it (the control runs the pair as the
+        // jump alone). An open IF takes the ENDIF, as cycles also write.
         match statement {
             StatementKind::If { jump: Some(_), .. } => {
                 state.jump_if = Some(block);
                 return;
             }
-            StatementKind::EndIf if let Some(start) = state.jump_if.take() => {
+            StatementKind::EndIf
+                if let Some(start) = state.jump_if.take()
+                    && !state.structures.iter().any(|open| open.kind == StructureKind::If) =>
+            {
                 let depth = state.structures.len() + 1;
                 self.structures.push(Structure { kind: StructureKind::If, start, middle: None, end: block, depth });
                 return;

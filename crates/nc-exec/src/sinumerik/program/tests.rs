@@ -311,8 +311,9 @@ fn unbalanced_structures_are_listed() {
 }
 
 /// Siemens's own cycles close a one-line conditional jump with ENDIF,
-/// words and comments between them; the documented form without ENDIF
-/// stays a jump of its own, inside a block IF too.
+/// words and comments between them, where no block IF is open; the
+/// documented form without ENDIF stays a jump of its own, and an open
+/// block IF takes the ENDIF after one.
 #[test]
 fn an_endif_after_a_one_line_jump_closes_it() {
     check(
@@ -326,16 +327,21 @@ fn an_endif_after_a_one_line_jump_closes_it() {
          WHILE R3<2\n\
          ENDWHILE\n\
          ENDIF\n\
+         IF R4\n\
+         IF R1==4 GOTOF END\n\
+         ENDIF\n\
          END:\n",
         expect![[r#"
-            label END at [11]
+            label END at [14]
             If 1..2 depth 1
             If 3..5 depth 1
             While 8..9 depth 2
             If 6..10 depth 1
-            GotoF at 1 -> line 11
-            GotoF at 3 -> line 11
-            GotoF at 7 -> line 11
+            If 11..13 depth 1
+            GotoF at 1 -> line 14
+            GotoF at 3 -> line 14
+            GotoF at 7 -> line 14
+            GotoF at 12 -> line 14
         "#]],
     );
 }
