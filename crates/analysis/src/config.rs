@@ -32,7 +32,7 @@
 //! tool-change-ms = 6000                   # M06
 //! look-ahead-blocks = 500                 # envelope velocity (CNC8x9): blocks planned ahead
 //! envelope-tick-us = 2000                 # envelope velocity: interpolator tick Ts
-//! feed-acceleration = 1000                # Haas lathe: mm/s², working feed
+//! feed-acceleration = 1000                # Haas lathe, Sinumerik: mm/s², working feed
 //! rapid-acceleration = 1000               # Haas lathe: mm/s², G00
 //! spindle-acceleration = 1000             # Haas lathe: rpm/s
 //! corner-rounding = "0.05"                # Haas lathe: Setting 85, mm
@@ -311,16 +311,18 @@ impl MachineFile {
             machine.envelope_tick_us = tick;
         }
         let haas = machine.control == Dialect::HaasLathe;
-        let haas_dynamics = [
+        // The Haas lathe and Sinumerik policies read their ramps from here.
+        let reads_ramps = haas || machine.control == Dialect::Sinumerik;
+        let ramps = [
             ("feed-acceleration", self.feed_acceleration, &mut machine.feed_acceleration),
             ("rapid-acceleration", self.rapid_acceleration, &mut machine.rapid_acceleration),
             ("spindle-acceleration", self.spindle_acceleration, &mut machine.spindle_acceleration),
         ];
-        for (key, value, slot) in haas_dynamics {
+        for (key, value, slot) in ramps {
             let Some(value) = value else { continue };
-            if !haas {
+            if !reads_ramps {
                 return Err(format!(
-                    "{origin}: {section}{key} describes a Haas lathe (dialect = \"haas-lathe\"); a CNC8x6 reads its ramps from R52, R236 and R237"
+                    "{origin}: {section}{key} describes a Haas lathe or a Sinumerik machine; a CNC8x6 reads its ramps from R52, R236 and R237"
                 ));
             }
             if value == 0 {
@@ -683,6 +685,9 @@ mod tests {
         }
         let error = load("[machine]\nrapid-acceleration = 1000\n", &[]).unwrap_err();
         assert!(error.contains("R52, R236 and R237"), "{error}");
+        // A Sinumerik machine's policy reads the ramps too.
+        let sinumerik = load("dialect = \"sinumerik\"\n[machine]\nfeed-acceleration = 700\n", &[]).unwrap().machine;
+        assert_eq!(sinumerik.feed_acceleration, Some(700));
         let error = load("[machine]\ncorner-rounding = \"0.1\"\n", &[]).unwrap_err();
         assert!(error.contains("Setting 85"), "{error}");
     }
