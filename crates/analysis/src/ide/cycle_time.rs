@@ -16,7 +16,7 @@ use nc_exec::{
     run::{Called, Checkpoint, Environment, Motion, Step, Totals, shift_count, shift_offset, shift_range},
     velocity::{self, Break, Stated, Timer, TimerState, TimingSink},
 };
-use ncc_syntax::{BlockParser, SyntaxNode, TextRange, TextSize, ast::AstNode};
+use ncc_syntax::{BlockParser, Dialect, SyntaxNode, TextRange, TextSize, ast::AstNode};
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
@@ -200,14 +200,14 @@ pub(crate) fn run_input(db: &dyn Db, file: SourceFile) -> Option<RunInput> {
         }
     }
     let machine = &settings.config(db).machine;
-    if *settings.dialect(db) == ncc_syntax::Dialect::HaasLathe {
+    if *settings.dialect(db) == Dialect::HaasLathe {
         for &other in settings.files(db) {
             if let Some(number) = ncc_catalog::program_file_number(Path::new(other.path(db))) {
                 files.programs.entry(number).or_insert_with(|| (other.path(db).clone(), other.text(db).clone()));
             }
         }
     }
-    if *settings.dialect(db) == ncc_syntax::Dialect::Sinumerik {
+    if *settings.dialect(db) == Dialect::Sinumerik {
         let others = settings.files(db).iter().filter(|&&other| other != file);
         files.control_files = others.map(|other| (other.path(db).clone(), other.text(db).clone())).collect();
     }
@@ -726,7 +726,11 @@ impl Estimate {
             if block.total <= 0.0 {
                 continue;
             }
-            let offset = hint_offset(&mut blocks, block.range);
+            let offset = match self.machine.control {
+                Dialect::Cnc8x6 => hint_offset(&mut blocks, block.range),
+                // One line is one block.
+                Dialect::HaasLathe | Dialect::Sinumerik => line_end(&self.text, block.range),
+            };
             // A block that ends where the range starts has its hints on
             // the line before.
             if range.is_some_and(|range| !range.contains_inclusive(offset)) {
@@ -831,6 +835,14 @@ impl BreakAt {
 fn hint_offset(blocks: &mut BlockParser<'_>, range: TextRange) -> TextSize {
     let block = blocks.block_at(range.start().into());
     block.map_or(range.end(), |(_, block)| range.start() + content_end(&SyntaxNode::new_root(block)))
+}
+
+/// The end of the first line of the block at `range`, before its line
+/// break.
+fn line_end(text: &str, range: TextRange) -> TextSize {
+    let line = text.get(usize::from(range.start())..usize::from(range.end())).unwrap_or_default();
+    let content = line.find(['\r', '\n']).unwrap_or(line.len());
+    range.start() + TextSize::new(content as u32)
 }
 
 /// Hours, minutes and seconds of a non-negative time.
@@ -1233,7 +1245,7 @@ mod tests {
     /// in the workspace, as the editor has it.
     #[test]
     fn a_haas_program_runs_the_program_files_of_the_workspace() {
-        let mut host = AnalysisHost::in_dialect(ncc_syntax::Dialect::HaasLathe, Config::default());
+        let mut host = AnalysisHost::in_dialect(Dialect::HaasLathe, Config::default());
         let file = host.add_file("/p/main.nc", "O1\nM98 P1000\nM30\n");
         host.add_file("/p/O01000.nc", "O1000\nG98 G01 W-10. F600.\nM99\n");
         host.add_file("/p/other.nc", "O2\nM30\n");
@@ -1245,11 +1257,27 @@ mod tests {
         assert!(total >= 1.0, "{total}");
     }
 
+    /// In a dialect whose lines are blocks, a block's hints stand at the
+    /// end of its own line, not after the lines below it.
+    #[test]
+    fn hints_of_a_line_dialect_stand_on_the_blocks_line() {
+        let machine = MachineConfig::of_control(Dialect::Sinumerik);
+        let text = Arc::new("G0 X10 Z2 ; in\nR1=5\nG1 X20 F600\nM30\n".to_owned());
+        let estimate = estimate(None, &text, &WorkspaceFiles::default(), &machine, 1000);
+        let lines: Vec<&str> = estimate
+            .inlay_hints(None, CycleTimeHints::PerBlock)
+            .iter()
+            .filter(|hint| hint.kind == InlayHintKind::BlockTime)
+            .map(|hint| text[..usize::from(hint.offset)].lines().last().unwrap_or_default())
+            .collect();
+        assert_eq!(lines, ["G0 X10 Z2 ; in", "G1 X20 F600"]);
+    }
+
     /// A Haas lathe estimate knows its input: an edit of another file
     /// does not run it again.
     #[test]
     fn a_haas_estimate_holds_for_its_input() {
-        let machine = MachineConfig::of_control(ncc_syntax::Dialect::HaasLathe);
+        let machine = MachineConfig::of_control(Dialect::HaasLathe);
         let text = Arc::new("O1\nG98 G01 X20. Z-10. F100.\nM30\n".to_owned());
         let files = WorkspaceFiles::default();
         let first = estimate(None, &text, &files, &machine, 1000);
@@ -1280,7 +1308,7 @@ mod tests {
     }
 
     fn haas_estimate_of(text: &str, previous: Option<&Estimate>) -> Estimate {
-        let machine = MachineConfig::of_control(ncc_syntax::Dialect::HaasLathe);
+        let machine = MachineConfig::of_control(Dialect::HaasLathe);
         estimate(previous, &Arc::new(text.to_owned()), &WorkspaceFiles::default(), &machine, 1_000_000)
     }
 
