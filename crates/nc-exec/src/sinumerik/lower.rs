@@ -493,6 +493,27 @@ pub enum ProgramEnd {
 const END_CODES: [(u64, ProgramEnd); 3] =
     [(2, ProgramEnd::Program), (17, ProgramEnd::Subprogram), (30, ProgramEnd::Program)];
 
+impl StatementKind {
+    /// Whether the statement opens, continues or closes a control
+    /// structure; a one-line `IF … GOTOF` does not.
+    pub fn is_structure(&self) -> bool {
+        matches!(
+            self,
+            StatementKind::If { jump: None, .. }
+                | StatementKind::Else
+                | StatementKind::EndIf
+                | StatementKind::While(_)
+                | StatementKind::EndWhile
+                | StatementKind::For { .. }
+                | StatementKind::EndFor
+                | StatementKind::Repeat
+                | StatementKind::Until(_)
+                | StatementKind::Loop
+                | StatementKind::EndLoop
+        )
+    }
+}
+
 impl SinumerikBlock {
     /// Lowers a `BLOCK` green node of the Sinumerik parser.
     pub fn lower(block: &GreenNodeData) -> SinumerikBlock {

@@ -226,17 +226,7 @@ impl SinumerikModel {
                 self.structures.push(Structure { kind: StructureKind::If, start, middle: None, end: block, depth });
                 return;
             }
-            StatementKind::If { .. }
-            | StatementKind::Else
-            | StatementKind::EndIf
-            | StatementKind::While(_)
-            | StatementKind::EndWhile
-            | StatementKind::For { .. }
-            | StatementKind::EndFor
-            | StatementKind::Repeat
-            | StatementKind::Until(_)
-            | StatementKind::Loop
-            | StatementKind::EndLoop => state.jump_if = None,
+            kind if kind.is_structure() => state.jump_if = None,
             _ => return,
         }
         let open = &mut state.structures;

@@ -191,22 +191,7 @@ fn structure_name(kind: StructureKind) -> (&'static str, &'static str) {
 /// The range of the statement of block `index` that opens, continues or
 /// closes a structure, else the block's.
 fn structure_range(file: &FileModel, index: usize) -> TextRange {
-    let statement = file.block(index).statements.iter().find(|s| {
-        matches!(
-            s.kind,
-            StatementKind::If { jump: None, .. }
-                | StatementKind::Else
-                | StatementKind::EndIf
-                | StatementKind::While(_)
-                | StatementKind::EndWhile
-                | StatementKind::For { .. }
-                | StatementKind::EndFor
-                | StatementKind::Repeat
-                | StatementKind::Until(_)
-                | StatementKind::Loop
-                | StatementKind::EndLoop
-        )
-    });
+    let statement = file.block(index).statements.iter().find(|s| s.kind.is_structure());
     file.in_file(index, statement.map_or_else(TextRange::default, |s| s.range))
 }
 
