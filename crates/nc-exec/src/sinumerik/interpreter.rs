@@ -1061,11 +1061,7 @@ impl<'a> Interpreter<'a> {
         mut end: Position,
         ccw: bool,
     ) -> Option<(Path, Position)> {
-        let (a, b) = match self.state.modes.get(PLANE) {
-            Some("G18") => (b'Z', b'X'),
-            Some("G19") => (b'Y', b'Z'),
-            _ => (b'X', b'Y'),
-        };
+        let [a, b, _] = self.plane().axes().map(|axis| XYZ[axis]);
         let from = [start[slot(a)], start[slot(b)]];
         let centre_word = |letter: u8| words.centre[usize::from(letter - b'X')];
         let centre = match (centre_word(a), centre_word(b)) {

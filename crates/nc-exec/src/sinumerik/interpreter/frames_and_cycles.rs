@@ -162,7 +162,7 @@ impl Interpreter<'_> {
         if self.state.frame.is_identity() {
             return path;
         }
-        let plane = Plane::from_code(self.state.modes.get(PLANE).unwrap_or("G17")).unwrap_or_default();
+        let plane = self.plane();
         if !self.state.frame.keeps_plane(plane) {
             let what = "an arc in a frame that makes its circle an ellipse or turns it out of its plane (run straight)";
             self.state.not_run(what, range);
