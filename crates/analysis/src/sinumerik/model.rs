@@ -50,9 +50,11 @@ impl FileModel {
         &self.chunks[chunk][index - self.firsts[chunk]]
     }
 
-    /// Every block, in order.
-    pub fn blocks(&self) -> impl Iterator<Item = &SinumerikBlock> + Clone {
-        self.chunks.iter().flat_map(|chunk| chunk.iter())
+    /// Every block, in order. A walk over a large file is one long query:
+    /// each block read is a point where an edit waiting to change the
+    /// inputs cancels it (an atomic load).
+    pub fn blocks<'a>(&'a self, db: &'a dyn Db) -> impl Iterator<Item = &'a SinumerikBlock> + Clone {
+        self.chunks.iter().flat_map(|chunk| chunk.iter()).inspect(move |_| db.unwind_if_revision_cancelled())
     }
 
     /// A range of block `index` (block-relative) in the file.
@@ -82,6 +84,8 @@ pub(crate) fn file_model(db: &dyn Db, file: SourceFile) -> FileModel {
         }
         chunks.push(blocks.clone());
     }
-    let model = SinumerikModel::new(chunks.iter().flat_map(|chunk| chunk.iter()));
+    // Cancellable at each block, as `FileModel::blocks`.
+    let blocks = chunks.iter().flat_map(|chunk| chunk.iter()).inspect(|_| db.unwind_if_revision_cancelled());
+    let model = SinumerikModel::new(blocks);
     FileModel { ranges, chunks, firsts, model }
 }

@@ -79,9 +79,9 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
             signatures.entry(proc.declaration.name.as_str()).or_insert((other.path(db).as_str(), other_model, proc));
         }
     }
-    let mut diagnostics = program::check(model);
-    diagnostics.extend(names::check(model, text, config));
-    diagnostics.extend(types::check(model, &signatures));
+    let mut diagnostics = program::check(db, model);
+    diagnostics.extend(names::check(db, model, text, config));
+    diagnostics.extend(types::check(db, model, &signatures));
     findings::sort_diagnostics(&mut diagnostics);
     Findings { diagnostics, omitted: Vec::new() }
 }

@@ -16,6 +16,7 @@ use ncc_syntax::{TextRange, TextSize};
 
 use crate::{
     Config, Diagnostic,
+    db::Db,
     diagnostic::declare_rules,
     sinumerik::{
         checks::visit::{each_expr, statement_exprs, written_places},
@@ -46,15 +47,15 @@ struct Occurrence<'a> {
     used: Use,
 }
 
-pub(crate) fn check(file: &FileModel, text: &str, config: &Config) -> Vec<Diagnostic> {
+pub(crate) fn check(db: &dyn Db, file: &FileModel, text: &str, config: &Config) -> Vec<Diagnostic> {
     let catalogue = Dialect::Sinumerik.catalogue();
-    let occurrences = occurrences(file, text);
+    let occurrences = occurrences(db, file, text);
     let mut declared: HashSet<&str> = file.model.labels.keys().map(String::as_str).collect();
     declared.extend(file.model.definitions.iter().map(|d| d.declared.name.as_str()));
     for proc in &file.model.procs {
         declared.extend(proc.declaration.parameters.iter().filter_map(|p| p.name.as_deref()));
     }
-    for block in file.blocks() {
+    for block in file.blocks(db) {
         for statement in &block.statements {
             if let StatementKind::Define { name, .. } = &statement.kind {
                 declared.insert(name);
@@ -76,7 +77,7 @@ pub(crate) fn check(file: &FileModel, text: &str, config: &Config) -> Vec<Diagno
     }
     named_like_address(catalogue, config, &occurrences, &mut out);
     unused_variables(file, &occurrences, &mut out);
-    unused_labels(file, &mut out);
+    unused_labels(db, file, &mut out);
     cases(text, &occurrences, &mut out);
     out
 }
@@ -100,9 +101,9 @@ fn name_at(text: &str, start: TextSize, name: &str) -> Option<TextRange> {
 }
 
 /// Every declaration, read and write of a user name, in file order.
-fn occurrences<'a>(file: &'a FileModel, text: &str) -> Vec<Occurrence<'a>> {
+fn occurrences<'a>(db: &'a dyn Db, file: &'a FileModel, text: &str) -> Vec<Occurrence<'a>> {
     let mut all = Vec::new();
-    for (index, block) in file.blocks().enumerate() {
+    for (index, block) in file.blocks(db).enumerate() {
         let mut push = |name: &'a str, start: TextSize, used: Use| {
             let start = file.in_file(index, TextRange::empty(start)).start();
             if let Some(range) = name_at(text, start, name) {
@@ -192,7 +193,7 @@ fn unused_variables(file: &FileModel, occurrences: &[Occurrence<'_>], out: &mut 
 
 /// Labels no jump names; none when a jump computes its target, which
 /// may name any of them.
-fn unused_labels(file: &FileModel, out: &mut Vec<Diagnostic>) {
+fn unused_labels(db: &dyn Db, file: &FileModel, out: &mut Vec<Diagnostic>) {
     let mut named: HashSet<&str> = HashSet::new();
     for site in &file.model.jumps {
         match &site.jump.target {
@@ -203,7 +204,7 @@ fn unused_labels(file: &FileModel, out: &mut Vec<Diagnostic>) {
             _ => {}
         }
     }
-    for block in file.blocks() {
+    for block in file.blocks(db) {
         for statement in &block.statements {
             match &statement.kind {
                 StatementKind::RepeatSection { start, end, .. } => {

@@ -27,6 +27,7 @@ use ncc_syntax::{TextEdit, TextRange, TextSize};
 
 use crate::{
     Diagnostic,
+    db::Db,
     diagnostic::declare_rules,
     sinumerik::{checks::visit::number, model::FileModel},
 };
@@ -74,21 +75,21 @@ const MODES_OFF_AT_END: [&str; 2] = ["TOROT", "FFWON"];
 const COMPRESSOR: &str = "COMPCAD";
 const SPLINE: &str = "BSPLINE";
 
-pub(crate) fn check(file: &FileModel) -> Vec<Diagnostic> {
+pub(crate) fn check(db: &dyn Db, file: &FileModel) -> Vec<Diagnostic> {
     let catalogue = Dialect::Sinumerik.catalogue();
     let mut out = Vec::new();
-    names(catalogue, file, &mut out);
-    declarations(file, &mut out);
+    names(db, catalogue, file, &mut out);
+    declarations(db, file, &mut out);
     structures(file, &mut out);
     jumps(file, &mut out);
-    modes_at_end(catalogue, file, &mut out);
-    Motion::check(catalogue, file, &mut out);
+    modes_at_end(db, catalogue, file, &mut out);
+    Motion::check(db, catalogue, file, &mut out);
     out
 }
 
 /// Rule 39: the names the program gives itself.
-fn names(catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnostic>) {
-    for (index, block) in file.blocks().enumerate() {
+fn names(db: &dyn Db, catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnostic>) {
+    for (index, block) in file.blocks(db).enumerate() {
         if let Some(header) = &block.header {
             let name = header.name.strip_prefix("_N_").and_then(|n| n.strip_suffix("_MPF").or(n.strip_suffix("_SPF")));
             if let Some(problem) = name.and_then(|name| name_problem(catalogue, name)) {
@@ -139,11 +140,11 @@ fn declares(kind: &StatementKind) -> bool {
 }
 
 /// Rules 43, 44 and 47.
-fn declarations(file: &FileModel, out: &mut Vec<Diagnostic>) {
+fn declarations(db: &dyn Db, file: &FileModel, out: &mut Vec<Diagnostic>) {
     let mut first_statement = true;
     let mut acted: Option<(usize, TextRange)> = None;
     let save = file.model.header().is_some_and(|proc| proc.declaration.attributes.iter().any(|a| a == "SAVE"));
-    for (index, block) in file.blocks().enumerate() {
+    for (index, block) in file.blocks(db).enumerate() {
         for statement in &block.statements {
             let range = file.in_file(index, statement.range);
             match &statement.kind {
@@ -319,13 +320,13 @@ impl<'a> Enclosing<'a> {
 
 /// Rules 68 and 69: the switches still on at the last block that ends
 /// the program.
-fn modes_at_end(catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnostic>) {
+fn modes_at_end(db: &dyn Db, catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnostic>) {
     let mut transformation: Option<(String, TextRange)> = None;
     let groups: Vec<Option<&str>> =
         MODES_OFF_AT_END.iter().map(|word| catalogue.word_code(word).and_then(|c| c.group.as_deref())).collect();
     let mut modes: Vec<Option<TextRange>> = vec![None; MODES_OFF_AT_END.len()];
     let mut at_end = None;
-    for (index, block) in file.blocks().enumerate() {
+    for (index, block) in file.blocks(db).enumerate() {
         for statement in &block.statements {
             let StatementKind::Command(command) = &statement.kind else { continue };
             let range = file.in_file(index, statement.range);
@@ -376,7 +377,7 @@ struct Motion<'a> {
 }
 
 impl Motion<'_> {
-    fn check(catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnostic>) {
+    fn check(db: &dyn Db, catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnostic>) {
         let mut motion = Motion {
             catalogue,
             motion: "",
@@ -389,7 +390,7 @@ impl Motion<'_> {
         };
         let motion_group = catalogue.word_code(SPLINE).and_then(|c| c.group.clone());
         let compressor_group = catalogue.word_code(COMPRESSOR).and_then(|c| c.group.clone());
-        for (index, block) in file.blocks().enumerate() {
+        for (index, block) in file.blocks(db).enumerate() {
             motion.codes(file, index, block, motion_group.as_deref(), compressor_group.as_deref());
             motion.moves(file, index, block, out);
         }

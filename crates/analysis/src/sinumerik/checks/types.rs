@@ -25,6 +25,7 @@ use ncc_syntax::TextRange;
 
 use crate::{
     Diagnostic,
+    db::Db,
     diagnostic::declare_rules,
     sinumerik::{checks::visit::statement_exprs, model::FileModel},
 };
@@ -122,7 +123,7 @@ pub(crate) fn program_name(name: &str) -> &str {
     name.strip_prefix("_N_").and_then(|n| n.strip_suffix("_SPF").or_else(|| n.strip_suffix("_MPF"))).unwrap_or(name)
 }
 
-pub(crate) fn check(file: &FileModel, signatures: &Signatures<'_>) -> Vec<Diagnostic> {
+pub(crate) fn check(db: &dyn Db, file: &FileModel, signatures: &Signatures<'_>) -> Vec<Diagnostic> {
     let catalogue = Dialect::Sinumerik.catalogue();
     let mut variables: HashMap<&str, &Type> = HashMap::new();
     for proc in &file.model.procs {
@@ -137,7 +138,7 @@ pub(crate) fn check(file: &FileModel, signatures: &Signatures<'_>) -> Vec<Diagno
     }
     let types = Types { catalogue, variables, known: RefCell::default() };
     let mut out = Vec::new();
-    for (index, block) in file.blocks().enumerate() {
+    for (index, block) in file.blocks(db).enumerate() {
         let offset = file.ranges[index].start();
         for statement in &block.statements {
             let mut found = Vec::new();
