@@ -659,7 +659,7 @@ impl<'a> Interpreter<'a> {
                 }
                 StatementKind::EndLoop => flow = self.structure_back(at.block, StructureKind::Loop, unit, range, 1),
                 StatementKind::RepeatSection { start, end, count } => {
-                    flow = self.repeat_section(at, unit, start, end.as_deref(), count.as_ref(), range);
+                    flow = self.repeat_section(at, unit, start, end.as_deref(), count.as_deref(), range);
                 }
                 StatementKind::Case { selector, arms } => flow = self.case(at.block, selector, arms, unit),
             }

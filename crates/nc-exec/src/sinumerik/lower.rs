@@ -80,6 +80,11 @@ pub struct Statement {
     pub range: TextRange,
 }
 
+// The statements are most of a lowered program's memory, and a CAM
+// program's are words: the rare large statements keep their expressions
+// boxed, so that a word does not take the room of a FOR.
+const _: () = assert!(std::mem::size_of::<Statement>() <= 88);
+
 #[derive(Debug, Clone, PartialEq)]
 pub enum StatementKind {
     /// An address with its value: `X10`, `X=R1`, `A3=1`, `CR=10`.
@@ -87,7 +92,7 @@ pub enum StatementKind {
     /// `R1=5`, `R[R2]=0`, `VAC_POLE[0,1]=SET(…)`, `$TC_DP1[1,1]=120`, `G[8]=2`.
     Assign {
         target: Place,
-        value: Expr,
+        value: Box<Expr>,
     },
     /// A code or keyword of the catalogue written as a name (`TRAORI`,
     /// `BSPLINE`, `STOPRE`), with its arguments and, for a frame, its words.
@@ -100,7 +105,7 @@ pub enum StatementKind {
     Return {
         arguments: Vec<Option<Expr>>,
     },
-    Def(Def),
+    Def(Box<Def>),
     Proc(Proc),
     Extern(Extern),
     /// `DEFINE name AS text`.
@@ -110,22 +115,22 @@ pub enum StatementKind {
     },
     /// `IF cond`, or the one-line `IF cond GOTOF target` (no ENDIF).
     If {
-        condition: Expr,
+        condition: Box<Expr>,
         jump: Option<Jump>,
     },
     Else,
     EndIf,
-    While(Expr),
+    While(Box<Expr>),
     EndWhile,
     /// `FOR var = start TO end`.
     For {
         variable: Place,
-        start: Expr,
-        end: Expr,
+        start: Box<Expr>,
+        end: Box<Expr>,
     },
     EndFor,
     Repeat,
-    Until(Expr),
+    Until(Box<Expr>),
     Loop,
     EndLoop,
     /// `REPEAT start [end] P=n`: runs the section from label `start` to
@@ -133,18 +138,18 @@ pub enum StatementKind {
     RepeatSection {
         start: String,
         end: Option<String>,
-        count: Option<Expr>,
+        count: Option<Box<Expr>>,
     },
     /// `CASE value OF 1 GOTOF L1 … DEFAULT GOTOF L9`.
     Case {
-        selector: Expr,
+        selector: Box<Expr>,
         arms: Vec<CaseArm>,
     },
     Jump(Jump),
     /// `[ID=n] [WHEN|WHENEVER|EVERY|FROM cond] DO actions`.
     SyncAction {
-        id: Option<SyncId>,
-        condition: Option<Expr>,
+        id: Option<Box<SyncId>>,
+        condition: Option<Box<Expr>>,
         actions: Vec<Statement>,
     },
 }
@@ -175,7 +180,7 @@ pub enum WordValue {
     Literal(Number),
     /// After `=`: `X=R1+5`, `T="DRILL"`; `X=AC(10)` and `X=IC(5)` name
     /// their dimension.
-    Expr { expr: Expr, dimension: Option<Dimension> },
+    Expr { expr: Box<Expr>, dimension: Option<Dimension> },
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -240,7 +245,7 @@ pub struct Call {
     /// In order; `None` for an omitted one (`PROFIL(,TRUE)`, 004:1490-1517).
     pub arguments: Vec<Option<Expr>>,
     /// `PROFIL P3`: how many times the program runs.
-    pub repetitions: Option<WordValue>,
+    pub repetitions: Option<Box<WordValue>>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -258,7 +263,7 @@ pub enum Callee {
     /// `PCALL /_N_SPF_DIR/_N_SUB_SPF`: the path as written.
     Path(String),
     /// `CALL program [BLOCK start TO end]`.
-    Indirect { program: Expr, section: Option<(Expr, Option<Expr>)> },
+    Indirect { program: Box<Expr>, section: Option<Box<(Expr, Option<Expr>)>> },
 }
 
 impl Callee {
@@ -386,7 +391,7 @@ pub enum JumpTarget {
     /// A label, upper case.
     Label(String),
     /// A string expression: `"N"<<R3`.
-    Computed(Expr),
+    Computed(Box<Expr>),
 }
 
 /// A variable, parameter or system variable, read or written.
@@ -629,7 +634,7 @@ fn lower_statement(catalogue: &Catalogue, node: &GreenNodeData, range: TextRange
         SyntaxKind::WORD => return statement(lower_word(catalogue, node, range), range),
         SyntaxKind::ASSIGN => lower_assign(catalogue, node, range),
         SyntaxKind::CALL_STMT => lower_call_statement(catalogue, node, range)?,
-        SyntaxKind::DEF_STMT => StatementKind::Def(lower_def(catalogue, node, range)),
+        SyntaxKind::DEF_STMT => StatementKind::Def(Box::new(lower_def(catalogue, node, range))),
         SyntaxKind::PROC_STMT => {
             let (name, parameters, attributes) = lower_signature(catalogue, node, range);
             StatementKind::Proc(Proc { name, parameters, attributes })
@@ -656,12 +661,12 @@ fn lower_statement(catalogue: &Catalogue, node: &GreenNodeData, range: TextRange
                 }
                 _ => None,
             });
-            StatementKind::If { condition: first_expr(), jump }
+            StatementKind::If { condition: Box::new(first_expr()), jump }
         }
         SyntaxKind::ELSE_STMT => StatementKind::Else,
         SyntaxKind::ENDIF_STMT => StatementKind::EndIf,
         SyntaxKind::LOOP_START => match keyword().as_str() {
-            "WHILE" => StatementKind::While(first_expr()),
+            "WHILE" => StatementKind::While(Box::new(first_expr())),
             "LOOP" => StatementKind::Loop,
             "REPEAT" => StatementKind::Repeat,
             _ => lower_for(catalogue, node, range),
@@ -670,7 +675,7 @@ fn lower_statement(catalogue: &Catalogue, node: &GreenNodeData, range: TextRange
             "ENDWHILE" => StatementKind::EndWhile,
             "ENDFOR" => StatementKind::EndFor,
             "ENDLOOP" => StatementKind::EndLoop,
-            _ => StatementKind::Until(first_expr()),
+            _ => StatementKind::Until(Box::new(first_expr())),
         },
         SyntaxKind::CASE_STMT => {
             let arms = items(node, range)
@@ -681,7 +686,7 @@ fn lower_statement(catalogue: &Catalogue, node: &GreenNodeData, range: TextRange
                     _ => None,
                 })
                 .collect();
-            StatementKind::Case { selector: first_expr(), arms }
+            StatementKind::Case { selector: Box::new(first_expr()), arms }
         }
         SyntaxKind::GOTO_STMT => StatementKind::Jump(lower_jump(catalogue, node, range)),
         SyntaxKind::SYNC_ACTION => {
@@ -696,7 +701,11 @@ fn lower_statement(catalogue: &Catalogue, node: &GreenNodeData, range: TextRange
                     _ => {}
                 }
             }
-            StatementKind::SyncAction { id: None, condition, actions: attach_words(catalogue, actions) }
+            StatementKind::SyncAction {
+                id: None,
+                condition: condition.map(Box::new),
+                actions: attach_words(catalogue, actions),
+            }
         }
         _ => return None,
     };
@@ -775,10 +784,10 @@ fn word_expr(expr: Expr) -> WordValue {
             _ => None,
         };
         if dimension.is_some() {
-            return WordValue::Expr { expr: inner.clone(), dimension };
+            return WordValue::Expr { expr: Box::new(inner.clone()), dimension };
         }
     }
-    WordValue::Expr { expr, dimension: None }
+    WordValue::Expr { expr: Box::new(expr), dimension: None }
 }
 
 /// `target=value`; a name the catalogue knows as an address of several
@@ -801,7 +810,7 @@ fn lower_assign(catalogue: &Catalogue, node: &GreenNodeData, range: TextRange) -
         Some((r, n)) => place(catalogue, n, r),
         None => Place { kind: PlaceKind::User, name: String::new(), indices: Vec::new() },
     };
-    StatementKind::Assign { target, value: value.unwrap_or_else(|| malformed(range)) }
+    StatementKind::Assign { target, value: Box::new(value.unwrap_or_else(|| malformed(range))) }
 }
 
 /// The name of a `NAME_REF`: its name, or its letter and digits (`X1`),
@@ -884,7 +893,7 @@ fn lower_call_statement(catalogue: &Catalogue, node: &GreenNodeData, range: Text
             let mut exprs = parts.filter_map(|(r, c)| expr_child(catalogue, c, r));
             let program = exprs.next().unwrap_or_else(|| malformed(first_range));
             let section = exprs.next().map(|start| (start, exprs.next()));
-            let callee = Callee::Indirect { program, section };
+            let callee = Callee::Indirect { program: Box::new(program), section: section.map(Box::new) };
             StatementKind::Call(Call { callee, arguments: Vec::new(), repetitions: None })
         }
         "PCALL" => {
@@ -1071,8 +1080,8 @@ fn lower_for(catalogue: &Catalogue, node: &GreenNodeData, range: TextRange) -> S
     }
     StatementKind::For {
         variable,
-        start: start.unwrap_or_else(|| malformed(range)),
-        end: end.unwrap_or_else(|| malformed(range)),
+        start: start.unwrap_or_else(|| Box::new(malformed(range))),
+        end: Box::new(end.unwrap_or_else(|| malformed(range))),
     }
 }
 
@@ -1106,7 +1115,7 @@ fn lower_jump(catalogue: &Catalogue, node: &GreenNodeData, range: TextRange) -> 
         NodeOrToken::Node(name) if kind(name.kind()) == SyntaxKind::NAME_REF => {
             Some(JumpTarget::Label(name_of(name, r)))
         }
-        _ => expr_child(catalogue, c, r).map(JumpTarget::Computed),
+        _ => expr_child(catalogue, c, r).map(|expr| JumpTarget::Computed(Box::new(expr))),
     });
     Jump { kind: jump_kind, target, range }
 }
@@ -1132,13 +1141,13 @@ fn attach_words(catalogue: &Catalogue, statements: Vec<Statement>) -> Vec<Statem
                     && !matches!(call.callee, Callee::Predefined(_))
                     && is_count(catalogue, word) =>
             {
-                call.repetitions = word.value.clone();
+                call.repetitions = word.value.clone().map(Box::new);
                 true
             }
             (StatementKind::Assign { target, value }, StatementKind::SyncAction { id: None, condition, actions })
                 if is_sync_id(catalogue, target) =>
             {
-                let id = SyncId { keyword: target.name.clone(), number: value.clone() };
+                let id = Box::new(SyncId { keyword: target.name.clone(), number: (**value).clone() });
                 previous.kind =
                     StatementKind::SyncAction { id: Some(id), condition: condition.clone(), actions: actions.clone() };
                 true
@@ -1167,7 +1176,7 @@ fn attach_words(catalogue: &Catalogue, statements: Vec<Statement>) -> Vec<Statem
                 if count.is_none() && is_count(catalogue, word) =>
             {
                 *count = word.value.clone().map(|value| match value {
-                    WordValue::Literal(number) => Expr { kind: ExprKind::Number(number), range: word.range },
+                    WordValue::Literal(number) => Box::new(Expr { kind: ExprKind::Number(number), range: word.range }),
                     WordValue::Expr { expr, .. } => expr,
                 });
                 true

@@ -36,7 +36,7 @@ pub(crate) fn statement_exprs<'a>(statement: &'a Statement, f: &mut impl FnMut(&
             f(start);
             f(end);
         }
-        StatementKind::RepeatSection { count, .. } => count.iter().for_each(f),
+        StatementKind::RepeatSection { count, .. } => count.iter().for_each(|count| f(count)),
         StatementKind::Case { selector, arms } => {
             f(selector);
             for arm in arms {
@@ -47,7 +47,7 @@ pub(crate) fn statement_exprs<'a>(statement: &'a Statement, f: &mut impl FnMut(&
         StatementKind::Jump(jump) => jump_exprs(jump, f),
         StatementKind::SyncAction { id, condition, actions } => {
             id.iter().for_each(|id| f(&id.number));
-            condition.iter().for_each(&mut *f);
+            condition.iter().for_each(|condition| f(condition));
             actions.iter().for_each(|action| statement_exprs(action, f));
         }
         StatementKind::ModalCall(None)
@@ -76,7 +76,7 @@ fn word_exprs<'a>(word: &'a Word, f: &mut impl FnMut(&'a Expr)) {
 
 fn call_exprs<'a>(call: &'a Call, f: &mut impl FnMut(&'a Expr)) {
     call.arguments.iter().flatten().for_each(&mut *f);
-    if let Some(WordValue::Expr { expr, .. }) = &call.repetitions {
+    if let Some(WordValue::Expr { expr, .. }) = call.repetitions.as_deref() {
         f(expr);
     }
     // A section's start and end are labels of the called program, no values.
@@ -129,7 +129,9 @@ pub(crate) fn written_places<'a>(statement: &'a Statement, f: &mut impl FnMut(&'
 pub(crate) fn number(value: &WordValue) -> Option<Number> {
     match value {
         WordValue::Literal(number) => Some(*number),
-        WordValue::Expr { expr: Expr { kind: ExprKind::Number(number), .. }, .. } => Some(*number),
-        WordValue::Expr { .. } => None,
+        WordValue::Expr { expr, .. } => match expr.kind {
+            ExprKind::Number(number) => Some(number),
+            _ => None,
+        },
     }
 }

@@ -242,7 +242,7 @@ fn number(value: u32) -> Expr {
         .statements
         .into_iter()
         .find_map(|statement| match statement.kind {
-            StatementKind::Assign { value, .. } => Some(value),
+            StatementKind::Assign { value, .. } => Some(*value),
             _ => None,
         })
         .expect("a number")

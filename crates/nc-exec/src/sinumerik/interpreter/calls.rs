@@ -88,7 +88,7 @@ impl Interpreter<'_> {
                 }
             }
         };
-        let runs = match &call.repetitions {
+        let runs = match call.repetitions.as_deref() {
             None => 1.0,
             Some(WordValue::Literal(number)) => number.value(),
             Some(WordValue::Expr { expr, .. }) => {

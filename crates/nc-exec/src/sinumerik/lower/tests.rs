@@ -101,7 +101,7 @@ fn show_jump(jump: &Jump) -> String {
 fn show_call(call: &Call) -> String {
     let callee = match &call.callee {
         Callee::Indirect { program, section } => {
-            let section = section.as_ref().map_or(String::new(), |(start, end)| {
+            let section = section.as_deref().map_or(String::new(), |(start, end)| {
                 format!(" block {} to {}", show(start), end.as_ref().map_or("-".to_owned(), show))
             });
             format!("Indirect {}{section}", show(program))
@@ -109,7 +109,7 @@ fn show_call(call: &Call) -> String {
         callee => format!("{callee:?}"),
     };
     let repetitions =
-        call.repetitions.as_ref().map_or(String::new(), |r| format!(" P{}", show_value(&Some(r.clone()))));
+        call.repetitions.as_ref().map_or(String::new(), |r| format!(" P{}", show_value(&Some((**r).clone()))));
     format!("call {callee}({}){repetitions}", show_list(&call.arguments))
 }
 
@@ -152,7 +152,7 @@ fn show_statement(statement: &Statement) -> String {
             format!("for {} = {} to {}", show_place(variable), show(start), show(end))
         }
         StatementKind::RepeatSection { start, end, count } => {
-            format!("repeat {start}..{end:?} times {}", count.as_ref().map_or("-".to_owned(), show))
+            format!("repeat {start}..{end:?} times {}", count.as_deref().map_or("-".to_owned(), show))
         }
         StatementKind::Case { selector, arms } => {
             let arms: Vec<String> = arms
@@ -167,7 +167,7 @@ fn show_statement(statement: &Statement) -> String {
         StatementKind::SyncAction { id, condition, actions } => {
             let id = id.as_ref().map_or(String::new(), |id| format!("{}={} ", id.keyword, show(&id.number)));
             let actions: Vec<String> = actions.iter().map(show_statement).collect();
-            format!("sync {id}{} do {}", condition.as_ref().map_or("-".to_owned(), show), actions.join(" "))
+            format!("sync {id}{} do {}", condition.as_deref().map_or("-".to_owned(), show), actions.join(" "))
         }
         other => format!("{other:?}"),
     }
