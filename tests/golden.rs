@@ -185,7 +185,7 @@ fn analysis_outputs(out: &mut String, program: &Path) {
         out.push_str("(not a program)\n");
         return;
     };
-    let estimate = input.estimate(None, RUN_BUDGET);
+    let estimate = input.estimate(None, RUN_BUDGET, &|| false).expect("never abandoned");
     writeln!(out, "{}", estimate.headline()).unwrap();
     for hint in estimate.inlay_hints(None, CycleTimeHints::PerBlock) {
         writeln!(out, "{:?} {:?} {:?}", hint.offset, hint.label, hint.tooltip).unwrap();

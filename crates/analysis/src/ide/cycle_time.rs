@@ -236,8 +236,34 @@ pub(crate) fn program_head(db: &dyn Db, file: SourceFile) -> Option<TextRange> {
 impl RunInput {
     /// The estimate of this input; `previous`, an estimate of an earlier
     /// text of the same file, lets the run resume where the texts part.
-    pub fn estimate(&self, previous: Option<&Estimate>, budget: usize) -> Estimate {
-        estimate(previous, &self.text, &self.files, &self.machine, budget)
+    /// `None` when `abandoned` came true meanwhile (a newer text waits):
+    /// the run asks it every few hundred blocks and gives up.
+    pub fn estimate(
+        &self,
+        previous: Option<&Estimate>,
+        budget: usize,
+        abandoned: &dyn Fn() -> bool,
+    ) -> Option<Estimate> {
+        let watched = Watched { files: &self.files, abandoned };
+        let estimate = estimate_in(previous, &self.text, &self.files, &watched, &self.machine, budget);
+        (!abandoned()).then_some(estimate)
+    }
+}
+
+/// The workspace's files as a run reads them, and whether the run is
+/// still wanted.
+struct Watched<'a> {
+    files: &'a WorkspaceFiles,
+    abandoned: &'a dyn Fn() -> bool,
+}
+
+impl Environment for Watched<'_> {
+    fn file(&self, called: &Called) -> Option<String> {
+        self.files.file(called)
+    }
+
+    fn abandoned(&self) -> bool {
+        (self.abandoned)()
     }
 }
 
@@ -266,6 +292,18 @@ pub fn estimate(
     machine: &MachineConfig,
     budget: usize,
 ) -> Estimate {
+    estimate_in(previous, text, files, files, machine, budget)
+}
+
+/// [`estimate`], the run reading the files through `environment`.
+fn estimate_in(
+    previous: Option<&Estimate>,
+    text: &Arc<String>,
+    files: &WorkspaceFiles,
+    environment: &dyn Environment,
+    machine: &MachineConfig,
+    budget: usize,
+) -> Estimate {
     let dynamics = nc_exec::run::dynamics(machine);
     let axes = machine.step_axes();
     let change = previous.and_then(|previous| Change::between(previous, text, files, machine, budget));
@@ -285,13 +323,13 @@ pub fn estimate(
             let stored = &previous.checkpoints[index];
             charges.resume(previous, index);
             let mut timer = Timer::resume(axes, &dynamics, stored.model.clone(), charges);
-            let trace = nc_exec::run::resume_into(Some(&stored.run), text, files, machine, budget, &mut timer);
+            let trace = nc_exec::run::resume_into(Some(&stored.run), text, environment, machine, budget, &mut timer);
             charges = timer.finish();
             trace
         }
         None => {
             let mut timer = Timer::new(axes, &dynamics, charges);
-            let trace = nc_exec::run::run_into(text, files, machine, budget, &mut timer);
+            let trace = nc_exec::run::run_into(text, environment, machine, budget, &mut timer);
             charges = timer.finish();
             trace
         }
@@ -897,7 +935,7 @@ mod tests {
             host.add_file(*path, *text);
         }
         let input = host.analysis().run_input(file).expect("a program");
-        input.estimate(None, nc_exec::run::DEFAULT_STEP_BUDGET)
+        input.estimate(None, nc_exec::run::DEFAULT_STEP_BUDGET, &|| false).expect("never abandoned")
     }
 
     /// One line per block: its first line, when it starts, its time, its
@@ -1253,8 +1291,18 @@ mod tests {
         assert_eq!(input.files.program_file(1000).map(|(path, _)| path), Some("/p/O01000.nc"));
         assert_eq!(input.files.program_file(2), None, "found by its file's name only");
         // 10 mm at 600 mm/min, with the ramps.
-        let total = input.estimate(None, 1000).totals.total;
+        let total = input.estimate(None, 1000, &|| false).expect("never abandoned").totals.total;
         assert!(total >= 1.0, "{total}");
+    }
+
+    /// An estimate asked for a text typed on meanwhile is given up.
+    #[test]
+    fn an_abandoned_estimate_is_none() {
+        let mut host = AnalysisHost::in_dialect(Dialect::Sinumerik, Config::default());
+        let file = host.add_file("/p/MAIN.MPF", "G1 X10 F100\nM30\n");
+        let input = host.analysis().run_input(file).expect("a program");
+        assert!(input.estimate(None, 1000, &|| true).is_none());
+        assert!(input.estimate(None, 1000, &|| false).is_some_and(|estimate| estimate.totals.total > 0.0));
     }
 
     /// In a dialect whose lines are blocks, a block's hints stand at the

@@ -2,7 +2,11 @@
 //!
 //! An edit (or an open) leaves a job per document; one worker thread runs
 //! the newest job of each document, so typing faster than a run takes
-//! skips the versions in between, as a debounce would. The run holds no
+//! skips the versions in between, as a debounce would. A run is given up
+//! when a newer version of its document waits, and a document whose last
+//! run took long ([`LONG_RUN`]) waits for a pause in typing
+//! ([`TYPING_PAUSE`]) before it runs: a run that the next key throws away
+//! only holds a core the edits' diagnostics need. The run holds no
 //! snapshot: it reads the text, the machine and the workspace's files
 //! first, and an edit meanwhile only makes its result stale. A result is
 //! kept only if the document is still at its version; then the client is
@@ -12,6 +16,7 @@
 use std::{
     collections::HashMap,
     sync::{Arc, Condvar, Mutex},
+    time::{Duration, Instant},
 };
 
 use ncc_analysis::{Cancelled, Estimate, TextRange, TextSize};
@@ -24,6 +29,14 @@ use super::{State, background_priority, lock};
 /// megabytes while the model times them; a program that runs longer (a
 /// jump loop without end) shows that its run stopped.
 const STEP_BUDGET: usize = 1_000_000;
+
+/// A run this long is not started while typing goes on: two keys come
+/// closer together.
+const LONG_RUN: Duration = Duration::from_millis(50);
+
+/// How long a document whose runs are long waits without an edit before it
+/// runs: shorter than a human's pause between keys.
+const TYPING_PAUSE: Duration = Duration::from_millis(40);
 
 /// A document's estimate, as the server keeps it.
 #[derive(Debug, Default)]
@@ -83,6 +96,8 @@ impl Timer {
             // Diagnostics and hovers of the edit come first: on two cores a
             // run at normal priority doubles their latency.
             background_priority();
+            // How long each document's last complete run took.
+            let mut took: HashMap<Uri, Duration> = HashMap::new();
             loop {
                 let (uri, version) = {
                     let (lock, ready) = &*jobs;
@@ -95,12 +110,29 @@ impl Timer {
                         guard = ready.wait(guard).unwrap_or_else(|poisoned| poisoned.into_inner());
                     }
                 };
+                if took.get(&uri).is_some_and(|&took| took >= LONG_RUN) {
+                    let (lock, ready) = &*jobs;
+                    let guard = lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+                    let (_guard, waited) = ready
+                        .wait_timeout_while(guard, TYPING_PAUSE, |jobs| !jobs.pending.contains_key(&uri))
+                        .unwrap_or_else(|poisoned| poisoned.into_inner());
+                    if !waited.timed_out() {
+                        // Typing goes on: the newer version is the job.
+                        continue;
+                    }
+                }
                 // A failed run must not end the worker: later edits may run.
-                match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&state, &uri, version))) {
-                    Ok(true) => {
+                match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&state, &jobs, &uri, version))) {
+                    Ok(Ran::Kept(run_took)) => {
+                        took.insert(uri, run_took);
                         let _ = refresh.send(());
                     }
-                    Ok(false) => {}
+                    // At least as long as it ran.
+                    Ok(Ran::GivenUp(ran)) => {
+                        let known = took.entry(uri).or_default();
+                        *known = (*known).max(ran);
+                    }
+                    Ok(Ran::Nothing) => {}
                     Err(_) => tracing::error!("{} v{version}: estimating the cycle time failed", uri.as_str()),
                 }
                 let (lock, _) = &*jobs;
@@ -130,26 +162,42 @@ impl Timer {
     }
 }
 
-/// Estimates one version; whether the result was kept.
-fn run(state: &Mutex<State>, uri: &Uri, version: i32) -> bool {
+/// What became of a job.
+enum Ran {
+    /// The estimate is the document's, after running this long.
+    Kept(Duration),
+    /// A newer version came after running this long.
+    GivenUp(Duration),
+    /// Nothing to run, or the result came too late.
+    Nothing,
+}
+
+/// Estimates one version, given up when a newer one is asked for (typing
+/// goes on: its result would be thrown away).
+fn run(state: &Mutex<State>, jobs: &(Mutex<Jobs>, Condvar), uri: &Uri, version: i32) -> Ran {
     let (analysis, file, previous) = {
         let state = lock(state);
         let Some(document) = state.documents.get(uri).filter(|document| document.version == version) else {
-            return false;
+            return Ran::Nothing;
         };
         let cycle = &document.cycle;
         (state.workspaces.get(document.workspace).analysis(), document.file, cycle.estimate.clone())
     };
-    let started = std::time::Instant::now();
+    let started = Instant::now();
     // Read, then let go of the snapshot: the run may take a while.
-    let Ok(input) = Cancelled::catch(|| analysis.run_input(file)) else { return false };
+    let Ok(input) = Cancelled::catch(|| analysis.run_input(file)) else { return Ran::Nothing };
     drop(analysis);
-    let Some(input) = input else { return false };
+    let Some(input) = input else { return Ran::Nothing };
     // Another document changed, but none this program reads.
     if previous.as_ref().is_some_and(|previous| previous.holds_for(&input)) {
-        return false;
+        return Ran::Nothing;
     }
-    let estimate = Arc::new(input.estimate(previous.as_deref(), STEP_BUDGET));
+    let newer = || jobs.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).pending.contains_key(uri);
+    let Some(estimate) = input.estimate(previous.as_deref(), STEP_BUDGET, &newer) else {
+        tracing::debug!("{} v{version}: cycle time given up for a newer version", uri.as_str());
+        return Ran::GivenUp(started.elapsed());
+    };
+    let estimate = Arc::new(estimate);
     drop(input);
     let rerun = &estimate.rerun;
     tracing::debug!(
@@ -161,9 +209,9 @@ fn run(state: &Mutex<State>, uri: &Uri, version: i32) -> bool {
     match state.documents.get_mut(uri) {
         Some(document) if document.version == version => {
             document.cycle = Cycle { estimate: Some(estimate), stale_from: None };
-            true
+            Ran::Kept(started.elapsed())
         }
-        _ => false,
+        _ => Ran::Nothing,
     }
 }
 

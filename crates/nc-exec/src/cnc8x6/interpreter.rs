@@ -52,8 +52,8 @@ use crate::{
     cnc8x6::program_flow::{BlockFlow, JumpCounts},
     machine::MachineConfig,
     trace::{
-        Called, Checkpoint, DELIVERY_BATCH, Environment, MAX_CALL_DEPTH, PROGRESS_INTERVAL, Resumable, RunRule,
-        StepSink, Trace, expected_blocks,
+        ABANDON_INTERVAL, Called, Checkpoint, DELIVERY_BATCH, Environment, MAX_CALL_DEPTH, PROGRESS_INTERVAL,
+        Resumable, RunRule, StepSink, Trace, expected_blocks,
     },
     transform::Frame,
 };
@@ -151,6 +151,9 @@ pub(crate) fn run_in<'a, 's>(
         executed += usize::from(resume.is_none());
         if executed % PROGRESS_INTERVAL == 0 {
             files.progress(executed);
+        }
+        if executed % ABANDON_INTERVAL == 0 && files.abandoned() {
+            break;
         }
         if executed > budget {
             let message = format!("stopped after {budget} blocks: a jump loop that never ends or runaway calls?");

@@ -127,8 +127,9 @@ use crate::{
     known::Known,
     machine::MachineConfig,
     trace::{
-        Axes, Called, Checkpoint, Compensated, DELIVERY_BATCH, Environment, Finding, Motion, PROGRESS_INTERVAL, Path,
-        PathMode, Position, Resumable, RunRule, Step, StepSink, Stop, Trace, Undelivered, round3, slot,
+        ABANDON_INTERVAL, Axes, Called, Checkpoint, Compensated, DELIVERY_BATCH, Environment, Finding, Motion,
+        PROGRESS_INTERVAL, Path, PathMode, Position, Resumable, RunRule, Step, StepSink, Stop, Trace, Undelivered,
+        round3, slot,
     },
     transform::{Frame, by_letter, over_axes},
 };
@@ -523,6 +524,9 @@ impl<'a> Interpreter<'a> {
             self.executed += 1;
             if self.executed.is_multiple_of(PROGRESS_INTERVAL) {
                 self.files.progress(self.executed);
+            }
+            if self.executed.is_multiple_of(ABANDON_INTERVAL) && self.files.abandoned() {
+                return;
             }
             let flow = self.block(place, program);
             if self.stopped {

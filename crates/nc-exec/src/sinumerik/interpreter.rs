@@ -104,8 +104,8 @@ use crate::{
     arc::{OffCircle, centre_by_radius, circle_through},
     machine::MachineConfig,
     trace::{
-        Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, PROGRESS_INTERVAL, Path, Position, RunRule,
-        Step, StepSink, Stop, Trace, Undelivered, slot,
+        ABANDON_INTERVAL, Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, PROGRESS_INTERVAL, Path,
+        Position, RunRule, Step, StepSink, Stop, Trace, Undelivered, slot,
     },
     transform::{Frame, over_axes},
 };
@@ -185,10 +185,15 @@ struct Unit {
 }
 
 impl Unit {
-    fn read(text: &str) -> Unit {
+    /// The file `text`, lowered; cut short when `files` says the run is
+    /// abandoned, which ends at its next look.
+    fn read(text: &str, files: &dyn Environment) -> Unit {
         let parse = Parse::new(text, Dialect::Sinumerik);
-        let (ranges, blocks): (Vec<TextRange>, Vec<SinumerikBlock>) =
-            block_nodes(parse.green()).map(|(range, block)| (range, SinumerikBlock::lower(block))).unzip();
+        let (ranges, blocks): (Vec<TextRange>, Vec<SinumerikBlock>) = block_nodes(parse.green())
+            .enumerate()
+            .take_while(|(index, _)| !(index.is_multiple_of(ABANDON_INTERVAL) && files.abandoned()))
+            .map(|(_, (range, block))| (range, SinumerikBlock::lower(block)))
+            .unzip();
         let model = SinumerikModel::new(&blocks);
         Unit { blocks, ranges, model }
     }
@@ -471,7 +476,7 @@ impl<'a> Interpreter<'a> {
         };
         Interpreter {
             files,
-            units: vec![Rc::new(Unit::read(text))],
+            units: vec![Rc::new(Unit::read(text, files))],
             called: Vec::new(),
             store: Store::new(),
             state,
@@ -541,6 +546,9 @@ impl<'a> Interpreter<'a> {
             self.executed += 1;
             if self.executed.is_multiple_of(PROGRESS_INTERVAL) {
                 self.files.progress(self.executed);
+            }
+            if self.executed.is_multiple_of(ABANDON_INTERVAL) && self.files.abandoned() {
+                break;
             }
             let flow = self.block(at, &unit);
             if self.state.stopped {

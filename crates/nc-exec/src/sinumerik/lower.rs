@@ -83,7 +83,7 @@ pub struct Statement {
 // The statements are most of a lowered program's memory, and a CAM
 // program's are words: the rare large statements keep their expressions
 // boxed, so that a word does not take the room of a FOR.
-const _: () = assert!(std::mem::size_of::<Statement>() <= 88);
+const _: () = assert!(size_of::<Statement>() <= 88);
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum StatementKind {

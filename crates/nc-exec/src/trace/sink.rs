@@ -26,6 +26,12 @@ pub trait Environment {
     fn file(&self, called: &Called) -> Option<String>;
     /// Called every [`PROGRESS_INTERVAL`] blocks with the number run so far.
     fn progress(&self, _blocks_run: usize) {}
+    /// Whether whoever asked for the run no longer wants it (the editor's
+    /// text changed again): asked every [`ABANDON_INTERVAL`] blocks read or
+    /// run, and the run ends there, its trace incomplete.
+    fn abandoned(&self) -> bool {
+        false
+    }
 }
 
 /// About as many blocks as a program of CAM output with this text has, or
@@ -36,6 +42,10 @@ pub fn expected_blocks(text: &str) -> usize {
 
 /// How often a run reports its progress, in blocks.
 pub const PROGRESS_INTERVAL: usize = 1 << 16;
+
+/// How often a run asks whether it is still wanted, in blocks: a
+/// fraction of a millisecond.
+pub const ABANDON_INTERVAL: usize = 1 << 10;
 
 /// The program alone: no other files.
 #[derive(Debug, Clone, Copy)]

@@ -277,7 +277,7 @@ impl Interpreter<'_> {
         if let Some(index) = (0..self.called.len()).find(|&index| unchanged(self, index)) {
             return index + 1;
         }
-        self.units.push(Rc::new(Unit::read(text)));
+        self.units.push(Rc::new(Unit::read(text, self.files)));
         self.called.push(called);
         self.units.len() - 1
     }
