@@ -490,6 +490,19 @@ fn explain_reads_the_sinumerik_catalogue() {
     assert!(stderr(&output).contains("of Siemens Sinumerik"), "{}", stderr(&output));
 }
 
+/// A diagnostic's code explains its rule, before what the catalogue reads
+/// in the same letters.
+#[test]
+fn explain_names_the_rule_of_a_diagnostic_code() {
+    let output = ncc(&["explain", "--dialect", "sinumerik", "k105"]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    let text = stdout(&output);
+    assert!(text.starts_with("### K105 — jump-wrong-direction\n"), "{text}");
+    assert!(text.contains("GOTOF to a target only behind the jump"), "{text}");
+    let text = stdout(&ncc(&["explain", "K047"]));
+    assert!(text.contains("warning, opt-in"), "{text}");
+}
+
 /// `ncc plot` draws the moves with their lines, rapids dashed, an arc as
 /// chords, the breaks marked and the total time in the legend.
 #[test]

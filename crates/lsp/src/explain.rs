@@ -1,7 +1,9 @@
-//! `ncc explain`: the catalogue's text for a code, like `rustc --explain`.
+//! `ncc explain`: the catalogue's text for a code, like `rustc --explain`,
+//! and the rule a diagnostic's code names (`K105`).
 
 use std::process::ExitCode;
 
+use ncc_analysis::Rule;
 use ncc_catalog::{Catalogue, Dialect};
 
 /// Explains `query` in `dialect`'s catalogue (the default dialect's when
@@ -14,12 +16,22 @@ pub(crate) fn run(query: Option<&str>, list: bool, dialect: Option<Dialect>) -> 
         return ExitCode::SUCCESS;
     }
     let query = query.unwrap_or_default();
+    // A diagnostic's code first; the catalogue may read the same letters
+    // as an address with a value.
+    let rule = Rule::all().find(|rule| rule.code.eq_ignore_ascii_case(query));
+    if let Some(rule) = rule {
+        print!("{}", crate::rules::markdown(rule));
+    }
     match catalogue.explain(query) {
         Ok(items) => {
             let texts: Vec<String> = items.iter().map(|item| item.markdown(catalogue)).collect();
+            if rule.is_some() {
+                println!();
+            }
             print!("{}", texts.join("\n"));
             ExitCode::SUCCESS
         }
+        Err(_) if rule.is_some() => ExitCode::SUCCESS,
         Err(not_found) => {
             eprintln!(
                 "error: `{}` is not a code, address, parameter, machine constant or operation of {}",

@@ -38,8 +38,7 @@ pub(crate) fn return_free_memory() {
     long_about = "Checker, language server and toolchain for CNC partprograms.\n\n\
         A program's dialect is `--dialect`, else `dialect` in its project's ncc.toml, else what its \
         extension maps to ([extensions] in ncc.toml; by default *.NCP and macrocycle files L<n> are \
-        cnc8x6 (MEFI CNC8x6), *.MPF and *.SPF sinumerik, *.nc and *.tap haas-lathe). This version \
-        reads cnc8x6 programs."
+        cnc8x6 (MEFI CNC8x6), *.MPF and *.SPF sinumerik, *.nc and *.tap haas-lathe)."
 )]
 struct Cli {
     /// The dialect of every program read, whatever its name and project
@@ -67,11 +66,13 @@ enum Command {
         #[arg(long, value_enum, default_value_t = check::Format::Human)]
         format: check::Format,
     },
-    /// Explain a code, address, parameter, machine constant or operation.
+    /// Explain a code, address, parameter, machine constant, operation or
+    /// the rule of a diagnostic's code.
     ///
     /// Examples: `G40`, `M30`, `X`, `&`, `R5` (program parameter), `R39`
     /// (machine constant 39, then parameter 39), `mc:39`, `param:39`,
-    /// `op:48` (parameter-arithmetic operation), `group:G3`.
+    /// `op:48` (parameter-arithmetic operation), `group:G3`, `K105` (the
+    /// rule of `ncc check`).
     Explain {
         /// What to explain.
         #[arg(required_unless_present = "list")]

@@ -89,6 +89,18 @@ fn reference<'a>(rules: impl Iterator<Item = &'a Rule>) -> String {
     out
 }
 
+/// One rule as `ncc explain` shows it.
+pub(crate) fn markdown(rule: &Rule) -> String {
+    let opt_in = if rule.opt_in { ", opt-in: off unless `ncc.toml` gives it a level" } else { "" };
+    format!(
+        "### {} — {}\n\n- Rule of `ncc check`, {}{opt_in}\n\n{}\n",
+        rule.code,
+        rule.name,
+        rule.severity.as_str(),
+        rule.summary
+    )
+}
+
 fn by_code<'a>(rules: impl Iterator<Item = &'a Rule>) -> Vec<&'a Rule> {
     let mut rules: Vec<&Rule> = rules.collect();
     rules.sort_by_key(|rule| rule.code);
