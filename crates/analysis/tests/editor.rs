@@ -895,6 +895,65 @@ fn sinumerik_definitions_of_calls_variables_and_parameters_across_files() {
     );
 }
 
+/// The hover text before `needle` in the first file.
+fn hover_at(files: &[(&str, &str)], needle: &str) -> String {
+    let files = with_cursor(files, needle);
+    let (host, _, cursor) = setup(&borrowed(&files));
+    let (file, offset) = cursor.unwrap();
+    host.analysis().hover(file, offset).map(|hover| hover.markdown).unwrap_or_default()
+}
+
+/// A name the program gives shows where it is defined and how often it is
+/// used; what the control knows shows the catalogue's text.
+#[test]
+fn sinumerik_hover_on_a_name_shows_its_definition() {
+    let files = [("MAIN.MPF", L19_MAIN), ("PROFIL.SPF", L19_SUB)];
+    expect![[r#"
+        **variable `DELKA`**
+
+        ```sinumerik
+         N60 DEF INT DELKA; Definice proměnné
+        ```
+        line 4
+
+        2 uses"#]]
+    .assert_eq(&hover_at(&files, "DELKA) ;"));
+    expect![[r#"
+        **program `PROFIL`**
+
+        ```sinumerik
+         PROC PROFIL (REAL C, BOOL H, REAL X, INT Y, REAL Z) ; Formální parametry by nabyly hodnotu: C=0, protože nebyl předán, H=TRUE, X=2.14, Y=DELKA=5.0 , Z=0, protože také nebyl zadán
+        ```
+        PROFIL.SPF line 4
+
+        1 use"#]]
+    .assert_eq(&hover_at(&files, "PROFIL ("));
+    let text = "DEF INT N\nBACK: N=N+1\nIF N<3 GOTOB BACK\nGOTOF MISSING\nM30\n";
+    expect![[r#"
+        **label `BACK`**
+
+        ```sinumerik
+        BACK: N=N+1
+        ```
+        line 2
+
+        1 use"#]]
+    .assert_eq(&hover_at(&[("LOOP.MPF", text)], "BACK\nGOTOF"));
+    expect![[r#"
+        **label `MISSING`**
+
+        no block of the program has it: a jump to it fails
+
+        1 use"#]]
+    .assert_eq(&hover_at(&[("LOOP.MPF", text)], "MISSING"));
+    assert!(
+        hover_at(&[("LOOP.MPF", text)], "GOTOB").starts_with("### GOTOB"),
+        "{}",
+        hover_at(&[("LOOP.MPF", text)], "GOTOB")
+    );
+    assert!(hover_at(&[("LOOP.MPF", text)], "M30").starts_with("### M30"));
+}
+
 /// L29 jumps to block numbers and labels and computes the target of some:
 /// those have no definition before a run.
 #[test]

@@ -30,13 +30,23 @@ fn catalogue() -> &'static Catalogue {
     Dialect::Sinumerik.catalogue()
 }
 
+/// The catalogue's text for what the control knows; for a name the
+/// program gives (a variable, a label, a jump's target, a program), its
+/// definition ([`navigation::hover`]).
 pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<HoverResult> {
     let token = token_at(&file.parse(db).syntax_node(), offset)?;
-    let (query, range) = query_of(&token)?;
-    let catalogue = catalogue();
-    let items = catalogue.explain(&query).ok()?;
-    let item = items.iter().find(|item| !matches!(item, Item::Group(_)))?;
-    Some(HoverResult { range, markdown: item.markdown(catalogue) })
+    let explained = || {
+        let (query, range) = query_of(&token)?;
+        let catalogue = catalogue();
+        let items = catalogue.explain(&query).ok()?;
+        let item = items.iter().find(|item| !matches!(item, Item::Group(_)))?;
+        Some(HoverResult { range, markdown: item.markdown(catalogue) })
+    };
+    // Only names ask the program model: a hover over a code after an edit
+    // does not wait for it.
+    let named = token.kind() == SyntaxKind::IDENT
+        || token.parent_ancestors().any(|node| matches!(node.kind(), SyntaxKind::GOTO_STMT | SyntaxKind::LABEL));
+    if named { navigation::hover(db, file, offset).or_else(explained) } else { explained() }
 }
 
 /// The significant token at `offset`; at the boundary of two, the one

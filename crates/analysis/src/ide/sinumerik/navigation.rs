@@ -28,7 +28,7 @@ use crate::{
     cnc8x6::model::file_stem,
     db::{Db, Settings, SourceFile},
     ide::{
-        NavigationTarget,
+        HoverResult, NavigationTarget,
         references::{Reference, ReferenceKind},
     },
     sinumerik::model::{FileModel, file_model},
@@ -294,6 +294,41 @@ fn jump_target(model: &FileModel, at: &Occurrence) -> Option<usize> {
         Resolved::Block(block) => Some(block),
         _ => None,
     }
+}
+
+/// What the name at `offset` stands for: the lines that define it (a DEF,
+/// a PROC, a label's block), and how often the file uses it. R
+/// parameters are the catalogue's to describe.
+pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<HoverResult> {
+    let at = occurrence_at(db, file, offset)?;
+    let (title, missing) = match &at.symbol {
+        Symbol::Label(name) => (format!("label `{name}`"), "no block of the program has it: a jump to it fails"),
+        Symbol::BlockNumber(number) => (format!("block `N{number}`"), "no block of the program has the number"),
+        Symbol::Variable(name) => (
+            format!("variable `{name}`"),
+            "not declared in this file: global user data or a macro of the machine (`[sinumerik] globals` in ncc.toml)",
+        ),
+        Symbol::Program(name) => (format!("program `{name}`"), "no file of the workspace holds it"),
+        Symbol::Parameter(_) => return None,
+    };
+    let mut markdown = format!("**{title}**");
+    let definitions = goto_definition(db, file, offset);
+    for definition in &definitions {
+        let text = definition.file.text(db);
+        let line = text[..usize::from(definition.range.start())].matches('\n').count() + 1;
+        let place = if definition.file == file {
+            format!("line {line}")
+        } else {
+            format!("{} line {line}", definition.file.path(db))
+        };
+        markdown.push_str(&format!("\n\n```sinumerik\n{}\n```\n{place}", &text[definition.range]));
+    }
+    if definitions.is_empty() {
+        markdown.push_str(&format!("\n\n{missing}"));
+    }
+    let uses = references(db, file, offset, false).len();
+    markdown.push_str(&format!("\n\n{uses} use{}", if uses == 1 { "" } else { "s" }));
+    Some(HoverResult { range: at.range, markdown })
 }
 
 /// The occurrences of the thing at `offset`: of a program, in every file of
