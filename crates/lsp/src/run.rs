@@ -575,9 +575,14 @@ pub(crate) fn lower(path: &Path, dialect: Option<Dialect>) -> ExitCode {
             }
         }
         Dialect::Sinumerik => {
-            let title = parse.dialect().title();
-            eprintln!("error: {}: `ncc lower` does not print {title} blocks yet", path.display());
-            return ExitCode::from(2);
+            for (range, block) in sinumerik::lower::block_nodes(parse.green()) {
+                // A line of only a comment or blanks is a block that does nothing.
+                let shown = sinumerik::lower::SinumerikBlock::lower(block).to_string();
+                if !shown.is_empty() {
+                    let line = lines.line_col(range.start(), Columns::Characters).0 + 1;
+                    let _ = writeln!(out, "{line:>6}  {shown}");
+                }
+            }
         }
     }
     let mut stdout = io::stdout().lock();

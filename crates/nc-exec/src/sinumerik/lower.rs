@@ -26,6 +26,8 @@ use rowan::{GreenNodeData, GreenTokenData, NodeOrToken};
 pub use crate::green::Skip;
 use crate::green::{GreenRef, children, is_trivia, kind, token_of};
 
+mod display;
+
 /// One block (one line).
 #[derive(Debug, Default, Clone, PartialEq)]
 pub struct SinumerikBlock {
