@@ -1,5 +1,5 @@
 //! Rules on the program as a whole, over the program model (digest §6
-//! rules 39, 42, 43, 44, 47, 59, 60, 68, 69, 76, 77, and the balance of the
+//! rules 39, 40, 42, 43, 44, 47, 59, 60, 68, 69, 76, 77, and the balance of the
 //! control structures and the direction of jumps). Each is one pass over
 //! the blocks or the model's lists.
 //!
@@ -18,8 +18,10 @@
 //!   from [`LONG_RUN`] such moves on; a move whose end or start is not
 //!   known from numbers written ends the run.
 
+use std::collections::HashSet;
+
 use nc_exec::sinumerik::{
-    lower::{Dimension, Jump, JumpKind, JumpTarget, SinumerikBlock, StatementKind, Word, WordValue},
+    lower::{Callee, Dimension, Jump, JumpKind, JumpTarget, SinumerikBlock, StatementKind, Word, WordValue},
     program::{Resolved, Structure, StructureKind, Unbalanced},
 };
 use ncc_catalog::{AddressRole, Catalogue, Dialect, KeywordKind};
@@ -33,6 +35,7 @@ use crate::{
 };
 
 declare_rules! {
+    AMBIGUOUS_PROGRAM_CALL = "K040", "ambiguous-program-call", Warning, "A call by the bare name of a program the workspace has both as a main program (MPF) and a subprogram (SPF): the control runs the MPF.";
     INVALID_PROGRAM_NAME = "K039", "invalid-program-name", Error, "A program name (PROC, `%_N_…_MPF`) that does not start with two letters or underscores, holds other characters than letters, digits and `_`, or is longer than 31 characters.";
     NESTING_TOO_DEEP = "K042", "nesting-too-deep", Error, "Control structures nested deeper than 16 levels.";
     PROC_NOT_FIRST = "K043", "proc-not-first", Error, "A PROC line that is not the program's first statement.";
@@ -75,10 +78,13 @@ const MODES_OFF_AT_END: [&str; 2] = ["TOROT", "FFWON"];
 const COMPRESSOR: &str = "COMPCAD";
 const SPLINE: &str = "BSPLINE";
 
-pub(crate) fn check(db: &dyn Db, file: &FileModel) -> Vec<Diagnostic> {
+/// `both`: the programs the workspace has as an MPF and as an SPF, upper
+/// case.
+pub(crate) fn check(db: &dyn Db, file: &FileModel, both: &HashSet<String>) -> Vec<Diagnostic> {
     let catalogue = Dialect::Sinumerik.catalogue();
     let mut out = Vec::new();
     names(db, catalogue, file, &mut out);
+    ambiguous_calls(file, both, &mut out);
     declarations(db, file, &mut out);
     structures(file, &mut out);
     jumps(file, &mut out);
@@ -103,6 +109,27 @@ fn names(db: &dyn Db, catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Dia
                 out.push(Diagnostic::new(&INVALID_PROGRAM_NAME, file.in_file(index, statement.range), problem));
             }
         }
+    }
+}
+
+/// Rule 40: a call by the bare name finds the MPF first (004:1452-1462),
+/// which a call of the subprogram does not mean.
+fn ambiguous_calls(file: &FileModel, both: &HashSet<String>, out: &mut Vec<Diagnostic>) {
+    for site in &file.model.calls {
+        let Callee::Program(name) = &site.callee else { continue };
+        if !both.contains(name) {
+            continue;
+        }
+        let called = |kind: &StatementKind| match kind {
+            StatementKind::Call(call) | StatementKind::ModalCall(Some(call)) => call.callee == site.callee,
+            _ => false,
+        };
+        let statements = &file.block(site.block).statements;
+        let Some(statement) = statements.iter().find(|statement| called(&statement.kind)) else { continue };
+        let message = format!(
+            "the workspace has {name} as a main program and a subprogram: the control runs {name}.MPF, found first; write _N_{name}_SPF to call the subprogram"
+        );
+        out.push(Diagnostic::new(&AMBIGUOUS_PROGRAM_CALL, file.in_file(site.block, statement.range), message));
     }
 }
 
