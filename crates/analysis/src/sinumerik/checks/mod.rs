@@ -24,7 +24,7 @@ pub(crate) mod program;
 pub(crate) mod types;
 pub(crate) mod visit;
 
-use std::collections::HashSet;
+use std::path::Path;
 
 use crate::{
     Diagnostic, Rule,
@@ -74,40 +74,21 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
     let config = settings.config(db);
     let text = file.text(db).as_str();
     let mut signatures = types::Signatures::new();
-    let (mut mains, mut subprograms) = (HashSet::new(), HashSet::new());
     for other in settings.files(db) {
-        match program_file(other.path(db)) {
-            Some((name, true)) => mains.insert(name),
-            Some((name, false)) => subprograms.insert(name),
-            None => false,
-        };
         let other_model = file_model(db, *other);
         if let Some(proc) = other_model.model.header() {
             signatures.entry(proc.declaration.name.as_str()).or_insert((other.path(db).as_str(), other_model, proc));
         }
     }
-    let both: HashSet<String> = mains.intersection(&subprograms).cloned().collect();
-    let mut diagnostics = program::check(db, model, &both);
+    // A control file (`_N_PART_SPF`) is found as the run finds it.
+    let in_workspace = |control_name: &str| {
+        settings.files(db).iter().any(|other| ncc_catalog::is_control_file(Path::new(other.path(db)), control_name))
+    };
+    let mut diagnostics = program::check(db, model, &in_workspace);
     diagnostics.extend(names::check(db, model, text, config));
     diagnostics.extend(types::check(db, model, &signatures));
     findings::sort_diagnostics(&mut diagnostics);
     Findings { diagnostics, omitted: Vec::new() }
-}
-
-/// The program a workspace file holds, upper case, and whether it is a
-/// main program (MPF) rather than a subprogram (SPF), by the file's name:
-/// `PART.MPF`, `_N_PART_SPF`.
-fn program_file(path: &str) -> Option<(String, bool)> {
-    let name = path.rsplit(['/', '\\']).next()?.to_ascii_uppercase();
-    let (stem, kind) = match name.rsplit_once('.') {
-        Some(split) => split,
-        None => name.strip_prefix("_N_")?.rsplit_once('_')?,
-    };
-    match kind {
-        "MPF" => Some((stem.to_owned(), true)),
-        "SPF" => Some((stem.to_owned(), false)),
-        _ => None,
-    }
 }
 
 #[cfg(test)]

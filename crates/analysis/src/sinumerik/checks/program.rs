@@ -18,8 +18,6 @@
 //!   from [`LONG_RUN`] such moves on; a move whose end or start is not
 //!   known from numbers written ends the run.
 
-use std::collections::HashSet;
-
 use nc_exec::sinumerik::{
     lower::{Callee, Dimension, Jump, JumpKind, JumpTarget, SinumerikBlock, StatementKind, Word, WordValue},
     program::{Resolved, Structure, StructureKind, Unbalanced},
@@ -78,13 +76,13 @@ const MODES_OFF_AT_END: [&str; 2] = ["TOROT", "FFWON"];
 const COMPRESSOR: &str = "COMPCAD";
 const SPLINE: &str = "BSPLINE";
 
-/// `both`: the programs the workspace has as an MPF and as an SPF, upper
-/// case.
-pub(crate) fn check(db: &dyn Db, file: &FileModel, both: &HashSet<String>) -> Vec<Diagnostic> {
+/// `in_workspace`: whether the workspace holds the control file of a name
+/// (`_N_PART_SPF`).
+pub(crate) fn check(db: &dyn Db, file: &FileModel, in_workspace: &dyn Fn(&str) -> bool) -> Vec<Diagnostic> {
     let catalogue = Dialect::Sinumerik.catalogue();
     let mut out = Vec::new();
     names(db, catalogue, file, &mut out);
-    ambiguous_calls(file, both, &mut out);
+    ambiguous_calls(file, in_workspace, &mut out);
     declarations(db, file, &mut out);
     structures(file, &mut out);
     jumps(file, &mut out);
@@ -114,10 +112,10 @@ fn names(db: &dyn Db, catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Dia
 
 /// Rule 40: a call by the bare name finds the MPF first (004:1452-1462),
 /// which a call of the subprogram does not mean.
-fn ambiguous_calls(file: &FileModel, both: &HashSet<String>, out: &mut Vec<Diagnostic>) {
+fn ambiguous_calls(file: &FileModel, in_workspace: &dyn Fn(&str) -> bool, out: &mut Vec<Diagnostic>) {
     for site in &file.model.calls {
         let Callee::Program(name) = &site.callee else { continue };
-        if !both.contains(name) {
+        if !(in_workspace(&format!("_N_{name}_MPF")) && in_workspace(&format!("_N_{name}_SPF"))) {
             continue;
         }
         let called = |kind: &StatementKind| match kind {
