@@ -52,8 +52,8 @@ use crate::{
     cnc8x6::program_flow::{BlockFlow, JumpCounts},
     machine::MachineConfig,
     trace::{
-        ABANDON_INTERVAL, Called, Checkpoint, DELIVERY_BATCH, Environment, MAX_CALL_DEPTH, PROGRESS_INTERVAL,
-        Resumable, RunRule, StepSink, Trace, expected_blocks,
+        Called, Checkpoint, DELIVERY_BATCH, Environment, MAX_CALL_DEPTH, Resumable, RunRule, StepSink, Trace,
+        expected_blocks, goes_on,
     },
     transform::Frame,
 };
@@ -149,10 +149,7 @@ pub(crate) fn run_in<'a, 's>(
             break;
         }
         executed += usize::from(resume.is_none());
-        if executed % PROGRESS_INTERVAL == 0 {
-            files.progress(executed);
-        }
-        if executed % ABANDON_INTERVAL == 0 && files.abandoned() {
+        if !goes_on(files, executed) {
             break;
         }
         if executed > budget {

@@ -127,9 +127,8 @@ use crate::{
     known::Known,
     machine::MachineConfig,
     trace::{
-        ABANDON_INTERVAL, Axes, Called, Checkpoint, Compensated, DELIVERY_BATCH, Environment, Finding, Motion,
-        PROGRESS_INTERVAL, Path, PathMode, Position, Resumable, RunRule, Step, StepSink, Stop, Trace, Undelivered,
-        round3, slot,
+        Axes, Called, Checkpoint, Compensated, DELIVERY_BATCH, Environment, Finding, Motion, Path, PathMode, Position,
+        Resumable, RunRule, Step, StepSink, Stop, Trace, Undelivered, goes_on, round3, slot,
     },
     transform::{Frame, by_letter, over_axes},
 };
@@ -522,10 +521,7 @@ impl<'a> Interpreter<'a> {
                 return;
             }
             self.executed += 1;
-            if self.executed.is_multiple_of(PROGRESS_INTERVAL) {
-                self.files.progress(self.executed);
-            }
-            if self.executed.is_multiple_of(ABANDON_INTERVAL) && self.files.abandoned() {
+            if !goes_on(self.files, self.executed) {
                 return;
             }
             let flow = self.block(place, program);

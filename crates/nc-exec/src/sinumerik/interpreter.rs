@@ -104,8 +104,8 @@ use crate::{
     arc::{OffCircle, centre_by_radius, circle_through},
     machine::MachineConfig,
     trace::{
-        ABANDON_INTERVAL, Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, PROGRESS_INTERVAL, Path,
-        Position, RunRule, Step, StepSink, Stop, Trace, Undelivered, slot,
+        ABANDON_INTERVAL, Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, Path, Position, RunRule,
+        Step, StepSink, Stop, Trace, Undelivered, goes_on, slot,
     },
     transform::{Frame, over_axes},
 };
@@ -544,10 +544,7 @@ impl<'a> Interpreter<'a> {
                 break;
             }
             self.executed += 1;
-            if self.executed.is_multiple_of(PROGRESS_INTERVAL) {
-                self.files.progress(self.executed);
-            }
-            if self.executed.is_multiple_of(ABANDON_INTERVAL) && self.files.abandoned() {
+            if !goes_on(self.files, self.executed) {
                 break;
             }
             let flow = self.block(at, &unit);

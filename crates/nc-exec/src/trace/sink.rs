@@ -47,6 +47,16 @@ pub const PROGRESS_INTERVAL: usize = 1 << 16;
 /// fraction of a millisecond.
 pub const ABANDON_INTERVAL: usize = 1 << 10;
 
+/// Reports the run's progress to `files` and asks whether it is abandoned,
+/// each at its interval, after `blocks_run` blocks: whether the run goes
+/// on. Every interpreter asks before each block it runs.
+pub(crate) fn goes_on(files: &dyn Environment, blocks_run: usize) -> bool {
+    if blocks_run.is_multiple_of(PROGRESS_INTERVAL) {
+        files.progress(blocks_run);
+    }
+    !(blocks_run.is_multiple_of(ABANDON_INTERVAL) && files.abandoned())
+}
+
 /// The program alone: no other files.
 #[derive(Debug, Clone, Copy)]
 pub struct NoFiles;
