@@ -6,12 +6,13 @@
 //! The variables ([`Store`]): the R parameters (`R5`, `R[expr]`; how
 //! many a control has is machine data, `$MN_MM_NUM_R_PARAM`, which the
 //! run does not know, and real programs use R999: every index below
-//! [`R_PARAMETER_LIMIT`] runs, the store growing to the highest written), the names DEF declares with their type and array
-//! dimensions, in scopes (a subprogram's DEFs are its own; a `VAR`
-//! formal parameter aliases the caller's variable or array element), and
-//! global user data (GUD), which the run creates when a program uses a
-//! name nothing declares. System variables (`$…`) and `G[n]` belong to
-//! the run, which answers them through [`Context`].
+//! [`R_PARAMETER_LIMIT`] runs, the store growing to the highest written),
+//! the names DEF declares with their type and array dimensions, in
+//! scopes (a subprogram's DEFs are its own; a `VAR` formal parameter
+//! aliases the caller's variable or array element), and global user data
+//! (GUD), which the run creates when a program uses a name nothing
+//! declares. System variables (`$…`) and `G[n]` belong to the run, which
+//! answers them through [`Context`].
 //!
 //! Conversions and arithmetic (Siemens documentation where the digest's
 //! seed is silent; each an assumption of this module):
