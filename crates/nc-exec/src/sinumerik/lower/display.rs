@@ -52,7 +52,7 @@ fn show_place(place: &Place) -> String {
     }
 }
 
-fn show_value(value: &Option<WordValue>) -> String {
+fn show_value(value: Option<&WordValue>) -> String {
     match value {
         None => "?".to_owned(),
         Some(WordValue::Literal(number)) => show_number(number),
@@ -62,7 +62,7 @@ fn show_value(value: &Option<WordValue>) -> String {
 }
 
 fn show_word(word: &Word) -> String {
-    format!("{}{}", word.address, show_value(&word.value))
+    format!("{}{}", word.address, show_value(word.value.as_ref()))
 }
 
 fn show_type(ty: &Type) -> String {
@@ -109,8 +109,7 @@ fn show_call(call: &Call) -> String {
         }
         callee => format!("{callee:?}"),
     };
-    let repetitions =
-        call.repetitions.as_ref().map_or(String::new(), |r| format!(" P{}", show_value(&Some((**r).clone()))));
+    let repetitions = call.repetitions.as_deref().map_or(String::new(), |r| format!(" P{}", show_value(Some(r))));
     format!("call {callee}({}){repetitions}", show_list(&call.arguments))
 }
 
