@@ -399,13 +399,16 @@ fn parse_prints_the_lossless_tree() {
     assert!(tree.contains("      WORD@51..54\n        LETTER@51..52 \"G\"\n        NUMBER@52..54 \"01\"\n"), "{tree}");
 }
 
+/// The first `lines` lines `ncc lower` prints for `path`.
+fn lowered(path: &str, lines: usize) -> Vec<String> {
+    let output = ncc(&["lower", path]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    stdout(&output).lines().take(lines).map(str::to_owned).collect()
+}
+
 /// `ncc lower` prints each block as the executor reads it, after its line.
 #[test]
 fn lower_prints_the_blocks_as_the_executor_reads_them() {
-    let output = ncc(&["lower", "examples/milling/holes.NCP"]);
-    assert_eq!(output.status.code(), Some(0));
-    let text = stdout(&output);
-    let first: Vec<&str> = text.lines().take(5).collect();
     expect![[r#"
         [
             "     5  N10 G90 G17 G80 G94 G54",
@@ -415,12 +418,8 @@ fn lower_prints_the_blocks_as_the_executor_reads_them() {
             "     9  N50 R20=30. R21=5 R22=2. R23=-2.5 R24=100 R25=30",
         ]
     "#]]
-    .assert_debug_eq(&first);
+    .assert_debug_eq(&lowered("examples/milling/holes.NCP", 5));
     assert_eq!(ncc(&["lower", "no/such/program.NCP"]).status.code(), Some(2));
-    let output = ncc(&["lower", "examples/sinumerik/POCKET.MPF"]);
-    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
-    let text = stdout(&output);
-    let first: Vec<&str> = text.lines().take(4).collect();
     expect![[r#"
         [
             "     4  def None Real DEPTH[]; STEP[] = 2",
@@ -429,7 +428,7 @@ fn lower_prints_the_blocks_as_the_executor_reads_them() {
             "     7  T=\"END MILL 10\"",
         ]
     "#]]
-    .assert_debug_eq(&first);
+    .assert_debug_eq(&lowered("examples/sinumerik/POCKET.MPF", 4));
 }
 
 /// A CAM program of a million blocks (about 35 MB) is checked completely.
