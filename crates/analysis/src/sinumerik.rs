@@ -4,3 +4,4 @@
 
 pub(crate) mod checks;
 pub(crate) mod model;
+pub(crate) mod walk;

@@ -31,4 +31,5 @@ pub mod expand;
 pub mod frames;
 pub(crate) mod interpreter;
 pub mod lower;
+pub mod modes;
 pub mod program;

@@ -114,9 +114,8 @@ mod bspline;
 mod calls;
 mod files;
 mod frames_and_cycles;
-mod modes;
 
-use modes::Modes;
+use super::modes::Modes;
 
 /// The catalogue's groups the interpreter reads.
 const MOTION: &str = "G1";

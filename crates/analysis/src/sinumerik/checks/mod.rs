@@ -6,19 +6,26 @@
 //! on the whole program ([`program`], [`names`], [`types`]) are one pass
 //! each over the file model and come with the flow findings.
 //!
+//! The rules on motion and technology ([`motion`]) read the modal state
+//! of a walk over the file ([`crate::sinumerik::walk`]).
+//!
 //! Not checked here:
 //! - rules 1, 2, 10, 11, 12 and 14 are the parser's (`space-in-word`,
 //!   `unexpected-character`, `parenthesis-comment`, the block skip's place,
 //!   `unclosed-string`, `template-placeholder`);
-//! - rules 3, 5, 6, 8, 9 are ISO conventions or off for Sinumerik;
-//! - rules 15–38 and 70–75, 78, 79, 81 follow the path, the tool or the
-//!   stock, which only a run knows; 41 and 48 need the calls' nesting at
-//!   run time; 51–54 and 58 depend on generated programs, the machine's
-//!   tool management or the control's version; 65 on the meaning of
-//!   comments; 67 on the order of blocks in the run;
+//! - rules 3, 5, 6, 8, 9 are ISO conventions or off for Sinumerik, and
+//!   25, 30, 33–36 ISO words (G28, H, G92 as a preset, M97–M98) that
+//!   Sinumerik writes otherwise;
+//! - rules 15, 23, 28, 38 and 70–75, 78 follow the stock, the tool's
+//!   shape or orientation or the operation's kind, which the program does
+//!   not state; 17 and 24 are the run's (rapid moves per axis, rotary
+//!   travel); 41 needs the calls' nesting at run time; 51, 53, 54 and 58
+//!   depend on generated programs, the machine's tool management or the
+//!   control's version; 65 on the meaning of comments;
 //! - computed jump targets (`GOTOF "N"<<R3`) are the run's.
 
 pub(crate) mod block;
+pub(crate) mod motion;
 pub(crate) mod names;
 pub(crate) mod program;
 pub(crate) mod types;
@@ -34,7 +41,7 @@ use crate::{
 };
 
 /// The rules of every check module.
-pub(crate) static RULES: &[&[&Rule]] = &[block::RULES, program::RULES, names::RULES, types::RULES];
+pub(crate) static RULES: &[&[&Rule]] = &[block::RULES, program::RULES, motion::RULES, names::RULES, types::RULES];
 
 /// The findings of a file's single blocks, chunk by chunk.
 pub(crate) fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
@@ -85,10 +92,21 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
         settings.files(db).iter().any(|other| ncc_catalog::is_control_file(Path::new(other.path(db)), control_name))
     };
     let mut diagnostics = program::check(db, model, &in_workspace);
+    let header = model.ranges.first().and_then(|_| model.block(0).header.as_ref());
+    let main = model.model.header().is_none()
+        && !is_subprogram_file(file.path(db))
+        && !header.is_some_and(|header| header.name.to_ascii_uppercase().ends_with("_SPF"));
+    diagnostics.extend(motion::check(db, model, main));
     diagnostics.extend(names::check(db, model, text, config));
     diagnostics.extend(types::check(db, model, &signatures));
     findings::sort_diagnostics(&mut diagnostics);
     Findings { diagnostics, omitted: Vec::new() }
+}
+
+/// Whether a file's name says a subprogram: `PART.SPF`, `_N_PART_SPF`.
+fn is_subprogram_file(path: &str) -> bool {
+    let name = Path::new(path).file_name().and_then(|name| name.to_str()).unwrap_or_default().to_ascii_uppercase();
+    name.ends_with(".SPF") || name.ends_with("_SPF")
 }
 
 #[cfg(test)]

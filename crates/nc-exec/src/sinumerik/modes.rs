@@ -2,13 +2,17 @@
 //! stand in a group like one (`BSPLINE`, `SOFT`), by the catalogue, each
 //! group starting at its default; `$P_GG[n]` reads them and `G[n]=k` sets
 //! them by their index in the group (004:3335-3341).
+//!
+//! The run and the checker's walk share them: for the walk a group with no
+//! code in force is one whose code it does not know.
 
 use ncc_catalog::{Catalogue, Code, Dialect, Modality};
 
 /// The code in force of every group of the catalogue.
 #[derive(Debug, Clone, PartialEq)]
-pub(super) struct Modes {
-    /// By group index; `None` for a group without a default.
+pub struct Modes {
+    /// By group index; `None` for a group without a default, or whose code
+    /// a static reading does not know.
     in_force: Vec<Option<&'static Code>>,
 }
 
@@ -17,7 +21,7 @@ fn catalogue() -> &'static Catalogue {
 }
 
 impl Modes {
-    pub(super) fn at_reset() -> Modes {
+    pub fn at_reset() -> Modes {
         let catalogue = catalogue();
         let in_force = catalogue
             .groups
@@ -27,8 +31,30 @@ impl Modes {
         Modes { in_force }
     }
 
+    /// No group's code known: where a subprogram starts, or after a call.
+    pub fn unknown() -> Modes {
+        Modes { in_force: vec![None; catalogue().groups.len()] }
+    }
+
+    /// What holds whichever of two ways the program took: each group's code
+    /// where both agree.
+    pub fn join(&self, other: &Modes) -> Modes {
+        let same = |(a, b): (&Option<&'static Code>, &Option<&'static Code>)| match (a, b) {
+            (Some(a), Some(b)) if std::ptr::eq(*a, *b) => Some(*a),
+            _ => None,
+        };
+        Modes { in_force: self.in_force.iter().zip(&other.in_force).map(same).collect() }
+    }
+
+    /// Forgets the code of `group` (`G[1]=R1`, a code a loop may change).
+    pub fn forget(&mut self, group: &str) {
+        if let Some(index) = catalogue().groups.iter().position(|g| g.id == group) {
+            self.in_force[index] = None;
+        }
+    }
+
     /// Puts `code` in force when it is modal in a group; whether it is.
-    pub(super) fn set(&mut self, code: &'static Code) -> bool {
+    pub fn set(&mut self, code: &'static Code) -> bool {
         let Some(group) = code.group.as_deref().filter(|_| code.modality == Modality::Modal) else { return false };
         match catalogue().groups.iter().position(|g| g.id == group) {
             Some(index) => {
@@ -41,18 +67,18 @@ impl Modes {
 
     /// The code in force in group `group` (`"G1"`), as the catalogue
     /// writes it (`G1`, `BSPLINE`).
-    pub(super) fn get(&self, group: &str) -> Option<&'static str> {
+    pub fn get(&self, group: &str) -> Option<&'static str> {
         self.code(group).map(|code| code.code.as_str())
     }
 
-    pub(super) fn code(&self, group: &str) -> Option<&'static Code> {
+    pub fn code(&self, group: &str) -> Option<&'static Code> {
         let index = catalogue().groups.iter().position(|g| g.id == group)?;
         self.in_force[index]
     }
 
     /// Puts the G codes in force that were in `saved` (SAVE), the M
     /// groups staying as they are.
-    pub(super) fn restore_g(&mut self, saved: &Modes) {
+    pub(crate) fn restore_g(&mut self, saved: &Modes) {
         for (index, group) in catalogue().groups.iter().enumerate() {
             if group.id.starts_with('G') {
                 self.in_force[index] = saved.in_force[index];
@@ -61,7 +87,7 @@ impl Modes {
     }
 
     /// Whether `code` is in force in its group.
-    pub(super) fn is(&self, group: &str, code: &str) -> bool {
+    pub fn is(&self, group: &str, code: &str) -> bool {
         self.get(group) == Some(code)
     }
 }

@@ -1,0 +1,425 @@
+//! Rules on motion and technology over the walk's modal state (digest §6
+//! rules 16, 18, 19, 20, 22, 26, 29, 48, 52, 67 and 81).
+//!
+//! Assumptions, where the digest is silent:
+//! - Rules 18 and 26 report the first block of a stretch, not every block
+//!   of it: the cause is one.
+//! - Rule 26 counts M5 and M19 (positioned) as a spindle that stands, and
+//!   leaves out measuring moves (`MEAS`, `MEAW`), which the probe makes
+//!   with the spindle still.
+//! - Rule 22 reads "at full feed" as at the feed of the cut in X or Y
+//!   that follows the plunge: of several steps down in a row, the last
+//!   enters the material. Whether the tool cuts at its centre is not
+//!   known.
+//! - Rule 48 cannot see the caller: it warns where the subprogram itself
+//!   put continuous-path mode in force.
+//! - Rule 81 counts M functions other than the stops and ends (M0, M1,
+//!   M2, M17, M30), MSG, WRITE and STOPRE as the blocks that break the
+//!   path (digest: inferred).
+
+use nc_exec::{
+    known::Known,
+    sinumerik::lower::{Callee, ProgramEnd, Statement, StatementKind, WordValue},
+};
+use ncc_catalog::{Catalogue, Dialect, KeywordKind};
+use ncc_syntax::{TextEdit, TextRange};
+
+use crate::{
+    Diagnostic,
+    db::Db,
+    diagnostic::declare_rules,
+    sinumerik::{
+        checks::visit::number,
+        model::FileModel,
+        walk::{self, MOTION, PATH_AXES, SPINDLE, Step, is_axis},
+    },
+};
+
+declare_rules! {
+    RAPID_PLUNGE_WITH_XY = "K016", "rapid-xy-and-z-down", Warning, "A G0 move that lowers Z while it moves X or Y: approach in X and Y first, then in Z.";
+    MISSING_FEED = "K018", "missing-feed", Error, "A feed move (G1, G2, G3, a spline) before any feed F was programmed.";
+    FULL_CIRCLE_WITH_RADIUS = "K019", "full-circle-with-radius", Error, "G2 or G3 with CR whose end point is its start point: a radius cannot give a full circle.";
+    RADIUS_TOO_SHORT = "K020", "radius-too-short", Error, "G2 or G3 with a radius CR shorter than half the distance from its start to its end.";
+    PLUNGE_AT_FULL_FEED = "K022", "plunge-at-full-feed", Warning, "A feed move down in Z alone at the feed of the cut in X or Y that follows it.";
+    CUT_WITH_SPINDLE_OFF = "K026", "cut-with-spindle-off", Error, "A feed move of X, Y or Z while the spindle stands (M5, M19, or never started in a main program).";
+    SPINDLE_WITHOUT_SPEED = "K029", "spindle-without-speed", Warning, "M3 or M4 before any spindle speed S was programmed.";
+    END_STOPS_PATH = "K048", "subprogram-end-stops-path", Warning, "A subprogram that ends with M17, M2 or M30 under the continuous-path mode it set: the end stops the path, RET keeps it.";
+    CONTOUR_NOT_LINES_AND_ARCS = "K052", "contour-not-lines-and-arcs", Error, "A spline or polynomial inside a CONTPRON contour, which takes only lines and arcs.";
+    OFFSETS_NOT_AFTER_TRAORI = "K067", "offsets-not-after-traori", Warning, "A move after TRAORI with no work offset (G54…) or tool offset D programmed since TRAORI.";
+    PATH_BROKEN = "K081", "path-broken-by-block", Warning, "An M function, MSG, WRITE or STOPRE between two feed blocks in continuous-path mode: the path slows down there.";
+}
+
+/// Points closer than this, in mm, are the same (rules 16, 19, 20, 22).
+const SAME_POINT_MM: f64 = 0.001;
+
+/// The motion codes CONTPRON takes: lines and arcs of group 1
+/// (004:1664-1668).
+const CONTOUR_MOTIONS: [&str; 6] = ["G0", "G1", "G2", "G3", "CIP", "CT"];
+
+/// The M functions that stop or end the program on purpose (rule 81).
+const STOPS_AND_ENDS: [u64; 5] = [0, 1, 2, 17, 30];
+
+/// The statements rule 81 names that break the path.
+const PATH_BREAKERS: [&str; 3] = ["MSG", "WRITE", "STOPRE"];
+
+/// The state the rules keep between blocks.
+#[derive(Default)]
+pub(crate) struct Motion {
+    feed_reported: bool,
+    /// The M5 or M19 that stopped the spindle, and whether a cut since it
+    /// was reported.
+    spindle_stop: Option<TextRange>,
+    spindle_reported: bool,
+    /// The last of the feed moves down in Z since the last cut in X or Y.
+    plunge: Option<(TextRange, f64)>,
+    contour: Option<TextRange>,
+    traori: Option<TextRange>,
+    /// The last move was a feed move in continuous-path mode; a block that
+    /// broke the path after it.
+    on_path: bool,
+    break_after: Option<(TextRange, String)>,
+}
+
+/// The range of the first statement of the block that `matches`.
+fn find(file: &FileModel, step: &Step<'_>, matches: impl Fn(&Statement) -> bool) -> Option<TextRange> {
+    step.block.statements.iter().find(|s| matches(s)).map(|s| file.in_file(step.index, s.range))
+}
+
+fn word_is(statement: &Statement, address: &str) -> bool {
+    matches!(&statement.kind, StatementKind::Word(word) if word.address == address)
+}
+
+/// The whole number of a literal M word.
+fn m_number(statement: &Statement) -> Option<u64> {
+    match &statement.kind {
+        StatementKind::Word(word) if word.address == "M" => match &word.value {
+            Some(WordValue::Literal(number)) => number.whole(),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+fn predefined(statement: &Statement) -> Option<&str> {
+    match &statement.kind {
+        StatementKind::Call(call) => match &call.callee {
+            Callee::Predefined(name) => Some(name),
+            _ => None,
+        },
+        StatementKind::Command(command) => Some(&command.name),
+        _ => None,
+    }
+}
+
+impl Motion {
+    /// `main`: the file starts at reset; `save`: its PROC line has SAVE.
+    pub(crate) fn step(
+        &mut self,
+        file: &FileModel,
+        step: &Step<'_>,
+        main: bool,
+        save: bool,
+        out: &mut Vec<Diagnostic>,
+    ) {
+        let catalogue = Dialect::Sinumerik.catalogue();
+        let state = step.state;
+        self.spindle(file, step, out);
+        if step.block.statements.iter().any(|s| word_is(s, "T") || m_number(s) == Some(6)) {
+            self.plunge = None;
+        }
+        self.contour(catalogue, file, step, out);
+        self.traori(catalogue, file, step, out);
+        if step.moves {
+            let feed_move = state.feed_motion() == Known::Is(true);
+            self.missing_feed(file, step, feed_move, out);
+            if feed_move {
+                self.cut_without_spindle(file, step, out);
+            }
+            self.rapid_plunge(file, step, out);
+            self.arc_radius(file, step, out);
+            self.plunge(file, step, out);
+            self.path(step, feed_move, out);
+        } else {
+            self.path_breaker(file, step);
+        }
+        if !main && state.continuous_path() == Known::Is(true) {
+            self.end_of_subprogram(file, step, save, out);
+        }
+    }
+
+    fn missing_feed(&mut self, file: &FileModel, step: &Step<'_>, feed_move: bool, out: &mut Vec<Diagnostic>) {
+        if !feed_move || step.state.feed != Known::Is(None) || self.feed_reported {
+            return;
+        }
+        self.feed_reported = true;
+        let motion = step.state.motion().unwrap_or_default();
+        let Some(range) = find(file, step, |s| matches!(&s.kind, StatementKind::Word(w) if is_axis(&w.address))) else {
+            return;
+        };
+        let message = format!(
+            "{motion} moves at the feed F, and no F was programmed before this block: the control stops with an alarm"
+        );
+        out.push(Diagnostic::new(&MISSING_FEED, range, message));
+    }
+
+    /// Where the spindle was stopped, from the blocks that set its group.
+    fn spindle(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        let stopped = matches!(step.state.modes.get(SPINDLE), Some("M5" | "M19"));
+        if !stopped {
+            self.spindle_stop = None;
+            self.spindle_reported = false;
+        } else if let Some(range) = find(file, step, |s| matches!(m_number(s), Some(5 | 19))) {
+            self.spindle_stop = Some(range);
+            self.spindle_reported = false;
+        }
+        // M3 or M4 with no S ever.
+        if step.state.speed == Known::Is(None)
+            && let Some(range) = find(file, step, |s| matches!(m_number(s), Some(3 | 4)))
+        {
+            let message = "the spindle starts with no speed S programmed: it turns at S0; write S with M3 or M4";
+            out.push(Diagnostic::new(&SPINDLE_WITHOUT_SPEED, range, message));
+        }
+    }
+
+    fn cut_without_spindle(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        let stopped = matches!(step.state.modes.get(SPINDLE), Some("M5" | "M19"));
+        let measuring = step.block.statements.iter().any(|s| word_is(s, "MEAS") || word_is(s, "MEAW"));
+        if !stopped || measuring || self.spindle_reported {
+            return;
+        }
+        let Some(range) = find(file, step, |s| PATH_AXES.iter().any(|axis| word_is(s, axis))) else { return };
+        self.spindle_reported = true;
+        let motion = step.state.motion().unwrap_or_default();
+        let diagnostic = match self.spindle_stop {
+            Some(stop) => Diagnostic::new(
+                &CUT_WITH_SPINDLE_OFF,
+                range,
+                format!("a {motion} feed move with the spindle stopped: start it with M3 or M4 before cutting"),
+            )
+            .with_related(None, stop, "the spindle stops here"),
+            None => Diagnostic::new(
+                &CUT_WITH_SPINDLE_OFF,
+                range,
+                format!("a {motion} feed move before the spindle was started: start it with M3 or M4 before cutting"),
+            ),
+        };
+        out.push(diagnostic);
+    }
+
+    /// Rule 16: G0 lowering Z while it moves X or Y.
+    fn rapid_plunge(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        let state = step.state;
+        if state.motion() != Some("G0") {
+            return;
+        }
+        let moves_xy = step.block.statements.iter().any(|s| word_is(s, "X") || word_is(s, "Y"));
+        let (Known::Is(from), Known::Is(to)) = (step.from[2], state.position[2]) else { return };
+        if !moves_xy || to > from - SAME_POINT_MM {
+            return;
+        }
+        let Some(range) = find(file, step, |s| word_is(s, "Z")) else { return };
+        let message = format!(
+            "G0 lowers Z from {from} to {to} while it moves X or Y: each axis runs at its own rate, so the tool may reach the work before it is above its point; approach in X and Y first, then in Z"
+        );
+        out.push(Diagnostic::new(&RAPID_PLUNGE_WITH_XY, range, message));
+    }
+
+    /// Rules 19 and 20: an arc by its radius CR.
+    fn arc_radius(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        let state = step.state;
+        let Some(motion @ ("G2" | "G3")) = state.motion() else { return };
+        let radius_word = step.block.statements.iter().find_map(|s| match &s.kind {
+            StatementKind::Word(word) if word.address == "CR" => Some((s, word)),
+            _ => None,
+        });
+        let Some((statement, word)) = radius_word else { return };
+        let Some(radius) = word.value.as_ref().and_then(number).map(|n| n.value().abs()) else { return };
+        let axes = match state.modes.get("G6") {
+            Some("G17") => [0, 1],
+            Some("G18") => [2, 0],
+            Some("G19") => [1, 2],
+            _ => return,
+        };
+        let mut chord = 0.0;
+        for axis in axes {
+            let (Known::Is(from), Known::Is(to)) = (step.from[axis], state.position[axis]) else { return };
+            chord += (to - from) * (to - from);
+        }
+        let chord: f64 = chord.sqrt();
+        let range = file.in_file(step.index, statement.range);
+        if chord < SAME_POINT_MM {
+            let message = format!(
+                "{motion} with CR ends where it starts: a radius gives no full circle; give the centre with I, J, K (or AR=360)"
+            );
+            out.push(Diagnostic::new(&FULL_CIRCLE_WITH_RADIUS, range, message));
+        } else if chord > 2.0 * radius + SAME_POINT_MM {
+            let message = format!(
+                "the arc's end is {chord:.3} mm from its start, more than the diameter {:.3} mm of the radius CR={radius}: no such arc joins them",
+                2.0 * radius
+            );
+            out.push(Diagnostic::new(&RADIUS_TOO_SHORT, range, message));
+        }
+    }
+
+    /// Rule 22: a plunge at the feed of the cut before or after it.
+    fn plunge(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        let state = step.state;
+        let Known::Is(Some(feed)) = state.feed else {
+            self.plunge = None;
+            return;
+        };
+        if !matches!(state.motion(), Some("G1" | "G2" | "G3")) {
+            return;
+        }
+        let changed = |axis: usize| match (step.from[axis], state.position[axis]) {
+            (Known::Is(from), Known::Is(to)) => Known::Is((to - from).abs() > SAME_POINT_MM),
+            _ => Known::Unknown,
+        };
+        let down =
+            matches!((step.from[2], state.position[2]), (Known::Is(from), Known::Is(to)) if to < from - SAME_POINT_MM);
+        let full = |cut: f64, plunge: f64| plunge >= cut - SAME_POINT_MM;
+        let mut report = |range: TextRange, feed: f64| {
+            let message = format!(
+                "the tool plunges in Z at F{feed}, the feed of the cut in X or Y after it: plunge at a lower feed (half is the thesis's advice), unless the tool cuts at its centre"
+            );
+            out.push(Diagnostic::new(&PLUNGE_AT_FULL_FEED, range, message));
+        };
+        if down && changed(0) == Known::Is(false) && changed(1) == Known::Is(false) {
+            self.plunge = find(file, step, |s| word_is(s, "Z")).map(|range| (range, feed));
+        } else if changed(0) == Known::Is(true) || changed(1) == Known::Is(true) {
+            if let Some((range, plunge)) = self.plunge.take()
+                && full(feed, plunge)
+            {
+                report(range, plunge);
+            }
+        } else {
+            self.plunge = None;
+        }
+    }
+
+    /// Rule 81: the move after a block that broke the path.
+    fn path(&mut self, step: &Step<'_>, feed_move: bool, out: &mut Vec<Diagnostic>) {
+        let on_path = feed_move && step.state.continuous_path() == Known::Is(true);
+        if let Some((range, what)) = self.break_after.take()
+            && on_path
+        {
+            let message = format!(
+                "{what} between two feed moves in continuous-path mode: the path slows down or stops here; put it before the contour or after it"
+            );
+            out.push(Diagnostic::new(&PATH_BROKEN, range, message));
+        }
+        self.on_path = on_path;
+    }
+
+    /// Rule 81: a block without motion after a feed move on the path.
+    fn path_breaker(&mut self, file: &FileModel, step: &Step<'_>) {
+        if !self.on_path || self.break_after.is_some() {
+            return;
+        }
+        for statement in &step.block.statements {
+            let what = match m_number(statement) {
+                Some(number) if !STOPS_AND_ENDS.contains(&number) => Some(format!("M{number}")),
+                _ => predefined(statement).filter(|name| PATH_BREAKERS.contains(name)).map(str::to_owned),
+            };
+            if let Some(what) = what {
+                self.break_after = Some((file.in_file(step.index, statement.range), what));
+                return;
+            }
+        }
+    }
+
+    /// Rule 52: the motion codes inside CONTPRON … EXECUTE.
+    fn contour(&mut self, catalogue: &Catalogue, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        for statement in &step.block.statements {
+            match &statement.kind {
+                StatementKind::Call(call) if matches!(&call.callee, Callee::Predefined(name) if name == "CONTPRON") => {
+                    self.contour = Some(file.in_file(step.index, statement.range));
+                }
+                StatementKind::Call(call) if matches!(&call.callee, Callee::Predefined(name) if name == "EXECUTE") => {
+                    self.contour = None;
+                }
+                StatementKind::Command(command) => {
+                    let Some(start) = self.contour else { continue };
+                    let Some(code) = catalogue.word_code(&command.name) else { continue };
+                    if code.group.as_deref() == Some(MOTION) && !CONTOUR_MOTIONS.contains(&code.code.as_str()) {
+                        let message = format!(
+                            "{} inside a contour preparation: CONTPRON takes only lines and arcs of group 1, no splines or polynomials",
+                            code.code
+                        );
+                        let range = file.in_file(step.index, statement.range);
+                        out.push(Diagnostic::new(&CONTOUR_NOT_LINES_AND_ARCS, range, message).with_related(
+                            None,
+                            start,
+                            "the contour preparation starts here",
+                        ));
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// Rule 67: the first move after TRAORI with no offsets since.
+    fn traori(&mut self, catalogue: &Catalogue, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        for statement in &step.block.statements {
+            match &statement.kind {
+                StatementKind::Command(command) => {
+                    let transformation =
+                        catalogue.keyword(&command.name).is_some_and(|k| k.kind == KeywordKind::Transformation);
+                    if transformation {
+                        self.traori =
+                            command.name.starts_with("TRAORI").then(|| file.in_file(step.index, statement.range));
+                    } else if catalogue.word_code(&command.name).and_then(|c| c.group.as_deref()) == Some("G8") {
+                        self.traori = None;
+                    }
+                }
+                StatementKind::Word(word) if word.address == "D" => self.traori = None,
+                StatementKind::Word(word) if word.address == "G" => {
+                    let code = word.value.as_ref().and_then(number).and_then(|n| n.whole());
+                    let code = code.and_then(|n| u32::try_from(n).ok()).and_then(|n| catalogue.code('G', n));
+                    if code.and_then(|c| c.group.as_deref()) == Some("G8") {
+                        self.traori = None;
+                    }
+                }
+                StatementKind::Call(call) if !matches!(call.callee, Callee::Predefined(_)) => self.traori = None,
+                _ => {}
+            }
+        }
+        if step.moves
+            && let Some(traori) = self.traori.take()
+        {
+            let range = file.in_file(step.index, step.block.statements[0].range);
+            let message = "the first move after TRAORI, with no work offset (G54 …) or tool offset D programmed since: TRAORI may reset them, so program them again after it";
+            out.push(Diagnostic::new(&OFFSETS_NOT_AFTER_TRAORI, range, message).with_related(None, traori, "TRAORI"));
+        }
+    }
+
+    /// Rule 48: M17, M2 or M30 ending a subprogram on the path.
+    fn end_of_subprogram(&mut self, file: &FileModel, step: &Step<'_>, save: bool, out: &mut Vec<Diagnostic>) {
+        if !matches!(step.block.program_end(), Some(ProgramEnd::Subprogram | ProgramEnd::Program)) {
+            return;
+        }
+        let end =
+            step.block.statements.iter().find_map(|s| m_number(s).filter(|n| matches!(n, 2 | 17 | 30)).map(|n| (s, n)));
+        let Some((statement, number)) = end else { return };
+        let range = file.in_file(step.index, statement.range);
+        let message = format!(
+            "M{number} ends the subprogram and the continuous-path mode it set: the caller's next move starts from a stop; RET returns and keeps the path (004:1561-1563)"
+        );
+        let mut diagnostic = Diagnostic::new(&END_STOPS_PATH, range, message);
+        // RET and SAVE do not go together (rule 47).
+        if !save {
+            diagnostic = diagnostic.with_fix("Return with RET", vec![TextEdit::replace(range, "RET")]);
+        }
+        out.push(diagnostic);
+    }
+}
+
+/// Runs the rules of this module over a walk of `file`.
+pub(crate) fn check(db: &dyn Db, file: &FileModel, main: bool) -> Vec<Diagnostic> {
+    let save = file.model.header().is_some_and(|proc| proc.declaration.attributes.iter().any(|a| a == "SAVE"));
+    let mut motion = Motion::default();
+    let mut out = Vec::new();
+    walk::walk(db, file, main, |step| motion.step(file, &step, main, save, &mut out));
+    out
+}

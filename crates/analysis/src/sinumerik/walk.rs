@@ -1,0 +1,412 @@
+//! The walk over a Sinumerik file with the modal state, for the rules that
+//! need what is in force at a block: the codes of the groups (the run's
+//! [`Modes`]), the feed, the spindle speed and where the tool stands.
+//!
+//! It visits each block once, in file order. A main program starts at
+//! reset (the catalogue's defaults, no F, no S); a subprogram (a PROC, an
+//! SPF file) from an unknown state, since its caller's is not known here,
+//! but without a modal call (MCALL) in force.
+//! Where the file's order is not the run's order, it keeps what holds
+//! whichever way the program goes:
+//!
+//! - IF/ELSE/ENDIF: after the ENDIF, what both branches agree on.
+//! - A loop (WHILE, FOR, REPEAT, LOOP) starts from the state before it
+//!   with everything its body may change forgotten, and a WHILE or FOR,
+//!   which may not run at all, ends so too.
+//! - A jump's target (every label and block number when a target is
+//!   computed) and the block after an unconditional jump, a RET or an end
+//!   of program start from an unknown state.
+//! - A call of a program, a repeated section and a modal call of a program
+//!   may change anything: after them nothing is known. A cycle leaves the
+//!   tool where the walk cannot say.
+//!
+//! An unknown value never produces a finding, so a rule reports only what
+//! holds on a way the program really runs.
+
+use nc_exec::{
+    known::Known,
+    sinumerik::{
+        lower::{Callee, Dimension, JumpKind, PlaceKind, SinumerikBlock, StatementKind, Word, WordValue},
+        modes::Modes,
+        program::{Resolved, Structure, StructureKind},
+    },
+};
+use ncc_catalog::{Catalogue, Code, Dialect, KeywordKind};
+use rustc_hash::{FxHashMap, FxHashSet};
+
+use crate::{db::Db, sinumerik::checks::visit::number, sinumerik::model::FileModel};
+
+/// The catalogue's groups the walk reads.
+pub(crate) const MOTION: &str = "G1";
+pub(crate) const PATH_MODE: &str = "G10";
+pub(crate) const SPINDLE: &str = "M2";
+const FRAMES: &str = "G3";
+const WORK_OFFSETS: &str = "G8";
+const MACHINE_COORDINATES: &str = "G9";
+const UNITS: &str = "G13";
+const DIMENSIONS: &str = "G14";
+
+/// The codes of the motion group that cut a thread: they move at the
+/// pitch and spindle speed, not at F.
+const THREADS: [&str; 3] = ["G33", "G331", "G332"];
+
+/// The path axes whose positions the walk follows.
+pub(crate) const PATH_AXES: [&str; 3] = ["X", "Y", "Z"];
+
+fn catalogue() -> &'static Catalogue {
+    Dialect::Sinumerik.catalogue()
+}
+
+/// What the control holds between blocks, as far as the walk knows.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct State {
+    pub modes: Modes,
+    /// The feed F: `Is(None)` before any was programmed.
+    pub feed: Known<Option<f64>>,
+    /// The spindle speed S: `Is(None)` before any was programmed.
+    pub speed: Known<Option<f64>>,
+    /// X, Y and Z in the frame in force.
+    pub position: [Known<f64>; 3],
+    /// A modal call (MCALL) in force, which runs at every move: `Is(true)`
+    /// for a program's, which may change anything.
+    modal_program: Known<Option<bool>>,
+}
+
+impl State {
+    /// At reset, as a main program starts.
+    pub(crate) fn at_reset() -> State {
+        State {
+            modes: Modes::at_reset(),
+            feed: Known::Is(None),
+            speed: Known::Is(None),
+            position: [Known::Unknown; 3],
+            modal_program: Known::Is(None),
+        }
+    }
+
+    /// Nothing known.
+    pub(crate) fn unknown() -> State {
+        State {
+            modes: Modes::unknown(),
+            feed: Known::Unknown,
+            speed: Known::Unknown,
+            position: [Known::Unknown; 3],
+            modal_program: Known::Unknown,
+        }
+    }
+
+    /// As a subprogram starts: its caller's state is not known, and it is
+    /// taken to be called without a modal call in force, as programs
+    /// mostly are (else every move would forget everything).
+    fn subprogram_start() -> State {
+        State { modal_program: Known::Is(None), ..State::unknown() }
+    }
+
+    /// Forgets everything but the modal call, which only MCALL changes.
+    fn forget(&mut self) {
+        *self = State { modal_program: self.modal_program, ..State::unknown() };
+    }
+
+    /// What holds whichever of the two ways the program took.
+    fn join(&self, other: &State) -> State {
+        fn same<T: PartialEq + Copy>(a: Known<T>, b: Known<T>) -> Known<T> {
+            if a == b { a } else { Known::Unknown }
+        }
+        State {
+            modes: self.modes.join(&other.modes),
+            feed: same(self.feed, other.feed),
+            speed: same(self.speed, other.speed),
+            position: [0, 1, 2].map(|axis| same(self.position[axis], other.position[axis])),
+            modal_program: same(self.modal_program, other.modal_program),
+        }
+    }
+
+    /// The motion code in force.
+    pub(crate) fn motion(&self) -> Option<&'static str> {
+        self.modes.get(MOTION)
+    }
+
+    /// Whether the motion in force moves at the feed F.
+    pub(crate) fn feed_motion(&self) -> Known<bool> {
+        match self.motion() {
+            Some(code) => Known::Is(code != "G0" && !THREADS.contains(&code)),
+            None => Known::Unknown,
+        }
+    }
+
+    /// Whether a continuous-path mode (G64, G641–G645) is in force.
+    pub(crate) fn continuous_path(&self) -> Known<bool> {
+        match self.modes.get(PATH_MODE) {
+            Some(code) => Known::Is(code != "G60"),
+            None => Known::Unknown,
+        }
+    }
+
+    /// The block's effect; whether it moves an axis. `variables`: the
+    /// names the program declares, which a word like `X=5` assigns.
+    pub(crate) fn apply(&mut self, block: &SinumerikBlock, variables: &Variables<'_>) -> bool {
+        let catalogue = catalogue();
+        let mut codes: Vec<&'static Code> = Vec::new();
+        for statement in &block.statements {
+            match &statement.kind {
+                StatementKind::Word(word) => self.function_word(word, &mut codes),
+                StatementKind::Command(command) => match catalogue.word_code(&command.name) {
+                    Some(code) => codes.push(code),
+                    None if catalogue
+                        .keyword(&command.name)
+                        .is_some_and(|keyword| keyword.kind == KeywordKind::Transformation) =>
+                    {
+                        self.position = [Known::Unknown; 3];
+                    }
+                    None => {}
+                },
+                // `G[1]=R1`: a group's code only the run knows.
+                StatementKind::Assign { target, .. } if target.kind == PlaceKind::GroupCode => {
+                    self.modes = Modes::unknown();
+                }
+                _ => {}
+            }
+        }
+        let in_group = |group: &str| codes.iter().any(|code| code.group.as_deref() == Some(group));
+        // The block's coordinates count in the new system.
+        if [FRAMES, WORK_OFFSETS, UNITS].into_iter().any(in_group) {
+            self.position = [Known::Unknown; 3];
+        }
+        for &code in &codes {
+            self.modes.set(code);
+        }
+        let dwell = codes.iter().any(|code| code.code == "G4");
+        let moved = self.values(block, dwell, variables);
+        // Machine coordinates for the block, or a reference point: where
+        // the tool ends in the frame is not known.
+        if in_group(MACHINE_COORDINATES) || codes.iter().any(|code| matches!(code.code.as_str(), "G74" | "G75")) {
+            self.position = [Known::Unknown; 3];
+        }
+        for statement in &block.statements {
+            match &statement.kind {
+                StatementKind::Call(call) => self.call(&call.callee),
+                StatementKind::ModalCall(call) => {
+                    self.modal_program = Known::Is(call.as_ref().map(|call| !matches!(call.callee, Callee::Cycle(_))));
+                }
+                StatementKind::RepeatSection { .. } => self.forget(),
+                _ => {}
+            }
+        }
+        if moved {
+            match self.modal_program {
+                Known::Is(None) => {}
+                Known::Is(Some(false)) => self.position = [Known::Unknown; 3],
+                Known::Is(Some(true)) | Known::Unknown => self.forget(),
+            }
+        }
+        moved
+    }
+
+    /// A G or M word: its code, or what it makes unknown.
+    fn function_word(&mut self, word: &Word, codes: &mut Vec<&'static Code>) {
+        let catalogue = catalogue();
+        let literal = match &word.value {
+            Some(WordValue::Literal(number)) => number.whole().and_then(|n| u32::try_from(n).ok()),
+            _ => None,
+        };
+        match (word.address.as_str(), literal) {
+            ("G", Some(number)) => match catalogue.code('G', number) {
+                Some(code) => codes.push(code),
+                // A code the catalogue does not list (`G505`): it may
+                // move the origin.
+                None => self.position = [Known::Unknown; 3],
+            },
+            ("G", None) => self.modes = Modes::unknown(),
+            ("M", Some(number)) => codes.extend(catalogue.code('M', number)),
+            // `M=R1`, `M1=3`, `SPOS=0`: another spindle or a value the
+            // walk does not know.
+            (address, _) if address.starts_with('M') || address.starts_with("SPOS") => self.forget_m_groups(),
+            _ => {}
+        }
+    }
+
+    fn forget_m_groups(&mut self) {
+        for group in &catalogue().groups {
+            if group.id.starts_with('M') {
+                self.modes.forget(&group.id);
+            }
+        }
+    }
+
+    /// F, S and the path axes; whether the block moves an axis.
+    fn values(&mut self, block: &SinumerikBlock, dwell: bool, variables: &Variables<'_>) -> bool {
+        let incremental = match self.modes.get(DIMENSIONS) {
+            Some(code) => Known::Is(code == "G91"),
+            None => Known::Unknown,
+        };
+        let mut moved = false;
+        for statement in &block.statements {
+            let StatementKind::Word(word) = &statement.kind else { continue };
+            if assigns(word, variables) {
+                continue;
+            }
+            let value = word.value.as_ref().and_then(number).map(|number| number.value());
+            match word.address.as_str() {
+                // In a G4 block F and S give the dwell.
+                "F" | "S" if dwell => {}
+                "F" => self.feed = value.map_or(Known::Unknown, |value| Known::Is(Some(value))),
+                "S" => self.speed = value.map_or(Known::Unknown, |value| Known::Is(Some(value))),
+                address if address.starts_with('S') && address[1..].bytes().all(|b| b.is_ascii_digit()) => {
+                    self.speed = Known::Unknown;
+                }
+                address => {
+                    if is_axis(address) {
+                        moved = true;
+                    }
+                    let Some(axis) = PATH_AXES.iter().position(|a| *a == address) else { continue };
+                    let incremental = match &word.value {
+                        Some(WordValue::Expr { dimension: Some(dimension), .. }) => {
+                            Known::Is(*dimension == Dimension::Incremental)
+                        }
+                        _ => incremental,
+                    };
+                    self.position[axis] = match (value, incremental) {
+                        (Some(value), Known::Is(true)) => match self.position[axis] {
+                            Known::Is(from) => Known::Is(from + value),
+                            Known::Unknown => Known::Unknown,
+                        },
+                        (Some(value), Known::Is(false)) => Known::Is(value),
+                        _ => Known::Unknown,
+                    };
+                }
+            }
+        }
+        moved
+    }
+
+    fn call(&mut self, callee: &Callee) {
+        match callee {
+            Callee::Predefined(_) => {}
+            Callee::Cycle(_) => self.position = [Known::Unknown; 3],
+            _ => self.forget(),
+        }
+    }
+}
+
+/// The names a program declares (DEF, its PROC's parameters), upper case.
+pub(crate) type Variables<'a> = FxHashSet<&'a str>;
+
+/// Whether a word assigns a declared variable (`X=5` after `DEF REAL X`),
+/// as the run reads it.
+fn assigns(word: &Word, variables: &Variables<'_>) -> bool {
+    matches!(&word.value, Some(WordValue::Expr { dimension: None, .. })) && variables.contains(word.address.as_str())
+}
+
+/// Whether `address` names an axis the control moves: its letter, or the
+/// letter with a number (`A2`, `X1`).
+pub(crate) fn is_axis(address: &str) -> bool {
+    let Some((&letter, number)) = address.as_bytes().split_first() else { return false };
+    b"XYZABCUVW".contains(&letter) && number.iter().all(u8::is_ascii_digit)
+}
+
+/// Whether a block's statements end the way on to the next block: an end
+/// of program, RET, or an unconditional jump.
+fn ends_way(block: &SinumerikBlock) -> bool {
+    block.program_end().is_some()
+        || block.statements.iter().any(|statement| match &statement.kind {
+            StatementKind::Jump(jump) => jump.kind != JumpKind::GotoC,
+            _ => false,
+        })
+}
+
+/// One block as the walk sees it.
+pub(crate) struct Step<'a> {
+    pub index: usize,
+    pub block: &'a SinumerikBlock,
+    /// Where the tool stood before the block.
+    pub from: [Known<f64>; 3],
+    /// The state after the block.
+    pub state: &'a State,
+    /// Whether the block moves an axis.
+    pub moves: bool,
+}
+
+/// Walks `file` from reset (`main`) or from an unknown state, calling
+/// `visit` at each block with the state after it.
+pub(crate) fn walk(db: &dyn Db, file: &FileModel, main: bool, mut visit: impl FnMut(Step<'_>)) {
+    let model = &file.model;
+    let mut variables: Variables<'_> = model.definitions.iter().map(|d| d.declared.name.as_str()).collect();
+    if let Some(proc) = model.header() {
+        variables.extend(proc.declaration.parameters.iter().filter_map(|p| p.name.as_deref()));
+    }
+    let mut targets = vec![false; file.ranges.len()];
+    let mut computed = false;
+    for site in &model.jumps {
+        match site.resolved {
+            Resolved::Block(target) => targets[target] = true,
+            Resolved::Start => targets[0] = true,
+            Resolved::Computed => computed = true,
+            Resolved::NotFound { .. } | Resolved::NoTarget => {}
+        }
+    }
+    if computed {
+        for &block in model.labels.values().chain(model.block_numbers.values()).flatten() {
+            targets[block] = true;
+        }
+    }
+    // Without MCALL in the file, no modal call is ever in force.
+    let modal_calls = file
+        .blocks(db)
+        .any(|block| block.statements.iter().any(|statement| matches!(statement.kind, StatementKind::ModalCall(_))));
+    let mut opens: FxHashMap<usize, &Structure> = FxHashMap::default();
+    let mut middles: FxHashMap<usize, &Structure> = FxHashMap::default();
+    let mut closes: FxHashMap<usize, &Structure> = FxHashMap::default();
+    for structure in &model.structures {
+        opens.insert(structure.start, structure);
+        if let Some(middle) = structure.middle {
+            middles.insert(middle, structure);
+        }
+        closes.insert(structure.end, structure);
+    }
+    // By a structure's start: for an IF the state of the way not taken,
+    // for a loop the state it ends with.
+    let mut saved: FxHashMap<usize, State> = FxHashMap::default();
+    let mut state = if main { State::at_reset() } else { State::subprogram_start() };
+    let mut cut_off = false;
+    for (index, block) in file.blocks(db).enumerate() {
+        if cut_off || targets[index] {
+            state.forget();
+            if modal_calls {
+                state.modal_program = Known::Unknown;
+            }
+        }
+        if let Some(structure) = middles.get(&index)
+            && let Some(other) = saved.get_mut(&structure.start)
+        {
+            std::mem::swap(&mut state, other);
+        }
+        if let Some(structure) = closes.get(&index)
+            && let Some(other) = saved.remove(&structure.start)
+        {
+            state = state.join(&other);
+        }
+        if let Some(structure) = opens.get(&index)
+            && structure.kind != StructureKind::If
+        {
+            let mut entry = state.clone();
+            for body in structure.start..=structure.end {
+                let mut after = entry.clone();
+                after.apply(file.block(body), &variables);
+                entry = entry.join(&after);
+            }
+            state = entry.clone();
+            if matches!(structure.kind, StructureKind::While | StructureKind::For) {
+                saved.insert(structure.start, entry);
+            }
+        }
+        let from = state.position;
+        let moves = state.apply(block, &variables);
+        visit(Step { index, block, from, state: &state, moves });
+        if let Some(structure) = opens.get(&index)
+            && structure.kind == StructureKind::If
+        {
+            saved.insert(structure.start, state.clone());
+        }
+        cut_off = ends_way(block);
+    }
+}
