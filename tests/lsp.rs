@@ -781,7 +781,8 @@ fn the_project_decides_a_documents_dialect() {
     let siemens = document(&dir, "siemens/A.NCP", "%1\nN10 G01 X1\n*\n");
     client.notify("textDocument/didOpen", siemens.did_open()).unwrap();
     let published = settled_diagnostics(&mut client, &siemens);
-    assert_eq!(published.params()["diagnostics"][0]["code"], "S001", "{}", published.json);
+    let mut codes = published.params()["diagnostics"].as_array().unwrap().iter().filter_map(|d| d["code"].as_str());
+    assert!(codes.any(|code| code == "S001"), "{}", published.json);
     // An extension of the project's own: analysed as CNC8x6.
     let mapped = document(&dir, "B.PRG", "%1\nN10 G01 X1\nN20 M30\n*\n");
     client.notify("textDocument/didOpen", mapped.did_open()).unwrap();

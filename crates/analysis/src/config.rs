@@ -18,6 +18,7 @@
 //! [sinumerik]
 //! globals = ["VAC_POLE"]       # names declared outside the file (GUD, macros)
 //! r-parameters = 100           # $MN_MM_NUM_R_PARAM: R0 to R99
+//! tool-management = true       # the machine manages its tools (GETSELT, GETEXET)
 //!
 //! [machine]
 //! file = "machines/mill.toml"             # a machine file; the keys below override it
@@ -174,6 +175,9 @@ pub struct SinumerikConfig {
     /// How many R parameters the control has (`$MN_MM_NUM_R_PARAM`);
     /// `None`: the catalogue's count.
     pub r_parameters: Option<u32>,
+    /// The control runs tool management, where `$P_TOOLNO` and `$P_TOOLP`
+    /// do not give the tool (004:3274-3280).
+    pub tool_management: bool,
 }
 
 impl SinumerikConfig {

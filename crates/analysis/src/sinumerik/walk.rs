@@ -309,7 +309,12 @@ pub(crate) fn is_axis(address: &str) -> bool {
 fn ends_way(block: &SinumerikBlock) -> bool {
     block.program_end().is_some()
         || block.statements.iter().any(|statement| match &statement.kind {
-            StatementKind::Jump(jump) => jump.kind != JumpKind::GotoC,
+            // A jump without its target is the parser's error, not an end.
+            StatementKind::Jump(jump) => match jump.kind {
+                JumpKind::GotoC => false,
+                JumpKind::GotoS => true,
+                _ => jump.target.is_some(),
+            },
             _ => false,
         })
 }
@@ -324,6 +329,9 @@ pub(crate) struct Step<'a> {
     pub state: &'a State,
     /// Whether the block moves an axis.
     pub moves: bool,
+    /// Whether a way the program runs reaches the block: not after an end
+    /// or an unconditional jump unless a jump or a structure leads there.
+    pub reached: bool,
 }
 
 /// Walks `file` from reset (`main`) or from an unknown state, calling
@@ -349,10 +357,20 @@ pub(crate) fn walk(db: &dyn Db, file: &FileModel, main: bool, mut visit: impl Fn
             targets[block] = true;
         }
     }
-    // Without MCALL in the file, no modal call is ever in force.
-    let modal_calls = file
-        .blocks(db)
-        .any(|block| block.statements.iter().any(|statement| matches!(statement.kind, StatementKind::ModalCall(_))));
+    // A repeated section runs from its label; without MCALL in the file,
+    // no modal call is ever in force.
+    let mut modal_calls = false;
+    for statement in file.blocks(db).flat_map(|block| &block.statements) {
+        match &statement.kind {
+            StatementKind::RepeatSection { start, .. } => {
+                for &target in model.labels.get(start).into_iter().flatten() {
+                    targets[target] = true;
+                }
+            }
+            StatementKind::ModalCall(_) => modal_calls = true,
+            _ => {}
+        }
+    }
     let mut opens: FxHashMap<usize, &Structure> = FxHashMap::default();
     let mut middles: FxHashMap<usize, &Structure> = FxHashMap::default();
     let mut closes: FxHashMap<usize, &Structure> = FxHashMap::default();
@@ -369,6 +387,8 @@ pub(crate) fn walk(db: &dyn Db, file: &FileModel, main: bool, mut visit: impl Fn
     let mut state = if main { State::at_reset() } else { State::subprogram_start() };
     let mut cut_off = false;
     for (index, block) in file.blocks(db).enumerate() {
+        let joins = middles.contains_key(&index) || closes.contains_key(&index);
+        let reached = !cut_off || targets[index] || joins;
         if cut_off || targets[index] {
             state.forget();
             if modal_calls {
@@ -401,7 +421,7 @@ pub(crate) fn walk(db: &dyn Db, file: &FileModel, main: bool, mut visit: impl Fn
         }
         let from = state.position;
         let moves = state.apply(block, &variables);
-        visit(Step { index, block, from, state: &state, moves });
+        visit(Step { index, block, from, state: &state, moves, reached });
         if let Some(structure) = opens.get(&index)
             && structure.kind == StructureKind::If
         {

@@ -1,5 +1,5 @@
 //! Rules on single blocks, from their statements alone (digest §6 rules 4,
-//! 7, 49, 50, 55, 56, 57, 80 and the comparison priority). They run per
+//! 7, 49, 50, 53, 55, 56, 57, 79, 80 and the comparison priority). They run per
 //! chunk of blocks, so an edit checks again only the chunk it touched.
 
 use nc_exec::sinumerik::lower::{BinaryOp, Callee, Expr, ExprKind, PlaceKind, SinumerikBlock, StatementKind};
@@ -19,7 +19,9 @@ declare_rules! {
     GROUP_NUMBER_NOT_CODE = "K050", "group-number-not-code", Warning, "`G[n]=1` where the group's first code is not G1: `G[1]=1` selects G0.";
     SYNC_ACTION_SHARES_BLOCK = "K055", "sync-action-shares-block", Error, "A synchronous action (`ID=1 WHENEVER … DO …`) with other statements in its block.";
     NUL_IN_STRING = "K056", "nul-in-string", Info, "A string with a NUL character, where the control cuts it off.";
+    TOOL_VARIABLE_UNDER_MANAGEMENT = "K053", "tool-variable-under-management", Warning, "`$P_TOOLNO` or `$P_TOOLP` on a machine with tool management (`[sinumerik] tool-management`), where GETEXET and GETSELT give the tool.";
     CYCLE832_OPTION = "K057", "cycle832-option", Hint, "CYCLE832 needs its option on the control; without it, its expansion does the same.";
+    INTERPOLATING_SPLINE = "K079", "interpolating-spline", Info, "ASPLINE or CSPLINE, which pass through every point: on digitised or noisy points BSPLINE, which approximates them, is smoother.";
     SPLINE_PARAMETER_RANGE = "K080", "spline-parameter-range", Error, "A spline degree SD other than 2 or 3, or a point weight PW outside 0 to 3.";
     COMPARISON_PRIORITY = "K107", "comparison-priority", Warning, "A comparison with an unparenthesised AND, OR, XOR or `<<` as operand: Sinumerik ranks comparisons below them, so `A>5 AND B<3` reads `A>(5 AND B)<3`.";
 }
@@ -29,6 +31,13 @@ const MAX_BLOCK_CHARS: usize = 512;
 
 /// What CYCLE832 switches on, written out (004:3302-3308).
 const CYCLE832_EXPANSION: &str = "SOFT DYNFINISH COMPCAD G645 FIFOCTRL FFWON";
+
+/// The system variables that do not give the tool under tool management,
+/// and what does (004:3274-3280).
+const TOOL_VARIABLES: [(&str, &str); 2] = [("$P_TOOLNO", "GETEXET"), ("$P_TOOLP", "GETSELT")];
+
+/// The splines that pass through their points (004:3488-3491).
+const INTERPOLATING_SPLINES: [&str; 2] = ["ASPLINE", "CSPLINE"];
 
 /// The findings of one block; `text` is the block's, and ranges are
 /// relative to its start.
@@ -40,6 +49,9 @@ pub(crate) fn check(block: &SinumerikBlock, text: &str, config: &Config) -> Vec<
     r_parameters(block, config, &mut out);
     statements(catalogue, block, &mut out);
     spline_words(block, &mut out);
+    if config.sinumerik.tool_management {
+        tool_variables(block, &mut out);
+    }
     for statement in &block.statements {
         statement_exprs(statement, &mut |expr| priority(text, expr, &mut out));
     }
@@ -143,6 +155,13 @@ fn statements(catalogue: &Catalogue, block: &SinumerikBlock, out: &mut Vec<Diagn
             StatementKind::Assign { target, value } if target.kind == PlaceKind::GroupCode => {
                 group_number(catalogue, &target.indices, value, statement.range, out);
             }
+            StatementKind::Command(command) if INTERPOLATING_SPLINES.contains(&command.name.as_str()) => {
+                let message = format!(
+                    "{} passes through every point it is given, so on digitised or noisy points it follows every error; BSPLINE approximates the points and gives a smoother path (004:3488-3491)",
+                    command.name
+                );
+                out.push(Diagnostic::new(&INTERPOLATING_SPLINE, statement.range, message));
+            }
             StatementKind::Call(call) if matches!(&call.callee, Callee::Cycle(name) if name == "CYCLE832") => {
                 let message = format!(
                     "CYCLE832 runs only with its option on the control; without it, write what it switches on: {CYCLE832_EXPANSION}"
@@ -160,6 +179,18 @@ fn statements(catalogue: &Catalogue, block: &SinumerikBlock, out: &mut Vec<Diagn
                 format!("the string holds a NUL character after {at} bytes: the control ends the string there");
             out.push(Diagnostic::new(&NUL_IN_STRING, expr.range, message));
         }
+    });
+}
+
+/// Rule 53: the tool's system variables read under tool management.
+fn tool_variables(block: &SinumerikBlock, out: &mut Vec<Diagnostic>) {
+    all_exprs(&block.statements, &mut |expr| {
+        let ExprKind::Name(place) = &expr.kind else { return };
+        let Some((name, instead)) = TOOL_VARIABLES.iter().find(|(name, _)| place.name == *name) else { return };
+        let message = format!(
+            "{name} does not give the tool on a machine with tool management: call {instead} instead (004:3274-3280)"
+        );
+        out.push(Diagnostic::new(&TOOL_VARIABLE_UNDER_MANAGEMENT, expr.range, message));
     });
 }
 

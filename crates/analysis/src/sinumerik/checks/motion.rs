@@ -1,5 +1,5 @@
 //! Rules on motion and technology over the walk's modal state (digest §6
-//! rules 16, 18, 19, 20, 22, 26, 29, 48, 52, 67 and 81).
+//! rules 16, 18, 19, 20, 22, 26, 27, 29, 31, 32, 48, 52, 67 and 81).
 //!
 //! Assumptions, where the digest is silent:
 //! - Rules 18 and 26 report the first block of a stretch, not every block
@@ -9,10 +9,24 @@
 //!   with the spindle still.
 //! - Rule 22 reads "at full feed" as at the feed of the cut in X or Y
 //!   that follows the plunge: of several steps down in a row, the last
-//!   enters the material. Whether the tool cuts at its centre is not
-//!   known.
+//!   enters the material. It is opt-in: whether the plunge enters the
+//!   stock is not known (the thesis's L26 plunges beside the part), nor
+//!   whether the tool cuts at its centre.
+//! - Rule 27 is opt-in: dry cutting and coolant through M functions of
+//!   the machine builder are common. It reads the catalogue's coolant
+//!   group (M7, M8 on; M9 off).
+//! - Rule 31 asks a main program to write at least one of tool radius
+//!   compensation (G40), a work offset (G500, G54 …) and the dimensions
+//!   (G90/G91) before its first move, as the thesis's safe block does
+//!   (004:493-501); a call before the first move may write them. It is
+//!   opt-in: the thesis's reason, modes surviving M30 (004:574-577), is
+//!   ISO's, and a Sinumerik puts its groups back to their reset values at
+//!   the end of a program (Siemens documentation, machine data MD20150).
+//! - Rule 32 reports blocks after an end or an unconditional jump that no
+//!   jump, repeated section or structure leads to, once per run of them.
 //! - Rule 48 cannot see the caller: it warns where the subprogram itself
-//!   put continuous-path mode in force.
+//!   put continuous-path mode in force, and not under SAVE, which gives
+//!   the caller its modes back and does not go with RET (rule 47).
 //! - Rule 81 counts M functions other than the stops and ends (M0, M1,
 //!   M2, M17, M30), MSG, WRITE and STOPRE as the blocks that break the
 //!   path (digest: inferred).
@@ -37,12 +51,15 @@ use crate::{
 
 declare_rules! {
     RAPID_PLUNGE_WITH_XY = "K016", "rapid-xy-and-z-down", Warning, "A G0 move that lowers Z while it moves X or Y: approach in X and Y first, then in Z.";
-    MISSING_FEED = "K018", "missing-feed", Error, "A feed move (G1, G2, G3, a spline) before any feed F was programmed.";
+    MISSING_FEED = "K018", "no-feed-programmed", Error, "A feed move (G1, G2, G3, a spline) before any feed F was programmed.";
     FULL_CIRCLE_WITH_RADIUS = "K019", "full-circle-with-radius", Error, "G2 or G3 with CR whose end point is its start point: a radius cannot give a full circle.";
     RADIUS_TOO_SHORT = "K020", "radius-too-short", Error, "G2 or G3 with a radius CR shorter than half the distance from its start to its end.";
-    PLUNGE_AT_FULL_FEED = "K022", "plunge-at-full-feed", Warning, "A feed move down in Z alone at the feed of the cut in X or Y that follows it.";
+    PLUNGE_AT_FULL_FEED = "K022", "plunge-at-full-feed", Warning, "A feed move down in Z alone at the feed of the cut in X or Y that follows it.", opt_in;
     CUT_WITH_SPINDLE_OFF = "K026", "cut-with-spindle-off", Error, "A feed move of X, Y or Z while the spindle stands (M5, M19, or never started in a main program).";
+    CUT_WITHOUT_COOLANT = "K027", "cut-without-coolant", Warning, "A feed move of X, Y or Z with the coolant off (M9, or never switched on in a main program).", opt_in;
     SPINDLE_WITHOUT_SPEED = "K029", "spindle-without-speed", Warning, "M3 or M4 before any spindle speed S was programmed.";
+    NO_SAFE_BLOCK = "K031", "no-safe-block", Info, "A main program that moves before it writes any of tool radius compensation (G40), a work offset or G90/G91: the modes stand as the machine's reset left them.", opt_in;
+    UNREACHABLE_CODE = "K032", "unreachable-code", Info, "Blocks after an end of program or an unconditional jump that no jump, repeated section or structure leads to.", unnecessary;
     END_STOPS_PATH = "K048", "subprogram-end-stops-path", Warning, "A subprogram that ends with M17, M2 or M30 under the continuous-path mode it set: the end stops the path, RET keeps it.";
     CONTOUR_NOT_LINES_AND_ARCS = "K052", "contour-not-lines-and-arcs", Error, "A spline or polynomial inside a CONTPRON contour, which takes only lines and arcs.";
     OFFSETS_NOT_AFTER_TRAORI = "K067", "offsets-not-after-traori", Warning, "A move after TRAORI with no work offset (G54…) or tool offset D programmed since TRAORI.";
@@ -62,14 +79,28 @@ const STOPS_AND_ENDS: [u64; 5] = [0, 1, 2, 17, 30];
 /// The statements rule 81 names that break the path.
 const PATH_BREAKERS: [&str; 3] = ["MSG", "WRITE", "STOPRE"];
 
+/// The coolant's group, and the code that switches it off.
+const COOLANT: &str = "M3";
+const COOLANT_OFF: &str = "M9";
+
+/// The groups the safe block writes (rule 31): tool radius compensation,
+/// work offset, dimensions.
+const SAFE_GROUPS: [&str; 3] = ["G7", "G8", "G14"];
+
 /// The state the rules keep between blocks.
-#[derive(Default)]
 pub(crate) struct Motion {
     feed_reported: bool,
     /// The M5 or M19 that stopped the spindle, and whether a cut since it
     /// was reported.
     spindle_stop: Option<TextRange>,
     spindle_reported: bool,
+    coolant_reported: bool,
+    /// Rule 31: which of [`SAFE_GROUPS`] the program wrote before its
+    /// first move; `None` once it moved or called a program.
+    safe: Option<[bool; 3]>,
+    /// The first block of the unreached run rule 32 reports, and its last
+    /// block with statements.
+    unreached: Option<(usize, usize)>,
     /// The last of the feed moves down in Z since the last cut in X or Y.
     plunge: Option<(TextRange, f64)>,
     contour: Option<TextRange>,
@@ -112,6 +143,22 @@ fn predefined(statement: &Statement) -> Option<&str> {
 }
 
 impl Motion {
+    fn new(main: bool) -> Motion {
+        Motion {
+            feed_reported: false,
+            spindle_stop: None,
+            spindle_reported: false,
+            coolant_reported: false,
+            safe: main.then_some([false; 3]),
+            unreached: None,
+            plunge: None,
+            contour: None,
+            traori: None,
+            on_path: false,
+            break_after: None,
+        }
+    }
+
     /// `main`: the file starts at reset; `save`: its PROC line has SAVE.
     pub(crate) fn step(
         &mut self,
@@ -123,6 +170,8 @@ impl Motion {
     ) {
         let catalogue = Dialect::Sinumerik.catalogue();
         let state = step.state;
+        self.unreached(file, step, out);
+        self.safe_block(catalogue, file, step, out);
         self.spindle(file, step, out);
         if step.block.statements.iter().any(|s| word_is(s, "T") || m_number(s) == Some(6)) {
             self.plunge = None;
@@ -134,6 +183,7 @@ impl Motion {
             self.missing_feed(file, step, feed_move, out);
             if feed_move {
                 self.cut_without_spindle(file, step, out);
+                self.cut_without_coolant(file, step, out);
             }
             self.rapid_plunge(file, step, out);
             self.arc_radius(file, step, out);
@@ -142,8 +192,10 @@ impl Motion {
         } else {
             self.path_breaker(file, step);
         }
-        if !main && state.continuous_path() == Known::Is(true) {
-            self.end_of_subprogram(file, step, save, out);
+        // Under SAVE the caller's modes come back anyway, and RET is no
+        // choice (rule 47).
+        if !main && !save && state.continuous_path() == Known::Is(true) {
+            self.end_of_subprogram(file, step, out);
         }
     }
 
@@ -204,6 +256,81 @@ impl Motion {
             ),
         };
         out.push(diagnostic);
+    }
+
+    /// Rule 27, as rule 26 for the coolant.
+    fn cut_without_coolant(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        if step.state.modes.get(COOLANT) != Some(COOLANT_OFF) {
+            self.coolant_reported = false;
+            return;
+        }
+        if self.coolant_reported {
+            return;
+        }
+        let Some(range) = find(file, step, |s| PATH_AXES.iter().any(|axis| word_is(s, axis))) else { return };
+        self.coolant_reported = true;
+        let message = "a feed move with the coolant off: switch it on (M8) before cutting, unless the cut is dry";
+        out.push(Diagnostic::new(&CUT_WITHOUT_COOLANT, range, message));
+    }
+
+    /// Rule 31: the groups a main program writes before it moves.
+    fn safe_block(&mut self, catalogue: &Catalogue, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        let Some(written) = &mut self.safe else { return };
+        for statement in &step.block.statements {
+            let group = match &statement.kind {
+                StatementKind::Word(word) if word.address == "G" => {
+                    let number = word.value.as_ref().and_then(number).and_then(|n| n.whole());
+                    match number.and_then(|n| u32::try_from(n).ok()) {
+                        // Settable work offsets beyond the catalogue's.
+                        Some(505..=599) => Some("G8"),
+                        Some(n) => catalogue.code('G', n).and_then(|code| code.group.as_deref()),
+                        None => None,
+                    }
+                }
+                StatementKind::Command(command) => catalogue.word_code(&command.name).and_then(|c| c.group.as_deref()),
+                StatementKind::Call(call) if !matches!(call.callee, Callee::Predefined(_) | Callee::Cycle(_)) => {
+                    self.safe = None;
+                    return;
+                }
+                _ => None,
+            };
+            if let Some(slot) = SAFE_GROUPS.iter().position(|g| Some(*g) == group) {
+                written[slot] = true;
+            }
+        }
+        if !step.moves {
+            return;
+        }
+        let wrote_any = written.iter().any(|&written| written);
+        self.safe = None;
+        if wrote_any {
+            return;
+        }
+        let range = file.in_file(step.index, step.block.statements[0].range);
+        let message = "the program moves before it writes a safe block: tool radius compensation (G40), a work offset (G54 …, G500) or the dimensions (G90, G91) stand as the machine's reset left them; start with a block such as `G17 G40 G90 G54` (004:493-501)";
+        out.push(Diagnostic::new(&NO_SAFE_BLOCK, range, message));
+    }
+
+    /// Rule 32: a run of blocks no way reaches.
+    fn unreached(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        if step.reached {
+            self.report_unreached(file, out);
+        } else if !step.block.statements.is_empty() {
+            match &mut self.unreached {
+                Some((_, last)) => *last = step.index,
+                None => self.unreached = Some((step.index, step.index)),
+            }
+        }
+    }
+
+    /// Rule 32 at the end of a run of unreached blocks.
+    fn report_unreached(&mut self, file: &FileModel, out: &mut Vec<Diagnostic>) {
+        let Some((first, last)) = self.unreached.take() else { return };
+        let end =
+            file.block(last).statements.last().map_or(file.ranges[last].end(), |s| file.in_file(last, s.range).end());
+        let range = TextRange::new(file.ranges[first].start(), end);
+        let message = "no jump, repeated section or structure leads here, after an end or an unconditional jump: the control never runs these blocks";
+        out.push(Diagnostic::new(&UNREACHABLE_CODE, range, message));
     }
 
     /// Rule 16: G0 lowering Z while it moves X or Y.
@@ -395,7 +522,7 @@ impl Motion {
     }
 
     /// Rule 48: M17, M2 or M30 ending a subprogram on the path.
-    fn end_of_subprogram(&mut self, file: &FileModel, step: &Step<'_>, save: bool, out: &mut Vec<Diagnostic>) {
+    fn end_of_subprogram(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
         if !matches!(step.block.program_end(), Some(ProgramEnd::Subprogram | ProgramEnd::Program)) {
             return;
         }
@@ -406,20 +533,17 @@ impl Motion {
         let message = format!(
             "M{number} ends the subprogram and the continuous-path mode it set: the caller's next move starts from a stop; RET returns and keeps the path (004:1561-1563)"
         );
-        let mut diagnostic = Diagnostic::new(&END_STOPS_PATH, range, message);
-        // RET and SAVE do not go together (rule 47).
-        if !save {
-            diagnostic = diagnostic.with_fix("Return with RET", vec![TextEdit::replace(range, "RET")]);
-        }
-        out.push(diagnostic);
+        let fix = vec![TextEdit::replace(range, "RET")];
+        out.push(Diagnostic::new(&END_STOPS_PATH, range, message).with_fix("Return with RET", fix));
     }
 }
 
 /// Runs the rules of this module over a walk of `file`.
 pub(crate) fn check(db: &dyn Db, file: &FileModel, main: bool) -> Vec<Diagnostic> {
     let save = file.model.header().is_some_and(|proc| proc.declaration.attributes.iter().any(|a| a == "SAVE"));
-    let mut motion = Motion::default();
+    let mut motion = Motion::new(main);
     let mut out = Vec::new();
     walk::walk(db, file, main, |step| motion.step(file, &step, main, save, &mut out));
+    motion.report_unreached(file, &mut out);
     out
 }

@@ -1,5 +1,5 @@
 //! Rules on the program as a whole, over the program model (digest §6
-//! rules 39, 40, 42, 43, 44, 47, 59, 60, 68, 69, 76, 77, and the balance of the
+//! rules 39, 40, 42, 43, 44, 47, 54, 59, 60, 68, 69, 76, 77, and the balance of the
 //! control structures and the direction of jumps). Each is one pass over
 //! the blocks or the model's lists.
 //!
@@ -19,7 +19,10 @@
 //!   known from numbers written ends the run.
 
 use nc_exec::sinumerik::{
-    lower::{Callee, Dimension, Jump, JumpKind, JumpTarget, SinumerikBlock, StatementKind, Word, WordValue},
+    lower::{
+        Callee, Dimension, ExprKind, Jump, JumpKind, JumpTarget, SinumerikBlock, Statement, StatementKind, Word,
+        WordValue,
+    },
     program::{Resolved, Structure, StructureKind, Unbalanced},
 };
 use ncc_catalog::{AddressRole, Catalogue, Dialect, KeywordKind};
@@ -29,7 +32,10 @@ use crate::{
     Diagnostic,
     db::Db,
     diagnostic::declare_rules,
-    sinumerik::{checks::visit::number, model::FileModel},
+    sinumerik::{
+        checks::visit::{all_exprs, number},
+        model::FileModel,
+    },
 };
 
 declare_rules! {
@@ -39,6 +45,7 @@ declare_rules! {
     PROC_NOT_FIRST = "K043", "proc-not-first", Error, "A PROC line that is not the program's first statement.";
     DEFINITION_AFTER_STATEMENT = "K044", "definition-after-statement", Error, "A DEF or EXTERN after the program's first statement that declares nothing.";
     RET_WITH_SAVE = "K047", "ret-with-save", Warning, "RET in a subprogram whose PROC line has SAVE, which the thesis says cannot be combined (Siemens's own cycles do combine them).", opt_in;
+    SIMULATION_BRANCH = "K054", "simulation-branch-and-files", Info, "A program that branches on `$P_ISTEST` and writes files: a simulation started from the programming screen writes none, so the branches differ; ISFILE tests for the file itself.";
     JUMP_TARGET_NOT_FOUND = "K059", "jump-target-not-found", Error, "A jump to a label or block number the program does not have.";
     JUMP_INTO_STRUCTURE = "K060", "jump-into-structure", Warning, "A jump from outside into the body of an IF, WHILE, FOR, REPEAT or LOOP.";
     TRANSFORMATION_AT_END = "K068", "transformation-at-end", Warning, "The program ends with TRAORI still on (no TRAFOOF after it).";
@@ -87,6 +94,7 @@ pub(crate) fn check(db: &dyn Db, file: &FileModel, in_workspace: &dyn Fn(&str) -
     structures(file, &mut out);
     jumps(file, &mut out);
     modes_at_end(db, catalogue, file, &mut out);
+    simulation_branch(db, file, &mut out);
     Motion::check(db, catalogue, file, &mut out);
     out
 }
@@ -340,6 +348,31 @@ impl<'a> Enclosing<'a> {
             at = self.parent[index];
         }
         entered
+    }
+}
+
+/// Rule 54: `$P_ISTEST` read in a program that writes files
+/// (004:3137-3143).
+fn simulation_branch(db: &dyn Db, file: &FileModel, out: &mut Vec<Diagnostic>) {
+    let mut tests = Vec::new();
+    let mut write = None;
+    for (index, block) in file.blocks(db).enumerate() {
+        all_exprs(&block.statements, &mut |expr| {
+            if matches!(&expr.kind, ExprKind::Name(place) if place.name == "$P_ISTEST") {
+                tests.push(file.in_file(index, expr.range));
+            }
+        });
+        let writes = |statement: &&Statement| matches!(&statement.kind, StatementKind::Call(call) if matches!(&call.callee, Callee::Predefined(name) if name == "WRITE"));
+        if write.is_none()
+            && let Some(statement) = block.statements.iter().find(writes)
+        {
+            write = Some(file.in_file(index, statement.range));
+        }
+    }
+    let Some(write) = write else { return };
+    for test in tests {
+        let message = "the program branches on $P_ISTEST and writes files: a simulation started from the programming screen writes no file, so the simulated way is not the real one; the thesis tests for the written file with ISFILE (004:3137-3143)";
+        out.push(Diagnostic::new(&SIMULATION_BRANCH, test, message).with_related(None, write, "WRITE"));
     }
 }
 
