@@ -5,7 +5,7 @@
 //! It visits each block once, in file order. A main program starts at
 //! reset (the catalogue's defaults, no F, no S); a subprogram (a PROC, an
 //! SPF file) from an unknown state, since its caller's is not known here,
-//! but without a modal call (MCALL) in force.
+//! but without a modal call (MCALL) in force and under G90.
 //! Where the file's order is not the run's order, it keeps what holds
 //! whichever way the program goes:
 //!
@@ -26,12 +26,13 @@
 use nc_exec::{
     known::Known,
     sinumerik::{
-        lower::{Callee, Dimension, JumpKind, PlaceKind, SinumerikBlock, StatementKind, Word, WordValue},
+        lower::{Callee, Command, Dimension, JumpKind, PlaceKind, SinumerikBlock, StatementKind, Word, WordValue},
         modes::Modes,
         program::{Resolved, Structure, StructureKind},
     },
 };
 use ncc_catalog::{Catalogue, Code, Dialect, KeywordKind};
+use ncc_syntax::TextRange;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::{db::Db, sinumerik::checks::visit::number, sinumerik::model::FileModel};
@@ -97,9 +98,16 @@ impl State {
 
     /// As a subprogram starts: its caller's state is not known, and it is
     /// taken to be called without a modal call in force, as programs
-    /// mostly are (else every move would forget everything).
+    /// mostly are (else every move would forget everything), and under
+    /// G90.
     fn subprogram_start() -> State {
-        State { modal_program: Known::Is(None), ..State::unknown() }
+        let mut state = State { modal_program: Known::Is(None), ..State::unknown() };
+        // Coordinates are taken as absolute until the subprogram says: the
+        // thesis's subprograms never write G90 (L26–L28).
+        if let Some(absolute) = catalogue().code_named("G90") {
+            state.modes.set(absolute);
+        }
+        state
     }
 
     /// Forgets everything but the modal call, which only MCALL changes.
@@ -151,6 +159,7 @@ impl State {
             match &statement.kind {
                 StatementKind::Word(word) => self.function_word(word, &mut codes),
                 StatementKind::Command(command) => match catalogue.word_code(&command.name) {
+                    Some(code) if code.group.as_deref() == Some(FRAMES) => self.frame(command),
                     Some(code) => codes.push(code),
                     None if catalogue
                         .keyword(&command.name)
@@ -169,7 +178,7 @@ impl State {
         }
         let in_group = |group: &str| codes.iter().any(|code| code.group.as_deref() == Some(group));
         // The block's coordinates count in the new system.
-        if [FRAMES, WORK_OFFSETS, UNITS].into_iter().any(in_group) {
+        if [WORK_OFFSETS, UNITS].into_iter().any(in_group) {
             self.position = [Known::Unknown; 3];
         }
         for &code in &codes {
@@ -200,6 +209,18 @@ impl State {
             }
         }
         moved
+    }
+
+    /// A frame moves the coordinates: those of the axes an additive
+    /// translation, scale or mirror names (`ATRANS X-300`), every one for
+    /// a rotation or a frame that replaces the one in force.
+    fn frame(&mut self, command: &Command) {
+        let additive = matches!(command.name.as_str(), "ATRANS" | "ASCALE" | "AMIRROR");
+        for (axis, name) in PATH_AXES.iter().enumerate() {
+            if !additive || command.words.iter().any(|word| word.address == *name) {
+                self.position[axis] = Known::Unknown;
+            }
+        }
     }
 
     /// A G or M word: its code, or what it makes unknown.
@@ -305,16 +326,13 @@ pub(crate) fn is_axis(address: &str) -> bool {
 }
 
 /// Whether a block's statements end the way on to the next block: an end
-/// of program, RET, or an unconditional jump.
-fn ends_way(block: &SinumerikBlock) -> bool {
+/// of program, RET, or an unconditional jump. A jump that finds no target
+/// is left out: the parser or a rule reports it, and what follows it is
+/// not reported again.
+fn ends_way(block: &SinumerikBlock, index: usize, failed: &FxHashSet<(usize, TextRange)>) -> bool {
     block.program_end().is_some()
         || block.statements.iter().any(|statement| match &statement.kind {
-            // A jump without its target is the parser's error, not an end.
-            StatementKind::Jump(jump) => match jump.kind {
-                JumpKind::GotoC => false,
-                JumpKind::GotoS => true,
-                _ => jump.target.is_some(),
-            },
+            StatementKind::Jump(jump) => jump.kind != JumpKind::GotoC && !failed.contains(&(index, jump.range)),
             _ => false,
         })
 }
@@ -334,37 +352,84 @@ pub(crate) struct Step<'a> {
     pub reached: bool,
 }
 
+/// What may hold on either of two ways; `None` is a way no run takes.
+fn join(a: Option<State>, b: Option<State>) -> Option<State> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.join(&b)),
+        (a, b) => a.or(b),
+    }
+}
+
+/// `entry` with everything blocks `body` may change forgotten: the state
+/// at the top of a loop over them, whichever time round.
+fn looped(
+    mut entry: State,
+    file: &FileModel,
+    body: std::ops::RangeInclusive<usize>,
+    variables: &Variables<'_>,
+) -> State {
+    for index in body {
+        let mut after = entry.clone();
+        after.apply(file.block(index), variables);
+        entry = entry.join(&after);
+    }
+    entry
+}
+
 /// Walks `file` from reset (`main`) or from an unknown state, calling
 /// `visit` at each block with the state after it.
+///
+/// A jump forward hands its state to its target, which joins it with the
+/// way into it; a jump back makes its target the top of a loop up to the
+/// jump, as WHILE does.
 pub(crate) fn walk(db: &dyn Db, file: &FileModel, main: bool, mut visit: impl FnMut(Step<'_>)) {
     let model = &file.model;
+    let count = file.ranges.len();
     let mut variables: Variables<'_> = model.definitions.iter().map(|d| d.declared.name.as_str()).collect();
     if let Some(proc) = model.header() {
         variables.extend(proc.declaration.parameters.iter().filter_map(|p| p.name.as_deref()));
     }
-    let mut targets = vec![false; file.ranges.len()];
+    // By block: its forward jumps' targets; by target: the last block that
+    // jumps back to it.
+    let mut forward: FxHashMap<usize, Vec<usize>> = FxHashMap::default();
+    let mut back_from: FxHashMap<usize, usize> = FxHashMap::default();
+    // Blocks a way the walk cannot follow reaches: computed targets,
+    // repeated sections.
+    let mut unknown_ways = vec![false; count];
     let mut computed = false;
+    let mut failed = FxHashSet::default();
     for site in &model.jumps {
-        match site.resolved {
-            Resolved::Block(target) => targets[target] = true,
-            Resolved::Start => targets[0] = true,
-            Resolved::Computed => computed = true,
-            Resolved::NotFound { .. } | Resolved::NoTarget => {}
+        let target = match site.resolved {
+            Resolved::Block(target) => target,
+            Resolved::Start => 0,
+            Resolved::Computed => {
+                computed = true;
+                continue;
+            }
+            Resolved::NotFound { .. } | Resolved::NoTarget => {
+                failed.insert((site.block, site.jump.range));
+                continue;
+            }
+        };
+        if target > site.block {
+            forward.entry(site.block).or_default().push(target);
+        } else {
+            let last = back_from.entry(target).or_insert(site.block);
+            *last = (*last).max(site.block);
         }
     }
     if computed {
         for &block in model.labels.values().chain(model.block_numbers.values()).flatten() {
-            targets[block] = true;
+            unknown_ways[block] = true;
         }
     }
-    // A repeated section runs from its label; without MCALL in the file,
-    // no modal call is ever in force.
+    // Without MCALL in the file, no modal call is ever in force.
     let mut modal_calls = false;
     for statement in file.blocks(db).flat_map(|block| &block.statements) {
         match &statement.kind {
             StatementKind::RepeatSection { start, .. } => {
                 for &target in model.labels.get(start).into_iter().flatten() {
-                    targets[target] = true;
+                    unknown_ways[target] = true;
                 }
             }
             StatementKind::ModalCall(_) => modal_calls = true,
@@ -381,52 +446,61 @@ pub(crate) fn walk(db: &dyn Db, file: &FileModel, main: bool, mut visit: impl Fn
         }
         closes.insert(structure.end, structure);
     }
+    let unknown = || {
+        let mut state = State::unknown();
+        if !modal_calls {
+            state.modal_program = Known::Is(None);
+        }
+        state
+    };
     // By a structure's start: for an IF the state of the way not taken,
     // for a loop the state it ends with.
-    let mut saved: FxHashMap<usize, State> = FxHashMap::default();
-    let mut state = if main { State::at_reset() } else { State::subprogram_start() };
-    let mut cut_off = false;
+    let mut saved: FxHashMap<usize, Option<State>> = FxHashMap::default();
+    // By target: the states forward jumps bring.
+    let mut arriving: FxHashMap<usize, State> = FxHashMap::default();
+    let mut way = Some(if main { State::at_reset() } else { State::subprogram_start() });
     for (index, block) in file.blocks(db).enumerate() {
-        let joins = middles.contains_key(&index) || closes.contains_key(&index);
-        let reached = !cut_off || targets[index] || joins;
-        if cut_off || targets[index] {
-            state.forget();
-            if modal_calls {
-                state.modal_program = Known::Unknown;
-            }
+        if unknown_ways[index] {
+            way = Some(unknown());
+        }
+        way = join(way, arriving.remove(&index));
+        if let Some(&last) = back_from.get(&index) {
+            way = Some(looped(way.unwrap_or_else(unknown), file, index..=last, &variables));
         }
         if let Some(structure) = middles.get(&index)
             && let Some(other) = saved.get_mut(&structure.start)
         {
-            std::mem::swap(&mut state, other);
+            std::mem::swap(&mut way, other);
         }
         if let Some(structure) = closes.get(&index)
             && let Some(other) = saved.remove(&structure.start)
         {
-            state = state.join(&other);
+            way = join(way, other);
         }
         if let Some(structure) = opens.get(&index)
             && structure.kind != StructureKind::If
         {
-            let mut entry = state.clone();
-            for body in structure.start..=structure.end {
-                let mut after = entry.clone();
-                after.apply(file.block(body), &variables);
-                entry = entry.join(&after);
-            }
-            state = entry.clone();
+            way = way.map(|entry| looped(entry, file, structure.start..=structure.end, &variables));
             if matches!(structure.kind, StructureKind::While | StructureKind::For) {
-                saved.insert(structure.start, entry);
+                saved.insert(structure.start, way.clone());
             }
         }
+        let reached = way.is_some();
+        let mut state = way.unwrap_or_else(unknown);
         let from = state.position;
         let moves = state.apply(block, &variables);
         visit(Step { index, block, from, state: &state, moves, reached });
         if let Some(structure) = opens.get(&index)
             && structure.kind == StructureKind::If
         {
-            saved.insert(structure.start, state.clone());
+            saved.insert(structure.start, reached.then(|| state.clone()));
         }
-        cut_off = ends_way(block);
+        if reached {
+            for &target in forward.get(&index).into_iter().flatten() {
+                let brought = join(arriving.remove(&target), Some(state.clone()));
+                arriving.extend(brought.map(|brought| (target, brought)));
+            }
+        }
+        way = (reached && !ends_way(block, index, &failed)).then_some(state);
     }
 }

@@ -1,5 +1,6 @@
 //! Rules on motion and technology over the walk's modal state (digest §6
-//! rules 16, 18, 19, 20, 22, 26, 27, 29, 31, 32, 48, 52, 67 and 81).
+//! rules 16, 18, 19, 20, 22, 26, 27, 29, 31, 32, 48, 52, 67, 76, 77 and
+//! 81).
 //!
 //! Assumptions, where the digest is silent:
 //! - Rules 18 and 26 report the first block of a stretch, not every block
@@ -27,6 +28,10 @@
 //! - Rule 48 cannot see the caller: it warns where the subprogram itself
 //!   put continuous-path mode in force, and not under SAVE, which gives
 //!   the caller its modes back and does not go with RET (rule 47).
+//! - Rule 76 takes points within [`SAME_POINT_MM`] for the same point.
+//! - Rule 77 calls a G1 move short below [`SHORT_MOVE_MM`] and a run long
+//!   from [`LONG_RUN`] such moves on; a move whose end or start the walk
+//!   does not know ends the run.
 //! - Rule 81 counts M functions other than the stops and ends (M0, M1,
 //!   M2, M17, M30), MSG, WRITE and STOPRE as the blocks that break the
 //!   path (digest: inferred).
@@ -63,11 +68,26 @@ declare_rules! {
     END_STOPS_PATH = "K048", "subprogram-end-stops-path", Warning, "A subprogram that ends with M17, M2 or M30 under the continuous-path mode it set: the end stops the path, RET keeps it.";
     CONTOUR_NOT_LINES_AND_ARCS = "K052", "contour-not-lines-and-arcs", Error, "A spline or polynomial inside a CONTPRON contour, which takes only lines and arcs.";
     OFFSETS_NOT_AFTER_TRAORI = "K067", "offsets-not-after-traori", Warning, "A move after TRAORI with no work offset (G54…) or tool offset D programmed since TRAORI.";
+    SPLINE_FIRST_POINT = "K076", "spline-first-point", Warning, "The first point after BSPLINE 1 µm or more from the current position, which the thesis's programs repeat there.";
+    SHORT_MOVE_RUN = "K077", "short-move-run", Hint, "20 or more G1 moves in a row shorter than 1 mm without a compressor or spline: the axes' velocities step at every block.";
     PATH_BROKEN = "K081", "path-broken-by-block", Warning, "An M function, MSG, WRITE or STOPRE between two feed blocks in continuous-path mode: the path slows down there.";
 }
 
-/// Points closer than this, in mm, are the same (rules 16, 19, 20, 22).
+/// Points closer than this, in mm, are the same (rules 16, 19, 20, 22,
+/// 76): the thesis's CAM output repeats the current point to a few tenths
+/// of a µm.
 const SAME_POINT_MM: f64 = 0.001;
+
+/// A G1 move shorter than this, in mm, is short (rule 77).
+const SHORT_MOVE_MM: f64 = 1.0;
+
+/// This many short G1 moves in a row are a long run (rule 77).
+const LONG_RUN: usize = 20;
+
+/// The spline the thesis's programs use, and a word of the compressors'
+/// group (rule 77).
+const SPLINE: &str = "BSPLINE";
+const COMPRESSOR: &str = "COMPCAD";
 
 /// The motion codes CONTPRON takes: lines and arcs of group 1
 /// (004:1664-1668).
@@ -109,6 +129,11 @@ pub(crate) struct Motion {
     /// broke the path after it.
     on_path: bool,
     break_after: Option<(TextRange, String)>,
+    /// The BSPLINE whose first point is still to come.
+    spline_start: Option<TextRange>,
+    /// The short G1 moves in a row, and where the run starts.
+    short_moves: usize,
+    short_run_start: Option<TextRange>,
 }
 
 /// The range of the first statement of the block that `matches`.
@@ -156,6 +181,9 @@ impl Motion {
             traori: None,
             on_path: false,
             break_after: None,
+            spline_start: None,
+            short_moves: 0,
+            short_run_start: None,
         }
     }
 
@@ -171,12 +199,21 @@ impl Motion {
         let catalogue = Dialect::Sinumerik.catalogue();
         let state = step.state;
         self.unreached(file, step, out);
+        // A block no run reaches changes nothing the rules follow.
+        if !step.reached {
+            return;
+        }
         self.safe_block(catalogue, file, step, out);
         self.spindle(file, step, out);
         if step.block.statements.iter().any(|s| word_is(s, "T") || m_number(s) == Some(6)) {
             self.plunge = None;
         }
         self.contour(catalogue, file, step, out);
+        if step.state.motion() == Some(SPLINE)
+            && let Some(range) = find(file, step, |s| matches!(&s.kind, StatementKind::Command(c) if c.name == SPLINE))
+        {
+            self.spline_start = Some(range);
+        }
         self.traori(catalogue, file, step, out);
         if step.moves {
             let feed_move = state.feed_motion() == Known::Is(true);
@@ -189,6 +226,8 @@ impl Motion {
             self.arc_radius(file, step, out);
             self.plunge(file, step, out);
             self.path(step, feed_move, out);
+            self.spline_first_point(file, step, out);
+            self.short_moves(catalogue, file, step, out);
         } else {
             self.path_breaker(file, step);
         }
@@ -421,6 +460,49 @@ impl Motion {
             }
         } else {
             self.plunge = None;
+        }
+    }
+
+    /// Rule 76: the first point after BSPLINE where the tool stands.
+    fn spline_first_point(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        let Some(spline) = self.spline_start.take() else { return };
+        let differs = (0..3).any(|axis| match (step.from[axis], step.state.position[axis]) {
+            (Known::Is(from), Known::Is(to)) => (from - to).abs() > SAME_POINT_MM,
+            _ => false,
+        });
+        if !differs || step.state.motion() != Some(SPLINE) {
+            return;
+        }
+        let Some(range) = find(file, step, |s| PATH_AXES.iter().any(|axis| word_is(s, axis))) else { return };
+        let message = "the spline's first point is not where the tool stands: the thesis's programs repeat the current position as the first point, so the spline starts there";
+        out.push(Diagnostic::new(&SPLINE_FIRST_POINT, range, message).with_related(None, spline, SPLINE));
+    }
+
+    /// Rule 77: runs of short G1 moves without a compressor.
+    fn short_moves(&mut self, catalogue: &Catalogue, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        let Some(range) = find(file, step, |s| PATH_AXES.iter().any(|axis| word_is(s, axis))) else { return };
+        let state = step.state;
+        let compressor_group = catalogue.word_code(COMPRESSOR).and_then(|c| c.group.as_deref());
+        // The compressors' group numbers COMPOF first.
+        let compressor_off =
+            compressor_group.and_then(|group| state.modes.code(group)).is_some_and(|c| c.index == Some(1));
+        let length = (0..3).try_fold(0.0, |sum, axis| match (step.from[axis], state.position[axis]) {
+            (Known::Is(from), Known::Is(to)) => Some(sum + (to - from) * (to - from)),
+            _ => None,
+        });
+        let short = state.motion() == Some("G1") && compressor_off && length.is_some_and(|l| l.sqrt() < SHORT_MOVE_MM);
+        if !short {
+            self.short_moves = 0;
+            self.short_run_start = None;
+            return;
+        }
+        self.short_moves += 1;
+        let start = *self.short_run_start.get_or_insert(range);
+        if self.short_moves == LONG_RUN {
+            let message = format!(
+                "{LONG_RUN} G1 moves in a row shorter than {SHORT_MOVE_MM} mm without a compressor or spline: the axes' velocities step at every block; COMPCAD or a spline smooths the path"
+            );
+            out.push(Diagnostic::new(&SHORT_MOVE_RUN, start, message));
         }
     }
 

@@ -1,5 +1,5 @@
 //! Rules on the program as a whole, over the program model (digest §6
-//! rules 39, 40, 42, 43, 44, 47, 54, 59, 60, 68, 69, 76, 77, and the balance of the
+//! rules 39, 40, 42, 43, 44, 47, 54, 59, 60, 68, 69, and the balance of the
 //! control structures and the direction of jumps). Each is one pass over
 //! the blocks or the model's lists.
 //!
@@ -13,16 +13,9 @@
 //!   deciding, and report at the last block that ends the program.
 //! - Rule 47 is opt-in: the digest doubts it (§8), and Siemens's own
 //!   cycles end with RET under SAVE.
-//! - Rule 76 takes points within [`SAME_POINT_MM`] for the same point.
-//! - Rule 77 calls a G1 move short below [`SHORT_MOVE_MM`] and a run long
-//!   from [`LONG_RUN`] such moves on; a move whose end or start is not
-//!   known from numbers written ends the run.
 
 use nc_exec::sinumerik::{
-    lower::{
-        Callee, Dimension, ExprKind, Jump, JumpKind, JumpTarget, SinumerikBlock, Statement, StatementKind, Word,
-        WordValue,
-    },
+    lower::{Callee, ExprKind, Jump, JumpKind, JumpTarget, Statement, StatementKind},
     program::{Resolved, Structure, StructureKind, Unbalanced},
 };
 use ncc_catalog::{AddressRole, Catalogue, Dialect, KeywordKind};
@@ -32,10 +25,7 @@ use crate::{
     Diagnostic,
     db::Db,
     diagnostic::declare_rules,
-    sinumerik::{
-        checks::visit::{all_exprs, number},
-        model::FileModel,
-    },
+    sinumerik::{checks::visit::all_exprs, model::FileModel},
 };
 
 declare_rules! {
@@ -50,8 +40,6 @@ declare_rules! {
     JUMP_INTO_STRUCTURE = "K060", "jump-into-structure", Warning, "A jump from outside into the body of an IF, WHILE, FOR, REPEAT or LOOP.";
     TRANSFORMATION_AT_END = "K068", "transformation-at-end", Warning, "The program ends with TRAORI still on (no TRAFOOF after it).";
     MODE_AT_END = "K069", "mode-at-end", Info, "The program ends with TOROT or FFWON still on (no TOROTOF or FFWOF after it).";
-    SPLINE_FIRST_POINT = "K076", "spline-first-point", Warning, "The first point after BSPLINE 1 µm or more from the current position, which the thesis's programs repeat there.";
-    SHORT_MOVE_RUN = "K077", "short-move-run", Hint, "20 or more G1 moves in a row shorter than 1 mm without a compressor or spline: the axes' velocities step at every block.";
     UNBALANCED_STRUCTURE = "K104", "unbalanced-structure", Error, "A control structure without its end, an end without its start, or an ELSE outside an IF.";
     JUMP_WRONG_DIRECTION = "K105", "jump-wrong-direction", Error, "GOTOF to a target only behind the jump, or GOTOB to one only ahead of it.";
 }
@@ -62,26 +50,12 @@ const MAX_DEPTH: usize = 16;
 /// The longest program name (004:1446-1450).
 const MAX_NAME_CHARS: usize = 31;
 
-/// A G1 move shorter than this, in mm, is short (rule 77).
-const SHORT_MOVE_MM: f64 = 1.0;
-
-/// Points closer than this, in mm, are the same (rule 76): the thesis's
-/// CAM output repeats the current point to a few tenths of a µm.
-const SAME_POINT_MM: f64 = 0.001;
-
-/// This many short G1 moves in a row are a long run (rule 77).
-const LONG_RUN: usize = 20;
-
 /// The word that switches TRAORI off; the other transformations' too.
 const TRANSFORMATION_OFF: &str = "TRAFOOF";
 
 /// The modes rule 69 wants off at the end: each the code of its group
 /// that switches it on.
 const MODES_OFF_AT_END: [&str; 2] = ["TOROT", "FFWON"];
-
-/// The words of the compressors' group and of the splines (rule 77).
-const COMPRESSOR: &str = "COMPCAD";
-const SPLINE: &str = "BSPLINE";
 
 /// `in_workspace`: whether the workspace holds the control file of a name
 /// (`_N_PART_SPF`).
@@ -95,7 +69,6 @@ pub(crate) fn check(db: &dyn Db, file: &FileModel, in_workspace: &dyn Fn(&str) -
     jumps(file, &mut out);
     modes_at_end(db, catalogue, file, &mut out);
     simulation_branch(db, file, &mut out);
-    Motion::check(db, catalogue, file, &mut out);
     out
 }
 
@@ -413,125 +386,5 @@ fn modes_at_end(db: &dyn Db, catalogue: &Catalogue, file: &FileModel, out: &mut 
             let message = format!("the program ends with {word} still on");
             out.push(Diagnostic::new(&MODE_AT_END, end, message).with_related(None, on, word.to_string()));
         }
-    }
-}
-
-/// The path axes rules 76 and 77 follow.
-const PATH_AXES: [&str; 3] = ["X", "Y", "Z"];
-
-/// The motion state rules 76 and 77 follow in file order.
-struct Motion<'a> {
-    catalogue: &'a Catalogue,
-    /// The code in force of the motion group (G1, BSPLINE, …).
-    motion: &'a str,
-    incremental: bool,
-    compressor: bool,
-    position: [Option<f64>; 3],
-    /// The BSPLINE whose first point is still to come.
-    spline_start: Option<TextRange>,
-    /// The short G1 moves in a row, and where the run starts.
-    run: usize,
-    run_start: Option<TextRange>,
-}
-
-impl Motion<'_> {
-    fn check(db: &dyn Db, catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnostic>) {
-        let mut motion = Motion {
-            catalogue,
-            motion: "",
-            incremental: false,
-            compressor: false,
-            position: [None; 3],
-            spline_start: None,
-            run: 0,
-            run_start: None,
-        };
-        let motion_group = catalogue.word_code(SPLINE).and_then(|c| c.group.clone());
-        let compressor_group = catalogue.word_code(COMPRESSOR).and_then(|c| c.group.clone());
-        for (index, block) in file.blocks(db).enumerate() {
-            motion.codes(file, index, block, motion_group.as_deref(), compressor_group.as_deref());
-            motion.moves(file, index, block, out);
-        }
-    }
-
-    fn codes(
-        &mut self,
-        file: &FileModel,
-        index: usize,
-        block: &SinumerikBlock,
-        motion_group: Option<&str>,
-        compressor_group: Option<&str>,
-    ) {
-        for statement in &block.statements {
-            let code = match &statement.kind {
-                StatementKind::Word(word) if word.address == "G" => {
-                    let Some(number) = word.value.as_ref().and_then(number).and_then(|n| n.whole()) else { continue };
-                    u32::try_from(number).ok().and_then(|number| self.catalogue.code('G', number))
-                }
-                StatementKind::Command(command) => self.catalogue.word_code(&command.name),
-                _ => None,
-            };
-            let Some(code) = code else { continue };
-            let group = code.group.as_deref();
-            if group.is_some() && group == motion_group {
-                if code.code == SPLINE && self.motion != SPLINE {
-                    self.spline_start = Some(file.in_file(index, statement.range));
-                }
-                self.motion = &code.code;
-            } else if group.is_some() && group == compressor_group {
-                self.compressor = code.index != Some(1);
-            } else if code.code == "G90" || code.code == "G91" {
-                self.incremental = code.code == "G91";
-            }
-        }
-    }
-
-    fn moves(&mut self, file: &FileModel, index: usize, block: &SinumerikBlock, out: &mut Vec<Diagnostic>) {
-        let mut next = self.position;
-        let mut first_word: Option<&Word> = None;
-        for word in block.words() {
-            let Some(axis) = PATH_AXES.iter().position(|a| *a == word.address) else { continue };
-            first_word.get_or_insert(word);
-            let incremental = match &word.value {
-                Some(WordValue::Expr { dimension: Some(dimension), .. }) => *dimension == Dimension::Incremental,
-                _ => self.incremental,
-            };
-            next[axis] = match word.value.as_ref().and_then(number) {
-                Some(number) if incremental => self.position[axis].map(|p| p + number.value()),
-                Some(number) => Some(number.value()),
-                None => None,
-            };
-        }
-        let Some(word) = first_word else { return };
-        let range = file.in_file(index, word.range);
-        if let Some(spline) = self.spline_start.take() {
-            let differs = (0..3).any(|axis| match (self.position[axis], next[axis]) {
-                (Some(from), Some(to)) => (from - to).abs() > SAME_POINT_MM,
-                _ => false,
-            });
-            if differs && self.motion == SPLINE {
-                let message = "the spline's first point is not where the tool stands: the thesis's programs repeat the current position as the first point, so the spline starts there";
-                out.push(Diagnostic::new(&SPLINE_FIRST_POINT, range, message).with_related(None, spline, SPLINE));
-            }
-        }
-        let length = (0..3).try_fold(0.0, |sum, axis| match (self.position[axis], next[axis]) {
-            (Some(from), Some(to)) => Some(sum + (to - from) * (to - from)),
-            _ => None,
-        });
-        let short = self.motion == "G1" && !self.compressor && length.is_some_and(|l| l.sqrt() < SHORT_MOVE_MM);
-        if short {
-            self.run += 1;
-            let start = *self.run_start.get_or_insert(range);
-            if self.run == LONG_RUN {
-                let message = format!(
-                    "{LONG_RUN} G1 moves in a row shorter than {SHORT_MOVE_MM} mm without a compressor or spline: the axes' velocities step at every block; COMPCAD or a spline smooths the path"
-                );
-                out.push(Diagnostic::new(&SHORT_MOVE_RUN, start, message));
-            }
-        } else {
-            self.run = 0;
-            self.run_start = None;
-        }
-        self.position = next;
     }
 }
