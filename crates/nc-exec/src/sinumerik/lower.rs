@@ -276,6 +276,31 @@ impl Callee {
             Callee::Predefined(_) | Callee::Numbered { .. } | Callee::Indirect { .. } => None,
         }
     }
+
+    /// The files the control looks the called program up in, in its
+    /// order; `None` for a cycle, a predefined procedure, and a program
+    /// only the run can name (`CALL` of an expression, `K12`).
+    pub fn control_files(&self) -> Option<Vec<String>> {
+        match self {
+            Callee::Program(name) | Callee::Path(name) => Some(control_files(name)),
+            Callee::Numbered { letter: b'L', number: Some(number) } => Some(control_files(&format!("L{number}"))),
+            _ => None,
+        }
+    }
+}
+
+/// The files the control looks a program named `name` up in, in its
+/// order: `PROFIL` is `_N_PROFIL_MPF`, found first, else `_N_PROFIL_SPF`
+/// (004:1452-1462); `_N_PROFIL_SPF`, or a path ending in it, is that
+/// file alone.
+pub fn control_files(name: &str) -> Vec<String> {
+    let name = name.rsplit('/').next().unwrap_or(name).trim().to_ascii_uppercase();
+    if let Some(inner) = name.strip_prefix("_N_")
+        && (inner.ends_with("_MPF") || inner.ends_with("_SPF"))
+    {
+        return vec![name];
+    }
+    ["MPF", "SPF"].iter().map(|kind| format!("_N_{name}_{kind}")).collect()
 }
 
 /// `DEF [scope] type name[dims]=value, …`.

@@ -21,17 +21,20 @@
 //!   not state; 17 and 24 are the run's (rapid moves per axis, rotary
 //!   travel); 41 needs the calls' nesting at run time; 51, 53, 54 and 58
 //!   depend on generated programs, the machine's tool management or the
-//!   control's version; 65 on the meaning of comments;
+//!   control's version;
 //! - computed jump targets (`GOTOF "N"<<R3`) are the run's.
 
 pub(crate) mod block;
 pub(crate) mod motion;
 pub(crate) mod names;
+pub(crate) mod parameters;
 pub(crate) mod program;
 pub(crate) mod types;
 pub(crate) mod visit;
 
 use std::path::Path;
+
+use nc_exec::sinumerik::lower::Callee;
 
 use crate::{
     Diagnostic, Rule,
@@ -41,7 +44,8 @@ use crate::{
 };
 
 /// The rules of every check module.
-pub(crate) static RULES: &[&[&Rule]] = &[block::RULES, program::RULES, motion::RULES, names::RULES, types::RULES];
+pub(crate) static RULES: &[&[&Rule]] =
+    &[block::RULES, program::RULES, motion::RULES, names::RULES, parameters::RULES, types::RULES];
 
 /// The findings of a file's single blocks, chunk by chunk.
 pub(crate) fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
@@ -98,6 +102,14 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
         && !header.is_some_and(|header| header.name.to_ascii_uppercase().ends_with("_SPF"));
     diagnostics.extend(motion::check(db, model, main));
     diagnostics.extend(names::check(db, model, text, config));
+    let reads: Vec<&parameters::Reads> =
+        settings.files(db).iter().map(|other| parameters::parameter_reads(db, *other)).collect();
+    let read = |number| reads.iter().any(|reads| reads.any || reads.indices.contains(&number));
+    let resolved = |callee: &Callee| match callee {
+        Callee::Cycle(_) | Callee::Predefined(_) => true,
+        callee => callee.control_files().is_some_and(|files| files.iter().any(|name| in_workspace(name))),
+    };
+    diagnostics.extend(parameters::check(db, model, &read, &resolved));
     diagnostics.extend(types::check(db, model, &signatures));
     findings::sort_diagnostics(&mut diagnostics);
     Findings { diagnostics, omitted: Vec::new() }

@@ -96,7 +96,9 @@ fn names(db: &dyn Db, catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Dia
 fn ambiguous_calls(file: &FileModel, in_workspace: &dyn Fn(&str) -> bool, out: &mut Vec<Diagnostic>) {
     for site in &file.model.calls {
         let Callee::Program(name) = &site.callee else { continue };
-        if !(in_workspace(&format!("_N_{name}_MPF")) && in_workspace(&format!("_N_{name}_SPF"))) {
+        // A bare name looks up both kinds.
+        let files = site.callee.control_files().unwrap_or_default();
+        if files.len() < 2 || !files.iter().all(|file| in_workspace(file)) {
             continue;
         }
         let called = |kind: &StatementKind| match kind {

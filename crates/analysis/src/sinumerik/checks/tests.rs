@@ -125,7 +125,13 @@ fn the_seed_listings_get_only_true_findings() {
         ),
         (
             &[("l29.mpf", include_str!("../../../../syntax/test_data/sinumerik/l29_blob_souradnice_dole.mpf"))],
-            &[("cycle832-option", 48), ("transformation-at-end", 116), ("mode-at-end", 116)],
+            // R7 (1=G01, 2=BSPLINE) is set and never read (digest rule 65).
+            &[
+                ("cycle832-option", 48),
+                ("parameter-never-read", 10),
+                ("transformation-at-end", 116),
+                ("mode-at-end", 116),
+            ],
         ),
         (
             &[

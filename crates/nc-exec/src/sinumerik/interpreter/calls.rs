@@ -12,7 +12,7 @@ use super::{At, Flow, Interpreter, Unit, files::DONE};
 use crate::{
     sinumerik::{
         eval::{Slot, Value},
-        lower::{Call, Callee, Expr, ExprKind, Place, PlaceKind, Type, WordValue},
+        lower::{Call, Callee, Expr, ExprKind, Place, PlaceKind, Type, WordValue, control_files},
     },
     trace::{Called, RunRule},
 };
@@ -45,20 +45,6 @@ pub(super) struct Frame {
 enum Bound {
     Value { name: String, ty: Type, value: Option<Value> },
     Alias { name: String, slot: Slot },
-}
-
-/// The name of a program as the control names its file: `PROFIL` and
-/// `_N_PROFIL_SPF` both name `PROFIL`, the latter an SPF.
-fn program_name(name: &str) -> (String, Option<&'static str>) {
-    let name = name.rsplit('/').next().unwrap_or(name).trim().to_ascii_uppercase();
-    if let Some(inner) = name.strip_prefix("_N_") {
-        for kind in ["MPF", "SPF"] {
-            if let Some(base) = inner.strip_suffix(&format!("_{kind}")) {
-                return (base.to_owned(), Some(kind));
-            }
-        }
-    }
-    (name, None)
 }
 
 impl Interpreter<'_> {
@@ -246,13 +232,7 @@ impl Interpreter<'_> {
     /// The source of the program `name`: a file the run wrote, one it
     /// read, or one the environment finds, MPF before SPF.
     fn program(&mut self, name: &str) -> Option<usize> {
-        let (base, kind) = program_name(name);
-        let kinds: &[&str] = match kind {
-            Some(kind) => &[if kind == "MPF" { "MPF" } else { "SPF" }],
-            None => &["MPF", "SPF"],
-        };
-        for kind in kinds {
-            let file = format!("_N_{base}_{kind}");
+        for file in control_files(name) {
             if let Some(written) = self.state.files.program(&file) {
                 let (path, text) = (written.path.clone(), written.text.clone());
                 return Some(self.unit_of(Called::Written(path), &text));
@@ -475,17 +455,5 @@ impl Interpreter<'_> {
         let message = format!("{name} lacks an argument: {}", signature.unwrap_or_default());
         self.state.finding(RunRule::ValueRefused, range, &message);
         Flow::Stop
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::program_name;
-
-    #[test]
-    fn program_names_drop_the_controls_prefix_and_suffix() {
-        assert_eq!(program_name("_N_GEOMETRIE_VACKA_SPF"), ("GEOMETRIE_VACKA".to_owned(), Some("SPF")));
-        assert_eq!(program_name("/_N_SPF_DIR/_N_SUB_MPF"), ("SUB".to_owned(), Some("MPF")));
-        assert_eq!(program_name("profil"), ("PROFIL".to_owned(), None));
     }
 }

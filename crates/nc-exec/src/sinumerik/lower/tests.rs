@@ -9,6 +9,16 @@ pub(crate) fn lower_text(text: &str) -> Vec<SinumerikBlock> {
     block_nodes(parse.green()).map(|(_, block)| SinumerikBlock::lower(block)).collect()
 }
 
+#[test]
+fn programs_are_looked_up_in_their_control_files() {
+    assert_eq!(control_files("profil"), ["_N_PROFIL_MPF", "_N_PROFIL_SPF"]);
+    assert_eq!(control_files("_N_GEOMETRIE_VACKA_SPF"), ["_N_GEOMETRIE_VACKA_SPF"]);
+    assert_eq!(control_files("/_N_SPF_DIR/_N_SUB_MPF"), ["_N_SUB_MPF"]);
+    let numbered = Callee::Numbered { letter: b'L', number: Some(140) };
+    assert_eq!(numbered.control_files(), Some(vec!["_N_L140_MPF".to_owned(), "_N_L140_SPF".to_owned()]));
+    assert_eq!(Callee::Cycle("CYCLE81".to_owned()).control_files(), None);
+}
+
 fn check(text: &str, expect: Expect) {
     let shown: Vec<String> =
         lower_text(text).iter().map(SinumerikBlock::to_string).filter(|line| !line.is_empty()).collect();
