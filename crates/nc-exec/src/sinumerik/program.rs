@@ -21,6 +21,10 @@ use std::collections::BTreeMap;
 
 use super::lower::{Callee, Declared, Extern, Jump, JumpKind, JumpTarget, Proc, SinumerikBlock, StatementKind, Type};
 
+/// The most program levels, the main program included (004:1464): the
+/// run's limit and the checker's.
+pub const PROGRAM_LEVELS: usize = 16;
+
 /// The model of one file.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SinumerikModel {

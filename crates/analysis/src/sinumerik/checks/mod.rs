@@ -19,12 +19,12 @@
 //! - rules 15, 23, 28, 38 and 70–75, 78 follow the stock, the tool's
 //!   shape or orientation or the operation's kind, which the program does
 //!   not state; 17 and 24 are the run's (rapid moves per axis, rotary
-//!   travel); 41 needs the calls' nesting at run time; 51, 53, 54 and 58
-//!   depend on generated programs, the machine's tool management or the
-//!   control's version;
+//!   travel); 51 and 58 depend on the programs a program generates and
+//!   on the control's version;
 //! - computed jump targets (`GOTOF "N"<<R3`) are the run's.
 
 pub(crate) mod block;
+pub(crate) mod calls;
 pub(crate) mod motion;
 pub(crate) mod names;
 pub(crate) mod parameters;
@@ -45,7 +45,7 @@ use crate::{
 
 /// The rules of every check module.
 pub(crate) static RULES: &[&[&Rule]] =
-    &[block::RULES, program::RULES, motion::RULES, names::RULES, parameters::RULES, types::RULES];
+    &[block::RULES, calls::RULES, program::RULES, motion::RULES, names::RULES, parameters::RULES, types::RULES];
 
 /// The findings of a file's single blocks, chunk by chunk.
 pub(crate) fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
@@ -92,9 +92,15 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
         }
     }
     // A control file (`_N_PART_SPF`) is found as the run finds it.
-    let in_workspace = |control_name: &str| {
-        settings.files(db).iter().any(|other| ncc_catalog::is_control_file(Path::new(other.path(db)), control_name))
+    let find = |control_name: &str| {
+        settings
+            .files(db)
+            .iter()
+            .copied()
+            .find(|other| ncc_catalog::is_control_file(Path::new(other.path(db)), control_name))
     };
+    let in_workspace = |control_name: &str| find(control_name).is_some();
+    let resolve = |callee: &Callee| callee.control_files()?.iter().find_map(|name| find(name));
     let mut diagnostics = program::check(db, model, &in_workspace);
     let header = model.ranges.first().and_then(|_| model.block(0).header.as_ref());
     let main = model.model.header().is_none()
@@ -105,11 +111,10 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
     let reads: Vec<&parameters::Reads> =
         settings.files(db).iter().map(|other| parameters::parameter_reads(db, *other)).collect();
     let read = |number| reads.iter().any(|reads| reads.any || reads.indices.contains(&number));
-    let resolved = |callee: &Callee| match callee {
-        Callee::Cycle(_) | Callee::Predefined(_) => true,
-        callee => callee.control_files().is_some_and(|files| files.iter().any(|name| in_workspace(name))),
-    };
+    let resolved =
+        |callee: &Callee| matches!(callee, Callee::Cycle(_) | Callee::Predefined(_)) || resolve(callee).is_some();
     diagnostics.extend(parameters::check(db, model, &read, &resolved));
+    diagnostics.extend(calls::check(db, file, model, main, &resolve));
     diagnostics.extend(types::check(db, model, &signatures));
     findings::sort_diagnostics(&mut diagnostics);
     Findings { diagnostics, omitted: Vec::new() }

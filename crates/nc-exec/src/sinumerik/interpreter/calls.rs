@@ -13,12 +13,10 @@ use crate::{
     sinumerik::{
         eval::{Slot, Value},
         lower::{Call, Callee, Expr, ExprKind, Place, PlaceKind, Type, WordValue, control_files},
+        program::PROGRAM_LEVELS,
     },
     trace::{Called, RunRule},
 };
-
-/// The most program levels, the main program included (004:1464).
-const PROGRAM_LEVELS: usize = 16;
 
 /// A call being run, or a program section REPEAT runs.
 pub(super) struct Frame {
