@@ -16,11 +16,14 @@
 //! - rules 3, 5, 6, 8, 9 are ISO conventions or off for Sinumerik, and
 //!   25, 30, 33–36 ISO words (G28, H, G92 as a preset, M97–M98) that
 //!   Sinumerik writes otherwise;
-//! - rules 15, 23, 28, 38 and 70–75, 78 follow the stock, the tool's
-//!   shape or orientation or the operation's kind, which the program does
-//!   not state; 17 and 24 are the run's (rapid moves per axis, rotary
-//!   travel); 51 and 58 depend on the programs a program generates and
-//!   on the control's version;
+//! - rules 15, 23, 28, 38, 70–72 and 75 follow the stock, the tool's
+//!   shape and orientation or the operation's kind, which the program
+//!   does not state; 17 and 24 are the run's (rapid moves per axis, rotary
+//!   travel); 51 and 58 depend on the programs a program generates and on
+//!   the control's version;
+//! - rule 73 is the catalogue's hover text of CUT3DC and CUT3DF; the
+//!   hovers of rules 21 (the arc a CR chooses) and 74 (the composed frame)
+//!   are not shown yet;
 //! - computed jump targets (`GOTOF "N"<<R3`) are the run's.
 
 pub(crate) mod block;

@@ -1,6 +1,6 @@
 //! Rules on motion and technology over the walk's modal state (digest §6
-//! rules 16, 18, 19, 20, 22, 26, 27, 29, 31, 32, 48, 52, 67, 76, 77 and
-//! 81).
+//! rules 16, 18, 19, 20, 22, 26, 27, 29, 31, 32, 48, 52, 67, 76, 77, 78
+//! and 81).
 //!
 //! Assumptions, where the digest is silent:
 //! - Rules 18 and 26 report the first block of a stretch, not every block
@@ -32,6 +32,9 @@
 //! - Rule 77 calls a G1 move short below [`SHORT_MOVE_MM`] and a run long
 //!   from [`LONG_RUN`] such moves on; a move whose end or start the walk
 //!   does not know ends the run.
+//! - Rule 78 calls heavy what the control computes between two feed moves
+//!   in continuous-path mode: a loop with no move in its body, or
+//!   [`HEAVY_STATEMENTS`] statements or more that do not move (file order).
 //! - Rule 81 counts M functions other than the stops and ends (M0, M1,
 //!   M2, M17, M30), MSG, WRITE and STOPRE as the blocks that break the
 //!   path (digest: inferred).
@@ -70,6 +73,7 @@ declare_rules! {
     OFFSETS_NOT_AFTER_TRAORI = "K067", "offsets-not-after-traori", Warning, "A move after TRAORI with no work offset (G54…) or tool offset D programmed since TRAORI.";
     SPLINE_FIRST_POINT = "K076", "spline-first-point", Warning, "The first point after BSPLINE 1 µm or more from the current position, which the thesis's programs repeat there.";
     SHORT_MOVE_RUN = "K077", "short-move-run", Hint, "20 or more G1 moves in a row shorter than 1 mm without a compressor or spline: the axes' velocities step at every block.";
+    HEAVY_COMPUTATION = "K078", "computation-between-moves", Info, "A loop without motion, or 10 or more computing statements, between two feed moves in continuous-path mode: block preparation may not keep up with the path.";
     PATH_BROKEN = "K081", "path-broken-by-block", Warning, "An M function, MSG, WRITE or STOPRE between two feed blocks in continuous-path mode: the path slows down there.";
 }
 
@@ -95,6 +99,9 @@ const CONTOUR_MOTIONS: [&str; 6] = ["G0", "G1", "G2", "G3", "CIP", "CT"];
 
 /// The M functions that stop or end the program on purpose (rule 81).
 const STOPS_AND_ENDS: [u64; 5] = [0, 1, 2, 17, 30];
+
+/// This many statements between two feed moves are heavy (rule 78).
+const HEAVY_STATEMENTS: usize = 10;
 
 /// The statements rule 81 names that break the path.
 const PATH_BREAKERS: [&str; 3] = ["MSG", "WRITE", "STOPRE"];
@@ -129,6 +136,11 @@ pub(crate) struct Motion {
     /// broke the path after it.
     on_path: bool,
     break_after: Option<(TextRange, String)>,
+    /// Rule 78: the statements computed since the last feed move on the
+    /// path, where they start, and a loop among them without motion.
+    computed: usize,
+    computed_start: Option<TextRange>,
+    idle_loop: bool,
     /// The BSPLINE whose first point is still to come.
     spline_start: Option<TextRange>,
     /// The short G1 moves in a row, and where the run starts.
@@ -181,6 +193,9 @@ impl Motion {
             traori: None,
             on_path: false,
             break_after: None,
+            computed: 0,
+            computed_start: None,
+            idle_loop: false,
             spline_start: None,
             short_moves: 0,
             short_run_start: None,
@@ -230,6 +245,7 @@ impl Motion {
             self.short_moves(catalogue, file, step, out);
         } else {
             self.path_breaker(file, step);
+            self.computation(file, step);
         }
         // Under SAVE the caller's modes come back anyway, and RET is no
         // choice (rule 47).
@@ -517,7 +533,51 @@ impl Motion {
             );
             out.push(Diagnostic::new(&PATH_BROKEN, range, message));
         }
+        if let Some(start) = self.computed_start.take()
+            && on_path
+            && (self.idle_loop || self.computed >= HEAVY_STATEMENTS)
+        {
+            let what = if self.idle_loop {
+                "a loop without motion".to_owned()
+            } else {
+                format!("{} statements without motion", self.computed)
+            };
+            let message = format!(
+                "{what} between two feed moves in continuous-path mode: the control prepares blocks while it moves, and if it cannot keep up the path slows down; compute before the contour, or generate the points beforehand (004:2541-2557)"
+            );
+            out.push(Diagnostic::new(&HEAVY_COMPUTATION, start, message));
+        }
+        self.computed = 0;
+        self.idle_loop = false;
         self.on_path = on_path;
+    }
+
+    /// Rule 78: what a block without motion computes after a feed move on
+    /// the path.
+    fn computation(&mut self, file: &FileModel, step: &Step<'_>) {
+        if !self.on_path {
+            return;
+        }
+        for statement in &step.block.statements {
+            let loop_start = matches!(
+                statement.kind,
+                StatementKind::While(_) | StatementKind::For { .. } | StatementKind::Loop | StatementKind::Repeat
+            );
+            if matches!(statement.kind, StatementKind::Word(_) | StatementKind::Command(_)) {
+                continue;
+            }
+            if loop_start && let Some(structure) = file.model.structures.iter().find(|s| s.start == step.index) {
+                let moves = (structure.start..=structure.end).any(|index| {
+                    file.block(index)
+                        .statements
+                        .iter()
+                        .any(|s| matches!(&s.kind, StatementKind::Word(w) if is_axis(&w.address)))
+                });
+                self.idle_loop |= !moves;
+            }
+            self.computed += 1;
+            self.computed_start.get_or_insert(file.in_file(step.index, statement.range));
+        }
     }
 
     /// Rule 81: a block without motion after a feed move on the path.
