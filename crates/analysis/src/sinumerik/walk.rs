@@ -350,6 +350,8 @@ pub(crate) struct Step<'a> {
     /// Whether a way the program runs reaches the block: not after an end
     /// or an unconditional jump unless a jump or a structure leads there.
     pub reached: bool,
+    /// The control structure the block opens.
+    pub opens: Option<&'a Structure>,
 }
 
 /// What may hold on either of two ways; `None` is a way no run takes.
@@ -489,7 +491,7 @@ pub(crate) fn walk(db: &dyn Db, file: &FileModel, main: bool, mut visit: impl Fn
         let mut state = way.unwrap_or_else(unknown);
         let from = state.position;
         let moves = state.apply(block, &variables);
-        visit(Step { index, block, from, state: &state, moves, reached });
+        visit(Step { index, block, from, state: &state, moves, reached, opens: opens.get(&index).copied() });
         if let Some(structure) = opens.get(&index)
             && structure.kind == StructureKind::If
         {

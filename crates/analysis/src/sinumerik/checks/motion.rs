@@ -566,7 +566,7 @@ impl Motion {
             if matches!(statement.kind, StatementKind::Word(_) | StatementKind::Command(_)) {
                 continue;
             }
-            if loop_start && let Some(structure) = file.model.structures.iter().find(|s| s.start == step.index) {
+            if loop_start && let Some(structure) = step.opens {
                 let moves = (structure.start..=structure.end).any(|index| {
                     file.block(index)
                         .statements
