@@ -51,8 +51,16 @@ const DIMENSIONS: &str = "G14";
 /// pitch and spindle speed, not at F.
 const THREADS: [&str; 3] = ["G33", "G331", "G332"];
 
-/// The path axes whose positions the walk follows.
+/// The path axes.
 pub(crate) const PATH_AXES: [&str; 3] = ["X", "Y", "Z"];
+
+/// The axes and orientation words whose positions the walk follows: the
+/// path axes first, then the rotary axes, the orientation's angles (A2 …)
+/// and its vector (A3 …).
+pub(crate) const FOLLOWED: [&str; 12] = ["X", "Y", "Z", "A", "B", "C", "A2", "B2", "C2", "A3", "B3", "C3"];
+
+/// Nothing known of where the tool stands.
+const NOWHERE: [Known<f64>; FOLLOWED.len()] = [Known::Unknown; FOLLOWED.len()];
 
 fn catalogue() -> &'static Catalogue {
     Dialect::Sinumerik.catalogue()
@@ -66,8 +74,8 @@ pub(crate) struct State {
     pub feed: Known<Option<f64>>,
     /// The spindle speed S: `Is(None)` before any was programmed.
     pub speed: Known<Option<f64>>,
-    /// X, Y and Z in the frame in force.
-    pub position: [Known<f64>; 3],
+    /// The [`FOLLOWED`] axes and words, in the frame in force.
+    pub position: [Known<f64>; FOLLOWED.len()],
     /// A modal call (MCALL) in force, which runs at every move: `Is(true)`
     /// for a program's, which may change anything.
     modal_program: Known<Option<bool>>,
@@ -80,7 +88,7 @@ impl State {
             modes: Modes::at_reset(),
             feed: Known::Is(None),
             speed: Known::Is(None),
-            position: [Known::Unknown; 3],
+            position: NOWHERE,
             modal_program: Known::Is(None),
         }
     }
@@ -91,7 +99,7 @@ impl State {
             modes: Modes::unknown(),
             feed: Known::Unknown,
             speed: Known::Unknown,
-            position: [Known::Unknown; 3],
+            position: NOWHERE,
             modal_program: Known::Unknown,
         }
     }
@@ -124,7 +132,7 @@ impl State {
             modes: self.modes.join(&other.modes),
             feed: same(self.feed, other.feed),
             speed: same(self.speed, other.speed),
-            position: [0, 1, 2].map(|axis| same(self.position[axis], other.position[axis])),
+            position: std::array::from_fn(|axis| same(self.position[axis], other.position[axis])),
             modal_program: same(self.modal_program, other.modal_program),
         }
     }
@@ -165,7 +173,7 @@ impl State {
                         .keyword(&command.name)
                         .is_some_and(|keyword| keyword.kind == KeywordKind::Transformation) =>
                     {
-                        self.position = [Known::Unknown; 3];
+                        self.position = NOWHERE;
                     }
                     None => {}
                 },
@@ -179,7 +187,7 @@ impl State {
         let in_group = |group: &str| codes.iter().any(|code| code.group.as_deref() == Some(group));
         // The block's coordinates count in the new system.
         if [WORK_OFFSETS, UNITS].into_iter().any(in_group) {
-            self.position = [Known::Unknown; 3];
+            self.position = NOWHERE;
         }
         for &code in &codes {
             self.modes.set(code);
@@ -189,7 +197,7 @@ impl State {
         // Machine coordinates for the block, or a reference point: where
         // the tool ends in the frame is not known.
         if in_group(MACHINE_COORDINATES) || codes.iter().any(|code| matches!(code.code.as_str(), "G74" | "G75")) {
-            self.position = [Known::Unknown; 3];
+            self.position = NOWHERE;
         }
         for statement in &block.statements {
             match &statement.kind {
@@ -204,7 +212,7 @@ impl State {
         if moved {
             match self.modal_program {
                 Known::Is(None) => {}
-                Known::Is(Some(false)) => self.position = [Known::Unknown; 3],
+                Known::Is(Some(false)) => self.position = NOWHERE,
                 Known::Is(Some(true)) | Known::Unknown => self.forget(),
             }
         }
@@ -216,7 +224,7 @@ impl State {
     /// a rotation or a frame that replaces the one in force.
     fn frame(&mut self, command: &Command) {
         let additive = matches!(command.name.as_str(), "ATRANS" | "ASCALE" | "AMIRROR");
-        for (axis, name) in PATH_AXES.iter().enumerate() {
+        for (axis, name) in FOLLOWED.iter().enumerate() {
             if !additive || command.words.iter().any(|word| word.address == *name) {
                 self.position[axis] = Known::Unknown;
             }
@@ -235,7 +243,7 @@ impl State {
                 Some(code) => codes.push(code),
                 // A code the catalogue does not list (`G505`): it may
                 // move the origin.
-                None => self.position = [Known::Unknown; 3],
+                None => self.position = NOWHERE,
             },
             ("G", None) => self.modes = Modes::unknown(),
             ("M", Some(number)) => codes.extend(catalogue.code('M', number)),
@@ -279,7 +287,7 @@ impl State {
                     if is_axis(address) {
                         moved = true;
                     }
-                    let Some(axis) = PATH_AXES.iter().position(|a| *a == address) else { continue };
+                    let Some(axis) = FOLLOWED.iter().position(|a| *a == address) else { continue };
                     let incremental = match &word.value {
                         Some(WordValue::Expr { dimension: Some(dimension), .. }) => {
                             Known::Is(*dimension == Dimension::Incremental)
@@ -303,7 +311,7 @@ impl State {
     fn call(&mut self, callee: &Callee) {
         match callee {
             Callee::Predefined(_) => {}
-            Callee::Cycle(_) => self.position = [Known::Unknown; 3],
+            Callee::Cycle(_) => self.position = NOWHERE,
             _ => self.forget(),
         }
     }
@@ -342,7 +350,7 @@ pub(crate) struct Step<'a> {
     pub index: usize,
     pub block: &'a SinumerikBlock,
     /// Where the tool stood before the block.
-    pub from: [Known<f64>; 3],
+    pub from: [Known<f64>; FOLLOWED.len()],
     /// The state after the block.
     pub state: &'a State,
     /// Whether the block moves an axis.

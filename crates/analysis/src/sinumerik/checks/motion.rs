@@ -1,6 +1,6 @@
 //! Rules on motion and technology over the walk's modal state (digest §6
-//! rules 16, 18, 19, 20, 22, 26, 27, 29, 31, 32, 48, 52, 67, 76, 77, 78
-//! and 81).
+//! rules 16, 18, 19, 20, 22, 26, 27, 29, 31, 32, 48, 52, 67, 70, 76, 77,
+//! 78 and 81).
 //!
 //! Assumptions, where the digest is silent:
 //! - Rules 18 and 26 report the first block of a stretch, not every block
@@ -28,6 +28,9 @@
 //! - Rule 48 cannot see the caller: it warns where the subprogram itself
 //!   put continuous-path mode in force, and not under SAVE, which gives
 //!   the caller its modes back and does not go with RET (rule 47).
+//! - Rule 70 reads a plunge as a feed move down in Z, and a turn as a
+//!   rotary axis (A, B, C) or orientation word (A2 …, A3 …) whose value the
+//!   block changes; whether the tool is in the material is not known.
 //! - Rule 76 takes points within [`SAME_POINT_MM`] for the same point.
 //! - Rule 77 calls a G1 move short below [`SHORT_MOVE_MM`] and a run long
 //!   from [`LONG_RUN`] such moves on; a move whose end or start the walk
@@ -53,7 +56,7 @@ use crate::{
     sinumerik::{
         checks::visit::number,
         model::FileModel,
-        walk::{self, MOTION, PATH_AXES, SPINDLE, Step, is_axis},
+        walk::{self, FOLLOWED, MOTION, PATH_AXES, SPINDLE, Step, is_axis},
     },
 };
 
@@ -71,6 +74,7 @@ declare_rules! {
     END_STOPS_PATH = "K048", "subprogram-end-stops-path", Warning, "A subprogram that ends with M17, M2 or M30 under the continuous-path mode it set: the end stops the path, RET keeps it.";
     CONTOUR_NOT_LINES_AND_ARCS = "K052", "contour-not-lines-and-arcs", Error, "A spline or polynomial inside a CONTPRON contour, which takes only lines and arcs.";
     OFFSETS_NOT_AFTER_TRAORI = "K067", "offsets-not-after-traori", Warning, "A move after TRAORI with no work offset (G54…) or tool offset D programmed since TRAORI.";
+    TURN_WHILE_PLUNGING = "K070", "turn-while-plunging", Warning, "A feed move down in Z that also turns the tool's orientation (rotary axes, A2 …, A3 …).";
     SPLINE_FIRST_POINT = "K076", "spline-first-point", Warning, "The first point after BSPLINE 1 µm or more from the current position, which the thesis's programs repeat there.";
     SHORT_MOVE_RUN = "K077", "short-move-run", Hint, "20 or more G1 moves in a row shorter than 1 mm without a compressor or spline: the axes' velocities step at every block.";
     HEAVY_COMPUTATION = "K078", "computation-between-moves", Info, "A loop without motion, or 10 or more computing statements, between two feed moves in continuous-path mode: block preparation may not keep up with the path.";
@@ -236,6 +240,7 @@ impl Motion {
             if feed_move {
                 self.cut_without_spindle(file, step, out);
                 self.cut_without_coolant(file, step, out);
+                self.turn_while_plunging(file, step, out);
             }
             self.rapid_plunge(file, step, out);
             self.arc_radius(file, step, out);
@@ -386,6 +391,28 @@ impl Motion {
         let range = TextRange::new(file.ranges[first].start(), end);
         let message = "no jump, repeated section or structure leads here, after an end or an unconditional jump: the control never runs these blocks";
         out.push(Diagnostic::new(&UNREACHABLE_CODE, range, message));
+    }
+
+    /// Rule 70: a plunge that turns the orientation (004:2786-2790).
+    fn turn_while_plunging(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        let (from, to) = (step.from, step.state.position);
+        let down = matches!((from[2], to[2]), (Known::Is(from), Known::Is(to)) if to < from - SAME_POINT_MM);
+        let turned: Vec<&str> = (PATH_AXES.len()..FOLLOWED.len())
+            .filter(
+                |&axis| matches!((from[axis], to[axis]), (Known::Is(a), Known::Is(b)) if (a - b).abs() > f64::EPSILON),
+            )
+            .map(|axis| FOLLOWED[axis])
+            .collect();
+        let Some(first) = turned.first() else { return };
+        if !down {
+            return;
+        }
+        let Some(range) = find(file, step, |s| word_is(s, first)) else { return };
+        let message = format!(
+            "the tool turns ({}) while it plunges in Z: the thesis's simulation showed a ball-nose cutter entering the material while the table turned to be a problem; plunge first, then turn, or approach along the path (004:2786-2790)",
+            turned.join(", ")
+        );
+        out.push(Diagnostic::new(&TURN_WHILE_PLUNGING, range, message));
     }
 
     /// Rule 16: G0 lowering Z while it moves X or Y.
