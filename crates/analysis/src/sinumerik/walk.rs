@@ -35,7 +35,7 @@ use ncc_catalog::{Catalogue, Code, Dialect, KeywordKind};
 use ncc_syntax::TextRange;
 use rustc_hash::{FxHashMap, FxHashSet};
 
-use crate::{db::Db, sinumerik::checks::visit::number, sinumerik::model::FileModel};
+use crate::{db::Db, sinumerik::checks::visit::signed_value, sinumerik::model::FileModel};
 
 /// The catalogue's groups the walk reads.
 pub(crate) const MOTION: &str = "G1";
@@ -274,7 +274,7 @@ impl State {
             if assigns(word, variables) {
                 continue;
             }
-            let value = word.value.as_ref().and_then(number).map(|number| number.value());
+            let value = word.value.as_ref().and_then(signed_value);
             match word.address.as_str() {
                 // In a G4 block F and S give the dwell.
                 "F" | "S" if dwell => {}

@@ -16,7 +16,7 @@
 //! - rules 3, 5, 6, 8, 9 are ISO conventions or off for Sinumerik, and
 //!   25, 30, 33–36 ISO words (G28, H, G92 as a preset, M97–M98) that
 //!   Sinumerik writes otherwise;
-//! - rules 15, 23, 28, 38, 71, 72 and 75 follow the stock, the tool's
+//! - rules 15, 23, 28, 38, 71 and 72 follow the stock, the tool's
 //!   shape and orientation or the operation's kind, which the program
 //!   does not state; 17 and 24 are the run's (rapid moves per axis, rotary
 //!   travel); 51 and 58 depend on the programs a program generates and on

@@ -1,6 +1,6 @@
 //! Rules on motion and technology over the walk's modal state (digest §6
-//! rules 16, 18, 19, 20, 22, 26, 27, 29, 31, 32, 48, 52, 67, 70, 76, 77,
-//! 78 and 81).
+//! rules 16, 18, 19, 20, 22, 26, 27, 29, 31, 32, 48, 52, 67, 70, 75, 76,
+//! 77, 78 and 81).
 //!
 //! Assumptions, where the digest is silent:
 //! - Rules 18 and 26 report the first block of a stretch, not every block
@@ -28,9 +28,13 @@
 //! - Rule 48 cannot see the caller: it warns where the subprogram itself
 //!   put continuous-path mode in force, and not under SAVE, which gives
 //!   the caller its modes back and does not go with RET (rule 47).
-//! - Rule 70 reads a plunge as a feed move down in Z, and a turn as a
+//! - Rule 70 reads a plunge as a feed move down in Z alone, and a turn as a
 //!   rotary axis (A, B, C) or orientation word (A2 …, A3 …) whose value the
 //!   block changes; whether the tool is in the material is not known.
+//! - Rule 75 compares the largest change of a rotary axis or orientation
+//!   angle (A, B, C, A2, B2, C2) with the block's path length, above
+//!   [`ORIENTATION_RATE_DEG_PER_MM`]; a block that turns without moving
+//!   the path is left out.
 //! - Rule 76 takes points within [`SAME_POINT_MM`] for the same point.
 //! - Rule 77 calls a G1 move short below [`SHORT_MOVE_MM`] and a run long
 //!   from [`LONG_RUN`] such moves on; a move whose end or start the walk
@@ -54,7 +58,7 @@ use crate::{
     db::Db,
     diagnostic::declare_rules,
     sinumerik::{
-        checks::visit::number,
+        checks::visit::{number, signed_value},
         model::FileModel,
         walk::{self, FOLLOWED, MOTION, PATH_AXES, SPINDLE, Step, is_axis},
     },
@@ -74,7 +78,8 @@ declare_rules! {
     END_STOPS_PATH = "K048", "subprogram-end-stops-path", Warning, "A subprogram that ends with M17, M2 or M30 under the continuous-path mode it set: the end stops the path, RET keeps it.";
     CONTOUR_NOT_LINES_AND_ARCS = "K052", "contour-not-lines-and-arcs", Error, "A spline or polynomial inside a CONTPRON contour, which takes only lines and arcs.";
     OFFSETS_NOT_AFTER_TRAORI = "K067", "offsets-not-after-traori", Warning, "A move after TRAORI with no work offset (G54…) or tool offset D programmed since TRAORI.";
-    TURN_WHILE_PLUNGING = "K070", "turn-while-plunging", Warning, "A feed move down in Z that also turns the tool's orientation (rotary axes, A2 …, A3 …).";
+    TURN_WHILE_PLUNGING = "K070", "turn-while-plunging", Warning, "A feed move down in Z alone that also turns the tool's orientation (rotary axes, A2 …, A3 …).";
+    ORIENTATION_RATE = "K075", "orientation-rate", Warning, "A feed move whose orientation turns by more than 20° per mm of path.";
     SPLINE_FIRST_POINT = "K076", "spline-first-point", Warning, "The first point after BSPLINE 1 µm or more from the current position, which the thesis's programs repeat there.";
     SHORT_MOVE_RUN = "K077", "short-move-run", Hint, "20 or more G1 moves in a row shorter than 1 mm without a compressor or spline: the axes' velocities step at every block.";
     HEAVY_COMPUTATION = "K078", "computation-between-moves", Info, "A loop without motion, or 10 or more computing statements, between two feed moves in continuous-path mode: block preparation may not keep up with the path.";
@@ -85,6 +90,15 @@ declare_rules! {
 /// 76): the thesis's CAM output repeats the current point to a few tenths
 /// of a µm.
 const SAME_POINT_MM: f64 = 0.001;
+
+/// The orientation's turn per mm of path above which rule 75 warns: the
+/// digest's example, L27's B2 turning 17° over 0.5 mm (004:4223-4225), is
+/// 34°/mm; two of its neighbours turn 28 and 33°/mm.
+const ORIENTATION_RATE_DEG_PER_MM: f64 = 20.0;
+
+/// The orientation angles among the walk's followed words (rule 75): the
+/// rotary axes and A2, B2, C2; A3 … are a vector's components.
+const ANGLES: std::ops::Range<usize> = 3..9;
 
 /// A G1 move shorter than this, in mm, is short (rule 77).
 const SHORT_MOVE_MM: f64 = 1.0;
@@ -241,6 +255,7 @@ impl Motion {
                 self.cut_without_spindle(file, step, out);
                 self.cut_without_coolant(file, step, out);
                 self.turn_while_plunging(file, step, out);
+                self.orientation_rate(file, step, out);
             }
             self.rapid_plunge(file, step, out);
             self.arc_radius(file, step, out);
@@ -397,6 +412,11 @@ impl Motion {
     fn turn_while_plunging(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
         let (from, to) = (step.from, step.state.position);
         let down = matches!((from[2], to[2]), (Known::Is(from), Known::Is(to)) if to < from - SAME_POINT_MM);
+        // A plunge moves Z alone: a surface followed down in 5 axes is none.
+        let still = |axis: usize| matches!((from[axis], to[axis]), (Known::Is(a), Known::Is(b)) if (a - b).abs() <= SAME_POINT_MM);
+        if !(down && still(0) && still(1)) {
+            return;
+        }
         let turned: Vec<&str> = (PATH_AXES.len()..FOLLOWED.len())
             .filter(
                 |&axis| matches!((from[axis], to[axis]), (Known::Is(a), Known::Is(b)) if (a - b).abs() > f64::EPSILON),
@@ -404,15 +424,38 @@ impl Motion {
             .map(|axis| FOLLOWED[axis])
             .collect();
         let Some(first) = turned.first() else { return };
-        if !down {
-            return;
-        }
         let Some(range) = find(file, step, |s| word_is(s, first)) else { return };
         let message = format!(
             "the tool turns ({}) while it plunges in Z: the thesis's simulation showed a ball-nose cutter entering the material while the table turned to be a problem; plunge first, then turn, or approach along the path (004:2786-2790)",
             turned.join(", ")
         );
         out.push(Diagnostic::new(&TURN_WHILE_PLUNGING, range, message));
+    }
+
+    /// Rule 75: the orientation's turn per mm of path.
+    fn orientation_rate(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        let (from, to) = (step.from, step.state.position);
+        let length = (0..PATH_AXES.len()).try_fold(0.0, |sum, axis| match (from[axis], to[axis]) {
+            (Known::Is(a), Known::Is(b)) => Some(sum + (b - a) * (b - a)),
+            _ => None,
+        });
+        let Some(length) = length.map(f64::sqrt).filter(|&length| length > SAME_POINT_MM) else { return };
+        let turn = ANGLES
+            .filter_map(|axis| match (from[axis], to[axis]) {
+                (Known::Is(a), Known::Is(b)) => Some((axis, (b - a).abs())),
+                _ => None,
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        let Some((axis, degrees)) = turn.filter(|(_, degrees)| degrees / length > ORIENTATION_RATE_DEG_PER_MM) else {
+            return;
+        };
+        let Some(range) = find(file, step, |s| word_is(s, FOLLOWED[axis])) else { return };
+        let message = format!(
+            "{} turns {degrees:.1}° over {length:.2} mm of path ({:.0}°/mm): the rotary axes cannot follow at the feed, so the path slows down, and the surface may show it (004:4223-4225)",
+            FOLLOWED[axis],
+            degrees / length
+        );
+        out.push(Diagnostic::new(&ORIENTATION_RATE, range, message));
     }
 
     /// Rule 16: G0 lowering Z while it moves X or Y.
@@ -442,7 +485,7 @@ impl Motion {
             _ => None,
         });
         let Some((statement, word)) = radius_word else { return };
-        let Some(radius) = word.value.as_ref().and_then(number).map(|n| n.value().abs()) else { return };
+        let Some(radius) = word.value.as_ref().and_then(signed_value).map(f64::abs) else { return };
         let axes = match state.modes.get("G6") {
             Some("G17") => [0, 1],
             Some("G18") => [2, 0],

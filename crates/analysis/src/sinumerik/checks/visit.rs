@@ -2,7 +2,7 @@
 //! every one of them.
 
 use nc_exec::sinumerik::lower::{
-    Call, Callee, Expr, ExprKind, Jump, JumpTarget, Number, Place, Statement, StatementKind, Word, WordValue,
+    Call, Callee, Expr, ExprKind, Jump, JumpTarget, Number, Place, Statement, StatementKind, UnaryOp, Word, WordValue,
 };
 
 /// Every expression written directly in `statement` (not those inside
@@ -123,6 +123,18 @@ pub(crate) fn written_places<'a>(statement: &'a Statement, f: &mut impl FnMut(&'
         StatementKind::SyncAction { actions, .. } => actions.iter().for_each(|action| written_places(action, f)),
         _ => {}
     }
+}
+
+/// A word's value when written as a number, signed or not: `X-5`,
+/// `B2=-11.03`.
+pub(crate) fn signed_value(value: &WordValue) -> Option<f64> {
+    if let WordValue::Expr { expr, .. } = value
+        && let ExprKind::Unary(op @ (UnaryOp::Minus | UnaryOp::Plus), operand) = &expr.kind
+        && let ExprKind::Number(number) = operand.kind
+    {
+        return Some(if *op == UnaryOp::Minus { -number.value() } else { number.value() });
+    }
+    number(value).map(|number| number.value())
 }
 
 /// A word's value when written as a number: after the address or `=`.
