@@ -133,7 +133,9 @@ const COOLANT_OFF: &str = "M9";
 const SAFE_GROUPS: [&str; 3] = ["G7", "G8", "G14"];
 
 /// The state the rules keep between blocks.
-pub(crate) struct Motion {
+struct Motion {
+    /// Rule 48 applies: a subprogram without SAVE.
+    ends_path: bool,
     feed_reported: bool,
     /// The M5 or M19 that stopped the spindle, and whether a cut since it
     /// was reported.
@@ -198,8 +200,12 @@ fn predefined(statement: &Statement) -> Option<&str> {
 }
 
 impl Motion {
-    fn new(main: bool) -> Motion {
+    /// `main`: the file starts at reset; `save`: its PROC line has SAVE.
+    fn new(main: bool, save: bool) -> Motion {
         Motion {
+            // Under SAVE the caller's modes come back anyway, and RET is no
+            // choice (rule 47).
+            ends_path: !main && !save,
             feed_reported: false,
             spindle_stop: None,
             spindle_reported: false,
@@ -220,15 +226,7 @@ impl Motion {
         }
     }
 
-    /// `main`: the file starts at reset; `save`: its PROC line has SAVE.
-    pub(crate) fn step(
-        &mut self,
-        file: &FileModel,
-        step: &Step<'_>,
-        main: bool,
-        save: bool,
-        out: &mut Vec<Diagnostic>,
-    ) {
+    fn step(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
         let catalogue = Dialect::Sinumerik.catalogue();
         let state = step.state;
         self.unreached(file, step, out);
@@ -267,9 +265,7 @@ impl Motion {
             self.path_breaker(file, step);
             self.computation(file, step);
         }
-        // Under SAVE the caller's modes come back anyway, and RET is no
-        // choice (rule 47).
-        if !main && !save && state.continuous_path() == Known::Is(true) {
+        if self.ends_path && state.continuous_path() == Known::Is(true) {
             self.end_of_subprogram(file, step, out);
         }
     }
@@ -753,9 +749,9 @@ impl Motion {
 /// Runs the rules of this module over a walk of `file`.
 pub(crate) fn check(db: &dyn Db, file: &FileModel, main: bool) -> Vec<Diagnostic> {
     let save = file.model.header().is_some_and(|proc| proc.declaration.attributes.iter().any(|a| a == "SAVE"));
-    let mut motion = Motion::new(main);
+    let mut motion = Motion::new(main, save);
     let mut out = Vec::new();
-    walk::walk(db, file, main, |step| motion.step(file, &step, main, save, &mut out));
+    walk::walk(db, file, main, |step| motion.step(file, &step, &mut out));
     motion.report_unreached(file, &mut out);
     out
 }
