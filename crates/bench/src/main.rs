@@ -480,7 +480,10 @@ fn check_benchmark(dialect: Dialect, blocks: usize) -> anyhow::Result<()> {
     let after_parse = IN_USE.load(Relaxed) - base;
     let diagnostics = host.analysis().diagnostics(file);
     let total = start.elapsed();
-    anyhow::ensure!(diagnostics.is_empty(), "findings in a generated program: {:?}", &diagnostics[..1]);
+    // Hints and infos (short moves without a compressor, an arc without
+    // nose compensation) are advice on a valid program.
+    let problems: Vec<_> = diagnostics.iter().filter(|d| d.severity >= ncc_analysis::Severity::Warning).collect();
+    anyhow::ensure!(problems.is_empty(), "findings in a generated program: {:?}", &problems[..1]);
     println!("check benchmark: {blocks} blocks ({mb:.1} MB)");
     println!("  parse            {:>9.1} ms", parsed.as_secs_f64() * 1e3);
     println!(
