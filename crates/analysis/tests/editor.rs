@@ -954,6 +954,23 @@ fn sinumerik_hover_on_a_name_shows_its_definition() {
     assert!(hover_at(&[("LOOP.MPF", text)], "M30").starts_with("### M30"));
 }
 
+/// CR names the radius; its hover also says which of the two arcs of that
+/// radius the block cuts, where the ends are known (digest §6 rule 21).
+#[test]
+fn sinumerik_hover_on_cr_shows_the_arc_it_chooses() {
+    let text = "G17 G90 G0 X0 Y0\nG2 X20 Y0 CR=10 F100\nG3 X0 Y0 CR=-10\nG2 X100 CR=5\nR1=2\nG2 X=R1 CR=6\n";
+    let first_line =
+        |needle: &str| hover_at(&[("ARCS.MPF", text)], needle).lines().next().unwrap_or_default().to_owned();
+    expect!["**This arc** (G2, a positive CR the shorter of the two arcs of radius 10): from X0.000 Y0.000 to X20.000 Y0.000 about X10.000 Y0.000, sweeping 180.0°"]
+        .assert_eq(&first_line("CR=10"));
+    expect!["**This arc** (G3, a negative CR the longer of the two arcs of radius 10): from X20.000 Y0.000 to X0.000 Y0.000 about X10.000 Y0.000, sweeping 180.0°"]
+        .assert_eq(&first_line("CR=-10"));
+    expect!["**This arc** (G2): no arc of radius 5 joins X0.000 Y0.000 and X100.000 Y0.000"]
+        .assert_eq(&first_line("CR=5\nR1"));
+    // An end the walk does not know: the catalogue's text alone.
+    assert!(first_line("CR=6").starts_with("### CR"), "{}", first_line("CR=6"));
+}
+
 /// L29 jumps to block numbers and labels and computes the target of some:
 /// those have no definition before a run.
 #[test]

@@ -6,6 +6,7 @@
 //! own names in completion ([`completion`]), read from the tree and the
 //! program model (`crate::sinumerik::model`).
 
+mod arcs;
 mod completion;
 mod navigation;
 mod outline;
@@ -46,6 +47,16 @@ pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<H
     // does not wait for it.
     let named = token.kind() == SyntaxKind::IDENT
         || token.parent_ancestors().any(|node| matches!(node.kind(), SyntaxKind::GOTO_STMT | SyntaxKind::LABEL));
+    // CR, unless a variable of that name: also the arc it chooses.
+    let explained = || {
+        let mut hover = explained()?;
+        if token.text().eq_ignore_ascii_case("CR")
+            && let Some(arc) = arcs::radius_arc(db, file, offset)
+        {
+            hover.markdown = format!("{arc}\n\n---\n\n{}", hover.markdown);
+        }
+        Some(hover)
+    };
     if named { navigation::hover(db, file, offset).or_else(explained) } else { explained() }
 }
 

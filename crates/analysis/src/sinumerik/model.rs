@@ -7,7 +7,7 @@
 //! other chunks' blocks. The program model is rebuilt from them, one pass
 //! over the blocks.
 
-use std::sync::Arc;
+use std::{path::Path, sync::Arc};
 
 use nc_exec::sinumerik::{lower::SinumerikBlock, program::SinumerikModel};
 use ncc_syntax::{TextRange, TextSize};
@@ -66,6 +66,20 @@ impl FileModel {
     pub fn block_starting_at(&self, start: TextSize) -> Option<usize> {
         self.ranges.binary_search_by_key(&start, |range| range.start()).ok()
     }
+}
+
+/// Whether the file is a main program, which starts at reset: no PROC
+/// line, and neither its name (`PART.SPF`, `_N_PART_SPF`) nor its header
+/// line says a subprogram.
+pub(crate) fn is_main_program(db: &dyn Db, file: SourceFile) -> bool {
+    let model = file_model(db, file);
+    let subprogram = |name: &str| {
+        let name = name.to_ascii_uppercase();
+        name.ends_with(".SPF") || name.ends_with("_SPF")
+    };
+    let file_name = Path::new(file.path(db)).file_name().and_then(|name| name.to_str()).unwrap_or_default();
+    let header = model.ranges.first().and_then(|_| model.block(0).header.as_ref());
+    model.model.header().is_none() && !subprogram(file_name) && !header.is_some_and(|header| subprogram(&header.name))
 }
 
 /// The file's model, rebuilt when its text changes.

@@ -23,10 +23,15 @@
 //! An unknown value never produces a finding, so a rule reports only what
 //! holds on a way the program really runs.
 
+use std::ops::ControlFlow;
+
 use nc_exec::{
     known::Known,
     sinumerik::{
-        lower::{Callee, Command, Dimension, JumpKind, PlaceKind, SinumerikBlock, StatementKind, Word, WordValue},
+        frames::Plane,
+        lower::{
+            Callee, Command, Dimension, JumpKind, PlaceKind, SinumerikBlock, Statement, StatementKind, Word, WordValue,
+        },
         modes::Modes,
         program::{Resolved, Structure, StructureKind},
     },
@@ -42,6 +47,7 @@ pub(crate) const MOTION: &str = "G1";
 pub(crate) const PATH_MODE: &str = "G10";
 pub(crate) const SPINDLE: &str = "M2";
 const FRAMES: &str = "G3";
+const PLANE: &str = "G6";
 const WORK_OFFSETS: &str = "G8";
 const MACHINE_COORDINATES: &str = "G9";
 const UNITS: &str = "G13";
@@ -326,6 +332,47 @@ fn assigns(word: &Word, variables: &Variables<'_>) -> bool {
     matches!(&word.value, Some(WordValue::Expr { dimension: None, .. })) && variables.contains(word.address.as_str())
 }
 
+/// A G2/G3 block's arc given by its radius CR, as the walk knows it: the
+/// two coordinates of the plane in force at its start and end, and CR as
+/// written (negative: the longer arc).
+pub(crate) struct RadiusArc<'a> {
+    /// The plane's axes, in the order G2 turns clockwise.
+    pub axes: [&'static str; 2],
+    pub from: [f64; 2],
+    pub to: [f64; 2],
+    pub radius: f64,
+    pub counter_clockwise: bool,
+    /// The `CR=…` statement.
+    pub written: &'a Statement,
+}
+
+impl RadiusArc<'_> {
+    /// The arc of block `block`, moved from `from` to `state`'s position;
+    /// `None` when it is no CR arc or an end is not known.
+    pub(crate) fn of<'a>(block: &'a SinumerikBlock, from: &[Known<f64>], state: &State) -> Option<RadiusArc<'a>> {
+        let counter_clockwise = match state.motion()? {
+            "G2" => false,
+            "G3" => true,
+            _ => return None,
+        };
+        let (written, radius) = block.statements.iter().find_map(|statement| match &statement.kind {
+            StatementKind::Word(word) if word.address == "CR" => Some((statement, word.value.as_ref()?)),
+            _ => None,
+        })?;
+        let radius = signed_value(radius)?;
+        let [a, b, _] = Plane::from_code(state.modes.get(PLANE)?)?.axes();
+        let known = |position: &[Known<f64>], axis: usize| position[axis].known();
+        Some(RadiusArc {
+            axes: [PATH_AXES[a], PATH_AXES[b]],
+            from: [known(from, a)?, known(from, b)?],
+            to: [known(&state.position, a)?, known(&state.position, b)?],
+            radius,
+            counter_clockwise,
+            written,
+        })
+    }
+}
+
 /// Whether `address` names an axis the control moves: its letter, or the
 /// letter with a number (`A2`, `X1`).
 pub(crate) fn is_axis(address: &str) -> bool {
@@ -387,12 +434,12 @@ fn looped(
 }
 
 /// Walks `file` from reset (`main`) or from an unknown state, calling
-/// `visit` at each block with the state after it.
+/// `visit` at each block with the state after it, until `visit` breaks.
 ///
 /// A jump forward hands its state to its target, which joins it with the
 /// way into it; a jump back makes its target the top of a loop up to the
 /// jump, as WHILE does.
-pub(crate) fn walk(db: &dyn Db, file: &FileModel, main: bool, mut visit: impl FnMut(Step<'_>)) {
+pub(crate) fn walk(db: &dyn Db, file: &FileModel, main: bool, mut visit: impl FnMut(Step<'_>) -> ControlFlow<()>) {
     let model = &file.model;
     let count = file.ranges.len();
     let mut variables: Variables<'_> = model.definitions.iter().map(|d| d.declared.name.as_str()).collect();
@@ -499,7 +546,11 @@ pub(crate) fn walk(db: &dyn Db, file: &FileModel, main: bool, mut visit: impl Fn
         let mut state = way.unwrap_or_else(unknown);
         let from = state.position;
         let moves = state.apply(block, &variables);
-        visit(Step { index, block, from, state: &state, moves, reached, opens: opens.get(&index).copied() });
+        if visit(Step { index, block, from, state: &state, moves, reached, opens: opens.get(&index).copied() })
+            .is_break()
+        {
+            return;
+        }
         if let Some(structure) = opens.get(&index)
             && structure.kind == StructureKind::If
         {

@@ -21,9 +21,9 @@
 //!   does not state; 17 and 24 are the run's (rapid moves per axis, rotary
 //!   travel); 51 and 58 depend on the programs a program generates and on
 //!   the control's version;
-//! - rule 73 is the catalogue's hover text of CUT3DC and CUT3DF; the
-//!   hovers of rules 21 (the arc a CR chooses) and 74 (the composed frame)
-//!   are not shown yet;
+//! - rules 21 and 73 are hover: the arc a CR chooses (the editor's hover
+//!   over CR), the catalogue's text of CUT3DC and CUT3DF; 74's hover, the
+//!   composed frame, is not shown yet;
 //! - computed jump targets (`GOTOF "N"<<R3`) are the run's.
 
 pub(crate) mod block;
@@ -43,7 +43,7 @@ use crate::{
     Diagnostic, Rule,
     db::{BlockChunk, Db, Settings, SourceFile, file_chunks},
     findings::{self, Findings},
-    sinumerik::model::{chunk_blocks, file_model},
+    sinumerik::model::{chunk_blocks, file_model, is_main_program},
 };
 
 /// The rules of every check module.
@@ -105,10 +105,7 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
     let in_workspace = |control_name: &str| find(control_name).is_some();
     let resolve = |callee: &Callee| callee.control_files()?.iter().find_map(|name| find(name));
     let mut diagnostics = program::check(db, model, &in_workspace);
-    let header = model.ranges.first().and_then(|_| model.block(0).header.as_ref());
-    let main = model.model.header().is_none()
-        && !is_subprogram_file(file.path(db))
-        && !header.is_some_and(|header| header.name.to_ascii_uppercase().ends_with("_SPF"));
+    let main = is_main_program(db, file);
     diagnostics.extend(motion::check(db, model, main));
     diagnostics.extend(names::check(db, model, text, config));
     let reads: Vec<&parameters::Reads> =
@@ -121,12 +118,6 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
     diagnostics.extend(types::check(db, model, &signatures));
     findings::sort_diagnostics(&mut diagnostics);
     Findings { diagnostics, omitted: Vec::new() }
-}
-
-/// Whether a file's name says a subprogram: `PART.SPF`, `_N_PART_SPF`.
-fn is_subprogram_file(path: &str) -> bool {
-    let name = Path::new(path).file_name().and_then(|name| name.to_str()).unwrap_or_default().to_ascii_uppercase();
-    name.ends_with(".SPF") || name.ends_with("_SPF")
 }
 
 #[cfg(test)]

@@ -46,7 +46,10 @@
 //!   M2, M17, M30), MSG, WRITE and STOPRE as the blocks that break the
 //!   path (digest: inferred).
 
+use std::ops::ControlFlow;
+
 use nc_exec::{
+    arc::centre_by_radius,
     known::Known,
     sinumerik::lower::{Callee, ProgramEnd, Statement, StatementKind, WordValue},
 };
@@ -58,9 +61,9 @@ use crate::{
     db::Db,
     diagnostic::declare_rules,
     sinumerik::{
-        checks::visit::{number, signed_value},
+        checks::visit::number,
         model::FileModel,
-        walk::{self, FOLLOWED, MOTION, PATH_AXES, SPINDLE, Step, is_axis},
+        walk::{self, FOLLOWED, MOTION, PATH_AXES, RadiusArc, SPINDLE, Step, is_axis},
     },
 };
 
@@ -474,33 +477,17 @@ impl Motion {
 
     /// Rules 19 and 20: an arc by its radius CR.
     fn arc_radius(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
-        let state = step.state;
-        let Some(motion @ ("G2" | "G3")) = state.motion() else { return };
-        let radius_word = step.block.statements.iter().find_map(|s| match &s.kind {
-            StatementKind::Word(word) if word.address == "CR" => Some((s, word)),
-            _ => None,
-        });
-        let Some((statement, word)) = radius_word else { return };
-        let Some(radius) = word.value.as_ref().and_then(signed_value).map(f64::abs) else { return };
-        let axes = match state.modes.get("G6") {
-            Some("G17") => [0, 1],
-            Some("G18") => [2, 0],
-            Some("G19") => [1, 2],
-            _ => return,
-        };
-        let mut chord = 0.0;
-        for axis in axes {
-            let (Known::Is(from), Known::Is(to)) = (step.from[axis], state.position[axis]) else { return };
-            chord += (to - from) * (to - from);
-        }
-        let chord: f64 = chord.sqrt();
-        let range = file.in_file(step.index, statement.range);
+        let Some(arc) = RadiusArc::of(step.block, &step.from, step.state) else { return };
+        let motion = if arc.counter_clockwise { "G3" } else { "G2" };
+        let chord = (arc.to[0] - arc.from[0]).hypot(arc.to[1] - arc.from[1]);
+        let radius = arc.radius.abs();
+        let range = file.in_file(step.index, arc.written.range);
         if chord < SAME_POINT_MM {
             let message = format!(
                 "{motion} with CR ends where it starts: a radius gives no full circle; give the centre with I, J, K (or AR=360)"
             );
             out.push(Diagnostic::new(&FULL_CIRCLE_WITH_RADIUS, range, message));
-        } else if chord > 2.0 * radius + SAME_POINT_MM {
+        } else if centre_by_radius(arc.from, arc.to, arc.radius, arc.counter_clockwise, SAME_POINT_MM).is_none() {
             let message = format!(
                 "the arc's end is {chord:.3} mm from its start, more than the diameter {:.3} mm of the radius CR={radius}: no such arc joins them",
                 2.0 * radius
@@ -751,7 +738,10 @@ pub(crate) fn check(db: &dyn Db, file: &FileModel, main: bool) -> Vec<Diagnostic
     let save = file.model.header().is_some_and(|proc| proc.declaration.attributes.iter().any(|a| a == "SAVE"));
     let mut motion = Motion::new(main, save);
     let mut out = Vec::new();
-    walk::walk(db, file, main, |step| motion.step(file, &step, &mut out));
+    walk::walk(db, file, main, |step| {
+        motion.step(file, &step, &mut out);
+        ControlFlow::Continue(())
+    });
     motion.report_unreached(file, &mut out);
     out
 }
