@@ -74,10 +74,12 @@ impl View {
     }
 }
 
-/// The newest version of each document to estimate.
+/// The newest version of each document to estimate, and how long each
+/// open document's last complete run took.
 #[derive(Debug, Default)]
 struct Jobs {
     pending: HashMap<Uri, i32>,
+    took: HashMap<Uri, Duration>,
 }
 
 /// The worker and its queue.
@@ -96,21 +98,20 @@ impl Timer {
             // Diagnostics and hovers of the edit come first: on two cores a
             // run at normal priority doubles their latency.
             background_priority();
-            // How long each document's last complete run took.
-            let mut took: HashMap<Uri, Duration> = HashMap::new();
             loop {
-                let (uri, version) = {
+                let (uri, version, took) = {
                     let (lock, ready) = &*jobs;
                     let mut guard = lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
                     loop {
                         if let Some(uri) = guard.pending.keys().next().cloned() {
                             let version = guard.pending.remove(&uri).expect("the key was just found");
-                            break (uri, version);
+                            let took = guard.took.get(&uri).copied();
+                            break (uri, version, took);
                         }
                         guard = ready.wait(guard).unwrap_or_else(|poisoned| poisoned.into_inner());
                     }
                 };
-                if took.get(&uri).is_some_and(|&took| took >= LONG_RUN) {
+                if took.is_some_and(|took| took >= LONG_RUN) {
                     let (lock, ready) = &*jobs;
                     let guard = lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
                     let (_guard, waited) = ready
@@ -122,21 +123,24 @@ impl Timer {
                     }
                 }
                 // A failed run must not end the worker: later edits may run.
-                match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&state, &jobs, &uri, version))) {
+                let ran = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&state, &jobs, &uri, version)));
+                let (lock, _) = &*jobs;
+                let mut guard = lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+                match ran {
                     Ok(Ran::Kept(run_took)) => {
-                        took.insert(uri, run_took);
+                        guard.took.insert(uri, run_took);
                         let _ = refresh.send(());
                     }
                     // At least as long as it ran.
                     Ok(Ran::GivenUp(ran)) => {
-                        let known = took.entry(uri).or_default();
+                        let known = guard.took.entry(uri).or_default();
                         *known = (*known).max(ran);
                     }
                     Ok(Ran::Nothing) => {}
                     Err(_) => tracing::error!("{} v{version}: estimating the cycle time failed", uri.as_str()),
                 }
-                let (lock, _) = &*jobs;
-                if lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).pending.is_empty() {
+                if guard.pending.is_empty() {
+                    drop(guard);
                     // Nothing more to estimate: typing paused.
                     crate::return_free_memory();
                 }
@@ -158,7 +162,9 @@ impl Timer {
 
     pub fn forget(&self, uri: &Uri) {
         let (lock, _) = &*self.jobs;
-        lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).pending.remove(uri);
+        let mut jobs = lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        jobs.pending.remove(uri);
+        jobs.took.remove(uri);
     }
 }
 
@@ -234,5 +240,23 @@ pub(crate) async fn refresh(client: Client, state: Arc<Mutex<State>>, mut ready:
         if can.code_lenses && client.code_lens_refresh().await.is_err() {
             tracing::debug!("the client refused to refresh code lenses");
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::str::FromStr;
+
+    use super::*;
+
+    #[test]
+    fn a_closed_document_leaves_nothing_behind() {
+        let timer = Timer { jobs: Arc::default() };
+        let uri = Uri::from_str("file:///PART.MPF").unwrap();
+        timer.request(uri.clone(), 3);
+        timer.jobs.0.lock().unwrap().took.insert(uri.clone(), LONG_RUN);
+        timer.forget(&uri);
+        let jobs = timer.jobs.0.lock().unwrap();
+        assert!(jobs.pending.is_empty() && jobs.took.is_empty(), "{jobs:?}");
     }
 }
