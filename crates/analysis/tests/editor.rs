@@ -952,6 +952,10 @@ fn sinumerik_hover_on_a_name_shows_its_definition() {
         hover_at(&[("LOOP.MPF", text)], "GOTOB")
     );
     assert!(hover_at(&[("LOOP.MPF", text)], "M30").starts_with("### M30"));
+    // Blank lines, comment lines and CR LF line ends are lines too.
+    let text = "\r\n; a comment\r\n\r\nDEF INT COUNT\r\nCOUNT=1\r\n";
+    let hover = hover_at(&[("LINES.MPF", text)], "COUNT=1");
+    assert!(hover.contains("\nline 4\n"), "{hover}");
 }
 
 /// CR names the radius; its hover also says which of the two arcs of that

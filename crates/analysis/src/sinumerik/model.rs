@@ -62,6 +62,11 @@ impl FileModel {
         range + self.ranges[index].start()
     }
 
+    /// The line (from 1) that holds `offset`: a block is a line.
+    pub fn line_at(&self, offset: TextSize) -> usize {
+        self.ranges.partition_point(|range| range.end() <= offset) + 1
+    }
+
     /// The index of the block that starts at `start`.
     pub fn block_starting_at(&self, start: TextSize) -> Option<usize> {
         self.ranges.binary_search_by_key(&start, |range| range.start()).ok()

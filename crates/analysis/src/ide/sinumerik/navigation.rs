@@ -315,7 +315,7 @@ pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<H
     let definitions = goto_definition(db, file, offset);
     for definition in &definitions {
         let text = definition.file.text(db);
-        let line = text[..usize::from(definition.range.start())].matches('\n').count() + 1;
+        let line = file_model(db, definition.file).line_at(definition.range.start());
         let place = if definition.file == file {
             format!("line {line}")
         } else {
@@ -431,7 +431,7 @@ fn check_new_name(db: &dyn Db, file: SourceFile, renamed: &Symbol, new_name: &st
     });
     match taken {
         Some(o) => {
-            let line = text[..usize::from(o.range.start())].matches('\n').count() + 1;
+            let line = file_model(db, file).line_at(o.range.start());
             Err(format!("`{new_name}` is already a name in this file (`{}` on line {line})", &text[o.range]))
         }
         None => Ok(()),
