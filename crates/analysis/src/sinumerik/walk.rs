@@ -32,7 +32,10 @@ use nc_exec::{
         lower::{
             Callee, Command, Dimension, JumpKind, PlaceKind, SinumerikBlock, Statement, StatementKind, Word, WordValue,
         },
-        modes::Modes,
+        modes::{
+            Modes,
+            groups::{DIMENSIONS, FRAMES, MACHINE_COORDINATES, MOTION, PATH_MODE, PLANE, UNITS, WORK_OFFSETS},
+        },
         program::{Resolved, Structure, StructureKind},
     },
 };
@@ -41,17 +44,6 @@ use ncc_syntax::TextRange;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::{db::Db, sinumerik::checks::visit::signed_value, sinumerik::model::FileModel};
-
-/// The catalogue's groups the walk reads.
-pub(crate) const MOTION: &str = "G1";
-pub(crate) const PATH_MODE: &str = "G10";
-pub(crate) const SPINDLE: &str = "M2";
-const FRAMES: &str = "G3";
-const PLANE: &str = "G6";
-const WORK_OFFSETS: &str = "G8";
-const MACHINE_COORDINATES: &str = "G9";
-const UNITS: &str = "G13";
-const DIMENSIONS: &str = "G14";
 
 /// The codes of the motion group that cut a thread: they move at the
 /// pitch and spindle speed, not at F.

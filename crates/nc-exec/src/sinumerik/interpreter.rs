@@ -115,17 +115,10 @@ mod calls;
 mod files;
 mod frames_and_cycles;
 
-use super::modes::Modes;
-
-/// The catalogue's groups the interpreter reads.
-const MOTION: &str = "G1";
-const PLANE: &str = "G6";
-const PATH_MODE: &str = "G10";
-const UNITS: &str = "G13";
-const DIMENSIONS: &str = "G14";
-const FEED_MODE: &str = "G15";
-const ACCELERATION: &str = "G21";
-const SPINDLE: &str = "M2";
+use super::modes::{
+    Modes,
+    groups::{ACCELERATION, DIMENSIONS, FEED_MODE, MOTION, PATH_MODE, PLANE, SPINDLE, UNITS},
+};
 
 /// The axes the programmable frame maps, in its order.
 const XYZ: [u8; 3] = [b'X', b'Y', b'Z'];

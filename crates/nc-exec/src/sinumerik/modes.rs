@@ -8,6 +8,23 @@
 
 use ncc_catalog::{Catalogue, Code, Dialect, Modality};
 
+/// The catalogue's groups the run and the checker read, by their id.
+pub mod groups {
+    pub const MOTION: &str = "G1";
+    pub const FRAMES: &str = "G3";
+    pub const PLANE: &str = "G6";
+    pub const TOOL_RADIUS: &str = "G7";
+    pub const WORK_OFFSETS: &str = "G8";
+    pub const MACHINE_COORDINATES: &str = "G9";
+    pub const PATH_MODE: &str = "G10";
+    pub const UNITS: &str = "G13";
+    pub const DIMENSIONS: &str = "G14";
+    pub const FEED_MODE: &str = "G15";
+    pub const ACCELERATION: &str = "G21";
+    pub const SPINDLE: &str = "M2";
+    pub const COOLANT: &str = "M3";
+}
+
 /// The code in force of every group of the catalogue.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Modes {

@@ -14,6 +14,7 @@ use std::path::Path;
 
 use nc_exec::sinumerik::{
     lower::{Callee, Dimension, StatementKind, WordValue},
+    modes::groups::{FRAMES, WORK_OFFSETS},
     program::PROGRAM_LEVELS,
 };
 use ncc_catalog::{Dialect, KeywordKind};
@@ -207,10 +208,10 @@ fn in_place(db: &dyn Db, file: SourceFile) -> Option<TextRange> {
         for statement in &block.statements {
             match &statement.kind {
                 StatementKind::Command(command) => {
-                    let shifts = catalogue
-                        .word_code(&command.name)
-                        .is_some_and(|code| matches!(code.group.as_deref(), Some("G3" | "G8")) || code.code == "G91")
-                        || catalogue.keyword(&command.name).is_some_and(|k| k.kind == KeywordKind::Transformation);
+                    let shifts =
+                        catalogue.word_code(&command.name).is_some_and(|code| {
+                            matches!(code.group.as_deref(), Some(FRAMES | WORK_OFFSETS)) || code.code == "G91"
+                        }) || catalogue.keyword(&command.name).is_some_and(|k| k.kind == KeywordKind::Transformation);
                     if shifts {
                         return None;
                     }
@@ -219,7 +220,7 @@ fn in_place(db: &dyn Db, file: SourceFile) -> Option<TextRange> {
                     let code = word.value.as_ref().and_then(number).and_then(|n| n.whole());
                     let code = code.and_then(|n| u32::try_from(n).ok()).and_then(|n| catalogue.code('G', n));
                     // A code the catalogue does not list (`G505`) may shift.
-                    if code.is_none_or(|code| matches!(code.group.as_deref(), Some("G8")) || code.code == "G91") {
+                    if code.is_none_or(|code| code.group.as_deref() == Some(WORK_OFFSETS) || code.code == "G91") {
                         return None;
                     }
                 }

@@ -51,7 +51,10 @@ use std::ops::ControlFlow;
 use nc_exec::{
     arc::centre_by_radius,
     known::Known,
-    sinumerik::lower::{Callee, ProgramEnd, Statement, StatementKind, WordValue},
+    sinumerik::{
+        lower::{Callee, ProgramEnd, Statement, StatementKind, WordValue},
+        modes::groups::{COOLANT, DIMENSIONS, MOTION, SPINDLE, TOOL_RADIUS, WORK_OFFSETS},
+    },
 };
 use ncc_catalog::{Catalogue, Dialect, KeywordKind};
 use ncc_syntax::{TextEdit, TextRange};
@@ -63,7 +66,7 @@ use crate::{
     sinumerik::{
         checks::visit::number,
         model::FileModel,
-        walk::{self, FOLLOWED, MOTION, PATH_AXES, RadiusArc, SPINDLE, Step, is_axis},
+        walk::{self, FOLLOWED, PATH_AXES, RadiusArc, Step, is_axis},
     },
 };
 
@@ -127,13 +130,12 @@ const HEAVY_STATEMENTS: usize = 10;
 /// The statements rule 81 names that break the path.
 const PATH_BREAKERS: [&str; 3] = ["MSG", "WRITE", "STOPRE"];
 
-/// The coolant's group, and the code that switches it off.
-const COOLANT: &str = "M3";
+/// The code of the coolant's group that switches it off.
 const COOLANT_OFF: &str = "M9";
 
 /// The groups the safe block writes (rule 31): tool radius compensation,
 /// work offset, dimensions.
-const SAFE_GROUPS: [&str; 3] = ["G7", "G8", "G14"];
+const SAFE_GROUPS: [&str; 3] = [TOOL_RADIUS, WORK_OFFSETS, DIMENSIONS];
 
 /// The state the rules keep between blocks.
 struct Motion {
@@ -356,7 +358,7 @@ impl Motion {
                     let number = word.value.as_ref().and_then(number).and_then(|n| n.whole());
                     match number.and_then(|n| u32::try_from(n).ok()) {
                         // Settable work offsets beyond the catalogue's.
-                        Some(505..=599) => Some("G8"),
+                        Some(505..=599) => Some(WORK_OFFSETS),
                         Some(n) => catalogue.code('G', n).and_then(|code| code.group.as_deref()),
                         None => None,
                     }
@@ -691,7 +693,8 @@ impl Motion {
                     if transformation {
                         self.traori =
                             command.name.starts_with("TRAORI").then(|| file.in_file(step.index, statement.range));
-                    } else if catalogue.word_code(&command.name).and_then(|c| c.group.as_deref()) == Some("G8") {
+                    } else if catalogue.word_code(&command.name).and_then(|c| c.group.as_deref()) == Some(WORK_OFFSETS)
+                    {
                         self.traori = None;
                     }
                 }
@@ -699,7 +702,7 @@ impl Motion {
                 StatementKind::Word(word) if word.address == "G" => {
                     let code = word.value.as_ref().and_then(number).and_then(|n| n.whole());
                     let code = code.and_then(|n| u32::try_from(n).ok()).and_then(|n| catalogue.code('G', n));
-                    if code.and_then(|c| c.group.as_deref()) == Some("G8") {
+                    if code.and_then(|c| c.group.as_deref()) == Some(WORK_OFFSETS) {
                         self.traori = None;
                     }
                 }
