@@ -63,7 +63,7 @@ syntax keyword sinumerikWordCode ORISOF ORISON
 syntax keyword sinumerikFunction SIN COS TAN ASIN ACOS ATAN2 SQRT POT ABS TRUNC ROUND ROUNDUP LN EXP
 syntax keyword sinumerikFunction MINVAL MAXVAL BOUND AC IC STRLEN INDEX RINDEX SUBSTR NUMBER ISNUMBER
 syntax keyword sinumerikFunction AXSTRING AXNAME TOUPPER TOLOWER SET REP WRITE DELETE READ ISFILE MSG
-syntax keyword sinumerikFunction GROUP_BEGIN GROUP_END WORKPIECE GETSELT GETEXET SPLINEPATH CONTPRON
+syntax keyword sinumerikFunction GROUP_BEGIN GROUP_END WORKPIECE GETSELT GETEXET SPLINEPATH CONTPRON EXECUTE
 
 " A string and a comment end with their line.
 syntax region sinumerikString start=/"/ end=/"/ end=/$/ oneline
