@@ -22,7 +22,7 @@ const LUA_TIMEOUT_MS: u64 = 3000;
 const PROGRAM: &str = "%1\nN10 G01 X- 5 F100\nN20 M30\n*\n";
 const MACRO: &str = "N10 G79 L9001\nN20 G90 G00 Z2.\nN30 G70\n*\n";
 /// A Sinumerik program with one error: the `(` not closed on line 4.
-const SINUMERIK: &str = "%_N_MAIN_MPF\n; a part\nDEF REAL DEPTH=2.5\nR1=(5+2\n/1 N10 G642 SOFT X=R1 CR=2\n\
+const SINUMERIK: &str = "%_N_MAIN_MPF\n; a part\nDEF REAL DEPTH=2.5\nR1=(5+2\n/1 N10 G642 SOFT X=R1 CR=2 F100 M3 S1000\n\
     START: $P_UIFR[1,X,TR]=5\nIF DEPTH>2 GOTOB START\nMSG(\"DONE \"<<DEPTH)\nCYCLE81(10,0,2) M30\n";
 /// Where the syntax file highlights what in `SINUMERIK`.
 const SINUMERIK_HIGHLIGHT: [(usize, &str, &str); 20] = [

@@ -20,6 +20,9 @@
 //!   may change anything: after them nothing is known. A cycle leaves the
 //!   tool where the walk cannot say.
 //!
+//! A block-delete block (`/`) is taken to run: a finding after it holds on
+//! the way where it runs.
+//!
 //! An unknown value never produces a finding, so a rule reports only what
 //! holds on a way the program really runs.
 
