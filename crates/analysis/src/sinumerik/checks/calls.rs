@@ -26,7 +26,7 @@ use crate::{
     db::{Db, SourceFile},
     diagnostic::declare_rules,
     sinumerik::{
-        checks::visit::number,
+        checks::visit::g_number,
         model::{FileModel, file_model},
         walk::PATH_AXES,
     },
@@ -217,8 +217,7 @@ fn in_place(db: &dyn Db, file: SourceFile) -> Option<TextRange> {
                     }
                 }
                 StatementKind::Word(word) if word.address == "G" => {
-                    let code = word.value.as_ref().and_then(number).and_then(|n| n.whole());
-                    let code = code.and_then(|n| u32::try_from(n).ok()).and_then(|n| catalogue.code('G', n));
+                    let code = g_number(word).and_then(|n| catalogue.code('G', n));
                     // A code the catalogue does not list (`G505`) may shift.
                     if code.is_none_or(|code| code.group.as_deref() == Some(WORK_OFFSETS) || code.code == "G91") {
                         return None;

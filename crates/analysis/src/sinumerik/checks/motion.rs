@@ -64,7 +64,7 @@ use crate::{
     db::Db,
     diagnostic::declare_rules,
     sinumerik::{
-        checks::visit::number,
+        checks::visit::g_number,
         model::FileModel,
         walk::{self, FOLLOWED, PATH_AXES, RadiusArc, Step, is_axis},
     },
@@ -355,8 +355,7 @@ impl Motion {
         for statement in &step.block.statements {
             let group = match &statement.kind {
                 StatementKind::Word(word) if word.address == "G" => {
-                    let number = word.value.as_ref().and_then(number).and_then(|n| n.whole());
-                    match number.and_then(|n| u32::try_from(n).ok()) {
+                    match g_number(word) {
                         // Settable work offsets beyond the catalogue's.
                         Some(505..=599) => Some(WORK_OFFSETS),
                         Some(n) => catalogue.code('G', n).and_then(|code| code.group.as_deref()),
@@ -700,8 +699,7 @@ impl Motion {
                 }
                 StatementKind::Word(word) if word.address == "D" => self.traori = None,
                 StatementKind::Word(word) if word.address == "G" => {
-                    let code = word.value.as_ref().and_then(number).and_then(|n| n.whole());
-                    let code = code.and_then(|n| u32::try_from(n).ok()).and_then(|n| catalogue.code('G', n));
+                    let code = g_number(word).and_then(|n| catalogue.code('G', n));
                     if code.and_then(|c| c.group.as_deref()) == Some(WORK_OFFSETS) {
                         self.traori = None;
                     }

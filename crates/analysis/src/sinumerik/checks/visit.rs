@@ -125,6 +125,12 @@ pub(crate) fn written_places<'a>(statement: &'a Statement, f: &mut impl FnMut(&'
     }
 }
 
+/// The number of a G word written as a whole number (`G505`).
+pub(crate) fn g_number(word: &Word) -> Option<u32> {
+    let number = word.value.as_ref().and_then(number)?.whole()?;
+    u32::try_from(number).ok()
+}
+
 /// A word's value when written as a number, signed or not: `X-5`,
 /// `B2=-11.03`.
 pub(crate) fn signed_value(value: &WordValue) -> Option<f64> {
