@@ -187,8 +187,11 @@ const RUN_FIXTURE_BUDGET: usize = 1000;
 /// in each of its files with their annotations; returns the rules found.
 fn run_check(fixture: &PathBuf) -> Result<Vec<&'static str>, String> {
     let Inputs { files, config, dialect } = inputs(fixture)?;
-    let program = files.iter().position(|(path, _)| path.extension().is_some_and(|e| e == "ncp")).unwrap();
-    let trace = nc_exec::run::run(&files[program].1, &FixtureFiles(&files), &config.machine, RUN_FIXTURE_BUDGET);
+    // The main program: its dialect's, of a main program's extension.
+    let program =
+        files.iter().position(|(path, _)| path.extension().is_some_and(|e| e == "ncp" || e == "mpf")).unwrap();
+    let machine = config.for_dialect(dialect).machine;
+    let trace = nc_exec::run::run(&files[program].1, &FixtureFiles(&files), &machine, RUN_FIXTURE_BUDGET);
     let file_of = |source: usize| match source.checked_sub(1).map(|called| &trace.files[called]) {
         None => program,
         Some(Called::Number(number)) => {

@@ -970,6 +970,9 @@ impl<'a> Interpreter<'a> {
             None if arc_by_angle && matches!(self.state.modes.get(MOTION), Some("G2" | "G3")) => start,
             None => return STILL,
         };
+        if self.beyond_turns(&end, range) {
+            return STILL;
+        }
         let motion = self.state.modes.get(MOTION).unwrap_or("G1");
         if motion == "BSPLINE" {
             self.state.position = end;
@@ -998,6 +1001,36 @@ impl<'a> Interpreter<'a> {
             return self.rapid(&start, &end, length);
         }
         self.feed_move(range, path, length)
+    }
+
+    /// Whether a rotary axis would leave its travel limits (`limits`, in
+    /// degrees): its cables allow only so many turns one way, and then it
+    /// must be unwound (004:936-938). Rotary axes are not in the frames, so
+    /// their program positions are the machine's; the linear axes' limits
+    /// would need the work offsets, which the run takes as zero.
+    fn beyond_turns(&mut self, end: &Position, range: TextRange) -> bool {
+        let machine = self.state.machine;
+        for &axis in machine.axes.iter().filter(|&&axis| !is_linear(axis)) {
+            let Some(limits) = machine.limits.get(&axis) else { continue };
+            let degrees = end[slot(axis)];
+            let beyond = |limit: Option<i32>, outside: fn(f64, f64) -> bool| {
+                limit.map(|limit| f64::from(limit) / 1000.0).filter(|&limit| outside(degrees, limit))
+            };
+            let Some(limit) =
+                beyond(limits.min, |value, min| value < min).or(beyond(limits.max, |value, max| value > max))
+            else {
+                continue;
+            };
+            let letter = char::from(axis);
+            let message = format!(
+                "{letter} would reach {degrees:.3}° ({:.2} turns), beyond its travel limit {limit}° ({:.2} turns): a rotary axis turns only so far one way before it must be unwound (004:936-938); the control stops",
+                degrees / 360.0,
+                limit / 360.0
+            );
+            self.state.finding(RunRule::BeyondAxisRange, range, &message);
+            return true;
+        }
+        false
     }
 
     /// A rapid move between base positions: each axis at its own rate, the
