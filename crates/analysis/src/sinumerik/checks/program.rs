@@ -1,7 +1,7 @@
 //! Rules on the program as a whole, over the program model (digest §6
 //! rules 39, 40, 42, 43, 44, 47, 54, 59, 60, 68, 69, and the balance of the
-//! control structures and the direction of jumps). Each is one pass over
-//! the blocks or the model's lists.
+//! control structures and the direction of jumps), and 51. Each is one
+//! pass over the blocks or the model's lists.
 //!
 //! Assumptions, where the digest is silent:
 //! - A program name is checked where the program writes it (its PROC line,
@@ -13,9 +13,13 @@
 //!   deciding, and report at the last block that ends the program.
 //! - Rule 47 is opt-in: the digest doubts it (§8), and Siemens's own
 //!   cycles end with RET under SAVE.
+//! - Rule 51 reports a group-1 code chosen by a value, `G[1]=R7` or the
+//!   text `"G[01]="<<$P_GG[1]` a WRITE puts in a generated program, when
+//!   no condition of the program (IF, WHILE, UNTIL, CASE) reads any of
+//!   the value's variables: such a test is taken to limit the choice.
 
 use nc_exec::sinumerik::{
-    lower::{Callee, ExprKind, Jump, JumpKind, JumpTarget, Statement, StatementKind},
+    lower::{BinaryOp, Callee, Expr, ExprKind, Jump, JumpKind, JumpTarget, Place, PlaceKind, Statement, StatementKind},
     program::{Resolved, Structure, StructureKind, Unbalanced},
 };
 use ncc_catalog::{AddressRole, Catalogue, Dialect, KeywordKind};
@@ -25,7 +29,10 @@ use crate::{
     Diagnostic,
     db::Db,
     diagnostic::declare_rules,
-    sinumerik::{checks::visit::all_exprs, model::FileModel},
+    sinumerik::{
+        checks::visit::{all_exprs, each_expr},
+        model::FileModel,
+    },
 };
 
 declare_rules! {
@@ -37,6 +44,7 @@ declare_rules! {
     RET_WITH_SAVE = "K047", "ret-with-save", Warning, "RET in a subprogram whose PROC line has SAVE, which the thesis says cannot be combined (Siemens's own cycles do combine them).", opt_in;
     SIMULATION_BRANCH = "K054", "simulation-branch-and-files", Info, "A program that branches on `$P_ISTEST` and writes files: a simulation started from the programming screen writes none, so the branches differ; ISFILE tests for the file itself.";
     JUMP_TARGET_NOT_FOUND = "K059", "jump-target-not-found", Error, "A jump to a label or block number the program does not have.";
+    UNTESTED_MOTION_CODE = "K051", "untested-motion-code", Info, "A motion code (G group 1) chosen by a value no condition of the program tests, in the program (`G[1]=R7`) or in a program it writes: a 1 there is G0.";
     JUMP_INTO_STRUCTURE = "K060", "jump-into-structure", Warning, "A jump from outside into the body of an IF, WHILE, FOR, REPEAT or LOOP.";
     TRANSFORMATION_AT_END = "K068", "transformation-at-end", Warning, "The program ends with TRAORI still on (no TRAFOOF after it).";
     MODE_AT_END = "K069", "mode-at-end", Info, "The program ends with TOROT or FFWON still on (no TOROTOF or FFWOF after it).";
@@ -69,6 +77,7 @@ pub(crate) fn check(db: &dyn Db, file: &FileModel, in_workspace: &dyn Fn(&str) -
     jumps(file, &mut out);
     modes_at_end(db, catalogue, file, &mut out);
     simulation_branch(db, file, &mut out);
+    untested_motion_code(db, catalogue, file, &mut out);
     out
 }
 
@@ -348,6 +357,93 @@ fn simulation_branch(db: &dyn Db, file: &FileModel, out: &mut Vec<Diagnostic>) {
     for test in tests {
         let message = "the program branches on $P_ISTEST and writes files: a simulation started from the programming screen writes no file, so the simulated way is not the real one; the thesis tests for the written file with ISFILE (004:3137-3143)";
         out.push(Diagnostic::new(&SIMULATION_BRANCH, test, message).with_related(None, write, "WRITE"));
+    }
+}
+
+/// A variable as rule 51 compares them: its name and literal indices
+/// (`R7`, `$P_GG[1]`), `None` for a computed one.
+type VariableKey = (String, Vec<Option<u64>>);
+
+fn variable_key(place: &Place) -> VariableKey {
+    let index = |expr: &Expr| match &expr.kind {
+        ExprKind::Number(number) => number.whole(),
+        _ => None,
+    };
+    (place.name.clone(), place.indices.iter().map(index).collect())
+}
+
+/// The variables an expression reads.
+fn variables_read(expr: &Expr) -> Vec<VariableKey> {
+    let mut read = Vec::new();
+    each_expr(expr, &mut |expr| {
+        if let ExprKind::Name(place) = &expr.kind
+            && place.kind != PlaceKind::GroupCode
+        {
+            read.push(variable_key(place));
+        }
+    });
+    read
+}
+
+/// Whether `G[…]` names group 1.
+fn is_motion_group(indices: &[Expr]) -> bool {
+    matches!(indices, [Expr { kind: ExprKind::Number(group), .. }] if group.whole() == Some(1))
+}
+
+/// The operands of a chain of `<<`, in order.
+fn concatenated<'a>(expr: &'a Expr, operands: &mut Vec<&'a Expr>) {
+    match &expr.kind {
+        ExprKind::Binary(BinaryOp::Concat, lhs, rhs) => {
+            concatenated(lhs, operands);
+            concatenated(rhs, operands);
+        }
+        _ => operands.push(expr),
+    }
+}
+
+/// Rule 51: a motion code chosen by a value no condition tests.
+fn untested_motion_code(db: &dyn Db, catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnostic>) {
+    let mut tested = rustc_hash::FxHashSet::default();
+    let mut chosen: Vec<(&Expr, TextRange, &str)> = Vec::new();
+    for (index, block) in file.blocks(db).enumerate() {
+        for statement in &block.statements {
+            match &statement.kind {
+                StatementKind::If { condition: test, .. }
+                | StatementKind::While(test)
+                | StatementKind::Until(test)
+                | StatementKind::Case { selector: test, .. } => tested.extend(variables_read(test)),
+                StatementKind::Assign { target, value }
+                    if target.kind == PlaceKind::GroupCode && is_motion_group(&target.indices) =>
+                {
+                    chosen.push((value, file.in_file(index, statement.range), "this program"));
+                }
+                StatementKind::Call(call) if matches!(&call.callee, Callee::Predefined(name) if name == "WRITE") => {
+                    for argument in call.arguments.iter().flatten() {
+                        let mut operands = Vec::new();
+                        concatenated(argument, &mut operands);
+                        for pair in operands.windows(2) {
+                            let ExprKind::String(text) = &pair[0].kind else { continue };
+                            let text = text.trim_end().to_ascii_uppercase();
+                            if text.ends_with("G[1]=") || text.ends_with("G[01]=") {
+                                chosen.push((pair[1], file.in_file(index, pair[1].range), "the program it writes"));
+                            }
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    let first = catalogue.code_at("G1", 1).map_or("G0", |code| code.code.as_str());
+    for (value, range, program) in chosen {
+        let read = variables_read(value);
+        if read.is_empty() || read.iter().any(|variable| tested.contains(variable)) {
+            continue;
+        }
+        let message = format!(
+            "the motion code of {program} is chosen by a value no condition tests: a 1 there selects {first}, as happened to the thesis's generated program (004:3331-3347); test that it is 2 (G1) or a spline's index first"
+        );
+        out.push(Diagnostic::new(&UNTESTED_MOTION_CODE, range, message));
     }
 }
 

@@ -146,7 +146,10 @@ fn the_seed_listings_get_only_true_findings() {
                 ("l30.mpf", include_str!("../../../../syntax/test_data/sinumerik/l30_run_vacka.mpf")),
                 ("l31.spf", include_str!("../../../../syntax/test_data/sinumerik/l31_vacka_cyklus.spf")),
             ],
+            // L31 writes `G[01]=` with the group-1 code in force, which no
+            // condition tests: the thesis's G0 story (digest rule 51).
             &[
+                ("untested-motion-code", 73),
                 ("undeclared-name", 19),
                 ("undeclared-name", 11),
                 ("inconsistent-case", 60),
