@@ -19,6 +19,7 @@
 //! globals = ["VAC_POLE"]       # names declared outside the file (GUD, macros)
 //! r-parameters = 100           # $MN_MM_NUM_R_PARAM: R0 to R99
 //! tool-management = true       # the machine manages its tools (GETSELT, GETEXET)
+//! stock-top = "0"              # the stock's top on the tool axis, in the program's coordinates
 //!
 //! [machine]
 //! file = "machines/mill.toml"             # a machine file; the keys below override it
@@ -178,6 +179,16 @@ pub struct SinumerikConfig {
     /// The control runs tool management, where `$P_TOOLNO` and `$P_TOOLP`
     /// do not give the tool (004:3274-3280).
     pub tool_management: bool,
+    /// The top of the stock on the tool axis in the program's coordinates,
+    /// in µm, for `rapid-into-stock`: a program does not say where it is.
+    #[serde(deserialize_with = "micrometres")]
+    pub stock_top: Option<i32>,
+}
+
+/// A length in mm written as text (`"-2.5"`), in µm.
+fn micrometres<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<Option<i32>, D::Error> {
+    let text: Option<String> = Option::deserialize(deserializer)?;
+    text.map(|text| tables::coordinate(&text).map_err(serde::de::Error::custom)).transpose()
 }
 
 impl SinumerikConfig {

@@ -490,6 +490,43 @@ entry! {
         /// The machine constants (Haas: Settings) that change what it does.
         #[serde(default)]
         pub machine_constants: Vec<u32>,
+        /// What a hole cycle does to the hole at the current position; it
+        /// leaves the tool above that hole.
+        #[serde(default)]
+        pub hole: Option<HoleOperation>,
+    }
+}
+
+/// What a hole cycle does to its hole, in the order a hole is made:
+/// drilled, then bored or tapped, then reamed (004:468-470).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum HoleOperation {
+    Drill,
+    Bore,
+    Tap,
+    Ream,
+}
+
+impl HoleOperation {
+    /// Its place in the order: an operation of a lower stage after one of
+    /// a higher stage at the same hole is out of order.
+    pub fn stage(self) -> u8 {
+        match self {
+            HoleOperation::Drill => 0,
+            HoleOperation::Bore | HoleOperation::Tap => 1,
+            HoleOperation::Ream => 2,
+        }
+    }
+
+    /// The verb, as in "drilled after reamed".
+    pub fn done(self) -> &'static str {
+        match self {
+            HoleOperation::Drill => "drilled",
+            HoleOperation::Bore => "bored",
+            HoleOperation::Tap => "tapped",
+            HoleOperation::Ream => "reamed",
+        }
     }
 }
 

@@ -42,7 +42,7 @@ use nc_exec::{
         program::{Resolved, Structure, StructureKind},
     },
 };
-use ncc_catalog::{Catalogue, Code, Dialect, KeywordKind};
+use ncc_catalog::{Catalogue, Code, Cycle, Dialect, KeywordKind};
 use ncc_syntax::TextRange;
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -51,6 +51,10 @@ use crate::{db::Db, sinumerik::checks::visit::signed_value, sinumerik::model::Fi
 /// The codes of the motion group that cut a thread: they move at the
 /// pitch and spindle speed, not at F.
 const THREADS: [&str; 3] = ["G33", "G331", "G332"];
+
+/// Points closer than this, in mm, are the same: the thesis's CAM output
+/// repeats the current point to a few tenths of a µm.
+pub(crate) const SAME_POINT_MM: f64 = 0.001;
 
 /// The path axes.
 pub(crate) const PATH_AXES: [&str; 3] = ["X", "Y", "Z"];
@@ -77,9 +81,38 @@ pub(crate) struct State {
     pub speed: Known<Option<f64>>,
     /// The [`FOLLOWED`] axes and words, in the frame in force.
     pub position: [Known<f64>; FOLLOWED.len()],
-    /// A modal call (MCALL) in force, which runs at every move: `Is(true)`
-    /// for a program's, which may change anything.
-    modal_program: Known<Option<bool>>,
+    /// The frame the positions count in: the block that last changed the
+    /// frame, a work offset or the transformation, `Is(None)` for the one
+    /// the program started in.
+    pub frame: Known<Option<usize>>,
+    /// A modal call (MCALL) in force, which runs at every move.
+    pub modal_call: Known<Option<ModalCall>>,
+}
+
+/// A modal call (MCALL) in force.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum ModalCall {
+    /// A program's, which may change anything.
+    Program,
+    /// A hole cycle's (the catalogue's `hole`): it leaves the tool above
+    /// the hole, where the move put it.
+    Hole(&'static Cycle),
+    /// Another cycle's.
+    Cycle,
+}
+
+impl ModalCall {
+    fn of(callee: &Callee) -> ModalCall {
+        match callee {
+            Callee::Cycle(name) => hole_cycle(name).map_or(ModalCall::Cycle, ModalCall::Hole),
+            _ => ModalCall::Program,
+        }
+    }
+}
+
+/// The catalogue's hole cycle of this name.
+pub(crate) fn hole_cycle(name: &str) -> Option<&'static Cycle> {
+    catalogue().cycles_for(name).find(|cycle| cycle.hole.is_some())
 }
 
 impl State {
@@ -90,7 +123,8 @@ impl State {
             feed: Known::Is(None),
             speed: Known::Is(None),
             position: NOWHERE,
-            modal_program: Known::Is(None),
+            frame: Known::Is(None),
+            modal_call: Known::Is(None),
         }
     }
 
@@ -101,7 +135,8 @@ impl State {
             feed: Known::Unknown,
             speed: Known::Unknown,
             position: NOWHERE,
-            modal_program: Known::Unknown,
+            frame: Known::Unknown,
+            modal_call: Known::Unknown,
         }
     }
 
@@ -110,7 +145,7 @@ impl State {
     /// mostly are (else every move would forget everything), and under
     /// G90.
     fn subprogram_start() -> State {
-        let mut state = State { modal_program: Known::Is(None), ..State::unknown() };
+        let mut state = State { frame: Known::Is(None), modal_call: Known::Is(None), ..State::unknown() };
         // Coordinates are taken as absolute until the subprogram says: the
         // thesis's subprograms never write G90 (L26–L28).
         if let Some(absolute) = catalogue().code_named("G90") {
@@ -121,7 +156,7 @@ impl State {
 
     /// Forgets everything but the modal call, which only MCALL changes.
     fn forget(&mut self) {
-        *self = State { modal_program: self.modal_program, ..State::unknown() };
+        *self = State { modal_call: self.modal_call, ..State::unknown() };
     }
 
     /// What holds whichever of the two ways the program took.
@@ -134,7 +169,8 @@ impl State {
             feed: same(self.feed, other.feed),
             speed: same(self.speed, other.speed),
             position: std::array::from_fn(|axis| same(self.position[axis], other.position[axis])),
-            modal_program: same(self.modal_program, other.modal_program),
+            frame: same(self.frame, other.frame),
+            modal_call: same(self.modal_call, other.modal_call),
         }
     }
 
@@ -159,28 +195,31 @@ impl State {
         }
     }
 
-    /// The block's effect; whether it moves an axis. `variables`: the
-    /// names the program declares, which a word like `X=5` assigns.
-    pub(crate) fn apply(&mut self, block: &SinumerikBlock, variables: &Variables<'_>) -> bool {
+    /// The effect of block `index`; whether it moves an axis. `variables`:
+    /// the names the program declares, which a word like `X=5` assigns.
+    pub(crate) fn apply(&mut self, index: usize, block: &SinumerikBlock, variables: &Variables<'_>) -> bool {
         let catalogue = catalogue();
         let mut codes: Vec<&'static Code> = Vec::new();
         for statement in &block.statements {
             match &statement.kind {
-                StatementKind::Word(word) => self.function_word(word, &mut codes),
+                StatementKind::Word(word) => self.function_word(index, word, &mut codes),
                 StatementKind::Command(command) => match catalogue.word_code(&command.name) {
-                    Some(code) if code.group.as_deref() == Some(FRAMES) => self.frame(command),
+                    Some(code) if code.group.as_deref() == Some(FRAMES) => self.frame(index, command),
                     Some(code) => codes.push(code),
                     None if catalogue
                         .keyword(&command.name)
                         .is_some_and(|keyword| keyword.kind == KeywordKind::Transformation) =>
                     {
-                        self.position = NOWHERE;
+                        self.new_frame(index);
                     }
                     None => {}
                 },
-                // `G[1]=R1`: a group's code only the run knows.
+                // `G[8]=R1`: a group's code only the run knows, maybe a
+                // work offset's.
                 StatementKind::Assign { target, .. } if target.kind == PlaceKind::GroupCode => {
                     self.modes = Modes::unknown();
+                    self.position = NOWHERE;
+                    self.frame = Known::Unknown;
                 }
                 _ => {}
             }
@@ -188,7 +227,7 @@ impl State {
         let in_group = |group: &str| codes.iter().any(|code| code.group.as_deref() == Some(group));
         // The block's coordinates count in the new system.
         if [WORK_OFFSETS, UNITS].into_iter().any(in_group) {
-            self.position = NOWHERE;
+            self.new_frame(index);
         }
         for &code in &codes {
             self.modes.set(code);
@@ -202,28 +241,46 @@ impl State {
         }
         for statement in &block.statements {
             match &statement.kind {
-                StatementKind::Call(call) => self.call(&call.callee),
+                StatementKind::Call(call) => self.call(index, &call.callee),
                 StatementKind::ModalCall(call) => {
-                    self.modal_program = Known::Is(call.as_ref().map(|call| !matches!(call.callee, Callee::Cycle(_))));
+                    self.modal_call = Known::Is(call.as_ref().map(|call| ModalCall::of(&call.callee)));
                 }
                 StatementKind::RepeatSection { .. } => self.forget(),
                 _ => {}
             }
         }
         if moved {
-            match self.modal_program {
+            match self.modal_call {
                 Known::Is(None) => {}
-                Known::Is(Some(false)) => self.position = NOWHERE,
-                Known::Is(Some(true)) | Known::Unknown => self.forget(),
+                Known::Is(Some(ModalCall::Hole(_))) => self.forget_tool_axis(),
+                Known::Is(Some(ModalCall::Cycle)) => self.position = NOWHERE,
+                Known::Is(Some(ModalCall::Program)) | Known::Unknown => self.forget(),
             }
         }
         moved
     }
 
+    /// Block `index` changed the frame, a work offset or the
+    /// transformation: the positions count anew.
+    fn new_frame(&mut self, index: usize) {
+        self.position = NOWHERE;
+        self.frame = Known::Is(Some(index));
+    }
+
+    /// A hole cycle ran: the tool stands above the hole, at a height along
+    /// the tool axis the walk does not follow.
+    fn forget_tool_axis(&mut self) {
+        match self.modes.get(PLANE).and_then(Plane::from_code) {
+            Some(plane) => self.position[plane.axes()[2]] = Known::Unknown,
+            None => self.position = NOWHERE,
+        }
+    }
+
     /// A frame moves the coordinates: those of the axes an additive
     /// translation, scale or mirror names (`ATRANS X-300`), every one for
     /// a rotation or a frame that replaces the one in force.
-    fn frame(&mut self, command: &Command) {
+    fn frame(&mut self, index: usize, command: &Command) {
+        self.frame = Known::Is(Some(index));
         let additive = matches!(command.name.as_str(), "ATRANS" | "ASCALE" | "AMIRROR");
         for (axis, name) in FOLLOWED.iter().enumerate() {
             if !additive || command.words.iter().any(|word| word.address == *name) {
@@ -233,7 +290,7 @@ impl State {
     }
 
     /// A G or M word: its code, or what it makes unknown.
-    fn function_word(&mut self, word: &Word, codes: &mut Vec<&'static Code>) {
+    fn function_word(&mut self, index: usize, word: &Word, codes: &mut Vec<&'static Code>) {
         let catalogue = catalogue();
         let literal = match &word.value {
             Some(WordValue::Literal(number)) => number.whole().and_then(|n| u32::try_from(n).ok()),
@@ -244,9 +301,13 @@ impl State {
                 Some(code) => codes.push(code),
                 // A code the catalogue does not list (`G505`): it may
                 // move the origin.
-                None => self.position = NOWHERE,
+                None => self.new_frame(index),
             },
-            ("G", None) => self.modes = Modes::unknown(),
+            ("G", None) => {
+                self.modes = Modes::unknown();
+                self.position = NOWHERE;
+                self.frame = Known::Unknown;
+            }
             ("M", Some(number)) => codes.extend(catalogue.code('M', number)),
             // `M=R1`, `M1=3`, `SPOS=0`: another spindle or a value the
             // walk does not know.
@@ -309,11 +370,16 @@ impl State {
         moved
     }
 
-    fn call(&mut self, callee: &Callee) {
-        match callee {
-            Callee::Predefined(_) => {}
-            Callee::Cycle(_) => self.position = NOWHERE,
-            _ => self.forget(),
+    fn call(&mut self, index: usize, callee: &Callee) {
+        if matches!(callee, Callee::Predefined(_)) {
+            return;
+        }
+        match ModalCall::of(callee) {
+            ModalCall::Hole(_) => self.forget_tool_axis(),
+            // CYCLE800 swivels the plane; other cycles leave the tool where
+            // the walk cannot say.
+            ModalCall::Cycle => self.new_frame(index),
+            ModalCall::Program => self.forget(),
         }
     }
 }
@@ -422,7 +488,7 @@ fn looped(
 ) -> State {
     for index in body {
         let mut after = entry.clone();
-        after.apply(file.block(index), variables);
+        after.apply(index, file.block(index), variables);
         entry = entry.join(&after);
     }
     entry
@@ -501,7 +567,7 @@ pub(crate) fn walk(db: &dyn Db, file: &FileModel, main: bool, mut visit: impl Fn
     let unknown = || {
         let mut state = State::unknown();
         if !modal_calls {
-            state.modal_program = Known::Is(None);
+            state.modal_call = Known::Is(None);
         }
         state
     };
@@ -540,7 +606,7 @@ pub(crate) fn walk(db: &dyn Db, file: &FileModel, main: bool, mut visit: impl Fn
         let reached = way.is_some();
         let mut state = way.unwrap_or_else(unknown);
         let from = state.position;
-        let moves = state.apply(block, &variables);
+        let moves = state.apply(index, block, &variables);
         if visit(Step { index, block, from, state: &state, moves, reached, opens: opens.get(&index).copied() })
             .is_break()
         {

@@ -41,7 +41,7 @@ use nalgebra::{Matrix3, Rotation3, Vector3};
 
 /// The working plane (G17, G18, G19): which axes an arc turns in and
 /// which one the tool points along.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Plane {
     /// G17: X/Y, the tool along Z.
     #[default]

@@ -11,12 +11,9 @@ use crate::{
     db::{Db, SourceFile},
     sinumerik::{
         model::{file_model, is_main_program},
-        walk::{RadiusArc, walk},
+        walk::{RadiusArc, SAME_POINT_MM, walk},
     },
 };
-
-/// How far an arc's end may lie off its circle for the hover's reading.
-const ARC_TOLERANCE_MM: f64 = 0.001;
 
 /// The arc the CR of the block at `offset` chooses, where the walk knows
 /// both of its ends (digest §6 rule 21).
@@ -42,9 +39,9 @@ fn describe_arc(arc: &RadiusArc<'_>) -> String {
     let (from, to) = (point(arc.from), point(arc.to));
     let motion = if arc.counter_clockwise { "G3" } else { "G2" };
     let chosen = if arc.radius < 0.0 { "a negative CR the longer" } else { "a positive CR the shorter" };
-    let centre = centre_by_radius(arc.from, arc.to, arc.radius, arc.counter_clockwise, ARC_TOLERANCE_MM);
-    let swept = centre
-        .and_then(|centre| circle_through(arc.from, arc.to, centre, arc.counter_clockwise, ARC_TOLERANCE_MM).ok());
+    let centre = centre_by_radius(arc.from, arc.to, arc.radius, arc.counter_clockwise, SAME_POINT_MM);
+    let swept =
+        centre.and_then(|centre| circle_through(arc.from, arc.to, centre, arc.counter_clockwise, SAME_POINT_MM).ok());
     match (centre, swept) {
         (Some(centre), Some(swept)) => format!(
             "**This arc** ({motion}, {chosen} of the two arcs of radius {}): from {from} to {to} about {}, sweeping {:.1}°",

@@ -6,8 +6,9 @@
 //! on the whole program ([`program`], [`names`], [`types`]) are one pass
 //! each over the file model and come with the flow findings.
 //!
-//! The rules on motion and technology ([`motion`]) read the modal state
-//! of a walk over the file ([`crate::sinumerik::walk`]).
+//! The rules on motion and technology ([`motion`]) and on the order of
+//! operations ([`operations`]) read the modal state of one walk over the
+//! file ([`crate::sinumerik::walk`]).
 //!
 //! Not checked here:
 //! - rules 1, 2, 10, 11, 12 and 14 are the parser's (`space-in-word`,
@@ -16,11 +17,11 @@
 //! - rules 3, 5, 6, 8, 9 are ISO conventions or off for Sinumerik, and
 //!   25, 30, 33–36 ISO words (G28, H, G92 as a preset, M97–M98) that
 //!   Sinumerik writes otherwise;
-//! - rules 15, 23, 28, 38, 71 and 72 follow the stock, the tool's
-//!   shape and orientation or the operation's kind, which the program
-//!   does not state; 17 and 24 are the run's (rapid moves per axis, rotary
-//!   travel); 51 and 58 depend on the programs a program generates and on
-//!   the control's version;
+//! - rules 71 and 72 follow the tool's shape and the surface, which the
+//!   program does not state; 58 depends on the control's version;
+//! - rule 17 is the run's timing of G0 (each axis at its own rate, the
+//!   slowest deciding), K016 and G0's hover; rule 24 is the run's travel
+//!   limit of a rotary axis (E002 `beyond-axis-range`, `limits` in degrees);
 //! - rules 21 and 73 are hover: the arc a CR chooses (the editor's hover
 //!   over CR), the catalogue's text of CUT3DC and CUT3DF; 74's hover, the
 //!   composed frame, is not shown yet;
@@ -30,12 +31,13 @@ pub(crate) mod block;
 pub(crate) mod calls;
 pub(crate) mod motion;
 pub(crate) mod names;
+pub(crate) mod operations;
 pub(crate) mod parameters;
 pub(crate) mod program;
 pub(crate) mod types;
 pub(crate) mod visit;
 
-use std::path::Path;
+use std::{ops::ControlFlow, path::Path};
 
 use nc_exec::sinumerik::lower::Callee;
 
@@ -43,12 +45,23 @@ use crate::{
     Diagnostic, Rule,
     db::{BlockChunk, Db, Settings, SourceFile, file_chunks},
     findings::{self, Findings},
-    sinumerik::model::{chunk_blocks, file_model, is_main_program},
+    sinumerik::{
+        model::{FileModel, chunk_blocks, file_model, is_main_program},
+        walk,
+    },
 };
 
 /// The rules of every check module.
-pub(crate) static RULES: &[&[&Rule]] =
-    &[block::RULES, calls::RULES, program::RULES, motion::RULES, names::RULES, parameters::RULES, types::RULES];
+pub(crate) static RULES: &[&[&Rule]] = &[
+    block::RULES,
+    calls::RULES,
+    program::RULES,
+    motion::RULES,
+    operations::RULES,
+    names::RULES,
+    parameters::RULES,
+    types::RULES,
+];
 
 /// The findings of a file's single blocks, chunk by chunk.
 pub(crate) fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
@@ -106,7 +119,7 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
     let resolve = |callee: &Callee| callee.control_files()?.iter().find_map(|name| find(name));
     let mut diagnostics = program::check(db, model, &in_workspace);
     let main = is_main_program(db, file);
-    diagnostics.extend(motion::check(db, model, main));
+    diagnostics.extend(walk_findings(db, model, main, config.sinumerik.stock_top));
     diagnostics.extend(names::check(db, model, text, config));
     let reads: Vec<&parameters::Reads> =
         settings.files(db).iter().map(|other| parameters::parameter_reads(db, *other)).collect();
@@ -118,6 +131,20 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
     diagnostics.extend(types::check(db, model, &signatures));
     findings::sort_diagnostics(&mut diagnostics);
     Findings { diagnostics, omitted: Vec::new() }
+}
+
+/// The findings of the rules on the modal state, from one walk.
+fn walk_findings(db: &dyn Db, file: &FileModel, main: bool, stock_top: Option<i32>) -> Vec<Diagnostic> {
+    let mut motion = motion::Motion::new(file, main);
+    let mut operations = operations::Operations::new(stock_top);
+    let mut out = Vec::new();
+    walk::walk(db, file, main, |step| {
+        motion.step(file, &step, &mut out);
+        operations.step(file, &step, &mut out);
+        ControlFlow::Continue(())
+    });
+    motion.report_unreached(file, &mut out);
+    out
 }
 
 #[cfg(test)]

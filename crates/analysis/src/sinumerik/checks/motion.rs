@@ -46,8 +46,6 @@
 //!   M2, M17, M30), MSG, WRITE and STOPRE as the blocks that break the
 //!   path (digest: inferred).
 
-use std::ops::ControlFlow;
-
 use nc_exec::{
     arc::centre_by_radius,
     known::Known,
@@ -61,12 +59,11 @@ use ncc_syntax::{TextEdit, TextRange};
 
 use crate::{
     Diagnostic,
-    db::Db,
     diagnostic::declare_rules,
     sinumerik::{
         checks::visit::g_number,
         model::FileModel,
-        walk::{self, FOLLOWED, PATH_AXES, RadiusArc, Step, is_axis},
+        walk::{FOLLOWED, PATH_AXES, RadiusArc, SAME_POINT_MM, Step, is_axis},
     },
 };
 
@@ -91,11 +88,6 @@ declare_rules! {
     HEAVY_COMPUTATION = "K078", "computation-between-moves", Info, "A loop without motion, or 10 or more computing statements, between two feed moves in continuous-path mode: block preparation may not keep up with the path.";
     PATH_BROKEN = "K081", "path-broken-by-block", Warning, "An M function, MSG, WRITE or STOPRE between two feed blocks in continuous-path mode: the path slows down there.";
 }
-
-/// Points closer than this, in mm, are the same (rules 16, 19, 20, 22,
-/// 76): the thesis's CAM output repeats the current point to a few tenths
-/// of a µm.
-const SAME_POINT_MM: f64 = 0.001;
 
 /// The orientation's turn per mm of path above which rule 75 warns: the
 /// digest's example, L27's B2 turning 17° over 0.5 mm (004:4223-4225), is
@@ -138,7 +130,7 @@ const COOLANT_OFF: &str = "M9";
 const SAFE_GROUPS: [&str; 3] = [TOOL_RADIUS, WORK_OFFSETS, DIMENSIONS];
 
 /// The state the rules keep between blocks.
-struct Motion {
+pub(crate) struct Motion {
     /// Rule 48 applies: a subprogram without SAVE.
     ends_path: bool,
     feed_reported: bool,
@@ -205,8 +197,9 @@ fn predefined(statement: &Statement) -> Option<&str> {
 }
 
 impl Motion {
-    /// `main`: the file starts at reset; `save`: its PROC line has SAVE.
-    fn new(main: bool, save: bool) -> Motion {
+    /// `main`: the file starts at reset.
+    pub(crate) fn new(file: &FileModel, main: bool) -> Motion {
+        let save = file.model.header().is_some_and(|proc| proc.declaration.attributes.iter().any(|a| a == "SAVE"));
         Motion {
             // Under SAVE the caller's modes come back anyway, and RET is no
             // choice (rule 47).
@@ -231,7 +224,7 @@ impl Motion {
         }
     }
 
-    fn step(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+    pub(crate) fn step(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
         let catalogue = Dialect::Sinumerik.catalogue();
         let state = step.state;
         self.unreached(file, step, out);
@@ -399,7 +392,7 @@ impl Motion {
     }
 
     /// Rule 32 at the end of a run of unreached blocks.
-    fn report_unreached(&mut self, file: &FileModel, out: &mut Vec<Diagnostic>) {
+    pub(crate) fn report_unreached(&mut self, file: &FileModel, out: &mut Vec<Diagnostic>) {
         let Some((first, last)) = self.unreached.take() else { return };
         let end =
             file.block(last).statements.last().map_or(file.ranges[last].end(), |s| file.in_file(last, s.range).end());
@@ -732,17 +725,4 @@ impl Motion {
         let fix = vec![TextEdit::replace(range, "RET")];
         out.push(Diagnostic::new(&END_STOPS_PATH, range, message).with_fix("Return with RET", fix));
     }
-}
-
-/// Runs the rules of this module over a walk of `file`.
-pub(crate) fn check(db: &dyn Db, file: &FileModel, main: bool) -> Vec<Diagnostic> {
-    let save = file.model.header().is_some_and(|proc| proc.declaration.attributes.iter().any(|a| a == "SAVE"));
-    let mut motion = Motion::new(main, save);
-    let mut out = Vec::new();
-    walk::walk(db, file, main, |step| {
-        motion.step(file, &step, &mut out);
-        ControlFlow::Continue(())
-    });
-    motion.report_unreached(file, &mut out);
-    out
 }
