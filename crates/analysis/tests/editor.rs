@@ -820,6 +820,7 @@ fn sinumerik_listings_highlight_without_errors() {
 /// computed jumps, L30 and the cycle L31 it calls.
 const L19_MAIN: &str = include_str!("../../syntax/test_data/sinumerik/l19_profil_main.mpf");
 const L19_SUB: &str = include_str!("../../syntax/test_data/sinumerik/l19_profil_sub.spf");
+const L25: &str = include_str!("../../syntax/test_data/sinumerik/l25_podpis_janskacel.mpf");
 const L29: &str = include_str!("../../syntax/test_data/sinumerik/l29_blob_souradnice_dole.mpf");
 const L30: &str = include_str!("../../syntax/test_data/sinumerik/l30_run_vacka.mpf");
 const L31: &str = include_str!("../../syntax/test_data/sinumerik/l31_vacka_cyklus.spf");
@@ -973,6 +974,24 @@ fn sinumerik_hover_on_cr_shows_the_arc_it_chooses() {
         .assert_eq(&first_line("CR=5\nR1"));
     // An end the walk does not know: the catalogue's text alone.
     assert!(first_line("CR=6").starts_with("### CR"), "{}", first_line("CR=6"));
+}
+
+/// Over a frame command, the frame it leaves in force: L25's scales compose
+/// as the digest says, 0.18·0.75 (rule 74), after CYCLE800 swivelled to
+/// nothing and with R1 set to 0.18.
+#[test]
+fn sinumerik_hover_on_a_frame_shows_the_composed_frame() {
+    let first_line = |needle: &str| hover_at(&[("L25.MPF", L25)], needle).lines().next().unwrap_or_default().to_owned();
+    expect!["**The frame after this block:** translation X55 Y4, scale X0.18 Y0.18 Z0.18"]
+        .assert_eq(&first_line("ASCALE X=R1"));
+    expect!["**The frame after this block:** translation X14.5 Y4, scale X0.18·0.75 Y0.18·0.75 Z0.18"]
+        .assert_eq(&first_line("ATRANS X-300"));
+    // A value the walk does not know: the run's.
+    let text = "G17 G71 R2=R1*2\nTRANS X=R2\nATRANS Y5\nTRANS X10\n";
+    let first_line =
+        |needle: &str| hover_at(&[("FRAMES.MPF", text)], needle).lines().next().unwrap_or_default().to_owned();
+    assert!(first_line("ATRANS").contains("is the run's"), "{}", first_line("ATRANS"));
+    expect!["**The frame after this block:** translation X10"].assert_eq(&first_line("TRANS X10"));
 }
 
 /// L29 jumps to block numbers and labels and computes the target of some:

@@ -6,12 +6,13 @@
 //! own names in completion ([`completion`]), read from the tree and the
 //! program model (`crate::sinumerik::model`).
 
-mod arcs;
 mod completion;
 mod navigation;
 mod outline;
 mod signature;
+mod walked;
 
+use nc_exec::sinumerik::frames::FrameCommand;
 use ncc_catalog::{AddressRole, Catalogue, Item};
 use ncc_syntax::{Dialect, SyntaxKind, SyntaxNode, SyntaxToken, TextRange, TextSize};
 
@@ -47,13 +48,19 @@ pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<H
     // does not wait for it.
     let named = token.kind() == SyntaxKind::IDENT
         || token.parent_ancestors().any(|node| matches!(node.kind(), SyntaxKind::GOTO_STMT | SyntaxKind::LABEL));
-    // CR, unless a variable of that name: also the arc it chooses.
+    // CR, unless a variable of that name: also the arc it chooses; a frame
+    // command: also the frame it leaves.
     let explained = || {
         let mut hover = explained()?;
-        if token.text().eq_ignore_ascii_case("CR")
-            && let Some(arc) = arcs::radius_arc(db, file, offset)
-        {
-            hover.markdown = format!("{arc}\n\n---\n\n{}", hover.markdown);
+        let walked = if token.text().eq_ignore_ascii_case("CR") {
+            walked::radius_arc(db, file, offset)
+        } else if FrameCommand::from_name(token.text()).is_some() {
+            walked::composed_frame(db, file, offset)
+        } else {
+            None
+        };
+        if let Some(walked) = walked {
+            hover.markdown = format!("{walked}\n\n---\n\n{}", hover.markdown);
         }
         Some(hover)
     };

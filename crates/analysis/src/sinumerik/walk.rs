@@ -1,6 +1,9 @@
 //! The walk over a Sinumerik file with the modal state, for the rules that
 //! need what is in force at a block: the codes of the groups (the run's
-//! [`Modes`]), the feed, the spindle speed and where the tool stands.
+//! [`Modes`]), the feed, the spindle speed, where the tool stands, which
+//! frame its coordinates count in, and the programmable frame composed as
+//! the run composes it (from the values frame commands and CYCLE800 write,
+//! and R parameters set to numbers).
 //!
 //! It visits each block once, in file order. A main program starts at
 //! reset (the catalogue's defaults, no F, no S); a subprogram (a PROC, an
@@ -26,14 +29,16 @@
 //! An unknown value never produces a finding, so a rule reports only what
 //! holds on a way the program really runs.
 
-use std::ops::ControlFlow;
+use std::{ops::ControlFlow, sync::Arc};
 
 use nc_exec::{
     known::Known,
     sinumerik::{
-        frames::Plane,
+        cycles::swivel,
+        frames::{FrameCommand, FrameKind, Plane, ProgrammableFrame},
         lower::{
-            Callee, Command, Dimension, JumpKind, PlaceKind, SinumerikBlock, Statement, StatementKind, Word, WordValue,
+            Call, Callee, Command, Dimension, Expr, ExprKind, JumpKind, Place, PlaceKind, SinumerikBlock, Statement,
+            StatementKind, UnaryOp, Word, WordValue,
         },
         modes::{
             Modes,
@@ -46,7 +51,13 @@ use ncc_catalog::{Catalogue, Code, Cycle, Dialect, KeywordKind};
 use ncc_syntax::TextRange;
 use rustc_hash::{FxHashMap, FxHashSet};
 
-use crate::{db::Db, sinumerik::checks::visit::signed_value, sinumerik::model::FileModel};
+use crate::{
+    db::Db,
+    sinumerik::{
+        checks::visit::{signed_value, written_places},
+        model::FileModel,
+    },
+};
 
 /// The codes of the motion group that cut a thread: they move at the
 /// pitch and spindle speed, not at F.
@@ -55,6 +66,9 @@ const THREADS: [&str; 3] = ["G33", "G331", "G332"];
 /// Points closer than this, in mm, are the same: the thesis's CAM output
 /// repeats the current point to a few tenths of a µm.
 pub(crate) const SAME_POINT_MM: f64 = 0.001;
+
+/// The cycle that swivels the working plane.
+const SWIVEL_CYCLE: &str = "CYCLE800";
 
 /// The path axes.
 pub(crate) const PATH_AXES: [&str; 3] = ["X", "Y", "Z"];
@@ -85,6 +99,12 @@ pub(crate) struct State {
     /// frame, a work offset or the transformation, `Is(None)` for the one
     /// the program started in.
     pub frame: Known<Option<usize>>,
+    /// The programmable frame in force, composed from the frame commands
+    /// with the values they write (digest rule 74).
+    pub composed: Known<Arc<ProgrammableFrame>>,
+    /// The R parameters last set to a number (`R1=0.18`), by number: what
+    /// a frame command or CYCLE800 may read of them.
+    parameters: Vec<(u64, f64)>,
     /// A modal call (MCALL) in force, which runs at every move.
     pub modal_call: Known<Option<ModalCall>>,
 }
@@ -124,6 +144,8 @@ impl State {
             speed: Known::Is(None),
             position: NOWHERE,
             frame: Known::Is(None),
+            composed: Known::Is(Arc::default()),
+            parameters: Vec::new(),
             modal_call: Known::Is(None),
         }
     }
@@ -136,6 +158,8 @@ impl State {
             speed: Known::Unknown,
             position: NOWHERE,
             frame: Known::Unknown,
+            composed: Known::Unknown,
+            parameters: Vec::new(),
             modal_call: Known::Unknown,
         }
     }
@@ -161,16 +185,18 @@ impl State {
 
     /// What holds whichever of the two ways the program took.
     fn join(&self, other: &State) -> State {
-        fn same<T: PartialEq + Copy>(a: Known<T>, b: Known<T>) -> Known<T> {
-            if a == b { a } else { Known::Unknown }
+        fn same<T: PartialEq + Clone>(a: &Known<T>, b: &Known<T>) -> Known<T> {
+            if a == b { a.clone() } else { Known::Unknown }
         }
         State {
             modes: self.modes.join(&other.modes),
-            feed: same(self.feed, other.feed),
-            speed: same(self.speed, other.speed),
-            position: std::array::from_fn(|axis| same(self.position[axis], other.position[axis])),
-            frame: same(self.frame, other.frame),
-            modal_call: same(self.modal_call, other.modal_call),
+            feed: same(&self.feed, &other.feed),
+            speed: same(&self.speed, &other.speed),
+            position: std::array::from_fn(|axis| same(&self.position[axis], &other.position[axis])),
+            frame: same(&self.frame, &other.frame),
+            composed: same(&self.composed, &other.composed),
+            parameters: self.parameters.iter().filter(|p| other.parameters.contains(p)).copied().collect(),
+            modal_call: same(&self.modal_call, &other.modal_call),
         }
     }
 
@@ -201,6 +227,7 @@ impl State {
         let catalogue = catalogue();
         let mut codes: Vec<&'static Code> = Vec::new();
         for statement in &block.statements {
+            self.parameter_written(statement);
             match &statement.kind {
                 StatementKind::Word(word) => self.function_word(index, word, &mut codes),
                 StatementKind::Command(command) => match catalogue.word_code(&command.name) {
@@ -220,6 +247,7 @@ impl State {
                     self.modes = Modes::unknown();
                     self.position = NOWHERE;
                     self.frame = Known::Unknown;
+                    self.composed = Known::Unknown;
                 }
                 _ => {}
             }
@@ -241,7 +269,7 @@ impl State {
         }
         for statement in &block.statements {
             match &statement.kind {
-                StatementKind::Call(call) => self.call(index, &call.callee),
+                StatementKind::Call(call) => self.call(index, call),
                 StatementKind::ModalCall(call) => {
                     self.modal_call = Known::Is(call.as_ref().map(|call| ModalCall::of(&call.callee)));
                 }
@@ -281,12 +309,109 @@ impl State {
     /// a rotation or a frame that replaces the one in force.
     fn frame(&mut self, index: usize, command: &Command) {
         self.frame = Known::Is(Some(index));
-        let additive = matches!(command.name.as_str(), "ATRANS" | "ASCALE" | "AMIRROR");
+        let frame_command = FrameCommand::from_name(&command.name);
+        let named_only = frame_command.is_some_and(|c| c.additive && c.kind != FrameKind::Rotation);
         for (axis, name) in FOLLOWED.iter().enumerate() {
-            if !additive || command.words.iter().any(|word| word.address == *name) {
+            if !named_only || command.words.iter().any(|word| word.address == *name) {
                 self.position[axis] = Known::Unknown;
             }
         }
+        self.composed = match frame_command {
+            Some(frame_command) => self.composed_with(frame_command, command).map_or(Known::Unknown, Known::Is),
+            None => Known::Unknown,
+        };
+    }
+
+    /// What a statement writes to R parameters.
+    fn parameter_written(&mut self, statement: &Statement) {
+        written_places(statement, &mut |place, _| {
+            if place.kind == PlaceKind::Parameter {
+                match parameter_number(place) {
+                    Some(number) => self.parameters.retain(|&(known, _)| known != number),
+                    None => self.parameters.clear(),
+                }
+            }
+        });
+        if let StatementKind::Assign { target, value } = &statement.kind
+            && target.kind == PlaceKind::Parameter
+            && let Some(number) = parameter_number(target)
+            && let Some(value) = self.number(value)
+        {
+            self.parameters.push((number, value));
+        }
+    }
+
+    /// An expression's value, where it is a number, or an R parameter the
+    /// walk knows, with its sign.
+    fn number(&self, expr: &Expr) -> Option<f64> {
+        match &expr.kind {
+            ExprKind::Number(number) => Some(number.value()),
+            ExprKind::Unary(UnaryOp::Minus, operand) => self.number(operand).map(|value| -value),
+            ExprKind::Unary(UnaryOp::Plus, operand) => self.number(operand),
+            ExprKind::Name(place) if place.kind == PlaceKind::Parameter => {
+                let number = parameter_number(place)?;
+                self.parameters.iter().find(|&&(known, _)| known == number).map(|&(_, value)| value)
+            }
+            _ => None,
+        }
+    }
+
+    /// A word's value, as [`State::number`].
+    fn word_number(&self, value: &WordValue) -> Option<f64> {
+        match value {
+            WordValue::Expr { expr, .. } => self.number(expr),
+            literal => signed_value(literal),
+        }
+    }
+
+    /// The programmable frame after a call of CYCLE800, as the run swivels
+    /// it, where the walk knows every argument (the swivel data record, a
+    /// string, is not read) and, for an additive swivel, the frame before.
+    fn swivelled(&self, call: &Call) -> Option<Arc<ProgrammableFrame>> {
+        if !matches!(&call.callee, Callee::Cycle(name) if name == SWIVEL_CYCLE) {
+            return None;
+        }
+        let arguments = call
+            .arguments
+            .iter()
+            .map(|argument| match argument {
+                None => Some(None),
+                Some(Expr { kind: ExprKind::String(_), .. }) => Some(None),
+                Some(expr) => self.number(expr).map(Some),
+            })
+            .collect::<Option<Vec<_>>>()?;
+        let swivel = swivel(&arguments).ok()?;
+        let mut frame = match &self.composed {
+            Known::Is(frame) => ProgrammableFrame::clone(frame),
+            Known::Unknown if !swivel.additive => ProgrammableFrame::default(),
+            Known::Unknown => return None,
+        };
+        swivel.apply_to(&mut frame);
+        Some(Arc::new(frame))
+    }
+
+    /// The programmable frame after `command`, as the run composes it,
+    /// where the walk knows the frame before it (unless the command
+    /// replaces it), the plane, the units and every value it writes.
+    fn composed_with(&self, frame_command: FrameCommand, command: &Command) -> Option<Arc<ProgrammableFrame>> {
+        let mut frame = match (&self.composed, frame_command.additive) {
+            (_, false) => ProgrammableFrame::default(),
+            (Known::Is(frame), true) => ProgrammableFrame::clone(frame),
+            (Known::Unknown, true) => return None,
+        };
+        let plane = Plane::from_code(self.modes.get(PLANE)?)?;
+        let per_unit = self.modes.mm_per_unit()?;
+        let values = command
+            .words
+            .iter()
+            .map(|word| {
+                let value = self.word_number(word.value.as_ref()?)?;
+                let value = if frame_command.kind == FrameKind::Translation { value * per_unit } else { value };
+                Some((word.address.as_str(), value))
+            })
+            .collect::<Option<Vec<_>>>()?;
+        frame.apply(frame_command, &values, plane).ok()?;
+        Some(Arc::new(frame))
     }
 
     /// A G or M word: its code, or what it makes unknown.
@@ -370,7 +495,8 @@ impl State {
         moved
     }
 
-    fn call(&mut self, index: usize, callee: &Callee) {
+    fn call(&mut self, index: usize, call: &Call) {
+        let callee = &call.callee;
         if matches!(callee, Callee::Predefined(_)) {
             return;
         }
@@ -378,9 +504,20 @@ impl State {
             ModalCall::Hole(_) => self.forget_tool_axis(),
             // CYCLE800 swivels the plane; other cycles leave the tool where
             // the walk cannot say.
-            ModalCall::Cycle => self.new_frame(index),
+            ModalCall::Cycle => {
+                self.new_frame(index);
+                self.composed = self.swivelled(call).map_or(Known::Unknown, Known::Is);
+            }
             ModalCall::Program => self.forget(),
         }
+    }
+}
+
+/// The number of `R5` or `R[5]`; `None` for a computed one.
+fn parameter_number(place: &Place) -> Option<u64> {
+    match place.indices.as_slice() {
+        [Expr { kind: ExprKind::Number(number), .. }] => number.whole(),
+        _ => None,
     }
 }
 

@@ -116,15 +116,12 @@ mod files;
 mod frames_and_cycles;
 
 use super::modes::{
-    Modes,
+    INCH, Modes,
     groups::{ACCELERATION, DIMENSIONS, FEED_MODE, MOTION, PATH_MODE, PLANE, SPINDLE, UNITS},
 };
 
 /// The axes the programmable frame maps, in its order.
 const XYZ: [u8; 3] = [b'X', b'Y', b'Z'];
-
-/// Millimetres in an inch.
-const INCH: f64 = 25.4;
 
 /// The frame a Sinumerik run starts in: none, the settable frames being
 /// zero.
@@ -939,10 +936,7 @@ impl<'a> Interpreter<'a> {
 
     /// A length as written, in mm: inch under G70 and G700.
     fn length(&self, value: f64) -> f64 {
-        match self.state.modes.get(UNITS) {
-            Some("G70" | "G700") => value * INCH,
-            _ => value,
-        }
+        value * self.state.modes.mm_per_unit().unwrap_or(1.0)
     }
 
     /// Where the block's axis words lead; `None` when it has none.

@@ -37,7 +37,19 @@ fn catalogue() -> &'static Catalogue {
     Dialect::Sinumerik.catalogue()
 }
 
+/// Millimetres in an inch.
+pub const INCH: f64 = 25.4;
+
 impl Modes {
+    /// Millimetres per unit of the lengths a program writes: an inch
+    /// under G70 and G700; `None` where the units are not known.
+    pub fn mm_per_unit(&self) -> Option<f64> {
+        Some(match self.get(groups::UNITS)? {
+            "G70" | "G700" => INCH,
+            _ => 1.0,
+        })
+    }
+
     pub fn at_reset() -> Modes {
         let catalogue = catalogue();
         let in_force = catalogue

@@ -22,9 +22,9 @@
 //! - rule 17 is the run's timing of G0 (each axis at its own rate, the
 //!   slowest deciding), K016 and G0's hover; rule 24 is the run's travel
 //!   limit of a rotary axis (E002 `beyond-axis-range`, `limits` in degrees);
-//! - rules 21 and 73 are hover: the arc a CR chooses (the editor's hover
-//!   over CR), the catalogue's text of CUT3DC and CUT3DF; 74's hover, the
-//!   composed frame, is not shown yet;
+//! - rules 21, 73 and 74 are hover: the arc a CR chooses (the editor's
+//!   hover over CR), the catalogue's text of CUT3DC and CUT3DF, and the
+//!   programmable frame a frame command leaves (the hover over it);
 //! - computed jump targets (`GOTOF "N"<<R3`) are the run's.
 
 pub(crate) mod block;

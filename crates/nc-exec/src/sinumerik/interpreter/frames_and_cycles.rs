@@ -53,19 +53,8 @@ impl Interpreter<'_> {
     /// block that calls them, CYCLE800 as the frame it swivels to; others
     /// (CYCLE832, …) are reported as not run.
     pub(super) fn cycle(&mut self, at: At, name: &str, arguments: &[Option<Expr>], range: TextRange) {
-        let drilling = matches!(
-            name,
-            "CYCLE81"
-                | "CYCLE82"
-                | "CYCLE83"
-                | "CYCLE84"
-                | "CYCLE840"
-                | "CYCLE85"
-                | "CYCLE86"
-                | "CYCLE87"
-                | "CYCLE88"
-                | "CYCLE89"
-        );
+        // The catalogue's hole cycles: CYCLE81 … CYCLE89, CYCLE840.
+        let drilling = Dialect::Sinumerik.catalogue().cycles_for(name).any(|cycle| cycle.hole.is_some());
         if !drilling && name != "CYCLE800" {
             return self.state.not_run(&format!("the cycle {name}"), range);
         }

@@ -1,34 +1,60 @@
-//! The hover's reading of an arc given by its radius CR (digest §6 rule
-//! 21): which of the two arcs of that radius the block cuts, from where the
-//! walk over the program's modal state says it starts.
+//! Hover text from the walk over the program's modal state: the arc a CR
+//! chooses (digest §6 rule 21) and the programmable frame a frame command
+//! leaves in force (rule 74).
 
 use std::ops::ControlFlow;
 
-use nc_exec::arc::{centre_by_radius, circle_through};
+use nc_exec::{
+    arc::{centre_by_radius, circle_through},
+    known::Known,
+};
 use ncc_syntax::TextSize;
 
 use crate::{
     db::{Db, SourceFile},
     sinumerik::{
         model::{file_model, is_main_program},
-        walk::{RadiusArc, SAME_POINT_MM, walk},
+        walk::{RadiusArc, SAME_POINT_MM, Step, walk},
     },
 };
 
-/// The arc the CR of the block at `offset` chooses, where the walk knows
-/// both of its ends (digest §6 rule 21).
-pub(super) fn radius_arc(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<String> {
+/// What `describe` says of the block at `offset` from the walk's state
+/// after it.
+fn at_block(
+    db: &dyn Db,
+    file: SourceFile,
+    offset: TextSize,
+    describe: impl FnOnce(&Step<'_>) -> Option<String>,
+) -> Option<String> {
     let model = file_model(db, file);
     let index = model.ranges.partition_point(|range| range.end() <= offset);
+    let mut describe = Some(describe);
     let mut text = None;
     walk(db, model, is_main_program(db, file), |step| {
         if step.index < index {
             return ControlFlow::Continue(());
         }
-        text = RadiusArc::of(step.block, &step.from, step.state).map(|arc| describe_arc(&arc));
+        text = describe.take().and_then(|describe| describe(&step));
         ControlFlow::Break(())
     });
     text
+}
+
+/// The arc the CR of the block at `offset` chooses, where the walk knows
+/// both of its ends.
+pub(super) fn radius_arc(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<String> {
+    at_block(db, file, offset, |step| RadiusArc::of(step.block, &step.from, step.state).map(|arc| describe_arc(&arc)))
+}
+
+/// The programmable frame in force after the frame command at `offset`:
+/// additive commands compose on top of the frame before them (004:1354-1356).
+pub(super) fn composed_frame(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<String> {
+    at_block(db, file, offset, |step| {
+        Some(match &step.state.composed {
+            Known::Is(frame) => format!("**The frame after this block:** {frame}"),
+            Known::Unknown => "**The frame after this block** is the run's: a value, the plane or the frame before it is not known without running the program".to_owned(),
+        })
+    })
 }
 
 fn describe_arc(arc: &RadiusArc<'_>) -> String {
