@@ -38,7 +38,7 @@ use nc_exec::{
         frames::{FrameCommand, FrameKind, Plane, ProgrammableFrame},
         lower::{
             Call, Callee, Command, Dimension, Expr, ExprKind, JumpKind, Place, PlaceKind, SinumerikBlock, Statement,
-            StatementKind, UnaryOp, Word, WordValue,
+            StatementKind, UnaryOp, Word, WordValue, is_axis,
         },
         modes::{
             Modes,
@@ -569,13 +569,6 @@ impl RadiusArc<'_> {
             written,
         })
     }
-}
-
-/// Whether `address` names an axis the control moves: its letter, or the
-/// letter with a number (`A2`, `X1`).
-pub(crate) fn is_axis(address: &str) -> bool {
-    let Some((&letter, number)) = address.as_bytes().split_first() else { return false };
-    b"XYZABCUVW".contains(&letter) && number.iter().all(u8::is_ascii_digit)
 }
 
 /// Whether a block's statements end the way on to the next block: an end

@@ -96,7 +96,7 @@ use super::{
     frames::ProgrammableFrame,
     lower::{
         Call, Command, Dimension, Expr, ExprKind, Jump, JumpKind, JumpTarget, Place, PlaceKind, SinumerikBlock,
-        StatementKind, Word, WordValue, block_nodes,
+        StatementKind, Word, WordValue, block_nodes, is_axis,
     },
     program::{Resolved, SinumerikModel, StructureKind},
 };
@@ -765,13 +765,9 @@ impl<'a> Interpreter<'a> {
             }
             return;
         }
-        let numbered_axis = |name: &str| {
-            name.len() > 1
-                && b"XYZABCUVW".contains(&name.as_bytes()[0])
-                && name[1..].bytes().all(|b| b.is_ascii_digit())
-        };
         let Some(role) = catalogue.address(address).map(|a| a.role) else {
-            let what = if numbered_axis(address) {
+            // A bare letter is an address the catalogue has.
+            let what = if is_axis(address) {
                 format!("axis {address} (the machine has none)")
             } else {
                 format!("the address {address}")

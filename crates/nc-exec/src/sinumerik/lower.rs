@@ -289,6 +289,13 @@ impl Callee {
     }
 }
 
+/// Whether `address` names an axis the control moves: its letter, or the
+/// letter with a number (`A2`, `X1`).
+pub fn is_axis(address: &str) -> bool {
+    let Some((&letter, number)) = address.as_bytes().split_first() else { return false };
+    b"XYZABCUVW".contains(&letter) && number.iter().all(u8::is_ascii_digit)
+}
+
 /// The files the control looks a program named `name` up in, in its
 /// order: `PROFIL` is `_N_PROFIL_MPF`, found first, else `_N_PROFIL_SPF`
 /// (004:1452-1462); `_N_PROFIL_SPF`, or a path ending in it, is that

@@ -50,7 +50,7 @@ use nc_exec::{
     arc::centre_by_radius,
     known::Known,
     sinumerik::{
-        lower::{Callee, ProgramEnd, Statement, StatementKind, WordValue},
+        lower::{Callee, ProgramEnd, Statement, StatementKind, WordValue, is_axis},
         modes::groups::{COOLANT, DIMENSIONS, MOTION, SPINDLE, TOOL_RADIUS, WORK_OFFSETS},
     },
 };
@@ -63,7 +63,7 @@ use crate::{
     sinumerik::{
         checks::visit::g_number,
         model::FileModel,
-        walk::{FOLLOWED, PATH_AXES, RadiusArc, SAME_POINT_MM, Step, is_axis},
+        walk::{FOLLOWED, PATH_AXES, RadiusArc, SAME_POINT_MM, Step},
     },
 };
 
