@@ -20,6 +20,7 @@
 //! r-parameters = 100           # $MN_MM_NUM_R_PARAM: R0 to R99
 //! tool-management = true       # the machine manages its tools (GETSELT, GETEXET)
 //! stock-top = "0"              # the stock's top on the tool axis, in the program's coordinates
+//! cycle-version = "classic"    # whose cycle argument lists calls must fit
 //!
 //! [machine]
 //! file = "machines/mill.toml"             # a machine file; the keys below override it
@@ -183,6 +184,18 @@ pub struct SinumerikConfig {
     /// in µm, for `rapid-into-stock`: a program does not say where it is.
     #[serde(deserialize_with = "micrometres")]
     pub stock_top: Option<i32>,
+    /// The version of the control's cycles, whose argument lists a call
+    /// must fit (004:3298-3302); `None`: not checked.
+    pub cycle_version: Option<CycleVersion>,
+}
+
+/// A version of Sinumerik's cycles whose argument lists the catalogue has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CycleVersion {
+    /// The 840D cycles' classic lists; SINUMERIK Operate adds arguments
+    /// after them.
+    Classic,
 }
 
 /// A length in mm written as text (`"-2.5"`), in µm.

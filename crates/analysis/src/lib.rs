@@ -43,7 +43,10 @@ pub use crate::ide::{
     symbols::{DocumentSymbol, SymbolKind},
 };
 pub use crate::{
-    config::{CONFIG_FILE, Config, Dialects, Level, MachineConfig, ReportConfig, SinumerikConfig, parse_constant},
+    config::{
+        CONFIG_FILE, Config, CycleVersion, Dialects, Level, MachineConfig, ReportConfig, SinumerikConfig,
+        parse_constant,
+    },
     db::{RootDatabase, SourceFile},
     diagnostic::{Diagnostic, Fix, Related, Rule},
     findings::{Findings, OmittedFindings},

@@ -213,7 +213,9 @@ pub(crate) fn run(paths: &[PathBuf], format: Format, forced: Option<Dialect>) ->
         return ExitCode::from(2);
     }
     for failure in &failures {
-        eprintln!("error: {}", visible::escaped(failure));
+        // Line by line: a TOML error points at its line with a few of its own.
+        let lines: Vec<_> = failure.lines().map(visible::escaped).collect();
+        eprintln!("error: {}", lines.join("\n"));
     }
     exit_code(&checked, &failures)
 }

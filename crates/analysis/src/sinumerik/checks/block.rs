@@ -8,6 +8,7 @@ use ncc_syntax::{TextEdit, TextRange, TextSize};
 
 use crate::{
     Config, Diagnostic,
+    config::CycleVersion,
     diagnostic::declare_rules,
     sinumerik::checks::visit::{all_exprs, number, statement_exprs, written_places},
 };
@@ -23,6 +24,7 @@ declare_rules! {
     CYCLE832_OPTION = "K057", "cycle832-option", Hint, "CYCLE832 needs its option on the control; without it, its expansion does the same.";
     INTERPOLATING_SPLINE = "K079", "interpolating-spline", Info, "ASPLINE or CSPLINE, which pass through every point: on digitised or noisy points BSPLINE, which approximates them, is smoother.";
     SPLINE_PARAMETER_RANGE = "K080", "spline-parameter-range", Error, "A spline degree SD other than 2 or 3, or a point weight PW outside 0 to 3.";
+    CYCLE_ARGUMENTS_FOR_VERSION = "K058", "cycle-arguments-for-version", Info, "A cycle call with more arguments than the cycle takes in the version `[sinumerik] cycle-version` names: the argument lists differ between versions.";
     COMPARISON_PRIORITY = "K107", "comparison-priority", Warning, "A comparison with an unparenthesised AND, OR, XOR or `<<` as operand: Sinumerik ranks comparisons below them, so `A>5 AND B<3` reads `A>(5 AND B)<3`.";
 }
 
@@ -52,10 +54,35 @@ pub(crate) fn check(block: &SinumerikBlock, text: &str, config: &Config) -> Vec<
     if config.sinumerik.tool_management {
         tool_variables(block, &mut out);
     }
+    if let Some(version) = config.sinumerik.cycle_version {
+        cycle_arguments(catalogue, block, version, &mut out);
+    }
     for statement in &block.statements {
         statement_exprs(statement, &mut |expr| priority(text, expr, &mut out));
     }
     out
+}
+
+/// Rule 58: a call of a cycle with more arguments than its list in
+/// `version` has; trailing ones may be left out.
+fn cycle_arguments(catalogue: &Catalogue, block: &SinumerikBlock, version: CycleVersion, out: &mut Vec<Diagnostic>) {
+    // The catalogue's lists are the classic ones.
+    let CycleVersion::Classic = version;
+    for statement in &block.statements {
+        let StatementKind::Call(call) = &statement.kind else { continue };
+        let Callee::Cycle(name) = &call.callee else { continue };
+        let Some(cycle) = catalogue.cycles_for(name).find(|cycle| !cycle.arguments.is_empty()) else { continue };
+        let takes = cycle.arguments.len();
+        if call.arguments.len() <= takes {
+            continue;
+        }
+        let range = call.arguments[takes..].iter().flatten().next().map_or(statement.range, |first| first.range);
+        let message = format!(
+            "{name} takes {takes} arguments in the classic cycles (`cycle-version`), and this call passes {}: cycle argument lists differ between versions of the control (004:3298-3302); SINUMERIK Operate adds arguments after these",
+            call.arguments.len()
+        );
+        out.push(Diagnostic::new(&CYCLE_ARGUMENTS_FOR_VERSION, range, message));
+    }
 }
 
 /// Rule 4.

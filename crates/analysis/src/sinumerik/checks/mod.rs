@@ -18,7 +18,7 @@
 //!   25, 30, 33–36 ISO words (G28, H, G92 as a preset, M97–M98) that
 //!   Sinumerik writes otherwise;
 //! - rules 71 and 72 follow the tool's shape and the surface, which the
-//!   program does not state; 58 depends on the control's version;
+//!   program does not state;
 //! - rule 17 is the run's timing of G0 (each axis at its own rate, the
 //!   slowest deciding), K016 and G0's hover; rule 24 is the run's travel
 //!   limit of a rotary axis (E002 `beyond-axis-range`, `limits` in degrees);

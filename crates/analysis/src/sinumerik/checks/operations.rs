@@ -300,20 +300,22 @@ impl Operations {
     /// Rule 28: repositioning in the plane at the depth of the cut.
     fn retract(&mut self, file: &FileModel, step: &Step<'_>, plane: Plane, out: &mut Vec<Diagnostic>) {
         let [a, b, tool] = plane.axes();
+        let moved = |axis: usize| matches!((step.from[axis], step.state.position[axis]), (Known::Is(f), Known::Is(t)) if (t - f).abs() > SAME_POINT_MM);
+        let in_plane = moved(a) || moved(b);
+        let rapid = step.state.motion() == Some("G0");
+        let into_stock = rapid
+            && self.rapid_into_stock(file, step, tool, [step.from[tool], step.state.position[tool]], in_plane, out);
         let (Known::Is(from), Known::Is(to)) = (step.from[tool], step.state.position[tool]) else {
             self.approach = None;
             self.cut = false;
             return;
         };
-        let moved = |axis: usize| matches!((step.from[axis], step.state.position[axis]), (Known::Is(f), Known::Is(t)) if (t - f).abs() > SAME_POINT_MM);
         match step.state.feed_motion() {
             Known::Is(true) => {
                 let approach = *self.approach.get_or_insert(from);
                 self.cut |= to < approach - SAME_POINT_MM;
             }
-            Known::Is(false) if step.state.motion() == Some("G0") => {
-                let in_plane = moved(a) || moved(b);
-                let into_stock = self.rapid_into_stock(file, step, tool, [from, to], in_plane, out);
+            Known::Is(false) if rapid => {
                 if !into_stock
                     && in_plane
                     && self.cut
@@ -339,24 +341,25 @@ impl Operations {
     }
 
     /// Rule 15: a G0 from `heights[0]` to `heights[1]` on the tool axis
-    /// that cuts the stock; whether it reported.
+    /// that cuts the stock, as far as the walk knows them; whether it
+    /// reported.
     fn rapid_into_stock(
         &self,
         file: &FileModel,
         step: &Step<'_>,
         tool: usize,
-        [from, to]: [f64; 2],
+        [from, to]: [Known<f64>; 2],
         in_plane: bool,
         out: &mut Vec<Diagnostic>,
     ) -> bool {
         let Some(top) = self.stock_top else { return false };
-        let below = |height: f64| height < top - SAME_POINT_MM;
+        let below = |height: Known<f64>| height.known().filter(|&height| height < top - SAME_POINT_MM);
         let axis = PATH_AXES[tool];
-        let message = if below(to) {
+        let message = if let Some(to) = below(to) {
             format!(
                 "G0 ends at {axis}{to}, below the stock's top {axis}{top}: a rapid move never cuts; stop above the stock and feed in (004:821-825, 444)"
             )
-        } else if in_plane && below(from) {
+        } else if let Some(from) = below(from).filter(|_| in_plane) {
             format!(
                 "G0 moves in the plane with the tool at {axis}{from}, below the stock's top {axis}{top}: it cuts at rapid; retract above the stock first (004:821-825, 444)"
             )
