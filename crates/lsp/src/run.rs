@@ -22,7 +22,7 @@ use nc_exec::{
     expand::{Expand, ExpandError},
     haas_lathe,
     run::{
-        Axes, Called, Environment, Message, MessageDisplay, Motion, Step, Stop, Totals, Trace, WrittenFile,
+        Axes, Called, Environment, Message, MessageDisplay, Motion, Step, Stop, Tool, Totals, Trace, WrittenFile,
         expected_blocks,
     },
     sinumerik,
@@ -759,7 +759,7 @@ fn summary(path: &Path, ran: &Ran, tally: &Tally) -> String {
         let codes: Vec<String> = codes.iter().map(u8::to_string).collect();
         let _ = writeln!(out, "  messages     {} by operation 51 (codes {})", trace.messages.len(), codes.join(", "));
     }
-    let tools: Vec<String> = trace.tools.iter().map(|tool| format!("T{tool}")).collect();
+    let tools: Vec<String> = trace.tools.iter().map(Tool::to_string).collect();
     let _ = writeln!(out, "  tools        {}", if tools.is_empty() { "none".to_owned() } else { tools.join(" ") });
     // Turners read the diameter axis as a diameter; the trace keeps radii.
     let as_written = |axis: u8, value: f64| if trace.diameter_axis == Some(axis) { 2.0 * value } else { value };
@@ -803,6 +803,23 @@ fn summary(path: &Path, ran: &Ran, tally: &Tally) -> String {
 
 /// `ncc run --format json`, written as it is serialised: a run of a
 /// million blocks never holds its records in memory.
+/// A tool in the report: its number, or its name (Sinumerik `T="…"`).
+#[derive(Serialize)]
+#[serde(untagged)]
+enum ToolJson<'a> {
+    Number(u32),
+    Name(&'a str),
+}
+
+impl<'a> ToolJson<'a> {
+    fn of(tool: &'a Tool) -> ToolJson<'a> {
+        match tool {
+            Tool::Number(number) => ToolJson::Number(*number),
+            Tool::Name(name) => ToolJson::Name(name),
+        }
+    }
+}
+
 #[derive(Serialize)]
 struct Report<'a> {
     file: String,
@@ -814,7 +831,7 @@ struct Report<'a> {
     dwell_time_s: f64,
     cutting_length_mm: f64,
     rapid_length_mm: f64,
-    tools: &'a [u32],
+    tools: Vec<ToolJson<'a>>,
     /// Where the tool centre ended, and the programmed end when the last
     /// block ran under radius compensation.
     end_position: Values<'a>,
@@ -841,7 +858,7 @@ impl<'a> Report<'a> {
             dwell_time_s: totals.time(Motion::Dwell),
             cutting_length_mm: totals.length(Motion::Feed),
             rapid_length_mm: totals.length(Motion::Rapid),
-            tools: &trace.tools,
+            tools: trace.tools.iter().map(ToolJson::of).collect(),
             end_position: Values(last.map_or(trace.end(), |last| trace.tool_end(last, &trace.end())), axes),
             programmed_end_position: last.and_then(|last| trace.centred(last)).map(|_| Values(trace.end(), axes)),
             blocks: Records { trace, timing, sources },

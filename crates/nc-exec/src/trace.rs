@@ -9,7 +9,7 @@ pub use self::{rules::RunRule, sink::*};
 pub use crate::axes::{Axes, MAX_AXES, Position};
 pub(crate) use crate::axes::{round3, slot};
 
-use std::ops::Range;
+use std::{fmt, ops::Range};
 
 use ncc_syntax::TextRange;
 
@@ -265,7 +265,7 @@ pub struct Trace {
     pub steps: Vec<Step>,
     pub findings: Vec<Finding>,
     /// Tools called with T, in order of first use.
-    pub tools: Vec<u32>,
+    pub tools: Vec<Tool>,
     /// The files the run read besides the program: source k is
     /// `files[k - 1]`.
     pub files: Vec<Called>,
@@ -275,6 +275,23 @@ pub struct Trace {
     /// The files the program wrote (Sinumerik: WRITE), with their final
     /// text, for whoever runs it to keep where it chooses.
     pub written: Vec<WrittenFile>,
+}
+
+/// A tool as a program selects it: by its number (`T5`), or by its name
+/// on a Sinumerik with tool management (`T="DRILL_8"`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Tool {
+    Number(u32),
+    Name(String),
+}
+
+impl fmt::Display for Tool {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Tool::Number(number) => write!(f, "T{number}"),
+            Tool::Name(name) => write!(f, "T=\"{name}\""),
+        }
+    }
 }
 
 /// A file a run wrote.

@@ -128,7 +128,7 @@ use crate::{
     machine::MachineConfig,
     trace::{
         Axes, Called, Checkpoint, Compensated, DELIVERY_BATCH, Environment, Finding, Motion, Path, PathMode, Position,
-        Resumable, RunRule, Step, StepSink, Stop, Trace, Undelivered, goes_on, round3, slot,
+        Resumable, RunRule, Step, StepSink, Stop, Tool, Trace, Undelivered, goes_on, round3, slot,
     },
     transform::{Frame, by_letter, over_axes},
 };
@@ -419,7 +419,7 @@ struct Interpreter<'a> {
     last_rpm: f32,
     steps: Undelivered,
     findings: Vec<Finding>,
-    tools: Vec<u32>,
+    tools: Vec<Tool>,
     executed: usize,
     /// Keys of what was reported once.
     reported: Vec<String>,
@@ -763,8 +763,8 @@ impl<'a> Interpreter<'a> {
         let tool = block.word(b'T').and_then(|word| self.number(word, range)).map(|tool| tool as u32);
         if let Some(tool) = tool {
             self.offset = (tool % 100) as u8;
-            if !self.tools.contains(&tool) {
-                self.tools.push(tool);
+            if !self.tools.contains(&Tool::Number(tool)) {
+                self.tools.push(Tool::Number(tool));
             }
         }
         let moved = if dwell {

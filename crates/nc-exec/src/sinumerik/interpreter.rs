@@ -81,8 +81,8 @@
 //! finding; `$AC_TIME` (the time since the block started) is 0 where a
 //! program reads it, and the run has no clock (`$A_YEAR` … read 0,
 //! reported once); `$AA_IM`, `$AA_IW` are the programmed position; a named
-//! tool has no number (`$P_TOOLNO` is 0) and is not listed in the trace's
-//! tools. The run takes no checkpoints: a Sinumerik run always starts at
+//! tool has no number (`$P_TOOLNO` is 0) and is listed in the trace's
+//! tools by its name. The run takes no checkpoints: a Sinumerik run always starts at
 //! the top.
 
 use std::{collections::HashSet, rc::Rc};
@@ -105,7 +105,7 @@ use crate::{
     machine::MachineConfig,
     trace::{
         ABANDON_INTERVAL, Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, Path, Position, RunRule,
-        Step, StepSink, Stop, Trace, Undelivered, goes_on, slot,
+        Step, StepSink, Stop, Tool, Trace, Undelivered, goes_on, slot,
     },
     transform::{Frame, over_axes},
 };
@@ -289,7 +289,7 @@ struct State<'a> {
     speed: f64,
     /// The tool T selected last: a number, or 0 for a named one.
     tool: u32,
-    tools: Vec<u32>,
+    tools: Vec<Tool>,
     /// The path modes G60, G64x, SOFT, BRISK with ADIS, ADISPOS and CTOL,
     /// kept in step with the groups of `modes` as each step is recorded.
     path: PathControl,
@@ -903,12 +903,18 @@ impl<'a> Interpreter<'a> {
     }
 
     fn select_tool(&mut self, tool: &Value) {
-        self.state.tool = match tool {
-            Value::Str(_) => 0,
-            number => number.int(TextRange::default()).ok().and_then(|n| u32::try_from(n).ok()).unwrap_or(0),
+        let selected = match tool {
+            Value::Str(name) => Some(Tool::Name(name.to_string())),
+            number => number.int(TextRange::default()).ok().and_then(|n| u32::try_from(n).ok()).map(Tool::Number),
         };
-        if self.state.tool != 0 && !self.state.tools.contains(&self.state.tool) {
-            self.state.tools.push(self.state.tool);
+        self.state.tool = match selected {
+            Some(Tool::Number(number)) => number,
+            _ => 0,
+        };
+        if let Some(tool) = selected.filter(|tool| *tool != Tool::Number(0))
+            && !self.state.tools.contains(&tool)
+        {
+            self.state.tools.push(tool);
         }
     }
 

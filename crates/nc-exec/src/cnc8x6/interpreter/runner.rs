@@ -110,7 +110,7 @@ pub(super) struct Runner {
     pub(super) findings: Vec<Finding>,
     /// T in force, and every T in order of first use.
     pub(super) tool: Option<u32>,
-    pub(super) tools: Vec<u32>,
+    pub(super) tools: Vec<Tool>,
     /// Kinds of work already reported as not run.
     pub(super) reported: Vec<String>,
 }
@@ -327,8 +327,8 @@ impl Runner {
                 Some(AddressRole::Tool) => {
                     if let Some(tool) = self.integer(word) {
                         self.tool = Some(tool);
-                        if !self.tools.contains(&tool) {
-                            self.tools.push(tool);
+                        if !self.tools.contains(&Tool::Number(tool)) {
+                            self.tools.push(Tool::Number(tool));
                         }
                     }
                 }

@@ -13,7 +13,7 @@ use crate::{
     run::{NoFiles, resume_into, run, run_into},
     trace::{
         Called, Checkpoint, Checkpoints, Closing, Compensated, DELIVERY_BATCH, Environment, Motion, Path, PathMode,
-        RunRule, Step, StepSink, Stop, Trace,
+        RunRule, Step, StepSink, Stop, Tool, Trace,
     },
     transform::Frame,
 };
@@ -168,7 +168,7 @@ fn stops_ends_tools_and_m_functions() {
     let steps = &trace.steps;
     assert_eq!(steps.len(), 5);
     assert!(steps[0].tool_change);
-    assert_eq!(trace.tools, [101]);
+    assert_eq!(trace.tools, [Tool::Number(101)]);
     assert_eq!(steps[1].m_functions, 1);
     assert_eq!((steps[2].stop, steps[3].stop), (Some(Stop::Program), Some(Stop::Optional)));
 }

@@ -579,3 +579,12 @@ fn cycles_drill_at_each_position_and_swivel_the_plane() {
     assert_eq!(findings(&swivelled, ""), []);
     assert_eq!(ends(&swivelled).last(), Some(&[0.0, 10.0, 0.0]));
 }
+
+/// Tools by number and by name (tool management), each once, in the order
+/// first selected; T0 selects none.
+#[test]
+fn the_trace_lists_numbered_and_named_tools() {
+    let trace = run("T5 M6\nT=\"BALL_6\" M6\nT5\nT=\"BALL_6\"\nT0\n");
+    assert_eq!(trace.tools, [Tool::Number(5), Tool::Name("BALL_6".to_owned())]);
+    assert_eq!(trace.tools.iter().map(Tool::to_string).collect::<Vec<_>>(), ["T5", "T=\"BALL_6\""]);
+}
