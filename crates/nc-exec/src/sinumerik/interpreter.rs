@@ -56,14 +56,17 @@
 //! - The drilling cycles CYCLE81–CYCLE89 and CYCLE840 ([`super::cycles`]) as
 //!   moves of the block that calls them, at the tool's position in the
 //!   plane, under MCALL after every block with a path motion.
+//! - Inverse-time feed G93 on lines and arcs: each block takes 1/F
+//!   minutes, whatever its length (Siemens documentation); the F in force
+//!   counts for every block until the next F.
 //! - WRITE, READ, DELETE and ISFILE on the run's own files (module
 //!   `files`).
 //!
 //! Reported once each as not run, moving nothing: the control's other
 //! cycles (CYCLE832, …), axes the machine does
 //! not have and orientation words, transformations (TRAORI), radius
-//! compensation G41/G42, inverse-time feed G93, synchronous actions and
-//! what [`super::eval`] does not model. System variables the run has no
+//! compensation G41/G42, inverse-time feed G93 on a spline, synchronous
+//! actions and what [`super::eval`] does not model. System variables the run has no
 //! value for read 0 with a finding once per name.
 //!
 //! A block makes a step when it has a word the machine acts on (an axis,
@@ -119,6 +122,9 @@ use super::modes::{
     INCH, Modes,
     groups::{ACCELERATION, DIMENSIONS, FEED_MODE, MOTION, PATH_MODE, PLANE, SPINDLE, UNITS},
 };
+
+/// Inverse-time feed: F is 1/minutes of each block.
+const INVERSE_TIME: &str = "G93";
 
 /// The axes the programmable frame maps, in its order.
 const XYZ: [u8; 3] = [b'X', b'Y', b'Z'];
@@ -844,7 +850,6 @@ impl<'a> Interpreter<'a> {
                 "G4" => dwell = true,
                 "G9" => facts.exact = true,
                 "G41" | "G42" => self.state.not_run("tool radius compensation G41/G42", range),
-                "G93" => self.state.not_run("inverse-time feed G93", range),
                 "G74" | "G75" => self.state.not_run("reference point approach G74/G75", range),
                 _ => {}
             }
@@ -1043,7 +1048,11 @@ impl<'a> Interpreter<'a> {
 
     /// A feed move of `length` mm along `path`.
     fn feed_move(&mut self, range: TextRange, path: Path, length: f64) -> Moved {
-        let minutes = self.feed_rate(range).map(|rate| length / rate);
+        let minutes = if self.state.modes.is(FEED_MODE, INVERSE_TIME) {
+            self.inverse_time(range)
+        } else {
+            self.feed_rate(range).map(|rate| length / rate)
+        };
         let (duration, feed) = match minutes {
             Some(minutes) => {
                 (minutes * 60.0, Some(length / minutes).filter(|f| f.is_finite()).or(self.feed_rate_quiet()))
@@ -1053,9 +1062,27 @@ impl<'a> Interpreter<'a> {
         Moved { motion: Motion::Feed, path, length, duration, feed }
     }
 
+    /// Under G93 a block takes 1/F minutes, whatever its length (Siemens
+    /// documentation); `None` after reporting a missing F.
+    fn inverse_time(&mut self, range: TextRange) -> Option<f64> {
+        let minutes = self.state.feed.filter(|&feed| feed > 0.0).map(|feed| 1.0 / feed);
+        if minutes.is_none() {
+            let message =
+                "inverse-time feed (G93) with no F: the block's time 1/F is not given, so the axes cannot move";
+            self.state.finding(RunRule::MotionWithoutFeed, range, message);
+        }
+        minutes
+    }
+
     /// The path feed in mm/min; `None` after reporting why the axes cannot
     /// move.
     fn feed_rate(&mut self, range: TextRange) -> Option<f64> {
+        if self.state.modes.is(FEED_MODE, INVERSE_TIME) {
+            // A spline's points share its curve: what 1/F of each is, the
+            // run does not divide.
+            self.state.not_run("inverse-time feed G93 on a spline or cycle", range);
+            return None;
+        }
         let rate = self.feed_rate_quiet();
         if rate.is_none() {
             let message = match self.state.modes.get(FEED_MODE) {
@@ -1073,6 +1100,7 @@ impl<'a> Interpreter<'a> {
         let spindle_on = matches!(self.state.modes.get(SPINDLE), Some("M3" | "M4"));
         match self.state.modes.get(FEED_MODE) {
             Some("G95") => (spindle_on && self.state.speed > 0.0).then_some(feed * self.state.speed),
+            Some(INVERSE_TIME) => None,
             _ => Some(feed),
         }
     }

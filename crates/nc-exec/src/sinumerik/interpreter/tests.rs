@@ -588,3 +588,15 @@ fn the_trace_lists_numbered_and_named_tools() {
     assert_eq!(trace.tools, [Tool::Number(5), Tool::Name("BALL_6".to_owned())]);
     assert_eq!(trace.tools.iter().map(Tool::to_string).collect::<Vec<_>>(), ["T5", "T=\"BALL_6\""]);
 }
+
+/// G93: a block takes 1/F minutes whatever its length; G94 goes back to
+/// mm/min.
+#[test]
+fn inverse_time_feed_gives_each_block_one_over_f_minutes() {
+    let trace = run("G17 G90 G0 X0 Y0\nG93 G1 X10 F2\nY30 F4\nX20 Y40\nG94 X30 F100\n");
+    let durations: Vec<f64> = moves(&trace).iter().skip(1).map(|step| step.duration).collect();
+    assert_eq!(durations, [30.0, 15.0, 15.0, 6.0]);
+    let feeds: Vec<Option<f64>> = moves(&trace).iter().skip(1).map(|step| step.feed).collect();
+    assert_eq!(feeds[0], Some(20.0), "10 mm in half a minute");
+    assert!(trace.findings.is_empty(), "{:?}", trace.findings);
+}
