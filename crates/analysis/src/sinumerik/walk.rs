@@ -8,7 +8,7 @@
 //! It visits each block once, in file order. A main program starts at
 //! reset (the catalogue's defaults, no F, no S); a subprogram (a PROC, an
 //! SPF file) from an unknown state, since its caller's is not known here,
-//! but without a modal call (MCALL) in force and under G90.
+//! but without a modal call (MCALL) in force, under G90 and ORIEULER.
 //! Where the file's order is not the run's order, it keeps what holds
 //! whichever way the program goes:
 //!
@@ -170,10 +170,13 @@ impl State {
     /// G90.
     fn subprogram_start() -> State {
         let mut state = State { frame: Known::Is(None), modal_call: Known::Is(None), ..State::unknown() };
-        // Coordinates are taken as absolute until the subprogram says: the
-        // thesis's subprograms never write G90 (L26–L28).
-        if let Some(absolute) = catalogue().code_named("G90") {
-            state.modes.set(absolute);
+        // Coordinates are taken as absolute and orientation angles as Euler
+        // angles until the subprogram says: the thesis's subprograms never
+        // write G90 or ORIEULER (L26–L28).
+        for assumed in ["G90", "ORIEULER"] {
+            if let Some(code) = catalogue().code_named(assumed) {
+                state.modes.set(code);
+            }
         }
         state
     }

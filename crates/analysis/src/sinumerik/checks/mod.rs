@@ -6,9 +6,10 @@
 //! on the whole program ([`program`], [`names`], [`types`]) are one pass
 //! each over the file model and come with the flow findings.
 //!
-//! The rules on motion and technology ([`motion`]) and on the order of
-//! operations ([`operations`]) read the modal state of one walk over the
-//! file ([`crate::sinumerik::walk`]).
+//! The rules on motion and technology ([`motion`]), on the order of
+//! operations ([`operations`]) and on the tool's orientation
+//! ([`orientation`]) read the modal state of one walk over the file
+//! ([`crate::sinumerik::walk`]).
 //!
 //! Not checked here:
 //! - rules 1, 2, 10, 11, 12 and 14 are the parser's (`space-in-word`,
@@ -17,7 +18,7 @@
 //! - rules 3, 5, 6, 8, 9 are ISO conventions or off for Sinumerik, and
 //!   25, 30, 33–36 ISO words (G28, H, G92 as a preset, M97–M98) that
 //!   Sinumerik writes otherwise;
-//! - rules 71 and 72 follow the tool's shape and the surface, which the
+//! - rule 71 follows the tool's shape and the surface's normal, which the
 //!   program does not state;
 //! - rule 17 is the run's timing of G0 (each axis at its own rate, the
 //!   slowest deciding), K016 and G0's hover; rule 24 is the run's travel
@@ -32,6 +33,7 @@ pub(crate) mod calls;
 pub(crate) mod motion;
 pub(crate) mod names;
 pub(crate) mod operations;
+pub(crate) mod orientation;
 pub(crate) mod parameters;
 pub(crate) mod program;
 pub(crate) mod types;
@@ -58,6 +60,7 @@ pub(crate) static RULES: &[&[&Rule]] = &[
     program::RULES,
     motion::RULES,
     operations::RULES,
+    orientation::RULES,
     names::RULES,
     parameters::RULES,
     types::RULES,
@@ -137,10 +140,12 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
 fn walk_findings(db: &dyn Db, file: &FileModel, main: bool, stock_top: Option<i32>) -> Vec<Diagnostic> {
     let mut motion = motion::Motion::new(file, main);
     let mut operations = operations::Operations::new(stock_top);
+    let mut orientation = orientation::Orientation::default();
     let mut out = Vec::new();
     walk::walk(db, file, main, |step| {
         motion.step(file, &step, &mut out);
         operations.step(file, &step, &mut out);
+        orientation.step(file, &step, &mut out);
         ControlFlow::Continue(())
     });
     motion.report_unreached(file, &mut out);

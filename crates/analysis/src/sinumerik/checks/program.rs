@@ -13,10 +13,11 @@
 //!   deciding, and report at the last block that ends the program.
 //! - Rule 47 is opt-in: the digest doubts it (§8), and Siemens's own
 //!   cycles end with RET under SAVE.
-//! - Rule 51 reports a group-1 code chosen by a value, `G[1]=R7` or the
-//!   text `"G[01]="<<$P_GG[1]` a WRITE puts in a generated program, when
-//!   no condition of the program (IF, WHILE, UNTIL, CASE) reads any of
-//!   the value's variables: such a test is taken to limit the choice.
+//! - Rule 51 reports a group-1 code a WRITE puts in a generated program
+//!   from a value, `"G[01]="<<$P_GG[1]`, when no condition of the program
+//!   (IF, WHILE, UNTIL, CASE) reads any of the value's variables: such a
+//!   test is taken to limit the choice. A program that chooses its own
+//!   motion by `G[1]=…` (a grinder's G2 or G3 from a table) is left alone.
 
 use nc_exec::sinumerik::{
     lower::{BinaryOp, Callee, Expr, ExprKind, Jump, JumpKind, JumpTarget, Place, PlaceKind, Statement, StatementKind},
@@ -44,7 +45,7 @@ declare_rules! {
     RET_WITH_SAVE = "K047", "ret-with-save", Warning, "RET in a subprogram whose PROC line has SAVE, which the thesis says cannot be combined (Siemens's own cycles do combine them).", opt_in;
     SIMULATION_BRANCH = "K054", "simulation-branch-and-files", Info, "A program that branches on `$P_ISTEST` and writes files: a simulation started from the programming screen writes none, so the branches differ; ISFILE tests for the file itself.";
     JUMP_TARGET_NOT_FOUND = "K059", "jump-target-not-found", Error, "A jump to a label or block number the program does not have.";
-    UNTESTED_MOTION_CODE = "K051", "untested-motion-code", Info, "A motion code (G group 1) chosen by a value no condition of the program tests, in the program (`G[1]=R7`) or in a program it writes: a 1 there is G0.";
+    UNTESTED_MOTION_CODE = "K051", "untested-motion-code", Info, "A motion code (G group 1) that a program writes into a generated program from a value no condition tests: a 1 there is G0.";
     JUMP_INTO_STRUCTURE = "K060", "jump-into-structure", Warning, "A jump from outside into the body of an IF, WHILE, FOR, REPEAT or LOOP.";
     TRANSFORMATION_AT_END = "K068", "transformation-at-end", Warning, "The program ends with TRAORI still on (no TRAFOOF after it).";
     MODE_AT_END = "K069", "mode-at-end", Info, "The program ends with TOROT or FFWON still on (no TOROTOF or FFWOF after it).";
@@ -385,11 +386,6 @@ fn variables_read(expr: &Expr) -> Vec<VariableKey> {
     read
 }
 
-/// Whether `G[…]` names group 1.
-fn is_motion_group(indices: &[Expr]) -> bool {
-    matches!(indices, [Expr { kind: ExprKind::Number(group), .. }] if group.whole() == Some(1))
-}
-
 /// The operands of a chain of `<<`, in order.
 fn concatenated<'a>(expr: &'a Expr, operands: &mut Vec<&'a Expr>) {
     match &expr.kind {
@@ -404,7 +400,7 @@ fn concatenated<'a>(expr: &'a Expr, operands: &mut Vec<&'a Expr>) {
 /// Rule 51: a motion code chosen by a value no condition tests.
 fn untested_motion_code(db: &dyn Db, catalogue: &Catalogue, file: &FileModel, out: &mut Vec<Diagnostic>) {
     let mut tested = rustc_hash::FxHashSet::default();
-    let mut chosen: Vec<(&Expr, TextRange, &str)> = Vec::new();
+    let mut chosen: Vec<(&Expr, TextRange)> = Vec::new();
     for (index, block) in file.blocks(db).enumerate() {
         for statement in &block.statements {
             match &statement.kind {
@@ -412,11 +408,6 @@ fn untested_motion_code(db: &dyn Db, catalogue: &Catalogue, file: &FileModel, ou
                 | StatementKind::While(test)
                 | StatementKind::Until(test)
                 | StatementKind::Case { selector: test, .. } => tested.extend(variables_read(test)),
-                StatementKind::Assign { target, value }
-                    if target.kind == PlaceKind::GroupCode && is_motion_group(&target.indices) =>
-                {
-                    chosen.push((value, file.in_file(index, statement.range), "this program"));
-                }
                 StatementKind::Call(call) if matches!(&call.callee, Callee::Predefined(name) if name == "WRITE") => {
                     for argument in call.arguments.iter().flatten() {
                         let mut operands = Vec::new();
@@ -425,7 +416,7 @@ fn untested_motion_code(db: &dyn Db, catalogue: &Catalogue, file: &FileModel, ou
                             let ExprKind::String(text) = &pair[0].kind else { continue };
                             let text = text.trim_end().to_ascii_uppercase();
                             if text.ends_with("G[1]=") || text.ends_with("G[01]=") {
-                                chosen.push((pair[1], file.in_file(index, pair[1].range), "the program it writes"));
+                                chosen.push((pair[1], file.in_file(index, pair[1].range)));
                             }
                         }
                     }
@@ -435,13 +426,13 @@ fn untested_motion_code(db: &dyn Db, catalogue: &Catalogue, file: &FileModel, ou
         }
     }
     let first = catalogue.code_at("G1", 1).map_or("G0", |code| code.code.as_str());
-    for (value, range, program) in chosen {
+    for (value, range) in chosen {
         let read = variables_read(value);
         if read.is_empty() || read.iter().any(|variable| tested.contains(variable)) {
             continue;
         }
         let message = format!(
-            "the motion code of {program} is chosen by a value no condition tests: a 1 there selects {first}, as happened to the thesis's generated program (004:3331-3347); test that it is 2 (G1) or a spline's index first"
+            "the motion code of the program written here is chosen by a value no condition tests: a 1 there selects {first}, as happened to the thesis's generated program (004:3331-3347); test that it is 2 (G1) or a spline's index first"
         );
         out.push(Diagnostic::new(&UNTESTED_MOTION_CODE, range, message));
     }

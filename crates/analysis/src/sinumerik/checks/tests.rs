@@ -118,13 +118,18 @@ fn the_seed_listings_get_only_true_findings() {
         (
             &[("l27.spf", include_str!("../../../../syntax/test_data/sinumerik/l27_krivky_x_const_a_rot.spf"))],
             // B2 turns 17° over 0.5 mm and its neighbours nearly as fast
-            // (digest rule 75).
+            // (digest rule 75); the tool tilts 17° to 28° at the three
+            // deepest points of the concave centre, where the thesis saw it
+            // gouge (rule 72).
             &[
                 ("cycle832-option", 9),
                 ("spline-first-point", 22),
+                ("tilt-in-concave", 50),
                 ("orientation-rate", 53),
                 ("orientation-rate", 54),
+                ("tilt-in-concave", 57),
                 ("orientation-rate", 59),
+                ("tilt-in-concave", 60),
             ],
         ),
         (

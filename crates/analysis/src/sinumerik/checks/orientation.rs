@@ -1,0 +1,141 @@
+//! Rules on the tool's orientation over the walk's modal state (digest §6
+//! rule 72): a tool tilted far at a concave point of its pass.
+//!
+//! Assumptions, where the digest is silent:
+//! - The tilt is the angle between the tool and Z, from which the
+//!   orientation is measured, whatever the plane: from the vector A3, B3,
+//!   C3 where the walk knows all three, else from the angles, B2 under
+//!   Euler angles (ORIEULER: A2 turns about Z, B2 then tilts) and
+//!   `acos(cos A2 · cos B2)` under RPY angles (ORIRPY), as Siemens
+//!   documents them.
+//! - A point of a pass is concave where the path bends towards the tool:
+//!   the tool-axis height at the end of a feed move lies more than
+//!   [`CONCAVE_MM`] below the chord from the start of that move to the end
+//!   of the next, measured by the distance in X and Y; a spline's control
+//!   points stand for its curve. What the surface does across the pass is
+//!   not known.
+//! - A tilt above [`TILT_IN_CONCAVE_DEGREES`] at such a point is reported
+//!   at the block that tilted the tool there: the thesis's L27 tilts 17° to
+//!   28° at the three deepest points of its concave centre, where it
+//!   gouged the finished surface in simulation (004:2957-2965), and up to
+//!   40° on its flanks, which are not concave.
+
+use nc_exec::{known::Known, sinumerik::lower::StatementKind};
+use ncc_syntax::TextRange;
+
+use crate::{
+    Diagnostic,
+    diagnostic::declare_rules,
+    sinumerik::{
+        model::FileModel,
+        walk::{FOLLOWED, SAME_POINT_MM, Step},
+    },
+};
+
+declare_rules! {
+    TILT_IN_CONCAVE = "K072", "tilt-in-concave", Warning, "A tool tilted more than 15° at a concave point of its pass: the tool may gouge the finished surface; scale the angle down there.";
+}
+
+/// A tilt above this at a concave point is reported.
+const TILT_IN_CONCAVE_DEGREES: f64 = 15.0;
+
+/// A point this far below the chord of its neighbours is concave.
+const CONCAVE_MM: f64 = 0.01;
+
+/// The orientation angles' group and its RPY member.
+const ANGLES_GROUP: &str = "G50";
+const RPY: &str = "ORIRPY";
+
+/// Where the followed words are: the angles A2, B2 and the vector A3, B3,
+/// C3.
+const A2: usize = 6;
+const B2: usize = 7;
+const VECTOR: std::ops::Range<usize> = 9..12;
+
+/// The last feed move's start and end, and the tilt at its end with the
+/// word that set it.
+struct Previous {
+    from: [f64; 3],
+    to: [f64; 3],
+    tilt: Option<(f64, TextRange)>,
+}
+
+#[derive(Default)]
+pub(crate) struct Orientation {
+    previous: Option<Previous>,
+}
+
+impl Orientation {
+    pub(crate) fn step(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        if !step.reached || !step.moves {
+            return;
+        }
+        let point = |position: &[Known<f64>]| -> Option<[f64; 3]> {
+            Some([position[0].known()?, position[1].known()?, position[2].known()?])
+        };
+        let (Known::Is(true), Some(from), Some(to)) =
+            (step.state.feed_motion(), point(&step.from), point(&step.state.position))
+        else {
+            self.previous = None;
+            return;
+        };
+        if let Some(previous) = self.previous.take()
+            && same(previous.to, from)
+            && let Some((tilt, range)) = previous.tilt
+            && tilt > TILT_IN_CONCAVE_DEGREES
+            && let Some(depth) = below_chord(previous.from, from, to).filter(|&depth| depth > CONCAVE_MM)
+        {
+            let message = format!(
+                "the tool tilts {tilt:.1}° from Z at a concave point of its pass, {depth:.3} mm below the chord of its neighbours: in the thesis's L27 such a tilt removed material of the finished surface; scale the angle down in concave regions (004:2957-2965)"
+            );
+            out.push(Diagnostic::new(&TILT_IN_CONCAVE, range, message));
+        }
+        self.previous = Some(Previous { from, to, tilt: tilt(file, step) });
+    }
+}
+
+fn same(a: [f64; 3], b: [f64; 3]) -> bool {
+    a.iter().zip(b).all(|(a, b)| (a - b).abs() <= SAME_POINT_MM)
+}
+
+/// How far `middle` lies below the chord from `start` to `end` in Z, at
+/// its share of the distance in the plane; `None` where the moves do not
+/// move in the plane.
+fn below_chord(start: [f64; 3], middle: [f64; 3], end: [f64; 3]) -> Option<f64> {
+    let first = (middle[0] - start[0]).hypot(middle[1] - start[1]);
+    let second = (end[0] - middle[0]).hypot(end[1] - middle[1]);
+    if first <= SAME_POINT_MM || second <= SAME_POINT_MM {
+        return None;
+    }
+    let chord = start[2] + (end[2] - start[2]) * first / (first + second);
+    Some(chord - middle[2])
+}
+
+/// The tool's tilt from Z after the step, in degrees, and the word of the
+/// block that gives it.
+fn tilt(file: &FileModel, step: &Step<'_>) -> Option<(f64, TextRange)> {
+    let position = &step.state.position;
+    let written = |axis: usize| {
+        step.block.statements.iter().find_map(|statement| match &statement.kind {
+            StatementKind::Word(word) if word.address == FOLLOWED[axis] => {
+                Some(file.in_file(step.index, statement.range))
+            }
+            _ => None,
+        })
+    };
+    let vector: Option<Vec<f64>> = VECTOR.clone().map(|axis| position[axis].known()).collect();
+    if let Some(vector) = vector {
+        let length = vector.iter().map(|c| c * c).sum::<f64>().sqrt();
+        if length <= f64::EPSILON {
+            return None;
+        }
+        let degrees = (vector[2] / length).clamp(-1.0, 1.0).acos().to_degrees();
+        return Some((degrees, VECTOR.clone().find_map(written)?));
+    }
+    let b = position[B2].known()?;
+    let degrees = match step.state.modes.get(ANGLES_GROUP)? {
+        RPY => (position[A2].known()?.to_radians().cos() * b.to_radians().cos()).clamp(-1.0, 1.0).acos().to_degrees(),
+        _ => b.abs(),
+    };
+    Some((degrees, written(B2).or_else(|| written(A2))?))
+}
