@@ -21,6 +21,7 @@
 //! tool-management = true       # the machine manages its tools (GETSELT, GETEXET)
 //! stock-top = "0"              # the stock's top on the tool axis, in the program's coordinates
 //! cycle-version = "classic"    # whose cycle argument lists calls must fit
+//! ball-nose-tools = ["BALL_6", "12"]   # tools (names, numbers) with a ball end
 //!
 //! [machine]
 //! file = "machines/mill.toml"             # a machine file; the keys below override it
@@ -187,6 +188,9 @@ pub struct SinumerikConfig {
     /// The version of the control's cycles, whose argument lists a call
     /// must fit (004:3298-3302); `None`: not checked.
     pub cycle_version: Option<CycleVersion>,
+    /// The tools with a ball end, by name (`T="BALL_6"`) or number, in any
+    /// case: a program does not say a tool's shape.
+    pub ball_nose_tools: Vec<String>,
 }
 
 /// A version of Sinumerik's cycles whose argument lists the catalogue has.

@@ -12,14 +12,14 @@
 //! ([`crate::sinumerik::walk`]).
 //!
 //! Not checked here:
-//! - rules 1, 2, 10, 11, 12 and 14 are the parser's (`space-in-word`,
+//! - rules 1, 2, 10, 11, 12, 13 and 14 are the parser's (`space-in-word`,
 //!   `unexpected-character`, `parenthesis-comment`, the block skip's place,
-//!   `unclosed-string`, `template-placeholder`);
+//!   `unclosed-string`, `template-placeholder`; an elided line, `...` or
+//!   `…`, is a placeholder or a character the control does not read, and
+//!   the seed's listings hold them as comments);
 //! - rules 3, 5, 6, 8, 9 are ISO conventions or off for Sinumerik, and
 //!   25, 30, 33–36 ISO words (G28, H, G92 as a preset, M97–M98) that
 //!   Sinumerik writes otherwise;
-//! - rule 71 follows the tool's shape and the surface's normal, which the
-//!   program does not state;
 //! - rule 17 is the run's timing of G0 (each axis at its own rate, the
 //!   slowest deciding), K016 and G0's hover; rule 24 is the run's travel
 //!   limit of a rotary axis (E002 `beyond-axis-range`, `limits` in degrees);
@@ -44,7 +44,7 @@ use std::{ops::ControlFlow, path::Path};
 use nc_exec::sinumerik::lower::Callee;
 
 use crate::{
-    Diagnostic, Rule,
+    Diagnostic, Rule, SinumerikConfig,
     db::{BlockChunk, Db, Settings, SourceFile, file_chunks},
     findings::{self, Findings},
     sinumerik::{
@@ -122,7 +122,7 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
     let resolve = |callee: &Callee| callee.control_files()?.iter().find_map(|name| find(name));
     let mut diagnostics = program::check(db, model, &in_workspace);
     let main = is_main_program(db, file);
-    diagnostics.extend(walk_findings(db, model, main, config.sinumerik.stock_top));
+    diagnostics.extend(walk_findings(db, model, main, &config.sinumerik));
     diagnostics.extend(names::check(db, model, text, config));
     let reads: Vec<&parameters::Reads> =
         settings.files(db).iter().map(|other| parameters::parameter_reads(db, *other)).collect();
@@ -137,10 +137,10 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
 }
 
 /// The findings of the rules on the modal state, from one walk.
-fn walk_findings(db: &dyn Db, file: &FileModel, main: bool, stock_top: Option<i32>) -> Vec<Diagnostic> {
+fn walk_findings(db: &dyn Db, file: &FileModel, main: bool, config: &SinumerikConfig) -> Vec<Diagnostic> {
     let mut motion = motion::Motion::new(file, main);
-    let mut operations = operations::Operations::new(stock_top);
-    let mut orientation = orientation::Orientation::default();
+    let mut operations = operations::Operations::new(config.stock_top);
+    let mut orientation = orientation::Orientation::new(&config.ball_nose_tools);
     let mut out = Vec::new();
     walk::walk(db, file, main, |step| {
         motion.step(file, &step, &mut out);

@@ -1,7 +1,18 @@
 //! Rules on the tool's orientation over the walk's modal state (digest §6
-//! rule 72): a tool tilted far at a concave point of its pass.
+//! rules 71 and 72): a ball-nose tool standing square to its path, a tool
+//! tilted far at a concave point of its pass.
 //!
 //! Assumptions, where the digest is silent:
+//! - Rule 71 needs the tools with a ball end, `[sinumerik]
+//!   ball-nose-tools`, which a program does not state; without the key it
+//!   is quiet. It reads "the tool axis normal to the surface" as the axis
+//!   square (within [`SQUARE_DEGREES`]) to a feed move under a
+//!   transformation (TRAORI), where the tool could tilt: the surface under
+//!   a path is not known, but a tool square to it is square to the
+//!   surface along it. The axis is the vector A3, B3, C3, or Z where the
+//!   angles leave the tool upright; other angles are not read, since their
+//!   direction depends on the machine. It reports the first such move of
+//!   each tool.
 //! - The tilt is the angle between the tool and Z, from which the
 //!   orientation is measured, whatever the plane: from the vector A3, B3,
 //!   C3 where the walk knows all three, else from the angles, B2 under
@@ -20,21 +31,30 @@
 //!   gouged the finished surface in simulation (004:2957-2965), and up to
 //!   40° on its flanks, which are not concave.
 
-use nc_exec::{known::Known, sinumerik::lower::StatementKind};
+use nc_exec::{
+    known::Known,
+    sinumerik::lower::{ExprKind, StatementKind, WordValue},
+};
+use ncc_catalog::{Dialect, KeywordKind};
 use ncc_syntax::TextRange;
 
 use crate::{
     Diagnostic,
     diagnostic::declare_rules,
     sinumerik::{
+        checks::{program::TRANSFORMATION_OFF, visit::number},
         model::FileModel,
         walk::{FOLLOWED, SAME_POINT_MM, Step},
     },
 };
 
 declare_rules! {
+    BALL_CENTRE_CUTS = "K071", "ball-centre-cuts", Info, "A ball-nose tool (`[sinumerik] ball-nose-tools`) whose axis stands square to its path under TRAORI: its centre, where the cutting speed is zero, cuts; tilt it along the path.";
     TILT_IN_CONCAVE = "K072", "tilt-in-concave", Warning, "A tool tilted more than 15° at a concave point of its pass: the tool may gouge the finished surface; scale the angle down there.";
 }
+
+/// A tool axis within this of a right angle to the path is square to it.
+const SQUARE_DEGREES: f64 = 2.0;
 
 /// A tilt above this at a concave point is reported.
 const TILT_IN_CONCAVE_DEGREES: f64 = 15.0;
@@ -60,16 +80,31 @@ struct Previous {
     tilt: Option<(f64, TextRange)>,
 }
 
-#[derive(Default)]
-pub(crate) struct Orientation {
+pub(crate) struct Orientation<'a> {
     previous: Option<Previous>,
+    /// Rule 71: the configured ball-nose tools, the tool in the spindle
+    /// (file order) and whether it is one, whether a transformation is on,
+    /// and the tools reported.
+    ball_nose_tools: &'a [String],
+    tool: Option<(String, bool)>,
+    transformed: bool,
+    reported: Vec<String>,
 }
 
-impl Orientation {
+impl<'a> Orientation<'a> {
+    pub(crate) fn new(ball_nose_tools: &'a [String]) -> Orientation<'a> {
+        Orientation { previous: None, ball_nose_tools, tool: None, transformed: false, reported: Vec::new() }
+    }
+
     pub(crate) fn step(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
-        if !step.reached || !step.moves {
+        if !step.reached {
             return;
         }
+        self.tool_and_transformation(step);
+        if !step.moves {
+            return;
+        }
+        self.ball_centre(file, step, out);
         let point = |position: &[Known<f64>]| -> Option<[f64; 3]> {
             Some([position[0].known()?, position[1].known()?, position[2].known()?])
         };
@@ -92,6 +127,81 @@ impl Orientation {
         }
         self.previous = Some(Previous { from, to, tilt: tilt(file, step) });
     }
+}
+
+impl Orientation<'_> {
+    /// The tool a T word selects, and TRAORI or TRAFOOF.
+    fn tool_and_transformation(&mut self, step: &Step<'_>) {
+        let catalogue = Dialect::Sinumerik.catalogue();
+        for statement in &step.block.statements {
+            match &statement.kind {
+                StatementKind::Word(word) if word.address == "T" => {
+                    self.tool = word.value.as_ref().and_then(tool_name).map(|name| {
+                        let ball = self.ball_nose_tools.iter().any(|tool| tool.eq_ignore_ascii_case(&name));
+                        (name, ball)
+                    });
+                }
+                StatementKind::Command(command)
+                    if catalogue.keyword(&command.name).is_some_and(|k| k.kind == KeywordKind::Transformation) =>
+                {
+                    self.transformed = command.name != TRANSFORMATION_OFF;
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// Rule 71: a ball-nose tool square to its path under TRAORI.
+    fn ball_centre(&mut self, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
+        let Some((tool, true)) = &self.tool else { return };
+        if !self.transformed || step.state.feed_motion() != Known::Is(true) || self.reported.contains(tool) {
+            return;
+        }
+        let direction: Option<Vec<f64>> =
+            (0..3).map(|axis| Some(step.state.position[axis].known()? - step.from[axis].known()?)).collect();
+        let (Some(direction), Some(axis)) = (direction, tool_axis(step)) else { return };
+        let length = direction.iter().map(|c| c * c).sum::<f64>().sqrt();
+        if length <= SAME_POINT_MM {
+            return;
+        }
+        let cos = direction.iter().zip(axis).map(|(d, a)| d * a).sum::<f64>() / length;
+        if cos.abs() > SQUARE_DEGREES.to_radians().sin() {
+            return;
+        }
+        self.reported.push(tool.clone());
+        let range = file.in_file(step.index, step.block.statements[0].range);
+        let message = format!(
+            "the ball-nose tool {tool} stands square to its path: its centre, where the cutting speed is zero, cuts the surface; tilt the tool along the path, as the thesis tilted it by the vector A3=1 B3=2 C3=6 (004:2947-2951)"
+        );
+        out.push(Diagnostic::new(&BALL_CENTRE_CUTS, range, message));
+    }
+}
+
+/// A tool as T names it: `T="BALL_6"`, `T12`, `T=12`.
+fn tool_name(value: &WordValue) -> Option<String> {
+    if let WordValue::Expr { expr, .. } = value
+        && let ExprKind::String(name) = &expr.kind
+    {
+        return Some(name.clone());
+    }
+    number(value).map(|number| number.value().to_string())
+}
+
+/// The tool's axis as a unit vector where the walk knows it: the vector
+/// A3, B3, C3, or Z where the angles leave the tool upright.
+fn tool_axis(step: &Step<'_>) -> Option<[f64; 3]> {
+    let position = &step.state.position;
+    let vector: Option<Vec<f64>> = VECTOR.clone().map(|axis| position[axis].known()).collect();
+    if let Some(vector) = vector {
+        let length = vector.iter().map(|c| c * c).sum::<f64>().sqrt();
+        return (length > f64::EPSILON).then(|| [vector[0] / length, vector[1] / length, vector[2] / length]);
+    }
+    let upright = |axis: usize| position[axis].known().is_some_and(|angle| angle.abs() <= f64::EPSILON);
+    let upright = match step.state.modes.get(ANGLES_GROUP)? {
+        RPY => upright(A2) && upright(B2),
+        _ => upright(B2),
+    };
+    upright.then_some([0.0, 0.0, 1.0])
 }
 
 fn same(a: [f64; 3], b: [f64; 3]) -> bool {

@@ -60,7 +60,7 @@ const MAX_DEPTH: usize = 16;
 const MAX_NAME_CHARS: usize = 31;
 
 /// The word that switches TRAORI off; the other transformations' too.
-const TRANSFORMATION_OFF: &str = "TRAFOOF";
+pub(crate) const TRANSFORMATION_OFF: &str = "TRAFOOF";
 
 /// The modes rule 69 wants off at the end: each the code of its group
 /// that switches it on.
