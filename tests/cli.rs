@@ -540,6 +540,32 @@ fn plot_draws_the_toolpath_as_svg() {
     assert!(svg.contains("XY plane · total time"), "{svg}");
 }
 
+/// `ncc plot -o NAME.png` draws the same picture as a PNG image at twice
+/// the SVG's size, on white, with the moves in colour.
+#[test]
+fn plot_writes_a_png_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("PLOT.NCP");
+    std::fs::write(&program, "%1\nN1 G00 X10 Y0\nN2 G01 X20 F600\nN3 G03 X30 Y0 I5 J0\nN4 M30\n").unwrap();
+    let (svg, png) = (dir.path().join("plot.svg"), dir.path().join("plot.PNG"));
+    for output in [&svg, &png] {
+        let run = ncc(&["plot", program.to_str().unwrap(), "-o", output.to_str().unwrap()]);
+        assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
+    }
+    let svg = std::fs::read_to_string(svg).unwrap();
+    let size = |attribute: &str| -> u32 {
+        let start = svg.find(&format!(" {attribute}=\"")).unwrap() + attribute.len() + 3;
+        svg[start..].split('"').next().unwrap().parse().unwrap()
+    };
+    let image = resvg::tiny_skia::Pixmap::decode_png(&std::fs::read(png).unwrap()).unwrap();
+    assert_eq!((image.width(), image.height()), (2 * size("width"), 2 * size("height")));
+    let pixels = image.pixels();
+    assert!(pixels[0].red() == 255 && pixels[0].green() == 255 && pixels[0].blue() == 255, "a white background");
+    let coloured =
+        pixels.iter().filter(|p| p.red().abs_diff(p.green()) > 64 || p.red().abs_diff(p.blue()) > 64).count();
+    assert!(coloured > 100, "the moves in the speed's colours: {coloured} pixels");
+}
+
 /// A lathe's picture in either view: the cut at X50. (a diameter) runs at
 /// the scale's mark 25 in the radius view and at the marks 50 on both
 /// sides of the spindle axis in the diameter view, the default, which

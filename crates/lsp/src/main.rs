@@ -137,7 +137,8 @@ enum Command {
     Plot {
         /// The program to draw.
         file: PathBuf,
-        /// The SVG file to write.
+        /// The SVG file to write; a name ending in `.png` writes the picture
+        /// as a PNG image instead, for reports.
         #[arg(short, long)]
         output: PathBuf,
         /// Stop after running this many blocks.

@@ -1,4 +1,5 @@
-//! `ncc plot FILE -o path.svg`: the toolpath as an SVG picture, in the XY
+//! `ncc plot FILE -o path.svg`: the toolpath as an SVG picture (or a PNG
+//! image of it, `-o path.png`), in the XY
 //! plane (ZX on a lathe), feed moves coloured by the speed the velocity
 //! model gives them, rapid moves dashed, and the breaks of the path speed
 //! marked; every move and mark carries its source line (`data-line`) and a
@@ -451,6 +452,36 @@ fn legend(
             escape(&capped_note(drawn, sketch.moves))
         );
     }
+}
+
+/// How many pixels a PNG has per unit of the SVG: twice, so that thin
+/// lines and labels stay sharp in a report.
+const PNG_SCALE: f32 = 2.0;
+
+/// The picture `svg` as a PNG image on white, its labels in a sans-serif
+/// font of the system's.
+pub(crate) fn png(svg: &str) -> Result<Vec<u8>, String> {
+    use resvg::{tiny_skia, usvg};
+    let mut options = usvg::Options::default();
+    let fonts = options.fontdb_mut();
+    fonts.load_system_fonts();
+    // fontdb takes Arial for sans-serif, which a Linux machine rarely has:
+    // the first sans-serif family installed stands in.
+    let sans = fonts
+        .faces()
+        .flat_map(|face| &face.families)
+        .map(|(family, _)| family.clone())
+        .find(|family| family.contains("Sans") && !family.contains("Mono") && !family.contains("Serif"));
+    if let Some(sans) = sans {
+        fonts.set_sans_serif_family(sans.clone());
+        options.font_family = sans;
+    }
+    let tree = usvg::Tree::from_str(svg, &options).map_err(|error| error.to_string())?;
+    let size = tree.size().to_int_size().scale_by(PNG_SCALE).ok_or("the picture has no size")?;
+    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height()).ok_or("the picture is too large")?;
+    pixmap.fill(tiny_skia::Color::WHITE);
+    resvg::render(&tree, tiny_skia::Transform::from_scale(PNG_SCALE, PNG_SCALE), &mut pixmap.as_mut());
+    pixmap.encode_png().map_err(|error| error.to_string())
 }
 
 /// What a picture that draws only the first `drawn` of a run's `moves`

@@ -512,7 +512,19 @@ fn plot_program(program: &Program<'_>, output: &Path, step_budget: usize, max_mo
     if let Some(note) = &picture.capped {
         eprintln!("note: {note} (--max-moves draws more)");
     }
-    match std::fs::write(output, picture.svg) {
+    let png = output.extension().is_some_and(|extension| extension.eq_ignore_ascii_case("png"));
+    let bytes = if png {
+        match crate::plot::png(&picture.svg) {
+            Ok(bytes) => bytes,
+            Err(error) => {
+                eprintln!("error: drawing {}: {error}", output.display());
+                return ExitCode::from(2);
+            }
+        }
+    } else {
+        picture.svg.into_bytes()
+    };
+    match std::fs::write(output, bytes) {
         Ok(()) => ran.exit_code(),
         Err(error) => {
             eprintln!("error: writing {}: {error}", output.display());
