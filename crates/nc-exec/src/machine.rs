@@ -87,6 +87,15 @@ pub struct TravelLimits {
     pub max: Option<i32>,
 }
 
+impl TravelLimits {
+    /// The limit a position (mm, or degrees) lies beyond, in its unit;
+    /// `None` within them.
+    pub fn passed_by(&self, position: f64) -> Option<f64> {
+        let limit = |limit: Option<i32>| limit.map(|limit| f64::from(limit) / 1000.0);
+        limit(self.min).filter(|&min| position < min).or(limit(self.max).filter(|&max| position > max))
+    }
+}
+
 impl Default for MachineConfig {
     fn default() -> Self {
         MachineConfig {

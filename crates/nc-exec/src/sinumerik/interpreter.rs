@@ -1012,16 +1012,8 @@ impl<'a> Interpreter<'a> {
     fn beyond_turns(&mut self, end: &Position, range: TextRange) -> bool {
         let machine = self.state.machine;
         for &axis in machine.axes.iter().filter(|&&axis| !is_linear(axis)) {
-            let Some(limits) = machine.limits.get(&axis) else { continue };
             let degrees = end[slot(axis)];
-            let beyond = |limit: Option<i32>, outside: fn(f64, f64) -> bool| {
-                limit.map(|limit| f64::from(limit) / 1000.0).filter(|&limit| outside(degrees, limit))
-            };
-            let Some(limit) =
-                beyond(limits.min, |value, min| value < min).or(beyond(limits.max, |value, max| value > max))
-            else {
-                continue;
-            };
+            let Some(limit) = machine.limits.get(&axis).and_then(|limits| limits.passed_by(degrees)) else { continue };
             let letter = char::from(axis);
             let message = format!(
                 "{letter} would reach {degrees:.3}° ({:.2} turns), beyond its travel limit {limit}° ({:.2} turns): a rotary axis turns only so far one way before it must be unwound (004:936-938); the control stops",

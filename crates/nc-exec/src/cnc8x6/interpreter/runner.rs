@@ -1119,12 +1119,7 @@ impl Runner {
         for (&axis, &real) in axes.iter().zip(&machine) {
             let letter = char::from(axis);
             let limits = self.machine.limits.get(&axis).copied().unwrap_or_default();
-            let beyond = |limit: Option<i32>, beyond: fn(f64, f64) -> bool| {
-                limit.map(|limit| f64::from(limit) / 1000.0).filter(|&limit| beyond(round3(real), limit))
-            };
-            if let Some(limit) =
-                beyond(limits.min, |value, min| value < min).or(beyond(limits.max, |value, max| value > max))
-            {
+            if let Some(limit) = limits.passed_by(round3(real)) {
                 return Some(format!(
                     "{letter} would reach {real:.3} in machine coordinates, beyond its travel limit {limit:.3} (`limits` of the machine): the control stops at the software limit switch"
                 ));
