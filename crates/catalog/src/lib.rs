@@ -467,6 +467,12 @@ impl Catalogue {
         let code = code.to_ascii_uppercase();
         self.cycles.iter().filter(move |c| c.code.eq_ignore_ascii_case(&code))
     }
+
+    /// The hole cycle with this code: one that says what it does to the
+    /// hole at the current position (`hole`).
+    pub fn hole_cycle(&self, code: &str) -> Option<&Cycle> {
+        self.cycles_for(code).find(|cycle| cycle.hole.is_some())
+    }
 }
 
 /// What the catalogue knows of a system variable.

@@ -124,15 +124,10 @@ pub(crate) enum ModalCall {
 impl ModalCall {
     fn of(callee: &Callee) -> ModalCall {
         match callee {
-            Callee::Cycle(name) => hole_cycle(name).map_or(ModalCall::Cycle, ModalCall::Hole),
+            Callee::Cycle(name) => catalogue().hole_cycle(name).map_or(ModalCall::Cycle, ModalCall::Hole),
             _ => ModalCall::Program,
         }
     }
-}
-
-/// The catalogue's hole cycle of this name.
-pub(crate) fn hole_cycle(name: &str) -> Option<&'static Cycle> {
-    catalogue().cycles_for(name).find(|cycle| cycle.hole.is_some())
 }
 
 impl State {

@@ -46,7 +46,7 @@ use nc_exec::{
         modes::groups::{PLANE, TOOL_RADIUS},
     },
 };
-use ncc_catalog::HoleOperation;
+use ncc_catalog::{Dialect, HoleOperation};
 use ncc_syntax::TextRange;
 use rustc_hash::FxHashMap;
 
@@ -56,7 +56,7 @@ use crate::{
     sinumerik::{
         checks::visit::{g_number, signed_value},
         model::FileModel,
-        walk::{ModalCall, PATH_AXES, SAME_POINT_MM, Step, hole_cycle},
+        walk::{ModalCall, PATH_AXES, SAME_POINT_MM, Step},
     },
 };
 
@@ -374,9 +374,10 @@ impl Operations {
     /// Rule 38: the operations on each hole, in order.
     fn holes(&mut self, file: &FileModel, step: &Step<'_>, plane: Option<Plane>, out: &mut Vec<Diagnostic>) {
         let state = step.state;
+        let catalogue = Dialect::Sinumerik.catalogue();
         let direct = step.block.statements.iter().find_map(|s| match &s.kind {
             StatementKind::Call(call) => match &call.callee {
-                Callee::Cycle(name) => hole_cycle(name).map(|cycle| (cycle, s.range)),
+                Callee::Cycle(name) => catalogue.hole_cycle(name).map(|cycle| (cycle, s.range)),
                 _ => None,
             },
             _ => None,

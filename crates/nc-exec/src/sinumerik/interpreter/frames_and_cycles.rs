@@ -54,7 +54,7 @@ impl Interpreter<'_> {
     /// (CYCLE832, …) are reported as not run.
     pub(super) fn cycle(&mut self, at: At, name: &str, arguments: &[Option<Expr>], range: TextRange) {
         // The catalogue's hole cycles: CYCLE81 … CYCLE89, CYCLE840.
-        let drilling = Dialect::Sinumerik.catalogue().cycles_for(name).any(|cycle| cycle.hole.is_some());
+        let drilling = Dialect::Sinumerik.catalogue().hole_cycle(name).is_some();
         if !drilling && name != "CYCLE800" {
             return self.state.not_run(&format!("the cycle {name}"), range);
         }
