@@ -47,14 +47,14 @@ use nc_exec::{
         program::{Resolved, Structure, StructureKind},
     },
 };
-use ncc_catalog::{Catalogue, Code, Cycle, Dialect, KeywordKind};
+use ncc_catalog::{Catalogue, Code, Cycle, Dialect};
 use ncc_syntax::TextRange;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::{
     db::Db,
     sinumerik::{
-        checks::visit::{signed_value, written_places},
+        checks::visit::{is_transformation, signed_value, written_places},
         model::FileModel,
     },
 };
@@ -231,20 +231,13 @@ impl State {
                 StatementKind::Command(command) => match catalogue.word_code(&command.name) {
                     Some(code) if code.group.as_deref() == Some(FRAMES) => self.frame(index, command),
                     Some(code) => codes.push(code),
-                    None if catalogue
-                        .keyword(&command.name)
-                        .is_some_and(|keyword| keyword.kind == KeywordKind::Transformation) =>
-                    {
-                        self.new_frame(index);
-                    }
+                    None if is_transformation(&command.name) => self.new_frame(index),
                     None => {}
                 },
                 // `G[8]=R1`: a group's code only the run knows, maybe a
                 // work offset's.
                 StatementKind::Assign { target, .. } if target.kind == PlaceKind::GroupCode => {
-                    self.modes = Modes::unknown();
-                    self.position = NOWHERE;
-                    self.frame = Known::Unknown;
+                    self.codes_unknown();
                     self.composed = Known::Unknown;
                 }
                 _ => {}
@@ -286,6 +279,19 @@ impl State {
         moved
     }
 
+    /// A code only the run knows (`G=R1`, `G[8]=R1`): any group's, a work
+    /// offset's too.
+    fn codes_unknown(&mut self) {
+        self.modes = Modes::unknown();
+        self.position = NOWHERE;
+        self.frame = Known::Unknown;
+    }
+
+    /// The working plane in force.
+    pub(crate) fn plane(&self) -> Option<Plane> {
+        self.modes.get(PLANE).and_then(Plane::from_code)
+    }
+
     /// Block `index` changed the frame, a work offset or the
     /// transformation: the positions count anew.
     fn new_frame(&mut self, index: usize) {
@@ -296,7 +302,7 @@ impl State {
     /// A hole cycle ran: the tool stands above the hole, at a height along
     /// the tool axis the walk does not follow.
     fn forget_tool_axis(&mut self) {
-        match self.modes.get(PLANE).and_then(Plane::from_code) {
+        match self.plane() {
             Some(plane) => self.position[plane.axes()[2]] = Known::Unknown,
             None => self.position = NOWHERE,
         }
@@ -397,7 +403,7 @@ impl State {
             (Known::Is(frame), true) => ProgrammableFrame::clone(frame),
             (Known::Unknown, true) => return None,
         };
-        let plane = Plane::from_code(self.modes.get(PLANE)?)?;
+        let plane = self.plane()?;
         let per_unit = self.modes.mm_per_unit()?;
         let values = command
             .words
@@ -426,11 +432,7 @@ impl State {
                 // move the origin.
                 None => self.new_frame(index),
             },
-            ("G", None) => {
-                self.modes = Modes::unknown();
-                self.position = NOWHERE;
-                self.frame = Known::Unknown;
-            }
+            ("G", None) => self.codes_unknown(),
             ("M", Some(number)) => codes.extend(catalogue.code('M', number)),
             // `M=R1`, `M1=3`, `SPOS=0`: another spindle or a value the
             // walk does not know.
@@ -556,7 +558,7 @@ impl RadiusArc<'_> {
             _ => None,
         })?;
         let radius = signed_value(radius)?;
-        let [a, b, _] = Plane::from_code(state.modes.get(PLANE)?)?.axes();
+        let [a, b, _] = state.plane()?.axes();
         let known = |position: &[Known<f64>], axis: usize| position[axis].known();
         Some(RadiusArc {
             axes: [PATH_AXES[a], PATH_AXES[b]],
@@ -596,6 +598,19 @@ pub(crate) struct Step<'a> {
     pub reached: bool,
     /// The control structure the block opens.
     pub opens: Option<&'a Structure>,
+}
+
+impl Step<'_> {
+    /// The range of the block's first statement that `matches`.
+    pub(crate) fn find(&self, file: &FileModel, matches: impl Fn(&Statement) -> bool) -> Option<TextRange> {
+        self.block.statements.iter().find(|s| matches(s)).map(|s| file.in_file(self.index, s.range))
+    }
+
+    /// The range of the block's first statement, for a finding on the
+    /// whole move; the block has one, since it moves.
+    pub(crate) fn first_statement(&self, file: &FileModel) -> TextRange {
+        file.in_file(self.index, self.block.statements[0].range)
+    }
 }
 
 /// What may hold on either of two ways; `None` is a way no run takes.

@@ -21,6 +21,7 @@ pub mod groups {
     pub const DIMENSIONS: &str = "G14";
     pub const FEED_MODE: &str = "G15";
     pub const ACCELERATION: &str = "G21";
+    pub const ORIENTATION_ANGLES: &str = "G50";
     pub const SPINDLE: &str = "M2";
     pub const COOLANT: &str = "M3";
 }

@@ -17,7 +17,7 @@ use nc_exec::sinumerik::{
     modes::groups::{FRAMES, WORK_OFFSETS},
     program::PROGRAM_LEVELS,
 };
-use ncc_catalog::{Dialect, KeywordKind};
+use ncc_catalog::Dialect;
 use ncc_syntax::TextRange;
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -26,7 +26,7 @@ use crate::{
     db::{Db, SourceFile},
     diagnostic::declare_rules,
     sinumerik::{
-        checks::visit::g_number,
+        checks::visit::{g_number, is_transformation},
         model::{FileModel, file_model},
         walk::PATH_AXES,
     },
@@ -208,10 +208,9 @@ fn in_place(db: &dyn Db, file: SourceFile) -> Option<TextRange> {
         for statement in &block.statements {
             match &statement.kind {
                 StatementKind::Command(command) => {
-                    let shifts =
-                        catalogue.word_code(&command.name).is_some_and(|code| {
-                            matches!(code.group.as_deref(), Some(FRAMES | WORK_OFFSETS)) || code.code == "G91"
-                        }) || catalogue.keyword(&command.name).is_some_and(|k| k.kind == KeywordKind::Transformation);
+                    let shifts = catalogue.word_code(&command.name).is_some_and(|code| {
+                        matches!(code.group.as_deref(), Some(FRAMES | WORK_OFFSETS)) || code.code == "G91"
+                    }) || is_transformation(&command.name);
                     if shifts {
                         return None;
                     }

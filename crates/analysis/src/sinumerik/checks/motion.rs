@@ -54,14 +54,14 @@ use nc_exec::{
         modes::groups::{COOLANT, DIMENSIONS, MOTION, SPINDLE, TOOL_RADIUS, WORK_OFFSETS},
     },
 };
-use ncc_catalog::{Catalogue, Dialect, KeywordKind};
+use ncc_catalog::{Catalogue, Dialect};
 use ncc_syntax::{TextEdit, TextRange};
 
 use crate::{
     Diagnostic,
     diagnostic::declare_rules,
     sinumerik::{
-        checks::visit::g_number,
+        checks::visit::{g_number, is_transformation, word_is},
         model::FileModel,
         walk::{FOLLOWED, PATH_AXES, RadiusArc, SAME_POINT_MM, Step},
     },
@@ -165,15 +165,6 @@ pub(crate) struct Motion {
     short_run_start: Option<TextRange>,
 }
 
-/// The range of the first statement of the block that `matches`.
-fn find(file: &FileModel, step: &Step<'_>, matches: impl Fn(&Statement) -> bool) -> Option<TextRange> {
-    step.block.statements.iter().find(|s| matches(s)).map(|s| file.in_file(step.index, s.range))
-}
-
-fn word_is(statement: &Statement, address: &str) -> bool {
-    matches!(&statement.kind, StatementKind::Word(word) if word.address == address)
-}
-
 /// The whole number of a literal M word.
 fn m_number(statement: &Statement) -> Option<u64> {
     match &statement.kind {
@@ -239,7 +230,7 @@ impl Motion {
         }
         self.contour(catalogue, file, step, out);
         if step.state.motion() == Some(SPLINE)
-            && let Some(range) = find(file, step, |s| matches!(&s.kind, StatementKind::Command(c) if c.name == SPLINE))
+            && let Some(range) = step.find(file, |s| matches!(&s.kind, StatementKind::Command(c) if c.name == SPLINE))
         {
             self.spline_start = Some(range);
         }
@@ -274,7 +265,7 @@ impl Motion {
         }
         self.feed_reported = true;
         let motion = step.state.motion().unwrap_or_default();
-        let Some(range) = find(file, step, |s| matches!(&s.kind, StatementKind::Word(w) if is_axis(&w.address))) else {
+        let Some(range) = step.find(file, |s| matches!(&s.kind, StatementKind::Word(w) if is_axis(&w.address))) else {
             return;
         };
         let message = format!(
@@ -289,13 +280,13 @@ impl Motion {
         if !stopped {
             self.spindle_stop = None;
             self.spindle_reported = false;
-        } else if let Some(range) = find(file, step, |s| matches!(m_number(s), Some(5 | 19))) {
+        } else if let Some(range) = step.find(file, |s| matches!(m_number(s), Some(5 | 19))) {
             self.spindle_stop = Some(range);
             self.spindle_reported = false;
         }
         // M3 or M4 with no S ever.
         if step.state.speed == Known::Is(None)
-            && let Some(range) = find(file, step, |s| matches!(m_number(s), Some(3 | 4)))
+            && let Some(range) = step.find(file, |s| matches!(m_number(s), Some(3 | 4)))
         {
             let message = "the spindle starts with no speed S programmed: it turns at S0; write S with M3 or M4";
             out.push(Diagnostic::new(&SPINDLE_WITHOUT_SPEED, range, message));
@@ -308,7 +299,7 @@ impl Motion {
         if !stopped || measuring || self.spindle_reported {
             return;
         }
-        let Some(range) = find(file, step, |s| PATH_AXES.iter().any(|axis| word_is(s, axis))) else { return };
+        let Some(range) = step.find(file, |s| PATH_AXES.iter().any(|axis| word_is(s, axis))) else { return };
         self.spindle_reported = true;
         let motion = step.state.motion().unwrap_or_default();
         let diagnostic = match self.spindle_stop {
@@ -336,7 +327,7 @@ impl Motion {
         if self.coolant_reported {
             return;
         }
-        let Some(range) = find(file, step, |s| PATH_AXES.iter().any(|axis| word_is(s, axis))) else { return };
+        let Some(range) = step.find(file, |s| PATH_AXES.iter().any(|axis| word_is(s, axis))) else { return };
         self.coolant_reported = true;
         let message = "a feed move with the coolant off: switch it on (M8) before cutting, unless the cut is dry";
         out.push(Diagnostic::new(&CUT_WITHOUT_COOLANT, range, message));
@@ -374,7 +365,7 @@ impl Motion {
         if wrote_any {
             return;
         }
-        let range = file.in_file(step.index, step.block.statements[0].range);
+        let range = step.first_statement(file);
         let message = "the program moves before it writes a safe block: tool radius compensation (G40), a work offset (G54 …, G500) or the dimensions (G90, G91) stand as the machine's reset left them; start with a block such as `G17 G40 G90 G54` (004:493-501)";
         out.push(Diagnostic::new(&NO_SAFE_BLOCK, range, message));
     }
@@ -417,7 +408,7 @@ impl Motion {
             .map(|axis| FOLLOWED[axis])
             .collect();
         let Some(first) = turned.first() else { return };
-        let Some(range) = find(file, step, |s| word_is(s, first)) else { return };
+        let Some(range) = step.find(file, |s| word_is(s, first)) else { return };
         let message = format!(
             "the tool turns ({}) while it plunges in Z: the thesis's simulation showed a ball-nose cutter entering the material while the table turned to be a problem; plunge first, then turn, or approach along the path (004:2786-2790)",
             turned.join(", ")
@@ -442,7 +433,7 @@ impl Motion {
         let Some((axis, degrees)) = turn.filter(|(_, degrees)| degrees / length > ORIENTATION_RATE_DEG_PER_MM) else {
             return;
         };
-        let Some(range) = find(file, step, |s| word_is(s, FOLLOWED[axis])) else { return };
+        let Some(range) = step.find(file, |s| word_is(s, FOLLOWED[axis])) else { return };
         let message = format!(
             "{} turns {degrees:.1}° over {length:.2} mm of path ({:.0}°/mm): the rotary axes cannot follow at the feed, so the path slows down, and the surface may show it (004:4223-4225)",
             FOLLOWED[axis],
@@ -462,7 +453,7 @@ impl Motion {
         if !moves_xy || to > from - SAME_POINT_MM {
             return;
         }
-        let Some(range) = find(file, step, |s| word_is(s, "Z")) else { return };
+        let Some(range) = step.find(file, |s| word_is(s, "Z")) else { return };
         let message = format!(
             "G0 lowers Z from {from} to {to} while it moves X or Y: each axis runs at its own rate, so the tool may reach the work before it is above its point; approach in X and Y first, then in Z"
         );
@@ -514,7 +505,7 @@ impl Motion {
             out.push(Diagnostic::new(&PLUNGE_AT_FULL_FEED, range, message));
         };
         if down && changed(0) == Known::Is(false) && changed(1) == Known::Is(false) {
-            self.plunge = find(file, step, |s| word_is(s, "Z")).map(|range| (range, feed));
+            self.plunge = step.find(file, |s| word_is(s, "Z")).map(|range| (range, feed));
         } else if changed(0) == Known::Is(true) || changed(1) == Known::Is(true) {
             if let Some((range, plunge)) = self.plunge.take()
                 && full(feed, plunge)
@@ -536,14 +527,14 @@ impl Motion {
         if !differs || step.state.motion() != Some(SPLINE) {
             return;
         }
-        let Some(range) = find(file, step, |s| PATH_AXES.iter().any(|axis| word_is(s, axis))) else { return };
+        let Some(range) = step.find(file, |s| PATH_AXES.iter().any(|axis| word_is(s, axis))) else { return };
         let message = "the spline's first point is not where the tool stands: the thesis's programs repeat the current position as the first point, so the spline starts there";
         out.push(Diagnostic::new(&SPLINE_FIRST_POINT, range, message).with_related(None, spline, SPLINE));
     }
 
     /// Rule 77: runs of short G1 moves without a compressor.
     fn short_moves(&mut self, catalogue: &Catalogue, file: &FileModel, step: &Step<'_>, out: &mut Vec<Diagnostic>) {
-        let Some(range) = find(file, step, |s| PATH_AXES.iter().any(|axis| word_is(s, axis))) else { return };
+        let Some(range) = step.find(file, |s| PATH_AXES.iter().any(|axis| word_is(s, axis))) else { return };
         let state = step.state;
         let compressor_group = catalogue.word_code(COMPRESSOR).and_then(|c| c.group.as_deref());
         // The compressors' group numbers COMPOF first.
@@ -680,9 +671,7 @@ impl Motion {
         for statement in &step.block.statements {
             match &statement.kind {
                 StatementKind::Command(command) => {
-                    let transformation =
-                        catalogue.keyword(&command.name).is_some_and(|k| k.kind == KeywordKind::Transformation);
-                    if transformation {
+                    if is_transformation(&command.name) {
                         self.traori =
                             command.name.starts_with("TRAORI").then(|| file.in_file(step.index, statement.range));
                     } else if catalogue.word_code(&command.name).and_then(|c| c.group.as_deref()) == Some(WORK_OFFSETS)
@@ -704,7 +693,7 @@ impl Motion {
         if step.moves
             && let Some(traori) = self.traori.take()
         {
-            let range = file.in_file(step.index, step.block.statements[0].range);
+            let range = step.first_statement(file);
             let message = "the first move after TRAORI, with no work offset (G54 …) or tool offset D programmed since: TRAORI may reset them, so program them again after it";
             out.push(Diagnostic::new(&OFFSETS_NOT_AFTER_TRAORI, range, message).with_related(None, traori, "TRAORI"));
         }

@@ -43,7 +43,7 @@ use nc_exec::{
     sinumerik::{
         frames::Plane,
         lower::{Callee, Dimension, StatementKind, WordValue},
-        modes::groups::{PLANE, TOOL_RADIUS},
+        modes::groups::TOOL_RADIUS,
     },
 };
 use ncc_catalog::{Dialect, HoleOperation};
@@ -192,7 +192,7 @@ impl Operations {
         if !step.reached {
             return;
         }
-        let plane = step.state.modes.get(PLANE).and_then(Plane::from_code);
+        let plane = step.state.plane();
         self.holes(file, step, plane, out);
         if !step.moves {
             return;
@@ -321,7 +321,7 @@ impl Operations {
                     && self.cut
                     && let Some(approach) = self.approach.filter(|&approach| from < approach - SAME_POINT_MM)
                 {
-                    let range = file.in_file(step.index, step.block.statements[0].range);
+                    let range = step.first_statement(file);
                     let axis = PATH_AXES[tool];
                     let message = format!(
                         "G0 moves in the plane with the tool at {axis}{from}, below {axis}{approach} where the cut started: the tool drags through the part or a clamp on its way; retract in {axis} alone first (004:381-383)"
@@ -366,7 +366,7 @@ impl Operations {
         } else {
             return false;
         };
-        let range = file.in_file(step.index, step.block.statements[0].range);
+        let range = step.first_statement(file);
         out.push(Diagnostic::new(&RAPID_INTO_STOCK, range, message));
         true
     }

@@ -33,16 +33,21 @@
 
 use nc_exec::{
     known::Known,
-    sinumerik::lower::{ExprKind, StatementKind, WordValue},
+    sinumerik::{
+        lower::{ExprKind, StatementKind, WordValue},
+        modes::groups::ORIENTATION_ANGLES,
+    },
 };
-use ncc_catalog::{Dialect, KeywordKind};
 use ncc_syntax::TextRange;
 
 use crate::{
     Diagnostic,
     diagnostic::declare_rules,
     sinumerik::{
-        checks::{program::TRANSFORMATION_OFF, visit::number},
+        checks::{
+            program::TRANSFORMATION_OFF,
+            visit::{is_transformation, number, word_is},
+        },
         model::FileModel,
         walk::{FOLLOWED, SAME_POINT_MM, Step},
     },
@@ -62,8 +67,7 @@ const TILT_IN_CONCAVE_DEGREES: f64 = 15.0;
 /// A point this far below the chord of its neighbours is concave.
 const CONCAVE_MM: f64 = 0.01;
 
-/// The orientation angles' group and its RPY member.
-const ANGLES_GROUP: &str = "G50";
+/// The orientation angles' code for RPY angles.
 const RPY: &str = "ORIRPY";
 
 /// Where the followed words are: the angles A2, B2 and the vector A3, B3,
@@ -132,7 +136,6 @@ impl<'a> Orientation<'a> {
 impl Orientation<'_> {
     /// The tool a T word selects, and TRAORI or TRAFOOF.
     fn tool_and_transformation(&mut self, step: &Step<'_>) {
-        let catalogue = Dialect::Sinumerik.catalogue();
         for statement in &step.block.statements {
             match &statement.kind {
                 StatementKind::Word(word) if word.address == "T" => {
@@ -141,9 +144,7 @@ impl Orientation<'_> {
                         (name, ball)
                     });
                 }
-                StatementKind::Command(command)
-                    if catalogue.keyword(&command.name).is_some_and(|k| k.kind == KeywordKind::Transformation) =>
-                {
+                StatementKind::Command(command) if is_transformation(&command.name) => {
                     self.transformed = command.name != TRANSFORMATION_OFF;
                 }
                 _ => {}
@@ -169,7 +170,7 @@ impl Orientation<'_> {
             return;
         }
         self.reported.push(tool.clone());
-        let range = file.in_file(step.index, step.block.statements[0].range);
+        let range = step.first_statement(file);
         let message = format!(
             "the ball-nose tool {tool} stands square to its path: its centre, where the cutting speed is zero, cuts the surface; tilt the tool along the path, as the thesis tilted it by the vector A3=1 B3=2 C3=6 (004:2947-2951)"
         );
@@ -187,17 +188,25 @@ fn tool_name(value: &WordValue) -> Option<String> {
     number(value).map(|number| number.value().to_string())
 }
 
+/// The vector A3, B3, C3 as a unit vector, where the walk knows all three
+/// (`Some(None)` for a vector without length); `None` where it does not.
+fn programmed_vector(step: &Step<'_>) -> Option<Option<[f64; 3]>> {
+    let position = &step.state.position;
+    let [a, b, c] = [VECTOR.start, VECTOR.start + 1, VECTOR.start + 2].map(|axis| position[axis].known());
+    let vector = [a?, b?, c?];
+    let length = vector.iter().map(|c| c * c).sum::<f64>().sqrt();
+    Some((length > f64::EPSILON).then(|| vector.map(|c| c / length)))
+}
+
 /// The tool's axis as a unit vector where the walk knows it: the vector
 /// A3, B3, C3, or Z where the angles leave the tool upright.
 fn tool_axis(step: &Step<'_>) -> Option<[f64; 3]> {
-    let position = &step.state.position;
-    let vector: Option<Vec<f64>> = VECTOR.clone().map(|axis| position[axis].known()).collect();
-    if let Some(vector) = vector {
-        let length = vector.iter().map(|c| c * c).sum::<f64>().sqrt();
-        return (length > f64::EPSILON).then(|| [vector[0] / length, vector[1] / length, vector[2] / length]);
+    if let Some(vector) = programmed_vector(step) {
+        return vector;
     }
+    let position = &step.state.position;
     let upright = |axis: usize| position[axis].known().is_some_and(|angle| angle.abs() <= f64::EPSILON);
-    let upright = match step.state.modes.get(ANGLES_GROUP)? {
+    let upright = match step.state.modes.get(ORIENTATION_ANGLES)? {
         RPY => upright(A2) && upright(B2),
         _ => upright(B2),
     };
@@ -224,26 +233,14 @@ fn below_chord(start: [f64; 3], middle: [f64; 3], end: [f64; 3]) -> Option<f64> 
 /// The tool's tilt from Z after the step, in degrees, and the word of the
 /// block that gives it.
 fn tilt(file: &FileModel, step: &Step<'_>) -> Option<(f64, TextRange)> {
-    let position = &step.state.position;
-    let written = |axis: usize| {
-        step.block.statements.iter().find_map(|statement| match &statement.kind {
-            StatementKind::Word(word) if word.address == FOLLOWED[axis] => {
-                Some(file.in_file(step.index, statement.range))
-            }
-            _ => None,
-        })
-    };
-    let vector: Option<Vec<f64>> = VECTOR.clone().map(|axis| position[axis].known()).collect();
-    if let Some(vector) = vector {
-        let length = vector.iter().map(|c| c * c).sum::<f64>().sqrt();
-        if length <= f64::EPSILON {
-            return None;
-        }
-        let degrees = (vector[2] / length).clamp(-1.0, 1.0).acos().to_degrees();
+    let written = |axis: usize| step.find(file, |statement| word_is(statement, FOLLOWED[axis]));
+    if let Some(vector) = programmed_vector(step) {
+        let degrees = vector?[2].clamp(-1.0, 1.0).acos().to_degrees();
         return Some((degrees, VECTOR.clone().find_map(written)?));
     }
+    let position = &step.state.position;
     let b = position[B2].known()?;
-    let degrees = match step.state.modes.get(ANGLES_GROUP)? {
+    let degrees = match step.state.modes.get(ORIENTATION_ANGLES)? {
         RPY => (position[A2].known()?.to_radians().cos() * b.to_radians().cos()).clamp(-1.0, 1.0).acos().to_degrees(),
         _ => b.abs(),
     };

@@ -23,7 +23,7 @@ use nc_exec::sinumerik::{
     lower::{BinaryOp, Callee, Expr, ExprKind, Jump, JumpKind, JumpTarget, Place, PlaceKind, Statement, StatementKind},
     program::{Resolved, Structure, StructureKind, Unbalanced},
 };
-use ncc_catalog::{AddressRole, Catalogue, Dialect, KeywordKind};
+use ncc_catalog::{AddressRole, Catalogue, Dialect};
 use ncc_syntax::{TextEdit, TextRange, TextSize};
 
 use crate::{
@@ -31,7 +31,7 @@ use crate::{
     db::Db,
     diagnostic::declare_rules,
     sinumerik::{
-        checks::visit::{all_exprs, each_expr},
+        checks::visit::{all_exprs, each_expr, is_transformation},
         model::FileModel,
     },
 };
@@ -450,7 +450,7 @@ fn modes_at_end(db: &dyn Db, catalogue: &Catalogue, file: &FileModel, out: &mut 
         for statement in &block.statements {
             let StatementKind::Command(command) = &statement.kind else { continue };
             let range = file.in_file(index, statement.range);
-            if catalogue.keyword(&command.name).is_some_and(|k| k.kind == KeywordKind::Transformation) {
+            if is_transformation(&command.name) {
                 transformation = (command.name != TRANSFORMATION_OFF).then(|| (command.name.clone(), range));
             }
             let Some(code) = catalogue.word_code(&command.name) else { continue };

@@ -1,9 +1,10 @@
 //! The expressions and places of a lowered block, for the rules that read
-//! every one of them.
+//! every one of them, and what its statements are.
 
 use nc_exec::sinumerik::lower::{
     Call, Callee, Expr, ExprKind, Jump, JumpTarget, Number, Place, Statement, StatementKind, UnaryOp, Word, WordValue,
 };
+use ncc_catalog::{Dialect, KeywordKind};
 
 /// Every expression written directly in `statement` (not those inside
 /// them), synchronous actions' included.
@@ -123,6 +124,17 @@ pub(crate) fn written_places<'a>(statement: &'a Statement, f: &mut impl FnMut(&'
         StatementKind::SyncAction { actions, .. } => actions.iter().for_each(|action| written_places(action, f)),
         _ => {}
     }
+}
+
+/// Whether a statement is a word of this address.
+pub(crate) fn word_is(statement: &Statement, address: &str) -> bool {
+    matches!(&statement.kind, StatementKind::Word(word) if word.address == address)
+}
+
+/// Whether a command names a kinematic transformation of the catalogue
+/// (`TRAORI`, `TRAFOOF`).
+pub(crate) fn is_transformation(name: &str) -> bool {
+    Dialect::Sinumerik.catalogue().keyword(name).is_some_and(|keyword| keyword.kind == KeywordKind::Transformation)
 }
 
 /// The number of a G word written as a whole number (`G505`).
