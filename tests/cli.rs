@@ -1493,3 +1493,60 @@ fn run_places(program: &Path) -> (serde_json::Value, Vec<(String, u64)>) {
         .collect();
     (json, places)
 }
+
+/// `ncc fmt --check` and `--diff` say what would change and exit with 1,
+/// changing nothing; `ncc fmt` writes the files in the project's style,
+/// in their own encoding, and leaves a formatted file alone.
+#[test]
+fn fmt_checks_diffs_and_writes_in_the_projects_style() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("ncc.toml"), "[format]\ncase = \"upper\"\nnumbers = \"trim\"\n").unwrap();
+    let (mill, lathe, done) = (dir.path().join("A.MPF"), dir.path().join("O0001.nc"), dir.path().join("B.SPF"));
+    let mill_text = "g1  x10.500 F1000 ; feed  \nM30\n";
+    std::fs::write(&mill, mill_text).unwrap();
+    // The control's code page: `Č` is byte 0x80 in Kamenický.
+    let lathe_bytes = b"G0  X1.0 (\x80)\nM30\n";
+    std::fs::write(&lathe, lathe_bytes).unwrap();
+    std::fs::write(&done, "G1 X1\nM17\n").unwrap();
+    let root = dir.path().to_str().unwrap();
+
+    let check = ncc(&["fmt", "--check", root]);
+    assert_eq!(check.status.code(), Some(1));
+    let out = stdout(&check).replace(root, "DIR");
+    expect_test::expect![[r#"
+        Would reformat: DIR/A.MPF
+        Would reformat: DIR/O0001.nc
+        2 files would be reformatted, 1 file already formatted
+    "#]]
+    .assert_eq(&out);
+
+    let diff = ncc(&["fmt", "--diff", mill.to_str().unwrap()]);
+    assert_eq!(diff.status.code(), Some(1));
+    let out = stdout(&diff).replace(root, "DIR");
+    expect_test::expect![[r#"
+        --- DIR/A.MPF
+        +++ DIR/A.MPF
+        @@ -1,2 +1,2 @@
+        -g1  x10.500 F1000 ; feed  
+        +G1 X10.5 F1000    ; feed  
+         M30
+        1 file would be reformatted, 0 files already formatted
+    "#]]
+    .assert_eq(&out);
+    assert_eq!(std::fs::read_to_string(&mill).unwrap(), mill_text, "--check and --diff change nothing");
+
+    let write = ncc(&["fmt", root]);
+    assert_eq!(write.status.code(), Some(0), "{}", String::from_utf8_lossy(&write.stderr));
+    assert_eq!(stdout(&write), "2 files reformatted, 1 file left unchanged\n");
+    assert_eq!(std::fs::read_to_string(&mill).unwrap(), "G1 X10.5 F1000    ; feed  \nM30\n");
+    assert_eq!(std::fs::read(&lathe).unwrap(), b"G0 X1.0  (\x80)\nM30\n");
+    let again = ncc(&["fmt", "--check", root]);
+    assert_eq!(again.status.code(), Some(0), "{}", stdout(&again));
+}
+
+#[test]
+fn fmt_fails_on_a_missing_path() {
+    let run = ncc(&["fmt", "no-such-file.NCP"]);
+    assert_eq!(run.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("no-such-file.NCP"));
+}

@@ -493,6 +493,32 @@ fn completion_in_a_haas_program_offers_the_targets() {
     assert_serving(&mut client, &dir);
 }
 
+/// Range formatting changes the selected lines only, in the project's
+/// style, and whole-document formatting all of them.
+#[test]
+fn range_formatting_formats_the_selected_lines_in_the_projects_style() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("ncc.toml"), "[format]\ncase = \"upper\"\n").unwrap();
+    let mut client = server();
+    let initialized = client.initialize(dir.path(), None).unwrap();
+    assert_eq!(initialized.result().unwrap()["capabilities"]["documentRangeFormattingProvider"], json!(true));
+    let doc = document(&dir, "PART.MPF", "g0  x1\ng1  x2 f100\ng1  x3\nM30\n");
+    open(&mut client, &doc);
+    let options = json!({ "tabSize": 4, "insertSpaces": true });
+    let line_2 = json!({ "start": { "line": 1, "character": 2 }, "end": { "line": 1, "character": 3 } });
+    let ranged = json!({ "textDocument": doc.id(), "range": line_2, "options": options });
+    let answer = client.call("textDocument/rangeFormatting", ranged).unwrap();
+    assert_eq!(
+        answer.result().unwrap_or_else(|| panic!("{}", answer.json)),
+        &json!([{ "range": { "start": { "line": 1, "character": 0 }, "end": { "line": 1, "character": 8 } },
+                  "newText": "G1 X2 F" }])
+    );
+    let whole = json!({ "textDocument": doc.id(), "options": options });
+    let answer = client.call("textDocument/formatting", whole).unwrap();
+    assert_eq!(answer.result().and_then(Value::as_array).map(Vec::len), Some(3), "{}", answer.json);
+    assert_serving(&mut client, &dir);
+}
+
 #[test]
 fn shutdown_then_exit_ends_with_success() {
     let (mut client, dir) = session();

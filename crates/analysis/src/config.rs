@@ -114,6 +114,7 @@ pub struct Config {
     pub report: ReportConfig,
     pub machine: MachineConfig,
     pub sinumerik: SinumerikConfig,
+    pub format: FormatConfig,
 }
 
 /// Which dialect a program is in: `dialect` and `[extensions]` in
@@ -193,6 +194,69 @@ pub struct SinumerikConfig {
     pub ball_nose_tools: Vec<String>,
 }
 
+/// The `[format]` section of `ncc.toml`: the style `ncc fmt` and the
+/// editor's formatting write. Every choice keeps what the program does;
+/// the defaults change spacing only.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "kebab-case", default)]
+pub struct FormatConfig {
+    pub spacing: WordSpacing,
+    pub case: LetterCase,
+    pub numbers: NumberStyle,
+    pub word_order: WordOrder,
+}
+
+/// What separates the words of a block.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum WordSpacing {
+    /// One space between the items of a block (`N10 G0 X0`).
+    #[default]
+    One,
+    /// Words written together (`N10G0X0`), as tape-era programs save
+    /// memory; other items keep one space. Sinumerik keeps one everywhere:
+    /// its names run on until a space.
+    None,
+}
+
+/// The case of address letters (and, in Sinumerik, of names and keywords,
+/// which it reads in any case; strings and comments are kept).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LetterCase {
+    #[default]
+    Keep,
+    Upper,
+}
+
+/// How numbers with a decimal point are written; a number without one is
+/// never touched, since the point can change what it means (CNC8x6
+/// `R1=864` is 0.864, Haas dwell `P30` is 30 ms).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum NumberStyle {
+    #[default]
+    Keep,
+    /// Zeros that say nothing go: `X010.500` becomes `X10.5`, `Z-2.000`
+    /// `Z-2.0` (one digit after the point stays); codes (`G54.1`) and block
+    /// numbers are kept.
+    Trim,
+}
+
+/// The order of a block's words.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum WordOrder {
+    #[default]
+    Keep,
+    /// Block number, G codes, axes, arc and corner words, feed, speed,
+    /// tool, offset, M codes, then the function's arguments (`P`, `Q`, `L`,
+    /// `H`), by the catalogue's address roles. Only blocks of plain words
+    /// (a letter and a number) on one line, with no letter twice but the
+    /// codes', are reordered: there the control reads the block as a whole.
+    Standard,
+}
+
 /// A version of Sinumerik's cycles whose argument lists the catalogue has.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -227,6 +291,8 @@ struct ConfigFile {
     report: ReportConfig,
     #[serde(default)]
     sinumerik: SinumerikConfig,
+    #[serde(default)]
+    format: FormatConfig,
     #[serde(default)]
     machine: Option<MachineFile>,
 }
@@ -552,6 +618,7 @@ impl Config {
             rules: file.rules,
             report: file.report,
             sinumerik: file.sinumerik,
+            format: file.format,
             // The machine's control is the project's dialect when this
             // build reads it; the machine's keys are read in its terms.
             machine: MachineConfig::of_control(file.dialect.unwrap_or_default()),

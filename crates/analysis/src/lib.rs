@@ -44,8 +44,8 @@ pub use crate::ide::{
 };
 pub use crate::{
     config::{
-        CONFIG_FILE, Config, CycleVersion, Dialects, Level, MachineConfig, ReportConfig, SinumerikConfig,
-        parse_constant,
+        CONFIG_FILE, Config, CycleVersion, Dialects, FormatConfig, LetterCase, Level, MachineConfig, NumberStyle,
+        ReportConfig, SinumerikConfig, WordOrder, WordSpacing, parse_constant,
     },
     db::{RootDatabase, SourceFile},
     diagnostic::{Diagnostic, Fix, Related, Rule},
@@ -299,10 +299,11 @@ impl Analysis {
         ide::references(&self.db, file, offset, include_declaration)
     }
 
-    /// The edits that format the file: spacing only (the style is in
-    /// `ide/format.rs`), sorted and not overlapping.
-    pub fn format(&self, file: FileId) -> Vec<TextEdit> {
-        ide::format(&self.db, file)
+    /// The edits that format the file in the project's style (`[format]`
+    /// in `ncc.toml`; what it does is in `ide/format.rs`): one per changed
+    /// line, sorted. With `range`, only the lines it touches change.
+    pub fn format(&self, file: FileId, range: Option<TextRange>) -> Vec<TextEdit> {
+        ide::format(&self.db, file, range)
     }
 
     /// What may be written at `offset`, most relevant first.

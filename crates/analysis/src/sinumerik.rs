@@ -5,3 +5,6 @@
 pub(crate) mod checks;
 pub(crate) mod model;
 pub(crate) mod walk;
+
+/// The longest block the control reads (004:284-286).
+pub(crate) const MAX_BLOCK_CHARS: usize = 512;

@@ -689,7 +689,7 @@ fn every_lathe_example_answers_everywhere() {
         let analysis = host.analysis();
         let file = ids[0];
         let _ = (analysis.document_symbols(file), analysis.folding_ranges(file), analysis.highlight(file));
-        let _ = (analysis.diagnostics(file), analysis.inlay_hints(file, None), analysis.format(file));
+        let _ = (analysis.diagnostics(file), analysis.inlay_hints(file, None), analysis.format(file, None));
         for offset in (0..=text.len()).filter(|&i| text.is_char_boundary(i)) {
             let offset = TextSize::try_from(offset).unwrap();
             let _ = analysis.hover(file, offset);

@@ -44,7 +44,7 @@ pub(crate) fn read_program(path: &Path) -> io::Result<String> {
 /// Reads a regular file (through symbolic links). Anything else is refused
 /// with what it is: a named pipe would wait for a writer forever, and a
 /// device may never end.
-fn read_file(path: &Path) -> io::Result<Vec<u8>> {
+pub(crate) fn read_file(path: &Path) -> io::Result<Vec<u8>> {
     let kind = std::fs::metadata(path)?.file_type();
     if kind.is_dir() {
         return Err(io::Error::new(io::ErrorKind::IsADirectory, "a directory, not a file"));

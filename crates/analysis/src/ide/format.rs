@@ -1,49 +1,124 @@
-//! Document formatting: spacing only, never the program's meaning.
+//! Document formatting: the style of `[format]` in `ncc.toml`, never the
+//! program's meaning.
 //!
-//! The style follows the manual's examples and common CNC8x6 practice:
+//! Always, in every dialect:
 //!
-//! * a block's `N` starts its line; a line that continues a block is
-//!   indented by one space (`N10 R1=100.` / ` R2=200.`);
 //! * one space between the items of a block (`N10 G0X0` → `N10 G0 X0`),
-//!   none inside a word or an assignment (`X  36.12` → `X36.12`,
-//!   `R1 = 5` → `R1=5`);
+//!   or none between words where `spacing = "none"` asks for it (not in
+//!   Sinumerik, whose names run on until a space);
 //! * a comment stays in its column: one after words keeps it as far as
 //!   the words before it leave room (aligned comments stay aligned), and
 //!   one that begins a line keeps its indentation;
-//! * trailing spaces and tabs are removed, tabs become spaces.
+//! * trailing spaces and tabs are removed.
 //!
-//! Everything else is kept as written: comments, line endings (`\r\n`
-//! stays), blank lines, the `%` header line, everything from the `*` end
-//! on, and the spacing around any syntax error, whose text may mean
-//! something else once respaced. Lines are never joined or split, and a
-//! line is left alone if respacing would make it longer than the
-//! control's 80 characters.
+//! CNC8x6, as the manual's examples write it: a block's `N` starts its
+//! line, a line that continues a block is indented by one space
+//! (`N10 R1=100.` / ` R2=200.`), and nothing separates the parts of a word
+//! or an assignment (`X  36.12` → `X36.12`, `R1 = 5` → `R1=5`). The Haas
+//! lathe and Sinumerik, whose block is a line, keep a line's indentation
+//! (Sinumerik's loops and branches are often indented) and the spacing
+//! inside a statement (`IF [#1 GT 2]`, `DEF REAL A`).
+//!
+//! On request, letters to upper case, redundant zeros of decimal numbers
+//! removed and the words of plain blocks put in the standard order (see
+//! [`FormatConfig`]).
+//!
+//! Everything else is kept as written: comments, strings, line endings
+//! (`\r\n` stays), blank lines, the CNC8x6 `%` header line and everything
+//! from its `*` end on, the Haas `%` tape marks, and the text around any
+//! syntax error, whose text may mean something else once changed. Lines
+//! are never joined or split, and a line is left alone if formatting would
+//! make it longer than the control reads.
 
-use ncc_catalog::AddressRole;
+use ncc_catalog::{AddressRole, Catalogue, Dialect, FunctionKind};
 use ncc_syntax::{MAX_LINE_CHARS, NcLanguage, Parse, SyntaxErrorKind, SyntaxKind, TextEdit, TextRange, TextSize};
 use rowan::{GreenNodeData, NodeOrToken};
 
-/// The edits that format `text`, whose parse is `parse`: sorted, not
-/// overlapping, each replacing one run of spaces (or the empty gap between
-/// two items) that changes.
-pub(crate) fn format(text: &str, parse: &Parse) -> Vec<TextEdit> {
-    let block_letter = parse.dialect().catalogue().letter_with_role(AddressRole::BlockNumber);
+use crate::config::{FormatConfig, LetterCase, NumberStyle, WordOrder, WordSpacing};
+
+/// The edits that format `text`, whose parse is `parse`, in `style`: one
+/// per changed line, sorted. With `range`, only the lines it touches
+/// change.
+pub(crate) fn format(text: &str, parse: &Parse, style: FormatConfig, range: Option<TextRange>) -> Vec<TextEdit> {
+    let dialect = parse.dialect();
+    let catalogue = dialect.catalogue();
+    // A long line is the line's, not its text's; a lower-case letter is
+    // what `case` changes.
+    let folds = style.case == LetterCase::Upper;
+    let errors = Errors::new(parse, |kind| {
+        kind != SyntaxErrorKind::LineTooLong && !(folds && kind == SyntaxErrorKind::LowercaseAddress)
+    });
     let mut formatter = Formatter {
         text,
-        errors: parse.errors().iter().filter(|e| e.kind != SyntaxErrorKind::LineTooLong).map(|e| e.range).collect(),
-        next_error: 0,
-        error_reach: None,
-        block_letter,
+        layout: Layout::of(dialect),
+        catalogue,
+        style,
+        errors,
+        block_letter: catalogue.letter_with_role(AddressRole::BlockNumber),
         items: 0,
         block_head: false,
         after_end: false,
-        edits: Vec::new(),
-        line: Line { start: 0, edits: 0, growth: 0 },
+        word_role: None,
+        slot: None,
+        out: String::with_capacity(text.len()),
+        line: Line { start: 0, out_start: 0 },
         prev: None,
     };
     formatter.node(parse.green(), 0, Place::Free);
     formatter.end_line(text.len());
-    formatter.edits
+    line_edits(text, &formatter.out, range)
+}
+
+/// What formatting must know of a dialect's layout.
+#[derive(Debug, Clone, Copy)]
+struct Layout {
+    /// A block is a line: a line's indentation is the programmer's.
+    block_is_line: bool,
+    /// Nothing separates the parts of an item (CNC8x6 `X36.12`, `R1=5`);
+    /// otherwise the spacing inside an item is kept.
+    tight_items: bool,
+    /// Words may be written together (`N10G0X0`).
+    joins_words: bool,
+    /// Names and keywords are read in any case, so `case` changes them too.
+    folds_names: bool,
+    /// The most characters a line may have after formatting: what the
+    /// control reads of a block.
+    line_limit: usize,
+}
+
+impl Layout {
+    fn of(dialect: Dialect) -> Layout {
+        match dialect {
+            Dialect::Cnc8x6 => Layout {
+                block_is_line: false,
+                tight_items: true,
+                joins_words: true,
+                folds_names: false,
+                line_limit: MAX_LINE_CHARS,
+            },
+            Dialect::HaasLathe => Layout {
+                block_is_line: true,
+                tight_items: false,
+                joins_words: true,
+                folds_names: false,
+                // The manual gives no limit.
+                line_limit: usize::MAX,
+            },
+            // Sinumerik reads a name until a space, so words stay apart.
+            Dialect::Sinumerik => Layout {
+                block_is_line: true,
+                tight_items: false,
+                joins_words: false,
+                folds_names: true,
+                line_limit: crate::sinumerik::MAX_BLOCK_CHARS,
+            },
+        }
+    }
+
+    /// Whether a node of `kind` directly in a block is one of its items.
+    fn is_item(self, kind: SyntaxKind) -> bool {
+        !self.tight_items || matches!(kind, SyntaxKind::WORD | SyntaxKind::PARAM_ASSIGN | SyntaxKind::BLOCK_SKIP)
+    }
 }
 
 /// Where a token sits, as far as spacing goes.
@@ -51,8 +126,9 @@ pub(crate) fn format(text: &str, parse: &Parse) -> Vec<TextEdit> {
 enum Place {
     /// Between the items of a block, or between blocks.
     Free,
-    /// Inside one item (a word, an assignment, a block skip), by number.
-    Item(u32),
+    /// Inside one item (a word, an assignment, a statement), by number,
+    /// and whether the item is a word.
+    Item(u32, bool),
     /// Kept as written: the header line, text the parser could not place.
     Verbatim,
 }
@@ -61,28 +137,27 @@ enum Place {
 #[derive(Debug, Clone, Copy)]
 struct Token {
     kind: SyntaxKind,
+    /// Where the gap after it starts.
     end: usize,
     place: Place,
     /// The block number that starts a block.
     starts_block: bool,
 }
 
-/// The line being formatted.
+/// The line being formatted: where it starts in the text and in the
+/// output.
 struct Line {
     start: usize,
-    /// Index of the line's first edit.
-    edits: usize,
-    /// Bytes the line's edits so far add (negative: remove).
-    growth: i64,
+    out_start: usize,
 }
 
 struct Formatter<'a> {
     text: &'a str,
-    /// Ranges of the syntax errors, by start.
-    errors: Vec<TextRange>,
-    next_error: usize,
-    /// The furthest end of the errors that start before the current gap.
-    error_reach: Option<TextSize>,
+    layout: Layout,
+    catalogue: &'static Catalogue,
+    style: FormatConfig,
+    /// The syntax errors that keep the text around them as written.
+    errors: Errors,
     block_letter: Option<u8>,
     /// Items numbered so far.
     items: u32,
@@ -90,7 +165,13 @@ struct Formatter<'a> {
     block_head: bool,
     /// The `*` end has been passed: nothing after it changes.
     after_end: bool,
-    edits: Vec<TextEdit>,
+    /// The role of the address of the word being read, once its letter
+    /// has been.
+    word_role: Option<AddressRole>,
+    /// Where the slot of a reordered item starts, until its first token
+    /// is written.
+    slot: Option<usize>,
+    out: String,
     line: Line,
     /// The previous token on the current line.
     prev: Option<Token>,
@@ -99,29 +180,48 @@ struct Formatter<'a> {
 impl Formatter<'_> {
     /// Visits the children of `node`, which starts at `offset`.
     fn node(&mut self, node: &GreenNodeData, mut offset: usize, place: Place) {
+        let reordered = self.reordered_items(node, offset, place);
+        let mut items = reordered.iter().flatten();
         for child in node.children() {
+            let len = usize::from(child.text_len());
             match child {
-                NodeOrToken::Token(token) => {
-                    self.token(kind(token.kind()), offset, token.text(), place);
-                }
+                NodeOrToken::Token(token) => self.token(kind(token.kind()), offset, token.text(), place),
                 NodeOrToken::Node(inner) => {
-                    let inner_place = match (place, kind(inner.kind())) {
-                        (Place::Verbatim, _) | (_, SyntaxKind::HEADER | SyntaxKind::ERROR) => Place::Verbatim,
-                        (Place::Free, SyntaxKind::WORD | SyntaxKind::PARAM_ASSIGN | SyntaxKind::BLOCK_SKIP) => {
-                            self.items += 1;
-                            Place::Item(self.items)
+                    let inner_kind = kind(inner.kind());
+                    let inner_place = match (place, inner_kind) {
+                        (Place::Verbatim, _) | (_, SyntaxKind::HEADER | SyntaxKind::ERROR | SyntaxKind::TAPE_MARK) => {
+                            Place::Verbatim
                         }
                         (Place::Free, SyntaxKind::BLOCK) => {
                             self.block_head = true;
                             Place::Free
                         }
+                        (Place::Free, SyntaxKind::BLOCK_RUN) => Place::Free,
+                        (Place::Free, _) if self.layout.is_item(inner_kind) => {
+                            self.items += 1;
+                            Place::Item(self.items, inner_kind == SyntaxKind::WORD)
+                        }
                         // A parameter reference inside its word, the end.
                         (place, _) => place,
                     };
-                    self.node(inner, offset, inner_place);
+                    if matches!(inner_place, Place::Item(..)) && inner_place != place {
+                        self.word_role = None;
+                    }
+                    match items.next() {
+                        // A reordered item takes the slot of the one it
+                        // replaces: the gaps around it are the slot's.
+                        Some(&(moved_from, moved)) => {
+                            self.slot = Some(offset);
+                            self.node(moved, moved_from, inner_place);
+                            if let Some(prev) = self.prev.as_mut() {
+                                prev.end = offset + len;
+                            }
+                        }
+                        None => self.node(inner, offset, inner_place),
+                    }
                 }
             }
-            offset += usize::from(child.text_len());
+            offset += len;
         }
     }
 
@@ -130,7 +230,8 @@ impl Formatter<'_> {
             SyntaxKind::WHITESPACE => {}
             SyntaxKind::NEWLINE => {
                 self.end_line(start);
-                self.line = Line { start: start + text.len(), edits: self.edits.len(), growth: 0 };
+                self.out.push_str(text);
+                self.line = Line { start: start + text.len(), out_start: self.out.len() };
             }
             _ => {
                 let place = match kind {
@@ -142,7 +243,9 @@ impl Formatter<'_> {
                 let head = std::mem::take(&mut self.block_head);
                 let starts_block = head && text.bytes().next().map(|b| b.to_ascii_uppercase()) == self.block_letter;
                 let token = Token { kind, end: start + text.len(), place, starts_block };
-                self.gap(start, Some(token));
+                let gap_end = self.slot.take().unwrap_or(start);
+                self.gap(gap_end, Some(token));
+                self.write_token(kind, start, text, place);
                 self.prev = Some(token);
                 if kind == SyntaxKind::STAR {
                     self.after_end = true;
@@ -151,29 +254,68 @@ impl Formatter<'_> {
         }
     }
 
-    /// Ends the line at `end`: its trailing spaces go, and its edits are
-    /// dropped if they would make it too long for the control.
+    /// Writes a token, in the style's case and number form where it may
+    /// change.
+    fn write_token(&mut self, kind: SyntaxKind, start: usize, text: &str, place: Place) {
+        if kind == SyntaxKind::LETTER && self.word_role.is_none() {
+            let upper = text.to_ascii_uppercase();
+            self.word_role = Some(self.catalogue.address(&upper).map_or(AddressRole::Parameter, |a| a.role));
+        }
+        let free = matches!(place, Place::Item(..)) && !self.after_end;
+        let end = start + text.len();
+        match kind {
+            SyntaxKind::LETTER | SyntaxKind::IDENT => {
+                let folds = kind == SyntaxKind::LETTER || self.layout.folds_names;
+                if self.style.case == LetterCase::Upper
+                    && folds
+                    && free
+                    && text.bytes().any(|b| b.is_ascii_lowercase())
+                    && !self.errors.touch(start, end)
+                {
+                    self.out.push_str(&text.to_ascii_uppercase());
+                    return;
+                }
+            }
+            SyntaxKind::NUMBER => {
+                let code = matches!(
+                    self.word_role,
+                    Some(AddressRole::Function | AddressRole::BlockNumber | AddressRole::ProgramNumber)
+                );
+                if self.style.numbers == NumberStyle::Trim
+                    && !code
+                    && free
+                    && let Some(trimmed) = trimmed_number(text)
+                    && !self.errors.touch(start, end)
+                {
+                    self.out.push_str(&trimmed);
+                    return;
+                }
+            }
+            _ => {}
+        }
+        self.out.push_str(text);
+    }
+
+    /// Ends the line at `end`: its trailing spaces go, and it is written
+    /// as it was if formatting made it too long for the control.
     fn end_line(&mut self, end: usize) {
         self.gap(end, None);
         self.prev = None;
-        if self.line.growth > 0 {
-            let chars = self.text[self.line.start..end].chars().count() as i64;
-            if chars + self.line.growth > MAX_LINE_CHARS as i64 {
-                self.edits.truncate(self.line.edits);
-            }
+        let old = &self.text[self.line.start..end];
+        let new = &self.out[self.line.out_start..];
+        if new.len() > old.len() && new.chars().count() > self.layout.line_limit {
+            self.out.truncate(self.line.out_start);
+            self.out.push_str(old);
         }
     }
 
-    /// Respaces the gap before `next` (`None`: the end of the line), which
+    /// Writes the gap before `next` (`None`: the end of the line), which
     /// ends at `end`.
     fn gap(&mut self, end: usize, next: Option<Token>) {
         let start = self.prev.map_or(self.line.start, |prev| prev.end);
-        let Some(spaces) = self.spacing(start, end, next) else { return };
-        let old = &self.text.as_bytes()[start..end];
-        self.line.growth += spaces as i64 - old.len() as i64;
-        if old.len() != spaces || old.iter().any(|&b| b != b' ') {
-            let range = TextRange::new(offset(start), offset(end));
-            self.edits.push(TextEdit::replace(range, " ".repeat(spaces)));
+        match self.spacing(start, end, next) {
+            Some(spaces) => self.out.extend(std::iter::repeat_n(' ', spaces)),
+            None => self.out.push_str(&self.text[start..end]),
         }
     }
 
@@ -182,7 +324,7 @@ impl Formatter<'_> {
     fn spacing(&mut self, start: usize, end: usize, next: Option<Token>) -> Option<usize> {
         let prev = self.prev;
         let verbatim = |token: Option<Token>| token.is_some_and(|t| t.place == Place::Verbatim);
-        if self.after_end || verbatim(prev) || verbatim(next) || self.touches_error(start, end) {
+        if self.after_end || verbatim(prev) || verbatim(next) || self.errors.touch(start, end) {
             return None;
         }
         let Some(next) = next else {
@@ -192,29 +334,239 @@ impl Formatter<'_> {
             return (!joins).then_some(0);
         };
         match prev {
+            None if self.layout.block_is_line => None,
             None if next.starts_block || next.kind == SyntaxKind::STAR => Some(0),
             None if next.kind == SyntaxKind::COMMENT => None,
             // A line that continues its block.
             None => Some(1),
             // The comment keeps its column if there is room.
             Some(_) if next.kind == SyntaxKind::COMMENT => {
+                let written = (self.out.len() - self.line.out_start) as i64;
+                let growth = written - (start - self.line.start) as i64;
                 let old = (end - start) as i64;
-                Some(usize::try_from(old - self.line.growth).unwrap_or(0).max(1))
+                Some(usize::try_from(old - growth).unwrap_or(0).max(1))
             }
-            Some(prev) if matches!(prev.place, Place::Item(_)) && prev.place == next.place => Some(0),
+            Some(Token { place: Place::Item(item, _), .. }) if matches!(next.place, Place::Item(i, _) if i == item) => {
+                self.layout.tight_items.then_some(0)
+            }
+            Some(Token { place: Place::Item(_, true), .. })
+                if matches!(next.place, Place::Item(_, true))
+                    && self.style.spacing == WordSpacing::None
+                    && self.layout.joins_words =>
+            {
+                Some(0)
+            }
             Some(_) => Some(1),
         }
     }
 
-    /// Whether the gap `start..end` touches a syntax error (other than a
-    /// long line). Gaps come in order, so the errors are swept once.
-    fn touches_error(&mut self, start: usize, end: usize) -> bool {
-        while let Some(error) = self.errors.get(self.next_error).filter(|e| e.start() <= offset(end)) {
-            self.error_reach = Some(self.error_reach.map_or(error.end(), |reach| reach.max(error.end())));
-            self.next_error += 1;
+    /// The items of `node` in the standard order, when it is a block the
+    /// style reorders and the order changes.
+    fn reordered_items<'n>(
+        &self,
+        node: &'n GreenNodeData,
+        offset: usize,
+        place: Place,
+    ) -> Option<Vec<(usize, &'n GreenNodeData)>> {
+        if self.style.word_order != WordOrder::Standard
+            || place != Place::Free
+            || kind(node.kind()) != SyntaxKind::BLOCK
+        {
+            return None;
         }
-        self.error_reach.is_some_and(|reach| reach >= offset(start))
+        let mut items = Vec::new();
+        let mut ended = false;
+        let (mut start, mut end, mut at) = (None, offset, offset);
+        for child in node.children() {
+            let child_start = at;
+            at += usize::from(child.text_len());
+            if child.as_node().is_some() {
+                start.get_or_insert(child_start);
+                end = at;
+            }
+            match child {
+                NodeOrToken::Token(token) => match kind(token.kind()) {
+                    SyntaxKind::WHITESPACE => {}
+                    // A comment or a line break ends the words: the block
+                    // is one line of words and a comment after them.
+                    SyntaxKind::COMMENT | SyntaxKind::NEWLINE => ended = true,
+                    _ => return None,
+                },
+                NodeOrToken::Node(_) if ended => return None,
+                NodeOrToken::Node(word) => items.push((self.rank(word)?, (child_start, word))),
+            }
+        }
+        let repeated = |(i, (rank, (_, word))): (usize, &(Rank, (usize, &GreenNodeData)))| {
+            !rank.is_code() && items[..i].iter().any(|(_, (_, other))| letter(other).eq_ignore_ascii_case(letter(word)))
+        };
+        // A block number elsewhere than first is not one to move there.
+        let misplaced_number = items.iter().skip(1).any(|(rank, _)| *rank == Rank::BlockNumber);
+        if misplaced_number
+            || items.iter().enumerate().any(repeated)
+            || items.is_sorted_by_key(|(rank, _)| *rank)
+            || self.errors.touch(start?, end)
+        {
+            return None;
+        }
+        items.sort_by_key(|(rank, _)| *rank);
+        Some(items.into_iter().map(|(_, word)| word).collect())
     }
+
+    /// Where a plain word (a letter, a sign and a number) goes in the
+    /// standard order; `None` for anything else. Words of one rank keep
+    /// the order they are written in: of two codes of one group the last
+    /// holds, and two letters may move one axis (Haas `X` and `U`).
+    fn rank(&self, word: &GreenNodeData) -> Option<Rank> {
+        match kind(word.kind()) {
+            SyntaxKind::BLOCK_NUMBER => return Some(Rank::BlockNumber),
+            SyntaxKind::WORD => {}
+            _ => return None,
+        }
+        let kinds: Vec<SyntaxKind> = word.children().map(|child| kind(child.kind())).collect();
+        let plain = matches!(
+            kinds.as_slice(),
+            [SyntaxKind::LETTER, SyntaxKind::NUMBER]
+                | [SyntaxKind::LETTER, SyntaxKind::MINUS | SyntaxKind::PLUS, SyntaxKind::NUMBER]
+        );
+        if !plain {
+            return None;
+        }
+        let address = self.catalogue.address(letter(word))?;
+        Rank::of(address.role, address.function)
+    }
+}
+
+/// Syntax errors of some kinds, to ask whether a range touches one.
+struct Errors {
+    /// By start.
+    ranges: Vec<TextRange>,
+    /// The furthest end of the errors up to each.
+    reach: Vec<TextSize>,
+}
+
+impl Errors {
+    fn new(parse: &Parse, counts: impl Fn(SyntaxErrorKind) -> bool) -> Errors {
+        let mut ranges: Vec<TextRange> = parse.errors().iter().filter(|e| counts(e.kind)).map(|e| e.range).collect();
+        ranges.sort_by_key(|e| e.start());
+        let reach = ranges
+            .iter()
+            .scan(TextSize::from(0), |reach, error| {
+                *reach = (*reach).max(error.end());
+                Some(*reach)
+            })
+            .collect();
+        Errors { ranges, reach }
+    }
+
+    /// Whether `start..end` touches one of the errors.
+    fn touch(&self, start: usize, end: usize) -> bool {
+        let before = self.ranges.partition_point(|e| e.start() <= offset(end));
+        before > 0 && self.reach[before - 1] >= offset(start)
+    }
+}
+
+/// The standard order of a block's words (Sinumerik's recommended
+/// `N G X Y Z F S T D M H`, the ISO controls' alike), by address role.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Rank {
+    BlockNumber,
+    Preparatory,
+    Axis,
+    Interpolation,
+    Corner,
+    Feed,
+    Speed,
+    Tool,
+    Offset,
+    Miscellaneous,
+    /// `P`, `Q`, `L`, `H`: what the block's function takes.
+    Arguments,
+}
+
+impl Rank {
+    fn of(role: AddressRole, function: Option<FunctionKind>) -> Option<Rank> {
+        Some(match role {
+            AddressRole::BlockNumber => Rank::BlockNumber,
+            AddressRole::Function => match function? {
+                FunctionKind::Preparatory => Rank::Preparatory,
+                FunctionKind::Miscellaneous => Rank::Miscellaneous,
+            },
+            AddressRole::Axis => Rank::Axis,
+            AddressRole::Interpolation => Rank::Interpolation,
+            AddressRole::Corner => Rank::Corner,
+            AddressRole::Feed => Rank::Feed,
+            AddressRole::Speed => Rank::Speed,
+            AddressRole::Tool => Rank::Tool,
+            AddressRole::Offset | AddressRole::LengthCompensation => Rank::Offset,
+            AddressRole::Count | AddressRole::Label | AddressRole::Auxiliary => Rank::Arguments,
+            _ => return None,
+        })
+    }
+
+    /// Codes may be written more than once in a block (codes of different
+    /// groups); a letter of any other address only once.
+    fn is_code(self) -> bool {
+        matches!(self, Rank::Preparatory | Rank::Miscellaneous)
+    }
+}
+
+/// The address letter of a word.
+fn letter(word: &GreenNodeData) -> &str {
+    word.children().next().and_then(NodeOrToken::into_token).map_or("", |token| token.text())
+}
+
+/// `number` (digits with a decimal point) without the zeros that say
+/// nothing, if it has any: `010.500` → `10.5`, `00.5` → `0.5`. A digit
+/// after the point stays (`2.000` → `2.0`): every control reads `2.0`.
+fn trimmed_number(number: &str) -> Option<String> {
+    let (int, frac) = number.split_once('.')?;
+    if !int.bytes().chain(frac.bytes()).all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    let int = match int.trim_start_matches('0') {
+        "" if !int.is_empty() => "0",
+        rest => rest,
+    };
+    let frac = match frac.trim_end_matches('0') {
+        "" if !frac.is_empty() => "0",
+        rest => rest,
+    };
+    let trimmed = format!("{int}.{frac}");
+    (trimmed != number).then_some(trimmed)
+}
+
+/// One edit per line of `old` that `new` (with the same lines) changes,
+/// from the first changed character to the last; with `range`, only of
+/// the lines it touches.
+fn line_edits(old: &str, new: &str, range: Option<TextRange>) -> Vec<TextEdit> {
+    // Formatting never adds or removes a line feed.
+    debug_assert_eq!(old.matches('\n').count(), new.matches('\n').count(), "formatting changed the lines");
+    let mut edits = Vec::new();
+    let mut start = 0;
+    for (old_line, new_line) in old.split('\n').zip(new.split('\n')) {
+        let line = TextRange::new(offset(start), offset(start + old_line.len()));
+        let touched = range.is_none_or(|range| range.intersect(line).is_some());
+        if old_line != new_line && touched {
+            let prefix = common_prefix(old_line, new_line);
+            let suffix = common_suffix(&old_line[prefix..], &new_line[prefix..]);
+            let delete = TextRange::new(offset(start + prefix), offset(start + old_line.len() - suffix));
+            edits.push(TextEdit::replace(delete, &new_line[prefix..new_line.len() - suffix]));
+        }
+        start += old_line.len() + 1;
+    }
+    edits
+}
+
+/// The length of the longest common prefix of `a` and `b`, on a character
+/// boundary.
+fn common_prefix(a: &str, b: &str) -> usize {
+    a.char_indices().zip(b.chars()).find(|((_, x), y)| x != y).map_or(a.len().min(b.len()), |((at, _), _)| at)
+}
+
+/// The length of the longest common suffix of `a` and `b`, on a character
+/// boundary.
+fn common_suffix(a: &str, b: &str) -> usize {
+    a.chars().rev().zip(b.chars().rev()).take_while(|(x, y)| x == y).map(|(x, _)| x.len_utf8()).sum()
 }
 
 fn kind(raw: rowan::SyntaxKind) -> SyntaxKind {

@@ -146,14 +146,11 @@ pub(crate) fn folding_ranges(db: &dyn Db, file: SourceFile) -> Vec<folding::Fold
     }
 }
 
-/// The edits that format the file.
-pub(crate) fn format(db: &dyn Db, file: SourceFile) -> Vec<TextEdit> {
-    match file.parse(db).dialect() {
-        Dialect::Cnc8x6 => format::format(file.text(db), file.parse(db)),
-        // No style is defined for Haas or Sinumerik programs yet:
-        // formatting changes nothing.
-        Dialect::HaasLathe | Dialect::Sinumerik => Vec::new(),
-    }
+/// The edits that format the file, or the lines `range` touches, in the
+/// project's style.
+pub(crate) fn format(db: &dyn Db, file: SourceFile, range: Option<TextRange>) -> Vec<TextEdit> {
+    let style = Settings::get(db).config(db).format;
+    format::format(file.text(db), file.parse(db), style, range)
 }
 
 /// The inlay hints of the blocks `range` touches.

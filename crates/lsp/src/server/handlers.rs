@@ -49,6 +49,7 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
             },
         )),
         document_formatting_provider: Some(lsp::OneOf::Left(true)),
+        document_range_formatting_provider: Some(lsp::OneOf::Left(true)),
         execute_command_provider: Some(lsp::ExecuteCommandOptions {
             commands: vec![super::plot::COMMAND.to_owned()],
             ..Default::default()
@@ -199,8 +200,10 @@ pub(crate) fn completion(s: &Snapshot, position: lsp::Position) -> Vec<lsp::Comp
         .collect()
 }
 
-pub(crate) fn formatting(s: &Snapshot) -> Vec<lsp::TextEdit> {
-    s.analysis.format(s.file).iter().map(|edit| s.map.text_edit(edit)).collect()
+/// The edits that format the document, or the lines `range` touches.
+pub(crate) fn formatting(s: &Snapshot, range: Option<lsp::Range>) -> Vec<lsp::TextEdit> {
+    let range = range.map(|range| s.map.range_offsets(range));
+    s.analysis.format(s.file, range).iter().map(|edit| s.map.text_edit(edit)).collect()
 }
 
 /// The parameter values and, where the estimate holds, the cycle time.

@@ -532,7 +532,14 @@ impl LanguageServer for Server {
     }
 
     async fn formatting(&self, params: lsp::DocumentFormattingParams) -> jsonrpc::Result<Option<Vec<lsp::TextEdit>>> {
-        self.query(&params.text_document.uri, handlers::formatting).await.map(Some)
+        self.query(&params.text_document.uri, |s| handlers::formatting(s, None)).await.map(Some)
+    }
+
+    async fn range_formatting(
+        &self,
+        params: lsp::DocumentRangeFormattingParams,
+    ) -> jsonrpc::Result<Option<Vec<lsp::TextEdit>>> {
+        self.query(&params.text_document.uri, move |s| handlers::formatting(s, Some(params.range))).await.map(Some)
     }
 
     async fn inlay_hint(&self, params: lsp::InlayHintParams) -> jsonrpc::Result<Option<Vec<lsp::InlayHint>>> {

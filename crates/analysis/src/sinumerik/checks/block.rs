@@ -10,7 +10,10 @@ use crate::{
     Config, Diagnostic,
     config::CycleVersion,
     diagnostic::declare_rules,
-    sinumerik::checks::visit::{all_exprs, number, statement_exprs, written_places},
+    sinumerik::{
+        MAX_BLOCK_CHARS,
+        checks::visit::{all_exprs, number, statement_exprs, written_places},
+    },
 };
 
 declare_rules! {
@@ -27,9 +30,6 @@ declare_rules! {
     CYCLE_ARGUMENTS_FOR_VERSION = "K058", "cycle-arguments-for-version", Info, "A cycle call with more arguments than the cycle takes in the version `[sinumerik] cycle-version` names: the argument lists differ between versions.";
     COMPARISON_PRIORITY = "K107", "comparison-priority", Warning, "A comparison with an unparenthesised AND, OR, XOR or `<<` as operand: Sinumerik ranks comparisons below them, so `A>5 AND B<3` reads `A>(5 AND B)<3`.";
 }
-
-/// The longest block the control reads (004:284-286).
-const MAX_BLOCK_CHARS: usize = 512;
 
 /// What CYCLE832 switches on, written out (004:3302-3308).
 const CYCLE832_EXPANSION: &str = "SOFT DYNFINISH COMPCAD G645 FIFOCTRL FFWON";
