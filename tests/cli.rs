@@ -1550,3 +1550,26 @@ fn fmt_fails_on_a_missing_path() {
     assert_eq!(run.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&run.stderr).contains("no-such-file.NCP"));
 }
+
+/// `ncc fmt --renumber` renumbers blocks with their references and then
+/// formats; a file it cannot renumber safely is left alone with the
+/// reason and where, and the exit status is 2.
+#[test]
+fn fmt_renumbers_blocks_with_their_references_or_says_why_not() {
+    let dir = tempfile::tempdir().unwrap();
+    let (good, bad) = (dir.path().join("O0001.nc"), dir.path().join("O0002.nc"));
+    std::fs::write(&good, "G71 P1 Q2 U0.4 W0.1 D2. F0.25\nN1  G00 X14.\nN2 X20.\nM30\n").unwrap();
+    std::fs::write(&bad, "N1 G00 X14.\nGOTO #1\nM30\n").unwrap();
+    let run = ncc(&["fmt", "--renumber", "100,5", dir.path().to_str().unwrap()]);
+    assert_eq!(run.status.code(), Some(2));
+    assert_eq!(
+        std::fs::read_to_string(&good).unwrap(),
+        "G71 P100 Q105 U0.4 W0.1 D2. F0.25\nN100 G00 X14.\nN105 X20.\nM30\n"
+    );
+    assert_eq!(std::fs::read_to_string(&bad).unwrap(), "N1 G00 X14.\nGOTO #1\nM30\n");
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("O0002.nc:2:1: not renumbered: the target is computed when the program runs"), "{stderr}");
+    let usage = ncc(&["fmt", "--renumber", "10,0", "."]);
+    assert_eq!(usage.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&usage.stderr).contains("a step above 0"));
+}

@@ -519,6 +519,38 @@ fn range_formatting_formats_the_selected_lines_in_the_projects_style() {
     assert_serving(&mut client, &dir);
 }
 
+/// On a line that starts with a block number, a source action renumbers
+/// the blocks with their jumps, or says, disabled, why it would be unsafe.
+#[test]
+fn renumbering_is_a_code_action_on_a_numbered_line() {
+    let (mut client, dir) = session();
+    let doc = document(&dir, "O0001.nc", "N5 G00 X1.\nIF [#1 LT 2] GOTO5\nM30\n");
+    open(&mut client, &doc);
+    let actions = |client: &mut Client, doc: &Document, line: u32| {
+        let range = json!({ "start": { "line": line, "character": 0 }, "end": { "line": line, "character": 0 } });
+        let params = json!({ "textDocument": doc.id(), "range": range, "context": { "diagnostics": [] } });
+        let answer = client.call("textDocument/codeAction", params).unwrap();
+        answer.result().unwrap_or_else(|| panic!("{}", answer.json)).clone()
+    };
+    let found = actions(&mut client, &doc, 0);
+    let renumber = found.as_array().unwrap().iter().find(|a| a["kind"] == "source").expect("a renumbering action");
+    assert_eq!(renumber["title"], "Renumber the blocks N10, N20, … and the jumps to them");
+    let edits = &renumber["edit"]["changes"][doc.uri.as_str()];
+    let texts: Vec<_> = edits.as_array().unwrap().iter().map(|edit| edit["newText"].clone()).collect();
+    assert_eq!(texts, [json!("10"), json!("10")], "{edits}");
+    assert!(!actions(&mut client, &doc, 2).as_array().unwrap().iter().any(|a| a["kind"] == "source"));
+
+    let refused = document(&dir, "O0002.nc", "N5 G00 X1.\nGOTO #1\nM30\n");
+    open(&mut client, &refused);
+    let found = actions(&mut client, &refused, 0);
+    let renumber = found.as_array().unwrap().iter().find(|a| a["kind"] == "source").expect("a renumbering action");
+    assert_eq!(
+        renumber["disabled"]["reason"],
+        "line 2: the target is computed when the program runs: renumbering could break it"
+    );
+    assert_serving(&mut client, &dir);
+}
+
 #[test]
 fn shutdown_then_exit_ends_with_success() {
     let (mut client, dir) = session();

@@ -50,7 +50,7 @@ pub use crate::{
     db::{RootDatabase, SourceFile},
     diagnostic::{Diagnostic, Fix, Related, Rule},
     findings::{Findings, OmittedFindings},
-    ide::{HoverResult, NavigationTarget, SignatureHelp, SignatureParameter},
+    ide::{HoverResult, NavigationTarget, SignatureHelp, SignatureParameter, renumber::RenumberError},
     suppress::Suppressions,
 };
 
@@ -304,6 +304,15 @@ impl Analysis {
     /// line, sorted. With `range`, only the lines it touches change.
     pub fn format(&self, file: FileId, range: Option<TextRange>) -> Vec<TextEdit> {
         ide::format(&self.db, file, range)
+    }
+
+    /// The edits that renumber the file's blocks `start`, `start + step`,
+    /// … in file order and rewrite every reference to them (jumps, contour
+    /// P/Q, local calls) to its block's new number; or, where a target is
+    /// computed, missing or ambiguous, why renumbering could change what
+    /// the program does.
+    pub fn renumber(&self, file: FileId, start: u64, step: u64) -> Result<Vec<TextEdit>, RenumberError> {
+        ide::renumber(&self.db, file, start, step)
     }
 
     /// What may be written at `offset`, most relevant first.

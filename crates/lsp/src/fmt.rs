@@ -32,7 +32,28 @@ struct Program {
     encoding: encoding::Encoding,
 }
 
-pub(crate) fn run(paths: &[PathBuf], mode: Mode, forced: Option<Dialect>) -> ExitCode {
+/// `--renumber START,STEP`: the first block number and the step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Renumber {
+    pub start: u64,
+    pub step: u64,
+}
+
+impl std::str::FromStr for Renumber {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Renumber, String> {
+        let parsed = text
+            .split_once(',')
+            .and_then(|(start, step)| Some((start.trim().parse().ok()?, step.trim().parse().ok()?)));
+        match parsed {
+            Some((start, step)) if step > 0 => Ok(Renumber { start, step }),
+            _ => Err(format!("`{text}` is not START,STEP with whole numbers and a step above 0 (`10,10`)")),
+        }
+    }
+}
+
+pub(crate) fn run(paths: &[PathBuf], mode: Mode, renumber: Option<Renumber>, forced: Option<Dialect>) -> ExitCode {
     let mut projects = Projects::default();
     let Found { files, mut failures } = collect_files(paths, &mut projects, forced);
     // The files of one dialect under the same `ncc.toml` share its style.
@@ -60,16 +81,33 @@ pub(crate) fn run(paths: &[PathBuf], mode: Mode, forced: Option<Dialect>) -> Exi
         };
         let mut host = AnalysisHost::in_dialect(dialect, config);
         for program in programs {
+            let shown = shown_path(&program.path);
             let file = host.add_file(program.path.display().to_string(), program.text.as_str());
-            let edits = host.analysis().format(file, None);
+            let renumbered = match renumber {
+                Some(Renumber { start, step }) => host.analysis().renumber(file, start, step),
+                None => Ok(Vec::new()),
+            };
+            let formatted = renumbered.map(|edits| {
+                if !edits.is_empty() {
+                    host.set_text(file, applied(&program.text, &edits));
+                }
+                let text = host.analysis().text(file);
+                applied(&text, &host.analysis().format(file, None))
+            });
             host.remove_file(file);
-            if edits.is_empty() {
+            let formatted = match formatted {
+                Ok(formatted) => formatted,
+                Err(error) => {
+                    let (line, column) = line_and_column(&program.text, error.range.start().into());
+                    failures.push(format!("{shown}:{line}:{column}: not renumbered: {}", error.message));
+                    continue;
+                }
+            };
+            if formatted == program.text {
                 unchanged += 1;
                 continue;
             }
             changed += 1;
-            let formatted = applied(&program.text, &edits);
-            let shown = shown_path(&program.path);
             match mode {
                 Mode::Write => {
                     if let Err(error) = std::fs::write(&program.path, encoding::encode(&formatted, program.encoding)) {
@@ -106,6 +144,14 @@ pub(crate) fn run(paths: &[PathBuf], mode: Mode, forced: Option<Dialect>) -> Exi
     } else {
         ExitCode::SUCCESS
     }
+}
+
+/// The line and column (characters), both from 1, of byte `offset` of
+/// `text`.
+fn line_and_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset];
+    let line_start = before.rfind('\n').map_or(0, |at| at + 1);
+    (before.matches('\n').count() + 1, before[line_start..].chars().count() + 1)
 }
 
 /// `text` with `edits` (sorted, not overlapping) made.

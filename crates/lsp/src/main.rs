@@ -90,6 +90,12 @@ enum Command {
         /// diff, and exit with 1 if it would change anything.
         #[arg(long)]
         diff: bool,
+        /// Renumber the blocks START, START+STEP, … in file order, with
+        /// every reference to them (jumps, contour P/Q, local calls), so the
+        /// program does what it did; a file where a computed or missing
+        /// target makes that unsafe is left as it is, with the reason.
+        #[arg(long, value_name = "START,STEP")]
+        renumber: Option<fmt::Renumber>,
     },
     /// Explain a code, address, parameter, machine constant, operation or
     /// the rule of a diagnostic's code.
@@ -213,7 +219,7 @@ fn main() -> ExitCode {
     let Cli { dialect, command } = Cli::parse();
     match command {
         Command::Check { paths, format } => check::run(&paths, format, dialect),
-        Command::Fmt { paths, check, diff } => {
+        Command::Fmt { paths, check, diff, renumber } => {
             let mode = if diff {
                 fmt::Mode::Diff
             } else if check {
@@ -221,7 +227,7 @@ fn main() -> ExitCode {
             } else {
                 fmt::Mode::Write
             };
-            fmt::run(&paths, mode, dialect)
+            fmt::run(&paths, mode, renumber, dialect)
         }
         Command::Explain { query, list } => explain::run(query.as_deref(), list, dialect),
         Command::Rules { query, markdown } => rules::run(query.as_deref(), markdown),

@@ -3,6 +3,7 @@
 //! model (`crate::haas_lathe::model`).
 
 pub(crate) mod completion;
+pub(crate) mod renumber;
 
 use std::path::Path;
 

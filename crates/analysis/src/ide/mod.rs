@@ -15,6 +15,7 @@ mod haas_lathe;
 pub(crate) mod highlight;
 pub(crate) mod inlay;
 pub(crate) mod references;
+pub(crate) mod renumber;
 mod sinumerik;
 pub(crate) mod symbols;
 
@@ -151,6 +152,23 @@ pub(crate) fn folding_ranges(db: &dyn Db, file: SourceFile) -> Vec<folding::Fold
 pub(crate) fn format(db: &dyn Db, file: SourceFile, range: Option<TextRange>) -> Vec<TextEdit> {
     let style = Settings::get(db).config(db).format;
     format::format(file.text(db), file.parse(db), style, range)
+}
+
+/// The edits that renumber the file's blocks from `start` by `step`, with
+/// every reference to them, or why that could change what it does.
+pub(crate) fn renumber(
+    db: &dyn Db,
+    file: SourceFile,
+    start: u64,
+    step: u64,
+) -> Result<Vec<TextEdit>, renumber::RenumberError> {
+    let parse = file.parse(db);
+    let numbering = match parse.dialect() {
+        Dialect::Cnc8x6 => cnc8x6::renumber::numbering(db, file),
+        Dialect::HaasLathe => haas_lathe::renumber::numbering(db, file),
+        Dialect::Sinumerik => sinumerik::renumber::numbering(db, file),
+    }?;
+    renumber::edits(file.text(db), parse.dialect().catalogue(), &numbering, start, step)
 }
 
 /// The inlay hints of the blocks `range` touches.

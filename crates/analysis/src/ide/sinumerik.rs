@@ -9,6 +9,7 @@
 mod completion;
 mod navigation;
 mod outline;
+pub(crate) mod renumber;
 mod signature;
 mod walked;
 

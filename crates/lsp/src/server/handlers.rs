@@ -19,7 +19,7 @@ pub(crate) fn capabilities() -> lsp::ServerCapabilities {
         hover_provider: Some(lsp::HoverProviderCapability::Simple(true)),
         definition_provider: Some(lsp::OneOf::Left(true)),
         code_action_provider: Some(lsp::CodeActionProviderCapability::Options(lsp::CodeActionOptions {
-            code_action_kinds: Some(vec![lsp::CodeActionKind::QUICKFIX]),
+            code_action_kinds: Some(vec![lsp::CodeActionKind::QUICKFIX, lsp::CodeActionKind::SOURCE]),
             ..Default::default()
         })),
         completion_provider: Some(lsp::CompletionOptions {
@@ -140,9 +140,11 @@ pub(crate) fn signature_help(s: &Snapshot, position: lsp::Position) -> Option<ls
     })
 }
 
-/// The quick fixes of the diagnostics that touch `range`.
+/// The quick fixes of the diagnostics that touch `range`, and renumbering
+/// on a line that starts with a block number.
 pub(crate) fn code_actions(s: &Snapshot, range: lsp::Range) -> lsp::CodeActionResponse {
     let range = s.map.range_offsets(range);
+    let renumbering = renumber_action(s, range.start());
     let diagnostics = s.analysis.diagnostics(s.file);
     let positions = s.map.positions();
     let mut actions = Vec::new();
@@ -164,7 +166,43 @@ pub(crate) fn code_actions(s: &Snapshot, range: lsp::Range) -> lsp::CodeActionRe
             }));
         }
     }
+    actions.extend(renumbering);
     actions
+}
+
+/// Renumbering the blocks N10, N20, … with every reference to them,
+/// offered where the line at `at` starts with a block number; where a
+/// computed or missing target makes it unsafe, offered disabled with the
+/// reason.
+fn renumber_action(s: &Snapshot, at: ncc_syntax::TextSize) -> Option<lsp::CodeActionOrCommand> {
+    const START: u64 = 10;
+    const STEP: u64 = 10;
+    let text = s.analysis.text(s.file);
+    let at = usize::from(at).min(text.len());
+    let line_start = text[..at].rfind('\n').map_or(0, |newline| newline + 1);
+    let line = text[line_start..].trim_start_matches([' ', '\t']).as_bytes();
+    let letter = s.analysis.dialect().catalogue().letter_with_role(AddressRole::BlockNumber)?;
+    if line.first().map(u8::to_ascii_uppercase) != Some(letter) || !line.get(1).is_some_and(u8::is_ascii_digit) {
+        return None;
+    }
+    let (edit, disabled) = match s.analysis.renumber(s.file, START, STEP) {
+        Ok(edits) => {
+            let edits = edits.iter().map(|edit| s.map.text_edit(edit)).collect();
+            let changes = HashMap::from([(s.uri.clone(), edits)]);
+            (Some(lsp::WorkspaceEdit { changes: Some(changes), ..Default::default() }), None)
+        }
+        Err(error) => {
+            let line = s.map.range(error.range).start.line + 1;
+            (None, Some(lsp::CodeActionDisabled { reason: format!("line {line}: {}", error.message) }))
+        }
+    };
+    Some(lsp::CodeActionOrCommand::CodeAction(lsp::CodeAction {
+        title: format!("Renumber the blocks N{START}, N{}, … and the jumps to them", START + STEP),
+        kind: Some(lsp::CodeActionKind::SOURCE),
+        edit,
+        disabled,
+        ..Default::default()
+    }))
 }
 
 pub(crate) fn completion(s: &Snapshot, position: lsp::Position) -> Vec<lsp::CompletionItem> {

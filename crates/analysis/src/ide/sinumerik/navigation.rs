@@ -276,7 +276,7 @@ pub(crate) fn goto_definition(db: &dyn Db, file: SourceFile, offset: TextSize) -
 }
 
 /// The block the jump or `REPEAT` section at `at` reaches.
-fn jump_target(model: &FileModel, at: &Occurrence) -> Option<usize> {
+pub(super) fn jump_target(model: &FileModel, at: &Occurrence) -> Option<usize> {
     let relative = at.range - model.ranges[at.block].start();
     let resolved = match model.model.jumps_from(at.block).find(|site| site.jump.range.contains_range(relative)) {
         Some(site) => site.resolved,
