@@ -551,6 +551,30 @@ fn renumbering_is_a_code_action_on_a_numbered_line() {
     assert_serving(&mut client, &dir);
 }
 
+/// Renaming a Sinumerik program edits every file that calls it and renames
+/// its file, as one workspace edit.
+#[test]
+fn renaming_a_program_edits_its_callers_and_renames_its_file() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("PROFIL.SPF"), "PROC PROFIL\nG1 X10 F100\nM17\n").unwrap();
+    let main = document(&dir, "MAIN.MPF", "PROFIL\nM30\n");
+    std::fs::write(dir.path().join("MAIN.MPF"), main.text()).unwrap();
+    let mut client = server();
+    client.initialize(dir.path(), None).unwrap();
+    open(&mut client, &main);
+    let mut params = main.at(main.position(2));
+    params["newName"] = json!("KONTUR");
+    let answer = client.call("textDocument/rename", params).unwrap();
+    let changes = answer.result().unwrap_or_else(|| panic!("{}", answer.json))["documentChanges"].clone();
+    let operations = changes.as_array().unwrap_or_else(|| panic!("{changes}"));
+    let renamed = operations.iter().find(|op| op["kind"] == "rename").unwrap_or_else(|| panic!("{changes}"));
+    assert!(renamed["oldUri"].as_str().unwrap().ends_with("/PROFIL.SPF"), "{renamed}");
+    assert!(renamed["newUri"].as_str().unwrap().ends_with("/KONTUR.SPF"), "{renamed}");
+    let edited: Vec<_> = operations.iter().filter_map(|op| op["textDocument"]["uri"].as_str()).collect();
+    assert_eq!(edited.len(), 2, "{changes}");
+    assert_serving(&mut client, &dir);
+}
+
 #[test]
 fn shutdown_then_exit_ends_with_success() {
     let (mut client, dir) = session();

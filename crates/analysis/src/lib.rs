@@ -50,7 +50,7 @@ pub use crate::{
     db::{RootDatabase, SourceFile},
     diagnostic::{Diagnostic, Fix, Related, Rule},
     findings::{Findings, OmittedFindings},
-    ide::{HoverResult, NavigationTarget, SignatureHelp, SignatureParameter, renumber::RenumberError},
+    ide::{HoverResult, NavigationTarget, Renaming, SignatureHelp, SignatureParameter, renumber::RenumberError},
     suppress::Suppressions,
 };
 
@@ -280,10 +280,11 @@ impl Analysis {
         ide::prepare_rename(&self.db, file, offset)
     }
 
-    /// The edits of `file` that give the name at `offset` the name
-    /// `new_name` wherever it is written, or why they cannot (the name is
-    /// not one the control takes, or is taken).
-    pub fn rename(&self, file: FileId, offset: TextSize, new_name: &str) -> Result<Vec<TextEdit>, String> {
+    /// The edits that give the name at `offset` the name `new_name`
+    /// wherever it is written (a program: in every file of the workspace,
+    /// and its file renamed), or why they cannot (the name is not one the
+    /// control takes, or is taken).
+    pub fn rename(&self, file: FileId, offset: TextSize, new_name: &str) -> Result<Renaming, String> {
         ide::rename(&self.db, file, offset, new_name)
     }
 

@@ -1058,7 +1058,7 @@ fn renamed(path: &str, text: &str, needle: &str, new_name: &str) -> Result<Strin
     let offset = cursor.unwrap().1;
     let prepared = analysis.prepare_rename(ids[0], offset)?;
     assert!(prepared.contains_inclusive(offset), "{prepared:?} at {offset:?}");
-    let mut edits = analysis.rename(ids[0], offset, new_name)?;
+    let mut edits = analysis.rename(ids[0], offset, new_name)?.in_file(ids[0]).to_vec();
     edits.sort_by_key(|edit| std::cmp::Reverse(edit.delete.start()));
     let mut text = analysis.text(ids[0]).to_string();
     for edit in edits {
@@ -1126,7 +1126,8 @@ fn sinumerik_rename_refuses_names_the_control_would_not_take() {
         ("BSPLINE", "TABLE"),
         ("$A_DAY", "TABLE"),
         ("N21 M", "TABLE"),
-        ("VACKA_CYKLUS (", "TABLE"),
+        ("VACKA_CYKLUS (", "AKT_X"),
+        ("VACKA_CYKLUS (", "CYCLE81"),
         (";pohyb", "TABLE"),
     ]
     .into_iter()
@@ -1147,16 +1148,46 @@ fn sinumerik_rename_refuses_names_the_control_would_not_take() {
         "KRUH:" → VACKA_CYKLUS: `VACKA_CYKLUS` is already a name in this file (`VACKA_CYKLUS` on line 3)
         "R=AKT_R" → VAC_POLE: `VAC_POLE` is already a name in this file (`VAC_POLE` on line 11)
         "VAC_POLE[0,1]" → TABLE: `VAC_POLE` is not declared in this file (no DEF or PROC parameter): it cannot be renamed here
-        "BSPLINE" → TABLE: Nothing to rename here: user variables, PROC parameters and labels can be renamed
-        "$A_DAY" → TABLE: Nothing to rename here: user variables, PROC parameters and labels can be renamed
+        "BSPLINE" → TABLE: Nothing to rename here: user variables, PROC parameters, labels and programs can be renamed
+        "$A_DAY" → TABLE: Nothing to rename here: user variables, PROC parameters, labels and programs can be renamed
         "N21 M" → TABLE: `N21` is a block number: renumber the block instead
-        "VACKA_CYKLUS (" → TABLE: `VACKA_CYKLUS` is a program: it is renamed with its file
-        ";pohyb" → TABLE: Nothing to rename here: user variables, PROC parameters and labels can be renamed"#]].assert_eq(&refusals.join("\n"));
+        "VACKA_CYKLUS (" → AKT_X: `AKT_X` is already a name in this file (`AKT_X` on line 4)
+        "VACKA_CYKLUS (" → CYCLE81: `CYCLE81` is a cycle of the control
+        ";pohyb" → TABLE: Nothing to rename here: user variables, PROC parameters, labels and programs can be renamed"#]].assert_eq(&refusals.join("\n"));
     // The same name in another case is the same name.
     assert!(renamed("VACKA_CYKLUS.SPF", L31, "AKT_X=", "Akt_X").is_ok());
     assert_eq!(
         renamed("BLOB.MPF", L29, "R3=100", "TABLE"),
         Err("`R3` is an R parameter: its number cannot be renamed".to_owned())
+    );
+}
+
+/// Renaming a program renames its PROC, every call and EXTERN of it in the
+/// workspace (bare or as `_N_NAME_SPF`), and its file.
+#[test]
+fn sinumerik_rename_of_a_program_changes_every_file_and_moves_its_file() {
+    let main = format!("{L19_MAIN}_N_PROFIL_SPF\n");
+    let files = with_cursor(&[("dir/MAIN.MPF", main.as_str()), ("dir/PROFIL.SPF", L19_SUB)], "PROFIL (,TRUE");
+    let (host, ids, cursor) = setup(&borrowed(&files));
+    let analysis = host.analysis();
+    let renaming = analysis.rename(ids[0], cursor.unwrap().1, "Kontura").unwrap();
+    let changed = |index: usize| {
+        let mut text = analysis.text(ids[index]).to_string();
+        for edit in renaming.in_file(ids[index]).iter().rev() {
+            edit.apply(&mut text);
+        }
+        changed_lines(&analysis.text(ids[index]), &text)
+    };
+    expect![[r#"
+        N70 Kontura (,TRUE,2.14,DELKA) ; Volání podprogramu se skutečnými parametry: 2.14 a DELKA
+        _N_Kontura_SPF"#]]
+    .assert_eq(&changed(0));
+    expect!["PROC Kontura (REAL C, BOOL H, REAL X, INT Y, REAL Z) ; Formální parametry by nabyly hodnotu: C=0, protože nebyl předán, H=TRUE, X=2.14, Y=DELKA=5.0 , Z=0, protože také nebyl zadán"]
+        .assert_eq(&changed(1));
+    assert_eq!(renaming.moved, vec![(ids[1], "dir/KONTURA.SPF".to_owned())]);
+    assert_eq!(
+        analysis.rename(ids[0], cursor.unwrap().1, "MAIN"),
+        Err("`MAIN` is already a program of the workspace (dir/MAIN.MPF)".to_owned())
     );
 }
 
@@ -1212,7 +1243,7 @@ proptest! {
         let offset = TextSize::try_from(text.find(old.as_str()).unwrap()).unwrap();
         let rename = |host: &AnalysisHost, to: &str| {
             let analysis = host.analysis();
-            let mut edits = analysis.rename(file, offset, to).unwrap_or_else(|why| panic!("{why}\n{}", analysis.text(file)));
+            let mut edits = analysis.rename(file, offset, to).unwrap_or_else(|why| panic!("{why}\n{}", analysis.text(file))).in_file(file).to_vec();
             edits.sort_by_key(|edit| std::cmp::Reverse(edit.delete.start()));
             let mut renamed = analysis.text(file).to_string();
             for edit in &edits {
@@ -1338,8 +1369,8 @@ fn every_sinumerik_listing_answers_everywhere() {
             assert!(analysis.references(file, offset, true).iter().all(|r| r.file != file || within(r.range)));
             if let Ok(range) = analysis.prepare_rename(file, offset) {
                 assert!(range.contains_inclusive(offset), "{name} at {offset:?}");
-                let edits = analysis.rename(file, offset, "RENAMED").unwrap();
-                assert!(edits.iter().all(|edit| within(edit.delete)), "{name}");
+                let renaming = analysis.rename(file, offset, "RENAMED").unwrap();
+                assert!(renaming.in_file(file).iter().all(|edit| within(edit.delete)), "{name}");
             }
             if let Some(help) = analysis.signature_help(file, offset) {
                 assert!(help.parameters.iter().all(|p| usize::from(p.range.end()) <= help.label.len()), "{help:?}");

@@ -49,6 +49,22 @@ pub struct NavigationTarget {
     pub focus: TextRange,
 }
 
+/// What a rename changes: the edits of each file, and the files renamed
+/// with the program they hold (a Sinumerik program is found by its file's
+/// name), each with its new path.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Renaming {
+    pub edits: Vec<(SourceFile, Vec<TextEdit>)>,
+    pub moved: Vec<(SourceFile, String)>,
+}
+
+impl Renaming {
+    /// The edits of `file`.
+    pub fn in_file(&self, file: SourceFile) -> &[TextEdit] {
+        self.edits.iter().find(|(edited, _)| *edited == file).map_or(&[], |(_, edits)| edits)
+    }
+}
+
 /// A called procedure's or function's signature, for the call the cursor
 /// is in.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -113,10 +129,10 @@ pub(crate) fn prepare_rename(db: &dyn Db, file: SourceFile, offset: TextSize) ->
 
 /// The edits that give the thing at `offset` the name `new_name`, or why
 /// they cannot.
-pub(crate) fn rename(db: &dyn Db, file: SourceFile, offset: TextSize, new_name: &str) -> Result<Vec<TextEdit>, String> {
+pub(crate) fn rename(db: &dyn Db, file: SourceFile, offset: TextSize, new_name: &str) -> Result<Renaming, String> {
     match file.parse(db).dialect() {
         Dialect::Sinumerik => sinumerik::rename(db, file, offset, new_name),
-        Dialect::HaasLathe | Dialect::Cnc8x6 => prepare_rename(db, file, offset).map(|_| Vec::new()),
+        Dialect::HaasLathe | Dialect::Cnc8x6 => prepare_rename(db, file, offset).map(|_| Renaming::default()),
     }
 }
 

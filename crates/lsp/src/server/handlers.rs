@@ -2,7 +2,9 @@
 
 use std::collections::HashMap;
 
-use ncc_analysis::{CompletionKind, Dialect, DocumentSymbol, FoldKind, NavigationTarget, ReferenceKind, SymbolKind};
+use ncc_analysis::{
+    CompletionKind, Dialect, DocumentSymbol, FoldKind, NavigationTarget, ReferenceKind, Renaming, SymbolKind,
+};
 use ncc_catalog::AddressRole;
 use tower_lsp_server::ls_types as lsp;
 
@@ -104,11 +106,9 @@ pub(crate) fn prepare_rename(s: &Snapshot, position: lsp::Position) -> Result<ls
     Ok(lsp::PrepareRenameResponse::Range(s.map.range(range)))
 }
 
-/// The document's edits that rename the name at `position`.
-pub(crate) fn rename(s: &Snapshot, position: lsp::Position, new_name: &str) -> Result<lsp::WorkspaceEdit, String> {
-    let edits = s.analysis.rename(s.file, s.map.offset(position), new_name)?;
-    let edits = edits.iter().map(|edit| s.map.text_edit(edit)).collect();
-    Ok(lsp::WorkspaceEdit { changes: Some(HashMap::from([(s.uri.clone(), edits)])), ..Default::default() })
+/// What renaming the name at `position` changes, in every file.
+pub(crate) fn rename(s: &Snapshot, position: lsp::Position, new_name: &str) -> Result<Renaming, String> {
+    s.analysis.rename(s.file, s.map.offset(position), new_name)
 }
 
 /// The signature of the call at `position`; parameters by their place in

@@ -590,10 +590,14 @@ impl LanguageServer for Server {
 
     async fn rename(&self, params: lsp::RenameParams) -> jsonrpc::Result<Option<lsp::WorkspaceEdit>> {
         let position = params.text_document_position;
-        let new_name = params.new_name;
-        let answer =
-            self.query(&position.text_document.uri, move |s| handlers::rename(s, position.position, &new_name)).await?;
-        answer.map(Some).map_err(request_failed)
+        let (uri, new_name) = (position.text_document.uri.clone(), params.new_name);
+        let renaming = self
+            .query(&uri, move |s| handlers::rename(s, position.position, &new_name))
+            .await?
+            .map_err(request_failed)?;
+        let state = self.state();
+        let Some(workspace) = state.documents.get(&uri).map(|d| d.workspace) else { return Ok(None) };
+        Ok(Some(state.workspaces.addresses(workspace).workspace_edit(&renaming)))
     }
 
     async fn signature_help(&self, params: lsp::SignatureHelpParams) -> jsonrpc::Result<Option<lsp::SignatureHelp>> {

@@ -7,7 +7,7 @@ use std::{
     path::{Path, PathBuf},
 };
 
-use ncc_analysis::{AnalysisHost, Config, Dialect, FileId, NavigationTarget};
+use ncc_analysis::{AnalysisHost, Config, Dialect, FileId, NavigationTarget, Renaming};
 use tower_lsp_server::ls_types::{self as lsp, Uri};
 
 use super::convert::LineMap;
@@ -206,6 +206,46 @@ impl Addresses<'_> {
     pub fn location(&mut self, file: FileId, range: ncc_analysis::TextRange) -> Option<lsp::Location> {
         let (uri, map) = self.of(file)?;
         Some(lsp::Location::new(uri, map.range(range)))
+    }
+
+    /// The edits of a rename in the protocol's terms: the changes of each
+    /// file, and the files it renames after them.
+    pub fn workspace_edit(&mut self, renaming: &Renaming) -> lsp::WorkspaceEdit {
+        let mut changes = Vec::new();
+        for (file, edits) in &renaming.edits {
+            if let Some((uri, map)) = self.of(*file) {
+                let edits = edits
+                    .iter()
+                    .map(|edit| lsp::TextEdit { range: map.range(edit.delete), new_text: edit.insert.clone() });
+                changes.push((uri, edits.collect::<Vec<_>>()));
+            }
+        }
+        if renaming.moved.is_empty() {
+            return lsp::WorkspaceEdit { changes: Some(changes.into_iter().collect()), ..Default::default() };
+        }
+        let mut operations: Vec<lsp::DocumentChangeOperation> = changes
+            .into_iter()
+            .map(|(uri, edits)| {
+                lsp::DocumentChangeOperation::Edit(lsp::TextDocumentEdit {
+                    text_document: lsp::OptionalVersionedTextDocumentIdentifier { uri, version: None },
+                    edits: edits.into_iter().map(lsp::OneOf::Left).collect(),
+                })
+            })
+            .collect();
+        for (file, path) in &renaming.moved {
+            if let (Some(old_uri), Some(new_uri)) = (self.uris.get(file), Uri::from_file_path(path)) {
+                operations.push(lsp::DocumentChangeOperation::Op(lsp::ResourceOp::Rename(lsp::RenameFile {
+                    old_uri: old_uri.clone(),
+                    new_uri,
+                    options: None,
+                    annotation_id: None,
+                })));
+            }
+        }
+        lsp::WorkspaceEdit {
+            document_changes: Some(lsp::DocumentChanges::Operations(operations)),
+            ..Default::default()
+        }
     }
 
     pub fn location_link(&mut self, target: NavigationTarget) -> Option<lsp::LocationLink> {

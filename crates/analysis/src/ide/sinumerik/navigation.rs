@@ -28,7 +28,7 @@ use crate::{
     cnc8x6::model::file_stem,
     db::{Db, Settings, SourceFile},
     ide::{
-        HoverResult, NavigationTarget,
+        HoverResult, NavigationTarget, Renaming,
         references::{Reference, ReferenceKind},
     },
     sinumerik::model::{FileModel, file_model},
@@ -370,23 +370,67 @@ pub(crate) fn prepare_rename(db: &dyn Db, file: SourceFile, offset: TextSize) ->
     renamed_at(db, file, offset).map(|at| at.range)
 }
 
-/// The edits that rename the thing at `offset` to `new_name` in the file,
-/// or why they cannot.
-pub(crate) fn rename(db: &dyn Db, file: SourceFile, offset: TextSize, new_name: &str) -> Result<Vec<TextEdit>, String> {
+/// The edits that rename the thing at `offset` to `new_name`, or why they
+/// cannot: a label or variable in the file; a program in every file of
+/// the workspace, with its file.
+pub(crate) fn rename(db: &dyn Db, file: SourceFile, offset: TextSize, new_name: &str) -> Result<Renaming, String> {
     let at = renamed_at(db, file, offset)?;
     check_new_name(db, file, &at.symbol, new_name)?;
-    Ok(occurrences(db, file)
-        .iter()
-        .filter(|o| o.symbol == at.symbol)
-        .map(|o| TextEdit::replace(o.range, new_name))
-        .collect())
+    let Symbol::Program(key) = &at.symbol else {
+        let edits = occurrences(db, file)
+            .iter()
+            .filter(|o| o.symbol == at.symbol)
+            .map(|o| TextEdit::replace(o.range, new_name))
+            .collect();
+        return Ok(Renaming { edits: vec![(file, edits)], moved: Vec::new() });
+    };
+    let new_key = program_key(new_name);
+    if let Some(taken) = program_files(db, &new_key).next() {
+        return Err(format!("`{new_name}` is already a program of the workspace ({})", taken.path(db)));
+    }
+    let mut renaming = Renaming::default();
+    for &other in Settings::get(db).files(db).iter().filter(|f| f.parse(db).dialect() == Dialect::Sinumerik) {
+        let text = other.text(db);
+        let edits: Vec<TextEdit> = occurrences(db, other)
+            .iter()
+            .filter(|o| o.symbol == at.symbol)
+            .map(|o| TextEdit::replace(o.range, renamed_program(&text[o.range], new_name)))
+            .collect();
+        if !edits.is_empty() {
+            renaming.edits.push((other, edits));
+        }
+    }
+    for program in program_files(db, key) {
+        let path = program.path(db);
+        let stem = file_stem(path);
+        let (directory, file_name) = path.split_at(path.rfind(['/', '\\']).map_or(0, |slash| slash + 1));
+        let extension = &file_name[stem.len()..];
+        let mut new_stem = renamed_program(stem, new_name);
+        if stem.bytes().all(|b| !b.is_ascii_lowercase()) {
+            new_stem.make_ascii_uppercase();
+        }
+        renaming.moved.push((program, format!("{directory}{new_stem}{extension}")));
+    }
+    Ok(renaming)
+}
+
+/// `new_name` written the way `old` names its program: bare, or with the
+/// control's prefix and suffix (`_N_PROFIL_SPF`).
+fn renamed_program(old: &str, new_name: &str) -> String {
+    let upper = old.to_ascii_uppercase();
+    let name = upper.rsplit('/').next().unwrap_or(&upper);
+    let prefix = &old[..old.len() - name.len()];
+    match (name.starts_with("_N_"), ["_SPF", "_MPF"].iter().find(|suffix| name.ends_with(*suffix))) {
+        (true, Some(suffix)) => format!("{prefix}_N_{new_name}{}", &old[old.len() - suffix.len()..]),
+        _ => format!("{prefix}{new_name}"),
+    }
 }
 
 /// The name at `offset` if rename can change it: a label, or a variable
 /// or parameter the file declares.
 fn renamed_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Result<&Occurrence, String> {
     let at = occurrence_at(db, file, offset).ok_or_else(|| {
-        "Nothing to rename here: user variables, PROC parameters and labels can be renamed".to_owned()
+        "Nothing to rename here: user variables, PROC parameters, labels and programs can be renamed".to_owned()
     })?;
     let written = &file.text(db)[at.range];
     match &at.symbol {
@@ -397,7 +441,10 @@ fn renamed_at(db: &dyn Db, file: SourceFile, offset: TextSize) -> Result<&Occurr
         )),
         Symbol::BlockNumber(_) => Err(format!("`{written}` is a block number: renumber the block instead")),
         Symbol::Parameter(_) => Err(format!("`{written}` is an R parameter: its number cannot be renamed")),
-        Symbol::Program(_) => Err(format!("`{written}` is a program: it is renamed with its file")),
+        Symbol::Program(key) if program_files(db, key).next().is_some() => Ok(at),
+        Symbol::Program(_) => Err(format!(
+            "`{written}` is not a program of the workspace (a cycle of the control, or a file not found): it cannot be renamed here"
+        )),
     }
 }
 
