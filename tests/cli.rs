@@ -537,7 +537,8 @@ fn plot_draws_the_toolpath_as_svg() {
     assert_eq!(paths[2].matches(" L").count(), 36, "{}", paths[2]);
     // Stops after the rapid, between the G98 moves and before M30.
     assert_eq!(svg.lines().filter(|line| line.starts_with("<circle data-line")).count(), 3, "{svg}");
-    assert!(svg.contains("XY plane · total time"), "{svg}");
+    // The part's extent is the cutting moves': the half circle dips to Y-5.
+    assert!(svg.contains("XY plane · part X 10…30, Y -5…0, Z 0…0 mm · total time"), "{svg}");
 }
 
 /// `ncc plot -o NAME.png` draws the same picture as a PNG image at twice
@@ -569,7 +570,8 @@ fn plot_writes_a_png_image() {
 /// A lathe's picture in either view: the cut at X50. (a diameter) runs at
 /// the scale's mark 25 in the radius view and at the marks 50 on both
 /// sides of the spindle axis in the diameter view, the default, which
-/// mirrors the path there; a mill's picture has no scale.
+/// mirrors the path there; a mill's picture has a scale in mm without a
+/// mirror image.
 #[test]
 fn plot_draws_a_lathe_in_the_radius_or_the_diameter_view() {
     let dir = tempfile::tempdir().unwrap();
@@ -620,7 +622,8 @@ fn plot_draws_a_lathe_in_the_radius_or_the_diameter_view() {
     let output = ncc(&["plot", mill.to_str().unwrap(), "-o", svg.to_str().unwrap(), "--view", "radius"]);
     assert_eq!(output.status.code(), Some(0));
     let svg = std::fs::read_to_string(svg).unwrap();
-    assert!(!svg.contains("id=\"scale\"") && !svg.contains("mirror-image") && svg.contains("XY plane ·"), "{svg}");
+    assert!(svg.contains("id=\"scale\"") && !svg.contains("mirror-image") && svg.contains("XY plane ·"), "{svg}");
+    assert!(svg.contains(">X mm</text>") && svg.contains(">Y mm</text>"), "a mill's scale names its axes: {svg}");
 }
 
 /// The height in pixels of a lathe picture's spindle axis.
@@ -1056,20 +1059,20 @@ fn plot_draws_the_tool_centre_and_the_programmed_contour() {
     assert_eq!(lines(&tool), ["4", "5", "6", "7", "8"], "{svg}");
     assert_eq!(lines(&programmed), ["5", "6", "7", "8"], "{svg}");
     assert!(programmed.iter().all(|path| path.contains("stroke-dasharray") && path.contains("programmed contour")));
-    // In program coordinates the rapid starts at X100 (the machine zero),
-    // and the picture spans X 0 to 100, Y -20 to 70: 960 pixels over 100 mm.
     // The corner block runs from the start move's end (0, 5) to (45, 5),
     // its programmed line from (0, 0) to (50, 0).
-    let scale = 9.6;
-    let pixel = |x: f64| 20.0 + x * scale;
+    let pixel = pixel_of(&svg);
     let d = |path: &str| path.split(" d=\"").nth(1).unwrap().split('"').next().unwrap().to_owned();
-    let y = |y: f64| 20.0 + (70.0 - y) * scale;
-    let expected = |(x0, y0): (f64, f64), (x1, y1): (f64, f64)| {
-        format!("M{:.2} {:.2} L{:.2} {:.2}", pixel(x0), y(y0), pixel(x1), y(y1))
+    let expected = |from: (f64, f64), to: (f64, f64)| {
+        let (from, to) = (pixel(from), pixel(to));
+        format!("M{:.2} {:.2} L{:.2} {:.2}", from.0, from.1, to.0, to.1)
     };
     assert_eq!(d(&tool[2]), expected((0.0, 5.0), (45.0, 5.0)));
     assert_eq!(d(&programmed[1]), expected((0.0, 0.0), (50.0, 0.0)));
-    assert!(svg.contains("programmed contour (G41/G42)</text>"), "the legend names the layer: {svg}");
+    assert!(
+        svg.contains(">programmed contour (G41/G42); solid: the tool centre</text>"),
+        "the legend names the layers: {svg}"
+    );
 }
 
 /// A program that ends (M30) with compensation still in force: the control
@@ -1102,16 +1105,27 @@ fn a_program_ending_under_compensation_ends_on_the_last_normal() {
     assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
     let expanded = std::fs::read_to_string(expanded).unwrap();
     assert!(expanded.contains(" G01 Y50.000\n"), "{expanded}");
-    // The picture's last tool-centre move runs from (45, 5) to (45, 50):
-    // X 0 to 50 and Y -20 to 50 over 960 pixels make 13.71 pixels a mm.
+    // The picture's last tool-centre move runs from (45, 5) to (45, 50).
     let svg = dir.path().join("open.svg");
     let output = ncc(&["plot", program, "-o", svg.to_str().unwrap()]);
     assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
     let svg = std::fs::read_to_string(svg).unwrap();
-    let scale = 960.0 / 70.0;
+    let pixel = pixel_of(&svg);
     let last_move = svg.lines().find(|line| line.starts_with("<path data-line=\"6\"")).unwrap();
-    let (x, y0, y1) = (20.0 + 45.0 * scale, 20.0 + 45.0 * scale, 20.0);
+    let ((x, y0), (_, y1)) = (pixel((45.0, 5.0)), pixel((45.0, 50.0)));
     assert!(last_move.contains(&format!(" d=\"M{x:.2} {y0:.2} L{x:.2} {y1:.2}\"")), "{svg}");
+}
+
+/// Where a plane picture puts program point (X, Y), by the frame its
+/// drawing states.
+fn pixel_of(svg: &str) -> impl Fn((f64, f64)) -> (f64, f64) {
+    let drawing = svg.lines().find(|line| line.starts_with("<g id=\"drawing\"")).expect("a drawing");
+    let attribute = |name: &str| -> f64 {
+        drawing.split(&format!(" {name}=\"")).nth(1).unwrap().split('"').next().unwrap().parse().unwrap()
+    };
+    let (min_x, max_y, scale) = (attribute("data-min-x"), attribute("data-max-y"), attribute("data-scale"));
+    let (left, top) = (attribute("data-left"), attribute("data-top"));
+    move |(x, y)| (left + (x - min_x) * scale, top + (max_y - y) * scale)
 }
 
 /// Three jump loops nested, each of a thousand runs: a billion blocks,
@@ -1572,4 +1586,40 @@ fn fmt_renumbers_blocks_with_their_references_or_says_why_not() {
     let usage = ncc(&["fmt", "--renumber", "10,0", "."]);
     assert_eq!(usage.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&usage.stderr).contains("a step above 0"));
+}
+
+/// The picture fits the part, the cutting moves, not the rapid from far
+/// away that reaches it (cut at the frame's edge); `--view iso` draws a
+/// mill's three axes in an isometric view.
+#[test]
+fn plot_fits_the_cutting_moves_and_draws_an_isometric_view() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("FAR.MPF");
+    std::fs::write(&program, "G0 X500 Y500 Z50\nG0 X0 Y0 Z2\nG1 Z-5 F200\nG1 X10 Y10 F500\nG0 Z50\nM30\n").unwrap();
+    let draw = |view: &str| {
+        let svg = dir.path().join("far.svg");
+        let output = ncc(&["plot", program.to_str().unwrap(), "-o", svg.to_str().unwrap(), "--view", view]);
+        assert_eq!(output.status.code(), Some(0), "{}", String::from_utf8_lossy(&output.stderr));
+        std::fs::read_to_string(svg).unwrap()
+    };
+    let top = draw("diameter");
+    let pixel = pixel_of(&top);
+    // The part spans 10 mm, with 5% around it: 10 mm are 960 / 11 pixels.
+    let (left, right) = (pixel((0.0, 0.0)).0, pixel((10.0, 0.0)).0);
+    assert!(((right - left) - 960.0 / 11.0 * 10.0).abs() < 0.01, "{left} {right}: {top}");
+    assert!(top.contains(r#"<g id="drawing" clip-path="url(#frame)" data-projection="plane""#), "{top}");
+    assert!(top.contains("XY plane · part X 0…10, Y 0…10, Z -5…2 mm"), "{top}");
+
+    let iso = draw("iso");
+    assert!(iso.contains(r#"data-projection="isometric""#), "{iso}");
+    assert!(iso.contains("isometric view · part X 0…10, Y 0…10, Z -5…2 mm"), "{iso}");
+    for axis in ["X", "Y", "Z"] {
+        assert!(iso.contains(&format!(r#"font-weight="bold">{axis}</text>"#)), "the axes' directions: {iso}");
+    }
+    // The plunge (line 3) goes straight down the picture.
+    let plunge = iso.lines().find(|line| line.starts_with("<path data-line=\"3\"")).unwrap();
+    let d = plunge.split(" d=\"").nth(1).unwrap().split('"').next().unwrap();
+    let xs: Vec<&str> =
+        d.split(['M', 'L']).filter(|p| !p.trim().is_empty()).map(|p| p.split_whitespace().next().unwrap()).collect();
+    assert!(xs.windows(2).all(|pair| pair[0] == pair[1]), "{d}");
 }

@@ -370,7 +370,11 @@ fn the_plot_command_draws_the_document_as_edited() {
     let first_time = result["totalTimeS"].as_f64().unwrap();
     assert!(first_time > 0.0, "{result}");
     assert_eq!(result["findings"], json!([]));
-    assert_eq!(result["view"], Value::Null, "a mill has no view to choose: {result}");
+    assert_eq!(result["view"], "top", "a mill's plane view by default: {result}");
+    let answer = plot(&mut client, json!([doc.uri, { "view": "iso" }]));
+    let result = answer.result().unwrap_or_else(|| panic!("{}", answer.json));
+    assert_eq!(result["view"], "iso", "{result}");
+    assert!(result["svg"].as_str().unwrap().contains("data-projection=\"isometric\""), "{result}");
 
     // An edit that is not saved: a move on a new line 5.
     let n40 = doc.text().find("N40").unwrap();

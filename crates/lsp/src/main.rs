@@ -162,9 +162,12 @@ enum Command {
         #[arg(long, default_value = "ncc-written")]
         write_dir: PathBuf,
     },
-    /// Draw the toolpath as an SVG picture: XY (ZX on a lathe), feed moves
-    /// coloured by the speed of the velocity model, rapid moves dashed, the
-    /// breaks of the path speed marked, with a legend and the total time.
+    /// Draw the toolpath as an SVG picture: XY (ZX on a lathe), or a mill's
+    /// three axes in an isometric view; feed moves coloured by the speed of
+    /// the velocity model, rapid moves dashed, the breaks of the path speed
+    /// marked, the programmed contour beside the tool centre under radius
+    /// compensation, a grid with a scale in mm, fitted to the cutting moves,
+    /// with a legend, the part's extent and the total time.
     Plot {
         /// The program to draw.
         file: PathBuf,
@@ -181,7 +184,9 @@ enum Command {
         max_moves: usize,
         /// On a lathe: `diameter` draws the whole profile, mirrored about
         /// the spindle axis, with X labelled as the program's diameters;
-        /// `radius` draws the machined half with X labelled as radii.
+        /// `radius` draws the machined half with X labelled as radii. On a
+        /// mill: `top` (or the default) draws the plane, `iso` the three
+        /// axes in an isometric view.
         #[arg(long, value_enum, default_value_t = plot::View::Diameter)]
         view: plot::View,
     },

@@ -35,22 +35,40 @@ use nc_exec::{
 /// The picture's width in pixels; the height follows the toolpath.
 const WIDTH: f64 = 1000.0;
 const MARGIN: f64 = 20.0;
-const LEGEND_HEIGHT: f64 = 70.0;
+const LEGEND_HEIGHT: f64 = 92.0;
 /// Slow to fast.
 const PALETTE: [&str; 5] = ["#3b4cc0", "#6f9bf5", "#a9c66a", "#f4a259", "#d1342f"];
 /// The programmed contour under radius compensation.
 const PROGRAMMED_STYLE: &str = r##"stroke="#111" stroke-width="0.8" stroke-dasharray="1.5 2""##;
 
-/// How a lathe's picture shows the diameter axis.
+/// How a picture shows the program: a lathe's diameter axis, or a mill's
+/// three axes. A lathe takes its views only, a mill its own: either's
+/// default, [`View::Diameter`], is the plane view on a mill.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, clap::ValueEnum, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub(crate) enum View {
-    /// The machined half profile, X labelled as a radius.
+    /// A lathe's machined half profile, X labelled as a radius.
     Radius,
-    /// The whole profile, mirrored about the spindle axis, X labelled as a
-    /// diameter.
+    /// A lathe's whole profile, mirrored about the spindle axis, X labelled
+    /// as a diameter.
     #[default]
     Diameter,
+    /// A mill's view plane seen from the tool axis.
+    Top,
+    /// A mill's three axes in an isometric view.
+    Iso,
+}
+
+impl View {
+    /// The view a picture of `trace` asked for in `self` is drawn in.
+    pub(crate) fn drawn(self, trace: &Trace) -> View {
+        match (trace.diameter_axis.is_some(), self) {
+            (true, View::Radius) => View::Radius,
+            (true, _) => View::Diameter,
+            (false, View::Iso) => View::Iso,
+            (false, _) => View::Top,
+        }
+    }
 }
 
 /// The scale's tick labels, the centre line and the mirror image.
@@ -132,58 +150,88 @@ fn source_attributes(lines: &impl Lines, step: usize) -> String {
     }
 }
 
-/// A step as drawn, in program coordinates of the view plane: the tool
-/// centre's path, and the programmed one where radius compensation moved
-/// the tool off it.
+/// A step as drawn, in program coordinates: the tool centre's path, and
+/// the programmed one where radius compensation moved the tool off it;
+/// each point is the view plane's two axes and the tool axis.
 struct Drawn {
-    tool: Vec<(f64, f64)>,
-    programmed: Option<Vec<(f64, f64)>>,
+    tool: Vec<Point>,
+    programmed: Option<Vec<Point>>,
+}
+
+/// A point in program coordinates: across and up in the view plane, and
+/// along the tool axis (0 on a machine without one).
+type Point = [f64; 3];
+
+/// How points of the program become points of the picture.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Projection {
+    /// The view plane seen from the tool axis.
+    Plane,
+    /// The three axes seen from above their first octant: the plane's axes
+    /// at 30° below the horizontal, the tool axis up.
+    Isometric,
+}
+
+impl Projection {
+    fn project(self, [u, v, w]: Point) -> (f64, f64) {
+        match self {
+            Projection::Plane => (u, v),
+            Projection::Isometric => {
+                let (cos, sin) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+                ((u - v) * cos, (u + v) * sin + w)
+            }
+        }
+    }
+}
+
+/// The picture's frame: what it shows of the program's plane, and how a
+/// point of it lands on the picture.
+struct Frame {
+    min: (f64, f64),
+    max: (f64, f64),
+    scale: f64,
+    height: f64,
+}
+
+impl Frame {
+    fn pixel(&self, (x, y): (f64, f64)) -> (f64, f64) {
+        (MARGIN + (x - self.min.0) * self.scale, MARGIN + (self.max.1 - y) * self.scale)
+    }
 }
 
 /// The SVG text of the run `sketch` kept, whose kept steps `trace` holds,
-/// titled `title`; a lathe's in `view`.
+/// titled `title`, in `view`.
 pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &str, view: View) -> String {
+    let view = view.drawn(trace);
     let lathe_view = trace.diameter_axis.map(|_| view);
+    let projection = if view == View::Iso { Projection::Isometric } else { Projection::Plane };
     let (across, up) = view_axes(trace);
     let slot = |letter: u8| trace.axes.iter().position(|&axis| axis == letter);
     let (Some(u), Some(v)) = (slot(across), slot(up)) else { return String::new() };
-    let plane = |values: &Axes| (values[u], values[v]);
+    let tool_axis = (trace.diameter_axis.is_none()).then(|| trace.axes.get(2).copied()).flatten();
+    let w = tool_axis.and_then(slot);
+    let point = |values: &Axes| [values[u], values[v], w.map_or(0.0, |w| values[w])];
     let drawn: Vec<Drawn> = (0..trace.steps.len())
         .map(|index| {
             let step = &trace.steps[index];
             let centred = trace.centred(index);
             let start = trace.tool_start_of(index);
-            let mut tool = vec![plane(&start)];
+            let mut tool = vec![point(&start)];
             let mut from = start;
             for tool_move in tool_moves(step, &start, centred.as_ref(), &trace.axes) {
-                let piece = polyline(plane(&from), tool_move.path, plane(&tool_move.end), (across, up));
+                let piece = path_points(point(&from), tool_move.path, point(&tool_move.end), (across, up));
                 tool.extend_from_slice(&piece[1..]);
                 from = tool_move.end;
             }
             let programmed =
-                centred.map(|_| polyline(plane(&trace.start_of(index)), step.path, plane(&step.end), (across, up)));
+                centred.map(|_| path_points(point(&trace.start_of(index)), step.path, point(&step.end), (across, up)));
             Drawn { tool, programmed }
         })
         .collect();
-    let points = drawn.iter().flat_map(|drawn| drawn.tool.iter().chain(drawn.programmed.iter().flatten()));
-    let (mut min, mut max) = ((f64::INFINITY, f64::INFINITY), (f64::NEG_INFINITY, f64::NEG_INFINITY));
-    for &(x, y) in points {
-        min = (min.0.min(x), min.1.min(y));
-        max = (max.0.max(x), max.1.max(y));
-    }
-    if !min.0.is_finite() {
-        min = (0.0, 0.0);
-        max = (1.0, 1.0);
-    }
-    if lathe_view == Some(View::Diameter) {
-        let reach = min.1.abs().max(max.1.abs());
-        (min.1, max.1) = (-reach, reach);
-    }
-    let span = (max.0 - min.0).max(max.1 - min.1).max(1e-3);
-    let scale = (WIDTH - 2.0 * MARGIN) / span;
-    let height = (max.1 - min.1) * scale + 2.0 * MARGIN;
-    let pixel = |(x, y): (f64, f64)| (MARGIN + (x - min.0) * scale, MARGIN + (max.1 - y) * scale);
-    let d = |polyline: &[(f64, f64)]| {
+    let extent = part_extent(trace, &drawn);
+    let frame = frame(trace, &drawn, extent, projection, lathe_view);
+    let pixel = |point: Point| frame.pixel(projection.project(point));
+    let d = |polyline: &[Point]| {
         let mut d = String::new();
         for (i, &point) in polyline.iter().enumerate() {
             let (x, y) = pixel(point);
@@ -198,26 +246,46 @@ pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &st
 
     let mut out = String::new();
     let legend_height = LEGEND_HEIGHT + if sketch.capped().is_some() { 22.0 } else { 0.0 };
-    let total_height = height + legend_height;
+    let total_height = frame.height + legend_height;
     let _ = writeln!(
         out,
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{total_height:.0}" viewBox="0 0 {WIDTH} {total_height:.0}" font-family="sans-serif" font-size="12">"#
     );
     let _ = writeln!(out, "<title>{}</title>", escape(title));
     let _ = writeln!(out, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    // Moves outside the frame (the first rapid from the machine's home)
+    // are cut at its edge.
+    let _ = writeln!(
+        out,
+        r#"<clipPath id="frame"><rect x="0" y="0" width="{WIDTH}" height="{:.2}"/></clipPath>"#,
+        frame.height
+    );
     // Written over the drawing, so that no move hides them.
-    let mut scale_labels = String::new();
-    if let Some(view) = lathe_view {
-        let axis_y = pixel((0.0, 0.0)).1;
-        scale_labels = lathe_scale(&mut out, view, (min, max), &pixel, axis_y);
-        if view == View::Diameter {
-            // The other half of the profile, as the same layers reflected.
-            let _ = writeln!(
-                out,
-                r##"<g id="mirror-image" transform="matrix(1 0 0 -1 0 {:.2})" opacity="{MIRROR_OPACITY}"><use href="#tool-centre"/><use href="#programmed-contour"/></g>"##,
-                2.0 * axis_y
-            );
-        }
+    let scale_labels = match (projection, lathe_view) {
+        (Projection::Isometric, _) => isometric_scale(&mut out, &frame, extent, (across, up, tool_axis)),
+        (Projection::Plane, view) => plane_scale(&mut out, &frame, view, (across, up)),
+    };
+    // Where program coordinates land, for a viewer that shows them (a
+    // plane view): x = left + (X − min-x) · scale, y = top + (max-y − Y) ·
+    // scale.
+    let _ = writeln!(
+        out,
+        r#"<g id="drawing" clip-path="url(#frame)" data-projection="{}" data-min-x="{:.6}" data-max-y="{:.6}" data-scale="{:.6}" data-left="{MARGIN}" data-top="{MARGIN}">"#,
+        match projection {
+            Projection::Plane => "plane",
+            Projection::Isometric => "isometric",
+        },
+        frame.min.0,
+        frame.max.1,
+        frame.scale
+    );
+    if lathe_view == Some(View::Diameter) {
+        // The other half of the profile, as the same layers reflected.
+        let _ = writeln!(
+            out,
+            r##"<g id="mirror-image" transform="matrix(1 0 0 -1 0 {:.2})" opacity="{MIRROR_OPACITY}"><use href="#tool-centre"/><use href="#programmed-contour"/></g>"##,
+            2.0 * frame.pixel((0.0, 0.0)).1
+        );
     }
     let _ = writeln!(out, r#"<g id="tool-centre">"#);
     for (index, drawn) in drawn.iter().enumerate() {
@@ -276,55 +344,200 @@ pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &st
             speed_break.lost
         );
     }
+    let _ = writeln!(out, "</g>");
     out.push_str(&scale_labels);
-    legend(&mut out, height, fastest, sketch, (across, up), compensated, lathe_view);
+    let shown = Shown { axes: (across, up, tool_axis), compensated, lathe_view, projection, extent };
+    legend(&mut out, frame.height, fastest, sketch, &shown);
     out.push_str("</svg>\n");
     out
 }
 
-/// The lathe's scale: grid lines at round steps in program units, and the
-/// spindle axis as a centre line where it is in the picture, under the
-/// drawing; the lines' values, X as `view` labels it, to write over it.
-fn lathe_scale(
-    out: &mut String,
-    view: View,
-    (min, max): ((f64, f64), (f64, f64)),
-    pixel: &impl Fn((f64, f64)) -> (f64, f64),
-    axis_y: f64,
-) -> String {
-    let (left, top) = pixel((min.0, max.1));
-    let (right, bottom) = pixel((max.0, min.1));
+/// What the legend says of the picture besides the speeds.
+struct Shown {
+    /// The view plane's axes and the tool axis.
+    axes: (u8, u8, Option<u8>),
+    compensated: bool,
+    lathe_view: Option<View>,
+    projection: Projection,
+    extent: Option<(Point, Point)>,
+}
+
+/// The part's extent: the smallest box around every cutting move of the
+/// tool centre, in program coordinates; `None` without one.
+fn part_extent(trace: &Trace, drawn: &[Drawn]) -> Option<(Point, Point)> {
+    let cutting = drawn.iter().enumerate().filter(|(index, _)| trace.steps[*index].motion == Motion::Feed);
+    let points = cutting.flat_map(|(_, drawn)| drawn.tool.iter().chain(drawn.programmed.iter().flatten()));
+    points.fold(None, |extent, &point| {
+        let (low, high) = extent.unwrap_or((point, point));
+        Some((std::array::from_fn(|i| low[i].min(point[i])), std::array::from_fn(|i| high[i].max(point[i]))))
+    })
+}
+
+/// The frame that fits the part (the cutting moves, with a margin) in
+/// `projection`: rapids that go further, the first from the machine's
+/// home above all, would shrink the part to a corner. A run without a
+/// cutting move is fitted to all its moves.
+fn frame(
+    trace: &Trace,
+    drawn: &[Drawn],
+    extent: Option<(Point, Point)>,
+    projection: Projection,
+    lathe_view: Option<View>,
+) -> Frame {
+    let corners = |(low, high): (Point, Point)| -> Vec<Point> {
+        (0..8).map(|i| std::array::from_fn(|axis| if i >> axis & 1 == 0 { low[axis] } else { high[axis] })).collect()
+    };
+    let fitted: Vec<Point> = match extent {
+        Some(extent) => corners(extent),
+        None => drawn
+            .iter()
+            .enumerate()
+            .filter(|(index, _)| trace.steps[*index].motion != Motion::Dwell)
+            .flat_map(|(_, drawn)| drawn.tool.iter().chain(drawn.programmed.iter().flatten()).copied())
+            .collect(),
+    };
+    let (mut min, mut max) = ((f64::INFINITY, f64::INFINITY), (f64::NEG_INFINITY, f64::NEG_INFINITY));
+    for point in fitted {
+        let (x, y) = projection.project(point);
+        min = (min.0.min(x), min.1.min(y));
+        max = (max.0.max(x), max.1.max(y));
+    }
+    if !min.0.is_finite() {
+        (min, max) = ((0.0, 0.0), (1.0, 1.0));
+    }
+    if lathe_view.is_some() {
+        // A lathe's part turns about the spindle axis: it stays in view.
+        (min.1, max.1) = (min.1.min(0.0), max.1.max(0.0));
+    }
+    let pad = 0.05 * (max.0 - min.0).max(max.1 - min.1).max(1.0);
+    (min, max) = ((min.0 - pad, min.1 - pad), (max.0 + pad, max.1 + pad));
+    if lathe_view == Some(View::Diameter) {
+        let reach = min.1.abs().max(max.1.abs());
+        (min.1, max.1) = (-reach, reach);
+    }
+    let span = (max.0 - min.0).max(max.1 - min.1).max(1e-3);
+    let scale = (WIDTH - 2.0 * MARGIN) / span;
+    let height = (max.1 - min.1) * scale + 2.0 * MARGIN;
+    Frame { min, max, scale, height }
+}
+
+/// The scale of a plane view: grid lines at round steps in mm, labelled
+/// along the bottom and the left edge, with the axes' names, under the
+/// drawing; the labels, to write over it. A lathe labels its diameter
+/// axis as `view` shows it, and draws the spindle axis as a centre line.
+fn plane_scale(out: &mut String, frame: &Frame, lathe_view: Option<View>, (across, up): (u8, u8)) -> String {
+    let (min, max) = (frame.min, frame.max);
+    let (left, top) = frame.pixel((min.0, max.1));
+    let (right, bottom) = frame.pixel((max.0, min.1));
     let mut labels = format!("<g id=\"scale\" {SCALE_STYLE}>\n");
     let _ = writeln!(out, r#"<g id="grid" {GRID_STYLE}>"#);
     for (value, label) in ticks(min.0, max.0) {
-        let x = pixel((value, 0.0)).0;
+        let x = frame.pixel((value, 0.0)).0;
         let _ = writeln!(out, r#"<line x1="{x:.2}" y1="{top:.2}" x2="{x:.2}" y2="{bottom:.2}"/>"#);
-        let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, x + 2.0, bottom + 12.0);
+        let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, x + 2.0, bottom - 4.0);
     }
-    let marks = match view {
-        View::Radius => ticks(min.1, max.1),
+    let marks = match lathe_view {
         // Round diameters, on both halves of the profile alike.
-        View::Diameter => ticks(0.0, 2.0 * max.1)
+        Some(View::Diameter) => ticks(0.0, 2.0 * max.1)
             .into_iter()
             .flat_map(|(diameter, label)| {
                 let mirrored = (diameter > 0.0).then(|| (-diameter / 2.0, label.clone()));
                 [(diameter / 2.0, label)].into_iter().chain(mirrored)
             })
             .collect(),
+        _ => ticks(min.1, max.1),
     };
     for (value, label) in marks {
-        let y = pixel((0.0, value)).1;
+        let y = frame.pixel((0.0, value)).1;
         let _ = writeln!(out, r#"<line x1="{left:.2}" y1="{y:.2}" x2="{right:.2}" y2="{y:.2}"/>"#);
         let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, left + 2.0, y - 2.0);
     }
     let _ = writeln!(out, "</g>");
+    let up_name = match lathe_view {
+        Some(View::Diameter) => format!("{} (diameter)", char::from(up)),
+        Some(View::Radius) => format!("{} (radius)", char::from(up)),
+        _ => char::from(up).to_string(),
+    };
+    let _ = writeln!(
+        labels,
+        r#"<text x="{:.2}" y="{:.2}" text-anchor="end" font-weight="bold">{} mm</text>"#,
+        right - 4.0,
+        bottom - 16.0,
+        char::from(across)
+    );
+    // Beside the top tick's label, not on it.
+    let _ = writeln!(
+        labels,
+        r#"<text x="{:.2}" y="{:.2}" font-weight="bold">{up_name} mm</text>"#,
+        left + 36.0,
+        top + 12.0
+    );
     labels.push_str("</g>\n");
-    if (top - 0.01..=bottom + 0.01).contains(&axis_y) {
+    let axis_y = frame.pixel((0.0, 0.0)).1;
+    if lathe_view.is_some() && (top - 0.01..=bottom + 0.01).contains(&axis_y) {
         let _ = writeln!(
             out,
             r#"<line id="spindle-axis" x1="{left:.2}" y1="{axis_y:.2}" x2="{right:.2}" y2="{axis_y:.2}" {CENTRE_LINE_STYLE}/>"#
         );
     }
+    labels
+}
+
+/// The scale of the isometric view: a grid at round steps in mm on the
+/// plane at the part's bottom, labelled along two of its edges, and the
+/// three axes' directions; the labels, to write over the drawing.
+fn isometric_scale(
+    out: &mut String,
+    frame: &Frame,
+    extent: Option<(Point, Point)>,
+    (across, up, tool_axis): (u8, u8, Option<u8>),
+) -> String {
+    let mut labels = format!("<g id=\"scale\" {SCALE_STYLE}>\n");
+    let pixel = |point: Point| frame.pixel(Projection::Isometric.project(point));
+    if let Some((low, high)) = extent {
+        let _ = writeln!(out, r#"<g id="grid" {GRID_STYLE}>"#);
+        let (u_ticks, v_ticks) = (ticks(low[0], high[0]), ticks(low[1], high[1]));
+        let floor = low[2];
+        for (value, label) in &u_ticks {
+            let (a, b) = (pixel([*value, low[1], floor]), pixel([*value, high[1], floor]));
+            let _ = writeln!(out, r#"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}"/>"#, a.0, a.1, b.0, b.1);
+            let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, a.0 - 6.0, a.1 + 14.0);
+        }
+        for (value, label) in &v_ticks {
+            let (a, b) = (pixel([low[0], *value, floor]), pixel([high[0], *value, floor]));
+            let _ = writeln!(out, r#"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}"/>"#, a.0, a.1, b.0, b.1);
+            let _ = writeln!(
+                labels,
+                r#"<text x="{:.2}" y="{:.2}" text-anchor="end">{label}</text>"#,
+                a.0 - 4.0,
+                a.1 + 12.0
+            );
+        }
+        let _ = writeln!(out, "</g>");
+    }
+    // The axes' directions, in the top left corner.
+    let origin = (MARGIN + 40.0, MARGIN + 50.0);
+    let names = [Some(across), Some(up), tool_axis];
+    for (index, name) in names.into_iter().enumerate() {
+        let Some(name) = name else { continue };
+        let mut unit = [0.0; 3];
+        unit[index] = 30.0;
+        let (x, y) = Projection::Isometric.project(unit);
+        let end = (origin.0 + x, origin.1 - y);
+        let _ = writeln!(
+            out,
+            r##"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}" stroke="#444" stroke-width="1.2"/>"##,
+            origin.0, origin.1, end.0, end.1
+        );
+        let _ = writeln!(
+            labels,
+            r#"<text x="{:.2}" y="{:.2}" font-weight="bold">{}</text>"#,
+            end.0 + 2.0,
+            end.1 + 4.0,
+            char::from(name)
+        );
+    }
+    labels.push_str("</g>\n");
     labels
 }
 
@@ -360,9 +573,10 @@ fn view_axes(trace: &Trace) -> (u8, u8) {
     }
 }
 
-/// A move from `from` along `path` to `to` in the view plane of the axes
-/// `letters`; an arc in that plane as chords of at most 5°.
-fn polyline(from: (f64, f64), path: Path, to: (f64, f64), letters: (u8, u8)) -> Vec<(f64, f64)> {
+/// A move from `from` along `path` to `to`, an arc in the view plane of
+/// the axes `letters` as chords of at most 5°, the tool axis moving
+/// evenly along it (a helix).
+fn path_points(from: Point, path: Path, to: Point, letters: (u8, u8)) -> Vec<Point> {
     let Path::Arc { plane, centre, clockwise } = path else { return vec![from, to] };
     let centre = if plane == letters {
         (centre[0], centre[1])
@@ -373,8 +587,8 @@ fn polyline(from: (f64, f64), path: Path, to: (f64, f64), letters: (u8, u8)) -> 
     };
     // Seen with the axes swapped, the arc turns the other way.
     let clockwise = clockwise == (plane == letters);
-    let radius = (from.0 - centre.0).hypot(from.1 - centre.1);
-    let angle_of = |(x, y): (f64, f64)| (y - centre.1).atan2(x - centre.0);
+    let radius = (from[0] - centre.0).hypot(from[1] - centre.1);
+    let angle_of = |point: Point| (point[1] - centre.1).atan2(point[0] - centre.0);
     let (a0, a1) = (angle_of(from), angle_of(to));
     let tau = std::f64::consts::TAU;
     let mut sweep = if clockwise { a0 - a1 } else { a1 - a0 };
@@ -385,8 +599,9 @@ fn polyline(from: (f64, f64), path: Path, to: (f64, f64), letters: (u8, u8)) -> 
     let sign = if clockwise { -1.0 } else { 1.0 };
     (0..=pieces)
         .map(|i| {
-            let angle = a0 + sign * sweep * i as f64 / pieces as f64;
-            (centre.0 + radius * angle.cos(), centre.1 + radius * angle.sin())
+            let share = i as f64 / pieces as f64;
+            let angle = a0 + sign * sweep * share;
+            [centre.0 + radius * angle.cos(), centre.1 + radius * angle.sin(), from[2] + (to[2] - from[2]) * share]
         })
         .collect()
 }
@@ -396,15 +611,7 @@ fn colour(speed: f64, fastest: f64) -> &'static str {
     PALETTE[bucket.min(PALETTE.len() - 1)]
 }
 
-fn legend(
-    out: &mut String,
-    top: f64,
-    fastest: f64,
-    sketch: &Sketch,
-    (across, up): (u8, u8),
-    compensated: bool,
-    lathe_view: Option<View>,
-) {
+fn legend(out: &mut String, top: f64, fastest: f64, sketch: &Sketch, shown: &Shown) {
     let y = top + 20.0;
     let buckets = PALETTE.len() as f64;
     for (i, colour) in PALETTE.iter().enumerate() {
@@ -425,22 +632,44 @@ fn legend(
     let _ = writeln!(out, r#"<text x="{}" y="{y2}">stop</text>"#, MARGIN + 108.0);
     let _ = writeln!(out, r##"<circle cx="{}" cy="{}" r="3" fill="#f4a259"/>"##, MARGIN + 160.0, y2 - 4.0);
     let _ = writeln!(out, r#"<text x="{}" y="{y2}">slow-down</text>"#, MARGIN + 168.0);
-    let mut x = MARGIN + 260.0;
-    if compensated {
+    if shown.compensated {
+        let x = MARGIN + 260.0;
         let _ = writeln!(out, r#"<line x1="{x}" y1="{0}" x2="{1}" y2="{0}" {PROGRAMMED_STYLE}/>"#, y2 - 4.0, x + 24.0);
-        let _ = writeln!(out, r#"<text x="{}" y="{y2}">programmed contour (G41/G42)</text>"#, x + 30.0);
-        x += 220.0;
+        let _ = writeln!(
+            out,
+            r#"<text x="{}" y="{y2}">programmed contour (G41/G42); solid: the tool centre</text>"#,
+            x + 30.0
+        );
     }
-    let view = match lathe_view {
-        Some(View::Radius) => format!(", {} as a radius", char::from(up)),
-        Some(View::Diameter) => format!(", {} as a diameter", char::from(up)),
-        None => String::new(),
+    let (across, up, tool_axis) = shown.axes;
+    let view = match (shown.projection, shown.lathe_view) {
+        (Projection::Isometric, _) => "isometric view".to_owned(),
+        (_, Some(View::Radius)) => {
+            format!("{}{} plane, {} as a radius", char::from(across), char::from(up), char::from(up))
+        }
+        (_, Some(View::Diameter)) => {
+            format!("{}{} plane, {} as a diameter", char::from(across), char::from(up), char::from(up))
+        }
+        _ => format!("{}{} plane", char::from(across), char::from(up)),
     };
+    let extent = shown.extent.map_or(String::new(), |(low, high)| {
+        let mut names = vec![across, up];
+        names.extend(tool_axis);
+        // A lathe's diameter view measures the part across the spindle.
+        let factor = |i: usize| if i == 1 && shown.lathe_view == Some(View::Diameter) { 2.0 } else { 1.0 };
+        let spans: Vec<String> = names
+            .iter()
+            .enumerate()
+            .map(|(i, &name)| {
+                format!("{} {}…{}", char::from(name), number(factor(i) * low[i]), number(factor(i) * high[i]))
+            })
+            .collect();
+        format!(" · part {} mm", spans.join(", "))
+    });
     let _ = writeln!(
         out,
-        r#"<text x="{x}" y="{y2}">{}{} plane{view} · total time {} · {} breaks</text>"#,
-        char::from(across),
-        char::from(up),
+        r#"<text x="{MARGIN}" y="{}">{view}{extent} · total time {} · {} breaks</text>"#,
+        y2 + 22.0,
         ncc_analysis::clock(sketch.total_time),
         sketch.break_count
     );
@@ -448,10 +677,17 @@ fn legend(
         let _ = writeln!(
             out,
             r##"<text x="{MARGIN}" y="{}" fill="#d1342f" font-weight="bold">{}</text>"##,
-            y2 + 22.0,
+            y2 + 44.0,
             escape(&capped_note(drawn, sketch.moves))
         );
     }
+}
+
+/// A coordinate as the legend writes it: to the µm, without trailing
+/// zeros.
+fn number(value: f64) -> String {
+    let text = format!("{:.3}", value + 0.0);
+    text.trim_end_matches('0').trim_end_matches('.').to_owned()
 }
 
 /// How many pixels a PNG has per unit of the SVG: twice, so that thin

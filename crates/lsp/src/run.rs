@@ -173,7 +173,7 @@ impl Ran {
 
     /// Runs `program` through the velocity model as the steps come, keeping
     /// what the picture draws of the first `max_moves` ([`Sketch`]), and
-    /// draws it, a lathe's in `view`: the trace keeps those steps only.
+    /// draws it in `view`: the trace keeps those steps only.
     pub(crate) fn plotted(
         program: &Program<'_>,
         step_budget: usize,
@@ -196,7 +196,7 @@ impl Ran {
         let title = format!("{} · ncc plot", ran.sources[0].name);
         let svg = crate::plot::svg(&ran.trace, &sketch, &ran, &title, view);
         let capped = sketch.capped().map(|drawn| crate::plot::capped_note(drawn, sketch.moves));
-        let view = ran.trace.diameter_axis.map(|_| view);
+        let view = view.drawn(&ran.trace);
         Ok((ran, Plot { svg, total_time: sketch.total_time, capped, view }))
     }
 
@@ -283,8 +283,8 @@ pub(crate) struct Plot {
     pub total_time: f64,
     /// What the picture says when it draws only the first moves.
     pub capped: Option<String>,
-    /// The view of a lathe's picture; `None` off a lathe.
-    pub view: Option<View>,
+    /// The view the picture is drawn in.
+    pub view: View,
 }
 
 /// Whether a long run shows a spinner.

@@ -262,11 +262,11 @@ describe('the packaged extension in code-server', () => {
     const rapid = await lineOf('milling/pocket.NCP', 'N40 G00 X60. Y40.');
     await workbench.runCommand('ncc: Show Toolpath');
     // The view is a webview: a frame in a frame, whose origin is its own.
-    const moves = await until(async () => {
+    const [moves, view] = await until(async () => {
       for (const frame of workbench.page.frames()) {
         const lines = await svgMoveLines(frame);
         if (lines && lines.length > 0) {
-          return lines;
+          return [lines, frame] as const;
         }
       }
       return undefined;
@@ -275,6 +275,23 @@ describe('the packaged extension in code-server', () => {
     await workbench.screenshot('4-toolpath');
     assert.ok(moves.length > 20, `the pocket has many moves: ${moves.length}`);
     assert.ok(moves.includes(rapid), `the rapid move of line ${rapid} is drawn`);
+    // The wheel zooms in about the pointer: the picture's box narrows.
+    const [before, after] = await view.evaluate(() => {
+      const svg = document.querySelector('#plot svg');
+      const plot = document.getElementById('plot');
+      if (svg === null || plot === null) {
+        return [null, null];
+      }
+      const box = svg.getAttribute('viewBox');
+      const rect = svg.getBoundingClientRect();
+      const at = { clientX: rect.left + rect.width / 2, clientY: rect.top + rect.height / 3 };
+      plot.dispatchEvent(new WheelEvent('wheel', { deltaY: -100, bubbles: true, cancelable: true, ...at }));
+      return [box, svg.getAttribute('viewBox')];
+    });
+    const width = (box: string | null) => Number((box ?? '').split(' ')[2]);
+    assert.ok(width(after) < width(before), `the wheel zooms in: ${before} → ${after}`);
+    await sleep(500);
+    await workbench.screenshot('4b-toolpath-zoomed');
   });
 
   test('a Haas lathe program opens in its language, and no request about it fails', async () => {

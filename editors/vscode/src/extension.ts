@@ -14,7 +14,7 @@ import {
 } from 'vscode-languageclient/node';
 import { DOCUMENT_SELECTOR, TOOLPATH_LANGUAGES } from './documents';
 import { type Environment, type Launch, readSettings, ServerStderr, serverLaunch, startFailure } from './server';
-import { type LatheView, PLOT_COMMAND, plotArguments } from './toolpath';
+import { type PlotView, PLOT_COMMAND, plotArguments } from './toolpath';
 import { ToolpathViews } from './toolpathView';
 
 /** How long a server that exited at start may take to finish its stderr. */
@@ -204,7 +204,7 @@ class Server implements vscode.Disposable {
    * default). Rejects with the server's error, whose `data` may hold the
    * picture of a run that stopped.
    */
-  async plot(uri: string, view: LatheView | undefined): Promise<unknown> {
+  async plot(uri: string, view: PlotView | undefined): Promise<unknown> {
     // A restart in progress brings a client to ask.
     await this.restarting;
     const client = this.client;

@@ -3,8 +3,11 @@
 // between the page and the extension, the line a click means, the answers
 // of the server's `ncc.plot` command and when to ask for them again.
 //
-// A lathe's picture comes in the radius or the diameter view (`ncc plot
-// --view`); the page offers the choice when the server says it drew one.
+// A lathe's picture comes in the radius or the diameter view, a mill's in
+// the plane or an isometric view (`ncc plot --view`); the page offers the
+// choices of the kind the server says it drew. The page zooms (the wheel,
+// about the pointer) and pans (a drag) by the picture's viewBox; a double
+// click shows the whole picture again.
 //
 // The picture is the SVG of `ncc plot`, pure data: every move and mark
 // carries `data-line` (its line, from 1) and, when a macrocycle file or the
@@ -20,8 +23,15 @@ export const VIEW_SCRIPT = 'toolpath.js';
 /** How long the document must rest before the picture is drawn again. */
 export const RENDER_DELAY_MS = 500;
 
-/** How a lathe's picture shows X: the machined half, or the whole profile labelled with diameters. */
-export type LatheView = 'radius' | 'diameter';
+/**
+ * How a picture shows the program: a lathe's machined half or whole profile
+ * labelled with diameters, a mill's plane or its three axes in an isometric view.
+ */
+export type PlotView = 'radius' | 'diameter' | 'top' | 'iso';
+
+/** The views of a lathe's picture, and of a mill's. */
+export const LATHE_VIEWS: readonly PlotView[] = ['diameter', 'radius'];
+export const MILL_VIEWS: readonly PlotView[] = ['top', 'iso'];
 
 /** The answer of `ncc.plot`. */
 export interface Plotted {
@@ -29,17 +39,17 @@ export interface Plotted {
   /** Seconds, with the control's velocity model. */
   totalTimeS: number;
   findings: Finding[];
-  /** The lathe's view drawn; `null` for a machine without a diameter axis. */
-  view: LatheView | null;
+  /** The view drawn; `null` when the server did not say. */
+  view: PlotView | null;
 }
 
 /** The arguments of `ncc.plot`: the document, and the view once one was chosen (else the server's default). */
-export function plotArguments(uri: string, view: LatheView | undefined): unknown[] {
+export function plotArguments(uri: string, view: PlotView | undefined): unknown[] {
   return view === undefined ? [uri] : [uri, { view }];
 }
 
-function isLatheView(value: unknown): value is LatheView {
-  return value === 'radius' || value === 'diameter';
+export function isPlotView(value: unknown): value is PlotView {
+  return value === 'radius' || value === 'diameter' || value === 'top' || value === 'iso';
 }
 
 /** What the run did not run, or where it stopped. */
@@ -54,12 +64,12 @@ export interface Finding {
 
 /** Messages from the extension to the page. */
 export type ToView =
-  | { type: 'plot'; svg: string; summary: string; notes: string[]; view: LatheView | null }
-  | { type: 'error'; message: string; svg?: string; notes: string[]; view?: LatheView | null }
+  | { type: 'plot'; svg: string; summary: string; notes: string[]; view: PlotView | null }
+  | { type: 'error'; message: string; svg?: string; notes: string[]; view?: PlotView | null }
   | { type: 'highlight'; line: number | null };
 
 /** Messages from the page to the extension. */
-export type FromView = { type: 'ready' } | Reveal | { type: 'view'; view: LatheView };
+export type FromView = { type: 'ready' } | Reveal | { type: 'view'; view: PlotView };
 
 /** A click on a move or mark: show its line. */
 export interface Reveal {
@@ -115,7 +125,7 @@ export function parseFromView(message: unknown): FromView | undefined {
     return { type: 'ready' };
   }
   if (type === 'view') {
-    return isLatheView(view) ? { type: 'view', view } : undefined;
+    return isPlotView(view) ? { type: 'view', view } : undefined;
   }
   if (type !== 'reveal' || typeof line !== 'number' || !Number.isSafeInteger(line) || line < 1) {
     return undefined;
@@ -203,7 +213,7 @@ export function parsePlotted(value: unknown): Plotted | undefined {
       checked.push(typeof file === 'string' ? { ...base, file } : base);
     }
   }
-  return { svg, totalTimeS, findings: checked, view: isLatheView(view) ? view : null };
+  return { svg, totalTimeS, findings: checked, view: isPlotView(view) ? view : null };
 }
 
 /** A finding as the page lists it: `line 12: …`, or `L9001 line 3: …` in another file. */
@@ -249,6 +259,66 @@ export function failureMessage(error: unknown): ToView & { type: 'error' } {
   };
 }
 
+/** The part of the picture shown: an SVG `viewBox`, in the picture's units. */
+export interface ViewBox {
+  x: number;
+  y: number;
+  width: number;
+  height: number;
+}
+
+/** A `viewBox` attribute's box, if it is four numbers and a size. */
+export function parseViewBox(text: string | null): ViewBox | undefined {
+  const numbers = (text ?? '').trim().split(/[\s,]+/).map(Number);
+  if (numbers.length !== 4 || !numbers.every(Number.isFinite) || numbers[2] <= 0 || numbers[3] <= 0) {
+    return undefined;
+  }
+  const [x, y, width, height] = numbers;
+  return { x, y, width, height };
+}
+
+export function viewBoxText(box: ViewBox): string {
+  return [box.x, box.y, box.width, box.height].map((n) => Number(n.toFixed(3))).join(' ');
+}
+
+/** The closest a zoom goes: a thousandth of the picture's width. */
+export const MAX_ZOOM = 1000;
+
+/**
+ * `box` zoomed by `factor` (above 1: closer) about the point `at` of the
+ * picture, which stays where it is on the screen; never wider than the
+ * whole picture `whole`, nor narrower than its width over {@link MAX_ZOOM}.
+ */
+export function zoomed(box: ViewBox, factor: number, at: { x: number; y: number }, whole: ViewBox): ViewBox {
+  const width = Math.min(Math.max(box.width / factor, whole.width / MAX_ZOOM), whole.width);
+  const scale = width / box.width;
+  return {
+    x: at.x - (at.x - box.x) * scale,
+    y: at.y - (at.y - box.y) * scale,
+    width,
+    height: box.height * scale,
+  };
+}
+
+/** `box` moved with a drag of `dx`, `dy` screen pixels over a picture `screenWidth` pixels wide. */
+export function panned(box: ViewBox, dx: number, dy: number, screenWidth: number): ViewBox {
+  const units = box.width / screenWidth;
+  return { ...box, x: box.x - dx * units, y: box.y - dy * units };
+}
+
+/** The point of the picture under screen point (`clientX`, `clientY`) of a picture shown in `rect`. */
+export function pictureAt(
+  box: ViewBox,
+  rect: { left: number; top: number; width: number; height: number },
+  clientX: number,
+  clientY: number,
+): { x: number; y: number } {
+  return {
+    x: box.x + ((clientX - rect.left) / rect.width) * box.width,
+    y: box.y + ((clientY - rect.top) / rect.height) * box.height,
+  };
+}
+
 /** A nonce for the page's Content-Security-Policy, from random bytes (16 or more): their hex digits. */
 export function nonceOf(bytes: Uint8Array): string {
   return Array.from(bytes, (byte) => byte.toString(16).padStart(2, '0')).join('');
@@ -287,10 +357,15 @@ export function pageHtml({ nonce, scriptUri, title }: PageOptions): string {
 </head>
 <body>
 <header><span id="summary">Drawing…</span>
-<fieldset id="views" hidden><legend>X as</legend>
+<fieldset id="lathe-views" class="views" hidden><legend>X as</legend>
 <label><input type="radio" name="view" value="diameter"> diameter (whole profile)</label>
 <label><input type="radio" name="view" value="radius"> radius (machined half)</label>
-</fieldset></header>
+</fieldset>
+<fieldset id="mill-views" class="views" hidden><legend>View</legend>
+<label><input type="radio" name="view" value="top"> plane</label>
+<label><input type="radio" name="view" value="iso"> 3D (isometric)</label>
+</fieldset>
+<span id="hint">wheel: zoom · drag: pan · double click: whole picture</span></header>
 <div id="error" role="alert" hidden></div>
 <ul id="notes"></ul>
 <main id="plot"></main>
@@ -303,13 +378,15 @@ export function pageHtml({ nonce, scriptUri, title }: PageOptions): string {
 const PAGE_STYLE = `
 body { padding: 0 12px; color: var(--vscode-foreground); font-family: var(--vscode-font-family); }
 header { padding: 6px 0; display: flex; gap: 16px; align-items: center; flex-wrap: wrap; }
-#views { display: flex; gap: 10px; border: none; margin: 0; padding: 0; }
-#views[hidden] { display: none; }
-#views legend { float: left; padding: 0; margin-right: 4px; }
+.views { display: flex; gap: 10px; border: none; margin: 0; padding: 0; }
+.views[hidden] { display: none; }
+.views legend { float: left; padding: 0; margin-right: 4px; }
+#hint { color: var(--vscode-descriptionForeground); }
 #error { padding: 6px 8px; margin-bottom: 6px; border: 1px solid var(--vscode-inputValidation-errorBorder, #be1100);
   background: var(--vscode-inputValidation-errorBackground, #5a1d1d); white-space: pre-wrap; }
 #notes { margin: 0 0 6px; padding-left: 18px; color: var(--vscode-descriptionForeground); }
-#plot svg { width: 100%; height: auto; display: block; }
+#plot svg { width: 100%; height: auto; display: block; touch-action: none; }
+#plot.dragging { cursor: grabbing; }
 #plot [data-line] { cursor: pointer; }
 #plot path[data-line]:hover { stroke-width: 3; }
 #plot path.selected { stroke: #e000e0; stroke-width: 4; }

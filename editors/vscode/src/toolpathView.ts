@@ -15,7 +15,7 @@ import {
   parsePlotted,
   plotMessage,
   RenderSchedule,
-  type LatheView,
+  type PlotView,
   type Reveal,
   revealTarget,
   sourceFiles,
@@ -27,7 +27,7 @@ import {
  * Asks the server for the picture of the document at `uri`, a lathe's in
  * `view` (else the server's default); rejects with the server's error.
  */
-export type Plot = (uri: string, view: LatheView | undefined) => Promise<unknown>;
+export type Plot = (uri: string, view: PlotView | undefined) => Promise<unknown>;
 
 /** One view per document, opened by `ncc.showToolpath`. */
 export class ToolpathViews implements vscode.Disposable {
@@ -75,7 +75,7 @@ class ToolpathView {
   /** The other files the picture names: the only ones a click may open. */
   private files: ReadonlySet<string> = new Set();
   /** The lathe's view the page chose; until then the server's default. */
-  private view: LatheView | undefined;
+  private view: PlotView | undefined;
   private disposed = false;
 
   constructor(

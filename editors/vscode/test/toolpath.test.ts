@@ -8,6 +8,14 @@ import * as path from 'node:path';
 import { describe, test } from 'node:test';
 import {
   clock,
+  LATHE_VIEWS,
+  MAX_ZOOM,
+  MILL_VIEWS,
+  panned,
+  parseViewBox,
+  pictureAt,
+  viewBoxText,
+  zoomed,
   type ElementLike,
   failureMessage,
   highlightSelector,
@@ -80,6 +88,8 @@ describe('messages from the page', () => {
     assert.deepEqual(parseFromView({ type: 'ready' }), { type: 'ready' });
     assert.deepEqual(parseFromView({ type: 'view', view: 'radius' }), { type: 'view', view: 'radius' });
     assert.deepEqual(parseFromView({ type: 'view', view: 'diameter' }), { type: 'view', view: 'diameter' });
+    assert.deepEqual(parseFromView({ type: 'view', view: 'iso' }), { type: 'view', view: 'iso' });
+    assert.deepEqual(parseFromView({ type: 'view', view: 'top' }), { type: 'view', view: 'top' });
   });
 
   test('anything else is dropped', () => {
@@ -174,10 +184,11 @@ describe('the page', () => {
     assert.notEqual(nonceOf(crypto.getRandomValues(new Uint8Array(16))), nonceOf(new Uint8Array(16)));
   });
 
-  test('offers the lathe’s two views, hidden until a lathe’s picture comes', () => {
-    assert.match(html, /<fieldset id="views" hidden>/);
+  test('offers a lathe’s two views and a mill’s two, each hidden until a picture of its kind comes', () => {
+    assert.match(html, /<fieldset id="lathe-views" class="views" hidden>/);
+    assert.match(html, /<fieldset id="mill-views" class="views" hidden>/);
     const values = [...html.matchAll(/<input type="radio" name="view" value="([a-z]+)">/g)].map((match) => match[1]);
-    assert.deepEqual(values, ['diameter', 'radius']);
+    assert.deepEqual(values, [...LATHE_VIEWS, ...MILL_VIEWS]);
   });
 
   test('loads the script the bundler writes and the package ships', () => {
@@ -376,5 +387,49 @@ describe('the command in the manifest', () => {
       (m: { command: string }) => m.command === 'ncc.showToolpath',
     );
     assert.equal(palette?.when, 'editorLangId == cnc8x6 || editorLangId == haas-lathe');
+  });
+});
+
+describe('zooming and panning the picture', () => {
+  const whole = { x: 0, y: 0, width: 1000, height: 800 };
+
+  test('reads and writes viewBox attributes, refusing what is no box', () => {
+    assert.deepEqual(parseViewBox('0 0 1000 800'), whole);
+    assert.deepEqual(parseViewBox(' 1,2, 3 4'), { x: 1, y: 2, width: 3, height: 4 });
+    for (const bad of [null, '', '0 0 1000', '0 0 0 800', '0 0 -1 800', 'a b c d', '0 0 1000 800 5']) {
+      assert.equal(parseViewBox(bad), undefined, String(bad));
+    }
+    assert.equal(viewBoxText({ x: 1 / 3, y: 0, width: 250, height: 200 }), '0.333 0 250 200');
+  });
+
+  test('a zoom keeps the point under the pointer where it is', () => {
+    const at = { x: 250, y: 200 };
+    const closer = zoomed(whole, 2, at, whole);
+    assert.deepEqual(closer, { x: 125, y: 100, width: 500, height: 400 });
+    // The point's share of the box is the same before and after.
+    assert.equal((at.x - closer.x) / closer.width, (at.x - whole.x) / whole.width);
+    assert.deepEqual(zoomed(closer, 0.5, at, whole), whole);
+  });
+
+  test('a zoom stops at the whole picture and at the closest zoom', () => {
+    assert.deepEqual(zoomed(whole, 0.5, { x: 500, y: 400 }, whole), whole);
+    let box = whole;
+    for (let i = 0; i < 100; i++) {
+      box = zoomed(box, 2, { x: 500, y: 400 }, whole);
+    }
+    assert.equal(box.width, whole.width / MAX_ZOOM);
+    assert.equal(box.height, whole.height / MAX_ZOOM);
+  });
+
+  test('a pan moves the picture with the pointer, in the picture’s units', () => {
+    const half = { x: 100, y: 100, width: 500, height: 400 };
+    // 500 units over 1000 screen pixels: a drag of 100 pixels is 50 units.
+    assert.deepEqual(panned(half, 100, -40, 1000), { x: 50, y: 120, width: 500, height: 400 });
+  });
+
+  test('the pointer’s place on the screen is a point of the shown box', () => {
+    const rect = { left: 10, top: 20, width: 500, height: 400 };
+    assert.deepEqual(pictureAt(whole, rect, 260, 220), { x: 500, y: 400 });
+    assert.deepEqual(pictureAt({ x: 100, y: 50, width: 100, height: 80 }, rect, 10, 20), { x: 100, y: 50 });
   });
 });

@@ -2,10 +2,11 @@
 //! `ncc plot` draws, of an open document's current text, unsaved edits
 //! included, for the editor's toolpath view.
 //!
-//! Arguments: the document's URI, then optionally `{ view }`, how a
-//! lathe's picture shows X (`"radius"` or `"diameter"`, the default, as
-//! `ncc plot --view`). The answer is `{ svg, totalTimeS, findings, view }`,
-//! `view` the one drawn, or null for a machine without a diameter axis. A run that stops on an error answers a `RequestFailed`
+//! Arguments: the document's URI, then optionally `{ view }`, as `ncc
+//! plot --view`: how a lathe's picture shows X (`"radius"` or
+//! `"diameter"`, the default), a mill's the plane (`"top"`, the default) or
+//! its three axes (`"iso"`). The answer is `{ svg, totalTimeS, findings,
+//! view }`, `view` the one drawn. A run that stops on an error answers a `RequestFailed`
 //! error whose message says where and why, with the picture of the run
 //! up to there as its `data`.
 
@@ -40,8 +41,8 @@ struct Plotted {
     total_time_s: f64,
     /// What the run did not run, and where it stopped.
     findings: Vec<Finding>,
-    /// The lathe's view drawn; `None` off a lathe, which has no choice.
-    view: Option<View>,
+    /// The view drawn.
+    view: View,
 }
 
 /// The optional second argument.
@@ -83,7 +84,7 @@ pub(crate) async fn execute(server: &Server, arguments: Vec<Value>) -> jsonrpc::
         [Value::String(uri), options] => (uri, Some(options)),
         _ => {
             return Err(invalid_params(format!(
-                "{COMMAND} takes the document's URI, then optionally {{ \"view\": \"radius\" | \"diameter\" }}"
+                "{COMMAND} takes the document's URI, then optionally {{ \"view\": \"radius\" | \"diameter\" | \"top\" | \"iso\" }}"
             )));
         }
     };

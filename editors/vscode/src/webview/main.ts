@@ -1,10 +1,25 @@
 // The toolpath view's page script. It runs in the webview, under the page's
 // Content-Security-Policy: it shows the picture the extension sends, posts a
-// click on a move or mark as the line to reveal, and highlights the moves
-// and marks of the line the cursor is on. The decisions are in
-// ../toolpath.ts, where node tests run them.
+// click on a move or mark as the line to reveal, highlights the moves and
+// marks of the line the cursor is on, and zooms and pans the picture. The
+// decisions are in ../toolpath.ts, where node tests run them.
 
-import { type FromView, highlightSelector, type LatheView, revealOf, type ToView } from '../toolpath';
+import {
+  type FromView,
+  highlightSelector,
+  isPlotView,
+  LATHE_VIEWS,
+  MILL_VIEWS,
+  panned,
+  parseViewBox,
+  pictureAt,
+  type PlotView,
+  revealOf,
+  type ToView,
+  type ViewBox,
+  viewBoxText,
+  zoomed,
+} from '../toolpath';
 
 declare function acquireVsCodeApi(): { postMessage(message: FromView): void };
 
@@ -22,7 +37,12 @@ const plot = element('plot');
 const summary = element('summary');
 const error = element('error');
 const notes = element('notes');
-const views = element('views');
+const latheViews = element('lathe-views');
+const millViews = element('mill-views');
+
+/** The whole picture's box, and the part shown when zoomed or panned. */
+let whole: ViewBox | undefined;
+let shown: ViewBox | undefined;
 
 /** The document's line the cursor is on, from 1. */
 let highlighted: number | null = null;
@@ -38,9 +58,28 @@ function showPicture(svg: string): boolean {
   for (const active of Array.from(root.querySelectorAll('script, foreignObject'))) {
     active.remove();
   }
+  // A redrawn picture of the same frame keeps the part shown.
+  const box = parseViewBox(root.getAttribute('viewBox'));
+  const same = box !== undefined && whole !== undefined && viewBoxText(box) === viewBoxText(whole);
+  whole = box;
+  if (!same) {
+    shown = undefined;
+  }
+  if (shown !== undefined) {
+    root.setAttribute('viewBox', viewBoxText(shown));
+  }
   plot.replaceChildren(document.importNode(root, true));
   highlight(highlighted);
   return true;
+}
+
+function picture(): SVGSVGElement | null {
+  return plot.querySelector('svg');
+}
+
+function show(box: ViewBox): void {
+  shown = box;
+  picture()?.setAttribute('viewBox', viewBoxText(box));
 }
 
 function showNotes(list: string[]): void {
@@ -58,10 +97,11 @@ function showError(message: string | undefined): void {
   error.textContent = message ?? '';
 }
 
-/** Offers the lathe's views, `view` chosen; none off a lathe (`null`). */
-function showView(view: LatheView | null): void {
-  views.hidden = view === null;
-  for (const input of Array.from(views.querySelectorAll('input'))) {
+/** Offers the views of the kind of `view` (a lathe's, a mill's), `view` chosen; none when unknown (`null`). */
+function showView(view: PlotView | null): void {
+  latheViews.hidden = view === null || !LATHE_VIEWS.includes(view);
+  millViews.hidden = view === null || !MILL_VIEWS.includes(view);
+  for (const input of Array.from(document.querySelectorAll<HTMLInputElement>('.views input'))) {
     input.checked = input.value === view;
   }
 }
@@ -110,16 +150,80 @@ window.addEventListener('message', (event: MessageEvent<ToView>) => {
   }
 });
 
+/** A drag in progress: where the pointer was, and whether it moved enough to be no click. */
+let drag: { x: number; y: number; moved: boolean } | undefined;
+/** The last drag moved the picture: the click that ends it reveals nothing. */
+let dragged = false;
+
 plot.addEventListener('click', (event) => {
+  if (dragged) {
+    dragged = false;
+    return;
+  }
   const reveal = revealOf(event.target instanceof Element ? event.target : null);
   if (reveal !== undefined) {
     vscode.postMessage(reveal);
   }
 });
 
-views.addEventListener('change', (event) => {
+plot.addEventListener(
+  'wheel',
+  (event) => {
+    const svg = picture();
+    const box = shown ?? whole;
+    if (svg === null || box === undefined || whole === undefined) {
+      return;
+    }
+    event.preventDefault();
+    const at = pictureAt(box, svg.getBoundingClientRect(), event.clientX, event.clientY);
+    show(zoomed(box, event.deltaY < 0 ? 1.25 : 1 / 1.25, at, whole));
+  },
+  { passive: false },
+);
+
+plot.addEventListener('pointerdown', (event) => {
+  if (event.button === 0) {
+    drag = { x: event.clientX, y: event.clientY, moved: false };
+  }
+});
+
+plot.addEventListener('pointermove', (event) => {
+  const svg = picture();
+  const box = shown ?? whole;
+  if (drag === undefined || svg === null || box === undefined) {
+    return;
+  }
+  const [dx, dy] = [event.clientX - drag.x, event.clientY - drag.y];
+  if (!drag.moved && Math.hypot(dx, dy) < 4) {
+    return;
+  }
+  if (!drag.moved) {
+    drag.moved = true;
+    plot.setPointerCapture(event.pointerId);
+    plot.classList.add('dragging');
+  }
+  show(panned(box, dx, dy, svg.getBoundingClientRect().width));
+  drag.x = event.clientX;
+  drag.y = event.clientY;
+});
+
+function endDrag(): void {
+  dragged = drag?.moved ?? false;
+  drag = undefined;
+  plot.classList.remove('dragging');
+}
+plot.addEventListener('pointerup', endDrag);
+plot.addEventListener('pointercancel', endDrag);
+
+plot.addEventListener('dblclick', () => {
+  if (whole !== undefined) {
+    show(whole);
+  }
+});
+
+document.addEventListener('change', (event) => {
   const value = event.target instanceof HTMLInputElement ? event.target.value : undefined;
-  if (value === 'radius' || value === 'diameter') {
+  if (isPlotView(value)) {
     vscode.postMessage({ type: 'view', view: value });
   }
 });
