@@ -4,12 +4,11 @@
 
 #[path = "../../syntax/tests/strategies/mod.rs"]
 mod strategies;
+mod support;
 
 use expect_test::{Expect, expect};
-use nc_exec::run::Step;
 use ncc_analysis::{
-    AnalysisHost, Config, Dialect, FormatConfig, LetterCase, MachineConfig, NumberStyle, TextEdit, WordOrder,
-    WordSpacing,
+    AnalysisHost, Config, Dialect, FormatConfig, LetterCase, NumberStyle, TextEdit, WordOrder, WordSpacing,
 };
 use ncc_syntax::{Parse, SyntaxErrorKind, SyntaxKind, SyntaxNode, TextRange, TextSize};
 use proptest::prelude::*;
@@ -243,26 +242,6 @@ fn trailing_spaces_go_in_every_dialect() {
     }
 }
 
-/// What a run of `text` does, in terms formatting must not change: its
-/// steps with the line of their block, its findings' rules and lines, its
-/// tools and the files it writes.
-fn run_of(dialect: Dialect, text: &str) -> String {
-    let machine = MachineConfig::of_control(dialect);
-    let trace = nc_exec::run::run(text, &nc_exec::run::NoFiles, &machine, 20_000);
-    let line = |range: TextRange| text[..usize::from(range.start())].matches('\n').count();
-    let mut out = String::new();
-    for step in &trace.steps {
-        let at = line(step.range);
-        let step = Step { range: TextRange::empty(TextSize::from(0)), ..step.clone() };
-        out.push_str(&format!("line {at}: {step:?}\n"));
-    }
-    for finding in &trace.findings {
-        out.push_str(&format!("{:?} {} {}\n", finding.rule, finding.source, line(finding.range)));
-    }
-    out.push_str(&format!("{:?} {:?}\n", trace.tools, trace.written));
-    out
-}
-
 /// The tree's node and token kinds without spaces (and nodes of spaces
 /// only): what case and number style leave as they are.
 fn kinds(node: &SyntaxNode, out: &mut Vec<SyntaxKind>) {
@@ -281,7 +260,7 @@ fn kinds(node: &SyntaxNode, out: &mut Vec<SyntaxKind>) {
 
 #[test]
 fn the_run_tells_programs_apart() {
-    let run = |text| run_of(Dialect::Sinumerik, text);
+    let run = |text| support::run_of(Dialect::Sinumerik, text);
     assert_eq!(run("G1 X10 F100\nM30\n"), run("G1   X10 F100\nM30\n"));
     assert_ne!(run("G1 X10 F100\nM30\n"), run("G1 X10.5 F100\nM30\n"));
     assert_ne!(run("G1 X10 F100\nM30\n"), run("\nG1 X10 F100\nM30\n"));
@@ -316,36 +295,15 @@ fn check_style_keeps_the_run(dialect: Dialect, style: FormatConfig, text: &str) 
     if codes(&before) != codes(&after) {
         return Err(format!("the errors changed: {formatted:?}"));
     }
-    if run_of(dialect, text) != run_of(dialect, &formatted) {
+    if support::run_of(dialect, text) != support::run_of(dialect, &formatted) {
         return Err(format!("the run changed: {formatted:?}"));
     }
     Ok(())
 }
 
-/// Every program of the repository: examples and fixtures, with their
-/// dialects.
-fn repository_programs() -> Vec<(std::path::PathBuf, Dialect)> {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let mut programs = Vec::new();
-    let mut dirs =
-        vec![root.join("examples"), root.join("crates/analysis/test_data"), root.join("crates/syntax/test_data")];
-    while let Some(dir) = dirs.pop() {
-        for entry in std::fs::read_dir(&dir).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                dirs.push(path);
-            } else if let Some(dialect) = Dialect::by_default_for(&path) {
-                programs.push((path, dialect));
-            }
-        }
-    }
-    programs.sort();
-    programs
-}
-
 #[test]
 fn every_style_keeps_the_run_of_every_program_of_the_repository() {
-    let programs = repository_programs();
+    let programs = support::repository_programs();
     for dialect in [Dialect::Cnc8x6, Dialect::HaasLathe, Dialect::Sinumerik] {
         assert!(programs.iter().filter(|(_, d)| *d == dialect).count() >= 10, "{dialect:?}: too few programs");
     }

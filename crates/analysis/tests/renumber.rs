@@ -6,11 +6,10 @@
 #[allow(dead_code)]
 #[path = "../../syntax/tests/strategies/mod.rs"]
 mod strategies;
+mod support;
 
 use expect_test::{Expect, expect};
-use nc_exec::run::Step;
-use ncc_analysis::{AnalysisHost, Config, Dialect, MachineConfig, RenumberError, TextEdit};
-use ncc_syntax::{TextRange, TextSize};
+use ncc_analysis::{AnalysisHost, Config, Dialect, RenumberError, TextEdit};
 use proptest::prelude::*;
 
 fn renumbered(dialect: Dialect, text: &str, start: u64, step: u64) -> Result<String, RenumberError> {
@@ -154,29 +153,11 @@ fn a_number_the_address_cannot_hold_is_refused() {
     assert_eq!(error.message, "2 blocks from 99999999 by 1 pass the largest number, 99999999");
 }
 
-/// What a run of `text` does, without where its blocks stand on their
-/// lines: its steps with their lines, its findings' rules and lines.
-fn run_of(dialect: Dialect, text: &str) -> String {
-    let machine = MachineConfig::of_control(dialect);
-    let trace = nc_exec::run::run(text, &nc_exec::run::NoFiles, &machine, 20_000);
-    let line = |range: TextRange| text[..usize::from(range.start())].matches('\n').count();
-    let mut out = String::new();
-    for step in &trace.steps {
-        let at = line(step.range);
-        let step = Step { range: TextRange::empty(TextSize::from(0)), ..step.clone() };
-        out.push_str(&format!("line {at}: {step:?}\n"));
-    }
-    for finding in &trace.findings {
-        out.push_str(&format!("{:?} {}\n", finding.rule, line(finding.range)));
-    }
-    out
-}
-
 /// Renumbering `text` either is refused or leaves its run as it was, and
 /// renumbering again with the same numbers changes nothing.
 fn check_keeps_the_run(dialect: Dialect, text: &str, start: u64, step: u64) -> Result<bool, String> {
     let Ok(new) = renumbered(dialect, text, start, step) else { return Ok(false) };
-    if run_of(dialect, text) != run_of(dialect, &new) {
+    if support::run_of(dialect, text) != support::run_of(dialect, &new) {
         return Err(format!("the run changed: {new:?}"));
     }
     match renumbered(dialect, &new, start, step) {
@@ -185,30 +166,11 @@ fn check_keeps_the_run(dialect: Dialect, text: &str, start: u64, step: u64) -> R
     }
 }
 
-fn repository_programs() -> Vec<(std::path::PathBuf, Dialect)> {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let mut programs = Vec::new();
-    let mut dirs =
-        vec![root.join("examples"), root.join("crates/analysis/test_data"), root.join("crates/syntax/test_data")];
-    while let Some(dir) = dirs.pop() {
-        for entry in std::fs::read_dir(&dir).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                dirs.push(path);
-            } else if let Some(dialect) = Dialect::by_default_for(&path) {
-                programs.push((path, dialect));
-            }
-        }
-    }
-    programs.sort();
-    programs
-}
-
 #[test]
 fn renumbering_keeps_the_run_of_every_program_of_the_repository() {
     let mut failures = Vec::new();
     let mut renumbered = [0; 3];
-    for (path, dialect) in repository_programs() {
+    for (path, dialect) in support::repository_programs() {
         let Ok(text) = std::fs::read_to_string(&path) else { continue };
         for (start, step) in [(10, 10), (1, 1), (1000, 5)] {
             match check_keeps_the_run(dialect, &text, start, step) {

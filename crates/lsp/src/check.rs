@@ -163,14 +163,9 @@ pub(crate) fn run(paths: &[PathBuf], format: Format, forced: Option<Dialect>) ->
     let mut checked = Vec::new();
     let mut sources = HashMap::new();
     for ((config_path, dialect), programs) in workspaces {
-        let config = match projects.config(config_path.as_deref()) {
-            Ok(config) => config.clone(),
-            Err(message) => {
-                failures.push(message.clone());
-                continue;
-            }
+        let Some(mut host) = workspace_host(&mut projects, config_path.as_deref(), dialect, &mut failures) else {
+            continue;
         };
-        let mut host = AnalysisHost::in_dialect(dialect, config);
         // Macrocycle files beside the checked programs are what their G72
         // calls run, so they are part of the workspace even when they are
         // not checked themselves.
@@ -218,6 +213,24 @@ pub(crate) fn run(paths: &[PathBuf], format: Format, forced: Option<Dialect>) ->
         eprintln!("error: {}", lines.join("\n"));
     }
     exit_code(&checked, &failures)
+}
+
+/// The analysis of the programs of `dialect` under the `ncc.toml` at
+/// `config_path`; `None`, with the reason in `failures`, when that file
+/// cannot be read.
+pub(crate) fn workspace_host(
+    projects: &mut Projects,
+    config_path: Option<&Path>,
+    dialect: Dialect,
+    failures: &mut Vec<String>,
+) -> Option<AnalysisHost> {
+    match projects.config(config_path) {
+        Ok(config) => Some(AnalysisHost::in_dialect(dialect, config.clone())),
+        Err(message) => {
+            failures.push(message.clone());
+            None
+        }
+    }
 }
 
 /// 2 when something could not be read, 1 when an error or a warning was

@@ -8,10 +8,10 @@ use std::{
     process::ExitCode,
 };
 
-use ncc_analysis::{AnalysisHost, Dialect, TextEdit};
+use ncc_analysis::{Dialect, TextEdit};
 use ncc_syntax::encoding;
 
-use crate::check::{Found, Projects, collect_files, read_file, shown_path};
+use crate::check::{Found, Projects, collect_files, read_file, shown_path, workspace_host};
 
 /// What `ncc fmt` does with the files it formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -72,14 +72,9 @@ pub(crate) fn run(paths: &[PathBuf], mode: Mode, renumber: Option<Renumber>, for
     let mut reports: Vec<(PathBuf, String)> = Vec::new();
     let (mut changed, mut unchanged) = (0, 0);
     for ((config_path, dialect), programs) in workspaces {
-        let config = match projects.config(config_path.as_deref()) {
-            Ok(config) => config.clone(),
-            Err(message) => {
-                failures.push(message.clone());
-                continue;
-            }
+        let Some(mut host) = workspace_host(&mut projects, config_path.as_deref(), dialect, &mut failures) else {
+            continue;
         };
-        let mut host = AnalysisHost::in_dialect(dialect, config);
         for program in programs {
             let shown = shown_path(&program.path);
             let file = host.add_file(program.path.display().to_string(), program.text.as_str());
