@@ -24,6 +24,7 @@ fuzz_target!(|data: &[u8]| {
         case: if choice & 8 == 0 { LetterCase::Keep } else { LetterCase::Upper },
         numbers: if choice & 16 == 0 { NumberStyle::Keep } else { NumberStyle::Trim },
         word_order: if choice & 32 == 0 { WordOrder::Keep } else { WordOrder::Standard },
+        indent: (choice & 64 != 0).then_some(2),
     };
     let mut host = AnalysisHost::in_dialect(dialect, Config { format: style, ..Config::default() });
     let file = host.add_file("main", text.as_str());

@@ -204,6 +204,11 @@ pub struct FormatConfig {
     pub case: LetterCase,
     pub numbers: NumberStyle,
     pub word_order: WordOrder,
+    /// Spaces per level of nesting that a line is indented by: Sinumerik's
+    /// IF, WHILE, FOR, REPEAT and LOOP bodies, the Haas lathe's `WHILE …
+    /// DOn` loops (CNC8x6 blocks have no nesting). `None`: each line keeps
+    /// its indentation.
+    pub indent: Option<u8>,
 }
 
 /// What separates the words of a block.

@@ -57,6 +57,7 @@ const EVERYTHING: FormatConfig = FormatConfig {
     case: LetterCase::Upper,
     numbers: NumberStyle::Trim,
     word_order: WordOrder::Standard,
+    indent: Some(2),
 };
 
 /// The choices of `[format]` but `spacing`.
@@ -174,8 +175,8 @@ fn cnc8x6_in_every_style() {
 }
 
 #[test]
-fn haas_lathe_keeps_indentation_statements_and_tape_marks() {
-    let text = "%  \nO1000 (SHAFT)\n  g0  x10.0 z-2.500 (c)\nG71 P10 Q20 U0.4 W0.1 D2. F0.25\n#1 = #2 + 3.50\nIF [#1 GT 2.0] GOTO10\nG4 P30\nG1 X20. ,C1. F0.2\nM30\n% \n";
+fn haas_lathe_keeps_or_sets_indentation_and_keeps_statements_and_tape_marks() {
+    let text = "%  \nO1000 (SHAFT)\n  g0  x10.0 z-2.500 (c)\nG71 P10 Q20 U0.4 W0.1 D2. F0.25\n#1 = #2 + 3.50\nIF [#1 GT 2.0] GOTO10\nWHILE [#1 LT 3] DO1\n#1 = #1 + 1\n  WHILE [#2 LT 3] DO2\n#2 = #2 + 1\n    END2\nEND1\nG4 P30\nG1 X20. ,C1. F0.2\nM30\n% \n";
     check_in(
         Dialect::HaasLathe,
         FormatConfig::default(),
@@ -187,6 +188,12 @@ fn haas_lathe_keeps_indentation_statements_and_tape_marks() {
             G71 P10 Q20 U0.4 W0.1 D2. F0.25|
             #1 = #2 + 3.50|
             IF [#1 GT 2.0] GOTO10|
+            WHILE [#1 LT 3] DO1|
+            #1 = #1 + 1|
+              WHILE [#2 LT 3] DO2|
+            #2 = #2 + 1|
+                END2|
+            END1|
             G4 P30|
             G1 X20. ,C1. F0.2|
             M30|
@@ -200,10 +207,16 @@ fn haas_lathe_keeps_indentation_statements_and_tape_marks() {
         expect![[r#"
             %  |
             O1000 (SHAFT)|
-              G0X10.0Z-2.5      (c)|
+            G0X10.0Z-2.5        (c)|
             G71U0.4W0.1F0.25P10Q20D2.|
             #1 = #2 + 3.5|
             IF [#1 GT 2.0] GOTO10|
+            WHILE [#1 LT 3] DO1|
+              #1 = #1 + 1|
+              WHILE [#2 LT 3] DO2|
+                #2 = #2 + 1|
+              END2|
+            END1|
             G4P30|
             G1X20.,C1.F0.2|
             M30|
@@ -213,7 +226,7 @@ fn haas_lathe_keeps_indentation_statements_and_tape_marks() {
 }
 
 #[test]
-fn sinumerik_keeps_one_space_strings_and_comments() {
+fn sinumerik_indents_structures_and_keeps_one_space_strings_and_comments() {
     let text = "PROC part(real depth) SAVE\n  def real a=1.50 ; Depth  \n  while a>0.0\n    g1   x=ic(5.0) f1000   Y10\n    a=a-0.50\n  endwhile\nLAB1:  msg(\"hello  World\")\nN10 Y10 G1 X20\nM17\n";
     check_in(
         Dialect::Sinumerik,
@@ -221,11 +234,11 @@ fn sinumerik_keeps_one_space_strings_and_comments() {
         text,
         expect![[r#"
             PROC PART(REAL DEPTH) SAVE|
-              DEF REAL A=1.5  ; Depth  |
-              WHILE A>0.0|
-                G1 X=IC(5.0) F1000 Y10|
-                A=A-0.5|
-              ENDWHILE|
+            DEF REAL A=1.5    ; Depth  |
+            WHILE A>0.0|
+              G1 X=IC(5.0) F1000 Y10|
+              A=A-0.5|
+            ENDWHILE|
             LAB1: MSG("hello  World")|
             N10 G1 Y10 X20|
             M17|

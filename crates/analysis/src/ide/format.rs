@@ -39,7 +39,15 @@ use crate::config::{FormatConfig, LetterCase, NumberStyle, WordOrder, WordSpacin
 /// The edits that format `text`, whose parse is `parse`, in `style`: one
 /// per changed line, sorted. With `range`, only the lines it touches
 /// change.
-pub(crate) fn format(text: &str, parse: &Parse, style: FormatConfig, range: Option<TextRange>) -> Vec<TextEdit> {
+/// `levels` are the nesting levels of the blocks that start at each
+/// offset, sorted, when `style` indents.
+pub(crate) fn format(
+    text: &str,
+    parse: &Parse,
+    style: FormatConfig,
+    range: Option<TextRange>,
+    levels: &[(TextSize, u32)],
+) -> Vec<TextEdit> {
     let dialect = parse.dialect();
     let catalogue = dialect.catalogue();
     // A long line is the line's, not its text's; a lower-case letter is
@@ -60,6 +68,8 @@ pub(crate) fn format(text: &str, parse: &Parse, style: FormatConfig, range: Opti
         after_end: false,
         word_role: None,
         slot: None,
+        levels,
+        level: None,
         out: String::with_capacity(text.len()),
         line: Line { start: 0, out_start: 0 },
         prev: None,
@@ -171,6 +181,11 @@ struct Formatter<'a> {
     /// Where the slot of a reordered item starts, until its first token
     /// is written.
     slot: Option<usize>,
+    /// The nesting level of each block by its start, when lines are
+    /// indented by it.
+    levels: &'a [(TextSize, u32)],
+    /// The level of the block being written.
+    level: Option<u32>,
     out: String,
     line: Line,
     /// The previous token on the current line.
@@ -194,6 +209,11 @@ impl Formatter<'_> {
                         }
                         (Place::Free, SyntaxKind::BLOCK) => {
                             self.block_head = true;
+                            self.level = self
+                                .levels
+                                .binary_search_by_key(&self::offset(offset), |&(start, _)| start)
+                                .ok()
+                                .map(|found| self.levels[found].1);
                             Place::Free
                         }
                         (Place::Free, SyntaxKind::BLOCK_RUN) => Place::Free,
@@ -334,7 +354,12 @@ impl Formatter<'_> {
             return (!joins).then_some(0);
         };
         match prev {
-            None if self.layout.block_is_line => None,
+            // A line's indentation: by its nesting when asked, else as
+            // written.
+            None if self.layout.block_is_line => match (self.style.indent, self.level) {
+                (Some(width), Some(level)) => Some(usize::from(width) * level as usize),
+                _ => None,
+            },
             None if next.starts_block || next.kind == SyntaxKind::STAR => Some(0),
             None if next.kind == SyntaxKind::COMMENT => None,
             // A line that continues its block.

@@ -112,6 +112,15 @@ fn literal(expr: &Expr) -> Option<u32> {
     expr.whole_number().and_then(|number| u32::try_from(number).ok())
 }
 
+/// Each block's start with the number of `WHILE … DOn` loops whose body
+/// holds it, for the formatter's indentation.
+pub(crate) fn nesting_levels(db: &dyn Db, file: SourceFile) -> Vec<(TextSize, u32)> {
+    let model = file_model(db, file);
+    let loops = model.model.programs.iter().flat_map(|program| &program.loops);
+    let starts: Vec<TextSize> = model.ranges.iter().map(|range| range.start()).collect();
+    super::levels(loops.map(|&(start, end)| (start, None, end)), &starts)
+}
+
 pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<HoverResult> {
     let model = file_model(db, file);
     let index = model.block_at(offset)?;

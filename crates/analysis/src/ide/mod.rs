@@ -167,7 +167,39 @@ pub(crate) fn folding_ranges(db: &dyn Db, file: SourceFile) -> Vec<folding::Fold
 /// project's style.
 pub(crate) fn format(db: &dyn Db, file: SourceFile, range: Option<TextRange>) -> Vec<TextEdit> {
     let style = Settings::get(db).config(db).format;
-    format::format(file.text(db), file.parse(db), style, range)
+    let levels = match file.parse(db).dialect() {
+        _ if style.indent.is_none() => Vec::new(),
+        Dialect::Sinumerik => sinumerik::nesting_levels(db, file),
+        Dialect::HaasLathe => haas_lathe::nesting_levels(db, file),
+        // A CNC8x6 program has no nested structures to indent.
+        Dialect::Cnc8x6 => Vec::new(),
+    };
+    format::format(file.text(db), file.parse(db), style, range, &levels)
+}
+
+/// The nesting level of blocks from the depth of the structures around
+/// them: `spans` are each structure's start and end block and its middle
+/// (ELSE) block, which stand at the structure's own level; `starts` are
+/// the blocks' starts in the file.
+fn levels(spans: impl Iterator<Item = (usize, Option<usize>, usize)>, starts: &[TextSize]) -> Vec<(TextSize, u32)> {
+    let mut change = vec![0i64; starts.len() + 1];
+    for (start, middle, end) in spans.filter(|&(start, _, end)| start < end && end < starts.len()) {
+        change[start + 1] += 1;
+        change[end] -= 1;
+        if let Some(middle) = middle.filter(|&middle| start < middle && middle < end) {
+            change[middle] -= 1;
+            change[middle + 1] += 1;
+        }
+    }
+    let mut level = 0i64;
+    starts
+        .iter()
+        .zip(&change)
+        .map(|(&start, &change)| {
+            level += change;
+            (start, u32::try_from(level).unwrap_or(0))
+        })
+        .collect()
 }
 
 /// The edits that renumber the file's blocks from `start` by `step`, with

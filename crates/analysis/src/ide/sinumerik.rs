@@ -135,6 +135,15 @@ fn line_range(text: &str, block: &SyntaxNode) -> TextRange {
 /// The block structures `IF`…`ENDIF`, `WHILE`…`ENDWHILE`, `FOR`…`ENDFOR`,
 /// `REPEAT`…`UNTIL` and `LOOP`…`ENDLOOP`, matched by a stack (an end
 /// without its start closes nothing), and the runs of comment lines.
+/// Each block's start with the number of structures (IF, WHILE, FOR,
+/// REPEAT, LOOP) whose body holds it, for the formatter's indentation.
+pub(crate) fn nesting_levels(db: &dyn Db, file: SourceFile) -> Vec<(TextSize, u32)> {
+    let model = crate::sinumerik::model::file_model(db, file);
+    let spans = model.model.structures.iter().map(|s| (s.start, s.middle, s.end));
+    let starts: Vec<TextSize> = model.ranges.iter().map(|range| range.start()).collect();
+    super::levels(spans, &starts)
+}
+
 pub(crate) fn folding_ranges(db: &dyn Db, file: SourceFile) -> Vec<Fold> {
     let text = file.text(db);
     let root = file.parse(db).syntax_node();
