@@ -371,6 +371,10 @@ const HAAS_PIECES: &[&str] = &[
     "G04 P30",
     "G4 P1.50",
     "G76 X18.16 Z-20. K0.92 D0.3 A60 P1 F1.5",
+    "WHILE [#1 LT 3] DO1\n",
+    "END1\n",
+    "  WHILE [#2 LT 3] DO2\n",
+    "END2\n",
 ];
 
 /// Pieces of Sinumerik programs, glued at random by the property test.
@@ -409,6 +413,11 @@ const SINUMERIK_PIECES: &[&str] = &[
     "CYCLE81(10,0,2,-5.0)",
     "G91 ",
     "G90 ",
+    "IF A>1\n",
+    "ELSE\n",
+    "ENDIF\n",
+    "  FOR R2=1 TO 3\n",
+    "ENDFOR\n",
 ];
 
 proptest! {
