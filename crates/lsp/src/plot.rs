@@ -194,6 +194,11 @@ struct Frame {
 }
 
 impl Frame {
+    /// The run stayed at one point: there is no scale to draw.
+    fn is_point(&self) -> bool {
+        (self.max.0 - self.min.0).max(self.max.1 - self.min.1) <= 1e-6
+    }
+
     fn pixel(&self, (x, y): (f64, f64)) -> (f64, f64) {
         (MARGIN + (x - self.min.0) * self.scale, MARGIN + (self.max.1 - y) * self.scale)
     }
@@ -262,6 +267,7 @@ pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &st
     );
     // Written over the drawing, so that no move hides them.
     let scale_labels = match (projection, lathe_view) {
+        _ if frame.is_point() => String::new(),
         (Projection::Isometric, _) => isometric_scale(&mut out, &frame, extent, (across, up, tool_axis)),
         (Projection::Plane, view) => plane_scale(&mut out, &frame, view, (across, up)),
     };
@@ -409,7 +415,10 @@ fn frame(
         // A lathe's part turns about the spindle axis: it stays in view.
         (min.1, max.1) = (min.1.min(0.0), max.1.max(0.0));
     }
-    let pad = 0.05 * (max.0 - min.0).max(max.1 - min.1).max(1.0);
+    // A margin around the part; a run that stays at one point has none
+    // to show.
+    let extent = (max.0 - min.0).max(max.1 - min.1);
+    let pad = if extent > 1e-6 { 0.05 * extent.max(1.0) } else { 0.0 };
     (min, max) = ((min.0 - pad, min.1 - pad), (max.0 + pad, max.1 + pad));
     if lathe_view == Some(View::Diameter) {
         let reach = min.1.abs().max(max.1.abs());
