@@ -11,7 +11,10 @@ use std::{
 use ncc_analysis::{Dialect, TextEdit};
 use ncc_syntax::encoding;
 
-use crate::check::{Found, Projects, collect_files, read_file, shown_path, workspace_host};
+use crate::{
+    check::{Found, Projects, collect_files, read_file, shown_path, workspace_host},
+    report::Positions,
+};
 
 /// What `ncc fmt` does with the files it formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -93,7 +96,7 @@ pub(crate) fn run(paths: &[PathBuf], mode: Mode, renumber: Option<Renumber>, for
             let formatted = match formatted {
                 Ok(formatted) => formatted,
                 Err(error) => {
-                    let (line, column) = line_and_column(&program.text, error.range.start().into());
+                    let (line, column) = Positions::new(&program.text).at(error.range.start());
                     failures.push(format!("{shown}:{line}:{column}: not renumbered: {}", error.message));
                     continue;
                 }
@@ -141,16 +144,8 @@ pub(crate) fn run(paths: &[PathBuf], mode: Mode, renumber: Option<Renumber>, for
     }
 }
 
-/// The line and column (characters), both from 1, of byte `offset` of
-/// `text`.
-fn line_and_column(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset];
-    let line_start = before.rfind('\n').map_or(0, |at| at + 1);
-    (before.matches('\n').count() + 1, before[line_start..].chars().count() + 1)
-}
-
 /// `text` with `edits` (sorted, not overlapping) made.
-pub(crate) fn applied(text: &str, edits: &[TextEdit]) -> String {
+fn applied(text: &str, edits: &[TextEdit]) -> String {
     let mut text = text.to_owned();
     for edit in edits.iter().rev() {
         edit.apply(&mut text);

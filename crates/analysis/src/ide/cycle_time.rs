@@ -24,7 +24,10 @@ use crate::{
     InlayHint, InlayHintKind, MachineConfig,
     cnc8x6::model::{self, FileKind},
     db::{Db, Settings, SourceFile},
-    ide::symbols::content_end,
+    ide::{
+        common_ends::{common_prefix, common_suffix},
+        symbols::content_end,
+    },
 };
 
 /// What the cycle-time inlay hints show.
@@ -377,32 +380,6 @@ impl<'a> Change<'a> {
         let shift = new.len() as i64 - old.len() as i64;
         Some(Change { previous, start: offset(common)?, end: offset(end)?, shift, budget })
     }
-}
-
-/// Bytes compared a run at a time, with `memcmp`, before byte by byte.
-const COMPARED_RUN: usize = 4096;
-
-/// How many bytes `a` and `b` start with alike.
-fn common_prefix(a: &[u8], b: &[u8]) -> usize {
-    let len = a.len().min(b.len());
-    let mut at = 0;
-    while at + COMPARED_RUN <= len && a[at..at + COMPARED_RUN] == b[at..at + COMPARED_RUN] {
-        at += COMPARED_RUN;
-    }
-    at + a[at..len].iter().zip(&b[at..len]).take_while(|(x, y)| x == y).count()
-}
-
-/// How many bytes `a` and `b` end with alike.
-fn common_suffix(a: &[u8], b: &[u8]) -> usize {
-    let len = a.len().min(b.len());
-    let (a, b) = (&a[a.len() - len..], &b[b.len() - len..]);
-    let mut alike = 0;
-    while alike + COMPARED_RUN <= len
-        && a[len - alike - COMPARED_RUN..len - alike] == b[len - alike - COMPARED_RUN..len - alike]
-    {
-        alike += COMPARED_RUN;
-    }
-    alike + a[..len - alike].iter().rev().zip(b[..len - alike].iter().rev()).take_while(|(x, y)| x == y).count()
 }
 
 /// A checkpoint of the run, the model's state and the charges there.

@@ -20,8 +20,8 @@
 //! inside a statement (`IF [#1 GT 2]`, `DEF REAL A`).
 //!
 //! On request, letters to upper case, redundant zeros of decimal numbers
-//! removed and the words of plain blocks put in the standard order (see
-//! [`FormatConfig`]).
+//! removed, the words of plain blocks put in the standard order and lines
+//! indented by their nesting (see [`FormatConfig`]).
 //!
 //! Everything else is kept as written: comments, strings, line endings
 //! (`\r\n` stays), blank lines, the CNC8x6 `%` header line and everything
@@ -34,13 +34,13 @@ use ncc_catalog::{AddressRole, Catalogue, Dialect, FunctionKind};
 use ncc_syntax::{MAX_LINE_CHARS, NcLanguage, Parse, SyntaxErrorKind, SyntaxKind, TextEdit, TextRange, TextSize};
 use rowan::{GreenNodeData, NodeOrToken};
 
+use super::common_ends::{common_prefix, common_suffix};
 use crate::config::{FormatConfig, LetterCase, NumberStyle, WordOrder, WordSpacing};
 
 /// The edits that format `text`, whose parse is `parse`, in `style`: one
 /// per changed line, sorted. With `range`, only the lines it touches
-/// change.
-/// `levels` are the nesting levels of the blocks that start at each
-/// offset, sorted, when `style` indents.
+/// change. `levels` are the nesting levels of the blocks that start at
+/// each offset, sorted, when `style` indents.
 pub(crate) fn format(
     text: &str,
     parse: &Parse,
@@ -278,8 +278,7 @@ impl Formatter<'_> {
     /// change.
     fn write_token(&mut self, kind: SyntaxKind, start: usize, text: &str, place: Place) {
         if kind == SyntaxKind::LETTER && self.word_role.is_none() {
-            let upper = text.to_ascii_uppercase();
-            self.word_role = Some(self.catalogue.address(&upper).map_or(AddressRole::Parameter, |a| a.role));
+            self.word_role = Some(self.catalogue.address(text).map_or(AddressRole::Parameter, |a| a.role));
         }
         let free = matches!(place, Place::Item(..)) && !self.after_end;
         let end = start + text.len();
@@ -447,11 +446,16 @@ impl Formatter<'_> {
             SyntaxKind::WORD => {}
             _ => return None,
         }
-        let kinds: Vec<SyntaxKind> = word.children().map(|child| kind(child.kind())).collect();
+        let mut kinds = word.children().map(|child| kind(child.kind()));
         let plain = matches!(
-            kinds.as_slice(),
-            [SyntaxKind::LETTER, SyntaxKind::NUMBER]
-                | [SyntaxKind::LETTER, SyntaxKind::MINUS | SyntaxKind::PLUS, SyntaxKind::NUMBER]
+            (kinds.next(), kinds.next(), kinds.next(), kinds.next()),
+            (Some(SyntaxKind::LETTER), Some(SyntaxKind::NUMBER), None, None)
+                | (
+                    Some(SyntaxKind::LETTER),
+                    Some(SyntaxKind::MINUS | SyntaxKind::PLUS),
+                    Some(SyntaxKind::NUMBER),
+                    None
+                )
         );
         if !plain {
             return None;
@@ -572,26 +576,23 @@ fn line_edits(old: &str, new: &str, range: Option<TextRange>) -> Vec<TextEdit> {
         let line = TextRange::new(offset(start), offset(start + old_line.len()));
         let touched = range.is_none_or(|range| range.intersect(line).is_some());
         if old_line != new_line && touched {
-            let prefix = common_prefix(old_line, new_line);
-            let suffix = common_suffix(&old_line[prefix..], &new_line[prefix..]);
+            // The common bytes, backed off to a character's start: where
+            // the bytes before are alike, both lines have one there.
+            let mut prefix = common_prefix(old_line.as_bytes(), new_line.as_bytes());
+            while !old_line.is_char_boundary(prefix) {
+                prefix -= 1;
+            }
+            let (old_rest, new_rest) = (&old_line[prefix..], &new_line[prefix..]);
+            let mut suffix = common_suffix(old_rest.as_bytes(), new_rest.as_bytes());
+            while !old_rest.is_char_boundary(old_rest.len() - suffix) {
+                suffix -= 1;
+            }
             let delete = TextRange::new(offset(start + prefix), offset(start + old_line.len() - suffix));
-            edits.push(TextEdit::replace(delete, &new_line[prefix..new_line.len() - suffix]));
+            edits.push(TextEdit::replace(delete, &new_rest[..new_rest.len() - suffix]));
         }
         start += old_line.len() + 1;
     }
     edits
-}
-
-/// The length of the longest common prefix of `a` and `b`, on a character
-/// boundary.
-fn common_prefix(a: &str, b: &str) -> usize {
-    a.char_indices().zip(b.chars()).find(|((_, x), y)| x != y).map_or(a.len().min(b.len()), |((at, _), _)| at)
-}
-
-/// The length of the longest common suffix of `a` and `b`, on a character
-/// boundary.
-fn common_suffix(a: &str, b: &str) -> usize {
-    a.chars().rev().zip(b.chars().rev()).take_while(|(x, y)| x == y).map(|(x, _)| x.len_utf8()).sum()
 }
 
 fn kind(raw: rowan::SyntaxKind) -> SyntaxKind {

@@ -7,6 +7,7 @@
 //! them all.
 
 mod cnc8x6;
+mod common_ends;
 pub(crate) mod completion;
 pub(crate) mod cycle_time;
 pub(crate) mod folding;

@@ -63,8 +63,8 @@ pub(crate) fn edits(
         .zip(&new_numbers)
         .map(|(&range, &number)| (range, number))
         .chain(numbering.references.iter().map(|&(range, block)| (range, new_numbers[block])))
-        .filter(|&(range, number)| text[range].parse::<u64>().ok() != Some(number) || text[range].starts_with('0'))
         .map(|(range, number)| TextEdit::replace(range, number.to_string()))
+        .filter(|edit| text[edit.delete] != edit.insert)
         .collect();
     edits.sort_by_key(|edit| edit.delete.start());
     Ok(edits)

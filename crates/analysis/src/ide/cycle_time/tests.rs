@@ -474,24 +474,6 @@ fn an_edit_of_a_haas_program_reruns_from_the_checkpoint_before_it_to_where_the_r
 }
 
 proptest::proptest! {
-    /// The run-at-a-time comparisons count what byte by byte does.
-    #[test]
-    fn common_starts_and_ends_are_counted_exactly(
-        shared in proptest::collection::vec(0u8..3, 0..9000),
-        a in proptest::collection::vec(0u8..3, 0..30),
-        b in proptest::collection::vec(0u8..3, 0..30),
-        tail in proptest::collection::vec(0u8..3, 0..9000),
-    ) {
-        let left: Vec<u8> = [&shared[..], &a, &tail].concat();
-        let right: Vec<u8> = [&shared[..], &b, &tail].concat();
-        let prefix = left.iter().zip(&right).take_while(|(x, y)| x == y).count();
-        let suffix = left.iter().rev().zip(right.iter().rev()).take_while(|(x, y)| x == y).count();
-        proptest::prop_assert_eq!(common_prefix(&left, &right), prefix);
-        proptest::prop_assert_eq!(common_suffix(&left, &right), suffix);
-    }
-}
-
-proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig::with_cases(12))]
 
     /// Resumed estimates equal whole runs, edit after edit: digits
