@@ -69,6 +69,25 @@ impl View {
             (false, _) => View::Top,
         }
     }
+
+    /// Whether the view is a lathe's.
+    fn is_lathe(self) -> bool {
+        matches!(self, View::Radius | View::Diameter)
+    }
+
+    /// Where a point of the program lands in the view's plane: the view
+    /// plane seen from the tool axis, or in the isometric view the three
+    /// axes seen from above their first octant, the plane's axes at 30°
+    /// below the horizontal, the tool axis up.
+    fn project(self, [u, v, w]: Point) -> (f64, f64) {
+        match self {
+            View::Iso => {
+                let (cos, sin) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+                ((u - v) * cos, (u + v) * sin + w)
+            }
+            View::Radius | View::Diameter | View::Top => (u, v),
+        }
+    }
 }
 
 /// The scale's tick labels, the centre line and the mirror image.
@@ -162,28 +181,6 @@ struct Drawn {
 /// along the tool axis (0 on a machine without one).
 type Point = [f64; 3];
 
-/// How points of the program become points of the picture.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Projection {
-    /// The view plane seen from the tool axis.
-    Plane,
-    /// The three axes seen from above their first octant: the plane's axes
-    /// at 30° below the horizontal, the tool axis up.
-    Isometric,
-}
-
-impl Projection {
-    fn project(self, [u, v, w]: Point) -> (f64, f64) {
-        match self {
-            Projection::Plane => (u, v),
-            Projection::Isometric => {
-                let (cos, sin) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
-                ((u - v) * cos, (u + v) * sin + w)
-            }
-        }
-    }
-}
-
 /// The picture's frame: what it shows of the program's plane, and how a
 /// point of it lands on the picture.
 struct Frame {
@@ -208,8 +205,6 @@ impl Frame {
 /// titled `title`, in `view`.
 pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &str, view: View) -> String {
     let view = view.drawn(trace);
-    let lathe_view = trace.diameter_axis.map(|_| view);
-    let projection = if view == View::Iso { Projection::Isometric } else { Projection::Plane };
     let (across, up) = view_axes(trace);
     let slot = |letter: u8| trace.axes.iter().position(|&axis| axis == letter);
     let (Some(u), Some(v)) = (slot(across), slot(up)) else { return String::new() };
@@ -234,8 +229,8 @@ pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &st
         })
         .collect();
     let extent = part_extent(trace, &drawn);
-    let frame = frame(trace, &drawn, extent, projection, lathe_view);
-    let pixel = |point: Point| frame.pixel(projection.project(point));
+    let frame = frame(trace, &drawn, extent, view);
+    let pixel = |point: Point| frame.pixel(view.project(point));
     let d = |polyline: &[Point]| {
         let mut d = String::new();
         for (i, &point) in polyline.iter().enumerate() {
@@ -266,10 +261,10 @@ pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &st
         frame.height
     );
     // Written over the drawing, so that no move hides them.
-    let scale_labels = match (projection, lathe_view) {
+    let scale_labels = match view {
         _ if frame.is_point() => String::new(),
-        (Projection::Isometric, _) => isometric_scale(&mut out, &frame, extent, (across, up, tool_axis)),
-        (Projection::Plane, view) => plane_scale(&mut out, &frame, view, (across, up)),
+        View::Iso => isometric_scale(&mut out, &frame, extent, (across, up, tool_axis)),
+        View::Radius | View::Diameter | View::Top => plane_scale(&mut out, &frame, view, (across, up)),
     };
     // Where program coordinates land, for a viewer that shows them (a
     // plane view): x = left + (X − min-x) · scale, y = top + (max-y − Y) ·
@@ -277,15 +272,12 @@ pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &st
     let _ = writeln!(
         out,
         r#"<g id="drawing" clip-path="url(#frame)" data-projection="{}" data-min-x="{:.6}" data-max-y="{:.6}" data-scale="{:.6}" data-left="{MARGIN}" data-top="{MARGIN}">"#,
-        match projection {
-            Projection::Plane => "plane",
-            Projection::Isometric => "isometric",
-        },
+        if view == View::Iso { "isometric" } else { "plane" },
         frame.min.0,
         frame.max.1,
         frame.scale
     );
-    if lathe_view == Some(View::Diameter) {
+    if view == View::Diameter {
         // The other half of the profile, as the same layers reflected.
         let _ = writeln!(
             out,
@@ -352,7 +344,7 @@ pub(crate) fn svg(trace: &Trace, sketch: &Sketch, lines: &impl Lines, title: &st
     }
     let _ = writeln!(out, "</g>");
     out.push_str(&scale_labels);
-    let shown = Shown { axes: (across, up, tool_axis), compensated, lathe_view, projection, extent };
+    let shown = Shown { axes: (across, up, tool_axis), compensated, view, extent };
     legend(&mut out, frame.height, fastest, sketch, &shown);
     out.push_str("</svg>\n");
     out
@@ -363,8 +355,7 @@ struct Shown {
     /// The view plane's axes and the tool axis.
     axes: (u8, u8, Option<u8>),
     compensated: bool,
-    lathe_view: Option<View>,
-    projection: Projection,
+    view: View,
     extent: Option<(Point, Point)>,
 }
 
@@ -380,16 +371,10 @@ fn part_extent(trace: &Trace, drawn: &[Drawn]) -> Option<(Point, Point)> {
 }
 
 /// The frame that fits the part (the cutting moves, with a margin) in
-/// `projection`: rapids that go further, the first from the machine's
+/// `view`: rapids that go further, the first from the machine's
 /// home above all, would shrink the part to a corner. A run without a
 /// cutting move is fitted to all its moves.
-fn frame(
-    trace: &Trace,
-    drawn: &[Drawn],
-    extent: Option<(Point, Point)>,
-    projection: Projection,
-    lathe_view: Option<View>,
-) -> Frame {
+fn frame(trace: &Trace, drawn: &[Drawn], extent: Option<(Point, Point)>, view: View) -> Frame {
     let corners = |(low, high): (Point, Point)| -> Vec<Point> {
         (0..8).map(|i| std::array::from_fn(|axis| if i >> axis & 1 == 0 { low[axis] } else { high[axis] })).collect()
     };
@@ -404,23 +389,23 @@ fn frame(
     };
     let (mut min, mut max) = ((f64::INFINITY, f64::INFINITY), (f64::NEG_INFINITY, f64::NEG_INFINITY));
     for point in fitted {
-        let (x, y) = projection.project(point);
+        let (x, y) = view.project(point);
         min = (min.0.min(x), min.1.min(y));
         max = (max.0.max(x), max.1.max(y));
     }
     if !min.0.is_finite() {
         (min, max) = ((0.0, 0.0), (1.0, 1.0));
     }
-    if lathe_view.is_some() {
+    if view.is_lathe() {
         // A lathe's part turns about the spindle axis: it stays in view.
         (min.1, max.1) = (min.1.min(0.0), max.1.max(0.0));
     }
     // A margin around the part; a run that stays at one point has none
     // to show.
-    let extent = (max.0 - min.0).max(max.1 - min.1);
-    let pad = if extent > 1e-6 { 0.05 * extent.max(1.0) } else { 0.0 };
+    let size = (max.0 - min.0).max(max.1 - min.1);
+    let pad = if size > 1e-6 { 0.05 * size.max(1.0) } else { 0.0 };
     (min, max) = ((min.0 - pad, min.1 - pad), (max.0 + pad, max.1 + pad));
-    if lathe_view == Some(View::Diameter) {
+    if view == View::Diameter {
         let reach = min.1.abs().max(max.1.abs());
         (min.1, max.1) = (-reach, reach);
     }
@@ -434,7 +419,7 @@ fn frame(
 /// along the bottom and the left edge, with the axes' names, under the
 /// drawing; the labels, to write over it. A lathe labels its diameter
 /// axis as `view` shows it, and draws the spindle axis as a centre line.
-fn plane_scale(out: &mut String, frame: &Frame, lathe_view: Option<View>, (across, up): (u8, u8)) -> String {
+fn plane_scale(out: &mut String, frame: &Frame, view: View, (across, up): (u8, u8)) -> String {
     let (min, max) = (frame.min, frame.max);
     let (left, top) = frame.pixel((min.0, max.1));
     let (right, bottom) = frame.pixel((max.0, min.1));
@@ -445,9 +430,9 @@ fn plane_scale(out: &mut String, frame: &Frame, lathe_view: Option<View>, (acros
         let _ = writeln!(out, r#"<line x1="{x:.2}" y1="{top:.2}" x2="{x:.2}" y2="{bottom:.2}"/>"#);
         let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, x + 2.0, bottom - 4.0);
     }
-    let marks = match lathe_view {
+    let marks = match view {
         // Round diameters, on both halves of the profile alike.
-        Some(View::Diameter) => ticks(0.0, 2.0 * max.1)
+        View::Diameter => ticks(0.0, 2.0 * max.1)
             .into_iter()
             .flat_map(|(diameter, label)| {
                 let mirrored = (diameter > 0.0).then(|| (-diameter / 2.0, label.clone()));
@@ -462,10 +447,10 @@ fn plane_scale(out: &mut String, frame: &Frame, lathe_view: Option<View>, (acros
         let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, left + 2.0, y - 2.0);
     }
     let _ = writeln!(out, "</g>");
-    let up_name = match lathe_view {
-        Some(View::Diameter) => format!("{} (diameter)", char::from(up)),
-        Some(View::Radius) => format!("{} (radius)", char::from(up)),
-        _ => char::from(up).to_string(),
+    let up_name = match view {
+        View::Diameter => format!("{} (diameter)", char::from(up)),
+        View::Radius => format!("{} (radius)", char::from(up)),
+        View::Top | View::Iso => char::from(up).to_string(),
     };
     let _ = writeln!(
         labels,
@@ -483,7 +468,7 @@ fn plane_scale(out: &mut String, frame: &Frame, lathe_view: Option<View>, (acros
     );
     labels.push_str("</g>\n");
     let axis_y = frame.pixel((0.0, 0.0)).1;
-    if lathe_view.is_some() && (top - 0.01..=bottom + 0.01).contains(&axis_y) {
+    if view.is_lathe() && (top - 0.01..=bottom + 0.01).contains(&axis_y) {
         let _ = writeln!(
             out,
             r#"<line id="spindle-axis" x1="{left:.2}" y1="{axis_y:.2}" x2="{right:.2}" y2="{axis_y:.2}" {CENTRE_LINE_STYLE}/>"#
@@ -502,7 +487,7 @@ fn isometric_scale(
     (across, up, tool_axis): (u8, u8, Option<u8>),
 ) -> String {
     let mut labels = format!("<g id=\"scale\" {SCALE_STYLE}>\n");
-    let pixel = |point: Point| frame.pixel(Projection::Isometric.project(point));
+    let pixel = |point: Point| frame.pixel(View::Iso.project(point));
     if let Some((low, high)) = extent {
         let _ = writeln!(out, r#"<g id="grid" {GRID_STYLE}>"#);
         let (u_ticks, v_ticks) = (ticks(low[0], high[0]), ticks(low[1], high[1]));
@@ -531,7 +516,7 @@ fn isometric_scale(
         let Some(name) = name else { continue };
         let mut unit = [0.0; 3];
         unit[index] = 30.0;
-        let (x, y) = Projection::Isometric.project(unit);
+        let (x, y) = View::Iso.project(unit);
         let end = (origin.0 + x, origin.1 - y);
         let _ = writeln!(
             out,
@@ -651,21 +636,17 @@ fn legend(out: &mut String, top: f64, fastest: f64, sketch: &Sketch, shown: &Sho
         );
     }
     let (across, up, tool_axis) = shown.axes;
-    let view = match (shown.projection, shown.lathe_view) {
-        (Projection::Isometric, _) => "isometric view".to_owned(),
-        (_, Some(View::Radius)) => {
-            format!("{}{} plane, {} as a radius", char::from(across), char::from(up), char::from(up))
-        }
-        (_, Some(View::Diameter)) => {
-            format!("{}{} plane, {} as a diameter", char::from(across), char::from(up), char::from(up))
-        }
-        _ => format!("{}{} plane", char::from(across), char::from(up)),
+    let view = match shown.view {
+        View::Iso => "isometric view".to_owned(),
+        View::Radius => format!("{}{} plane, {} as a radius", char::from(across), char::from(up), char::from(up)),
+        View::Diameter => format!("{}{} plane, {} as a diameter", char::from(across), char::from(up), char::from(up)),
+        View::Top => format!("{}{} plane", char::from(across), char::from(up)),
     };
     let extent = shown.extent.map_or(String::new(), |(low, high)| {
         let mut names = vec![across, up];
         names.extend(tool_axis);
         // A lathe's diameter view measures the part across the spindle.
-        let factor = |i: usize| if i == 1 && shown.lathe_view == Some(View::Diameter) { 2.0 } else { 1.0 };
+        let factor = |i: usize| if i == 1 && shown.view == View::Diameter { 2.0 } else { 1.0 };
         let spans: Vec<String> = names
             .iter()
             .enumerate()
