@@ -524,7 +524,8 @@ fn range_formatting_formats_the_selected_lines_in_the_projects_style() {
 }
 
 /// On a line that starts with a block number, a source action renumbers
-/// the blocks with their jumps, or says, disabled, why it would be unsafe.
+/// the blocks with their jumps, or says, disabled, why it would be unsafe;
+/// only when asked for, not as the cursor moves.
 #[test]
 fn renumbering_is_a_code_action_on_a_numbered_line() {
     let (mut client, dir) = session();
@@ -543,6 +544,12 @@ fn renumbering_is_a_code_action_on_a_numbered_line() {
     let texts: Vec<_> = edits.as_array().unwrap().iter().map(|edit| edit["newText"].clone()).collect();
     assert_eq!(texts, [json!("10"), json!("10")], "{edits}");
     assert!(!actions(&mut client, &doc, 2).as_array().unwrap().iter().any(|a| a["kind"] == "source"));
+    // Not where the editor asks by itself as the cursor moves.
+    let range = json!({ "start": { "line": 0, "character": 0 }, "end": { "line": 0, "character": 0 } });
+    let automatic =
+        json!({ "textDocument": doc.id(), "range": range, "context": { "diagnostics": [], "triggerKind": 2 } });
+    let answer = client.call("textDocument/codeAction", automatic).unwrap();
+    assert_eq!(answer.result(), Some(&json!([])), "{}", answer.json);
 
     let refused = document(&dir, "O0002.nc", "N5 G00 X1.\nGOTO #1\nM30\n");
     open(&mut client, &refused);

@@ -141,10 +141,17 @@ pub(crate) fn signature_help(s: &Snapshot, position: lsp::Position) -> Option<ls
 }
 
 /// The quick fixes of the diagnostics that touch `range`, and renumbering
-/// on a line that starts with a block number.
-pub(crate) fn code_actions(s: &Snapshot, range: lsp::Range) -> lsp::CodeActionResponse {
+/// on a line that starts with a block number when asked for (not where
+/// the editor asks by itself as the cursor moves: it renumbers the whole
+/// file).
+pub(crate) fn code_actions(
+    s: &Snapshot,
+    range: lsp::Range,
+    context: &lsp::CodeActionContext,
+) -> lsp::CodeActionResponse {
     let range = s.map.range_offsets(range);
-    let renumbering = renumber_action(s, range.start());
+    let asked = context.trigger_kind != Some(lsp::CodeActionTriggerKind::AUTOMATIC);
+    let renumbering = asked.then(|| renumber_action(s, range.start())).flatten();
     let diagnostics = s.analysis.diagnostics(s.file);
     let positions = s.map.positions();
     let mut actions = Vec::new();

@@ -660,7 +660,7 @@ impl LanguageServer for Server {
 
     async fn code_action(&self, params: lsp::CodeActionParams) -> jsonrpc::Result<Option<lsp::CodeActionResponse>> {
         let uri = params.text_document.uri.clone();
-        self.query(&uri, move |s| handlers::code_actions(s, params.range)).await.map(Some)
+        self.query(&uri, move |s| handlers::code_actions(s, params.range, &params.context)).await.map(Some)
     }
 
     async fn execute_command(&self, params: lsp::ExecuteCommandParams) -> jsonrpc::Result<Option<lsp::LSPAny>> {
