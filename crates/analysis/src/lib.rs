@@ -15,6 +15,7 @@ mod dialect;
 mod findings;
 mod haas_lathe;
 mod ide;
+mod lowered;
 mod sinumerik;
 mod suppress;
 

@@ -1,36 +1,63 @@
 //! A Haas file as the rules see it: its blocks lowered, where each stands,
 //! and the program model (programs, block numbers, contours, references).
+//!
+//! Blocks are lowered per chunk ([`chunk_blocks`]): after an edit only the
+//! chunk the edit touched is lowered again. The program model is rebuilt
+//! from them.
+
+use std::{ops::Deref, sync::Arc};
 
 use nc_exec::haas_lathe::{
-    lower::{HaasBlock, Statement, block_nodes},
-    program::{ProgramModel, Reference, ReferenceKind},
+    lower::{HaasBlock, Statement},
+    program::{Blocks, ProgramModel, Reference, ReferenceKind},
 };
-use ncc_syntax::{TextRange, TextSize};
+use ncc_syntax::TextRange;
 
-use crate::db::{Db, SourceFile};
+use crate::{
+    db::{BlockChunk, Db, SourceFile},
+    lowered::Lowered,
+};
+
+/// The lowered blocks of a chunk, in order.
+#[salsa::tracked(returns(ref))]
+pub(crate) fn chunk_blocks<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Arc<Vec<HaasBlock>> {
+    Arc::new(chunk.blocks(db).map(HaasBlock::lower).collect())
+}
+
+impl Blocks for Lowered<HaasBlock> {
+    fn count(&self) -> usize {
+        Lowered::count(self)
+    }
+
+    fn at(&self, index: usize) -> &HaasBlock {
+        self.block(index)
+    }
+
+    fn span(&self, range: std::ops::Range<usize>) -> impl Iterator<Item = &HaasBlock> {
+        self.blocks_from(range.start).take(range.len())
+    }
+}
 
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct FileModel {
-    /// Each block's range in the file.
-    pub ranges: Vec<TextRange>,
-    pub blocks: Vec<HaasBlock>,
+    pub lowered: Lowered<HaasBlock>,
     pub model: ProgramModel,
 }
 
-impl FileModel {
-    /// A range of block `index` (block-relative) in the file.
-    pub fn in_file(&self, index: usize, range: TextRange) -> TextRange {
-        range + self.ranges[index].start()
-    }
+/// A file model is its blocks, with the program model beside them.
+impl Deref for FileModel {
+    type Target = Lowered<HaasBlock>;
 
+    fn deref(&self) -> &Lowered<HaasBlock> {
+        &self.lowered
+    }
+}
+
+impl FileModel {
     /// Where block `index`'s word `letter` + `number` stands in the file,
     /// or the block's start when it has none.
     pub fn code_range(&self, index: usize, letter: u8, number: u32) -> TextRange {
-        let word = self.blocks[index]
-            .words
-            .iter()
-            .find(|w| w.letter == letter && w.value.as_ref().and_then(|v| v.whole_number()) == Some(u64::from(number)));
-        self.in_file(index, word.map_or(TextRange::empty(0.into()), |w| w.range))
+        self.in_file(index, code_range(self.block(index), letter, number))
     }
 
     /// Where a reference's number stands: the P or Q word, or the GOTO
@@ -39,7 +66,7 @@ impl FileModel {
         let letter = match reference.kind {
             ReferenceKind::ContourEnd => b'Q',
             ReferenceKind::Goto => {
-                let goto = self.blocks[reference.block].statements.iter().map(statement_range).next();
+                let goto = self.block(reference.block).statements.iter().map(statement_range).next();
                 return self.in_file(reference.block, goto.unwrap_or_default());
             }
             _ => b'P',
@@ -49,33 +76,31 @@ impl FileModel {
 
     /// Block `index`'s number word in the file, else its start.
     pub fn number_range(&self, index: usize) -> TextRange {
-        self.in_file(index, self.blocks[index].number.map_or_else(TextRange::default, |number| number.range))
-    }
-
-    /// The index of the block at `offset`; a position at a block's end
-    /// (before its line break) belongs to it.
-    pub fn block_at(&self, offset: TextSize) -> Option<usize> {
-        let index = self.ranges.partition_point(|range| range.end() <= offset);
-        match self.ranges.get(index) {
-            Some(range) if range.contains_inclusive(offset) => Some(index),
-            _ => index.checked_sub(1).filter(|&before| self.ranges[before].end() == offset),
-        }
+        self.in_file(index, self.block(index).number.map_or_else(TextRange::default, |number| number.range))
     }
 
     /// Where block `index`'s first word `letter` stands in the file.
     pub fn word_range(&self, index: usize, letter: u8) -> Option<TextRange> {
-        self.blocks[index].word(letter).map(|w| self.in_file(index, w.range))
+        self.block(index).word(letter).map(|w| self.in_file(index, w.range))
     }
+}
+
+/// Where `block`'s word `letter` + `number` stands in it, or its start
+/// when it has none.
+pub(crate) fn code_range(block: &HaasBlock, letter: u8, number: u32) -> TextRange {
+    let word = block
+        .words
+        .iter()
+        .find(|w| w.letter == letter && w.value.as_ref().and_then(|v| v.whole_number()) == Some(u64::from(number)));
+    word.map_or(TextRange::empty(0.into()), |w| w.range)
 }
 
 /// The file's model, rebuilt when its text changes.
 #[salsa::tracked(returns(ref))]
 pub(crate) fn file_model(db: &dyn Db, file: SourceFile) -> FileModel {
-    let parse = file.parse(db);
-    let (ranges, blocks): (Vec<TextRange>, Vec<HaasBlock>) =
-        block_nodes(parse.green()).map(|(range, block)| (range, HaasBlock::lower(block))).unzip();
-    let model = ProgramModel::new(&blocks);
-    FileModel { ranges, blocks, model }
+    let lowered = Lowered::new(db, file, |chunk| chunk_blocks(db, chunk).clone(), |block| block.len);
+    let model = ProgramModel::new(&lowered);
+    FileModel { lowered, model }
 }
 
 fn statement_range(statement: &Statement) -> TextRange {

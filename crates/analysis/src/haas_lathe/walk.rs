@@ -33,7 +33,7 @@ use nc_exec::{
         eval::{MacroValue, Variables},
         lower::{ExprKind, HaasBlock, Statement, Value, Word},
         modes::Modes,
-        program::{Contour, Finding, Program, ReferenceKind, Target},
+        program::{Blocks, Contour, Finding, Program, ReferenceKind, Target},
     },
     known::Known,
 };
@@ -252,8 +252,40 @@ pub(crate) fn walk(file: &FileModel, visit: &mut dyn FnMut(&Visit<'_>)) {
     let catalogue = Dialect::HaasLathe.catalogue();
     for (index, program) in file.model.programs.iter().enumerate() {
         let mut walker = Walker { file, catalogue, program: index, visit };
-        walker.program(program);
+        let start = walker.start(program);
+        walker.program(program, Resume { at: program.blocks.start, state: start }, usize::MAX, &mut |_| {});
     }
+}
+
+/// Where the walk of a program stands between two blocks: the next block
+/// to run and the state before it.
+#[derive(Debug, Clone)]
+pub(crate) struct Resume {
+    pub at: usize,
+    pub state: State,
+}
+
+/// Walks program `program` of `file` from `from` until it passes block
+/// `until`, showing `visit` each block it runs, and `stand` each place it
+/// stands at between blocks (where it may resume).
+pub(crate) fn walk_from(
+    file: &FileModel,
+    program: usize,
+    from: Resume,
+    until: usize,
+    visit: &mut dyn FnMut(&Visit<'_>),
+    stand: &mut dyn FnMut(&Resume),
+) {
+    let catalogue = Dialect::HaasLathe.catalogue();
+    let mut walker = Walker { file, catalogue, program, visit };
+    walker.program(&file.model.programs[program], from, until, stand);
+}
+
+/// The state program `program` of `file` starts in.
+pub(crate) fn program_start(file: &FileModel, program: usize) -> State {
+    let catalogue = Dialect::HaasLathe.catalogue();
+    let walker = Walker { file, catalogue, program, visit: &mut |_| {} };
+    walker.start(&file.model.programs[program])
 }
 
 /// The blocks of `program` where the walk forgets the state: jump targets
@@ -298,30 +330,36 @@ struct Step {
 }
 
 impl<'a> Walker<'a, '_> {
-    fn program(&mut self, program: &Program) {
-        let blocks = &self.file.blocks;
-        let subprogram = program.blocks.clone().any(|i| blocks[i].has_code(b'M', 99))
-            && !program.blocks.clone().any(|i| ends_program(&blocks[i]));
-        let mut state = if subprogram { State::unknown(self.catalogue) } else { State::at_start(self.catalogue) };
+    /// The state `program` starts in: power-on for a main program, nothing
+    /// known for a subprogram.
+    fn start(&self, program: &Program) -> State {
+        let blocks = &self.file.lowered;
+        let subprogram = blocks.span(program.blocks.clone()).any(|block| block.has_code(b'M', 99))
+            && !blocks.span(program.blocks.clone()).any(ends_program);
+        if subprogram { State::unknown(self.catalogue) } else { State::at_start(self.catalogue) }
+    }
+
+    fn program(&mut self, program: &Program, from: Resume, until: usize, stand: &mut dyn FnMut(&Resume)) {
+        let blocks = &self.file.lowered;
         let joins = joins(self.file, program);
-        let mut at = program.blocks.start;
-        while at < program.blocks.end {
-            if joins.contains(&at) {
-                state = State::unknown(self.catalogue);
+        let mut here = from;
+        while here.at < program.blocks.end && here.at <= until {
+            if joins.contains(&here.at) {
+                here.state = State::unknown(self.catalogue);
             }
-            if !blocks[at].has_content() {
-                at += 1;
+            if !blocks.block(here.at).has_content() {
+                here.at += 1;
                 continue;
             }
-            let step = self.block(at, &state, None);
-            state = step.after;
-            at = step.next.unwrap_or(at + 1);
+            let step = self.block(here.at, &here.state, None);
+            here = Resume { at: step.next.unwrap_or(here.at + 1), state: step.after };
+            stand(&here);
         }
     }
 
     /// Runs block `at` from `before`, in the contour of a cycle or not.
     fn block(&mut self, at: usize, before: &State, contour: Option<&Contour>) -> Step {
-        let block = &self.file.blocks[at];
+        let block = self.file.block(at);
         let mut after = before.clone();
         let kind = self.apply(at, before, &mut after, contour.is_some());
         let mut next = None;
@@ -368,7 +406,7 @@ impl<'a> Walker<'a, '_> {
         let mut run = ContourRun::default();
         let mut state = start.clone();
         for at in contour.blocks.clone() {
-            if !self.file.blocks[at].has_content() {
+            if !self.file.block(at).has_content() {
                 continue;
             }
             let step = self.block(at, &state, Some(contour));
@@ -376,7 +414,7 @@ impl<'a> Walker<'a, '_> {
                 run.p_kind = Some(step.kind);
             }
             // The move that cancels the compensation departs from the contour.
-            let departs = self.file.blocks[at].has_code(b'G', 40);
+            let departs = self.file.block(at).has_code(b'G', 40);
             if let (Kind::Move(Known::Is(1..=3)), Known::Is(x), Known::Is(z), false) =
                 (step.kind, step.after.x, step.after.z, departs)
             {
@@ -390,7 +428,7 @@ impl<'a> Walker<'a, '_> {
     /// Block `at`'s effects on `after` (a copy of `before`); what it does
     /// with its axis words.
     fn apply(&self, at: usize, before: &State, after: &mut State, in_contour: bool) -> Kind {
-        let block = &self.file.blocks[at];
+        let block = self.file.block(at);
         for code in block.codes(b'G') {
             after.modes.set('G', code);
             let group = self.catalogue.group_of('G', code).map(|group| group.id.as_str());

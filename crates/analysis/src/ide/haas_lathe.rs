@@ -9,6 +9,7 @@ use std::path::Path;
 
 use nc_exec::haas_lathe::{
     lower::{Expr, ExprKind, HaasBlock, Statement, Value, Word},
+    modes::Modes,
     program::{Finding, ReferenceKind, Target},
 };
 use ncc_catalog::{AddressRole, Catalogue, Item, program_file_number};
@@ -25,7 +26,7 @@ use crate::{
     db::{Db, Settings, SourceFile},
     haas_lathe::{
         model::{FileModel, file_model},
-        walk::walk,
+        walk::{Resume, program_start, walk_from},
     },
 };
 
@@ -126,7 +127,7 @@ pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<H
     let index = model.block_at(offset)?;
     let start = model.ranges[index].start();
     let catalogue = Dialect::HaasLathe.catalogue();
-    let (items, range) = match under(&model.blocks[index], offset - start)? {
+    let (items, range) = match under(model.block(index), offset - start)? {
         Under::Word(word) => (word_items(catalogue, word)?, word.range),
         Under::Variable { number, range } => (catalogue.explain(&format!("param:{number}")).ok()?, range),
         Under::Function { name, range } => {
@@ -139,45 +140,92 @@ pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<H
     if let Some(target) = target_text(db, file, model, range + start) {
         markdown = format!("{target}\n\n{markdown}");
     }
-    markdown.push_str(&modal_text(&modal_states(db, file)[index]));
+    markdown.push_str(&modal_text(&modal_states(db, file, index)));
     Some(HoverResult { range: range + start, markdown })
 }
 
-/// The codes in force before each block of the file, once per distinct
-/// state the checker's walk reached it in (none for a block it does not
-/// reach).
-#[salsa::tracked(returns(ref))]
-fn modal_states(db: &dyn Db, file: SourceFile) -> Vec<Vec<String>> {
+/// How many blocks apart the places are where a hover's walk may resume.
+const CHECKPOINT_EVERY: usize = 64;
+
+/// Where the checker's walk stands every [`CHECKPOINT_EVERY`] blocks of
+/// each program, in order: a hover walks from the nearest one, not from
+/// the program's start.
+#[salsa::tracked(returns(ref), no_eq)]
+fn walk_checkpoints(db: &dyn Db, file: SourceFile) -> Vec<Vec<Resume>> {
     let model = file_model(db, file);
-    let catalogue = Dialect::HaasLathe.catalogue();
-    let mut states = vec![Vec::new(); model.blocks.len()];
-    walk(model, &mut |visit| {
-        let mut codes = Vec::new();
-        let mut unknown = false;
-        for group in &catalogue.groups {
-            let letter = group.id.chars().next().unwrap_or('G');
-            match visit.before.modes.known(&group.id) {
-                // Of the many M groups, those the program changed.
-                Known::Is(Some(number))
-                    if letter == 'G' || group.default.as_deref() != Some(&format!("M{number:02}")) =>
-                {
-                    codes.push(format!("{letter}{number:02}"));
-                }
-                Known::Is(_) => {}
-                Known::Unknown => unknown = true,
+    let mut checkpoints = Vec::with_capacity(model.model.programs.len());
+    for (index, program) in model.model.programs.iter().enumerate() {
+        let start = Resume { at: program.blocks.start, state: program_start(model, index) };
+        let mut kept = vec![start.clone()];
+        let mut since = 0;
+        walk_from(model, index, start, usize::MAX, &mut |_| db.unwind_if_revision_cancelled(), &mut |here| {
+            since += 1;
+            if since >= CHECKPOINT_EVERY {
+                since = 0;
+                kept.push(here.clone());
             }
-        }
-        let line = match (codes.is_empty(), unknown) {
-            (true, true) => "not known here (after a jump, a loop or a call)".to_owned(),
-            (false, true) => format!("`{}` · other groups not known", codes.join(" ")),
-            (_, false) => format!("`{}`", codes.join(" ")),
-        };
-        let seen: &mut Vec<String> = &mut states[visit.index];
-        if !seen.contains(&line) {
-            seen.push(line);
-        }
-    });
+        });
+        checkpoints.push(kept);
+    }
+    checkpoints
+}
+
+/// The codes in force before block `index`, once per distinct state the
+/// checker's walk reaches it in (none for a block it does not reach): as
+/// a block of its program, and as a block of each contour that holds it.
+fn modal_states(db: &dyn Db, file: SourceFile, index: usize) -> Vec<String> {
+    let model = file_model(db, file);
+    let Some(program) = model.model.programs.iter().position(|p| p.blocks.contains(&index)) else {
+        return Vec::new();
+    };
+    // The cycles that run the block in their contours run it from their
+    // own state.
+    let cycles = model.model.contours().filter(|c| c.blocks.contains(&index)).map(|c| c.cycle);
+    let (first, last) = cycles.fold((index, index), |(first, last), cycle| (first.min(cycle), last.max(cycle)));
+    let checkpoints = &walk_checkpoints(db, file)[program];
+    let nearest = checkpoints.partition_point(|resume| resume.at <= first).saturating_sub(1);
+    let catalogue = Dialect::HaasLathe.catalogue();
+    let mut states = Vec::new();
+    walk_from(
+        model,
+        program,
+        checkpoints[nearest].clone(),
+        last,
+        &mut |visit| {
+            if visit.index != index {
+                return;
+            }
+            let line = modal_line(catalogue, &visit.before.modes);
+            if !states.contains(&line) {
+                states.push(line);
+            }
+        },
+        &mut |_| {},
+    );
     states
+}
+
+/// The codes in force in `modes`: every G group, and the M groups the
+/// program changed.
+fn modal_line(catalogue: &Catalogue, modes: &Modes) -> String {
+    let mut codes = Vec::new();
+    let mut unknown = false;
+    for group in &catalogue.groups {
+        let letter = group.id.chars().next().unwrap_or('G');
+        match modes.known(&group.id) {
+            // Of the many M groups, those the program changed.
+            Known::Is(Some(number)) if letter == 'G' || group.default.as_deref() != Some(&format!("M{number:02}")) => {
+                codes.push(format!("{letter}{number:02}"));
+            }
+            Known::Is(_) => {}
+            Known::Unknown => unknown = true,
+        }
+    }
+    match (codes.is_empty(), unknown) {
+        (true, true) => "not known here (after a jump, a loop or a call)".to_owned(),
+        (false, true) => format!("`{}` · other groups not known", codes.join(" ")),
+        (_, false) => format!("`{}`", codes.join(" ")),
+    }
 }
 
 /// The modal states before a block, for its hover.
@@ -247,7 +295,7 @@ fn line_range(db: &dyn Db, file: SourceFile, model: &FileModel, index: usize) ->
 
 fn block_target(db: &dyn Db, file: SourceFile, model: &FileModel, index: usize) -> NavigationTarget {
     let range = line_range(db, file, model, index);
-    let block = &model.blocks[index];
+    let block = model.block(index);
     let name = block.number.map(|number| number.range).or(block.program.as_ref().map(|program| program.range));
     let focus = name.map_or(range, |name| model.in_file(index, name));
     NavigationTarget { file, range, focus }
@@ -268,7 +316,7 @@ fn workspace_programs(db: &dyn Db) -> Vec<(u32, SourceFile, usize)> {
             }
         }
         if let Some(number) = program_file_number(Path::new(other.path(db))).filter(|number| !numbers.contains(number))
-            && !model.blocks.is_empty()
+            && model.count() > 0
         {
             programs.push((number, other, 0));
         }
@@ -311,7 +359,7 @@ pub(crate) fn goto_definition(db: &dyn Db, file: SourceFile, offset: TextSize) -
 /// The block number at `offset`, or the block a reference there names.
 fn block_named_at(model: &FileModel, offset: TextSize) -> Option<usize> {
     let own = model.block_at(offset).filter(|&index| {
-        model.blocks[index].number.is_some_and(|number| model.in_file(index, number.range).contains_inclusive(offset))
+        model.block(index).number.is_some_and(|number| model.in_file(index, number.range).contains_inclusive(offset))
     });
     own.or_else(|| {
         model.model.findings.iter().find_map(|finding| match finding {
@@ -358,10 +406,10 @@ pub(crate) fn document_symbols(db: &dyn Db, file: SourceFile) -> Vec<DocumentSym
     for program in &model.model.programs {
         let Some(range) = blocks_range(db, file, model, program.blocks.clone()) else { continue };
         let first = program.blocks.start;
-        let selection = model.blocks[first].program.as_ref().map_or(range, |o| model.in_file(first, o.range));
+        let selection = model.block(first).program.as_ref().map_or(range, |o| model.in_file(first, o.range));
         let mut children = Vec::new();
         for index in program.blocks.clone() {
-            let block = &model.blocks[index];
+            let block = model.block(index);
             if let Some(tool) = block.word(b'T') {
                 let name = format!("T{}", value_text(tool));
                 let detail = block.comments.first().map(|comment| comment.body.trim().to_owned());
@@ -428,4 +476,54 @@ pub(crate) fn folding_ranges(db: &dyn Db, file: SourceFile) -> Vec<Fold> {
         .map(|range| Fold { range, kind: FoldKind::Region })
         .collect();
     with_comment_runs(db, file, folds)
+}
+
+#[cfg(test)]
+mod tests {
+    use ncc_syntax::Dialect;
+
+    use super::*;
+    use crate::{AnalysisHost, Config, haas_lathe::walk::walk};
+
+    /// A hover resumes the walk from a checkpoint: each block gets the
+    /// states a walk of the whole file gives it, in long files with
+    /// contours, loops and jumps (each program repeated, so that
+    /// checkpoints fall inside programs and contours).
+    #[test]
+    fn modal_states_from_checkpoints_are_those_of_the_whole_walk() {
+        let programs = [
+            include_str!("../../../syntax/test_data/haas-lathe/e14_g71_type1_program.nc"),
+            include_str!("../../../syntax/test_data/haas-lathe/e12_g71_g70_skeleton.nc"),
+            include_str!("../../../syntax/test_data/haas-lathe/macro_program.nc"),
+            include_str!("../../../syntax/test_data/haas-lathe/e22_corner_examples.nc"),
+            include_str!("../../../../examples/haas-lathe/O1000.nc"),
+        ];
+        // A finishing cycle whose contour comes later, checkpoints between.
+        let ahead = format!(
+            "O2\nG54 G00 X50. Z2.\nG70 P100 Q110 F0.1\n{}N100 G01 X20. G42\nG02 X30. Z-5. R5.\nN110 G01 Z-20. G40\nM30\n",
+            "G01 Z-1. F0.1\nG00 Z2. M08\n".repeat(CHECKPOINT_EVERY)
+        );
+        let catalogue = Dialect::HaasLathe.catalogue();
+        for text in programs.into_iter().chain([ahead.as_str()]) {
+            // Without tape marks: the text after a closing `%` is not read.
+            let once: String = text.lines().filter(|line| line.trim() != "%").map(|line| format!("{line}\n")).collect();
+            let long = once.repeat(3 * CHECKPOINT_EVERY / once.lines().count() + 1);
+            let mut host = AnalysisHost::in_dialect(Dialect::HaasLathe, Config::default());
+            let file = host.add_file("O1.nc", long.as_str());
+            let db = host.db();
+            let model = file_model(db, file);
+            let mut whole: Vec<Vec<String>> = vec![Vec::new(); model.count()];
+            walk(model, &mut |visit| {
+                let line = modal_line(catalogue, &visit.before.modes);
+                if !whole[visit.index].contains(&line) {
+                    whole[visit.index].push(line);
+                }
+            });
+            let reached = whole.iter().filter(|states| !states.is_empty()).count();
+            assert!(reached > 2 * CHECKPOINT_EVERY, "{reached} of {} blocks reached", whole.len());
+            for (index, states) in whole.iter().enumerate() {
+                assert_eq!(&modal_states(db, file, index), states, "block {index} of\n{text}");
+            }
+        }
+    }
 }

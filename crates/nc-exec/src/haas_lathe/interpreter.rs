@@ -195,7 +195,7 @@ impl Unit {
         let parse = Parse::new(text, Dialect::HaasLathe);
         let (ranges, blocks): (Vec<TextRange>, Vec<HaasBlock>) =
             block_nodes(parse.green()).map(|(range, block)| (range, HaasBlock::lower(block))).unzip();
-        let model = ProgramModel::new(&blocks);
+        let model = ProgramModel::new(blocks.as_slice());
         Unit { blocks, ranges, model }
     }
 

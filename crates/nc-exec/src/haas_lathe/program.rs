@@ -14,6 +14,32 @@ use ncc_syntax::{Dialect, Parse};
 
 use super::lower::{HaasBlock, Statement, Value, Word, block_nodes};
 
+/// A file's lowered blocks by index: a slice, or the parts an editor keeps
+/// them in (lowered again only where an edit touched them).
+pub trait Blocks {
+    fn count(&self) -> usize;
+    fn at(&self, index: usize) -> &HaasBlock;
+
+    /// The blocks of `range`, in order.
+    fn span(&self, range: Range<usize>) -> impl Iterator<Item = &HaasBlock> {
+        range.map(|index| self.at(index))
+    }
+}
+
+impl Blocks for [HaasBlock] {
+    fn count(&self) -> usize {
+        self.len()
+    }
+
+    fn at(&self, index: usize) -> &HaasBlock {
+        &self[index]
+    }
+
+    fn span(&self, range: Range<usize>) -> impl Iterator<Item = &HaasBlock> {
+        self[range].iter()
+    }
+}
+
 /// One program: from its `O` line to the next, or the blocks before the
 /// first `O` line when they hold anything.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -217,7 +243,7 @@ pub struct ProgramModel {
 }
 
 impl ProgramModel {
-    pub fn new(blocks: &[HaasBlock]) -> ProgramModel {
+    pub fn new(blocks: &(impl Blocks + ?Sized)) -> ProgramModel {
         let programs = split_programs(blocks);
         let mut model = ProgramModel { programs, findings: Vec::new() };
         for program in 0..model.programs.len() {
@@ -239,14 +265,15 @@ impl ProgramModel {
         })
     }
 
-    fn read_references(&mut self, blocks: &[HaasBlock], program: usize) {
+    fn read_references(&mut self, blocks: &(impl Blocks + ?Sized), program: usize) {
         let range = self.programs[program].blocks.clone();
-        let motions = motion_codes(&blocks[range.clone()]);
-        for index in range.clone() {
-            let block = &blocks[index];
+        // Read only for a program with a contour cycle: most have none.
+        let mut motions = None;
+        for (index, block) in range.clone().zip(blocks.span(range.clone())) {
             for code in block.codes(b'G') {
                 if CONTOUR_CYCLES.contains(&code) {
-                    self.read_cycle(blocks, program, index, code, &motions);
+                    let motions = motions.get_or_insert_with(|| motion_codes(blocks, range.clone()));
+                    self.read_cycle(blocks, program, index, code, motions);
                 }
             }
             for (letter, number, kind) in CALLS {
@@ -325,8 +352,15 @@ impl ProgramModel {
 
     /// A G70–G73 block: its P and Q, then its contour. `motions` are the
     /// motion codes in force after each block of the program.
-    fn read_cycle(&mut self, blocks: &[HaasBlock], program: usize, cycle: usize, code: u32, motions: &[Option<u32>]) {
-        let block = &blocks[cycle];
+    fn read_cycle(
+        &mut self,
+        blocks: &(impl Blocks + ?Sized),
+        program: usize,
+        cycle: usize,
+        code: u32,
+        motions: &[Option<u32>],
+    ) {
+        let block = blocks.at(cycle);
         let start = Reference { block: cycle, kind: ReferenceKind::ContourStart };
         let end = Reference { block: cycle, kind: ReferenceKind::ContourEnd };
         let p = self.target_number(block.word(b'P'), start, b'P');
@@ -343,9 +377,9 @@ impl ProgramModel {
             self.findings.push(Finding::QBeforeP { cycle, p, q });
             return;
         }
-        let contour = &blocks[p..=q];
+        let contour = p..q + 1;
         let roughing_type = (code == 71).then(|| {
-            let writes = |abs, inc| blocks[p].word(abs).is_some() || blocks[p].word(inc).is_some();
+            let writes = |abs, inc| blocks.at(p).word(abs).is_some() || blocks.at(p).word(inc).is_some();
             if writes(b'X', b'U') && writes(b'Z', b'W') { RoughingType::TypeII } else { RoughingType::TypeI }
         });
         let monotonic_axis = match (code, roughing_type) {
@@ -353,11 +387,11 @@ impl ProgramModel {
             (72, _) => Some((b'Z', b'W')),
             _ => None,
         };
-        let monotony =
-            monotonic_axis.map(|(axis, inc)| AxisMonotony { axis, monotony: monotony(contour, p, axis, inc) });
+        let monotony = monotonic_axis
+            .map(|(axis, inc)| AxisMonotony { axis, monotony: monotony(blocks, contour.clone(), axis, inc) });
         let program_start = self.programs[program].blocks.start;
         let motion_in = |index: usize| motions.get(index - program_start).copied().flatten();
-        let ignored = ignored_words(contour, p, code, motion_in);
+        let ignored = ignored_words(blocks, contour, code, motion_in);
         self.findings.push(Finding::Contour(Contour { cycle, code, blocks: p..=q, roughing_type, monotony, ignored }));
     }
 }
@@ -372,16 +406,18 @@ pub fn first_program_number(text: &str) -> Option<u32> {
     first?.program?.number
 }
 
-fn split_programs(blocks: &[HaasBlock]) -> Vec<Program> {
-    let starts: Vec<usize> = blocks.iter().enumerate().filter(|(_, b)| b.program.is_some()).map(|(i, _)| i).collect();
+fn split_programs(blocks: &(impl Blocks + ?Sized)) -> Vec<Program> {
+    let count = blocks.count();
+    let starts: Vec<usize> =
+        blocks.span(0..count).enumerate().filter(|(_, b)| b.program.is_some()).map(|(i, _)| i).collect();
     let mut programs = Vec::new();
-    let first = starts.first().copied().unwrap_or(blocks.len());
-    if blocks[..first].iter().any(HaasBlock::has_content) || starts.is_empty() {
+    let first = starts.first().copied().unwrap_or(count);
+    if blocks.span(0..first).any(HaasBlock::has_content) || starts.is_empty() {
         programs.push(program(blocks, None, None, 0..first));
     }
     for (i, &start) in starts.iter().enumerate() {
-        let end = starts.get(i + 1).copied().unwrap_or(blocks.len());
-        let header = blocks[start].program.as_ref();
+        let end = starts.get(i + 1).copied().unwrap_or(count);
+        let header = blocks.at(start).program.as_ref();
         let number = header.and_then(|h| h.number);
         let title = header.and_then(|h| h.title.clone());
         programs.push(program(blocks, number, title, start..end));
@@ -389,20 +425,25 @@ fn split_programs(blocks: &[HaasBlock]) -> Vec<Program> {
     programs
 }
 
-fn program(blocks: &[HaasBlock], number: Option<u32>, title: Option<String>, range: Range<usize>) -> Program {
+fn program(
+    blocks: &(impl Blocks + ?Sized),
+    number: Option<u32>,
+    title: Option<String>,
+    range: Range<usize>,
+) -> Program {
     let mut block_numbers: BTreeMap<u64, Vec<usize>> = BTreeMap::new();
-    for index in range.clone() {
-        if let Some(value) = blocks[index].number.and_then(|n| n.value) {
+    for (index, block) in range.clone().zip(blocks.span(range.clone())) {
+        if let Some(value) = block.number.and_then(|n| n.value) {
             block_numbers.entry(value).or_default().push(index);
         }
     }
-    let loops = loop_pairs(&blocks[range.clone()], range.start);
+    let loops = loop_pairs(blocks, range.clone());
     Program { number, title, blocks: range, block_numbers, loops }
 }
 
-/// Each `DOn` block with the nearest `ENDn` after it, by index in the file;
-/// `first` is the index of `blocks[0]`.
-fn loop_pairs(blocks: &[HaasBlock], first: usize) -> Vec<(usize, usize)> {
+/// Each `DOn` block of `range` with the nearest `ENDn` after it in `range`,
+/// by index in the file.
+fn loop_pairs(blocks: &(impl Blocks + ?Sized), range: Range<usize>) -> Vec<(usize, usize)> {
     let loop_id = |block: &HaasBlock, starts: bool| {
         block.statements.iter().find_map(|statement| match statement {
             Statement::LoopStart { id, .. } if starts => Some(*id),
@@ -411,22 +452,22 @@ fn loop_pairs(blocks: &[HaasBlock], first: usize) -> Vec<(usize, usize)> {
         })
     };
     let mut pairs = Vec::new();
-    for (start, block) in blocks.iter().enumerate() {
+    for (start, block) in range.clone().zip(blocks.span(range.clone())) {
         let Some(id) = loop_id(block, true) else { continue };
-        let end = blocks[start + 1..].iter().position(|later| loop_id(later, false) == Some(id));
+        let end = blocks.span(start + 1..range.end).position(|later| loop_id(later, false) == Some(id));
         if let Some(end) = end {
-            pairs.push((first + start, first + start + 1 + end));
+            pairs.push((start, start + 1 + end));
         }
     }
     pairs
 }
 
-/// The motion code (G00–G03) in force after each block, as far as literal
-/// codes tell.
-fn motion_codes(blocks: &[HaasBlock]) -> Vec<Option<u32>> {
+/// The motion code (G00–G03) in force after each block of `range`, as far
+/// as literal codes tell.
+fn motion_codes(blocks: &(impl Blocks + ?Sized), range: Range<usize>) -> Vec<Option<u32>> {
     let mut motion = None;
     blocks
-        .iter()
+        .span(range)
         .map(|block| {
             if let Some(code) = block.codes(b'G').filter(|code| *code <= 3).last() {
                 motion = Some(code);
@@ -436,14 +477,13 @@ fn motion_codes(blocks: &[HaasBlock]) -> Vec<Option<u32>> {
         .collect()
 }
 
-/// Whether the contour's end points along `axis` (absolute) or `inc`
-/// (incremental) never turn back; `first` is the contour's first block
-/// index. Arcs are judged by their end points.
-fn monotony(contour: &[HaasBlock], first: usize, axis: u8, inc: u8) -> Monotony {
+/// Whether the end points of the contour's blocks along `axis` (absolute)
+/// or `inc` (incremental) never turn back. Arcs are judged by their end
+/// points.
+fn monotony(blocks: &(impl Blocks + ?Sized), contour: Range<usize>, axis: u8, inc: u8) -> Monotony {
     let mut position: Option<f64> = None;
     let mut direction: Option<bool> = None;
-    for (offset, block) in contour.iter().enumerate() {
-        let index = first + offset;
+    for (index, block) in contour.clone().zip(blocks.span(contour)) {
         let literal = |letter| match block.word(letter).map(|w| w.value.as_ref()) {
             None => Ok(None),
             Some(Some(Value::Literal(decimal))) => Ok(Some(decimal.to_f64())),
@@ -469,17 +509,16 @@ fn monotony(contour: &[HaasBlock], first: usize, axis: u8, inc: u8) -> Monotony 
     Monotony::Monotonic
 }
 
-/// The words of the contour the cycle `code` does not execute.
+/// The words of the contour's blocks the cycle `code` does not execute.
 fn ignored_words(
-    contour: &[HaasBlock],
-    first: usize,
+    blocks: &(impl Blocks + ?Sized),
+    contour: Range<usize>,
     code: u32,
     motion_in: impl Fn(usize) -> Option<u32>,
 ) -> Vec<IgnoredWord> {
     let roughing = matches!(code, 71 | 72);
     let mut ignored = Vec::new();
-    for (offset, block) in contour.iter().enumerate() {
-        let index = first + offset;
+    for (index, block) in contour.clone().zip(blocks.span(contour)) {
         let linear = motion_in(index) == Some(1);
         for word in &block.words {
             let why = match word.letter {
@@ -513,7 +552,7 @@ mod tests {
         let parse = Parse::new(text, Dialect::HaasLathe);
         let tree = parse.green();
         let blocks: Vec<HaasBlock> = block_nodes(tree).map(|(_, block)| HaasBlock::lower(block)).collect();
-        ProgramModel::new(&blocks)
+        ProgramModel::new(blocks.as_slice())
     }
 
     fn reference(block: usize, kind: ReferenceKind) -> Reference {

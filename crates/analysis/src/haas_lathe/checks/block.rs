@@ -5,12 +5,16 @@
 
 use nc_exec::haas_lathe::lower::{HaasBlock, Value, Word};
 use ncc_catalog::{AddressRole, Catalogue, Code, Dialect};
-use ncc_syntax::{Decimal, TextEdit};
+use ncc_syntax::{Decimal, TextEdit, TextRange, TextSize};
 
 use crate::{
     Config, Diagnostic,
+    db::{BlockChunk, Db, Settings},
     diagnostic::declare_rules,
-    haas_lathe::{model::FileModel, walk::drilling_cycle},
+    haas_lathe::{
+        model::{chunk_blocks, code_range},
+        walk::drilling_cycle,
+    },
 };
 
 declare_rules! {
@@ -34,23 +38,29 @@ declare_rules! {
     THREAD_METHOD = "L104", "thread-method", Error, "G76 P other than the cutting methods P1–P4 (lathe manual §9 rule 45, its second part).";
 }
 
-/// The findings of every block of the file.
-pub(crate) fn check(file: &FileModel, config: &Config) -> Vec<Diagnostic> {
+/// The findings of the blocks of a chunk; ranges relative to the chunk's
+/// start.
+#[salsa::tracked(returns(ref))]
+pub(crate) fn chunk_findings<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<Diagnostic> {
+    let config = Settings::get(db).config(db);
     let catalogue = Dialect::HaasLathe.catalogue();
     let mut out = Vec::new();
-    for (index, block) in file.blocks.iter().enumerate() {
-        let block = Block { file, index, block, catalogue };
-        block.codes(config, &mut out);
-        block.dwell(&mut out);
-        block.axes(&mut out);
-        block.cycles(&mut out);
+    let mut start = TextSize::from(0);
+    for block in chunk_blocks(db, chunk).iter() {
+        let checked = Block { block, catalogue };
+        let mut found = Vec::new();
+        checked.codes(config, &mut found);
+        checked.dwell(&mut found);
+        checked.axes(&mut found);
+        checked.cycles(&mut found);
+        out.extend(found.into_iter().map(|d| d.shifted(start)));
+        start += block.len;
     }
     out
 }
 
+/// A block, with ranges relative to its start.
 struct Block<'a> {
-    file: &'a FileModel,
-    index: usize,
     block: &'a HaasBlock,
     catalogue: &'static Catalogue,
 }
@@ -64,8 +74,8 @@ fn literal(word: &Word) -> Option<&Decimal> {
 }
 
 impl Block<'_> {
-    fn range(&self, word: &Word) -> ncc_syntax::TextRange {
-        self.file.in_file(self.index, word.range)
+    fn range(&self, word: &Word) -> TextRange {
+        word.range
     }
 
     /// The words `letter` with their literal values.
@@ -165,7 +175,7 @@ impl Block<'_> {
         }
         if self.writes(4) && self.block.word(b'P').is_none() {
             let message = "G04 without P: the block gives no dwell time";
-            out.push(Diagnostic::new(&DWELL_WITHOUT_P, self.file.code_range(self.index, b'G', 4), message));
+            out.push(Diagnostic::new(&DWELL_WITHOUT_P, code_range(self.block, b'G', 4), message));
         }
         // With a point P counts plain seconds: nothing to show.
         for word in self.block.words_with(b'P') {
@@ -218,7 +228,7 @@ impl Block<'_> {
                 let message = format!(
                     "G{number:02} without R: the cycle has no reference plane to start drilling from and to return to"
                 );
-                out.push(Diagnostic::new(&DRILLING_WITHOUT_R, self.file.code_range(self.index, b'G', number), message));
+                out.push(Diagnostic::new(&DRILLING_WITHOUT_R, code_range(self.block, b'G', number), message));
             }
         }
         if self.writes(83) {
@@ -268,7 +278,7 @@ impl Block<'_> {
             );
             // A whole angle keeps its value without the point.
             if let (Some(whole), Some(value)) = (decimal.scaled(0), word.value_range) {
-                let edit = TextEdit::replace(self.file.in_file(self.index, value), whole.to_string());
+                let edit = TextEdit::replace(value, whole.to_string());
                 diagnostic = diagnostic.with_fix(format!("Write A{whole}"), vec![edit]);
             }
             out.push(diagnostic);
@@ -301,7 +311,7 @@ impl Block<'_> {
         let name = &code.code;
         let Some(word) = self.block.word(b'D') else {
             let message = format!("{name} without D, {meaning}: the control cannot rough without it");
-            out.push(Diagnostic::new(&CYCLE_WITHOUT_DEPTH, self.file.code_range(self.index, b'G', number), message));
+            out.push(Diagnostic::new(&CYCLE_WITHOUT_DEPTH, code_range(self.block, b'G', number), message));
             return;
         };
         let Some(decimal) = literal(word) else { return };

@@ -127,7 +127,7 @@ pub(crate) fn check(file: &FileModel) -> Vec<Diagnostic> {
         seen.push(contour.blocks.clone());
         let mut last = None;
         for index in contour.blocks.clone() {
-            for (code, word) in file.blocks[index].code_words(b'G').filter(|&(code, _)| (40..=42).contains(&code)) {
+            for (code, word) in file.block(index).code_words(b'G').filter(|&(code, _)| (40..=42).contains(&code)) {
                 last = Some((code, index, word));
             }
         }

@@ -68,7 +68,7 @@ fn finishing(file: &FileModel, out: &mut Vec<Diagnostic>) {
         // Without allowances the roughing is the finish.
         let allowance: Vec<String> = [b'U', b'W']
             .into_iter()
-            .filter_map(|letter| file.blocks[rough.cycle].word(letter))
+            .filter_map(|letter| file.block(rough.cycle).word(letter))
             .filter(|word| !matches!(&word.value, Some(Value::Literal(decimal)) if decimal.to_f64() == 0.0))
             .map(ToString::to_string)
             .collect();
@@ -95,7 +95,7 @@ fn content(file: &FileModel, out: &mut Vec<Diagnostic>) {
         }
         seen.push(contour.blocks.clone());
         for index in contour.blocks.clone() {
-            let block = &file.blocks[index];
+            let block = file.block(index);
             let codes = block.code_words(b'G').map(|(code, word)| ('G', code, word));
             for (letter, code, word) in codes.chain(block.code_words(b'M').map(|(code, word)| ('M', code, word))) {
                 let group = catalogue.group_of(letter, code).map(|group| group.id.as_str());
@@ -181,7 +181,7 @@ pub(crate) fn visit(visit: &Visit<'_>, out: &mut Out) {
 fn referrer(file: &FileModel, reference: Reference, number: u64) -> String {
     match reference.kind {
         ReferenceKind::ContourStart | ReferenceKind::ContourEnd => {
-            let code = file.blocks[reference.block].codes(b'G').find(|c| (70..=73).contains(c)).unwrap_or(70);
+            let code = file.block(reference.block).codes(b'G').find(|c| (70..=73).contains(c)).unwrap_or(70);
             let letter = if reference.kind == ReferenceKind::ContourStart { 'P' } else { 'Q' };
             format!("G{code} {letter}{number}")
         }
@@ -195,7 +195,7 @@ fn referrer(file: &FileModel, reference: Reference, number: u64) -> String {
 fn model_finding(file: &FileModel, finding: &Finding, out: &mut Vec<Diagnostic>) {
     match finding {
         Finding::MissingAddress { block, letter } => {
-            let cycle = file.blocks[*block].codes(b'G').find(|c| (70..=73).contains(c));
+            let cycle = file.block(*block).codes(b'G').find(|c| (70..=73).contains(c));
             let letter = char::from(*letter);
             let diagnostic = match cycle {
                 Some(code) => Diagnostic::new(
@@ -209,7 +209,7 @@ fn model_finding(file: &FileModel, finding: &Finding, out: &mut Vec<Diagnostic>)
                 None => {
                     let (code_letter, number) = [(b'M', 97), (b'M', 98), (b'G', 65)]
                         .into_iter()
-                        .find(|&(l, n)| file.blocks[*block].has_code(l, n))
+                        .find(|&(l, n)| file.block(*block).has_code(l, n))
                         .unwrap_or((b'M', 98));
                     Diagnostic::new(
                         &CALL_WITHOUT_P,
@@ -237,14 +237,14 @@ fn model_finding(file: &FileModel, finding: &Finding, out: &mut Vec<Diagnostic>)
             );
             let mut diagnostic = Diagnostic::new(&AMBIGUOUS_BLOCK_NUMBER, file.reference_range(*reference), message);
             for &block in blocks {
-                let range = file.blocks[block].number.map_or_else(Default::default, |n| file.in_file(block, n.range));
+                let range = file.block(block).number.map_or_else(Default::default, |n| file.in_file(block, n.range));
                 diagnostic = diagnostic.with_related(None, range, format!("N{number}"));
             }
             out.push(diagnostic);
         }
         Finding::QBeforeP { cycle, p, q } => {
             let range = |index: usize| {
-                file.blocks[index]
+                file.block(index)
                     .number
                     .map_or_else(|| file.in_file(index, Default::default()), |n| file.in_file(index, n.range))
             };
@@ -269,7 +269,7 @@ fn contour_findings(file: &FileModel, contour: &Contour, out: &mut Vec<Diagnosti
         let axis = char::from(monotony.axis);
         let cycle = file.code_range(contour.cycle, b'G', contour.code);
         let at =
-            file.blocks[block].word(monotony.axis).or(file.blocks[block].word(if axis == 'X' { b'U' } else { b'W' }));
+            file.block(block).word(monotony.axis).or(file.block(block).word(if axis == 'X' { b'U' } else { b'W' }));
         let range = at.map_or(cycle, |w| file.in_file(block, w.range));
         let diagnostic = if contour.roughing_type == Some(RoughingType::TypeI) {
             Diagnostic::new(

@@ -20,7 +20,7 @@ use std::collections::BTreeSet;
 
 use crate::{
     Diagnostic, Rule,
-    db::{Db, Settings, SourceFile},
+    db::{Db, Settings, SourceFile, file_chunks},
     findings::Findings,
     haas_lathe::{
         model::file_model,
@@ -35,7 +35,10 @@ pub(crate) static RULES: &[&[&Rule]] =
 /// The findings of a file that need no flow walk.
 pub(crate) fn local_findings(db: &dyn Db, file: SourceFile) -> Findings {
     let model = file_model(db, file);
-    let mut diagnostics = block::check(model, Settings::get(db).config(db));
+    let mut diagnostics = Vec::new();
+    for chunk in file_chunks(db, file) {
+        diagnostics.extend(block::chunk_findings(db, chunk.chunk).iter().map(|d| d.clone().shifted(chunk.offset)));
+    }
     diagnostics.extend(contours::check(model));
     diagnostics.extend(compensation::check(model));
     diagnostics.extend(program::check(model));

@@ -166,7 +166,12 @@ fn corner(visit: &Visit<'_>, out: &mut Out) {
     if visit.kind == Kind::Still {
         return;
     }
-    let Some(corner_word) = visit.file.blocks.get(corner.block).and_then(|b| b.words.get(corner.word)) else { return };
+    let Some(corner_word) = (corner.block < visit.file.count())
+        .then(|| visit.file.block(corner.block))
+        .and_then(|b| b.words.get(corner.word))
+    else {
+        return;
+    };
     let corner_range = visit.file.in_file(corner.block, corner_word.range);
     let (other, letters) = if along == b'X' { ('Z', [b'Z', b'W']) } else { ('X', [b'X', b'U']) };
     let written = |axis: [u8; 2]| axis.iter().any(|&l| visit.block.word(l).is_some());

@@ -1,6 +1,6 @@
 //! The program as a whole (lathe manual §9 rules 53, 55–57).
 
-use nc_exec::known::Known;
+use nc_exec::{haas_lathe::program::Blocks, known::Known};
 
 use crate::{
     Diagnostic,
@@ -23,12 +23,11 @@ declare_rules! {
 pub(crate) fn check(file: &FileModel) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for program in &file.model.programs {
-        let blocks = &file.blocks[program.blocks.clone()];
-        if blocks.iter().any(|block| ends_program(block) || block.has_code(b'M', 99)) {
+        if file.lowered.span(program.blocks.clone()).any(|block| ends_program(block) || block.has_code(b'M', 99)) {
             continue;
         }
-        let Some(last) = program.blocks.clone().rev().find(|&index| file.blocks[index].has_content()) else { continue };
-        let block = &file.blocks[last];
+        let Some(last) = program.blocks.clone().rev().find(|&index| file.block(index).has_content()) else { continue };
+        let block = file.block(last);
         let range = block.program.as_ref().map(|o| o.range).or(block.words.first().map(|w| w.range));
         let message = "the program has no end: M30 ends it and goes back to its start, M02 ends it (a subprogram returns with M99)";
         out.push(Diagnostic::new(&NO_PROGRAM_END, file.in_file(last, range.unwrap_or_default()), message));

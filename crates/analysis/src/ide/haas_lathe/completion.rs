@@ -58,7 +58,7 @@ pub(crate) fn completions(db: &dyn Db, file: SourceFile, offset: TextSize) -> Ve
     let model = file_model(db, file);
     let Some(index) = model.block_at(offset) else { return Vec::new() };
     let range = model.ranges[index];
-    let block = &model.blocks[index];
+    let block = model.block(index);
     let at = offset - range.start();
     if block.comments.iter().any(|c| c.range.start() < at && (at < c.range.end() || c.unclosed)) {
         return Vec::new();
@@ -242,7 +242,7 @@ impl Request<'_> {
         let text = self.file.text(self.site.db);
         blocks
             .filter_map(|index| {
-                let number = self.model.blocks[index].number?.value?;
+                let number = self.model.block(index).number?.value?;
                 let block = &text[self.model.ranges[index]];
                 let line = block.lines().next().unwrap_or_default().trim_end().to_owned();
                 Some(self.site.item(label(number), CompletionKind::Block, line, Some(fenced(block)), replace))
@@ -367,7 +367,7 @@ fn has_word(text: &str, word: &str) -> bool {
 /// literal number.
 fn used_variables(model: &FileModel) -> BTreeSet<u32> {
     let mut used = BTreeSet::new();
-    for block in &model.blocks {
+    for block in model.blocks_from(0) {
         let mut expressions: Vec<&Expr> = Vec::new();
         for word in block.words.iter().chain(&block.corners) {
             match &word.value {

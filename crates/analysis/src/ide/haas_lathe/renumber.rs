@@ -17,8 +17,8 @@ pub(crate) fn numbering(db: &dyn Db, file: SourceFile) -> Result<Numbering, Renu
     let text = file.text(db);
     let model = file_model(db, file);
     let mut numbering = Numbering::default();
-    let mut slots = vec![None; model.blocks.len()];
-    for (index, block) in model.blocks.iter().enumerate() {
+    let mut slots = vec![None; model.count()];
+    for (index, block) in model.blocks_from(0).enumerate() {
         if let Some(number) = block.number.filter(|number| number.value.is_some())
             && let Some(range) = digits(text, model.in_file(index, number.range))
         {
