@@ -24,6 +24,8 @@
 //! - A variable number with a fraction is rounded to the nearest whole
 //!   number (assumption from Fanuc).
 
+use std::sync::Arc;
+
 use super::lower::{BinaryOp, Expr, ExprKind, Function, UnaryOp};
 use crate::known::Known;
 use ncc_syntax::TextRange;
@@ -83,8 +85,10 @@ pub enum EvalError {
 /// `#1000` on read as unknown, as nothing here models them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variables {
-    /// The locals, then `#100`–`#199`, then `#500`–`#699`.
-    values: [Known<MacroValue>; 333],
+    /// The locals, then `#100`–`#199`, then `#500`–`#699`. Shared until
+    /// written: the checker's walk keeps a copy before and after each
+    /// block, and few blocks write a variable.
+    values: Arc<[Known<MacroValue>; 333]>,
 }
 
 /// How many locals there are: `#1`–`#33`.
@@ -129,7 +133,7 @@ impl Variables {
     pub fn at_power_on() -> Variables {
         let mut values = [Known::Is(MacroValue::Vacant); 333];
         values[133..].fill(Known::Unknown);
-        Variables { values }
+        Variables { values: Arc::new(values) }
     }
 
     /// The locals `#1`–`#33`, which a macro call (G65) keeps per level.
@@ -141,13 +145,13 @@ impl Variables {
 
     /// Puts `locals` in place of `#1`–`#33`.
     pub fn set_locals(&mut self, locals: &Locals) {
-        self.values[..LOCALS].copy_from_slice(&locals.0);
+        Arc::make_mut(&mut self.values)[..LOCALS].copy_from_slice(&locals.0);
     }
 
     /// Every variable unknown, for reading a program with no assumption
     /// about how it is called.
     pub fn unknown() -> Variables {
-        Variables { values: [Known::Unknown; 333] }
+        Variables { values: Arc::new([Known::Unknown; 333]) }
     }
 
     /// The value of `#number`; `None` when the control has no such
@@ -165,7 +169,7 @@ impl Variables {
     pub fn set(&mut self, number: u32, value: Known<MacroValue>) -> bool {
         match slot(number) {
             Some(slot) => {
-                self.values[slot] = value;
+                Arc::make_mut(&mut self.values)[slot] = value;
                 true
             }
             None => false,
