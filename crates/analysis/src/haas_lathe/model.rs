@@ -5,16 +5,19 @@
 //! chunk the edit touched is lowered again. The program model is rebuilt
 //! from them.
 
-use std::{ops::Deref, sync::Arc};
+use std::{
+    ops::{Deref, Range},
+    sync::Arc,
+};
 
 use nc_exec::haas_lathe::{
     lower::{HaasBlock, Statement},
-    program::{Blocks, ProgramModel, Reference, ReferenceKind},
+    program::{Blocks, ProgramModel, Reference, ReferenceKind, marked},
 };
 use ncc_syntax::TextRange;
 
 use crate::{
-    db::{BlockChunk, Db, SourceFile},
+    db::{BlockChunk, Db, SourceFile, file_chunks},
     lowered::Lowered,
 };
 
@@ -24,23 +27,43 @@ pub(crate) fn chunk_blocks<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Arc<
     Arc::new(chunk.blocks(db).map(HaasBlock::lower).collect())
 }
 
-impl Blocks for Lowered<HaasBlock> {
+/// The indices in a chunk of the blocks the program model reads.
+#[salsa::tracked(returns(ref))]
+fn chunk_marks<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<u32> {
+    let blocks = chunk_blocks(db, chunk).iter();
+    blocks.enumerate().filter(|(_, block)| marked(block)).map(|(index, _)| index as u32).collect()
+}
+
+/// The file's blocks, with the indices of the marked ones.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct HaasBlocks {
+    pub lowered: Lowered<HaasBlock>,
+    /// In order.
+    marks: Vec<usize>,
+}
+
+impl Blocks for HaasBlocks {
     fn count(&self) -> usize {
-        Lowered::count(self)
+        self.lowered.count()
     }
 
     fn at(&self, index: usize) -> &HaasBlock {
-        self.block(index)
+        self.lowered.block(index)
     }
 
-    fn span(&self, range: std::ops::Range<usize>) -> impl Iterator<Item = &HaasBlock> {
-        self.blocks_from(range.start).take(range.len())
+    fn span(&self, range: Range<usize>) -> impl Iterator<Item = &HaasBlock> {
+        self.lowered.blocks_from(range.start).take(range.len())
+    }
+
+    fn marked(&self, range: Range<usize>) -> impl Iterator<Item = usize> {
+        let first = self.marks.partition_point(|&index| index < range.start);
+        self.marks[first..].iter().copied().take_while(move |&index| index < range.end)
     }
 }
 
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct FileModel {
-    pub lowered: Lowered<HaasBlock>,
+    pub blocks: HaasBlocks,
     pub model: ProgramModel,
 }
 
@@ -49,7 +72,7 @@ impl Deref for FileModel {
     type Target = Lowered<HaasBlock>;
 
     fn deref(&self) -> &Lowered<HaasBlock> {
-        &self.lowered
+        &self.blocks.lowered
     }
 }
 
@@ -99,8 +122,13 @@ pub(crate) fn code_range(block: &HaasBlock, letter: u8, number: u32) -> TextRang
 #[salsa::tracked(returns(ref))]
 pub(crate) fn file_model(db: &dyn Db, file: SourceFile) -> FileModel {
     let lowered = Lowered::new(db, file, |chunk| chunk_blocks(db, chunk).clone(), |block| block.len);
-    let model = ProgramModel::new(&lowered);
-    FileModel { lowered, model }
+    let marks = file_chunks(db, file)
+        .iter()
+        .flat_map(|chunk| chunk_marks(db, chunk.chunk).iter().map(|&index| chunk.first + index as usize))
+        .collect();
+    let blocks = HaasBlocks { lowered, marks };
+    let model = ProgramModel::new(&blocks);
+    FileModel { blocks, model }
 }
 
 fn statement_range(statement: &Statement) -> TextRange {

@@ -333,14 +333,15 @@ impl<'a> Walker<'a, '_> {
     /// The state `program` starts in: power-on for a main program, nothing
     /// known for a subprogram.
     fn start(&self, program: &Program) -> State {
-        let blocks = &self.file.lowered;
-        let subprogram = blocks.span(program.blocks.clone()).any(|block| block.has_code(b'M', 99))
-            && !blocks.span(program.blocks.clone()).any(ends_program);
+        // The ends are marked blocks.
+        let blocks = &self.file.blocks;
+        let ends = || blocks.marked(program.blocks.clone()).map(|index| blocks.at(index));
+        let subprogram = ends().any(|block| block.has_code(b'M', 99)) && !ends().any(ends_program);
         if subprogram { State::unknown(self.catalogue) } else { State::at_start(self.catalogue) }
     }
 
     fn program(&mut self, program: &Program, from: Resume, until: usize, stand: &mut dyn FnMut(&Resume)) {
-        let blocks = &self.file.lowered;
+        let blocks = &self.file.blocks.lowered;
         let joins = joins(self.file, program);
         let mut here = from;
         while here.at < program.blocks.end && here.at <= until {

@@ -24,6 +24,25 @@ pub trait Blocks {
     fn span(&self, range: Range<usize>) -> impl Iterator<Item = &HaasBlock> {
         range.map(|index| self.at(index))
     }
+
+    /// The indices of the [`marked`] blocks of `range`, in order: all the
+    /// model reads besides the blocks of contours.
+    fn marked(&self, range: Range<usize>) -> impl Iterator<Item = usize> {
+        range.filter(|&index| marked(self.at(index)))
+    }
+}
+
+/// Whether the model reads `block` (a program's start, a block number, a
+/// macro statement, a contour cycle, a call) or the program's end (M30,
+/// M02, M99), so that a long program is read through the few blocks that
+/// say anything to it.
+pub fn marked(block: &HaasBlock) -> bool {
+    block.program.is_some()
+        || block.number.is_some()
+        || !block.statements.is_empty()
+        || block.codes(b'G').any(|code| CONTOUR_CYCLES.contains(&code))
+        || block.codes(b'M').any(|code| matches!(code, 2 | 30 | 99))
+        || CALLS.iter().any(|&(letter, number, _)| block.has_code(letter, number))
 }
 
 impl Blocks for [HaasBlock] {
@@ -269,7 +288,8 @@ impl ProgramModel {
         let range = self.programs[program].blocks.clone();
         // Read only for a program with a contour cycle: most have none.
         let mut motions = None;
-        for (index, block) in range.clone().zip(blocks.span(range.clone())) {
+        for index in blocks.marked(range.clone()) {
+            let block = blocks.at(index);
             for code in block.codes(b'G') {
                 if CONTOUR_CYCLES.contains(&code) {
                     let motions = motions.get_or_insert_with(|| motion_codes(blocks, range.clone()));
@@ -408,8 +428,7 @@ pub fn first_program_number(text: &str) -> Option<u32> {
 
 fn split_programs(blocks: &(impl Blocks + ?Sized)) -> Vec<Program> {
     let count = blocks.count();
-    let starts: Vec<usize> =
-        blocks.span(0..count).enumerate().filter(|(_, b)| b.program.is_some()).map(|(i, _)| i).collect();
+    let starts: Vec<usize> = blocks.marked(0..count).filter(|&index| blocks.at(index).program.is_some()).collect();
     let mut programs = Vec::new();
     let first = starts.first().copied().unwrap_or(count);
     if blocks.span(0..first).any(HaasBlock::has_content) || starts.is_empty() {
@@ -432,8 +451,8 @@ fn program(
     range: Range<usize>,
 ) -> Program {
     let mut block_numbers: BTreeMap<u64, Vec<usize>> = BTreeMap::new();
-    for (index, block) in range.clone().zip(blocks.span(range.clone())) {
-        if let Some(value) = block.number.and_then(|n| n.value) {
+    for index in blocks.marked(range.clone()) {
+        if let Some(value) = blocks.at(index).number.and_then(|n| n.value) {
             block_numbers.entry(value).or_default().push(index);
         }
     }
@@ -452,11 +471,11 @@ fn loop_pairs(blocks: &(impl Blocks + ?Sized), range: Range<usize>) -> Vec<(usiz
         })
     };
     let mut pairs = Vec::new();
-    for (start, block) in range.clone().zip(blocks.span(range.clone())) {
-        let Some(id) = loop_id(block, true) else { continue };
-        let end = blocks.span(start + 1..range.end).position(|later| loop_id(later, false) == Some(id));
+    for start in blocks.marked(range.clone()) {
+        let Some(id) = loop_id(blocks.at(start), true) else { continue };
+        let end = blocks.marked(start + 1..range.end).find(|&later| loop_id(blocks.at(later), false) == Some(id));
         if let Some(end) = end {
-            pairs.push((start, start + 1 + end));
+            pairs.push((start, end));
         }
     }
     pairs

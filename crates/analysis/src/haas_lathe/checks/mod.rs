@@ -94,14 +94,18 @@ impl Out {
 
 #[cfg(test)]
 mod tests {
-    use ncc_syntax::{Dialect, TextSize};
+    use nc_exec::haas_lathe::{
+        lower::{HaasBlock, block_nodes},
+        program::ProgramModel,
+    };
+    use ncc_syntax::{Dialect, Parse, TextSize};
     use proptest::prelude::*;
 
-    use crate::{AnalysisHost, Config};
+    use crate::{AnalysisHost, Config, haas_lathe::model::file_model};
 
     proptest! {
         /// Whatever the blocks and their order, the rules answer, inside
-        /// the text.
+        /// the text, from the model the run has.
         #[test]
         fn any_program_is_checked(lines in prop::collection::vec(prop::sample::select(vec![
             "O1", "O2", "%", "G54 G00 X40. Z2.", "G01 Z-10. F0.2", "X#1 Z[#2 * 2.]", "G02 X50. Z-15. R-5.",
@@ -111,13 +115,21 @@ mod tests {
             "G76 X27. Z-30. K-1. A60. P5 F2.", "G92 X30. Z-20. F2.", "G32 Z-10.", "M23", "G96 S200", "G50 S2000",
             "G53 X-100. Z-200.", "M97 P10", "M98 P2", "G65 P9010 A1.", "#1 = #1 + 1", "IF [#1 LT 3] GOTO 10",
             "GOTO #1", "WHILE [#1 LT 3] DO1", "END1", "/ G01 X10. F0.1", "M30", "M99", "G04", "X..", "",
-        ]), 0..40)) {
-            let text = lines.join("\n");
+        ]), 0..40), copies in 1..20usize) {
+            // Copies make files of several chunks.
+            let text = vec![lines.join("\n"); copies].join("\n");
             let mut host = AnalysisHost::in_dialect(Dialect::HaasLathe, Config::default());
             let file = host.add_file("O1.nc", text.as_str());
             for diagnostic in host.analysis().diagnostics(file) {
                 prop_assert!(diagnostic.range.end() <= TextSize::of(text.as_str()), "{diagnostic:?}");
             }
+            // The model read through the chunks' marked blocks is the one
+            // the run reads from every block.
+            let parse = Parse::new(&text, Dialect::HaasLathe);
+            let blocks: Vec<HaasBlock> = block_nodes(parse.green()).map(|(_, block)| HaasBlock::lower(block)).collect();
+            let model = file_model(host.db(), file);
+            prop_assert_eq!(model.count(), blocks.len());
+            prop_assert_eq!(&model.model, &ProgramModel::new(blocks.as_slice()));
         }
     }
 }

@@ -23,7 +23,9 @@ declare_rules! {
 pub(crate) fn check(file: &FileModel) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for program in &file.model.programs {
-        if file.lowered.span(program.blocks.clone()).any(|block| ends_program(block) || block.has_code(b'M', 99)) {
+        // The ends are marked blocks.
+        let mut ends = file.blocks.marked(program.blocks.clone()).map(|index| file.block(index));
+        if ends.any(|block| ends_program(block) || block.has_code(b'M', 99)) {
             continue;
         }
         let Some(last) = program.blocks.clone().rev().find(|&index| file.block(index).has_content()) else { continue };
