@@ -62,8 +62,9 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> &Findings {
 pub(crate) fn prepare_states(db: &dyn Db, file: SourceFile) {
     match file.parse(db).dialect() {
         Dialect::Cnc8x6 => cnc8x6::states::prepare(db, file),
-        // Hover reads nothing prepared about a Haas or Sinumerik file.
-        Dialect::HaasLathe | Dialect::Sinumerik => {}
+        Dialect::HaasLathe => haas_lathe::states::prepare(db, file),
+        // Hover reads nothing prepared about a Sinumerik file.
+        Dialect::Sinumerik => {}
     }
 }
 

@@ -5,4 +5,5 @@
 pub(crate) mod checks;
 pub(crate) mod ide;
 pub(crate) mod model;
+pub(crate) mod states;
 pub(crate) mod walk;

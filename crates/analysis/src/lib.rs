@@ -7,6 +7,7 @@
 //! answer is plain Rust data with text ranges; line/column conversion, LSP
 //! and terminal output are the caller's business.
 
+mod changed;
 pub mod cnc8x6;
 mod config;
 mod db;

@@ -49,12 +49,14 @@ impl Catalogue {
     /// special role (`R5`), else the machine constant. Prefixes pick one
     /// kind: `mc:39`, `param:39`, `op:48`, `group:G3`.
     pub fn explain(&self, query: &str) -> Result<Vec<Item<'_>>, NotFound> {
-        let items = self.lookup(query.trim());
-        if items.is_empty() {
-            Err(NotFound { query: query.trim().to_owned(), suggestions: self.suggestions(query.trim()) })
-        } else {
-            Ok(items)
-        }
+        self.items(query)
+            .ok_or_else(|| NotFound { query: query.trim().to_owned(), suggestions: self.suggestions(query.trim()) })
+    }
+
+    /// What `explain` finds, without the suggestions it makes when it finds
+    /// nothing (they compare the query with every entry): for hover.
+    pub fn items(&self, query: &str) -> Option<Vec<Item<'_>>> {
+        Some(self.lookup(query.trim())).filter(|items| !items.is_empty())
     }
 
     fn lookup(&self, query: &str) -> Vec<Item<'_>> {

@@ -26,7 +26,7 @@
 //! walk cannot know (a computed word, a forgotten state) is unknown, never
 //! wrong.
 
-use std::collections::BTreeSet;
+use std::{collections::BTreeSet, ops::ControlFlow};
 
 use nc_exec::{
     haas_lathe::{
@@ -79,7 +79,7 @@ pub(crate) struct Corner {
 }
 
 /// What the control holds between blocks, as far as the walk knows.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct State {
     pub modes: Modes,
     pub variables: Variables,
@@ -253,7 +253,8 @@ pub(crate) fn walk(file: &FileModel, visit: &mut dyn FnMut(&Visit<'_>)) {
     for (index, program) in file.model.programs.iter().enumerate() {
         let mut walker = Walker { file, catalogue, program: index, visit };
         let start = walker.start(program);
-        walker.program(program, Resume { at: program.blocks.start, state: start }, usize::MAX, &mut |_| {});
+        let from = Resume { at: program.blocks.start, state: start };
+        walker.program(program, from, usize::MAX, &mut |_| ControlFlow::Continue(()));
     }
 }
 
@@ -267,14 +268,14 @@ pub(crate) struct Resume {
 
 /// Walks program `program` of `file` from `from` until it passes block
 /// `until`, showing `visit` each block it runs, and `stand` each place it
-/// stands at between blocks (where it may resume).
+/// stands at between blocks (where it may resume), which may end it.
 pub(crate) fn walk_from(
     file: &FileModel,
     program: usize,
     from: Resume,
     until: usize,
     visit: &mut dyn FnMut(&Visit<'_>),
-    stand: &mut dyn FnMut(&Resume),
+    stand: &mut dyn FnMut(&Resume) -> ControlFlow<()>,
 ) {
     let catalogue = Dialect::HaasLathe.catalogue();
     let mut walker = Walker { file, catalogue, program, visit };
@@ -290,7 +291,7 @@ pub(crate) fn program_start(file: &FileModel, program: usize) -> State {
 
 /// The blocks of `program` where the walk forgets the state: jump targets
 /// and loops.
-fn joins(file: &FileModel, program: &Program) -> BTreeSet<usize> {
+pub(crate) fn joins(file: &FileModel, program: &Program) -> BTreeSet<usize> {
     let mut joins = BTreeSet::new();
     for finding in &file.model.findings {
         match finding {
@@ -340,7 +341,13 @@ impl<'a> Walker<'a, '_> {
         if subprogram { State::unknown(self.catalogue) } else { State::at_start(self.catalogue) }
     }
 
-    fn program(&mut self, program: &Program, from: Resume, until: usize, stand: &mut dyn FnMut(&Resume)) {
+    fn program(
+        &mut self,
+        program: &Program,
+        from: Resume,
+        until: usize,
+        stand: &mut dyn FnMut(&Resume) -> ControlFlow<()>,
+    ) {
         let blocks = &self.file.blocks.lowered;
         let joins = joins(self.file, program);
         let mut here = from;
@@ -354,7 +361,9 @@ impl<'a> Walker<'a, '_> {
             }
             let step = self.block(here.at, &here.state, None);
             here = Resume { at: step.next.unwrap_or(here.at + 1), state: step.after };
-            stand(&here);
+            if stand(&here).is_break() {
+                return;
+            }
         }
     }
 

@@ -26,7 +26,7 @@ use crate::{
     db::{Db, Settings, SourceFile},
     haas_lathe::{
         model::{FileModel, file_model},
-        walk::{Resume, program_start, walk_from},
+        states::walk_between,
     },
 };
 
@@ -129,7 +129,7 @@ pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<H
     let catalogue = Dialect::HaasLathe.catalogue();
     let (items, range) = match under(model.block(index), offset - start)? {
         Under::Word(word) => (word_items(catalogue, word)?, word.range),
-        Under::Variable { number, range } => (catalogue.explain(&format!("param:{number}")).ok()?, range),
+        Under::Variable { number, range } => (catalogue.items(&format!("param:{number}"))?, range),
         Under::Function { name, range } => {
             let operation = catalogue.operations.iter().find(|op| op.symbol.as_deref() == Some(name))?;
             (vec![Item::Operation(operation)], range)
@@ -144,32 +144,6 @@ pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<H
     Some(HoverResult { range: range + start, markdown })
 }
 
-/// How many blocks apart the places are where a hover's walk may resume.
-const CHECKPOINT_EVERY: usize = 64;
-
-/// Where the checker's walk stands every [`CHECKPOINT_EVERY`] blocks of
-/// each program, in order: a hover walks from the nearest one, not from
-/// the program's start.
-#[salsa::tracked(returns(ref), no_eq)]
-fn walk_checkpoints(db: &dyn Db, file: SourceFile) -> Vec<Vec<Resume>> {
-    let model = file_model(db, file);
-    let mut checkpoints = Vec::with_capacity(model.model.programs.len());
-    for (index, program) in model.model.programs.iter().enumerate() {
-        let start = Resume { at: program.blocks.start, state: program_start(model, index) };
-        let mut kept = vec![start.clone()];
-        let mut since = 0;
-        walk_from(model, index, start, usize::MAX, &mut |_| db.unwind_if_revision_cancelled(), &mut |here| {
-            since += 1;
-            if since >= CHECKPOINT_EVERY {
-                since = 0;
-                kept.push(here.clone());
-            }
-        });
-        checkpoints.push(kept);
-    }
-    checkpoints
-}
-
 /// The codes in force before block `index`, once per distinct state the
 /// checker's walk reaches it in (none for a block it does not reach): as
 /// a block of its program, and as a block of each contour that holds it.
@@ -182,26 +156,17 @@ fn modal_states(db: &dyn Db, file: SourceFile, index: usize) -> Vec<String> {
     // own state.
     let cycles = model.model.contours().filter(|c| c.blocks.contains(&index)).map(|c| c.cycle);
     let (first, last) = cycles.fold((index, index), |(first, last), cycle| (first.min(cycle), last.max(cycle)));
-    let checkpoints = &walk_checkpoints(db, file)[program];
-    let nearest = checkpoints.partition_point(|resume| resume.at <= first).saturating_sub(1);
     let catalogue = Dialect::HaasLathe.catalogue();
     let mut states = Vec::new();
-    walk_from(
-        model,
-        program,
-        checkpoints[nearest].clone(),
-        last,
-        &mut |visit| {
-            if visit.index != index {
-                return;
-            }
-            let line = modal_line(catalogue, &visit.before.modes);
-            if !states.contains(&line) {
-                states.push(line);
-            }
-        },
-        &mut |_| {},
-    );
+    walk_between(db, file, program, first, last, &mut |visit| {
+        if visit.index != index {
+            return;
+        }
+        let line = modal_line(catalogue, &visit.before.modes);
+        if !states.contains(&line) {
+            states.push(line);
+        }
+    });
     states
 }
 
@@ -249,7 +214,7 @@ fn word_items<'a>(catalogue: &'a Catalogue, word: &Word) -> Option<Vec<Item<'a>>
         Some(number) if catalogue.role_of(word.letter) == Some(AddressRole::Function) => format!("{letter}{number}"),
         _ => letter.to_string(),
     };
-    catalogue.explain(&query).ok()
+    catalogue.items(&query)
 }
 
 /// Where the reference at `range` leads, in words, for the hover's first
@@ -480,17 +445,16 @@ pub(crate) fn folding_ranges(db: &dyn Db, file: SourceFile) -> Vec<Fold> {
 
 #[cfg(test)]
 mod tests {
-    use ncc_syntax::Dialect;
+    use ncc_syntax::{Dialect, TextRange};
 
     use super::*;
-    use crate::{AnalysisHost, Config, haas_lathe::walk::walk};
+    use crate::{AnalysisHost, Config, FileId, TextEdit, haas_lathe::states::STRIDE, haas_lathe::walk::walk};
 
-    /// A hover resumes the walk from a checkpoint: each block gets the
-    /// states a walk of the whole file gives it, in long files with
-    /// contours, loops and jumps (each program repeated, so that
-    /// checkpoints fall inside programs and contours).
-    #[test]
-    fn modal_states_from_checkpoints_are_those_of_the_whole_walk() {
+    /// Long programs with contours, loops and jumps: the repository's
+    /// programs repeated, so that checkpoints fall inside programs and
+    /// contours, and a finishing cycle whose contour comes later with
+    /// checkpoints between.
+    fn long_programs() -> Vec<String> {
         let programs = [
             include_str!("../../../syntax/test_data/haas-lathe/e14_g71_type1_program.nc"),
             include_str!("../../../syntax/test_data/haas-lathe/e12_g71_g70_skeleton.nc"),
@@ -498,31 +462,80 @@ mod tests {
             include_str!("../../../syntax/test_data/haas-lathe/e22_corner_examples.nc"),
             include_str!("../../../../examples/haas-lathe/O1000.nc"),
         ];
-        // A finishing cycle whose contour comes later, checkpoints between.
-        let ahead = format!(
+        let mut long: Vec<String> = programs
+            .iter()
+            .map(|text| {
+                // Without tape marks: the text after a closing `%` is not read.
+                let once: String =
+                    text.lines().filter(|line| line.trim() != "%").map(|line| format!("{line}\n")).collect();
+                once.repeat(3 * STRIDE / once.lines().count() + 1)
+            })
+            .collect();
+        long.push(format!(
             "O2\nG54 G00 X50. Z2.\nG70 P100 Q110 F0.1\n{}N100 G01 X20. G42\nG02 X30. Z-5. R5.\nN110 G01 Z-20. G40\nM30\n",
-            "G01 Z-1. F0.1\nG00 Z2. M08\n".repeat(CHECKPOINT_EVERY)
-        );
+            "G01 Z-1. F0.1\nG00 Z2. M08\n".repeat(STRIDE)
+        ));
+        long
+    }
+
+    /// Hover's states of every block against those a walk of the whole
+    /// file gives.
+    fn assert_hover_states_are_the_whole_walks(host: &AnalysisHost, file: FileId, what: &str) {
+        let db = host.db();
         let catalogue = Dialect::HaasLathe.catalogue();
-        for text in programs.into_iter().chain([ahead.as_str()]) {
-            // Without tape marks: the text after a closing `%` is not read.
-            let once: String = text.lines().filter(|line| line.trim() != "%").map(|line| format!("{line}\n")).collect();
-            let long = once.repeat(3 * CHECKPOINT_EVERY / once.lines().count() + 1);
+        let model = file_model(db, file);
+        let mut whole: Vec<Vec<String>> = vec![Vec::new(); model.count()];
+        walk(model, &mut |visit| {
+            let line = modal_line(catalogue, &visit.before.modes);
+            if !whole[visit.index].contains(&line) {
+                whole[visit.index].push(line);
+            }
+        });
+        let reached = whole.iter().filter(|states| !states.is_empty()).count();
+        assert!(reached > 2 * STRIDE, "{reached} of {} blocks reached", whole.len());
+        for (index, states) in whole.iter().enumerate() {
+            assert_eq!(&modal_states(db, file, index), states, "block {index} {what}");
+        }
+    }
+
+    /// A hover walks from a checkpoint: each block gets the states a walk
+    /// of the whole file gives it, before and after the checkpoints are
+    /// prepared, and after edits that change the modal state, with and
+    /// without preparing between them.
+    #[test]
+    fn hover_states_from_checkpoints_are_those_of_the_whole_walk_across_edits() {
+        for text in long_programs() {
             let mut host = AnalysisHost::in_dialect(Dialect::HaasLathe, Config::default());
-            let file = host.add_file("O1.nc", long.as_str());
-            let db = host.db();
-            let model = file_model(db, file);
-            let mut whole: Vec<Vec<String>> = vec![Vec::new(); model.count()];
-            walk(model, &mut |visit| {
-                let line = modal_line(catalogue, &visit.before.modes);
-                if !whole[visit.index].contains(&line) {
-                    whole[visit.index].push(line);
+            let file = host.add_file("O1.nc", text.as_str());
+            assert_hover_states_are_the_whole_walks(&host, file, "unprepared");
+            host.analysis().prepare_states(file);
+            assert_hover_states_are_the_whole_walks(&host, file, "prepared");
+            // G00 and G01 swapped at places spread over the file; a line
+            // break now and then moves the blocks.
+            let mut seed = 7_u64;
+            for edit in 0..12 {
+                seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                let current = host.analysis().text(file);
+                let codes: Vec<usize> = current.match_indices("G0").map(|(at, _)| at + 2).collect();
+                let at = codes[(seed >> 33) as usize % codes.len()];
+                let (insert, delete) = match (edit % 5, &current[at..=at]) {
+                    (4, _) => ("\n", 0),
+                    (_, "0") => ("1", 1),
+                    (_, "1") => ("0", 1),
+                    _ => ("", 0),
+                };
+                let (at, insert, delete) = match current.find("Z-20. G40") {
+                    // A contour after its cycle, checkpoints between: the
+                    // feed mode it leaves holds after the cycle.
+                    Some(contour_end) if edit == 1 => (contour_end + 9, " G98", 0),
+                    _ => (at, insert, delete),
+                };
+                let range = TextRange::at(TextSize::from(at as u32), TextSize::from(delete));
+                host.apply_edit(file, &TextEdit::replace(range, insert));
+                if edit % 3 == 0 {
+                    host.analysis().prepare_states(file);
                 }
-            });
-            let reached = whole.iter().filter(|states| !states.is_empty()).count();
-            assert!(reached > 2 * CHECKPOINT_EVERY, "{reached} of {} blocks reached", whole.len());
-            for (index, states) in whole.iter().enumerate() {
-                assert_eq!(&modal_states(db, file, index), states, "block {index} of\n{text}");
+                assert_hover_states_are_the_whole_walks(&host, file, &format!("after edit {edit} at {at}"));
             }
         }
     }

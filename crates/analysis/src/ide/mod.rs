@@ -312,7 +312,7 @@ fn hover_in_unit(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<Hove
                 }
                 _ => letter.to_string(),
             };
-            let items = catalogue.explain(&query).ok()?;
+            let items = catalogue.items(&query)?;
             let item = items.iter().find(|item| !matches!(item, Item::Group(_)))?;
             let mut markdown = item.markdown(catalogue);
             if letter == 'L'
@@ -324,7 +324,7 @@ fn hover_in_unit(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<Hove
             Some(HoverResult { range: word.range + start, markdown })
         }
         Target::Parameter { index: number, range } => {
-            let items = catalogue.explain(&format!("param:{number}")).ok()?;
+            let items = catalogue.items(&format!("param:{number}"))?;
             let mut markdown = items.first()?.markdown(catalogue);
             let states = flow::states_before(db, file, index);
             markdown.push_str(&values_text(number, states.iter().map(|(_, params)| params)));

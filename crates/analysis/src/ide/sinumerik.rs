@@ -41,7 +41,7 @@ pub(crate) fn hover(db: &dyn Db, file: SourceFile, offset: TextSize) -> Option<H
     let explained = || {
         let (query, range) = query_of(&token)?;
         let catalogue = catalogue();
-        let items = catalogue.explain(&query).ok()?;
+        let items = catalogue.items(&query)?;
         let item = items.iter().find(|item| !matches!(item, Item::Group(_)))?;
         Some(HoverResult { range, markdown: item.markdown(catalogue) })
     };
