@@ -140,6 +140,10 @@ pub struct WorkspaceFiles {
     /// Haas program files named after their number (`O01234.nc`): path and
     /// text by number.
     programs: FxHashMap<u32, (String, Arc<String>)>,
+    /// The number the running program's own file is named after, whose
+    /// text is the run's: kept apart, so that an edit of the program leaves
+    /// the files as they were and its estimate resumes.
+    own_program: Option<u32>,
     /// The files named as the machine's cycle file, by their name without
     /// directory and extension, with their path.
     by_stem: Vec<(String, String, Arc<String>)>,
@@ -205,8 +209,14 @@ pub(crate) fn run_input(db: &dyn Db, file: SourceFile) -> Option<RunInput> {
     let machine = &settings.config(db).machine;
     if *settings.dialect(db) == Dialect::HaasLathe {
         for &other in settings.files(db) {
-            if let Some(number) = ncc_catalog::program_file_number(Path::new(other.path(db))) {
-                files.programs.entry(number).or_insert_with(|| (other.path(db).clone(), other.text(db).clone()));
+            let Some(number) = ncc_catalog::program_file_number(Path::new(other.path(db))) else { continue };
+            if files.own_program == Some(number) || files.programs.contains_key(&number) {
+                continue;
+            }
+            if other == file {
+                files.own_program = Some(number);
+            } else {
+                files.programs.insert(number, (other.path(db).clone(), other.text(db).clone()));
             }
         }
     }
@@ -307,6 +317,7 @@ fn estimate_in(
     machine: &MachineConfig,
     budget: usize,
 ) -> Estimate {
+    let environment = &WithOwnProgram { environment, number: files.own_program, text };
     let dynamics = nc_exec::run::dynamics(machine);
     let axes = machine.step_axes();
     let change = previous.and_then(|previous| Change::between(previous, text, files, machine, budget));
@@ -341,6 +352,27 @@ fn estimate_in(
     let mut estimate = charges.into_estimate(text, files, machine, stopped, (trace.blocks_run, budget));
     estimate.rerun.start = rerun_from;
     estimate
+}
+
+/// The workspace's files, and the running program's own file as its
+/// current text.
+struct WithOwnProgram<'a> {
+    environment: &'a dyn Environment,
+    number: Option<u32>,
+    text: &'a str,
+}
+
+impl Environment for WithOwnProgram<'_> {
+    fn file(&self, called: &Called) -> Option<String> {
+        match called {
+            &Called::Program(number) if Some(number) == self.number => Some(self.text.to_owned()),
+            _ => self.environment.file(called),
+        }
+    }
+
+    fn abandoned(&self) -> bool {
+        self.environment.abandoned()
+    }
 }
 
 /// How a text differs from the text of a previous estimate: one changed

@@ -1,7 +1,7 @@
 use expect_test::{Expect, expect};
 
 use super::*;
-use crate::{AnalysisHost, Config};
+use crate::{AnalysisHost, Config, TextEdit};
 
 /// The estimate of `program` in a workspace that also holds `others`
 /// (path, text).
@@ -329,6 +329,7 @@ fn under_the_envelope_velocity_an_edit_reruns_from_the_checkpoint_before_it_to_t
 fn a_changed_macrocycle_file_reruns_from_the_last_checkpoint() {
     let text = long_program(2500).replace("N99999 G00 Z5 M30", "N99998 G72 L9001\nN99999 G00 Z5 M30");
     let files = |x: &str| WorkspaceFiles {
+        own_program: None,
         macrocycles: [(
             9001,
             ("L9001".to_owned(), Arc::new(format!("N1 G79 L9001\nN2 G91 G01 X{x}\nN3 G90 G70\n*\n"))),
@@ -367,6 +368,29 @@ fn a_haas_program_runs_the_program_files_of_the_workspace() {
     // 10 mm at 600 mm/min, with the ramps.
     let total = input.estimate(None, 1000, &|| false).expect("never abandoned").totals.total;
     assert!(total >= 1.0, "{total}");
+}
+
+/// The program file being edited is one of the workspace's program files
+/// (`O01234.nc`): its edit changes the run's text, not the files it calls,
+/// so the estimate resumes and rejoins; its own number runs its current
+/// text.
+#[test]
+fn an_edit_of_a_haas_program_file_named_after_its_number_resumes_its_estimate() {
+    let text = long_haas_program(5000);
+    let mut host = AnalysisHost::in_dialect(Dialect::HaasLathe, Config::default());
+    let file = host.add_file("/p/O00001.nc", text.as_str());
+    let input = host.analysis().run_input(file).expect("a program");
+    assert_eq!(input.files.program_file(1), None, "the run's own text, not a copy");
+    let first = input.estimate(None, 1_000_000, &|| false).expect("never abandoned");
+    let at = text.find("N2503 X").expect("the block") + "N2503 X".len();
+    host.apply_edit(file, &TextEdit::replace(TextRange::empty(TextSize::of(&text[..at])), "7"));
+    let edited = host.analysis().run_input(file).expect("a program");
+    let resumed = edited.estimate(Some(&first), 1_000_000, &|| false).expect("never abandoned");
+    assert!(usize::from(resumed.rerun.end) < edited.text.len(), "{:?}", resumed.rerun);
+    assert_alike(&resumed, &haas_estimate_of(&edited.text, None));
+
+    let own = WithOwnProgram { environment: &edited.files, number: edited.files.own_program, text: &edited.text };
+    assert_eq!(own.file(&Called::Program(1)).as_deref(), Some(edited.text.as_str()));
 }
 
 /// An estimate asked for a text typed on meanwhile is given up.
