@@ -9,11 +9,15 @@
 //! previous checkpoint reaches. An edit that leaves the walk's plan as it
 //! was (the programs, where jumps and loops join, the contours) unlinks
 //! the checkpoints whose walk from the previous one crosses the edit, or
-//! runs a contour the edit meets; any other edit drops them all. A
-//! question walks from the last checkpoint before it that only linked ones
-//! precede, and changes nothing: the lock is taken for the lookup only.
-//! [`prepare`], in idle time, walks from there across the edit and links
-//! the checkpoints again where the walk reaches the same state.
+//! runs a contour the edit meets; any other edit drops them all. Those
+//! that only linked ones precede hold. A question walks from the one
+//! before each unlinked checkpoint before it to that checkpoint and links
+//! it again when the state there is the same (otherwise its state is
+//! replaced, and the next one unlinked), then from the nearest one: a
+//! walk across each edit, not from the program's start. The walks take
+//! no lock: a question takes it to copy the checkpoints it needs and to
+//! store what it learnt, unless another stored something meanwhile.
+//! [`prepare`], in idle time, does the same for the whole file.
 
 use std::{
     collections::{BTreeSet, hash_map::Entry},
@@ -103,12 +107,15 @@ struct Checkpoints {
     /// Each program's, sorted by block, the first at its start (empty
     /// until the program is walked).
     programs: Vec<Vec<Checkpoint>>,
+    /// Counts the changes of `programs`: a walk's result is stored only
+    /// over the checkpoints it started from.
+    version: u64,
 }
 
 impl Checkpoints {
     fn new(root: GreenNode, plan: Plan) -> Checkpoints {
         let programs = vec![Vec::new(); plan.programs.len()];
-        Checkpoints { root, plan, programs }
+        Checkpoints { root, plan, programs, version: 0 }
     }
 
     /// Carries the checkpoints over to the file's current tree and plan.
@@ -123,6 +130,7 @@ impl Checkpoints {
         }
         let changed = changed_blocks(&self.root, &root);
         self.root = root;
+        self.version += 1;
         // The same plan has the same blocks: an edit replaced blocks one
         // for one.
         let edited = changed.new;
@@ -139,15 +147,6 @@ impl Checkpoints {
                 }
             }
         }
-    }
-
-    /// Where a walk to block `first` of `program` can start: the last
-    /// checkpoint at or before it that only linked ones precede.
-    fn start(&self, program: usize, first: usize) -> Option<&Checkpoint> {
-        let points = self.programs.get(program)?;
-        let trusted = points.iter().position(|point| !point.linked).unwrap_or(points.len());
-        let nearest = points[..trusted].partition_point(|point| point.resume.at <= first);
-        nearest.checked_sub(1).map(|index| &points[index])
     }
 }
 
@@ -170,8 +169,8 @@ fn checkpoints<'a>(
 }
 
 /// Walks program `program` from a checkpoint up to block `last`, showing
-/// `visit` each block it runs: from the last one at or before block
-/// `first`, else from the program's start.
+/// `visit` each block it runs: from the nearest one at or before block
+/// `first` that holds, after linking those before it.
 pub(crate) fn walk_between(
     db: &dyn Db,
     file: SourceFile,
@@ -181,77 +180,67 @@ pub(crate) fn walk_between(
     visit: &mut dyn FnMut(&Visit<'_>),
 ) {
     let model = file_model(db, file);
+    let Some(blocks) = model.model.programs.get(program).map(|program| program.blocks.clone()) else { return };
     let plan = Plan::of(model);
-    let start = {
+    let (version, mut points) = {
         let mut files = lock(&state_cache(db).files);
-        checkpoints(&mut files, db, file, plan).start(program, first).map(|point| point.resume.clone())
+        let checkpoints = checkpoints(&mut files, db, file, plan);
+        let points = &checkpoints.programs[program];
+        // And the one after: linking the last may unlink it.
+        let needed = (points.partition_point(|point| point.resume.at <= first) + 1).min(points.len());
+        (checkpoints.version, points[..needed].to_vec())
     };
-    let Some(start) = start.or_else(|| {
-        let program_blocks = &model.model.programs.get(program)?.blocks;
-        Some(Resume { at: program_blocks.start, state: program_start(model, program) })
-    }) else {
-        return;
+    let copied = points.len();
+    let (nearest, changed) = link(db, model, program, &mut points, first);
+    let start = match nearest {
+        Some(nearest) => points[nearest].resume.clone(),
+        None => Resume { at: blocks.start, state: program_start(model, program) },
     };
+    if changed {
+        store(db, file, program, version, points, copied);
+    }
     walk_from(model, program, start, last, visit, &mut |_| ControlFlow::Continue(()));
 }
 
-/// Walks every program whose checkpoints an edit unlinked (or that has
-/// none) from its last trusted one, leaving checkpoints, until the walk
-/// reaches the state of an unlinked one after which all are linked. The
-/// lock is held only to read where to start and to store what was found.
+/// Links every program's checkpoints (walking a program without any from
+/// its start, leaving them), so that a question anywhere walks little.
 pub(crate) fn prepare(db: &dyn Db, file: SourceFile) {
     let model = file_model(db, file);
     let plan = Plan::of(model);
     for program in 0..model.model.programs.len() {
-        let (root, old) = {
+        let (version, mut points) = {
             let mut files = lock(&state_cache(db).files);
             let checkpoints = checkpoints(&mut files, db, file, plan.clone());
-            (checkpoints.root.clone(), checkpoints.programs[program].clone())
+            (checkpoints.version, checkpoints.programs[program].clone())
         };
-        let Some(walked) = walk_across(db, model, program, &old) else { continue };
-        let mut files = lock(&state_cache(db).files);
-        let Some(checkpoints) = files.get_mut(&file) else { return };
-        // An edit came meanwhile: its question or preparation walks again.
-        if !std::ptr::eq::<rowan::GreenNodeData>(&*checkpoints.root, &*root) || checkpoints.plan != plan {
-            return;
+        let copied = points.len();
+        let changed = if points.is_empty() {
+            points = walked(db, model, program);
+            true
+        } else {
+            link(db, model, program, &mut points, usize::MAX).1
+        };
+        if changed {
+            store(db, file, program, version, points, copied);
         }
-        checkpoints.programs[program] = walked;
     }
 }
 
-/// The checkpoints of `program` after a walk from the last trusted one of
-/// `old` (its start when none) across the unlinked ones; `None` when all
-/// are linked.
-fn walk_across(db: &dyn Db, model: &FileModel, program: usize, old: &[Checkpoint]) -> Option<Vec<Checkpoint>> {
-    let unlinked = old.iter().position(|point| !point.linked);
-    if !old.is_empty() && unlinked.is_none() {
-        return None;
-    }
-    let kept = unlinked.unwrap_or(0);
-    let mut points: Vec<Checkpoint> = old[..kept].to_vec();
-    let start = match points.last() {
-        Some(point) => point.resume.clone(),
-        None => {
-            let resume =
-                Resume { at: model.model.programs[program].blocks.start, state: program_start(model, program) };
-            points.push(Checkpoint { resume: resume.clone(), linked: true });
-            resume
-        }
-    };
-    // The old checkpoints after the last unlinked one are linked: reaching
-    // the state of one at or after it, the walk may stop there.
-    let last_unlinked = old.iter().rposition(|point| !point.linked).unwrap_or(0);
-    let mut rest = None;
+/// Stores `points`, what became of the first `replaced` checkpoints of
+/// `program` in the checkpoints of `version`, unless they changed since.
+fn store(db: &dyn Db, file: SourceFile, program: usize, version: u64, points: Vec<Checkpoint>, replaced: usize) {
+    let mut files = lock(&state_cache(db).files);
+    let Some(checkpoints) = files.get_mut(&file).filter(|checkpoints| checkpoints.version == version) else { return };
+    checkpoints.programs[program].splice(..replaced, points);
+    checkpoints.version += 1;
+}
+
+/// The checkpoints of a walk of `program` from its start to its end.
+fn walked(db: &dyn Db, model: &FileModel, program: usize) -> Vec<Checkpoint> {
+    let start = Resume { at: model.model.programs[program].blocks.start, state: program_start(model, program) };
+    let mut points = vec![Checkpoint { resume: start.clone(), linked: true }];
     let mut since = 0;
     walk_from(model, program, start, usize::MAX, &mut |_| db.unwind_if_revision_cancelled(), &mut |here| {
-        let old_here = old.binary_search_by_key(&here.at, |point| point.resume.at);
-        if let Ok(index) = old_here
-            && index >= last_unlinked
-            && old[index].resume.state == here.state
-        {
-            rest = Some(index);
-            return ControlFlow::Break(());
-        }
         since += 1;
         if since >= STRIDE {
             since = 0;
@@ -259,8 +248,57 @@ fn walk_across(db: &dyn Db, model: &FileModel, program: usize, old: &[Checkpoint
         }
         ControlFlow::Continue(())
     });
-    if let Some(index) = rest {
-        points.extend(old[index..].iter().cloned().map(|point| Checkpoint { linked: true, ..point }));
+    points
+}
+
+/// Links the unlinked checkpoints of `points` at or before block `first`:
+/// walks from the one before each (which holds) to it, and links it when
+/// the walk reaches its state there, or gives it that state and unlinks
+/// the next; a checkpoint the walk no longer stands at goes. Returns the
+/// index of the last checkpoint at or before `first`, which then holds,
+/// and whether any checkpoint changed.
+fn link(
+    db: &dyn Db,
+    model: &FileModel,
+    program: usize,
+    points: &mut Vec<Checkpoint>,
+    first: usize,
+) -> (Option<usize>, bool) {
+    let mut changed = false;
+    loop {
+        let trusted = points.iter().position(|point| !point.linked).unwrap_or(points.len());
+        if points.get(trusted).is_none_or(|point| point.resume.at > first) {
+            return (points[..trusted].partition_point(|point| point.resume.at <= first).checked_sub(1), changed);
+        }
+        changed = true;
+        // The first checkpoint is the program's start, always linked.
+        let from = points[trusted - 1].resume.clone();
+        let target = points[trusted].resume.at;
+        let mut reached = None;
+        let cancel = &mut |_: &Visit<'_>| db.unwind_if_revision_cancelled();
+        walk_from(model, program, from, usize::MAX, cancel, &mut |here| {
+            if here.at < target {
+                return ControlFlow::Continue(());
+            }
+            reached = Some(here.clone());
+            ControlFlow::Break(())
+        });
+        match reached.filter(|here| here.at == target) {
+            Some(here) => {
+                if here.state != points[trusted].resume.state {
+                    points[trusted].resume = here;
+                    if let Some(next) = points.get_mut(trusted + 1) {
+                        next.linked = false;
+                    }
+                }
+                points[trusted].linked = true;
+            }
+            None => {
+                points.remove(trusted);
+                if let Some(next) = points.get_mut(trusted) {
+                    next.linked = false;
+                }
+            }
+        }
     }
-    Some(points)
 }

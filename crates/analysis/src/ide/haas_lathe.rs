@@ -535,6 +535,10 @@ mod tests {
                 if edit % 3 == 0 {
                     host.analysis().prepare_states(file);
                 }
+                // Some edits pile up before a question.
+                if edit % 4 == 2 {
+                    continue;
+                }
                 assert_hover_states_are_the_whole_walks(&host, file, &format!("after edit {edit} at {at}"));
             }
         }

@@ -51,7 +51,9 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
     let model = file_model(db, file);
     let config = Settings::get(db).config(db);
     let mut out = Out::default();
+    // A long walk: an edit waiting to change the inputs cancels it.
     walk(model, &mut |visit| {
+        db.unwind_if_revision_cancelled();
         motion::visit(visit, config, &mut out);
         compensation::visit(visit, &mut out);
         contours::visit(visit, &mut out);
