@@ -15,7 +15,7 @@
 //! - it is cancelled on the first step that moves in the plane without a
 //!   side, which must be a line, ending on the programmed point;
 //! - it ends where it is (the last element on its normal) when the step's
-//!   frame changes, or at the run's end;
+//!   frame or plane changes, or at the run's end;
 //! - each piece takes the time of its length at the step's feed (scaled
 //!   on compensated arcs), or at the rapid rates of the plane's axes.
 
@@ -33,19 +33,19 @@ pub struct Start {
     pub side: Side,
     pub radius: f64,
     pub settings: Settings,
-    /// The plane's axes, the order of the points.
-    pub plane: (u8, u8),
     /// From the compensated point to the point the control positions.
     pub shift: Vector2<f64>,
 }
 
 /// A step's move as compensation sees it: its start and end in the plane,
-/// and the frame it runs in (compensation does not cross a change).
+/// the plane's axes (the order of the points) and the frame it runs in
+/// (compensation does not cross a change of either).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlaneMove {
     pub step: usize,
     pub from: Point2<f64>,
     pub to: Point2<f64>,
+    pub plane: (u8, u8),
     pub frame: usize,
 }
 
@@ -100,7 +100,7 @@ impl Driver {
         moved: PlaneMove,
         start: Option<Start>,
     ) -> Result<(), Refusal> {
-        let PlaneMove { step: index, from, to, frame } = moved;
+        let PlaneMove { step: index, from, to, plane, frame } = moved;
         let step = steps.get(index);
         let moves = from != to || matches!(step.path, Path::Arc { .. });
         let line = matches!(step.motion, Motion::Rapid | Motion::Feed) && step.path == Path::Straight;
@@ -110,7 +110,7 @@ impl Driver {
             }
             _ => Element::Line { from, to },
         };
-        if self.active.as_ref().is_some_and(|active| active.frame != frame) {
+        if self.active.as_ref().is_some_and(|active| (active.frame, active.plane) != (frame, plane)) {
             self.end(steps, machine);
         }
         let (pieces, active) = match (self.active.take(), start) {
@@ -121,7 +121,7 @@ impl Driver {
                 if !line {
                     return Err(Refusal::StartNotLine);
                 }
-                let Start { side, radius, settings, shift, plane } = start;
+                let Start { side, radius, settings, shift } = start;
                 let compensator = Compensator::start(settings, side, radius, index, from - shift, to - shift);
                 self.active = Some(Active { compensator, shift, plane, frame });
                 self.compensated.push(Compensated { steps: index..index + 1, plane });

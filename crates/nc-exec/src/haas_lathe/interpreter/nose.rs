@@ -91,9 +91,9 @@ impl Interpreter<'_> {
             let radius = f64::from(entry.radius) / 1000.0;
             // The driver moves the nose centre's path by this to the tip.
             let shift = tip_vector(entry.tip, radius);
-            Start { side, radius, settings: SETTINGS, shift, plane: (b'Z', b'X') }
+            Start { side, radius, settings: SETTINGS, shift }
         });
-        let moved = PlaneMove { step: index, from: point(from), to: point(to), frame };
+        let moved = PlaneMove { step: index, from: point(from), to: point(to), plane: (b'Z', b'X'), frame };
         let message = match self.compensation.follow(&mut self.steps, &self.machine, moved, start) {
             Ok(()) => return,
             Err(Refusal::StartNotLine) => "tool-nose radius compensation starts on an arc or a thread: the first move after G41 or G42 must be a line, G00 or G01 (lathe manual §7.1 (001:960-961))".to_owned(),
