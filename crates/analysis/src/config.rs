@@ -49,6 +49,7 @@
 //!
 //! [machine.tool-offsets]                   # Haas lathe: the offset yy of Txxyy
 //! 1 = { radius = "0.8", tip = 3 }          # nose radius (mm) and tip code 0-9
+//! T1D1 = { radius = "5" }                  # Sinumerik: tool T1's edge D1, radius mm
 //!
 //! [machine.constants]                      # as in TAB0.REK
 //! R339 = "01000000"                        # the eight decades
@@ -73,6 +74,8 @@ pub use nc_exec::machine::{MachineConfig, OffsetTable, ToolTable, TravelLimits, 
 use nc_exec::{
     cnc8x6::tables::{self, Finding},
     haas_lathe::offsets,
+    machine::ToolEntry,
+    sinumerik,
 };
 use ncc_syntax::{Dialect, Severity};
 use serde::Deserialize;
@@ -337,7 +340,8 @@ struct MachineFile {
     constants: BTreeMap<String, String>,
 }
 
-/// A Haas lathe's tool offset: its nose radius and tip code.
+/// A Haas lathe's tool offset: its nose radius and tip code; a Sinumerik
+/// tool's cutting edge: its radius.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ToolOffsetFile {
@@ -499,10 +503,11 @@ impl MachineFile {
                 "{origin}: {section}offset-file and tool-file are the CNC8x6's tables; a Haas lathe gives work-offsets and tool-offsets"
             ));
         }
-        let haas_keys = !self.work_offsets.is_empty() || !self.tool_offsets.is_empty();
+        let sinumerik = machine.control == Dialect::Sinumerik;
+        let haas_keys = !self.work_offsets.is_empty() || (!self.tool_offsets.is_empty() && !sinumerik);
         if haas_keys && !haas {
             return Err(format!(
-                "{origin}: {section}work-offsets and tool-offsets describe a Haas lathe (dialect = \"haas-lathe\"); a CNC8x6 reads offset-file and tool-file"
+                "{origin}: {section}work-offsets and tool-offsets describe a Haas lathe (dialect = \"haas-lathe\") or, tool-offsets only, a Sinumerik's cutting edges; a CNC8x6 reads offset-file and tool-file"
             ));
         }
         if let Some(name) = self.offset_file {
@@ -525,7 +530,20 @@ impl MachineFile {
             }
             tables.work_offsets.insert(code, row);
         }
-        for (key, offset) in self.tool_offsets {
+        for (key, offset) in self.tool_offsets.iter().filter(|_| sinumerik) {
+            let edge = sinumerik::cutting_edge_key(key)
+                .ok_or_else(|| format!("{origin}: {section}tool-offsets key `{key}` is no tool edge like `T1D1`"))?;
+            let field = |e: String| format!("{origin}: {section}tool-offsets.{key}: {e}");
+            if offset.tip.is_some() {
+                return Err(field("a tip code is a lathe's; a Sinumerik edge gives its radius".to_owned()));
+            }
+            let radius = offset.radius.as_deref().map(tables::coordinate).transpose().map_err(field)?.unwrap_or(0);
+            if radius < 0 {
+                return Err(field("the radius must not be negative".to_owned()));
+            }
+            machine.cutting_edges.insert(edge, ToolEntry { radius, ..ToolEntry::default() });
+        }
+        for (key, offset) in self.tool_offsets.into_iter().filter(|_| !sinumerik) {
             let number = offsets::tool_offset_number(&key)
                 .ok_or_else(|| format!("{origin}: {section}tool-offsets key `{key}` is no offset number 1-99"))?;
             let field = |e: String| format!("{origin}: {section}tool-offsets.{key}: {e}");
@@ -769,6 +787,23 @@ mod tests {
         }
         let error = load("[machine.tool-offsets]\n1 = { tip = 3 }\n", &[]).unwrap_err();
         assert!(error.contains("haas-lathe"), "{error}");
+    }
+
+    #[test]
+    fn a_sinumerik_gives_its_tools_cutting_edges() {
+        let keys = "dialect = \"sinumerik\"\n[machine.tool-offsets]\nT1D1 = { radius = \"5\" }\nT12D2 = { radius = \"0.4\" }\n";
+        let machine = load(keys, &[]).unwrap().machine;
+        let radii: Vec<_> = machine.cutting_edges.iter().map(|(&edge, entry)| (edge, entry.radius)).collect();
+        assert_eq!(radii, [((1, 1), 5000), ((12, 2), 400)]);
+        for (offset, says) in [
+            ("1 = { radius = \"5\" }", "`1`"),
+            ("T1D0 = { radius = \"5\" }", "`T1D0`"),
+            ("T1D1 = { radius = \"5\", tip = 3 }", "tip"),
+            ("T1D1 = { radius = \"-5\" }", "negative"),
+        ] {
+            let error = load(&format!("dialect = \"sinumerik\"\n[machine.tool-offsets]\n{offset}\n"), &[]).unwrap_err();
+            assert!(error.contains(says), "{offset}: {error}");
+        }
     }
 
     #[test]

@@ -80,6 +80,7 @@ pub mod arc;
 pub(crate) mod axes;
 pub mod cnc8x6;
 pub(crate) mod compensation;
+pub(crate) mod compensation_driver;
 pub(crate) mod envelope;
 pub mod expand;
 pub(crate) mod green;

@@ -46,6 +46,9 @@ pub struct MachineConfig {
     /// TAB0.KOR. Haas lathe: the tool offsets 1-99 that `Txxyy` selects by
     /// `yy`, their nose radius and tip only.
     pub tools: ToolTable,
+    /// Sinumerik: the cutting edges of the tool data, by tool T and edge D
+    /// (`T1 D1`), their radius only; an edge not given has radius 0.
+    pub cutting_edges: BTreeMap<(u32, u32), ToolEntry>,
     /// The pause between blocks under G98, where the next block is not
     /// prepared ahead, in ms. It depends on the hardware; the manual gives
     /// no number, so the default is an assumption.
@@ -110,6 +113,7 @@ impl Default for MachineConfig {
             cycle_file: None,
             offsets: OffsetTable::default(),
             tools: ToolTable::default(),
+            cutting_edges: BTreeMap::new(),
             block_pause_ms: 20,
             settle_time_ms: 10,
             m_function_ms: 0,

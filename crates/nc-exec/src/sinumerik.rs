@@ -33,3 +33,14 @@ pub(crate) mod interpreter;
 pub mod lower;
 pub mod modes;
 pub mod program;
+
+/// The tool and edge of a machine configuration's tool offset key
+/// `T<t>D<d>` (`T1D1`), both from 1.
+pub fn cutting_edge_key(key: &str) -> Option<(u32, u32)> {
+    let rest = key.strip_prefix(['T', 't'])?;
+    let (tool, edge) = rest.split_once(['D', 'd'])?;
+    let number = |text: &str| {
+        text.bytes().all(|byte| byte.is_ascii_digit()).then(|| text.parse().ok()).flatten().filter(|&n| n > 0)
+    };
+    Some((number(tool)?, number(edge)?))
+}

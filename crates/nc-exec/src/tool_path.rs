@@ -6,12 +6,14 @@
 //! reports, the moves `ncc plot` draws and the blocks `ncc expand` writes
 //! are these; a step's end ([`Step::end`]) stays the programmed point.
 
+use std::collections::VecDeque;
+
 use nalgebra::Point2;
 use smallvec::{SmallVec, smallvec};
 
 use crate::{
     compensation::{Element, ToolElement},
-    trace::{Axes, MAX_AXES, Path, Step, Trace},
+    trace::{Axes, Compensated, MAX_AXES, Path, Step, Trace},
 };
 
 /// A step's part in radius compensation.
@@ -24,6 +26,65 @@ pub struct Centred<'a> {
     /// Where the tool-centre path ends before them: the end of the last
     /// piece of the compensation's earlier steps, if it has any.
     pub before: Option<Point2<f64>>,
+}
+
+/// A step's part in radius compensation, for a sink that is handed the
+/// steps one by one: [`Centred`] with the pieces its own.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OwnCentred {
+    pub plane: (u8, u8),
+    pub pieces: SmallVec<[ToolElement; 2]>,
+    pub before: Option<Point2<f64>>,
+}
+
+impl OwnCentred {
+    pub fn centred(&self) -> Centred<'_> {
+        Centred { plane: self.plane, pieces: &self.pieces, before: self.before }
+    }
+}
+
+/// What a [`StepSink`](crate::trace::StepSink) keeps of radius
+/// compensation to give each step handed to it its part: the spans and the
+/// pieces of the tool-centre path it was told of, and where the path ended.
+#[derive(Debug, Clone, Default)]
+pub struct CentredSteps {
+    spans: VecDeque<Compensated>,
+    pieces: VecDeque<ToolElement>,
+    /// The step of the last piece handed out, and where it ends.
+    path_end: Option<(usize, Point2<f64>)>,
+    /// The index of the step to come.
+    next: usize,
+}
+
+impl CentredSteps {
+    /// Takes what the sink is told before the steps they concern.
+    pub fn references(&mut self, compensated: &[Compensated], pieces: &[ToolElement]) {
+        // The last span may have grown since.
+        let first = compensated.partition_point(|span| span.steps.end <= self.next);
+        self.spans.clear();
+        self.spans.extend(compensated[first..].iter().cloned());
+        self.pieces.extend(pieces);
+    }
+
+    /// The part of the step to come; `None` outside compensation.
+    pub fn next_step(&mut self) -> Option<OwnCentred> {
+        let index = self.next;
+        self.next += 1;
+        while self.spans.front().is_some_and(|span| span.steps.end <= index) {
+            self.spans.pop_front();
+        }
+        let mut own: SmallVec<[ToolElement; 2]> = SmallVec::new();
+        while let Some(piece) = self.pieces.front().filter(|piece| piece.block == index) {
+            own.push(*piece);
+            self.pieces.pop_front();
+        }
+        let span = self.spans.front().filter(|span| span.steps.contains(&index))?;
+        let before = self.path_end.filter(|&(block, _)| block >= span.steps.start).map(|(_, end)| end);
+        if let Some(last) = own.last() {
+            self.path_end = Some((index, last.path.end()));
+        }
+        Some(OwnCentred { plane: span.plane, pieces: own, before })
+    }
 }
 
 /// A move of the tool centre, to `end` over the machine's axes in the

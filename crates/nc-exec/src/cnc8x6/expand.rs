@@ -14,12 +14,8 @@
 //! tables, with the zero offsets, length corrections, recalculations
 //! G35–G37 and transformations G38/G39/G31 the run had applied.
 
-use std::{
-    collections::VecDeque,
-    io::{self, Write},
-};
+use std::io::{self, Write};
 
-use nalgebra::Point2;
 use smallvec::SmallVec;
 
 use crate::{
@@ -27,7 +23,7 @@ use crate::{
     compensation::ToolElement,
     expand::{Expand, ExpandError, Unwritable, centre_offsets},
     machine::MachineConfig,
-    tool_path::{Centred, tool_moves},
+    tool_path::{Centred, CentredSteps, OwnCentred, tool_moves},
     trace::{Compensated, Motion, Path, Position, Step, StepSink, Stop, round3, slot},
     transform::{Frame, by_letter, over_axes},
 };
@@ -51,14 +47,8 @@ pub struct Expansion<W: Write> {
     written: Frame,
     /// The run's frames so far.
     frames: Vec<Frame>,
-    /// The spans of radius compensation the steps to come may be in, and
-    /// the pieces of the tool-centre path of those steps.
-    spans: VecDeque<Compensated>,
-    pieces: VecDeque<ToolElement>,
-    /// The step of the last piece written, and where it ends.
-    path_end: Option<(usize, Point2<f64>)>,
-    /// The index of the step to come.
-    next: usize,
+    /// Radius compensation of the steps to come.
+    centres: CentredSteps,
     /// What stopped the expansion: nothing is written after it.
     failure: Option<ExpandError>,
 }
@@ -73,10 +63,7 @@ impl<W: Write> Expansion<W> {
             axes: machine.step_axes().to_vec(),
             written: reset_frame(machine),
             frames: Vec::new(),
-            spans: VecDeque::new(),
-            pieces: VecDeque::new(),
-            path_end: None,
-            next: 0,
+            centres: CentredSteps::default(),
             failure: None,
         };
         let title: String = title.chars().filter(|&c| c != '"' && !c.is_control()).collect();
@@ -143,27 +130,11 @@ impl<W: Write> Expansion<W> {
 
 impl<W: Write> StepSink for Expansion<W> {
     fn step(&mut self, step: Step) {
-        let index = self.next;
-        self.next += 1;
-        while self.spans.front().is_some_and(|span| span.steps.end <= index) {
-            self.spans.pop_front();
-        }
-        let mut own: SmallVec<[ToolElement; 2]> = SmallVec::new();
-        while let Some(piece) = self.pieces.front().filter(|piece| piece.block == index) {
-            own.push(*piece);
-            self.pieces.pop_front();
-        }
+        let own = self.centres.next_step();
         if self.failure.is_some() {
             return;
         }
-        let centred = self.spans.front().filter(|span| span.steps.contains(&index)).map(|span| Centred {
-            plane: span.plane,
-            pieces: &own,
-            before: self.path_end.filter(|&(block, _)| block >= span.steps.start).map(|(_, end)| end),
-        });
-        if let Some(last) = own.last() {
-            self.path_end = Some((index, last.path.end()));
-        }
+        let centred = own.as_ref().map(OwnCentred::centred);
         if let Err(failure) = self.write(&step, centred.as_ref()) {
             self.failure = Some(failure);
         }
@@ -171,11 +142,7 @@ impl<W: Write> StepSink for Expansion<W> {
 
     fn references(&mut self, frames: &[Frame], compensated: &[Compensated], pieces: &[ToolElement]) {
         self.frames.extend_from_slice(frames.get(self.frames.len()..).unwrap_or_default());
-        // The last span may have grown since.
-        let first = compensated.partition_point(|span| span.steps.end <= self.next);
-        self.spans.clear();
-        self.spans.extend(compensated[first..].iter().cloned());
-        self.pieces.extend(pieces);
+        self.centres.references(compensated, pieces);
     }
 
     /// Nothing more is written after a failure, so the run need not go on.

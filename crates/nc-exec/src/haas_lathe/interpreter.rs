@@ -123,12 +123,13 @@ use super::{
 };
 use crate::{
     arc::{CircleArc, OffCircle, centre_by_radius, circle_through},
-    compensation::{Side, ToolElement},
+    compensation::Side,
+    compensation_driver::Driver,
     known::Known,
     machine::MachineConfig,
     trace::{
-        Axes, Called, Checkpoint, Compensated, DELIVERY_BATCH, Environment, Finding, Motion, Path, PathMode, Position,
-        Resumable, RunRule, Step, StepSink, Stop, Tool, Trace, Undelivered, goes_on, round3, slot,
+        Axes, Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, Path, PathMode, Position, Resumable,
+        RunRule, Step, StepSink, Stop, Tool, Trace, Undelivered, goes_on, round3, slot,
     },
     transform::{Frame, by_letter, over_axes},
 };
@@ -162,15 +163,14 @@ pub(crate) fn run_in(
     if let Some(sink) = sink {
         interpreter.deliver(sink, true);
     }
-    // Pieces come in the order compensation fixes them, a move late.
-    interpreter.tool_centre.sort_by_key(|piece| piece.block);
+    let (tool_centre, compensated) = interpreter.compensation.into_parts();
     Trace {
         axes: machine.step_axes().to_vec(),
         diameter_axis: Some(b'X'),
         reset_frame: reset_frame(machine),
         frames: interpreter.frames,
-        tool_centre: interpreter.tool_centre,
-        compensated: interpreter.compensated,
+        tool_centre,
+        compensated,
         messages: Vec::new(),
         steps: interpreter.steps.steps,
         findings: interpreter.findings,
@@ -402,9 +402,7 @@ struct Interpreter<'a> {
     offset: u8,
     /// Tool-nose radius compensation in force, the tool path it made, and
     /// the steps it ran over.
-    nose: Option<nose::Nose>,
-    tool_centre: Vec<ToolElement>,
-    compensated: Vec<Compensated>,
+    compensation: Driver,
     /// F as written: mm/rev or mm/min by the feed mode.
     feed: Option<f64>,
     /// S as written: rpm under G97, m/min under G96.
@@ -450,9 +448,7 @@ impl<'a> Interpreter<'a> {
             frame: 0,
             coordinates: coordinates::Coordinates::default(),
             offset: 0,
-            nose: None,
-            tool_centre: Vec::new(),
-            compensated: Vec::new(),
+            compensation: Driver::default(),
             feed: None,
             speed: 0.0,
             speed_limit: None,
@@ -499,7 +495,7 @@ impl<'a> Interpreter<'a> {
                 && fresh
                 && self.calls.is_empty()
                 && self.called.is_empty()
-                && self.nose.is_none()
+                && !self.compensation.is_active()
                 && !covers(&read_back, place.block)
                 && sink.checkpoint_wanted(place.block, unit.ranges[place.block].start())
             {
@@ -549,8 +545,9 @@ impl<'a> Interpreter<'a> {
     /// else those before the first one tool-nose radius compensation may
     /// still change.
     fn deliver(&mut self, sink: &mut dyn StepSink, end: bool) {
-        let open = self.nose.as_ref().filter(|_| !end).map(nose::Nose::open_step);
-        self.steps.deliver(sink, open, &self.frames, &self.compensated, &mut self.tool_centre);
+        let open = self.compensation.open_step().filter(|_| !end);
+        let Driver { tool_centre, compensated, .. } = &mut self.compensation;
+        self.steps.deliver(sink, open, &self.frames, compensated, tool_centre);
     }
 
     /// Goes past the blocks of the main file from the furthest one run to
@@ -585,11 +582,9 @@ impl<'a> Interpreter<'a> {
             frame,
             coordinates,
             offset,
-            // None in force at a checkpoint.
-            nose: _,
-            // Reported by the run up to the checkpoint.
-            tool_centre: _,
-            compensated: _,
+            // None in force at a checkpoint; its path is reported by the
+            // run up to the checkpoint.
+            compensation: _,
             findings: _,
             tools: _,
             feed,

@@ -22,14 +22,20 @@
 //!   expansion writes a block once the next one has come).
 //! - Tools, the spindle and other M functions are not written: the
 //!   expansion is the path and its time.
+//! - Under tool radius compensation G41/G42 the moves are those of the
+//!   tool centre ([`crate::tool_path`]), a step's pieces one block each,
+//!   and G41/G42/G40 are not written.
 
 use std::io::{self, Write};
 
 use super::interpreter::reset_frame;
 use crate::{
+    compensation::ToolElement,
     expand::{Expand, ExpandError, centre_offsets},
     machine::MachineConfig,
-    trace::{Motion, Path, PathMode, Step, StepSink, Stop, round3},
+    tool_path::{CentredSteps, OwnCentred, tool_moves},
+    trace::{Axes, Compensated, MAX_AXES, Motion, Path, PathMode, Step, StepSink, Stop, round3},
+    transform::Frame,
 };
 
 /// Writes the moves of a Sinumerik run to `out` while the run goes: a
@@ -51,6 +57,8 @@ pub struct Expansion<W: Write> {
     /// The words of the block written last: how the path passes from it
     /// into the next one is that step's to say.
     pending: Option<Vec<String>>,
+    /// Radius compensation of the steps to come.
+    centres: CentredSteps,
     failure: Option<ExpandError>,
 }
 
@@ -69,6 +77,7 @@ impl<W: Write> Expansion<W> {
             jerk_limited: false,
             corner: None,
             pending: None,
+            centres: CentredSteps::default(),
             failure: None,
         };
         let title: String = title.chars().filter(|c| !c.is_control()).collect();
@@ -80,6 +89,24 @@ impl<W: Write> Expansion<W> {
     /// The position `step` ends at, in thousandths, by the machine's axes.
     fn thousandths(&self, step: &Step) -> Vec<i64> {
         self.axes.iter().zip(&step.end).map(|(_, &value)| (round3(value) * 1000.0).round() as i64).collect()
+    }
+
+    /// Writes the blocks of `step`: under radius compensation (`own`) one
+    /// for each move of the tool centre, the last with the step's stop.
+    fn write_centred(&mut self, step: &Step, own: Option<&OwnCentred>) -> io::Result<()> {
+        let Some(own) = own else { return self.write(step) };
+        let mut start: Axes = [0.0; MAX_AXES];
+        for (value, &at) in start.iter_mut().zip(self.at.iter().flatten()) {
+            *value = at as f64 / 1000.0;
+        }
+        let moves = tool_moves(step, &start, Some(&own.centred()), &self.axes);
+        let last = moves.len() - 1;
+        for (k, tool_move) in moves.into_iter().enumerate() {
+            let stop = if k == last { step.stop } else { None };
+            let made = Step { end: tool_move.end, path: tool_move.path, feed: tool_move.feed, stop, ..step.clone() };
+            self.write(&made)?;
+        }
+        Ok(())
     }
 
     /// Writes the block of `step`: none for a step without motion, time or
@@ -217,11 +244,16 @@ fn decimal(thousandths: i64) -> String {
 
 impl<W: Write> StepSink for Expansion<W> {
     fn step(&mut self, step: Step) {
+        let own = self.centres.next_step();
         if self.failure.is_none()
-            && let Err(error) = self.write(&step)
+            && let Err(error) = self.write_centred(&step, own.as_ref())
         {
             self.failure = Some(ExpandError::Io(error));
         }
+    }
+
+    fn references(&mut self, _frames: &[Frame], compensated: &[Compensated], pieces: &[ToolElement]) {
+        self.centres.references(compensated, pieces);
     }
 
     fn closed(&self) -> bool {

@@ -61,11 +61,13 @@
 //!   counts for every block until the next F.
 //! - WRITE, READ, DELETE and ISFILE on the run's own files (module
 //!   `files`).
+//! - Tool radius compensation G41/G42/G40 (module `radius`) with the
+//!   radius of the edge D of tool T: the tool-centre path in the trace.
 //!
 //! Reported once each as not run, moving nothing: the control's other
 //! cycles (CYCLE832, …), axes the machine does
-//! not have and orientation words, transformations (TRAORI), radius
-//! compensation G41/G42, inverse-time feed G93 on a spline, synchronous
+//! not have and orientation words, transformations (TRAORI),
+//! inverse-time feed G93 on a spline, synchronous
 //! actions and what [`super::eval`] does not model. System variables the run has no
 //! value for read 0 with a finding once per name.
 //!
@@ -88,7 +90,10 @@
 //! tools by its name. The run takes no checkpoints: a Sinumerik run always starts at
 //! the top.
 
-use std::{collections::HashSet, rc::Rc};
+use std::{
+    collections::{HashMap, HashSet},
+    rc::Rc,
+};
 
 use ncc_catalog::{AddressRole, Code, Dialect, KeywordKind};
 use ncc_syntax::{Parse, TextRange, TextSize};
@@ -105,6 +110,7 @@ use super::{
 };
 use crate::{
     arc::{OffCircle, centre_by_radius, circle_through},
+    compensation_driver::Driver,
     machine::MachineConfig,
     trace::{
         ABANDON_INTERVAL, Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, Path, Position, RunRule,
@@ -117,10 +123,11 @@ mod bspline;
 mod calls;
 mod files;
 mod frames_and_cycles;
+mod radius;
 
 use super::modes::{
     INCH, Modes,
-    groups::{ACCELERATION, DIMENSIONS, FEED_MODE, MOTION, PATH_MODE, PLANE, SPINDLE, UNITS},
+    groups::{ACCELERATION, DIMENSIONS, FEED_MODE, MOTION, PATH_MODE, PLANE, SPINDLE, TOOL_RADIUS, UNITS},
 };
 
 /// Inverse-time feed: F is 1/minutes of each block.
@@ -149,17 +156,19 @@ pub(crate) fn run_in(
 ) -> Trace {
     let mut interpreter = Interpreter::new(machine, files, text);
     interpreter.run(budget, sink.as_deref_mut());
+    interpreter.end_compensation();
     if let Some(sink) = sink {
         interpreter.deliver(sink, true);
     }
-    let Interpreter { steps, state, called, executed, .. } = interpreter;
+    let Interpreter { steps, state, called, executed, compensation, .. } = interpreter;
+    let (tool_centre, compensated) = compensation.into_parts();
     Trace {
         axes: machine.step_axes().to_vec(),
         diameter_axis: machine.diameter_axis,
         frames: vec![reset_frame(machine)],
         reset_frame: reset_frame(machine),
-        tool_centre: Vec::new(),
-        compensated: Vec::new(),
+        tool_centre,
+        compensated,
         messages: Vec::new(),
         steps: steps.steps,
         findings: state.findings,
@@ -228,6 +237,8 @@ struct Words {
     feed: Option<f64>,
     speed: Option<f64>,
     tool: Option<Value>,
+    /// D: the tool's cutting edge.
+    edge: Option<f64>,
     m: Vec<u32>,
     /// The codes written, in order (G numbers and words like `SOFT`).
     codes: Vec<&'static Code>,
@@ -250,6 +261,9 @@ impl Words {
             feed,
             speed,
             tool,
+            // D only picks the edge whose radius compensation takes: the
+            // machine sees nothing of it until a move.
+            edge: _,
             m,
             codes,
             path,
@@ -295,6 +309,11 @@ struct State<'a> {
     speed: f64,
     /// The tool T selected last: a number, or 0 for a named one.
     tool: u32,
+    /// The cutting edge D selected last (0: none).
+    edge: u32,
+    /// Tool data the program wrote: `$TC_DP<n>[t,d]` by name, tool and
+    /// edge.
+    tool_data: HashMap<(String, i64, i64), f64>,
     tools: Vec<Tool>,
     /// The path modes G60, G64x, SOFT, BRISK with ADIS, ADISPOS and CTOL,
     /// kept in step with the groups of `modes` as each step is recorded.
@@ -302,6 +321,9 @@ struct State<'a> {
     /// The programmable frame: program coordinates to base ones (the
     /// settable frame's, which are zero).
     frame: ProgrammableFrame,
+    /// How often the frame changed: radius compensation does not go
+    /// across a change.
+    frames: usize,
     files: files::Files,
     findings: Vec<Finding>,
     /// Keys of what was reported once.
@@ -354,6 +376,13 @@ impl State<'_> {
         self.report_once(RunRule::NotRunYet, what, range, &message);
     }
 
+    /// The key of tool data `name[indices]` the run keeps: `$TC_DP<n>[t,d]`.
+    fn tool_data_key(name: &str, indices: &[Value], range: TextRange) -> Option<(String, i64, i64)> {
+        let [tool, edge] = indices else { return None };
+        let key = (name.to_owned(), tool.int(range).ok()?, edge.int(range).ok()?);
+        name.starts_with("$TC_DP").then_some(key)
+    }
+
     /// The value of axis `name` in program coordinates.
     fn axis_value(&self, name: &str) -> Option<f64> {
         let &[letter] = name.as_bytes() else { return None };
@@ -384,6 +413,11 @@ impl Context for State<'_> {
             "$P_TOOLNO" | "$P_TOOLP" => Value::Int(i64::from(self.tool)),
             "$P_ISTEST" => Value::Bool(false),
             "$AC_TIME" => Value::Real(0.0),
+            _ if let Some(value) =
+                Self::tool_data_key(name, indices, range).and_then(|key| self.tool_data.get(&key)) =>
+            {
+                Value::Real(*value)
+            }
             "$MN_MM_NUM_R_PARAM" | "$MC_MM_NUM_R_PARAM" => {
                 Value::Int(i64::from(Dialect::Sinumerik.catalogue().parameters.count))
             }
@@ -401,8 +435,13 @@ impl Context for State<'_> {
         Ok(value)
     }
 
-    fn write_system(&mut self, name: &str, _: &[Value], _: Value, range: TextRange) -> Result<(), EvalError> {
-        self.not_run(&format!("writes of the system variable {name}"), range);
+    fn write_system(&mut self, name: &str, indices: &[Value], value: Value, range: TextRange) -> Result<(), EvalError> {
+        match Self::tool_data_key(name, indices, range) {
+            Some(key) => {
+                self.tool_data.insert(key, value.number(range)?);
+            }
+            None => self.not_run(&format!("writes of the system variable {name}"), range),
+        }
         Ok(())
     }
 
@@ -446,6 +485,8 @@ struct Interpreter<'a> {
     /// MCALL's program and arguments.
     modal_call: Option<Call>,
     spline: Option<bspline::Pending>,
+    /// Radius compensation, and the tool-centre path it made.
+    compensation: Driver,
     steps: Undelivered,
     executed: usize,
 }
@@ -459,9 +500,12 @@ impl<'a> Interpreter<'a> {
             feed: None,
             speed: 0.0,
             tool: 0,
+            edge: 1,
+            tool_data: HashMap::new(),
             tools: Vec::new(),
             path: PathControl::default(),
             frame: ProgrammableFrame::default(),
+            frames: 0,
             files: files::Files::default(),
             findings: Vec::new(),
             reported: HashSet::new(),
@@ -478,6 +522,7 @@ impl<'a> Interpreter<'a> {
             calls: Vec::new(),
             modal_call: None,
             spline: None,
+            compensation: Driver::default(),
             steps: Undelivered::default(),
             executed: 0,
         }
@@ -569,10 +614,13 @@ impl<'a> Interpreter<'a> {
     }
 
     /// Hands `sink` the steps no later block can change: all at the
-    /// `end`, else those before an open spline's.
+    /// `end`, else those before an open spline's or the first one radius
+    /// compensation may still change.
     fn deliver(&mut self, sink: &mut dyn StepSink, end: bool) {
-        let open = self.spline.as_ref().filter(|_| !end).map(bspline::Pending::first_step);
-        self.steps.deliver(sink, open, &[reset_frame(self.state.machine)], &[], &mut []);
+        let spline = self.spline.as_ref().map(bspline::Pending::first_step);
+        let open = [spline, self.compensation.open_step()].into_iter().flatten().min().filter(|_| !end);
+        let Driver { tool_centre, compensated, .. } = &mut self.compensation;
+        self.steps.deliver(sink, open, &[reset_frame(self.state.machine)], compensated, tool_centre);
     }
 
     /// Runs the block at `at` of `unit`: its statements in order, then its
@@ -670,6 +718,7 @@ impl<'a> Interpreter<'a> {
                 break;
             }
         }
+        let start = self.state.to_base(&self.state.position);
         let (moved, stop, end, facts) = self.codes_and_motion(&words, whole);
         if self.state.stopped {
             return Flow::Stop;
@@ -678,6 +727,13 @@ impl<'a> Interpreter<'a> {
         // the machine sees nothing of it.
         if !words.is_empty() || moved.motion != Motion::None || stop.is_some() {
             self.record(at, whole, moved.clone(), facts, stop);
+            // A spline's steps stand in for its curve until it is built.
+            if self.spline.is_none() {
+                self.compensate(&start, whole);
+                if self.state.stopped {
+                    return Flow::Stop;
+                }
+            }
         }
         if end {
             self.end_spline();
@@ -810,7 +866,8 @@ impl<'a> Interpreter<'a> {
             (AddressRole::Spline, "PW") => words.weight = Some(value),
             (AddressRole::Spline, "PL") => words.interval = Some(value),
             (AddressRole::Auxiliary, _) => words.auxiliary = words.auxiliary.saturating_add(1),
-            // Tool offsets select lengths the run does not model; the
+            (AddressRole::Offset, "D") => words.edge = Some(value),
+            // Other offsets select lengths the run does not model; the
             // count belongs to a call, tolerances of orientation to what
             // is reported below.
             (AddressRole::Offset | AddressRole::Count | AddressRole::Tolerance, _) => {}
@@ -849,7 +906,6 @@ impl<'a> Interpreter<'a> {
             match code.code.as_str() {
                 "G4" => dwell = true,
                 "G9" => facts.exact = true,
-                "G41" | "G42" => self.state.not_run("tool radius compensation G41/G42", range),
                 "G74" | "G75" => self.state.not_run("reference point approach G74/G75", range),
                 _ => {}
             }
@@ -884,6 +940,11 @@ impl<'a> Interpreter<'a> {
         }
         if let Some(tool) = &words.tool {
             self.select_tool(tool);
+            // The control's default edge of a new tool.
+            self.state.edge = 1;
+        }
+        if let Some(edge) = words.edge {
+            self.state.edge = if edge >= 0.0 && edge.fract() == 0.0 { edge as u32 } else { 0 };
         }
         if dwell {
             return (self.dwell(words, range), stop, end, facts);
@@ -976,6 +1037,7 @@ impl<'a> Interpreter<'a> {
         }
         let motion = self.state.modes.get(MOTION).unwrap_or("G1");
         if motion == "BSPLINE" {
+            self.end_compensation();
             self.state.position = end;
             // A frame is affine: the curve of the mapped control points is
             // the mapped curve.

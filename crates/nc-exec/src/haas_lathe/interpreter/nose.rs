@@ -3,8 +3,9 @@
 //! programmed contour, on its left under G41 and its right under G42
 //! (looking along the motion, +Z to the right and +X up), built by the
 //! project's compensation ([`crate::compensation`]) in the plane (Z, X
-//! radius). The radius and the tip code come from the tool offset that T
-//! selects (`Txxyy`: offset `yy`, 001:825-826).
+//! radius) and run by its shared driver ([`crate::compensation_driver`]).
+//! The radius and the tip code come from the tool offset that T selects
+//! (`Txxyy`: offset `yy`, 001:825-826).
 //!
 //! The start and the cancel follow the manual's rules: the first move after
 //! G41/G42 starts the compensation and must be a line (G00/G01); after it
@@ -50,8 +51,9 @@ use nalgebra::{Point2, Vector2};
 
 use super::{Interpreter, Point};
 use crate::{
-    compensation::{CompensationError, Compensator, Element, Settings, Side, ToolElement},
-    trace::{Compensated, Motion, Path, RunRule},
+    compensation::{CompensationError, Settings, Side},
+    compensation_driver::{PlaneMove, Refusal, Start},
+    trace::RunRule,
 };
 
 /// The catalogue's group of G40/G41/G42.
@@ -67,22 +69,6 @@ const SETTINGS: Settings = Settings {
     contact_feed: false,
 };
 
-/// Compensation in force.
-pub(super) struct Nose {
-    compensator: Compensator,
-    /// From the nose-radius centre to the imaginary tip.
-    tip: Vector2<f64>,
-    /// The frame its steps run in.
-    frame: usize,
-}
-
-impl Nose {
-    /// The first step whose tool path may still change.
-    pub(super) fn open_step(&self) -> usize {
-        self.compensator.open_block()
-    }
-}
-
 impl Interpreter<'_> {
     /// The side G41 or G42 puts the tool on; `None` under G40.
     pub(super) fn nose_side(&self) -> Option<Side> {
@@ -95,76 +81,32 @@ impl Interpreter<'_> {
 
     /// Follows step `index`, which moved from `from` to `to` (Z, X radius),
     /// with compensation on `side` (`None`: G40 or a move that runs
-    /// without): starts, continues or cancels it, and puts the tool path's
-    /// length and time on the steps it belongs to, one move late as the
-    /// control's look-ahead fixes them.
+    /// without), through the shared driver, one move late as the control's
+    /// look-ahead fixes the tool path.
     pub(super) fn compensate(&mut self, index: usize, from: Point, to: Point, side: Option<Side>) {
         let step = self.steps.get(index);
         let (range, frame) = (step.range, step.frame);
-        let moves = from != to || matches!(step.path, Path::Arc { .. });
-        let line = matches!(step.motion, Motion::Rapid | Motion::Feed) && step.path == Path::Straight;
-        let element = match step.path {
-            Path::Arc { centre, clockwise, .. } => {
-                Element::Arc { from: point(from), to: point(to), centre: point(centre), clockwise }
-            }
-            _ => Element::Line { from: point(from), to: point(to) },
+        let start = side.map(|side| {
+            let entry = self.machine.tools.entry(self.offset);
+            let radius = f64::from(entry.radius) / 1000.0;
+            // The driver moves the nose centre's path by this to the tip.
+            let shift = tip_vector(entry.tip, radius);
+            Start { side, radius, settings: SETTINGS, shift }
+        });
+        let moved = PlaneMove { step: index, from: point(from), to: point(to), plane: (b'Z', b'X'), frame };
+        let message = match self.compensation.follow(&mut self.steps, &self.machine, moved, start) {
+            Ok(()) => return,
+            Err(Refusal::StartNotLine) => "tool-nose radius compensation starts on an arc or a thread: the first move after G41 or G42 must be a line, G00 or G01 (lathe manual §7.1 (001:960-961))".to_owned(),
+            Err(Refusal::CancelNotLine) => "tool-nose radius compensation ends on an arc or a thread: the first move after G40 must be a line, G00 or G01 (lathe manual §7.1 (001:965, 1043-1044))".to_owned(),
+            Err(Refusal::Failed(error)) => return self.compensation_failed(&error),
         };
-        if self.nose.as_ref().is_some_and(|nose| nose.frame != frame) {
-            self.end_compensation();
-        }
-        let (pieces, tip) = match (self.nose.take(), side) {
-            (None, Some(side)) if moves => {
-                let entry = self.machine.tools.entry(self.offset);
-                let radius = f64::from(entry.radius) / 1000.0;
-                if radius <= 0.0 {
-                    return;
-                }
-                if !line {
-                    let message = "tool-nose radius compensation starts on an arc or a thread: the first move after G41 or G42 must be a line, G00 or G01 (lathe manual §7.1 (001:960-961))";
-                    self.finding(RunRule::CompensationFailed, range, message);
-                    return;
-                }
-                let tip = tip_vector(entry.tip, radius);
-                let compensator = Compensator::start(SETTINGS, side, radius, index, point(from) - tip, point(to) - tip);
-                self.nose = Some(Nose { compensator, tip, frame });
-                self.compensated.push(Compensated { steps: index..index + 1, plane: (b'Z', b'X') });
-                return;
-            }
-            (Some(nose), None) if moves => {
-                if !line {
-                    let message = "tool-nose radius compensation ends on an arc or a thread: the first move after G40 must be a line, G00 or G01 (lathe manual §7.1 (001:965, 1043-1044))";
-                    self.finding(RunRule::CompensationFailed, range, message);
-                    return;
-                }
-                (nose.compensator.cancel(index, point(to) - nose.tip), nose.tip)
-            }
-            (Some(mut nose), _) => {
-                let pushed = if moves { nose.compensator.push(index, element) } else { Ok(Vec::new()) };
-                let tip = nose.tip;
-                self.nose = Some(nose);
-                match pushed {
-                    Ok(pieces) => (pieces, tip),
-                    Err(error) => {
-                        self.compensation_failed(&error);
-                        return;
-                    }
-                }
-            }
-            (None, _) => return,
-        };
-        if let Some(compensated) = self.compensated.last_mut() {
-            compensated.steps.end = index + 1;
-        }
-        self.charge(pieces, tip);
+        self.finding(RunRule::CompensationFailed, range, &message);
     }
 
-    /// Ends compensation still in force where the run ends or its frame
-    /// changes: the nose centre stays on the normal at the last programmed
-    /// point.
+    /// Ends compensation still in force where the run ends: the nose
+    /// centre stays on the normal at the last programmed point.
     pub(super) fn end_compensation(&mut self) {
-        if let Some(nose) = self.nose.take() {
-            self.charge(vec![nose.compensator.finish()], nose.tip);
-        }
+        self.compensation.end(&mut self.steps, &self.machine);
     }
 
     fn compensation_failed(&mut self, error: &CompensationError) {
@@ -178,33 +120,6 @@ impl Interpreter<'_> {
             ),
         };
         self.finding(RunRule::CompensationFailed, range, &message);
-    }
-
-    /// Puts the length and time of the nose centre's `pieces`, shifted to
-    /// the tip by `tip`, on the steps they belong to, in place of the
-    /// programmed ones.
-    fn charge(&mut self, pieces: Vec<ToolElement>, tip: Vector2<f64>) {
-        for piece in pieces {
-            let piece = ToolElement { path: shifted(piece.path, tip), ..piece };
-            let length = piece.path.length();
-            let (start, end) = (piece.path.start(), piece.path.end());
-            let step = self.steps.get(piece.block);
-            let duration = match (step.motion, step.feed) {
-                (Motion::Feed, Some(feed)) => length / feed * 60.0,
-                (Motion::Feed, None) => 0.0,
-                _ => self.rapid_seconds([start.x, start.y], [end.x, end.y]),
-            };
-            // A block's pieces come together (its corner, then its
-            // contour): the first replaces the programmed length and time.
-            let first = self.tool_centre.last().is_none_or(|last| last.block != piece.block);
-            let step = self.steps.get_mut(piece.block);
-            if first {
-                (step.length, step.duration) = (0.0, 0.0);
-            }
-            step.length += length;
-            step.duration += duration;
-            self.tool_centre.push(piece);
-        }
     }
 }
 
@@ -227,13 +142,4 @@ fn tip_vector(tip: Option<u8>, radius: f64) -> Vector2<f64> {
         _ => (0.0, 0.0),
     };
     Vector2::new(z, x) * radius
-}
-
-fn shifted(element: Element, by: Vector2<f64>) -> Element {
-    match element {
-        Element::Line { from, to } => Element::Line { from: from + by, to: to + by },
-        Element::Arc { from, to, centre, clockwise } => {
-            Element::Arc { from: from + by, to: to + by, centre: centre + by, clockwise }
-        }
-    }
 }

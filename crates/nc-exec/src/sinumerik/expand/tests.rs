@@ -45,3 +45,16 @@ fn the_expansion_runs_the_same_moves() {
     assert_eq!(joins(&original), joins(&again), "{expanded}");
     assert_eq!(original.end_position(), again.end_position());
 }
+
+#[test]
+fn under_radius_compensation_the_tool_centre_is_written() {
+    // G41 radius 2 outside a right turn: the corner's arc is a block of
+    // its own, before the next side; the cancel goes back to (30, -10).
+    let text = "$TC_DP6[1,1]=2\nT1 D1\nG0 X0 Y-10\nG41 G1 X0 Y0 F500\nX20\nY-10\nG40 X30\nM30\n";
+    let expected = "; EXPANDED FROM T.MPF\nG17 G71 G90 G94 G60 BRISK\nG0 X0 Y-10 Z0\nG1 Y2 F500\nG1 X20\nG2 X22 Y0 I0 J-2\nG1 Y-10\nG1 X30\nM30\n";
+    assert_eq!(expand(text), expected);
+    // G42 is inside both corners: the sides meet at their intersection.
+    let expected =
+        "; EXPANDED FROM T.MPF\nG17 G71 G90 G94 G60 BRISK\nG0 X0 Y-10 Z0\nG1 Y-2 F500\nG1 X18\nG1 Y-10\nG1 X30\nM30\n";
+    assert_eq!(expand(&text.replace("G41", "G42")), expected);
+}

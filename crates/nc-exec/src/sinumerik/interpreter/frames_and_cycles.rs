@@ -36,7 +36,10 @@ impl Interpreter<'_> {
         let plane = self.plane();
         let base = self.state.to_base(&self.state.position);
         match self.state.frame.apply(frame_command, &values, plane) {
-            Ok(()) => self.state.position = self.state.to_program(&base),
+            Ok(()) => {
+                self.state.position = self.state.to_program(&base);
+                self.state.frames += 1;
+            }
             Err(error) => {
                 let range = command.words.get(error.word).map_or(range, |word| word.range);
                 self.state.finding(RunRule::ValueRefused, range, &error.to_string());
@@ -85,6 +88,7 @@ impl Interpreter<'_> {
                 let base = self.state.to_base(&self.state.position);
                 swivel.apply_to(&mut self.state.frame);
                 self.state.position = self.state.to_program(&base);
+                self.state.frames += 1;
             })
         };
         if let Err(error) = result {
@@ -94,6 +98,7 @@ impl Interpreter<'_> {
 
     /// A drilling cycle's moves as steps of the block at `at`.
     pub(super) fn cycle_moves(&mut self, at: At, moves: &[CycleMove], range: TextRange) {
+        self.end_compensation();
         for cycle_move in moves {
             let start = self.state.to_base(&self.state.position);
             let mut to_point = |to: &[f64; 3]| {

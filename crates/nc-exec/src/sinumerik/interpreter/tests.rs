@@ -600,3 +600,118 @@ fn inverse_time_feed_gives_each_block_one_over_f_minutes() {
     assert_eq!(feeds[0], Some(20.0), "10 mm in half a minute");
     assert!(trace.findings.is_empty(), "{:?}", trace.findings);
 }
+
+/// A run that reports nothing.
+fn run_clean(text: &str) -> Trace {
+    let trace = run(text);
+    assert_eq!(findings(&trace, text), []);
+    trace
+}
+
+/// The tool-centre ends of the moves in the plane's axes `(a, b)`, to the
+/// micrometre.
+fn centre_ends(trace: &Trace, (a, b): (u8, u8)) -> Vec<(f64, f64)> {
+    let round = |value: f64| (value * 1000.0).round() / 1000.0 + 0.0;
+    (0..trace.steps.len())
+        .filter(|&index| matches!(trace.steps[index].motion, Motion::Rapid | Motion::Feed))
+        .map(|index| {
+            let end = trace.tool_end(index, &trace.steps[index].end);
+            (round(trace.axis(&end, a)), round(trace.axis(&end, b)))
+        })
+        .collect()
+}
+
+/// A pocket 20 × 10 counter-clockwise from (0, 0) in the plane of `plane`
+/// (its axes `a`, `b`), under `side` with the tool data of `tool`.
+fn pocket(plane: &str, [a, b]: [char; 2], side: &str, tool: &str) -> String {
+    format!(
+        "{tool}\n{plane} G0 {a}-10 {b}-10\n{side} G1 {a}0 {b}0 F1000\n{a}20\n{b}10\n{a}0\n{b}0\nG40 G0 {a}-10 {b}-10\nM30\n"
+    )
+}
+
+/// Inside the pocket, radius 2: the start ends on the first side's normal,
+/// the corners are the equidistants' intersections, the last side ends on
+/// its normal, and G40 goes back to the programmed point.
+const INSIDE: [(f64, f64); 7] =
+    [(-10.0, -10.0), (0.0, 2.0), (18.0, 2.0), (18.0, 8.0), (2.0, 8.0), (2.0, 0.0), (-10.0, -10.0)];
+
+#[test]
+fn g41_runs_the_tool_centre_left_of_the_contour_in_g17() {
+    let text = pocket("G17", ['X', 'Y'], "G41", "$TC_DP6[1,1]=2\nT1 D1");
+    let trace = run_clean(&text);
+    assert_eq!(centre_ends(&trace, (b'X', b'Y')), INSIDE);
+    assert_eq!(trace.compensated.iter().map(|span| span.plane).collect::<Vec<_>>(), [(b'X', b'Y')]);
+    // The steps' ends stay the programmed points; their lengths are the
+    // tool centre's: the side along X from (0, 2) to (18, 2), the one
+    // along Y from (18, 2) to (18, 8).
+    let made = moves(&trace);
+    assert_eq!(end(&trace), [-10.0, -10.0, 0.0]);
+    assert_eq!([made[2].length, made[3].length], [18.0, 6.0]);
+}
+
+#[test]
+fn g42_goes_round_outside_corners_on_arcs_under_g450_and_to_intersections_under_g451() {
+    let text = pocket("G17", ['X', 'Y'], "G42", "$TC_DP6[1,1]=2\nT1 D1");
+    let trace = run_clean(&text);
+    // Outside, right of the motion: the corner (20, 0) is passed on an arc
+    // from (20, -2) to (22, 0), which belongs to the block after it.
+    assert_eq!(
+        centre_ends(&trace, (b'X', b'Y')),
+        [(-10.0, -10.0), (0.0, -2.0), (20.0, -2.0), (22.0, 10.0), (0.0, 12.0), (-2.0, 0.0), (-10.0, -10.0)]
+    );
+    assert!(trace.tool_centre.iter().any(|piece| matches!(piece.path, crate::compensation::Element::Arc { .. })));
+    let text = text.replace("G42", "G451 G42");
+    let trace = run(&text);
+    assert_eq!(
+        centre_ends(&trace, (b'X', b'Y')),
+        [(-10.0, -10.0), (0.0, -2.0), (22.0, -2.0), (22.0, 12.0), (-2.0, 12.0), (-2.0, 0.0), (-10.0, -10.0)]
+    );
+}
+
+#[test]
+fn g41_in_g18_offsets_in_the_z_x_plane() {
+    let text = pocket("G18", ['Z', 'X'], "G41", "$TC_DP6[1,1]=2\nT1 D1");
+    let trace = run_clean(&text);
+    assert_eq!(centre_ends(&trace, (b'Z', b'X')), INSIDE);
+    assert_eq!(trace.compensated[0].plane, (b'Z', b'X'));
+}
+
+#[test]
+fn a_mirror_of_one_axis_swaps_the_side_so_the_tool_stays_inside_the_mirrored_pocket() {
+    let text = pocket("G17", ['X', 'Y'], "G41", "$TC_DP6[1,1]=2\nT1 D1\nMIRROR X0");
+    let trace = run_clean(&text);
+    let mirrored: Vec<(f64, f64)> = INSIDE.iter().map(|&(x, y)| (-x + 0.0, y)).collect();
+    assert_eq!(centre_ends(&trace, (b'X', b'Y')), mirrored);
+}
+
+#[test]
+fn without_a_known_radius_or_under_d0_the_path_is_the_programmed_one() {
+    let programmed = [(-10.0, -10.0), (0.0, 0.0), (20.0, 0.0), (20.0, 10.0), (0.0, 10.0), (0.0, 0.0), (-10.0, -10.0)];
+    for tool in ["T1 D1", "$TC_DP6[1,1]=2\nT1 D0", "$TC_DP6[1,1]=2\nT2"] {
+        let text = pocket("G17", ['X', 'Y'], "G41", tool);
+        let trace = run(&text);
+        assert_eq!(findings(&trace, &text), [], "{tool}");
+        assert_eq!(centre_ends(&trace, (b'X', b'Y')), programmed, "{tool}");
+        assert!(trace.compensated.is_empty() && trace.tool_centre.is_empty(), "{tool}");
+    }
+}
+
+#[test]
+fn the_radius_comes_from_the_machine_s_cutting_edges_unless_the_program_writes_it() {
+    let mut machine = machine();
+    machine.cutting_edges.insert((1, 1), crate::machine::ToolEntry { radius: 2000, ..Default::default() });
+    let text = pocket("G17", ['X', 'Y'], "G41", "T1 D1");
+    let trace = run_in(&text, &NoFiles, &machine, DEFAULT_STEP_BUDGET, None, None);
+    assert_eq!(centre_ends(&trace, (b'X', b'Y')), INSIDE);
+    let text = pocket("G17", ['X', 'Y'], "G41", "$TC_DP6[1,1]=1\nT1 D1\nR1=$TC_DP6[1,1]");
+    let trace = run_in(&text, &NoFiles, &machine, DEFAULT_STEP_BUDGET, None, None);
+    assert_eq!(findings(&trace, &text), []);
+    assert_eq!(centre_ends(&trace, (b'X', b'Y'))[1], (0.0, 1.0));
+}
+
+#[test]
+fn compensation_starting_on_an_arc_stops_the_run() {
+    let text = "$TC_DP6[1,1]=2\nT1 D1\nG0 X0 Y0\nG41 G2 X10 Y0 CR=5 F100\nG40 G1 X0\nM30\n";
+    let trace = run(text);
+    assert_eq!(findings(&trace, text), [(RunRule::CompensationFailed, "G41 G2 X10 Y0 CR=5 F100\n")]);
+}
