@@ -16,6 +16,7 @@ mod dialect;
 mod findings;
 mod haas_lathe;
 mod ide;
+pub mod interactive;
 mod lowered;
 mod sinumerik;
 mod suppress;

@@ -9,7 +9,10 @@ use std::sync::Arc;
 
 use ncc_syntax::{TextRange, TextSize};
 
-use crate::db::{BlockChunk, Db, SourceFile, file_chunks};
+use crate::{
+    db::{BlockChunk, Db, SourceFile, file_chunks},
+    interactive::between_blocks,
+};
 
 #[derive(Debug, Clone)]
 pub(crate) struct Lowered<B> {
@@ -76,9 +79,9 @@ impl<B> Lowered<B> {
 
     /// Every block, in order. A walk over a large file is one long query:
     /// each block read is a point where an edit waiting to change the
-    /// inputs cancels it (an atomic load).
+    /// inputs cancels it and a request makes it give way (atomic loads).
     pub fn blocks<'a>(&'a self, db: &'a dyn Db) -> impl Iterator<Item = &'a B> + Clone {
-        self.chunks.iter().flat_map(|chunk| chunk.iter()).inspect(move |_| db.unwind_if_revision_cancelled())
+        self.chunks.iter().flat_map(|chunk| chunk.iter()).inspect(move |_| between_blocks(db))
     }
 
     /// A range of block `index` (block-relative) in the file.

@@ -36,6 +36,7 @@ use crate::{
     cnc8x6::model::{self, FileKind, Program},
     db::{self, Db, Settings, SourceFile},
     findings::Findings,
+    interactive::between_blocks,
     lower::{BlockData, Value, Word},
 };
 
@@ -314,7 +315,7 @@ impl<'db> Blocks<'db> {
     fn get(&mut self, index: usize) -> (TextSize, Arc<BlockData>) {
         // A walk over a large file is one long query: an edit waiting to
         // change the inputs waits for this check (an atomic load).
-        self.db.unwind_if_revision_cancelled();
+        between_blocks(self.db);
         let offset = self.program.block(index).offset;
         if let Some(block) = self.cache.get(&index) {
             return (offset, block.clone());

@@ -37,6 +37,7 @@ use crate::{
     cnc8x6::flow::{Course, ModalState, ParamState, Walk},
     cnc8x6::model::{self, Program},
     db::{Db, DialectCache, Settings, SourceFile},
+    interactive,
 };
 
 /// Blocks between checkpoints: walking this many costs well under a
@@ -456,7 +457,8 @@ fn walk_to(
         }
     };
     let waiting = (asker == Asker::Preparation).then_some(&cache.waiting);
-    Some(checkpoints.state_before(db, file, program, index, waiting))
+    // Under the lock a question waits for: it lets go for questions itself.
+    Some(interactive::without_giving_way(|| checkpoints.state_before(db, file, program, index, waiting)))
 }
 
 #[cfg(test)]

@@ -35,6 +35,7 @@ use crate::{
         model::{FileModel, file_model},
         walk::{Resume, State, Visit, joins, program_start, walk_from},
     },
+    interactive::between_blocks,
 };
 
 /// Blocks between checkpoints: walking this many costs a few tens of
@@ -240,7 +241,7 @@ fn walked(db: &dyn Db, model: &FileModel, program: usize) -> Vec<Checkpoint> {
     let start = Resume { at: model.model.programs[program].blocks.start, state: program_start(model, program) };
     let mut points = vec![Checkpoint { resume: start.clone(), linked: true }];
     let mut since = 0;
-    walk_from(model, program, start, usize::MAX, &mut |_| db.unwind_if_revision_cancelled(), &mut |here| {
+    walk_from(model, program, start, usize::MAX, &mut |_| between_blocks(db), &mut |here| {
         since += 1;
         if since >= STRIDE {
             since = 0;
@@ -275,7 +276,7 @@ fn link(
         let from = points[trusted - 1].resume.clone();
         let target = points[trusted].resume.at;
         let mut reached = None;
-        let cancel = &mut |_: &Visit<'_>| db.unwind_if_revision_cancelled();
+        let cancel = &mut |_: &Visit<'_>| between_blocks(db);
         walk_from(model, program, from, usize::MAX, cancel, &mut |here| {
             if here.at < target {
                 return ControlFlow::Continue(());

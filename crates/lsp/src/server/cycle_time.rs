@@ -19,7 +19,7 @@ use std::{
     time::{Duration, Instant},
 };
 
-use ncc_analysis::{Cancelled, Estimate, TextRange, TextSize};
+use ncc_analysis::{Cancelled, Estimate, TextRange, TextSize, interactive};
 use tokio::sync::mpsc;
 use tower_lsp_server::{Client, ls_types::Uri};
 
@@ -198,7 +198,11 @@ fn run(state: &Mutex<State>, jobs: &(Mutex<Jobs>, Condvar), uri: &Uri, version: 
     if previous.as_ref().is_some_and(|previous| previous.holds_for(&input)) {
         return Ran::Nothing;
     }
-    let newer = || jobs.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).pending.contains_key(uri);
+    // Asked between blocks: the run gives way to requests there too.
+    let newer = || {
+        interactive::give_way();
+        jobs.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).pending.contains_key(uri)
+    };
     let Some(estimate) = input.estimate(previous.as_deref(), STEP_BUDGET, &newer) else {
         tracing::debug!("{} v{version}: cycle time given up for a newer version", uri.as_str());
         return Ran::GivenUp(started.elapsed());

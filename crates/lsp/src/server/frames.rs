@@ -5,7 +5,13 @@
 //! protocol say (Parse error, Invalid request, MethodNotFound for unknown
 //! `$/` requests) and reading goes on.
 
-use std::io;
+use std::{
+    collections::HashMap,
+    io,
+    sync::{Arc, Mutex, MutexGuard},
+};
+
+use ncc_analysis::interactive;
 
 use serde_json::{Value, json};
 use tokio::{
@@ -73,7 +79,9 @@ fn error_response(id: Value, code: i64, message: &str) -> Vec<u8> {
 }
 
 /// What to do with a message body: pass it on, or answer it here.
-fn check(body: &[u8]) -> Result<(), Vec<u8>> {
+/// A well-formed message's request id (`None`: a notification or a
+/// response), or the answer to a malformed one.
+fn check(body: &[u8]) -> Result<Option<Value>, Vec<u8>> {
     let value: Value =
         serde_json::from_slice(body).map_err(|error| error_response(Value::Null, -32700, &error.to_string()))?;
     let Some(message) = value.as_object() else {
@@ -86,8 +94,8 @@ fn check(body: &[u8]) -> Result<(), Vec<u8>> {
         (Some(method), Some(id)) if method.starts_with("$/") => {
             Err(error_response(id, -32601, &format!("unknown method {method}")))
         }
-        (Some(_), _) => Ok(()),
-        (None, Some(_)) if message.contains_key("result") || message.contains_key("error") => Ok(()),
+        (Some(_), id) => Ok(id),
+        (None, Some(_)) if message.contains_key("result") || message.contains_key("error") => Ok(None),
         (None, id) => Err(error_response(id.unwrap_or(Value::Null), -32600, "neither a request nor a response")),
     }
 }
@@ -98,12 +106,16 @@ pub(crate) async fn guard_input(
     input: impl AsyncRead + Unpin,
     mut server: impl AsyncWrite + Unpin,
     output: mpsc::UnboundedSender<Vec<u8>>,
+    pending: Pending,
 ) -> io::Result<()> {
     let mut reader = BufReader::new(input);
     while let Some(frame) = read_frame(&mut reader).await? {
         match frame {
             Frame::Body(body) => match check(&body) {
-                Ok(()) => {
+                Ok(id) => {
+                    if let Some(id) = id {
+                        pending.read(&id);
+                    }
                     server.write_all(&framed(&body)).await?;
                     server.flush().await?;
                 }
@@ -122,14 +134,45 @@ pub(crate) async fn guard_input(
 pub(crate) async fn forward_output(
     server: impl AsyncRead + Unpin,
     output: mpsc::UnboundedSender<Vec<u8>>,
+    pending: Pending,
 ) -> io::Result<()> {
     let mut reader = BufReader::new(server);
     while let Some(frame) = read_frame(&mut reader).await? {
         if let Frame::Body(body) = frame {
+            pending.answered(&body);
             let _ = output.send(framed(&body));
         }
     }
     Ok(())
+}
+
+/// The client's requests the server has not answered yet: background work
+/// gives way to them from the moment they are read until their answers
+/// leave, so that the hand-overs between the threads that read, answer
+/// and write find a core.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Pending(Arc<Mutex<HashMap<String, interactive::Request>>>);
+
+impl Pending {
+    fn read(&self, id: &Value) {
+        self.lock().insert(id.to_string(), interactive::Request::begin());
+    }
+
+    /// Ends the request `body` answers, if it is a response.
+    fn answered(&self, body: &[u8]) {
+        /// A message's id and whether it has a method, the rest skipped.
+        #[derive(serde::Deserialize)]
+        struct Envelope {
+            id: Option<Value>,
+            method: Option<serde::de::IgnoredAny>,
+        }
+        let Ok(Envelope { id: Some(id), method: None }) = serde_json::from_slice(body) else { return };
+        self.lock().remove(&id.to_string());
+    }
+
+    fn lock(&self) -> MutexGuard<'_, HashMap<String, interactive::Request>> {
+        self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
 }
 
 /// Writes whole frames to `out` until every sender is gone.
@@ -181,5 +224,25 @@ mod tests {
         assert_eq!(code(r#"{"jsonrpc":"2.0","method":"$/cancelRequest","params":{"id":1}}"#), None);
         assert_eq!(code(r#"{"jsonrpc":"2.0","id":1,"method":"initialize","params":{}}"#), None);
         assert_eq!(code(r#"{"jsonrpc":"2.0","id":1,"result":null}"#), None);
+    }
+
+    /// A request is pending from when it is read until its answer passes;
+    /// notifications and the server's own requests are not.
+    #[test]
+    fn requests_are_pending_until_answered() {
+        let pending = Pending::default();
+        let hover = br#"{"jsonrpc":"2.0","id":7,"method":"textDocument/hover","params":{}}"#;
+        let changed = br#"{"jsonrpc":"2.0","method":"textDocument/didChange","params":{}}"#;
+        for body in [&hover[..], &changed[..]] {
+            if let Some(id) = check(body).expect("well-formed") {
+                pending.read(&id);
+            }
+        }
+        assert_eq!(pending.lock().keys().collect::<Vec<_>>(), ["7"]);
+        pending.answered(br#"{"jsonrpc":"2.0","id":1,"method":"workspace/inlayHint/refresh"}"#);
+        pending.answered(br#"{"jsonrpc":"2.0","id":8,"result":null}"#);
+        assert_eq!(pending.lock().len(), 1);
+        pending.answered(br#"{"jsonrpc":"2.0","result":{"contents":"G01"},"id":7}"#);
+        assert!(pending.lock().is_empty());
     }
 }

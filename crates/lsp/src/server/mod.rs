@@ -33,7 +33,9 @@ use std::{
     },
 };
 
-use ncc_analysis::{Analysis, Cancelled, CycleTimeHints, Diagnostic, Dialect, FileId, Findings, TextRange, TextSize};
+use ncc_analysis::{
+    Analysis, Cancelled, CycleTimeHints, Diagnostic, Dialect, FileId, Findings, TextRange, TextSize, interactive,
+};
 use tokio::sync::mpsc;
 use tower_lsp_server::{
     Client, LanguageServer, LspService,
@@ -94,8 +96,10 @@ pub(crate) fn run(log_level: LogLevel, dialect: Option<Dialect>) -> ExitCode {
         let (server_input, guarded_input) = tokio::io::duplex(1 << 16);
         let (server_output, server_frames) = tokio::io::duplex(1 << 16);
         let (frames_tx, frames_rx) = mpsc::unbounded_channel();
-        let guard = tokio::spawn(frames::guard_input(tokio::io::stdin(), guarded_input, frames_tx.clone()));
-        let forward = tokio::spawn(frames::forward_output(server_frames, frames_tx));
+        let pending = frames::Pending::default();
+        let guard =
+            tokio::spawn(frames::guard_input(tokio::io::stdin(), guarded_input, frames_tx.clone(), pending.clone()));
+        let forward = tokio::spawn(frames::forward_output(server_frames, frames_tx, pending));
         let writer = tokio::spawn(frames::write_output(tokio::io::stdout(), frames_rx));
         tower_lsp_server::Server::new(server_input, server_output, socket).serve(service).await;
         // Stdin may never close (a client that sent `exit`): stop reading,
@@ -319,18 +323,20 @@ impl Server {
     }
 }
 
-/// Lowers the calling thread's priority (nice 10): the flow walk, the
-/// state preparation and the cycle-time run take up to hundreds of
-/// milliseconds on a large program, and
-/// edits and hovers must not wait for a core behind them. Not the idle
-/// scheduling class: on a busy machine (a build running) that starves the
-/// walk, and the complete diagnostics would not come until the machine is
-/// idle.
+/// Lowers the calling thread's priority (nice 10), and makes its work give
+/// way to requests between blocks: the flow walk, the state preparation
+/// and the cycle-time run take up to hundreds of milliseconds on a large
+/// program, and edits and hovers must not wait for a core behind them (a
+/// lower priority alone lets a thread that wakes wait for a running one's
+/// time slice). Not the idle scheduling class: on a busy machine (a build
+/// running) that starves the walk, and the complete diagnostics would not
+/// come until the machine is idle.
 fn background_priority() {
     // On Linux the "process" priority is the calling thread's. Failing
     // leaves the thread as it was.
     #[cfg(target_os = "linux")]
     let _ = rustix::process::setpriority_process(None, 10);
+    interactive::run_in_background();
 }
 
 /// Transparent huge pages off for the server's process. mimalloc asks for

@@ -26,6 +26,7 @@ use crate::{
         model::file_model,
         walk::{Visit, walk},
     },
+    interactive::between_blocks,
 };
 
 /// The rules of every check module.
@@ -53,7 +54,7 @@ pub(crate) fn flow_findings(db: &dyn Db, file: SourceFile) -> Findings {
     let mut out = Out::default();
     // A long walk: an edit waiting to change the inputs cancels it.
     walk(model, &mut |visit| {
-        db.unwind_if_revision_cancelled();
+        between_blocks(db);
         motion::visit(visit, config, &mut out);
         compensation::visit(visit, &mut out);
         contours::visit(visit, &mut out);
