@@ -507,7 +507,7 @@ fn check_benchmark(dialect: Dialect, blocks: usize) -> anyhow::Result<()> {
 /// The latency goals of the language server.
 const EDIT_GOAL: Duration = Duration::from_millis(16);
 const HOVER_GOAL: Duration = Duration::from_millis(2);
-const CYCLE_TIME_GOAL: Duration = Duration::from_millis(50);
+const CYCLE_TIME_GOAL: Duration = Duration::from_millis(16);
 /// Edits without a new time, and none with one, after which the cycle-time
 /// latency is given up.
 const UNFOLLOWED_EDITS: usize = 10;
