@@ -193,8 +193,15 @@ struct Unit {
 impl Unit {
     fn read(text: &str) -> Unit {
         let parse = Parse::new(text, Dialect::HaasLathe);
-        let (ranges, blocks): (Vec<TextRange>, Vec<HaasBlock>) =
-            block_nodes(parse.green()).map(|(range, block)| (range, HaasBlock::lower(block))).unzip();
+        // Sized first (the root's runs hold the blocks): a large file's
+        // blocks were copied again and again as the vectors grew.
+        let runs = parse.green().children().filter_map(rowan::NodeOrToken::into_node);
+        let most = runs.map(|run| run.children().len()).sum();
+        let (mut ranges, mut blocks) = (Vec::with_capacity(most), Vec::with_capacity(most));
+        for (range, block) in block_nodes(parse.green()) {
+            ranges.push(range);
+            blocks.push(HaasBlock::lower(block));
+        }
         let model = ProgramModel::new(blocks.as_slice());
         Unit { blocks, ranges, model }
     }
