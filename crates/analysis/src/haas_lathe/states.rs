@@ -82,15 +82,24 @@ struct Plan {
 }
 
 impl Plan {
-    fn of(file: &FileModel) -> Plan {
-        let programs = &file.model.programs;
-        Plan {
-            programs: (0..programs.len())
-                .map(|index| (programs[index].blocks.clone(), program_start(file, index)))
-                .collect(),
-            joins: programs.iter().map(|program| joins(file, program)).collect(),
-            contours: file.model.contours().map(|contour| (contour.cycle, contour.blocks.clone())).collect(),
-        }
+    /// Where the walk of `program` starts.
+    fn start(&self, program: usize) -> Option<Resume> {
+        let (blocks, state) = self.programs.get(program)?;
+        Some(Resume { at: blocks.start, state: state.clone() })
+    }
+}
+
+/// The file's plan, once per edit: questions and the preparation share it.
+#[salsa::tracked(returns(ref))]
+fn walk_plan(db: &dyn Db, file: SourceFile) -> Plan {
+    let model = file_model(db, file);
+    let programs = &model.model.programs;
+    Plan {
+        programs: (0..programs.len())
+            .map(|index| (programs[index].blocks.clone(), program_start(model, index)))
+            .collect(),
+        joins: programs.iter().map(|program| joins(model, program)).collect(),
+        contours: model.model.contours().map(|contour| (contour.cycle, contour.blocks.clone())).collect(),
     }
 }
 
@@ -120,9 +129,9 @@ impl Checkpoints {
     }
 
     /// Carries the checkpoints over to the file's current tree and plan.
-    fn update(&mut self, root: GreenNode, plan: Plan) {
-        if plan != self.plan {
-            *self = Checkpoints::new(root, plan);
+    fn update(&mut self, root: GreenNode, plan: &Plan) {
+        if *plan != self.plan {
+            *self = Checkpoints::new(root, plan.clone());
             return;
         }
         // Identity, not `!=`: rowan compares green trees deeply.
@@ -156,11 +165,11 @@ fn checkpoints<'a>(
     files: &'a mut FxHashMap<SourceFile, Checkpoints>,
     db: &dyn Db,
     file: SourceFile,
-    plan: Plan,
+    plan: &Plan,
 ) -> &'a mut Checkpoints {
     let root = file.parse(db).green().clone();
     match files.entry(file) {
-        Entry::Vacant(entry) => entry.insert(Checkpoints::new(root, plan)),
+        Entry::Vacant(entry) => entry.insert(Checkpoints::new(root, plan.clone())),
         Entry::Occupied(entry) => {
             let checkpoints = entry.into_mut();
             checkpoints.update(root, plan);
@@ -181,8 +190,8 @@ pub(crate) fn walk_between(
     visit: &mut dyn FnMut(&Visit<'_>),
 ) {
     let model = file_model(db, file);
-    let Some(blocks) = model.model.programs.get(program).map(|program| program.blocks.clone()) else { return };
-    let plan = Plan::of(model);
+    let plan = walk_plan(db, file);
+    let Some(program_start_point) = plan.start(program) else { return };
     let (version, mut points) = {
         let mut files = lock(&state_cache(db).files);
         let checkpoints = checkpoints(&mut files, db, file, plan);
@@ -193,10 +202,7 @@ pub(crate) fn walk_between(
     };
     let copied = points.len();
     let (nearest, changed) = link(db, model, program, &mut points, first);
-    let start = match nearest {
-        Some(nearest) => points[nearest].resume.clone(),
-        None => Resume { at: blocks.start, state: program_start(model, program) },
-    };
+    let start = nearest.map_or(program_start_point, |nearest| points[nearest].resume.clone());
     if changed {
         store(db, file, program, version, points, copied);
     }
@@ -207,19 +213,20 @@ pub(crate) fn walk_between(
 /// its start, leaving them), so that a question anywhere walks little.
 pub(crate) fn prepare(db: &dyn Db, file: SourceFile) {
     let model = file_model(db, file);
-    let plan = Plan::of(model);
-    for program in 0..model.model.programs.len() {
+    let plan = walk_plan(db, file);
+    for program in 0..plan.programs.len() {
         let (version, mut points) = {
             let mut files = lock(&state_cache(db).files);
-            let checkpoints = checkpoints(&mut files, db, file, plan.clone());
+            let checkpoints = checkpoints(&mut files, db, file, plan);
             (checkpoints.version, checkpoints.programs[program].clone())
         };
         let copied = points.len();
-        let changed = if points.is_empty() {
-            points = walked(db, model, program);
-            true
-        } else {
-            link(db, model, program, &mut points, usize::MAX).1
+        let changed = match plan.start(program) {
+            Some(start) if points.is_empty() => {
+                points = walked(db, model, program, start);
+                true
+            }
+            _ => link(db, model, program, &mut points, usize::MAX).1,
         };
         if changed {
             store(db, file, program, version, points, copied);
@@ -236,9 +243,9 @@ fn store(db: &dyn Db, file: SourceFile, program: usize, version: u64, points: Ve
     checkpoints.version += 1;
 }
 
-/// The checkpoints of a walk of `program` from its start to its end.
-fn walked(db: &dyn Db, model: &FileModel, program: usize) -> Vec<Checkpoint> {
-    let start = Resume { at: model.model.programs[program].blocks.start, state: program_start(model, program) };
+/// The checkpoints of a walk of `program` from `start`, its start, to its
+/// end.
+fn walked(db: &dyn Db, model: &FileModel, program: usize, start: Resume) -> Vec<Checkpoint> {
     let mut points = vec![Checkpoint { resume: start.clone(), linked: true }];
     let mut since = 0;
     walk_from(model, program, start, usize::MAX, &mut |_| between_blocks(db), &mut |here| {
