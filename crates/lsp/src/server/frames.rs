@@ -166,6 +166,11 @@ impl Pending {
             id: Option<Value>,
             method: Option<serde::de::IgnoredAny>,
         }
+        // Most frames pass with no request pending (diagnostics, which may
+        // be large): they are not read.
+        if self.lock().is_empty() {
+            return;
+        }
         let Ok(Envelope { id: Some(id), method: None }) = serde_json::from_slice(body) else { return };
         self.lock().remove(&id.to_string());
     }
