@@ -60,7 +60,6 @@ pub struct Estimate {
     checkpoints: Vec<Stored>,
     /// What `totals` shows, as a later estimate moves it.
     sums: Sums,
-    revisited: Option<TextSize>,
     /// Blocks the run executed, and the most it could.
     blocks_run: usize,
     budget: usize,
@@ -515,11 +514,10 @@ struct Charges<'a> {
     /// its, and a new execution starts when another block's step comes.
     current: Option<usize>,
     sums: Sums,
+    /// The checkpoints of the run that no block before them ran after:
+    /// a block that runs again drops those after its start, which no
+    /// longer have the final charges of the blocks before them.
     checkpoints: Vec<Stored>,
-    /// The first block in the text that ran again after other blocks (a
-    /// jump back): a checkpoint after its start no longer has the final
-    /// charges of the blocks before it.
-    revisited: Option<TextSize>,
     change: Option<Change<'a>>,
     /// The previous estimate's checkpoint where the run took its course
     /// again, once it has.
@@ -535,7 +533,6 @@ impl<'a> Charges<'a> {
             current: None,
             sums: Sums::default(),
             checkpoints: Vec::new(),
-            revisited: None,
             change,
             rejoined: None,
         }
@@ -638,11 +635,7 @@ impl<'a> Charges<'a> {
             sums = previous.sums.moved(&from.charges.sums, &to.charges.sums);
             stopped.clone_from(&previous.stopped);
             blocks_run = previous.blocks_run - from.run.blocks_run() + to.run.blocks_run();
-            // The run before the checkpoint went block after block.
-            self.revisited = previous.revisited.map(|first| shift_offset(first, change.shift));
         }
-        let revisited = self.revisited;
-        self.checkpoints.retain(|stored| revisited.is_none_or(|first| stored.run.offset() <= first));
         if !self.in_order {
             self.blocks.sort_by_key(|block| block.range.start());
         }
@@ -653,7 +646,6 @@ impl<'a> Charges<'a> {
             stopped,
             rerun: TextSize::default()..rerun_end,
             checkpoints: self.checkpoints,
-            revisited,
             blocks_run,
             budget,
             text: text.clone(),
@@ -702,9 +694,12 @@ impl TimingSink for Charges<'_> {
             } else {
                 block.executions += 1;
                 block.profile = profile;
-                if block.executions > 1 {
+                // After the rejoining checkpoint the steps are the previous
+                // estimate's, which kept it.
+                if block.executions > 1 && self.rejoined.is_none() {
                     let start = block.range.start();
-                    self.revisited = Some(self.revisited.map_or(start, |first| first.min(start)));
+                    let kept = self.checkpoints.partition_point(|stored| stored.run.offset() <= start);
+                    self.checkpoints.truncate(kept);
                 }
             }
             self.current = index;

@@ -285,6 +285,21 @@ fn checkpoints_after_the_first_block_a_jump_goes_back_to_are_not_used() {
 }
 
 #[test]
+fn checkpoints_after_a_loop_that_closed_before_them_are_used() {
+    // N1000 … N1010 run twice, and nothing after them goes back.
+    let text = long_haas_program(2500).replace("N1011 ", "#1 = #1 + 1\nIF [#1 LT 2] GOTO 1000\nN1011 ");
+    let first = haas_estimate_of(&text, None);
+    let loop_end = TextSize::of(&text[..text.find("N1011 ").expect("the block")]);
+    assert!(first.checkpoints.iter().any(|stored| stored.run.offset() > loop_end));
+    let at = text.find("N2200 X").expect("the block") + "N2200 X".len();
+    let edited = format!("{}7{}", &text[..at], &text[at..]);
+    let resumed = haas_estimate_of(&edited, Some(&first));
+    assert_alike(&resumed, &haas_estimate_of(&edited, None));
+    assert!(resumed.rerun.start > loop_end, "{:?} reran from before the loop's end", resumed.rerun);
+    assert!(resumed.blocks.iter().any(|block| block.executions == 2));
+}
+
+#[test]
 fn a_block_more_in_a_program_that_fills_the_step_budget_stops_the_run() {
     let machine = MachineConfig::default();
     let files = WorkspaceFiles::default();
