@@ -2,6 +2,7 @@
 //! dialect does, each an exhaustive `match` on [`Dialect`], so a new
 //! dialect is added here and the neutral modules never name one.
 
+use nc_exec::run::LoweredProgram;
 use ncc_syntax::Dialect;
 
 use crate::{
@@ -65,6 +66,17 @@ pub(crate) fn prepare_states(db: &dyn Db, file: SourceFile) {
         Dialect::HaasLathe => haas_lathe::states::prepare(db, file),
         // Hover reads nothing prepared about a Sinumerik file.
         Dialect::Sinumerik => {}
+    }
+}
+
+/// The blocks of `file` as its run reads them, from the analysis's
+/// lowered chunks; `None` where the run lowers the text itself.
+pub(crate) fn lowered_program(db: &dyn Db, file: SourceFile) -> Option<LoweredProgram> {
+    match file.parse(db).dialect() {
+        // The run reads its text as it goes.
+        Dialect::Cnc8x6 => None,
+        Dialect::HaasLathe => Some(LoweredProgram::HaasLathe(haas_lathe::model::file_model(db, file).unit.clone())),
+        Dialect::Sinumerik => None,
     }
 }
 

@@ -3,109 +3,44 @@
 //!
 //! Each dialect lowers a chunk in a tracked query of its own, so after an
 //! edit only the chunk the edit touched is lowered again, and the file's
-//! blocks share the other chunks' vectors.
+//! blocks share the other chunks' vectors, as does a run of the file.
 
 use std::sync::Arc;
 
-use ncc_syntax::{TextRange, TextSize};
+pub(crate) use nc_exec::lowered::Lowered;
+use ncc_syntax::TextSize;
 
 use crate::{
     db::{BlockChunk, Db, SourceFile, file_chunks},
     interactive::between_blocks,
 };
 
-#[derive(Debug, Clone)]
-pub(crate) struct Lowered<B> {
-    /// Each block's range in the file.
-    pub ranges: Vec<TextRange>,
-    /// The chunks' blocks, in order.
-    chunks: Vec<Arc<Vec<B>>>,
-    /// The index of each chunk's first block.
-    firsts: Vec<usize>,
+/// The blocks of `file`, each chunk's from `lower` (the dialect's query)
+/// and each block's length from `len`.
+pub(crate) fn lowered<'db, B>(
+    db: &'db dyn Db,
+    file: SourceFile,
+    lower: impl Fn(BlockChunk<'db>) -> Arc<Vec<B>>,
+    len: impl Fn(&B) -> TextSize,
+) -> Lowered<B> {
+    Lowered::from_chunks(file_chunks(db, file).iter().map(|chunk| (chunk.offset, lower(chunk.chunk))), len)
 }
 
-/// Chunks an edit did not touch are the same chunks: compared by address,
-/// an edit compares the blocks of the chunk it touched only.
-impl<B: PartialEq> PartialEq for Lowered<B> {
-    fn eq(&self, other: &Self) -> bool {
-        self.ranges == other.ranges
-            && self.firsts == other.firsts
-            && self.chunks.len() == other.chunks.len()
-            && self.chunks.iter().zip(&other.chunks).all(|(a, b)| Arc::ptr_eq(a, b) || a == b)
-    }
-}
-
-impl<B> Lowered<B> {
-    /// The file's blocks, each chunk's from `lower` (the dialect's query)
-    /// and each block's length from `len`.
-    pub fn new<'db>(
-        db: &'db dyn Db,
-        file: SourceFile,
-        lower: impl Fn(BlockChunk<'db>) -> Arc<Vec<B>>,
-        len: impl Fn(&B) -> TextSize,
-    ) -> Lowered<B> {
-        let chunks = file_chunks(db, file);
-        let mut lowered = Lowered { ranges: Vec::new(), chunks: Vec::with_capacity(chunks.len()), firsts: Vec::new() };
-        for chunk in chunks {
-            let blocks = lower(chunk.chunk);
-            lowered.firsts.push(chunk.first);
-            let mut offset = chunk.offset;
-            for block in blocks.iter() {
-                lowered.ranges.push(TextRange::at(offset, len(block)));
-                offset += len(block);
-            }
-            lowered.chunks.push(blocks);
-        }
-        lowered
-    }
-
-    /// How many blocks the file has.
-    pub fn count(&self) -> usize {
-        self.ranges.len()
-    }
-
-    /// Block `index`.
-    pub fn block(&self, index: usize) -> &B {
-        let chunk = self.firsts.partition_point(|&first| first <= index) - 1;
-        &self.chunks[chunk][index - self.firsts[chunk]]
-    }
-
-    /// The blocks from `start` on, in order.
-    pub fn blocks_from(&self, start: usize) -> impl Iterator<Item = &B> + Clone {
-        let chunk = self.firsts.partition_point(|&first| first <= start).saturating_sub(1);
-        let skip = start.saturating_sub(self.firsts.get(chunk).copied().unwrap_or(0));
-        self.chunks[chunk.min(self.chunks.len())..].iter().flat_map(|chunk| chunk.iter()).skip(skip)
-    }
-
+/// A file's lowered blocks as the analysis reads them.
+pub(crate) trait Watched<B> {
     /// Every block, in order. A walk over a large file is one long query:
     /// each block read is a point where an edit waiting to change the
     /// inputs cancels it and a request makes it give way (atomic loads).
-    pub fn blocks<'a>(&'a self, db: &'a dyn Db) -> impl Iterator<Item = &'a B> + Clone {
-        self.chunks.iter().flat_map(|chunk| chunk.iter()).inspect(move |_| between_blocks(db))
-    }
+    fn blocks<'a>(&'a self, db: &'a dyn Db) -> impl Iterator<Item = &'a B> + Clone
+    where
+        B: 'a;
+}
 
-    /// A range of block `index` (block-relative) in the file.
-    pub fn in_file(&self, index: usize, range: TextRange) -> TextRange {
-        range + self.ranges[index].start()
-    }
-
-    /// The line (from 1) that holds `offset`: a block is a line.
-    pub fn line_at(&self, offset: TextSize) -> usize {
-        self.ranges.partition_point(|range| range.end() <= offset) + 1
-    }
-
-    /// The index of the block that starts at `start`.
-    pub fn block_starting_at(&self, start: TextSize) -> Option<usize> {
-        self.ranges.binary_search_by_key(&start, |range| range.start()).ok()
-    }
-
-    /// The index of the block at `offset`; a position at a block's end
-    /// (before its line break) belongs to it.
-    pub fn block_at(&self, offset: TextSize) -> Option<usize> {
-        let index = self.ranges.partition_point(|range| range.end() <= offset);
-        match self.ranges.get(index) {
-            Some(range) if range.contains_inclusive(offset) => Some(index),
-            _ => index.checked_sub(1).filter(|&before| self.ranges[before].end() == offset),
-        }
+impl<B> Watched<B> for Lowered<B> {
+    fn blocks<'a>(&'a self, db: &'a dyn Db) -> impl Iterator<Item = &'a B> + Clone
+    where
+        B: 'a,
+    {
+        self.iter().inspect(move |_| between_blocks(db))
     }
 }

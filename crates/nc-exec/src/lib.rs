@@ -46,6 +46,8 @@
 //!   planner of up to 500 blocks with linear or jerk-limited ramps.
 //! - `green`: reading the parsers' green trees, for every dialect's lowering.
 //! - [`known`]: values a static reading may not know.
+//! - [`lowered`]: a file's lowered blocks in chunks, which the editor's
+//!   analysis and a run share.
 //! - [`machine`]: the machine a program runs on (its control, axes, rates,
 //!   limits, constants and tables).
 //! - `ramp`: how fast the path speed may change (acceleration and jerk:
@@ -86,6 +88,7 @@ pub mod expand;
 pub(crate) mod green;
 pub mod haas_lathe;
 pub mod known;
+pub mod lowered;
 pub mod machine;
 pub(crate) mod ramp;
 pub mod run;

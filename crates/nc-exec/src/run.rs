@@ -7,7 +7,10 @@
 //! velocity policy that times the steps; and the trace's vocabulary
 //! ([`crate::trace`]), which the interpreters write.
 
-use std::{sync::mpsc, thread::Scope};
+use std::{
+    sync::{Arc, mpsc},
+    thread::Scope,
+};
 
 use ncc_catalog::Dialect;
 
@@ -21,7 +24,7 @@ pub use crate::trace::*;
 /// blocks. Files are read from `files` when first needed, and the run
 /// reports its progress there.
 pub fn run(text: &str, files: &dyn Environment, machine: &MachineConfig, budget: usize) -> Trace {
-    std::thread::scope(|scope| run_in(scope, text, files, machine, budget, None, None))
+    std::thread::scope(|scope| run_in(scope, Program { text, lowered: None }, files, machine, budget, None, None))
 }
 
 /// The frame in which a run on `machine` starts ([`Trace::reset_frame`]):
@@ -80,7 +83,37 @@ pub fn resume_into(
     budget: usize,
     sink: &mut dyn StepSink,
 ) -> Trace {
-    std::thread::scope(|scope| run_in(scope, text, files, machine, budget, Some(sink), checkpoint))
+    resume_lowered_into(checkpoint, text, None, files, machine, budget, sink)
+}
+
+/// A program's blocks as its control's interpreter reads them, lowered by
+/// whoever asks for the run (the editor's analysis keeps them between
+/// edits), so that the run does not lower the whole text again.
+#[derive(Debug, Clone)]
+pub enum LoweredProgram {
+    HaasLathe(Arc<haas_lathe::interpreter::Unit>),
+}
+
+/// Like [`resume_into`], reading the program's blocks from `lowered`, the
+/// blocks of `text`, when it has those of the machine's control.
+pub fn resume_lowered_into(
+    checkpoint: Option<&Checkpoint>,
+    text: &str,
+    lowered: Option<&LoweredProgram>,
+    files: &dyn Environment,
+    machine: &MachineConfig,
+    budget: usize,
+    sink: &mut dyn StepSink,
+) -> Trace {
+    let program = Program { text, lowered };
+    std::thread::scope(|scope| run_in(scope, program, files, machine, budget, Some(sink), checkpoint))
+}
+
+/// The program a run runs: its text, and its blocks if already lowered.
+#[derive(Clone, Copy)]
+struct Program<'a> {
+    text: &'a str,
+    lowered: Option<&'a LoweredProgram>,
 }
 
 /// Like [`run_into`], with `sink` on a thread of its own, so that what it
@@ -104,7 +137,8 @@ pub fn run_beside<S: StepSink + Send>(
             sink
         });
         let mut handing = Batches { batch: Vec::with_capacity(DELIVERY_BATCH), sender, emptied };
-        let trace = run_in(scope, text, files, machine, budget, Some(&mut handing), None);
+        let program = Program { text, lowered: None };
+        let trace = run_in(scope, program, files, machine, budget, Some(&mut handing), None);
         let Batches { batch, sender, .. } = handing;
         // The sink's thread ends when the last batch is in and the channel
         // closes.
@@ -114,10 +148,10 @@ pub fn run_beside<S: StepSink + Send>(
     })
 }
 
-/// Runs `text` in the language of the machine's control.
+/// Runs `program` in the language of the machine's control.
 fn run_in<'a, 's>(
     scope: &'s Scope<'s, 'a>,
-    text: &'a str,
+    Program { text, lowered }: Program<'a>,
     files: &dyn Environment,
     machine: &MachineConfig,
     budget: usize,
@@ -126,7 +160,10 @@ fn run_in<'a, 's>(
 ) -> Trace {
     match machine.control {
         Dialect::Cnc8x6 => cnc8x6::interpreter::run_in(scope, text, files, machine, budget, sink, checkpoint),
-        Dialect::HaasLathe => haas_lathe::interpreter::run_in(text, files, machine, budget, sink, checkpoint),
+        Dialect::HaasLathe => {
+            let lowered = lowered.map(|LoweredProgram::HaasLathe(unit)| unit);
+            haas_lathe::interpreter::run_in(text, lowered, files, machine, budget, sink, checkpoint)
+        }
         Dialect::Sinumerik => sinumerik::interpreter::run_in(text, files, machine, budget, sink, checkpoint),
     }
 }

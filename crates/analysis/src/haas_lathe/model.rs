@@ -11,6 +11,7 @@ use std::{
 };
 
 use nc_exec::haas_lathe::{
+    interpreter::Unit,
     lower::{HaasBlock, Statement},
     program::{Blocks, ProgramModel, Reference, ReferenceKind, marked},
 };
@@ -18,7 +19,7 @@ use ncc_syntax::TextRange;
 
 use crate::{
     db::{BlockChunk, Db, SourceFile, file_chunks},
-    lowered::Lowered,
+    lowered::{Lowered, lowered},
 };
 
 /// The lowered blocks of a chunk, in order.
@@ -35,14 +36,14 @@ fn chunk_marks<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<u32> {
 }
 
 /// The file's blocks, with the indices of the marked ones.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct HaasBlocks {
-    pub lowered: Lowered<HaasBlock>,
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct HaasBlocks<'a> {
+    lowered: &'a Lowered<HaasBlock>,
     /// In order.
-    marks: Vec<usize>,
+    marks: &'a [usize],
 }
 
-impl Blocks for HaasBlocks {
+impl Blocks for HaasBlocks<'_> {
     fn count(&self) -> usize {
         self.lowered.count()
     }
@@ -61,22 +62,31 @@ impl Blocks for HaasBlocks {
     }
 }
 
+/// The file's blocks and program model, as a run of its text reads them
+/// too, and which blocks the model reads.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct FileModel {
-    pub blocks: HaasBlocks,
-    pub model: ProgramModel,
+    pub unit: Arc<Unit>,
+    /// In order.
+    marks: Vec<usize>,
 }
 
-/// A file model is its blocks, with the program model beside them.
+/// A file model is its unit: the blocks, with the program model beside
+/// them.
 impl Deref for FileModel {
-    type Target = Lowered<HaasBlock>;
+    type Target = Unit;
 
-    fn deref(&self) -> &Lowered<HaasBlock> {
-        &self.blocks.lowered
+    fn deref(&self) -> &Unit {
+        &self.unit
     }
 }
 
 impl FileModel {
+    /// The blocks, with the ones the program model reads.
+    pub fn blocks(&self) -> HaasBlocks<'_> {
+        HaasBlocks { lowered: &self.unit.blocks, marks: &self.marks }
+    }
+
     /// Where block `index`'s word `letter` + `number` stands in the file,
     /// or the block's start when it has none.
     pub fn code_range(&self, index: usize, letter: u8, number: u32) -> TextRange {
@@ -121,14 +131,13 @@ pub(crate) fn code_range(block: &HaasBlock, letter: u8, number: u32) -> TextRang
 /// The file's model, rebuilt when its text changes.
 #[salsa::tracked(returns(ref))]
 pub(crate) fn file_model(db: &dyn Db, file: SourceFile) -> FileModel {
-    let lowered = Lowered::new(db, file, |chunk| chunk_blocks(db, chunk).clone(), |block| block.len);
-    let marks = file_chunks(db, file)
+    let blocks = lowered(db, file, |chunk| chunk_blocks(db, chunk).clone(), |block| block.len);
+    let marks: Vec<usize> = file_chunks(db, file)
         .iter()
         .flat_map(|chunk| chunk_marks(db, chunk.chunk).iter().map(|&index| chunk.first + index as usize))
         .collect();
-    let blocks = HaasBlocks { lowered, marks };
-    let model = ProgramModel::new(&blocks);
-    FileModel { blocks, model }
+    let model = ProgramModel::new(&HaasBlocks { lowered: &blocks, marks: &marks });
+    FileModel { unit: Arc::new(Unit { blocks, model }), marks }
 }
 
 fn statement_range(statement: &Statement) -> TextRange {

@@ -335,7 +335,7 @@ impl<'a> Walker<'a, '_> {
     /// known for a subprogram.
     fn start(&self, program: &Program) -> State {
         // The ends are marked blocks.
-        let blocks = &self.file.blocks;
+        let blocks = self.file.blocks();
         let ends = || blocks.marked(program.blocks.clone()).map(|index| blocks.at(index));
         let subprogram = ends().any(|block| block.has_code(b'M', 99)) && !ends().any(ends_program);
         if subprogram { State::unknown(self.catalogue) } else { State::at_start(self.catalogue) }
@@ -348,7 +348,7 @@ impl<'a> Walker<'a, '_> {
         until: usize,
         stand: &mut dyn FnMut(&Resume) -> ControlFlow<()>,
     ) {
-        let blocks = &self.file.blocks.lowered;
+        let blocks = &self.file.unit.blocks;
         let joins = joins(self.file, program);
         let mut here = from;
         while here.at < program.blocks.end && here.at <= until {

@@ -13,7 +13,10 @@
 use std::{fmt::Write as _, ops::ControlFlow, path::Path, sync::Arc};
 
 use nc_exec::{
-    run::{Called, Checkpoint, Environment, Motion, Step, Totals, shift_count, shift_offset, shift_range},
+    run::{
+        Called, Checkpoint, Environment, LoweredProgram, Motion, Step, Totals, resume_lowered_into, shift_count,
+        shift_offset, shift_range,
+    },
     velocity::{self, Break, Stated, Timer, TimerState, TimingSink},
 };
 use ncc_syntax::{BlockParser, Dialect, SyntaxNode, TextRange, TextSize, ast::AstNode};
@@ -24,6 +27,7 @@ use crate::{
     InlayHint, InlayHintKind, MachineConfig,
     cnc8x6::model::{self, FileKind},
     db::{Db, Settings, SourceFile},
+    dialect,
     ide::{
         common_ends::{common_prefix, common_suffix},
         symbols::content_end,
@@ -127,6 +131,9 @@ pub struct RunInput {
     pub text: Arc<String>,
     pub machine: MachineConfig,
     pub files: WorkspaceFiles,
+    /// The text's blocks as the analysis lowered them, which the run reads
+    /// instead of lowering the text again.
+    pub lowered: Option<LoweredProgram>,
 }
 
 /// The macrocycle files and possible cycle files of a workspace, or its
@@ -233,7 +240,8 @@ pub(crate) fn run_input(db: &dyn Db, file: SourceFile) -> Option<RunInput> {
             }
         }
     }
-    Some(RunInput { text: file.text(db).clone(), machine: machine.clone(), files })
+    let lowered = dialect::lowered_program(db, file);
+    Some(RunInput { text: file.text(db).clone(), machine: machine.clone(), files, lowered })
 }
 
 /// Where the program's total is shown: the `%` header, or the first block.
@@ -257,7 +265,8 @@ impl RunInput {
         abandoned: &dyn Fn() -> bool,
     ) -> Option<Estimate> {
         let watched = Watched { files: &self.files, abandoned };
-        let estimate = estimate_in(previous, &self.text, &self.files, &watched, &self.machine, budget);
+        let program = (&self.text, self.lowered.as_ref());
+        let estimate = estimate_in(previous, program, &self.files, &watched, &self.machine, budget);
         (!abandoned()).then_some(estimate)
     }
 }
@@ -304,13 +313,13 @@ pub fn estimate(
     machine: &MachineConfig,
     budget: usize,
 ) -> Estimate {
-    estimate_in(previous, text, files, files, machine, budget)
+    estimate_in(previous, (text, None), files, files, machine, budget)
 }
 
 /// [`estimate`], the run reading the files through `environment`.
 fn estimate_in(
     previous: Option<&Estimate>,
-    text: &Arc<String>,
+    (text, lowered): (&Arc<String>, Option<&LoweredProgram>),
     files: &WorkspaceFiles,
     environment: &dyn Environment,
     machine: &MachineConfig,
@@ -336,13 +345,14 @@ fn estimate_in(
             let stored = &previous.checkpoints[index];
             charges.resume(previous, index);
             let mut timer = Timer::resume(axes, &dynamics, stored.model.clone(), charges);
-            let trace = nc_exec::run::resume_into(Some(&stored.run), text, environment, machine, budget, &mut timer);
+            let checkpoint = Some(&stored.run);
+            let trace = resume_lowered_into(checkpoint, text, lowered, environment, machine, budget, &mut timer);
             charges = timer.finish();
             trace
         }
         None => {
             let mut timer = Timer::new(axes, &dynamics, charges);
-            let trace = nc_exec::run::run_into(text, environment, machine, budget, &mut timer);
+            let trace = resume_lowered_into(None, text, lowered, environment, machine, budget, &mut timer);
             charges = timer.finish();
             trace
         }

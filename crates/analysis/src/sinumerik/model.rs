@@ -11,7 +11,7 @@ use std::{ops::Deref, path::Path, sync::Arc};
 
 use crate::{
     db::{BlockChunk, Db, SourceFile},
-    lowered::Lowered,
+    lowered::{Lowered, Watched, lowered},
 };
 use nc_exec::sinumerik::{lower::SinumerikBlock, program::SinumerikModel};
 
@@ -53,7 +53,7 @@ pub(crate) fn is_main_program(db: &dyn Db, file: SourceFile) -> bool {
 /// The file's model, rebuilt when its text changes.
 #[salsa::tracked(returns(ref))]
 pub(crate) fn file_model(db: &dyn Db, file: SourceFile) -> FileModel {
-    let lowered = Lowered::new(db, file, |chunk| chunk_blocks(db, chunk).clone(), |block| block.len);
+    let lowered = lowered(db, file, |chunk| chunk_blocks(db, chunk).clone(), |block| block.len);
     let model = SinumerikModel::new(lowered.blocks(db));
     FileModel { lowered, model }
 }

@@ -51,6 +51,7 @@ use ncc_catalog::{Catalogue, Code, Cycle, Dialect};
 use ncc_syntax::TextRange;
 use rustc_hash::{FxHashMap, FxHashSet};
 
+use crate::lowered::Watched;
 use crate::{
     db::Db,
     sinumerik::{

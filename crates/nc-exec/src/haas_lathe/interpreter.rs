@@ -106,8 +106,7 @@ use std::{
     any::Any,
     f64::consts::TAU,
     hash::{DefaultHasher, Hash, Hasher},
-    ops::Range,
-    rc::Rc,
+    ops::{Deref, Range},
     sync::Arc,
 };
 
@@ -126,6 +125,7 @@ use crate::{
     compensation::Side,
     compensation_driver::Driver,
     known::Known,
+    lowered::Lowered,
     machine::MachineConfig,
     trace::{
         Axes, Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, Path, PathMode, Position, Resumable,
@@ -150,13 +150,15 @@ const SPINDLE: &str = "M2";
 /// they are final when there is one.
 pub(crate) fn run_in(
     text: &str,
+    lowered: Option<&Arc<Unit>>,
     files: &dyn Environment,
     machine: &MachineConfig,
     budget: usize,
     mut sink: Option<&mut dyn StepSink>,
     checkpoint: Option<&Checkpoint>,
 ) -> Trace {
-    let mut interpreter = Interpreter::new(Arc::new(machine.clone()), files, text);
+    let unit = lowered.cloned().unwrap_or_else(|| Arc::new(Unit::read(text)));
+    let mut interpreter = Interpreter::new(Arc::new(machine.clone()), files, text, unit);
     let start = checkpoint.and_then(|checkpoint| interpreter.resume(checkpoint));
     interpreter.run(budget, start, sink.as_deref_mut());
     interpreter.end_compensation();
@@ -182,16 +184,25 @@ pub(crate) fn run_in(
 }
 
 /// One file of a run, lowered: the program's (source 0) or one that a
-/// call read.
-struct Unit {
-    blocks: Vec<HaasBlock>,
-    /// Each block's range in the file.
-    ranges: Vec<TextRange>,
-    model: ProgramModel,
+/// call read. The editor's analysis keeps the program's between edits and
+/// hands it to the run of the same text.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Unit {
+    pub blocks: Lowered<HaasBlock>,
+    pub model: ProgramModel,
+}
+
+/// A unit is its blocks, with the program model beside them.
+impl Deref for Unit {
+    type Target = Lowered<HaasBlock>;
+
+    fn deref(&self) -> &Lowered<HaasBlock> {
+        &self.blocks
+    }
 }
 
 impl Unit {
-    fn read(text: &str) -> Unit {
+    pub fn read(text: &str) -> Unit {
         let parse = Parse::new(text, Dialect::HaasLathe);
         // Sized first (the root's runs hold the blocks): a large file's
         // blocks were copied again and again as the vectors grew.
@@ -203,7 +214,7 @@ impl Unit {
             blocks.push(HaasBlock::lower(block));
         }
         let model = ProgramModel::new(blocks.as_slice());
-        Unit { blocks, ranges, model }
+        Unit { blocks: Lowered::whole(blocks, ranges), model }
     }
 
     /// The contour of the cycle in block `cycle`.
@@ -391,7 +402,7 @@ struct Interpreter<'a> {
     text: &'a str,
     /// The files of the run: the program's, then those calls read, in the
     /// order of [`Interpreter::called`].
-    units: Vec<Rc<Unit>>,
+    units: Vec<Arc<Unit>>,
     called: Vec<Called>,
     /// The file of the block being run.
     source: usize,
@@ -438,13 +449,13 @@ struct Interpreter<'a> {
 }
 
 impl<'a> Interpreter<'a> {
-    fn new(machine: Arc<MachineConfig>, files: &'a dyn Environment, text: &'a str) -> Self {
+    fn new(machine: Arc<MachineConfig>, files: &'a dyn Environment, text: &'a str, unit: Arc<Unit>) -> Self {
         let corner_tolerance = dynamics::corner_rounding(&machine);
         let mut interpreter = Interpreter {
             machine,
             files,
             text,
-            units: vec![Rc::new(Unit::read(text))],
+            units: vec![unit],
             called: Vec::new(),
             source: 0,
             calls: Vec::new(),
@@ -485,7 +496,7 @@ impl<'a> Interpreter<'a> {
         self.reached = self.reached.max(first.blocks.start);
         let read_back = contours_read_back(&self.units[0]);
         loop {
-            let unit = Rc::clone(&self.units[place.source]);
+            let unit = Arc::clone(&self.units[place.source]);
             let program = &unit.model.programs[place.program];
             self.source = place.source;
             if !program.blocks.contains(&place.block) {
@@ -515,7 +526,7 @@ impl<'a> Interpreter<'a> {
                 }
             }
             if fresh {
-                self.before = fold(self.before, (0u8, unit.blocks[place.block].number.and_then(|n| n.value)));
+                self.before = fold(self.before, (0u8, unit.block(place.block).number.and_then(|n| n.value)));
                 self.reached = place.block + 1;
             }
             if self.executed >= budget {
@@ -560,10 +571,10 @@ impl<'a> Interpreter<'a> {
     /// Goes past the blocks of the main file from the furthest one run to
     /// `block`, which a jump, a cycle or a call has skipped.
     fn pass_to(&mut self, block: usize) {
-        let unit = Rc::clone(&self.units[0]);
+        let unit = Arc::clone(&self.units[0]);
         for skipped in self.reached..block {
             let text = &self.text[unit.ranges[skipped]];
-            self.before = fold(self.before, (1u8, unit.blocks[skipped].number.and_then(|n| n.value), text));
+            self.before = fold(self.before, (1u8, unit.block(skipped).number.and_then(|n| n.value), text));
         }
         self.reached = block;
     }
@@ -687,8 +698,8 @@ impl<'a> Interpreter<'a> {
     /// Runs the block at `place` of `program`: its codes, motion, macro
     /// statement, then its call or return.
     fn block(&mut self, place: Place, program: &Program) -> Flow {
-        let unit = Rc::clone(&self.units[place.source]);
-        let (block, range) = (&unit.blocks[place.block], unit.ranges[place.block]);
+        let unit = Arc::clone(&self.units[place.source]);
+        let (block, range) = (&unit.block(place.block), unit.ranges[place.block]);
         if block.words.is_empty() && block.statements.is_empty() && block.corners.is_empty() {
             return Flow::Next;
         }

@@ -22,9 +22,10 @@ declare_rules! {
 /// Rule 53 (001:293, 312): every program ends; a subprogram with M99.
 pub(crate) fn check(file: &FileModel) -> Vec<Diagnostic> {
     let mut out = Vec::new();
+    let blocks = file.blocks();
     for program in &file.model.programs {
         // The ends are marked blocks.
-        let mut ends = file.blocks.marked(program.blocks.clone()).map(|index| file.block(index));
+        let mut ends = blocks.marked(program.blocks.clone()).map(|index| file.block(index));
         if ends.any(|block| ends_program(block) || block.has_code(b'M', 99)) {
             continue;
         }

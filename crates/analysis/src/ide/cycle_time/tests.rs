@@ -358,9 +358,19 @@ fn a_changed_macrocycle_file_reruns_from_the_last_checkpoint() {
     let machine = MachineConfig::default();
     let text = Arc::new(text);
     let first = estimate(None, &text, &files("10"), &machine, 1_000_000);
-    assert!(first.holds_for(&RunInput { text: text.clone(), machine: machine.clone(), files: files("10") }));
+    assert!(first.holds_for(&RunInput {
+        text: text.clone(),
+        machine: machine.clone(),
+        files: files("10"),
+        lowered: None
+    }));
     let changed = files("30");
-    assert!(!first.holds_for(&RunInput { text: text.clone(), machine: machine.clone(), files: changed.clone() }));
+    assert!(!first.holds_for(&RunInput {
+        text: text.clone(),
+        machine: machine.clone(),
+        files: changed.clone(),
+        lowered: None
+    }));
     let resumed = estimate(Some(&first), &text, &changed, &machine, 1_000_000);
     assert!(resumed.rerun.start > TextSize::default());
     assert_alike(&resumed, &estimate(None, &text, &changed, &machine, 1_000_000));
@@ -408,6 +418,35 @@ fn an_edit_of_a_haas_program_file_named_after_its_number_resumes_its_estimate() 
     assert_eq!(own.file(&Called::Program(1)).as_deref(), Some(edited.text.as_str()));
 }
 
+/// The run of a Haas program in the editor reads the blocks the analysis
+/// lowered chunk by chunk, edit after edit, and times them as a run that
+/// lowers the text itself does.
+#[test]
+fn a_haas_run_of_the_analysis_blocks_equals_a_run_of_the_text() {
+    let text = long_haas_program(5000);
+    let mut host = AnalysisHost::in_dialect(Dialect::HaasLathe, Config::default());
+    let file = host.add_file("/p/surface.nc", text.as_str());
+    let input = host.analysis().run_input(file).expect("a program");
+    assert!(input.lowered.is_some());
+    let mut previous = input.estimate(None, 1_000_000, &|| false).expect("never abandoned");
+    assert_alike(&previous, &haas_estimate_of(&input.text, None));
+    // A digit typed, a loop back inserted before a block, a digit deleted.
+    let lines = "N4000 G01 X5. Z-3.\n#1 = #1 + 1\nIF [#1 LT 2] GOTO 3000\n";
+    for (before, deleted, written) in [("N2503 X", 0, "7"), ("N4000 ", 0, lines), ("N17 X", 1, "")] {
+        let text = host.analysis().run_input(file).expect("a program").text;
+        let mut at = text.find(before).expect("the block");
+        if before.ends_with('X') {
+            at += before.len();
+        }
+        let range = TextRange::at(TextSize::of(&text[..at]), TextSize::from(deleted));
+        host.apply_edit(file, &TextEdit::replace(range, written));
+        let edited = host.analysis().run_input(file).expect("a program");
+        let resumed = edited.estimate(Some(&previous), 1_000_000, &|| false).expect("never abandoned");
+        assert_alike(&resumed, &haas_estimate_of(&edited.text, None));
+        previous = resumed;
+    }
+}
+
 /// An estimate asked for a text typed on meanwhile is given up.
 #[test]
 fn an_abandoned_estimate_is_none() {
@@ -445,9 +484,14 @@ fn a_haas_estimate_holds_for_its_input() {
     assert_eq!(first.checkpoints.iter().map(|stored| stored.run.block()).collect::<Vec<_>>(), [0]);
     // 5 mm of radius and 10 mm of Z at 100 mm/min, with the ramps.
     assert!(first.totals.total > 125.0f64.sqrt() / 100.0 * 60.0, "{}", first.totals.total);
-    assert!(first.holds_for(&RunInput { text: text.clone(), machine: machine.clone(), files: files.clone() }));
+    assert!(first.holds_for(&RunInput {
+        text: text.clone(),
+        machine: machine.clone(),
+        files: files.clone(),
+        lowered: None
+    }));
     let milling = MachineConfig::default();
-    assert!(!first.holds_for(&RunInput { text: text.clone(), machine: milling, files }));
+    assert!(!first.holds_for(&RunInput { text: text.clone(), machine: milling, files, lowered: None }));
 }
 
 /// A long Haas lathe program: moves from CAM, a dwell now and then, and

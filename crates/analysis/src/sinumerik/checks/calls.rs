@@ -21,6 +21,7 @@ use ncc_catalog::Dialect;
 use ncc_syntax::TextRange;
 use rustc_hash::{FxHashMap, FxHashSet};
 
+use crate::lowered::Watched;
 use crate::{
     Diagnostic,
     db::{Db, SourceFile},

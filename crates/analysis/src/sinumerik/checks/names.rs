@@ -14,6 +14,7 @@ use nc_exec::sinumerik::lower::{Callee, ExprKind, JumpTarget, PlaceKind, Stateme
 use ncc_catalog::{Catalogue, Dialect};
 use ncc_syntax::{TextRange, TextSize};
 
+use crate::lowered::Watched;
 use crate::{
     Config, Diagnostic,
     db::Db,

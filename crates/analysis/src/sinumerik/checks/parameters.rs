@@ -9,6 +9,7 @@
 use nc_exec::sinumerik::lower::{Callee, Expr, ExprKind, PlaceKind, StatementKind};
 use rustc_hash::FxHashSet;
 
+use crate::lowered::Watched;
 use crate::{
     Diagnostic,
     db::{Db, SourceFile},

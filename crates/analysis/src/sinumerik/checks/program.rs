@@ -26,6 +26,7 @@ use nc_exec::sinumerik::{
 use ncc_catalog::{AddressRole, Catalogue, Dialect};
 use ncc_syntax::{TextEdit, TextRange, TextSize};
 
+use crate::lowered::Watched;
 use crate::{
     Diagnostic,
     db::Db,

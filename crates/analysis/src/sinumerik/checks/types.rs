@@ -23,6 +23,7 @@ use nc_exec::sinumerik::{
 use ncc_catalog::{Catalogue, Dialect, SystemVariableInfo};
 use ncc_syntax::TextRange;
 
+use crate::lowered::Watched;
 use crate::{
     Diagnostic,
     db::Db,

@@ -36,7 +36,7 @@
 //! - The block of M97, M98 or M99 makes its move first, then calls or
 //!   returns.
 
-use std::rc::Rc;
+use std::sync::Arc;
 
 use ncc_syntax::TextRange;
 
@@ -211,7 +211,7 @@ impl Interpreter<'_> {
             self.variables.set_locals(caller);
         }
         let Some(number) = to else { return Flow::Go(call.back) };
-        let unit = Rc::clone(&self.units[call.back.source]);
+        let unit = Arc::clone(&self.units[call.back.source]);
         match self.numbered(&unit.model.programs[call.back.program], number, range, "M99") {
             Some(block) => Flow::Go(Place { block, ..call.back }),
             None => Flow::End,
@@ -245,7 +245,7 @@ impl Interpreter<'_> {
             let unit = Unit::read(&self.files.file(&called)?);
             let program = numbered(&unit).unwrap_or(0);
             unit.model.programs.get(program)?;
-            self.units.push(Rc::new(unit));
+            self.units.push(Arc::new(unit));
             self.called.push(called);
             Some((self.units.len() - 1, program))
         });

@@ -17,7 +17,7 @@
 //! - A move of a cycle without a feed or a turning spindle is reported
 //!   once for the block, not once per move.
 
-use std::rc::Rc;
+use std::sync::Arc;
 
 use ncc_syntax::TextRange;
 
@@ -267,13 +267,13 @@ impl Interpreter<'_> {
     /// or Z). `None` after reporting an arc off its circle.
     fn profile(&mut self, contour: &Contour) -> Option<Profile> {
         let (z, x) = (slot(b'Z'), slot(b'X'));
-        let unit = Rc::clone(&self.units[self.source]);
+        let unit = Arc::clone(&self.units[self.source]);
         let mut position = self.position;
         let start = [position[z], position[x]];
         let (mut mode, mut side) = (self.modes.get(MOTION), self.nose_side());
         let (mut pieces, mut nose) = (Vec::new(), Vec::new());
         for index in contour.blocks.clone() {
-            let (block, range) = (&unit.blocks[index], unit.ranges[index]);
+            let (block, range) = (&unit.block(index), unit.ranges[index]);
             for code in block.codes(b'G') {
                 match code {
                     0..=3 => mode = Some(code),
