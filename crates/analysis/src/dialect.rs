@@ -76,7 +76,7 @@ pub(crate) fn lowered_program(db: &dyn Db, file: SourceFile) -> Option<LoweredPr
         // The run reads its text as it goes.
         Dialect::Cnc8x6 => None,
         Dialect::HaasLathe => Some(LoweredProgram::HaasLathe(haas_lathe::model::file_model(db, file).unit.clone())),
-        Dialect::Sinumerik => None,
+        Dialect::Sinumerik => Some(LoweredProgram::Sinumerik(sinumerik::model::file_model(db, file).unit.clone())),
     }
 }
 

@@ -92,6 +92,7 @@ pub fn resume_into(
 #[derive(Debug, Clone)]
 pub enum LoweredProgram {
     HaasLathe(Arc<haas_lathe::interpreter::Unit>),
+    Sinumerik(Arc<sinumerik::Unit>),
 }
 
 /// Like [`resume_into`], reading the program's blocks from `lowered`, the
@@ -161,9 +162,18 @@ fn run_in<'a, 's>(
     match machine.control {
         Dialect::Cnc8x6 => cnc8x6::interpreter::run_in(scope, text, files, machine, budget, sink, checkpoint),
         Dialect::HaasLathe => {
-            let lowered = lowered.map(|LoweredProgram::HaasLathe(unit)| unit);
+            let lowered = lowered.and_then(|lowered| match lowered {
+                LoweredProgram::HaasLathe(unit) => Some(unit),
+                LoweredProgram::Sinumerik(_) => None,
+            });
             haas_lathe::interpreter::run_in(text, lowered, files, machine, budget, sink, checkpoint)
         }
-        Dialect::Sinumerik => sinumerik::interpreter::run_in(text, files, machine, budget, sink, checkpoint),
+        Dialect::Sinumerik => {
+            let lowered = lowered.and_then(|lowered| match lowered {
+                LoweredProgram::Sinumerik(unit) => Some(unit),
+                LoweredProgram::HaasLathe(_) => None,
+            });
+            sinumerik::interpreter::run_in(text, lowered, files, machine, budget, sink, checkpoint)
+        }
     }
 }

@@ -34,6 +34,8 @@ pub mod lower;
 pub mod modes;
 pub mod program;
 
+pub use interpreter::Unit;
+
 /// The tool and edge of a machine configuration's tool offset key
 /// `T<t>D<d>` (`T1D1`), both from 1.
 pub fn cutting_edge_key(key: &str) -> Option<(u32, u32)> {

@@ -11,9 +11,9 @@ use std::{ops::Deref, path::Path, sync::Arc};
 
 use crate::{
     db::{BlockChunk, Db, SourceFile},
-    lowered::{Lowered, Watched, lowered},
+    lowered::{Watched, lowered},
 };
-use nc_exec::sinumerik::{lower::SinumerikBlock, program::SinumerikModel};
+use nc_exec::sinumerik::{Unit, lower::SinumerikBlock, program::SinumerikModel};
 
 /// The lowered blocks of a chunk, in order.
 #[salsa::tracked(returns(ref))]
@@ -21,18 +21,20 @@ pub(crate) fn chunk_blocks<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Arc<
     Arc::new(chunk.blocks(db).map(SinumerikBlock::lower).collect())
 }
 
+/// The file's blocks and program model, as a run of its text reads them
+/// too.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct FileModel {
-    pub lowered: Lowered<SinumerikBlock>,
-    pub model: SinumerikModel,
+    pub unit: Arc<Unit>,
 }
 
-/// A file model is its blocks, with the program model beside them.
+/// A file model is its unit: the blocks, with the program model beside
+/// them.
 impl Deref for FileModel {
-    type Target = Lowered<SinumerikBlock>;
+    type Target = Unit;
 
-    fn deref(&self) -> &Lowered<SinumerikBlock> {
-        &self.lowered
+    fn deref(&self) -> &Unit {
+        &self.unit
     }
 }
 
@@ -53,7 +55,7 @@ pub(crate) fn is_main_program(db: &dyn Db, file: SourceFile) -> bool {
 /// The file's model, rebuilt when its text changes.
 #[salsa::tracked(returns(ref))]
 pub(crate) fn file_model(db: &dyn Db, file: SourceFile) -> FileModel {
-    let lowered = lowered(db, file, |chunk| chunk_blocks(db, chunk).clone(), |block| block.len);
-    let model = SinumerikModel::new(lowered.blocks(db));
-    FileModel { lowered, model }
+    let blocks = lowered(db, file, |chunk| chunk_blocks(db, chunk).clone(), |block| block.len);
+    let model = SinumerikModel::new(blocks.blocks(db));
+    FileModel { unit: Arc::new(Unit { blocks, model }) }
 }

@@ -92,7 +92,8 @@
 
 use std::{
     collections::{HashMap, HashSet},
-    rc::Rc,
+    ops::Deref,
+    sync::Arc,
 };
 
 use ncc_catalog::{AddressRole, Code, Dialect, KeywordKind};
@@ -111,6 +112,7 @@ use super::{
 use crate::{
     arc::{OffCircle, centre_by_radius, circle_through},
     compensation_driver::Driver,
+    lowered::Lowered,
     machine::MachineConfig,
     trace::{
         ABANDON_INTERVAL, Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, Path, Position, RunRule,
@@ -148,13 +150,15 @@ pub(crate) fn reset_frame(_machine: &MachineConfig) -> Frame {
 /// resumed from.
 pub(crate) fn run_in(
     text: &str,
+    lowered: Option<&Arc<Unit>>,
     files: &dyn Environment,
     machine: &MachineConfig,
     budget: usize,
     mut sink: Option<&mut dyn StepSink>,
     _checkpoint: Option<&Checkpoint>,
 ) -> Trace {
-    let mut interpreter = Interpreter::new(machine, files, text);
+    let unit = lowered.cloned().unwrap_or_else(|| Arc::new(Unit::read(text, files)));
+    let mut interpreter = Interpreter::new(machine, files, unit);
     interpreter.run(budget, sink.as_deref_mut());
     interpreter.end_compensation();
     if let Some(sink) = sink {
@@ -180,12 +184,21 @@ pub(crate) fn run_in(
 }
 
 /// One file of a run, lowered: the program's (source 0), or one a call
-/// read.
-struct Unit {
-    blocks: Vec<SinumerikBlock>,
-    /// Each block's range in the file.
-    ranges: Vec<TextRange>,
-    model: SinumerikModel,
+/// read. The editor's analysis keeps the program's between edits and hands
+/// it to the run of the same text.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Unit {
+    pub blocks: Lowered<SinumerikBlock>,
+    pub model: SinumerikModel,
+}
+
+/// A unit is its blocks, with the program model beside them.
+impl Deref for Unit {
+    type Target = Lowered<SinumerikBlock>;
+
+    fn deref(&self) -> &Lowered<SinumerikBlock> {
+        &self.blocks
+    }
 }
 
 impl Unit {
@@ -199,7 +212,7 @@ impl Unit {
             .map(|(_, (range, block))| (range, SinumerikBlock::lower(block)))
             .unzip();
         let model = SinumerikModel::new(&blocks);
-        Unit { blocks, ranges, model }
+        Unit { blocks: Lowered::whole(blocks, ranges), model }
     }
 }
 
@@ -476,7 +489,7 @@ fn failed(range: TextRange, message: String) -> EvalError {
 
 struct Interpreter<'a> {
     files: &'a dyn Environment,
-    units: Vec<Rc<Unit>>,
+    units: Vec<Arc<Unit>>,
     /// The files read besides the program, source k being `called[k - 1]`.
     called: Vec<Called>,
     store: Store,
@@ -492,7 +505,7 @@ struct Interpreter<'a> {
 }
 
 impl<'a> Interpreter<'a> {
-    fn new(machine: &'a MachineConfig, files: &'a dyn Environment, text: &str) -> Self {
+    fn new(machine: &'a MachineConfig, files: &'a dyn Environment, unit: Arc<Unit>) -> Self {
         let state = State {
             machine,
             modes: Modes::at_reset(),
@@ -515,7 +528,7 @@ impl<'a> Interpreter<'a> {
         };
         Interpreter {
             files,
-            units: vec![Rc::new(Unit::read(text, files))],
+            units: vec![unit],
             called: Vec::new(),
             store: Store::new(),
             state,
@@ -541,9 +554,9 @@ impl<'a> Interpreter<'a> {
             let called = Called::ControlFile(format!("_N_{name}_DEF"));
             let Some(text) = self.files.file(&called) else { continue };
             let source = self.unit_of(called, &text);
-            let unit = Rc::clone(&self.units[source]);
+            let unit = Arc::clone(&self.units[source]);
             self.state.source = source;
-            for (block, range) in unit.blocks.iter().zip(&unit.ranges) {
+            for (block, range) in unit.iter().zip(&unit.ranges) {
                 self.state.block_start = range.start();
                 for statement in &block.statements {
                     if let StatementKind::Def(def) = &statement.kind {
@@ -563,9 +576,9 @@ impl<'a> Interpreter<'a> {
         self.bind_own_parameters();
         let mut at = At { source: 0, block: 0 };
         loop {
-            let unit = Rc::clone(&self.units[at.source]);
+            let unit = Arc::clone(&self.units[at.source]);
             self.state.source = at.source;
-            if at.block >= unit.blocks.len() {
+            if at.block >= unit.count() {
                 // The end of the file: a subprogram returns, the main
                 // program ends.
                 match self.return_from() {
@@ -579,7 +592,7 @@ impl<'a> Interpreter<'a> {
             self.state.block_start = unit.ranges[at.block].start();
             if self.executed >= budget {
                 let message = format!("the run went past its budget of {budget} blocks");
-                let range = TextRange::up_to(unit.blocks[at.block].len);
+                let range = TextRange::up_to(unit.block(at.block).len);
                 self.state.finding(RunRule::StepBudget, range, &message);
                 break;
             }
@@ -626,7 +639,7 @@ impl<'a> Interpreter<'a> {
     /// Runs the block at `at` of `unit`: its statements in order, then its
     /// codes and motion, then its call, jump or end.
     fn block(&mut self, at: At, unit: &Unit) -> Flow {
-        let block = &unit.blocks[at.block];
+        let block = &unit.block(at.block);
         if block.statements.is_empty() {
             return Flow::Next;
         }
@@ -1332,7 +1345,7 @@ impl<'a> Interpreter<'a> {
         else {
             return self.unmatched(StructureKind::For, range);
         };
-        let header = unit.blocks[structure.start].statements.iter().find_map(|statement| match &statement.kind {
+        let header = unit.block(structure.start).statements.iter().find_map(|statement| match &statement.kind {
             StatementKind::For { variable, end, .. } => Some((variable, end)),
             _ => None,
         });

@@ -423,26 +423,54 @@ fn an_edit_of_a_haas_program_file_named_after_its_number_resumes_its_estimate() 
 /// lowers the text itself does.
 #[test]
 fn a_haas_run_of_the_analysis_blocks_equals_a_run_of_the_text() {
-    let text = long_haas_program(5000);
-    let mut host = AnalysisHost::in_dialect(Dialect::HaasLathe, Config::default());
+    // A digit typed, a loop back inserted before a block, a digit deleted.
+    let lines = "N4000 G01 X5. Z-3.\n#1 = #1 + 1\nIF [#1 LT 2] GOTO 3000\n";
+    let edits = [("N2503 X", 0, "7"), ("N4000 ", 0, lines), ("N17 X", 1, "")];
+    assert_runs_of_the_analysis_blocks_equal_runs_of_the_text(Dialect::HaasLathe, long_haas_program(5000), &edits);
+}
+
+/// As [`a_haas_run_of_the_analysis_blocks_equals_a_run_of_the_text`], for
+/// Sinumerik.
+#[test]
+fn a_sinumerik_run_of_the_analysis_blocks_equals_a_run_of_the_text() {
+    let mut text = String::from("DEF INT I\nN1 G54 G90 G17 G0 X0 Y0 Z5 M3 S8000\nN2 G1 Z-1 F1200\n");
+    for n in 3..5000 {
+        text.push_str(&format!("N{n} X{:.3} Y{:.3}\n", (n % 97) as f64 * 0.7, (n / 97) as f64 * 1.3));
+    }
+    text.push_str("M30\n");
+    let lines = "I=0\nWHILE I<2\nN4000 G1 X5 Y-3\nI=I+1\nENDWHILE\n";
+    let edits = [("N2503 X", 0, "7"), ("N4000 ", 0, lines), ("N17 X", 1, "")];
+    assert_runs_of_the_analysis_blocks_equal_runs_of_the_text(Dialect::Sinumerik, text, &edits);
+}
+
+/// Opens `text` in the analysis and applies `edits` (after the first
+/// `before` (its end, when it ends with a letter), `deleted` bytes
+/// replaced by `written`): each time, the estimate of the analysis's run
+/// input, resumed from the last, equals a whole run of the text.
+fn assert_runs_of_the_analysis_blocks_equal_runs_of_the_text(
+    dialect: Dialect,
+    text: String,
+    edits: &[(&str, u32, &str)],
+) {
+    let machine = MachineConfig::of_control(dialect);
+    let whole = |text: &Arc<String>| estimate(None, text, &WorkspaceFiles::default(), &machine, 1_000_000);
+    let mut host = AnalysisHost::in_dialect(dialect, Config::default());
     let file = host.add_file("/p/surface.nc", text.as_str());
     let input = host.analysis().run_input(file).expect("a program");
     assert!(input.lowered.is_some());
     let mut previous = input.estimate(None, 1_000_000, &|| false).expect("never abandoned");
-    assert_alike(&previous, &haas_estimate_of(&input.text, None));
-    // A digit typed, a loop back inserted before a block, a digit deleted.
-    let lines = "N4000 G01 X5. Z-3.\n#1 = #1 + 1\nIF [#1 LT 2] GOTO 3000\n";
-    for (before, deleted, written) in [("N2503 X", 0, "7"), ("N4000 ", 0, lines), ("N17 X", 1, "")] {
+    assert_alike(&previous, &whole(&input.text));
+    for &(before, deleted, written) in edits {
         let text = host.analysis().run_input(file).expect("a program").text;
         let mut at = text.find(before).expect("the block");
-        if before.ends_with('X') {
+        if before.ends_with(|c: char| c.is_ascii_alphabetic()) {
             at += before.len();
         }
         let range = TextRange::at(TextSize::of(&text[..at]), TextSize::from(deleted));
         host.apply_edit(file, &TextEdit::replace(range, written));
         let edited = host.analysis().run_input(file).expect("a program");
         let resumed = edited.estimate(Some(&previous), 1_000_000, &|| false).expect("never abandoned");
-        assert_alike(&resumed, &haas_estimate_of(&edited.text, None));
+        assert_alike(&resumed, &whole(&edited.text));
         previous = resumed;
     }
 }

@@ -4,7 +4,7 @@
 //! DELETE; GROUP_BEGIN, GROUP_END and WORKPIECE are markers for the editor
 //! and the simulation and do nothing).
 
-use std::rc::Rc;
+use std::sync::Arc;
 
 use ncc_syntax::TextRange;
 
@@ -132,8 +132,8 @@ impl Interpreter<'_> {
             self.state.finding(RunRule::CallDepth, range, &message);
             return Flow::Stop;
         }
-        let unit = Rc::clone(&self.units[source]);
-        if unit.blocks.is_empty() {
+        let unit = Arc::clone(&self.units[source]);
+        if unit.count() == 0 {
             // An empty file does nothing, however often it runs.
             return Flow::Next;
         }
@@ -198,7 +198,7 @@ impl Interpreter<'_> {
     /// The parameters of the PROC line of the program being run by
     /// itself: zero, as if a call left them all out.
     pub(super) fn bind_own_parameters(&mut self) {
-        let unit = Rc::clone(&self.units[0]);
+        let unit = Arc::clone(&self.units[0]);
         let Some(header) = unit.model.header() else { return };
         self.state.block_start = unit.ranges[header.block].start();
         for parameter in &header.declaration.parameters {
@@ -255,7 +255,7 @@ impl Interpreter<'_> {
         if let Some(index) = (0..self.called.len()).find(|&index| unchanged(self, index)) {
             return index + 1;
         }
-        self.units.push(Rc::new(Unit::read(text, self.files)));
+        self.units.push(Arc::new(Unit::read(text, self.files)));
         self.called.push(called);
         self.units.len() - 1
     }

@@ -29,7 +29,7 @@ fn machine() -> MachineConfig {
 }
 
 fn run_with(text: &str, files: &dyn Environment) -> Trace {
-    run_in(text, files, &machine(), DEFAULT_STEP_BUDGET, None, None)
+    run_in(text, None, files, &machine(), DEFAULT_STEP_BUDGET, None, None)
 }
 
 fn run(text: &str) -> Trace {
@@ -159,7 +159,7 @@ DONE: G0 X=VISITS Y=R1 Z=I_1
 #[test]
 fn a_loop_without_end_stops_at_the_budget() {
     let text = "LOOP\nG91 G1 X1 F1000\nENDLOOP\n";
-    let trace = run_in(text, &NoFiles, &machine(), 1000, None, None);
+    let trace = run_in(text, None, &NoFiles, &machine(), 1000, None, None);
     let [finding] = trace.findings.as_slice() else { panic!("{:?}", trace.findings) };
     assert_eq!(finding.rule, RunRule::StepBudget);
     assert_eq!(trace.blocks_run, 1000);
@@ -476,7 +476,7 @@ proptest! {
     #[test]
     fn any_bytes_run_without_panic_within_the_budget(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
         let text = String::from_utf8_lossy(&bytes);
-        let trace = run_in(&text, &NoFiles, &machine(), 2000, None, None);
+        let trace = run_in(&text, None, &NoFiles, &machine(), 2000, None, None);
         prop_assert!(trace.blocks_run <= 2000);
     }
 
@@ -488,7 +488,7 @@ proptest! {
     ]), 0..60)) {
         let text = parts.join(" ");
         let files = Beside::with(&[("_N_SUB_SPF", "PROC SUB(INT N)\nSUB(N+1)\n"), ("_N_EMPTY_SPF", "")]);
-        let trace = run_in(&text, &files, &machine(), 3000, None, None);
+        let trace = run_in(&text, None, &files, &machine(), 3000, None, None);
         prop_assert!(trace.blocks_run <= 3000);
     }
 }
@@ -701,10 +701,10 @@ fn the_radius_comes_from_the_machine_s_cutting_edges_unless_the_program_writes_i
     let mut machine = machine();
     machine.cutting_edges.insert((1, 1), crate::machine::ToolEntry { radius: 2000, ..Default::default() });
     let text = pocket("G17", ['X', 'Y'], "G41", "T1 D1");
-    let trace = run_in(&text, &NoFiles, &machine, DEFAULT_STEP_BUDGET, None, None);
+    let trace = run_in(&text, None, &NoFiles, &machine, DEFAULT_STEP_BUDGET, None, None);
     assert_eq!(centre_ends(&trace, (b'X', b'Y')), INSIDE);
     let text = pocket("G17", ['X', 'Y'], "G41", "$TC_DP6[1,1]=1\nT1 D1\nR1=$TC_DP6[1,1]");
-    let trace = run_in(&text, &NoFiles, &machine, DEFAULT_STEP_BUDGET, None, None);
+    let trace = run_in(&text, None, &NoFiles, &machine, DEFAULT_STEP_BUDGET, None, None);
     assert_eq!(findings(&trace, &text), []);
     assert_eq!(centre_ends(&trace, (b'X', b'Y'))[1], (0.0, 1.0));
 }
