@@ -7,17 +7,16 @@
 
 use std::{
     collections::HashMap,
-    io,
+    io::{self, Read, Write},
+    pin::Pin,
     sync::{Arc, Mutex, MutexGuard},
+    task::{Context, Poll},
 };
 
 use ncc_analysis::interactive;
 
 use serde_json::{Value, json};
-use tokio::{
-    io::{AsyncBufRead, AsyncBufReadExt, AsyncRead, AsyncReadExt, AsyncWrite, AsyncWriteExt, BufReader},
-    sync::mpsc,
-};
+use tokio::io::{AsyncBufRead, AsyncBufReadExt, AsyncRead, AsyncReadExt, AsyncWrite, AsyncWriteExt, BufReader, ReadBuf};
 
 const CONTENT_LENGTH: &[u8] = b"content-length:";
 
@@ -100,12 +99,12 @@ fn check(body: &[u8]) -> Result<Option<Value>, Vec<u8>> {
     }
 }
 
-/// Copies well-formed messages from `input` to `server`, and sends the
-/// answers to the rest to `output`.
+/// Copies well-formed messages from `input` to `server`, and answers the
+/// rest through `answer`.
 pub(crate) async fn guard_input(
     input: impl AsyncRead + Unpin,
     mut server: impl AsyncWrite + Unpin,
-    output: mpsc::UnboundedSender<Vec<u8>>,
+    answer: impl Fn(&[u8]) -> io::Result<()>,
     pending: Pending,
 ) -> io::Result<()> {
     let mut reader = BufReader::new(input);
@@ -119,9 +118,9 @@ pub(crate) async fn guard_input(
                     server.write_all(&framed(&body)).await?;
                     server.flush().await?;
                 }
-                Err(answer) => {
+                Err(rejection) => {
                     tracing::warn!("rejected a message: {}", String::from_utf8_lossy(&body));
-                    let _ = output.send(answer);
+                    answer(&rejection)?;
                 }
             },
             Frame::BadHeader => tracing::warn!("skipped a message without a valid Content-Length"),
@@ -130,20 +129,41 @@ pub(crate) async fn guard_input(
     Ok(())
 }
 
-/// Passes the server's messages, whole, to `output`.
+/// Passes the server's messages, whole, to `write`.
 pub(crate) async fn forward_output(
     server: impl AsyncRead + Unpin,
-    output: mpsc::UnboundedSender<Vec<u8>>,
+    write: impl Fn(&[u8]) -> io::Result<()>,
     pending: Pending,
 ) -> io::Result<()> {
     let mut reader = BufReader::new(server);
     while let Some(frame) = read_frame(&mut reader).await? {
         if let Frame::Body(body) = frame {
             pending.answered(&body);
-            let _ = output.send(framed(&body));
+            write(&framed(&body))?;
         }
     }
     Ok(())
+}
+
+/// Writes one whole frame to stdout: the threads that write hold its lock
+/// for a frame, so frames never interleave.
+pub(crate) fn write_stdout(frame: &[u8]) -> io::Result<()> {
+    let mut out = io::stdout().lock();
+    out.write_all(frame)?;
+    out.flush()
+}
+
+/// A stream read on the thread that polls it. On a thread of its own a
+/// read waits there, where `tokio::io::stdin` hands every read to the
+/// blocking pool and back: two thread wake-ups per message, each a wait
+/// for a core while background work holds both.
+pub(crate) struct Blocking<R>(pub R);
+
+impl<R: Read + Unpin> AsyncRead for Blocking<R> {
+    fn poll_read(mut self: Pin<&mut Self>, _cx: &mut Context<'_>, buf: &mut ReadBuf<'_>) -> Poll<io::Result<()>> {
+        let read = self.0.read(buf.initialize_unfilled());
+        Poll::Ready(read.map(|count| buf.advance(count)))
+    }
 }
 
 /// The client's requests the server has not answered yet: background work
@@ -177,15 +197,6 @@ impl Pending {
 
     fn lock(&self) -> MutexGuard<'_, HashMap<String, interactive::Request>> {
         self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
-    }
-}
-
-/// Writes whole frames to `out` until every sender is gone.
-pub(crate) async fn write_output(mut out: impl AsyncWrite + Unpin, mut frames: mpsc::UnboundedReceiver<Vec<u8>>) {
-    while let Some(frame) = frames.recv().await {
-        if out.write_all(&frame).await.is_err() || out.flush().await.is_err() {
-            return;
-        }
     }
 }
 

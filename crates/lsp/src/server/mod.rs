@@ -95,18 +95,29 @@ pub(crate) fn run(log_level: LogLevel, dialect: Option<Dialect>) -> ExitCode {
         // between them and stdio.
         let (server_input, guarded_input) = tokio::io::duplex(1 << 16);
         let (server_output, server_frames) = tokio::io::duplex(1 << 16);
-        let (frames_tx, frames_rx) = mpsc::unbounded_channel();
         let pending = frames::Pending::default();
-        let guard =
-            tokio::spawn(frames::guard_input(tokio::io::stdin(), guarded_input, frames_tx.clone(), pending.clone()));
-        let forward = tokio::spawn(frames::forward_output(server_frames, frames_tx, pending));
-        let writer = tokio::spawn(frames::write_output(tokio::io::stdout(), frames_rx));
+        // Stdin and stdout each have a thread of their own that reads or
+        // writes them directly: a message crosses one thread fewer each way
+        // than through the runtime's tasks and blocking pool.
+        let handle = tokio::runtime::Handle::current();
+        let (reading, writing) = (handle.clone(), pending.clone());
+        let spawned = std::thread::Builder::new().name("ncc-stdin".into()).spawn(move || {
+            let stdin = frames::Blocking(std::io::stdin());
+            reading.block_on(frames::guard_input(stdin, guarded_input, frames::write_stdout, pending))
+        });
+        let forward = std::thread::Builder::new().name("ncc-stdout".into()).spawn(move || {
+            handle.block_on(frames::forward_output(server_frames, frames::write_stdout, writing))
+        });
+        if let Err(error) = spawned.as_ref().and(forward.as_ref()) {
+            tracing::error!("cannot start the threads that read and write stdio: {error}");
+            return;
+        }
         tower_lsp_server::Server::new(server_input, server_output, socket).serve(service).await;
-        // Stdin may never close (a client that sent `exit`): stop reading,
-        // and let everything the server wrote reach stdout.
-        guard.abort();
-        let _ = forward.await;
-        let _ = writer.await;
+        // Stdin may never close (a client that sent `exit`): its thread
+        // ends with the process. Everything the server wrote reaches stdout.
+        if let Ok(forward) = forward {
+            let _ = tokio::task::spawn_blocking(move || forward.join()).await;
+        }
     });
     // Blocking tasks still computing are abandoned: their snapshots answer
     // nobody now.
