@@ -105,9 +105,9 @@ pub(crate) fn run(log_level: LogLevel, dialect: Option<Dialect>) -> ExitCode {
             let stdin = frames::Blocking(std::io::stdin());
             reading.block_on(frames::guard_input(stdin, guarded_input, frames::write_stdout, pending))
         });
-        let forward = std::thread::Builder::new().name("ncc-stdout".into()).spawn(move || {
-            handle.block_on(frames::forward_output(server_frames, frames::write_stdout, writing))
-        });
+        let forward = std::thread::Builder::new()
+            .name("ncc-stdout".into())
+            .spawn(move || handle.block_on(frames::forward_output(server_frames, frames::write_stdout, writing)));
         if let Err(error) = spawned.as_ref().and(forward.as_ref()) {
             tracing::error!("cannot start the threads that read and write stdio: {error}");
             return;

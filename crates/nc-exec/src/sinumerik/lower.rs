@@ -43,6 +43,10 @@ pub struct SinumerikBlock {
     pub comments: Vec<Comment>,
     /// The block's length in bytes, line break included.
     pub len: TextSize,
+    /// Whether a statement is one the program model reads (a structure, a
+    /// declaration, a jump or a call): the model skips the others' lists,
+    /// which a large file's words fill.
+    pub modelled: bool,
 }
 
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -535,6 +539,23 @@ const END_CODES: [(u64, ProgramEnd); 3] =
 impl StatementKind {
     /// Whether the statement opens, continues or closes a control
     /// structure; a one-line `IF … GOTOF` does not.
+    /// Whether the program model reads it: a structure, a declaration, a
+    /// jump or a call.
+    pub fn is_modelled(&self) -> bool {
+        self.is_structure()
+            || matches!(
+                self,
+                StatementKind::If { .. }
+                    | StatementKind::Proc(_)
+                    | StatementKind::Extern(_)
+                    | StatementKind::Def(_)
+                    | StatementKind::Jump(_)
+                    | StatementKind::Case { .. }
+                    | StatementKind::Call(_)
+                    | StatementKind::ModalCall(_)
+            )
+    }
+
     pub fn is_structure(&self) -> bool {
         matches!(
             self,
@@ -590,6 +611,7 @@ impl SinumerikBlock {
             }
         }
         data.statements = attach_words(catalogue, statements);
+        data.modelled = data.statements.iter().any(|statement| statement.kind.is_modelled());
         data
     }
 

@@ -19,20 +19,26 @@
 
 use std::collections::BTreeMap;
 
+use smallvec::SmallVec;
+
 use super::lower::{Callee, Declared, Extern, Jump, JumpKind, JumpTarget, Proc, SinumerikBlock, StatementKind, Type};
 
 /// The most program levels, the main program included (004:1464): the
 /// run's limit and the checker's.
 pub const PROGRAM_LEVELS: usize = 16;
 
+/// The blocks carrying a label or number: almost always one, kept without
+/// an allocation of its own.
+pub type Blocks = SmallVec<[usize; 1]>;
+
 /// The model of one file.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SinumerikModel {
     /// Every block carrying each label (upper case), in file order.
-    pub labels: BTreeMap<String, Vec<usize>>,
+    pub labels: BTreeMap<String, Blocks>,
     /// Every block carrying each block number (`N10` or `:10`), in file
     /// order.
-    pub block_numbers: BTreeMap<u64, Vec<usize>>,
+    pub block_numbers: BTreeMap<u64, Blocks>,
     /// The matched structures, in the order they close.
     pub structures: Vec<Structure>,
     /// Starts never closed, ends and ELSEs without their start, in the
@@ -152,23 +158,27 @@ impl SinumerikModel {
         I: IntoIterator<Item = &'a SinumerikBlock>,
         I::IntoIter: Clone,
     {
-        let blocks = blocks.into_iter();
         let mut model = SinumerikModel::default();
-        for (index, block) in blocks.clone().enumerate() {
+        let mut open = Opened::default();
+        // One pass, the jumps resolved after it, once every label is known:
+        // a large file's blocks are read from memory once.
+        for (index, block) in blocks.into_iter().enumerate() {
             if let Some(label) = &block.label {
                 model.labels.entry(label.name.clone()).or_default().push(index);
             }
             if let Some(number) = block.number.and_then(|number| number.value) {
                 model.block_numbers.entry(number).or_default().push(index);
             }
-        }
-        let mut open = Opened::default();
-        for (index, block) in blocks.enumerate() {
-            for statement in &block.statements {
+            for statement in block.statements.iter().filter(|_| block.modelled) {
                 model.structure(&mut open, index, &statement.kind);
                 model.declarations_and_calls(index, &statement.kind);
             }
         }
+        let mut jumps = std::mem::take(&mut model.jumps);
+        for site in &mut jumps {
+            site.resolved = model.resolve(site.block, &site.jump);
+        }
+        model.jumps = jumps;
         model.unmatched.extend(open.structures.into_iter().map(|o| Unmatched {
             block: o.start,
             kind: o.kind,
@@ -201,7 +211,7 @@ impl SinumerikModel {
             Some(JumpTarget::Label(label)) => self.labels.get(label),
             Some(JumpTarget::BlockNumber(Some(number))) => self.block_numbers.get(number),
         };
-        let candidates = candidates.map_or(&[][..], Vec::as_slice);
+        let candidates = candidates.map_or(&[][..], |blocks| blocks.as_slice());
         let forward = || candidates.iter().copied().find(|&block| block > from);
         let backward = || candidates.iter().copied().rev().find(|&block| block <= from);
         let found = match jump.kind {
@@ -312,9 +322,9 @@ impl SinumerikModel {
         }
     }
 
+    /// Notes the jump; it is resolved once the labels are known.
     fn jump(&mut self, block: usize, jump: &Jump) {
-        let resolved = self.resolve(block, jump);
-        self.jumps.push(JumpSite { block, jump: jump.clone(), resolved });
+        self.jumps.push(JumpSite { block, jump: jump.clone(), resolved: Resolved::NoTarget });
     }
 }
 

@@ -337,7 +337,7 @@ impl Interpreter<'_> {
             }
             None => 1,
         };
-        let labelled = |label: &str| unit.model.labels.get(label).map_or(&[][..], Vec::as_slice);
+        let labelled = |label: &str| unit.model.labels.get(label).map_or(&[][..], |blocks| blocks.as_slice());
         let first = labelled(start).iter().rev().copied().find(|&block| block < at.block);
         let last = match (first, end) {
             (Some(first), Some(end)) => labelled(end).iter().copied().find(|&block| block >= first && block < at.block),
