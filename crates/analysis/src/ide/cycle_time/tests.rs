@@ -529,6 +529,85 @@ proptest::proptest! {
     }
 }
 
+/// A CAM-like Sinumerik program of `blocks` moves after a few variables,
+/// a label to jump back to and the modes.
+fn long_sinumerik_program(blocks: usize) -> String {
+    let mut text = String::from("DEF REAL SAFE=5\nDEF INT PASS\nTOP: R2=R2+1\nR1=0\n");
+    text.push_str("N1 G17 G54 G90 G0 X0 Y0 Z=SAFE S8000 M3\nN2 G1 Z-1 F1200\n");
+    for i in 0..blocks {
+        let (x, y) = ((i % 97) as f64 * 0.7, (i / 97) as f64 * 1.3 + (i % 5) as f64 * 0.2);
+        let block = match i % 250 {
+            17 => "G4 F0.01".to_owned(),
+            31 => format!("G0 X{x:.3} Y{y:.3}"),
+            32 => format!("G1 X{x:.3} Y{y:.3} F900"),
+            _ => format!("G1 X{x:.3} Y{y:.3} F{}", 1000 + i % 3 * 100),
+        };
+        text.push_str(&format!("N{} {block}\n", i + 3));
+    }
+    text.push_str("N99999 G0 Z5 M30\n");
+    text
+}
+
+fn sinumerik_estimate_of(text: &str, previous: Option<&Estimate>) -> Estimate {
+    let machine = MachineConfig::of_control(Dialect::Sinumerik);
+    estimate(previous, &Arc::new(text.to_owned()), &WorkspaceFiles::default(), &machine, 1_000_000)
+}
+
+#[test]
+fn an_edit_of_a_sinumerik_program_reruns_from_the_checkpoint_before_it_to_where_the_run_takes_its_course_again() {
+    let text = long_sinumerik_program(5000);
+    let first = sinumerik_estimate_of(&text, None);
+    assert_eq!(first.stopped, None);
+    assert!(first.checkpoints.len() >= 5, "{} checkpoints", first.checkpoints.len());
+    // A digit typed into an absolute coordinate in the middle.
+    let at = text.find("N2503 G1 X").expect("the block") + "N2503 G1 X".len();
+    let edited = format!("{}7{}", &text[..at], &text[at..]);
+    let resumed = sinumerik_estimate_of(&edited, Some(&first));
+    let whole = sinumerik_estimate_of(&edited, None);
+    assert_alike(&resumed, &whole);
+    assert!(resumed.totals.total > first.totals.total, "the move got longer");
+    // From the checkpoint at block 2000 (N1997) to the one at block 3000.
+    let rerun = usize::from(resumed.rerun.start)..usize::from(resumed.rerun.end);
+    assert!(edited[rerun.clone()].starts_with("N1997 ") && edited[rerun.end..].starts_with("N2997 "), "{rerun:?}");
+    // Edited again, from the resumed estimate: its checkpoints hold.
+    let at = edited.find("N4321 G1 X").expect("the block") + "N4321 G1 X".len();
+    let again = format!("{}{}", &edited[..at], &edited[at + 1..]);
+    let resumed = sinumerik_estimate_of(&again, Some(&resumed));
+    assert_alike(&resumed, &sinumerik_estimate_of(&again, None));
+    assert!(resumed.rerun.end < TextSize::of(again.as_str()));
+    // A variable the moves do not read, set otherwise before the
+    // checkpoints: a jump back to the label could run it, so the run goes
+    // to the end; and the same as a whole run.
+    let renamed = again.replace("R1=0", "R1=0+0");
+    let resumed = sinumerik_estimate_of(&renamed, Some(&resumed));
+    assert_alike(&resumed, &sinumerik_estimate_of(&renamed, None));
+    assert_eq!(resumed.rerun.end, TextSize::of(renamed.as_str()));
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(12))]
+
+    /// Resumed estimates of a Sinumerik program equal whole runs, edit
+    /// after edit: digits typed or deleted, blocks inserted or removed, a
+    /// WHILE loop, a jump back to the label at the top, a label and a jump
+    /// back to it, IF … ENDIF, a jump to no label (the run stops there).
+    #[test]
+    fn resumed_sinumerik_estimates_equal_whole_runs(
+        edits in proptest::collection::vec((0.0f64..1.0, 0u8..10), 1..4),
+    ) {
+        let later = [
+            "WHILE R1<2\nR1=R1+1\nG1 X=R1 Y1\nENDWHILE\n",
+            "IF R2<2 GOTOB TOP\n",
+            "LBL: G1 X2 Y2\n",
+            "R3=R3+1\nIF R3<2 GOTOB LBL\n",
+            "IF R2>0\nG1 X3 Y3\nENDIF\n",
+            "GOTOF NOWHERE\n",
+        ];
+        let first = "N5 G1 X1 Y1 F2000\n";
+        assert_edits_resume_as_whole_runs(long_sinumerik_program(2500), &edits, first, &later, sinumerik_estimate_of);
+    }
+}
+
 /// Applies `edits` to `text` one by one, at a place (a fraction of the
 /// text) of a kind: a digit typed into (0) or deleted from (1) an X
 /// word, the block `first` inserted anywhere (2), a block of `later`
