@@ -584,6 +584,27 @@ fn an_edit_of_a_sinumerik_program_reruns_from_the_checkpoint_before_it_to_where_
     assert_eq!(resumed.rerun.end, TextSize::of(renamed.as_str()));
 }
 
+#[test]
+fn a_sinumerik_block_without_a_step_that_a_jump_back_runs_again_is_part_of_the_course() {
+    // The label's block is the last before the checkpoint at block 1000,
+    // and the jump back runs it again: what it computes then shows only
+    // in the move at the end.
+    let text = long_sinumerik_program(2500);
+    let at = text.match_indices('\n').nth(998).expect("the line").0 + 1;
+    let end = "R2=R2+1\nIF R2<3 GOTOB LBL\nG1 X=R1 Y1\nN99999 ";
+    let text = format!("{}LBL: R1=R2-1\n{}", &text[..at], &text[at..]).replace("N99999 ", end);
+    let first = sinumerik_estimate_of(&text, None);
+    assert_eq!(first.stopped, None);
+    let after = TextSize::of(&text[..at]) + TextSize::of("LBL: R1=R2-1\n");
+    assert!(first.checkpoints.iter().any(|stored| stored.run.offset() == after));
+    // As long, and the same value on the first run (R2 is 1), another on
+    // the second.
+    let edited = text.replace("LBL: R1=R2-1", "LBL: R1=1-R2");
+    let resumed = sinumerik_estimate_of(&edited, Some(&first));
+    assert_alike(&resumed, &sinumerik_estimate_of(&edited, None));
+    assert_ne!(resumed.totals.total, first.totals.total, "the last move ends elsewhere");
+}
+
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig::with_cases(12))]
 

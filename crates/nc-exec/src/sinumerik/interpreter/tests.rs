@@ -885,13 +885,14 @@ fn no_checkpoint_after_a_start_never_closed_or_with_global_data() {
     assert_eq!(sink.steps.iter().map(|step| step.end[0]).collect::<Vec<_>>(), [0.0, 2.0, 2.0], "G1 X=DEPTH is 2");
 }
 
-/// Modal state and variables set early, then moves, then a jump back.
+/// Modal state and variables set early, then moves, then jumps back, one
+/// to a label the program does not have.
 fn resumable_program(first_x: &str) -> String {
-    let mut text = format!("DEF REAL D=5\nR1=2\n; setup\nG0 X{first_x} Y0 Z5 S1000 M3\nG1 Z=-D F300\n");
+    let mut text = format!("DEF REAL D=5\nR4=2\n; setup\nG0 X{first_x} Y0 Z5 S1000 M3\nR1=2 G1 Z=-D F300\n");
     for i in 0..40 {
-        text.push_str(&format!("N{} X{} Y=R1\n", 100 + i, i * 3));
+        text.push_str(&format!("N{} X{} Y{}\n", 100 + i, i * 3, i % 7));
     }
-    text.push_str("BACK: G1 X1\nR1=R1+1\nIF R1<4 GOTOB BACK\nM30\n");
+    text.push_str("BACK: G1 Y=R1\nR1=R1+1\nIF R1<4 GOTOB BACK\nIF R1<5 GOTOC AGAIN\nM30\n");
     text
 }
 
@@ -899,32 +900,56 @@ fn resumable_program(first_x: &str) -> String {
 fn checkpoints_after_an_edit_take_the_same_course_once_the_edit_no_longer_matters() {
     let text = resumable_program("0");
     let before = checkpoints(&text, &NoFiles, 7);
-    assert_eq!(before.iter().map(Checkpoint::block).collect::<Vec<_>>(), [0, 7, 14, 21, 28, 35, 42]);
+    assert_eq!(before.iter().map(Checkpoint::block).collect::<Vec<_>>(), [0, 7, 14, 21, 28, 35, 42, 49]);
     let course = |edited: &str, shift: i64| {
         let after = checkpoints(edited, &NoFiles, 7);
         assert_eq!(after.len(), before.len(), "{edited}");
-        after
-            .iter()
-            .zip(&before)
-            .skip(1)
-            .map(|(after, before)| after.same_course(&before.shifted(shift, 0, 0)))
-            .collect::<Vec<bool>>()
+        let pairs = after.iter().zip(&before).skip(1);
+        pairs.map(|(after, before)| after.same_course(&before.shifted(shift, 0, 0))).collect::<Vec<bool>>()
     };
-    // An absolute move written longer, or a comment: the course is the same
-    // from the next block on.
-    assert_eq!(course(&resumable_program("1234"), 3), [true; 6]);
-    assert_eq!(course(&text.replace("; setup", "; set up"), 1), [true; 6]);
-    // A variable the moves read carries the difference to the end.
-    assert_eq!(course(&text.replace("R1=2", "R1=3"), 0), [false; 6]);
-    // The same value written otherwise: a jump back could run the block,
-    // which makes no step to show it.
-    assert_eq!(course(&text.replace("R1=2", "R1=1+1"), 2), [false; 6]);
+    // An absolute move written longer, a comment, the same value written
+    // otherwise in a block with a step: the course is the same from the
+    // next block on.
+    assert_eq!(course(&resumable_program("1234"), 3), [true; 7]);
+    assert_eq!(course(&text.replace("; setup", "; set up"), 1), [true; 7]);
+    assert_eq!(course(&text.replace("R1=2 ", "R1=1+1 "), 2), [true; 7]);
+    // A variable read at the end carries the difference there, until the
+    // loop has made it 4 either way.
+    let mut differs = [false; 7];
+    differs[6] = true;
+    assert_eq!(course(&text.replace("R1=2 ", "R1=3 "), 0), differs);
+    // So do the modes, the feed, the spindle, a frame, the tool and its
+    // data.
+    for (from, to) in [
+        ("S1000 M3", "S1000 M4"),
+        ("S1000 M3", "S1200 M3"),
+        ("F300", "F301"),
+        ("G0 X0", "G0 G91 X0"),
+        ("G0 X0", "G0 X0 T2"),
+        ("G0 X0", "G0 X0 D2"),
+        ("R1=2 G1", "R1=2 TRANS Z1\nG1"),
+        ("R1=2 G1", "R1=2 $TC_DP6[1,1]=2 G1"),
+    ] {
+        let edited = text.replace(from, to);
+        let shift = edited.len() as i64 - text.len() as i64;
+        let blocks = i64::from(to.contains('\n'));
+        let after = checkpoints(&edited, &NoFiles, 7);
+        let same =
+            after.iter().skip(1).filter(|after| before.iter().any(|b| after.same_course(&b.shifted(shift, blocks, 0))));
+        assert_eq!(same.count(), 0, "{to}");
+    }
+    // A frame moved otherwise, the text of the blocks without a step the
+    // same.
+    let moved =
+        |z: &str| text.replace("G0 X0", &format!("R5={z} G0 X0")).replace("R1=2 G1", "TRANS Z=R5\nR5=0 R1=2 G1");
+    let (one, two) = (checkpoints(&moved("1"), &NoFiles, 7), checkpoints(&moved("2"), &NoFiles, 7));
+    assert!(one.iter().zip(&two).skip(1).all(|(one, two)| !one.same_course(two)));
+    // The same value written otherwise in a block without a step: a jump
+    // back could run it again unseen.
+    assert_eq!(course(&text.replace("R4=2", "R4=1+1"), 2), [false; 7]);
     // A label or another block number before them: jumps back look them up.
-    assert_eq!(course(&text.replace("R1=2", "BACK: R1=2"), 6), [false; 6]);
-    assert_eq!(course(&text.replace("N100 ", "N10 "), -1), [false; 6]);
-    // A frame or a tool's data is part of the course.
-    assert_eq!(course(&text.replace("; setup", "TRANS Z1"), 2), [false; 6]);
-    assert_eq!(course(&text.replace("; setup", "$TC_DP6[1,1]=2"), 8), [false; 6]);
+    assert_eq!(course(&text.replace("N101 ", "N101 AGAIN: "), 7), [false; 7]);
+    assert_eq!(course(&text.replace("N100 ", "N10 "), -1), [false; 7]);
 }
 
 #[test]
