@@ -965,3 +965,56 @@ fn a_block_jumped_over_before_a_checkpoint_is_part_of_its_course() {
     assert!(short[1].same_course(&long[1]));
     assert_resumes_as_the_whole_run(&program("1"), &NoFiles, 1);
 }
+
+/// Pieces of programs to put together: moves, variables, IF … ELSE …
+/// ENDIF, WHILE and FOR loops, a jump over a block and one back to a
+/// label, frames, a compensated stretch, a spline, a modal drilling cycle,
+/// a call, a dwell. `{n}` is a number of its own for each piece.
+const PIECES: [&str; 13] = [
+    "G1 X=R1+1 Y2\n",
+    "G0 X5 Y5\n",
+    "R1=R1+1\nIF R1>3\nR2=R1\nELSE\nG1 X1\nENDIF\n",
+    "R5=0\nWHILE R5<2\nG1 X=R5 Y1\nR5=R5+1\nENDWHILE\n",
+    "FOR I=1 TO 2\nG1 Y=I\nENDFOR\n",
+    "GOTOF SKIP{n}\nG1 X77\nSKIP{n}: G1 Y-1\n",
+    "R7=0\nBACK{n}: G1 X3\nR7=R7+1\nIF R7<2 GOTOB BACK{n}\n",
+    "TRANS X{n}\nAROT Z10\nG1 X1\nTRANS\n",
+    "$TC_DP6[1,1]=2\nT1 D1\nG41 G1 X0 Y0\nG1 X10\nG1 Y10\nG40 G1 X-10 Y-10\n",
+    "BSPLINE X1 Y1\nX2 Y3\nX4 Y1\nG1 X5 Y5\n",
+    "MCALL CYCLE81(10,0,2,-20)\nG0 X3 Y3\nMCALL\n",
+    "PROFIL\n",
+    "G4 F0.1\n",
+];
+
+/// A program of `pieces` after a start.
+fn generated(pieces: &[usize]) -> String {
+    let mut text = String::from("DEF INT I\nG17 G0 X0 Y0 Z5 S1000 M3\nF500\n");
+    for (n, &piece) in pieces.iter().enumerate() {
+        text.push_str(&PIECES[piece].replace("{n}", &(100 + n).to_string()));
+    }
+    text.push_str("M30\n");
+    text
+}
+
+#[test]
+fn the_pieces_of_generated_programs_run_without_findings() {
+    let text = generated(&(0..PIECES.len()).collect::<Vec<_>>());
+    let trace = run_with(&text, &profil());
+    assert_eq!(findings(&trace, &text), []);
+    assert!(!trace.tool_centre.is_empty() && trace.files.len() == 1);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// Over generated programs with loops, jumps, frames, compensation,
+    /// splines, cycles and calls, a run resumed from any checkpoint goes on
+    /// as the whole run.
+    #[test]
+    fn runs_resumed_from_any_checkpoint_go_on_as_whole_runs(
+        pieces in proptest::collection::vec(0..PIECES.len(), 1..24),
+        every in 1usize..4,
+    ) {
+        assert_resumes_as_the_whole_run(&generated(&pieces), &profil(), every);
+    }
+}
