@@ -786,7 +786,7 @@ impl<'a> Interpreter<'a> {
     }
 
     /// Goes past the blocks of the main file from the furthest one run to
-    /// `block`, which a jump or a call has skipped.
+    /// `block`, which a jump or a structure left early has skipped.
     fn pass_to(&mut self, block: usize) {
         let unit = Rc::clone(&self.units[0]);
         for skipped in self.reached..block {
@@ -814,6 +814,7 @@ impl<'a> Interpreter<'a> {
             // None under way at a checkpoint.
             calls: _,
             modal_call,
+            // None pending at a checkpoint.
             spline: _,
             // None in force at a checkpoint; its path is reported by the
             // run up to the checkpoint.
