@@ -105,7 +105,6 @@
 use std::{
     any::Any,
     f64::consts::TAU,
-    hash::{DefaultHasher, Hash, Hasher},
     ops::{Deref, Range},
     sync::Arc,
 };
@@ -129,7 +128,7 @@ use crate::{
     machine::MachineConfig,
     trace::{
         Axes, Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, Path, PathMode, Position, Resumable,
-        RunRule, Step, StepSink, Stop, Tool, Trace, Undelivered, goes_on, round3, slot,
+        RunRule, Step, StepSink, Stop, Tool, Trace, Undelivered, covers, fold, goes_on, merged, round3, slot,
     },
     transform::{Frame, by_letter, over_axes},
 };
@@ -359,39 +358,18 @@ impl Resumable for Resumed {
     }
 }
 
-/// `before` with `part` folded in.
-fn fold(before: u64, part: impl Hash) -> u64 {
-    let mut hasher = DefaultHasher::new();
-    (before, part).hash(&mut hasher);
-    hasher.finish()
-}
-
 /// The blocks of `unit` before which a run takes no checkpoint because a
 /// cycle after them reads a contour that starts before them (G70 after
 /// the contour G71 skipped): the text before such a checkpoint would
 /// decide the run after it. Sorted and apart.
 fn contours_read_back(unit: &Unit) -> Vec<Range<usize>> {
-    let mut spans: Vec<Range<usize>> = unit
+    let spans = unit
         .model
         .contours()
         .filter(|contour| *contour.blocks.start() < contour.cycle)
         .map(|contour| contour.blocks.start() + 1..contour.cycle + 1)
         .collect();
-    spans.sort_by_key(|span| span.start);
-    let mut merged: Vec<Range<usize>> = Vec::with_capacity(spans.len());
-    for span in spans {
-        match merged.last_mut() {
-            Some(last) if span.start <= last.end => last.end = last.end.max(span.end),
-            _ => merged.push(span),
-        }
-    }
-    merged
-}
-
-/// Whether one of the sorted, disjoint `spans` holds `block`.
-fn covers(spans: &[Range<usize>], block: usize) -> bool {
-    let after = spans.partition_point(|span| span.end <= block);
-    spans.get(after).is_some_and(|span| span.start <= block)
+    merged(spans)
 }
 
 struct Interpreter<'a> {

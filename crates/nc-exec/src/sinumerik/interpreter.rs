@@ -87,12 +87,26 @@
 //! program reads it, and the run has no clock (`$A_YEAR` … read 0,
 //! reported once); `$AA_IM`, `$AA_IW` are the programmed position; a named
 //! tool has no number (`$P_TOOLNO` is 0) and is listed in the trace's
-//! tools by its name. The run takes no checkpoints: a Sinumerik run always starts at
-//! the top.
+//! tools by its name.
+//!
+//! A run into a sink takes the checkpoints the sink asks for before blocks
+//! of the main program that it has not gone past yet, so that every step
+//! before a checkpoint is of a block before it: outside calls and program
+//! sections, before the first file the run reads (a program, or the global
+//! user data), without radius compensation or a spline in force; and
+//! resumes from them. Not inside a control structure, nor after a start
+//! that is never closed: an end after the checkpoint that pairs with a
+//! start before it would let the text before the checkpoint decide the run
+//! after it. A checkpoint's course includes the labels and block numbers
+//! before it, which jumps back and REPEAT look up, and the text of the
+//! blocks it went past without running them or ran without a step, which a
+//! later jump back may run (a block run again that makes a step shows in
+//! its steps).
 
 use std::{
+    any::Any,
     collections::{HashMap, HashSet},
-    ops::Deref,
+    ops::{Deref, Range},
     sync::Arc,
 };
 
@@ -107,7 +121,7 @@ use super::{
         Call, Command, Dimension, Expr, ExprKind, Jump, JumpKind, JumpTarget, Place, PlaceKind, SinumerikBlock,
         StatementKind, Word, WordValue, block_nodes, is_axis,
     },
-    program::{Resolved, SinumerikModel, StructureKind},
+    program::{Resolved, SinumerikModel, StructureKind, Unbalanced},
 };
 use crate::{
     arc::{OffCircle, centre_by_radius, circle_through},
@@ -115,8 +129,8 @@ use crate::{
     lowered::Lowered,
     machine::MachineConfig,
     trace::{
-        ABANDON_INTERVAL, Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, Path, Position, RunRule,
-        Step, StepSink, Stop, Tool, Trace, Undelivered, goes_on, slot,
+        ABANDON_INTERVAL, Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, Path, Position, Resumable,
+        RunRule, Step, StepSink, Stop, Tool, Trace, Undelivered, covers, fold, goes_on, merged, slot,
     },
     transform::{Frame, over_axes},
 };
@@ -146,8 +160,7 @@ pub(crate) fn reset_frame(_machine: &MachineConfig) -> Frame {
 
 /// Runs `text` on `machine` for at most `budget` blocks, reading the
 /// programs it calls through `files`, handing the steps to `sink` as they
-/// are final when there is one. A checkpoint is never taken, so none is
-/// resumed from.
+/// are final when there is one, from its start or from `checkpoint`.
 pub(crate) fn run_in(
     text: &str,
     lowered: Option<&Arc<Unit>>,
@@ -155,11 +168,13 @@ pub(crate) fn run_in(
     machine: &MachineConfig,
     budget: usize,
     mut sink: Option<&mut dyn StepSink>,
-    _checkpoint: Option<&Checkpoint>,
+    checkpoint: Option<&Checkpoint>,
 ) -> Trace {
+    let shared = Arc::new(machine.clone());
     let unit = lowered.cloned().unwrap_or_else(|| Arc::new(Unit::read(text, files)));
-    let mut interpreter = Interpreter::new(machine, files, unit);
-    interpreter.run(budget, sink.as_deref_mut());
+    let mut interpreter = Interpreter::new(&shared, files, text, unit);
+    let start = checkpoint.and_then(|checkpoint| interpreter.resume(checkpoint));
+    interpreter.run(budget, start, sink.as_deref_mut());
     interpreter.end_compensation();
     if let Some(sink) = sink {
         interpreter.deliver(sink, true);
@@ -487,8 +502,120 @@ fn failed(range: TextRange, message: String) -> EvalError {
     EvalError { kind: ErrorKind::Failed, message, range }
 }
 
+/// The run between two blocks of the main program outside calls, which a
+/// [`Checkpoint`] keeps: the modal state, position, feed, spindle, tool and
+/// its data, path modes, frame, variables, MCALL and written files.
+#[derive(Clone)]
+struct Resumed {
+    machine: Arc<MachineConfig>,
+    modes: Modes,
+    position: Position,
+    feed: Option<f64>,
+    speed: f64,
+    tool: u32,
+    edge: u32,
+    tool_data: HashMap<(String, i64, i64), f64>,
+    path: PathControl,
+    frame: ProgrammableFrame,
+    frames: usize,
+    files: files::Files,
+    reported: HashSet<String>,
+    store: Store,
+    modal_call: Option<Call>,
+    /// What the run after the checkpoint may read of the text before it,
+    /// besides the blocks it ran with a step, which a run revisiting them
+    /// shows in its steps: the labels and block numbers, which jumps and
+    /// REPEAT look up, and the text of the blocks it went past or ran
+    /// without a step.
+    before: u64,
+    /// Steps made before it.
+    steps: usize,
+}
+
+impl Resumed {
+    /// See [`Checkpoint::same_course`].
+    fn same_course(&self, other: &Resumed) -> bool {
+        // Every field named, so that a new one must be placed here.
+        let Resumed {
+            machine,
+            modes,
+            position,
+            feed,
+            speed,
+            tool,
+            edge,
+            tool_data,
+            path,
+            frame,
+            frames,
+            files,
+            reported,
+            store,
+            modal_call,
+            before,
+            steps: _,
+        } = self;
+        **machine == *other.machine
+            && *modes == other.modes
+            && *position == other.position
+            && *feed == other.feed
+            && *speed == other.speed
+            && *tool == other.tool
+            && *edge == other.edge
+            && *tool_data == other.tool_data
+            && *path == other.path
+            && *frame == other.frame
+            && *frames == other.frames
+            && *files == other.files
+            && *reported == other.reported
+            && *store == other.store
+            && *modal_call == other.modal_call
+            && *before == other.before
+    }
+}
+
+impl Resumable for Resumed {
+    fn boxed_clone(&self) -> Box<dyn Resumable> {
+        Box::new(self.clone())
+    }
+
+    fn steps(&self) -> usize {
+        self.steps
+    }
+
+    fn set_steps(&mut self, steps: usize) {
+        self.steps = steps;
+    }
+
+    fn same_course(&self, other: &dyn Resumable) -> bool {
+        (other as &dyn Any).downcast_ref::<Resumed>().is_some_and(|other| Resumed::same_course(self, other))
+    }
+}
+
+/// The blocks of `model` before which a run takes no checkpoint: those
+/// after a structure's start up to its end, and all after a start never
+/// closed. An end after such a checkpoint could pair with a start before
+/// it, so that the text before it would decide the run after it; a
+/// one-line `IF … GOTO` that an ENDIF pairs with is among the structures.
+/// Sorted and apart.
+fn inside_structures(model: &SinumerikModel) -> Vec<Range<usize>> {
+    let matched = model.structures.iter().map(|s| s.start + 1..s.end + 1);
+    let unclosed = model.unmatched.iter().filter(|u| u.problem == Unbalanced::NotClosed);
+    merged(matched.chain(unclosed.map(|u| u.block + 1..usize::MAX)).collect())
+}
+
+/// The global user data definition files (Siemens's `_N_SGUD_DEF`,
+/// `_N_MGUD_DEF`, `_N_UGUD_DEF`, `_N_GUD4_DEF` … `_N_GUD9_DEF`).
+fn global_data_files() -> impl Iterator<Item = Called> {
+    let names = ["SGUD", "MGUD", "UGUD", "GUD4", "GUD5", "GUD6", "GUD7", "GUD8", "GUD9"];
+    names.into_iter().map(|name| Called::ControlFile(format!("_N_{name}_DEF")))
+}
+
 struct Interpreter<'a> {
+    machine: &'a Arc<MachineConfig>,
     files: &'a dyn Environment,
+    /// The program's text.
+    text: &'a str,
     units: Vec<Arc<Unit>>,
     /// The files read besides the program, source k being `called[k - 1]`.
     called: Vec<Called>,
@@ -502,10 +629,14 @@ struct Interpreter<'a> {
     compensation: Driver,
     steps: Undelivered,
     executed: usize,
+    /// One past the furthest block of the main file run, and what a run
+    /// after it may read of the text before it ([`Resumed::before`]).
+    reached: usize,
+    before: u64,
 }
 
 impl<'a> Interpreter<'a> {
-    fn new(machine: &'a MachineConfig, files: &'a dyn Environment, unit: Arc<Unit>) -> Self {
+    fn new(machine: &'a Arc<MachineConfig>, files: &'a dyn Environment, text: &'a str, unit: Arc<Unit>) -> Self {
         let state = State {
             machine,
             modes: Modes::at_reset(),
@@ -527,7 +658,9 @@ impl<'a> Interpreter<'a> {
             stopped: false,
         };
         Interpreter {
+            machine,
             files,
+            text,
             units: vec![unit],
             called: Vec::new(),
             store: Store::new(),
@@ -538,6 +671,8 @@ impl<'a> Interpreter<'a> {
             compensation: Driver::default(),
             steps: Undelivered::default(),
             executed: 0,
+            reached: 0,
+            before: 0,
         }
     }
 
@@ -546,12 +681,9 @@ impl<'a> Interpreter<'a> {
     }
 
     /// Declares the global user data of the definition files the
-    /// environment has (Siemens's `_N_SGUD_DEF`, `_N_MGUD_DEF`,
-    /// `_N_UGUD_DEF`, `_N_GUD4_DEF` … `_N_GUD9_DEF`): their DEF lines.
+    /// environment has ([`global_data_files`]): their DEF lines.
     fn define_globals(&mut self) {
-        let names = ["SGUD", "MGUD", "UGUD", "GUD4", "GUD5", "GUD6", "GUD7", "GUD8", "GUD9"];
-        for name in names {
-            let called = Called::ControlFile(format!("_N_{name}_DEF"));
+        for called in global_data_files() {
             let Some(text) = self.files.file(&called) else { continue };
             let source = self.unit_of(called, &text);
             let unit = Arc::clone(&self.units[source]);
@@ -570,11 +702,16 @@ impl<'a> Interpreter<'a> {
         }
     }
 
-    /// Runs the program from its first block for at most `budget` blocks.
-    fn run(&mut self, budget: usize, mut sink: Option<&mut (dyn StepSink + '_)>) {
-        self.define_globals();
-        self.bind_own_parameters();
-        let mut at = At { source: 0, block: 0 };
+    /// Runs the program for at most `budget` blocks, from its first block
+    /// or from `start`; hands `sink` the steps as they are final and the
+    /// checkpoints it asks for.
+    fn run(&mut self, budget: usize, start: Option<At>, mut sink: Option<&mut (dyn StepSink + '_)>) {
+        if start.is_none() {
+            self.define_globals();
+            self.bind_own_parameters();
+        }
+        let mut at = start.unwrap_or(At { source: 0, block: 0 });
+        let inside = inside_structures(&self.units[0].model);
         loop {
             let unit = Arc::clone(&self.units[at.source]);
             self.state.source = at.source;
@@ -590,6 +727,34 @@ impl<'a> Interpreter<'a> {
                 }
             }
             self.state.block_start = unit.ranges[at.block].start();
+            // A block of the main file the run has not gone past yet.
+            let fresh = at.source == 0 && at.block >= self.reached;
+            if fresh {
+                self.pass_to(at.block);
+            }
+            if let Some(sink) = sink.as_deref_mut()
+                && fresh
+                && self.calls.is_empty()
+                && self.called.is_empty()
+                && !self.compensation.is_active()
+                && self.spline.is_none()
+                && !covers(&inside, at.block)
+                && sink.checkpoint_wanted(at.block, unit.ranges[at.block].start())
+            {
+                self.deliver(sink, false);
+                let offset = unit.ranges[at.block].start();
+                let checkpoint =
+                    Checkpoint { state: Box::new(self.resumed()), block: at.block, offset, executed: self.executed };
+                if sink.checkpoint(checkpoint).is_break() {
+                    return;
+                }
+            }
+            if fresh {
+                let block = &unit.block(at.block);
+                let label = block.label.as_ref().map(|label| label.name.as_str());
+                self.before = fold(self.before, (0u8, label, block.number.and_then(|n| n.value)));
+                self.reached = at.block + 1;
+            }
             if self.executed >= budget {
                 let message = format!("the run went past its budget of {budget} blocks");
                 let range = TextRange::up_to(unit.block(at.block).len);
@@ -600,7 +765,12 @@ impl<'a> Interpreter<'a> {
             if !goes_on(self.files, self.executed) {
                 break;
             }
+            let made = self.steps.next();
             let flow = self.block(at, &unit);
+            if fresh && self.steps.next() == made && !unit.block(at.block).statements.is_empty() {
+                // A jump back may run it again without a step to show it.
+                self.before = fold(self.before, (1u8, &self.text[unit.ranges[at.block]]));
+            }
             if self.state.stopped {
                 break;
             }
@@ -624,6 +794,131 @@ impl<'a> Interpreter<'a> {
         }
         // A curve the run stopped in still ends where its points lead.
         self.end_spline();
+    }
+
+    /// Goes past the blocks of the main file from the furthest one run to
+    /// `block`, which a jump or a structure left early has skipped.
+    fn pass_to(&mut self, block: usize) {
+        let unit = Arc::clone(&self.units[0]);
+        for skipped in self.reached..block {
+            let (block, range) = (&unit.block(skipped), unit.ranges[skipped]);
+            let label = block.label.as_ref().map(|label| label.name.as_str());
+            let text = if block.statements.is_empty() { "" } else { &self.text[range] };
+            self.before = fold(self.before, (2u8, label, block.number.and_then(|n| n.value), text));
+        }
+        self.reached = self.reached.max(block);
+    }
+
+    /// The state to resume from before the next block, every step before
+    /// it handed on.
+    fn resumed(&self) -> Resumed {
+        // Every field named, so that a new one must be placed here.
+        let Interpreter {
+            machine,
+            files: _,
+            text: _,
+            units: _,
+            // None read: a checkpoint is taken only before the first.
+            called: _,
+            store,
+            state,
+            // None under way at a checkpoint.
+            calls: _,
+            modal_call,
+            // None pending at a checkpoint.
+            spline: _,
+            // None in force at a checkpoint; its path is reported by the
+            // run up to the checkpoint.
+            compensation: _,
+            steps,
+            executed: _,
+            reached: _,
+            before,
+        } = self;
+        let State {
+            machine: _,
+            modes,
+            position,
+            feed,
+            speed,
+            tool,
+            edge,
+            tool_data,
+            // A resumed run lists the tools it selects itself.
+            tools: _,
+            path,
+            frame,
+            frames,
+            files,
+            findings: _,
+            reported,
+            source: _,
+            block_start: _,
+            stopped: _,
+        } = state;
+        Resumed {
+            machine: Arc::clone(machine),
+            modes: modes.clone(),
+            position: *position,
+            feed: *feed,
+            speed: *speed,
+            tool: *tool,
+            edge: *edge,
+            tool_data: tool_data.clone(),
+            path: path.clone(),
+            frame: frame.clone(),
+            frames: *frames,
+            files: files.clone(),
+            reported: reported.clone(),
+            store: store.clone(),
+            modal_call: modal_call.clone(),
+            before: *before,
+            steps: steps.next(),
+        }
+    }
+
+    /// Goes on from `checkpoint`, a checkpoint of a run of this program on
+    /// this machine: where it resumes; `None`, to run from the start, for a
+    /// checkpoint of another control or machine, of a block this text does
+    /// not have there, or where the global user data a run from the start
+    /// reads is there now.
+    fn resume(&mut self, checkpoint: &Checkpoint) -> Option<At> {
+        let resumed = (&*checkpoint.state as &dyn Any).downcast_ref::<Resumed>()?;
+        let block = checkpoint.block;
+        let here = self.units[0].ranges.get(block).is_some_and(|range| range.start() == checkpoint.offset);
+        if !here || *resumed.machine != **self.machine {
+            return None;
+        }
+        // The checkpoint's run read none.
+        if global_data_files().any(|called| self.files.file(&called).is_some()) {
+            return None;
+        }
+        let Resumed {
+            machine: _,
+            modes,
+            position,
+            feed,
+            speed,
+            tool,
+            edge,
+            tool_data,
+            path,
+            frame,
+            frames,
+            files,
+            reported,
+            store,
+            modal_call,
+            before,
+            steps,
+        } = resumed.clone();
+        let state = &mut self.state;
+        (state.modes, state.position, state.feed, state.speed) = (modes, position, feed, speed);
+        (state.tool, state.edge, state.tool_data, state.path) = (tool, edge, tool_data, path);
+        (state.frame, state.frames, state.files, state.reported) = (frame, frames, files, reported);
+        (self.store, self.modal_call, self.before, self.steps.delivered) = (store, modal_call, before, steps);
+        (self.executed, self.reached) = (checkpoint.executed, block);
+        Some(At { source: 0, block })
     }
 
     /// Hands `sink` the steps no later block can change: all at the

@@ -52,6 +52,9 @@ pub struct SinumerikModel {
     pub jumps: Vec<JumpSite>,
     /// The calls of programs and cycles (not of predefined procedures).
     pub calls: Vec<CallSite>,
+    /// Each block where a structure starts, continues or ends, with the
+    /// structure's index, sorted: a run looks them up at every loop pass.
+    at_block: Vec<(usize, usize)>,
 }
 
 /// A declaration with its block.
@@ -184,6 +187,13 @@ impl SinumerikModel {
             kind: o.kind,
             problem: Unbalanced::NotClosed,
         }));
+        for (index, s) in model.structures.iter().enumerate() {
+            model.at_block.push((s.start, index));
+            // A one-line `IF … GOTO … ENDIF` starts and ends in its block.
+            let others = s.middle.into_iter().chain([s.end]).filter(|&block| block != s.start);
+            model.at_block.extend(others.map(|block| (block, index)));
+        }
+        model.at_block.sort_unstable();
         model
     }
 
@@ -194,12 +204,16 @@ impl SinumerikModel {
 
     /// The structures that start, continue or end at `block`.
     pub fn structures_at(&self, block: usize) -> impl Iterator<Item = &Structure> {
-        self.structures.iter().filter(move |s| s.start == block || s.middle == Some(block) || s.end == block)
+        let first = self.at_block.partition_point(|&(at, _)| at < block);
+        let here = self.at_block[first..].iter().take_while(move |&&(at, _)| at == block);
+        here.map(|&(_, index)| &self.structures[index])
     }
 
     /// The jumps written in `block`.
     pub fn jumps_from(&self, block: usize) -> impl Iterator<Item = &JumpSite> {
-        self.jumps.iter().filter(move |site| site.block == block)
+        // Found in block order.
+        let first = self.jumps.partition_point(|site| site.block < block);
+        self.jumps[first..].iter().take_while(move |site| site.block == block)
     }
 
     /// The block a jump from `from` reaches (see the module documentation).

@@ -2,7 +2,8 @@
 //! checkpoints a run can resume from, and the files it reads.
 
 use std::{
-    ops::ControlFlow,
+    hash::{DefaultHasher, Hash, Hasher},
+    ops::{ControlFlow, Range},
     sync::mpsc::{self, Receiver},
 };
 
@@ -186,6 +187,34 @@ impl Checkpoint {
         shifted.state.set_steps(shift_count(self.state.steps(), steps));
         shifted
     }
+}
+
+/// `before` with `part` folded in: what a checkpoint's run may read of
+/// the text before it.
+pub(crate) fn fold(before: u64, part: impl Hash) -> u64 {
+    let mut hasher = DefaultHasher::new();
+    (before, part).hash(&mut hasher);
+    hasher.finish()
+}
+
+/// `spans` sorted and joined where they meet or overlap: the blocks before
+/// which a run takes no checkpoint, for [`covers`].
+pub(crate) fn merged(mut spans: Vec<Range<usize>>) -> Vec<Range<usize>> {
+    spans.sort_by_key(|span| span.start);
+    let mut merged: Vec<Range<usize>> = Vec::with_capacity(spans.len());
+    for span in spans {
+        match merged.last_mut() {
+            Some(last) if span.start <= last.end => last.end = last.end.max(span.end),
+            _ => merged.push(span),
+        }
+    }
+    merged
+}
+
+/// Whether one of the sorted, disjoint `spans` holds `block`.
+pub(crate) fn covers(spans: &[Range<usize>], block: usize) -> bool {
+    let after = spans.partition_point(|span| span.end <= block);
+    spans.get(after).is_some_and(|span| span.start <= block)
 }
 
 /// `offset` moved by `by` bytes, held inside the text's range.

@@ -433,14 +433,9 @@ fn a_haas_run_of_the_analysis_blocks_equals_a_run_of_the_text() {
 /// Sinumerik.
 #[test]
 fn a_sinumerik_run_of_the_analysis_blocks_equals_a_run_of_the_text() {
-    let mut text = String::from("DEF INT I\nN1 G54 G90 G17 G0 X0 Y0 Z5 M3 S8000\nN2 G1 Z-1 F1200\n");
-    for n in 3..5000 {
-        text.push_str(&format!("N{n} X{:.3} Y{:.3}\n", (n % 97) as f64 * 0.7, (n / 97) as f64 * 1.3));
-    }
-    text.push_str("M30\n");
-    let lines = "I=0\nWHILE I<2\nN4000 G1 X5 Y-3\nI=I+1\nENDWHILE\n";
-    let edits = [("N2503 X", 0, "7"), ("N4000 ", 0, lines), ("N17 X", 1, "")];
-    assert_runs_of_the_analysis_blocks_equal_runs_of_the_text(Dialect::Sinumerik, text, &edits);
+    let lines = "R1=0\nWHILE R1<2\nN4000 G1 X5 Y-3\nR1=R1+1\nENDWHILE\n";
+    let edits = [("N2503 G1 X", 0, "7"), ("N4000 ", 0, lines), ("N17 G1 X", 1, "")];
+    assert_runs_of_the_analysis_blocks_equal_runs_of_the_text(Dialect::Sinumerik, long_sinumerik_program(5000), &edits);
 }
 
 /// Opens `text` in the analysis and applies `edits` (after the first
@@ -613,6 +608,106 @@ proptest::proptest! {
         let later = ["#1 = #1 + 1\nIF [#1 LT 2] GOTO 1000\n", "GOTO 77777\n", "M97 P90000\n", "N1000 G01 X2.\n"];
         let first = "N5 G01 X1. Z1. F2000.\n";
         assert_edits_resume_as_whole_runs(long_haas_program(2500), &edits, first, &later, haas_estimate_of);
+    }
+}
+
+/// A CAM-like Sinumerik program of `blocks` moves after a few variables,
+/// a label to jump back to and the modes.
+fn long_sinumerik_program(blocks: usize) -> String {
+    let mut text = String::from("DEF REAL SAFE=5\nDEF INT PASS\nTOP: R2=R2+1\nR1=0\n");
+    text.push_str("N1 G17 G54 G90 G0 X0 Y0 Z=SAFE S8000 M3\nN2 G1 Z-1 F1200\n");
+    for i in 0..blocks {
+        let (x, y) = ((i % 97) as f64 * 0.7, (i / 97) as f64 * 1.3 + (i % 5) as f64 * 0.2);
+        let block = match i % 250 {
+            17 => "G4 F0.01".to_owned(),
+            31 => format!("G0 X{x:.3} Y{y:.3}"),
+            32 => format!("G1 X{x:.3} Y{y:.3} F900"),
+            _ => format!("G1 X{x:.3} Y{y:.3} F{}", 1000 + i % 3 * 100),
+        };
+        text.push_str(&format!("N{} {block}\n", i + 3));
+    }
+    text.push_str("N99999 G0 Z5 M30\n");
+    text
+}
+
+fn sinumerik_estimate_of(text: &str, previous: Option<&Estimate>) -> Estimate {
+    let machine = MachineConfig::of_control(Dialect::Sinumerik);
+    estimate(previous, &Arc::new(text.to_owned()), &WorkspaceFiles::default(), &machine, 1_000_000)
+}
+
+#[test]
+fn an_edit_of_a_sinumerik_program_reruns_from_the_checkpoint_before_it_to_where_the_run_takes_its_course_again() {
+    let text = long_sinumerik_program(5000);
+    let first = sinumerik_estimate_of(&text, None);
+    assert_eq!(first.stopped, None);
+    assert!(first.checkpoints.len() >= 5, "{} checkpoints", first.checkpoints.len());
+    // A digit typed into an absolute coordinate in the middle.
+    let at = text.find("N2503 G1 X").expect("the block") + "N2503 G1 X".len();
+    let edited = format!("{}7{}", &text[..at], &text[at..]);
+    let resumed = sinumerik_estimate_of(&edited, Some(&first));
+    let whole = sinumerik_estimate_of(&edited, None);
+    assert_alike(&resumed, &whole);
+    assert!(resumed.totals.total > first.totals.total, "the move got longer");
+    // From the checkpoint at block 2000 (N1997) to the one at block 3000.
+    let rerun = usize::from(resumed.rerun.start)..usize::from(resumed.rerun.end);
+    assert!(edited[rerun.clone()].starts_with("N1997 ") && edited[rerun.end..].starts_with("N2997 "), "{rerun:?}");
+    // Edited again, from the resumed estimate: its checkpoints hold.
+    let at = edited.find("N4321 G1 X").expect("the block") + "N4321 G1 X".len();
+    let again = format!("{}{}", &edited[..at], &edited[at + 1..]);
+    let resumed = sinumerik_estimate_of(&again, Some(&resumed));
+    assert_alike(&resumed, &sinumerik_estimate_of(&again, None));
+    assert!(resumed.rerun.end < TextSize::of(again.as_str()));
+    // A variable the moves do not read, set otherwise before the
+    // checkpoints: a jump back to the label could run it, so the run goes
+    // to the end; and the same as a whole run.
+    let renamed = again.replace("R1=0", "R1=0+0");
+    let resumed = sinumerik_estimate_of(&renamed, Some(&resumed));
+    assert_alike(&resumed, &sinumerik_estimate_of(&renamed, None));
+    assert_eq!(resumed.rerun.end, TextSize::of(renamed.as_str()));
+}
+
+#[test]
+fn a_sinumerik_block_without_a_step_that_a_jump_back_runs_again_is_part_of_the_course() {
+    // The label's block is the last before the checkpoint at block 1000,
+    // and the jump back runs it again: what it computes then shows only
+    // in the move at the end.
+    let text = long_sinumerik_program(2500);
+    let at = text.match_indices('\n').nth(998).expect("the line").0 + 1;
+    let end = "R2=R2+1\nIF R2<3 GOTOB LBL\nG1 X=R1 Y1\nN99999 ";
+    let text = format!("{}LBL: R1=R2-1\n{}", &text[..at], &text[at..]).replace("N99999 ", end);
+    let first = sinumerik_estimate_of(&text, None);
+    assert_eq!(first.stopped, None);
+    let after = TextSize::of(&text[..at]) + TextSize::of("LBL: R1=R2-1\n");
+    assert!(first.checkpoints.iter().any(|stored| stored.run.offset() == after));
+    // As long, and the same value on the first run (R2 is 1), another on
+    // the second.
+    let edited = text.replace("LBL: R1=R2-1", "LBL: R1=1-R2");
+    let resumed = sinumerik_estimate_of(&edited, Some(&first));
+    assert_alike(&resumed, &sinumerik_estimate_of(&edited, None));
+    assert_ne!(resumed.totals.total, first.totals.total, "the last move ends elsewhere");
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(12))]
+
+    /// Resumed estimates of a Sinumerik program equal whole runs, edit
+    /// after edit: digits typed or deleted, blocks inserted or removed, a
+    /// WHILE loop, a jump back to the label at the top, a label and a jump
+    /// back to it, IF … ENDIF, a jump to no label (the run stops there).
+    #[test]
+    fn resumed_sinumerik_estimates_equal_whole_runs(
+        edits in proptest::collection::vec((0.0f64..1.0, 0u8..10), 1..4),
+    ) {
+        let later = [
+            "WHILE R1<2\nR1=R1+1\nG1 X=R1 Y1\nENDWHILE\n",
+            "IF R2<2 GOTOB TOP\n",
+            "LBL: G1 X2 Y2\n",
+            "R3=R3+1\nIF R3<2 GOTOB LBL\n",
+            "IF R2>0\nG1 X3 Y3\nENDIF\n",
+            "GOTOF NOWHERE\n",
+        ];
+        let first = "N5 G1 X1 Y1 F2000\n";
+        assert_edits_resume_as_whole_runs(long_sinumerik_program(2500), &edits, first, &later, sinumerik_estimate_of);
     }
 }
 

@@ -1,9 +1,12 @@
-use std::collections::BTreeMap;
+use std::{collections::BTreeMap, ops::ControlFlow};
 
 use proptest::prelude::*;
 
 use super::*;
-use crate::trace::{DEFAULT_STEP_BUDGET, NoFiles, PathMode, WrittenFile};
+use crate::{
+    run::{resume_into, run_into},
+    trace::{Checkpoints, DEFAULT_STEP_BUDGET, NoFiles, PathMode, WrittenFile},
+};
 
 /// Files beside the program by the control's name (`_N_PROFIL_SPF`).
 #[derive(Default)]
@@ -714,4 +717,304 @@ fn compensation_starting_on_an_arc_stops_the_run() {
     let text = "$TC_DP6[1,1]=2\nT1 D1\nG0 X0 Y0\nG41 G2 X10 Y0 CR=5 F100\nG40 G1 X0\nM30\n";
     let trace = run(text);
     assert_eq!(findings(&trace, text), [(RunRule::CompensationFailed, "G41 G2 X10 Y0 CR=5 F100\n")]);
+}
+
+/// Wants one checkpoint, at block `at`, and ends the run there.
+struct StopAt {
+    at: usize,
+}
+
+impl StepSink for StopAt {
+    fn step(&mut self, _step: Step) {}
+
+    fn checkpoint_wanted(&mut self, block: usize, _offset: TextSize) -> bool {
+        block == self.at
+    }
+
+    fn checkpoint(&mut self, _checkpoint: Checkpoint) -> ControlFlow<()> {
+        ControlFlow::Break(())
+    }
+}
+
+/// Checks that a run of `text` resumed from each of its checkpoints (one
+/// every `every` blocks) goes on as the whole run: the same steps, and
+/// after what the run reported up to the checkpoint, the same findings and
+/// tool-centre path; it takes the same checkpoints after it. The blocks of
+/// the checkpoints.
+fn assert_resumes_as_the_whole_run(text: &str, files: &dyn Environment, every: usize) -> Vec<usize> {
+    let (machine, budget) = (machine(), 20_000);
+    let mut whole = Checkpoints { every, ..Checkpoints::default() };
+    let trace = resume_into(None, text, files, &machine, budget, &mut whole);
+    for checkpoint in &whole.taken {
+        let at = checkpoint.block();
+        let before = run_into(text, files, &machine, budget, &mut StopAt { at });
+        let mut resumed = Checkpoints { before: checkpoint.steps(), every, ..Checkpoints::default() };
+        let after = resume_into(Some(checkpoint), text, files, &machine, budget, &mut resumed);
+        assert_eq!(resumed.steps, whole.steps[checkpoint.steps()..], "from block {at}");
+        assert_eq!([&before.findings[..], &after.findings[..]].concat(), trace.findings, "from block {at}");
+        assert_eq!([&before.tool_centre[..], &after.tool_centre[..]].concat(), trace.tool_centre, "from block {at}");
+        assert_eq!([&before.compensated[..], &after.compensated[..]].concat(), trace.compensated, "from block {at}");
+        assert_eq!((&after.files, after.blocks_run), (&trace.files, trace.blocks_run), "from block {at}");
+        let later: Vec<&Checkpoint> = whole.taken.iter().filter(|c| c.block() >= at).collect();
+        assert_eq!(resumed.taken.len(), later.len(), "from block {at}");
+        for (again, first) in resumed.taken.iter().zip(later) {
+            assert!(again.same_course(first) && again.offset() == first.offset(), "from block {at}");
+        }
+    }
+    whole.taken.iter().map(Checkpoint::block).collect()
+}
+
+/// Variables, loops, a branch, a jump over a block, frames, a compensated
+/// stretch, a spline, a jump back to a label and a call.
+const RESUMABLE: &str = "\
+DEF REAL DEPTH=2
+DEF INT I
+R1=0 R2=5
+G17 G0 X0 Y0 Z5 S1000 M3
+G1 Z=-DEPTH F500
+TRANS X10
+AROT Z30
+WHILE R1<3
+  R1=R1+1
+  G1 X=R1*10 Y=R1
+ENDWHILE
+FOR I=1 TO 3
+  G1 X=I Y=I*2
+ENDFOR
+IF R2>3
+  G1 X20
+ELSE
+  G1 X30
+ENDIF
+GOTOF SKIP
+G1 X99
+SKIP:
+TRANS
+$TC_DP6[1,1]=5
+T1 D1
+G41 G1 X0 Y0
+G1 X40
+G1 Y40
+G40 G1 X60 Y60
+BSPLINE X61 Y61
+X62 Y63
+X64 Y64
+G1 X65 Y65
+BACK: G1 X70
+R3=R3+1
+IF R3<2 GOTOB BACK
+G1 X80
+PROFIL
+G1 X90
+M30
+";
+
+fn profil() -> Beside {
+    Beside::with(&[("_N_PROFIL_SPF", "G1 X1 Y1\nM17\n")])
+}
+
+#[test]
+fn a_run_resumed_from_a_checkpoint_goes_on_as_the_whole_run() {
+    let files = profil();
+    let trace = run_with(RESUMABLE, &files);
+    assert_eq!(findings(&trace, RESUMABLE), []);
+    assert!(!trace.tool_centre.is_empty() && trace.files.len() == 1);
+    let blocks = assert_resumes_as_the_whole_run(RESUMABLE, &files, 1);
+    let lines: Vec<&str> = RESUMABLE.lines().collect();
+    let taken: Vec<&str> = blocks.iter().map(|&block| lines[block]).collect();
+    // Before WHILE, FOR and IF, none inside them; the jump's target, not
+    // the block it jumps over; up to G41's block and none until G40's has
+    // run; BSPLINE's, none until the line after the curve has ended it;
+    // each block of the jump back once; none after the call.
+    assert_eq!(
+        taken,
+        [
+            "DEF REAL DEPTH=2",
+            "DEF INT I",
+            "R1=0 R2=5",
+            "G17 G0 X0 Y0 Z5 S1000 M3",
+            "G1 Z=-DEPTH F500",
+            "TRANS X10",
+            "AROT Z30",
+            "WHILE R1<3",
+            "FOR I=1 TO 3",
+            "IF R2>3",
+            "GOTOF SKIP",
+            "SKIP:",
+            "TRANS",
+            "$TC_DP6[1,1]=5",
+            "T1 D1",
+            "G41 G1 X0 Y0",
+            "BSPLINE X61 Y61",
+            "BACK: G1 X70",
+            "R3=R3+1",
+            "IF R3<2 GOTOB BACK",
+            "G1 X80",
+            "PROFIL",
+        ]
+    );
+    // Every other block: the same steps from a checkpoint as from the start.
+    assert_resumes_as_the_whole_run(RESUMABLE, &files, 2);
+}
+
+/// The checkpoints of a run of `text`, one every `every` blocks.
+fn checkpoints(text: &str, files: &dyn Environment, every: usize) -> Vec<Checkpoint> {
+    let mut sink = Checkpoints { every, ..Checkpoints::default() };
+    resume_into(None, text, files, &machine(), 10_000, &mut sink);
+    sink.taken
+}
+
+#[test]
+fn no_checkpoint_after_a_start_never_closed_or_with_global_data() {
+    let text = "G0 X0 F100\nG1 X1\nWHILE R1<2\nR1=R1+1\nG1 X2\nG1 X3\nM30\n";
+    let blocks: Vec<usize> = checkpoints(text, &NoFiles, 1).iter().map(Checkpoint::block).collect();
+    assert_eq!(blocks, [0, 1, 2]);
+    // Global user data read at the start: the files can change under a
+    // checkpoint.
+    let globals = Beside::with(&[("_N_UGUD_DEF", "DEF NCK REAL DEPTH\n")]);
+    let text = "DEPTH=2\nG0 X0 F100\nG1 X=DEPTH\nM30\n";
+    assert!(checkpoints(text, &globals, 1).is_empty());
+    let taken = checkpoints(text.replace("DEPTH", "R1").as_str(), &NoFiles, 1);
+    assert_eq!(taken.len(), 4);
+    // Resumed where global data is now there, the run starts at the top.
+    let mut sink = Checkpoints { every: 1, ..Checkpoints::default() };
+    let trace = resume_into(Some(&taken[2]), text, &globals, &machine(), 10_000, &mut sink);
+    assert_eq!(findings(&trace, text), []);
+    assert_eq!(sink.steps, run_with(text, &globals).steps);
+    assert_eq!(sink.steps.iter().map(|step| step.end[0]).collect::<Vec<_>>(), [0.0, 2.0, 2.0], "G1 X=DEPTH is 2");
+    assert_eq!(sink.steps.iter().map(|step| step.end[0]).collect::<Vec<_>>(), [0.0, 2.0, 2.0], "G1 X=DEPTH is 2");
+}
+
+/// Modal state and variables set early, then moves, then jumps back, one
+/// to a label the program does not have.
+fn resumable_program(first_x: &str) -> String {
+    let mut text = format!("DEF REAL D=5\nR4=2\n; setup\nG0 X{first_x} Y0 Z5 S1000 M3\nR1=2 G1 Z=-D F300\n");
+    for i in 0..40 {
+        text.push_str(&format!("N{} X{} Y{}\n", 100 + i, i * 3, i % 7));
+    }
+    text.push_str("BACK: G1 Y=R1\nR1=R1+1\nIF R1<4 GOTOB BACK\nIF R1<5 GOTOC AGAIN\nM30\n");
+    text
+}
+
+#[test]
+fn checkpoints_after_an_edit_take_the_same_course_once_the_edit_no_longer_matters() {
+    let text = resumable_program("0");
+    let before = checkpoints(&text, &NoFiles, 7);
+    assert_eq!(before.iter().map(Checkpoint::block).collect::<Vec<_>>(), [0, 7, 14, 21, 28, 35, 42, 49]);
+    let course = |edited: &str, shift: i64| {
+        let after = checkpoints(edited, &NoFiles, 7);
+        assert_eq!(after.len(), before.len(), "{edited}");
+        let pairs = after.iter().zip(&before).skip(1);
+        pairs.map(|(after, before)| after.same_course(&before.shifted(shift, 0, 0))).collect::<Vec<bool>>()
+    };
+    // An absolute move written longer, a comment, the same value written
+    // otherwise in a block with a step: the course is the same from the
+    // next block on.
+    assert_eq!(course(&resumable_program("1234"), 3), [true; 7]);
+    assert_eq!(course(&text.replace("; setup", "; set up"), 1), [true; 7]);
+    assert_eq!(course(&text.replace("R1=2 ", "R1=1+1 "), 2), [true; 7]);
+    // A variable read at the end carries the difference there, until the
+    // loop has made it 4 either way.
+    let mut differs = [false; 7];
+    differs[6] = true;
+    assert_eq!(course(&text.replace("R1=2 ", "R1=3 "), 0), differs);
+    // So do the modes, the feed, the spindle, a frame, the tool and its
+    // data.
+    for (from, to) in [
+        ("S1000 M3", "S1000 M4"),
+        ("S1000 M3", "S1200 M3"),
+        ("F300", "F301"),
+        ("G0 X0", "G0 G91 X0"),
+        ("G0 X0", "G0 X0 T2"),
+        ("G0 X0", "G0 X0 D2"),
+        ("R1=2 G1", "R1=2 TRANS Z1\nG1"),
+        ("R1=2 G1", "R1=2 $TC_DP6[1,1]=2 G1"),
+    ] {
+        let edited = text.replace(from, to);
+        let shift = edited.len() as i64 - text.len() as i64;
+        let blocks = i64::from(to.contains('\n'));
+        let after = checkpoints(&edited, &NoFiles, 7);
+        let same =
+            after.iter().skip(1).filter(|after| before.iter().any(|b| after.same_course(&b.shifted(shift, blocks, 0))));
+        assert_eq!(same.count(), 0, "{to}");
+    }
+    // A frame moved otherwise, the text of the blocks without a step the
+    // same.
+    let moved =
+        |z: &str| text.replace("G0 X0", &format!("R5={z} G0 X0")).replace("R1=2 G1", "TRANS Z=R5\nR5=0 R1=2 G1");
+    let (one, two) = (checkpoints(&moved("1"), &NoFiles, 7), checkpoints(&moved("2"), &NoFiles, 7));
+    assert!(one.iter().zip(&two).skip(1).all(|(one, two)| !one.same_course(two)));
+    // The same value written otherwise in a block without a step: a jump
+    // back could run it again unseen.
+    assert_eq!(course(&text.replace("R4=2", "R4=1+1"), 2), [false; 7]);
+    // A label or another block number before them: jumps back look them up.
+    assert_eq!(course(&text.replace("N101 ", "N101 AGAIN: "), 7), [false; 7]);
+    assert_eq!(course(&text.replace("N100 ", "N10 "), -1), [false; 7]);
+}
+
+#[test]
+fn a_block_jumped_over_before_a_checkpoint_is_part_of_its_course() {
+    // `AGAIN: G1 X{x}` runs only after the checkpoints: its text decides
+    // the run.
+    let program = |x: &str| {
+        format!("G0 X0 F100\nGOTOF START\nAGAIN: G1 X{x}\nGOTOF END\nSTART: G1 Y1\nG1 Y2\nGOTOB AGAIN\nEND: M30\n")
+    };
+    let (short, long) = (checkpoints(&program("1"), &NoFiles, 1), checkpoints(&program("10"), &NoFiles, 1));
+    assert_eq!(short.iter().map(Checkpoint::block).collect::<Vec<_>>(), [0, 1, 4, 5, 6, 7]);
+    assert!(!short[2].same_course(&long[2].shifted(-1, 0, 0)));
+    assert!(short[1].same_course(&long[1]));
+    assert_resumes_as_the_whole_run(&program("1"), &NoFiles, 1);
+}
+
+/// Pieces of programs to put together: moves, variables, IF … ELSE …
+/// ENDIF, WHILE and FOR loops, a jump over a block and one back to a
+/// label, frames, a compensated stretch, a spline, a modal drilling cycle,
+/// a call, a dwell. `{n}` is a number of its own for each piece.
+const PIECES: [&str; 13] = [
+    "G1 X=R1+1 Y2\n",
+    "G0 X5 Y5\n",
+    "R1=R1+1\nIF R1>3\nR2=R1\nELSE\nG1 X1\nENDIF\n",
+    "R5=0\nWHILE R5<2\nG1 X=R5 Y1\nR5=R5+1\nENDWHILE\n",
+    "FOR I=1 TO 2\nG1 Y=I\nENDFOR\n",
+    "GOTOF SKIP{n}\nG1 X77\nSKIP{n}: G1 Y-1\n",
+    "R7=0\nBACK{n}: G1 X3\nR7=R7+1\nIF R7<2 GOTOB BACK{n}\n",
+    "TRANS X{n}\nAROT Z10\nG1 X1\nTRANS\n",
+    "$TC_DP6[1,1]=2\nT1 D1\nG41 G1 X0 Y0\nG1 X10\nG1 Y10\nG40 G1 X-10 Y-10\n",
+    "BSPLINE X1 Y1\nX2 Y3\nX4 Y1\nG1 X5 Y5\n",
+    "MCALL CYCLE81(10,0,2,-20)\nG0 X3 Y3\nMCALL\n",
+    "PROFIL\n",
+    "G4 F0.1\n",
+];
+
+/// A program of `pieces` after a start.
+fn generated(pieces: &[usize]) -> String {
+    let mut text = String::from("DEF INT I\nG17 G0 X0 Y0 Z5 S1000 M3\nF500\n");
+    for (n, &piece) in pieces.iter().enumerate() {
+        text.push_str(&PIECES[piece].replace("{n}", &(100 + n).to_string()));
+    }
+    text.push_str("M30\n");
+    text
+}
+
+#[test]
+fn the_pieces_of_generated_programs_run_without_findings() {
+    let text = generated(&(0..PIECES.len()).collect::<Vec<_>>());
+    let trace = run_with(&text, &profil());
+    assert_eq!(findings(&trace, &text), []);
+    assert!(!trace.tool_centre.is_empty() && trace.files.len() == 1);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// Over generated programs with loops, jumps, frames, compensation,
+    /// splines, cycles and calls, a run resumed from any checkpoint goes on
+    /// as the whole run.
+    #[test]
+    fn runs_resumed_from_any_checkpoint_go_on_as_whole_runs(
+        pieces in proptest::collection::vec(0..PIECES.len(), 1..24),
+        every in 1usize..4,
+    ) {
+        assert_resumes_as_the_whole_run(&generated(&pieces), &profil(), every);
+    }
 }

@@ -423,5 +423,12 @@ proptest::proptest! {
             let middle = structure.middle.unwrap_or(structure.start + 1);
             proptest::prop_assert!(structure.start < middle && middle <= structure.end);
         }
+        // The index finds at each block what a search of all finds.
+        for block in 0..=lines.len() {
+            let all = model.structures.iter().filter(|s| s.start == block || s.middle == Some(block) || s.end == block);
+            proptest::prop_assert_eq!(model.structures_at(block).collect::<Vec<_>>(), all.collect::<Vec<_>>());
+            let jumps = model.jumps.iter().filter(|site| site.block == block);
+            proptest::prop_assert_eq!(model.jumps_from(block).collect::<Vec<_>>(), jumps.collect::<Vec<_>>());
+        }
     }
 }
