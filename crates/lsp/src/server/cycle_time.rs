@@ -11,7 +11,8 @@
 //! first, and an edit meanwhile only makes its result stale. A result is
 //! kept only if the document is still at its version; then the client is
 //! asked to refresh its inlay hints and code lenses. The worker runs at the
-//! lower priority of the flow walk.
+//! lower priority of the flow walk, and gives back the memory it freed once
+//! typing pauses.
 
 use std::{
     collections::HashMap,
@@ -37,6 +38,12 @@ const LONG_RUN: Duration = Duration::from_millis(50);
 /// How long a document whose runs are long waits without an edit before it
 /// runs: shorter than a human's pause between keys.
 const TYPING_PAUSE: Duration = Duration::from_millis(40);
+
+/// How long the worker goes without a job before it gives the memory its
+/// runs freed back to the system: longer than a pause between keys, so
+/// that the next edit's run reuses that memory rather than fresh pages the
+/// system must clear for it (a large file's estimate fills megabytes).
+const IDLE_BEFORE_RETURNING_MEMORY: Duration = Duration::from_millis(500);
 
 /// A document's estimate, as the server keeps it.
 #[derive(Debug, Default)]
@@ -98,6 +105,8 @@ impl Timer {
             // Diagnostics and hovers of the edit come first: on two cores a
             // run at normal priority doubles their latency.
             background_priority();
+            // Whether runs freed memory since it was last given back.
+            let mut holding = false;
             loop {
                 let (uri, version, took) = {
                     let (lock, ready) = &*jobs;
@@ -108,7 +117,20 @@ impl Timer {
                             let took = guard.took.get(&uri).copied();
                             break (uri, version, took);
                         }
-                        guard = ready.wait(guard).unwrap_or_else(|poisoned| poisoned.into_inner());
+                        if !holding {
+                            guard = ready.wait(guard).unwrap_or_else(|poisoned| poisoned.into_inner());
+                            continue;
+                        }
+                        let waited = ready.wait_timeout(guard, IDLE_BEFORE_RETURNING_MEMORY);
+                        let (waiting, timeout) = waited.unwrap_or_else(|poisoned| poisoned.into_inner());
+                        guard = waiting;
+                        if timeout.timed_out() && guard.pending.is_empty() {
+                            // Typing paused.
+                            drop(guard);
+                            crate::return_free_memory();
+                            holding = false;
+                            guard = lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+                        }
                     }
                 };
                 if took.is_some_and(|took| took >= LONG_RUN) {
@@ -139,11 +161,8 @@ impl Timer {
                     Ok(Ran::Nothing) => {}
                     Err(_) => tracing::error!("{} v{version}: estimating the cycle time failed", uri.as_str()),
                 }
-                if guard.pending.is_empty() {
-                    drop(guard);
-                    // Nothing more to estimate: typing paused.
-                    crate::return_free_memory();
-                }
+                holding = true;
+                drop(guard);
             }
         });
         if let Err(error) = spawned {
