@@ -104,9 +104,8 @@
 //! its steps).
 
 use std::{
-    any::Any,
     collections::{HashMap, HashSet},
-    ops::{Deref, Range},
+    ops::Deref,
     sync::Arc,
 };
 
@@ -115,13 +114,13 @@ use ncc_syntax::{Parse, TextRange, TextSize};
 
 use super::{
     dynamics::PathControl,
-    eval::{Context, ErrorKind, Eval, EvalError, Store, Value, equal},
+    eval::{Context, ErrorKind, Eval, EvalError, Store, Value},
     frames::ProgrammableFrame,
     lower::{
-        Call, Command, Dimension, Expr, ExprKind, Jump, JumpKind, JumpTarget, Place, PlaceKind, SinumerikBlock,
-        StatementKind, Word, WordValue, block_nodes, is_axis,
+        Call, Command, Dimension, Expr, Place, PlaceKind, SinumerikBlock, StatementKind, Word, WordValue, block_nodes,
+        is_axis,
     },
-    program::{Resolved, SinumerikModel, StructureKind, Unbalanced},
+    program::{SinumerikModel, StructureKind},
 };
 use crate::{
     arc::{OffCircle, centre_by_radius, circle_through},
@@ -129,8 +128,8 @@ use crate::{
     lowered::Lowered,
     machine::MachineConfig,
     trace::{
-        ABANDON_INTERVAL, Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, Path, Position, Resumable,
-        RunRule, Step, StepSink, Stop, Tool, Trace, Undelivered, covers, fold, goes_on, merged, slot,
+        ABANDON_INTERVAL, Called, Checkpoint, DELIVERY_BATCH, Environment, Finding, Motion, Path, Position, RunRule,
+        Step, StepSink, Stop, Tool, Trace, Undelivered, covers, fold, goes_on, slot,
     },
     transform::{Frame, over_axes},
 };
@@ -138,8 +137,12 @@ use crate::{
 mod bspline;
 mod calls;
 mod files;
+mod flow;
 mod frames_and_cycles;
 mod radius;
+mod resume;
+
+use resume::{global_data_files, inside_structures};
 
 use super::modes::{
     INCH, Modes,
@@ -502,115 +505,6 @@ fn failed(range: TextRange, message: String) -> EvalError {
     EvalError { kind: ErrorKind::Failed, message, range }
 }
 
-/// The run between two blocks of the main program outside calls, which a
-/// [`Checkpoint`] keeps: the modal state, position, feed, spindle, tool and
-/// its data, path modes, frame, variables, MCALL and written files.
-#[derive(Clone)]
-struct Resumed {
-    machine: Arc<MachineConfig>,
-    modes: Modes,
-    position: Position,
-    feed: Option<f64>,
-    speed: f64,
-    tool: u32,
-    edge: u32,
-    tool_data: HashMap<(String, i64, i64), f64>,
-    path: PathControl,
-    frame: ProgrammableFrame,
-    frames: usize,
-    files: files::Files,
-    reported: HashSet<String>,
-    store: Store,
-    modal_call: Option<Call>,
-    /// What the run after the checkpoint may read of the text before it,
-    /// besides the blocks it ran with a step, which a run revisiting them
-    /// shows in its steps: the labels and block numbers, which jumps and
-    /// REPEAT look up, and the text of the blocks it went past or ran
-    /// without a step.
-    before: u64,
-    /// Steps made before it.
-    steps: usize,
-}
-
-impl Resumed {
-    /// See [`Checkpoint::same_course`].
-    fn same_course(&self, other: &Resumed) -> bool {
-        // Every field named, so that a new one must be placed here.
-        let Resumed {
-            machine,
-            modes,
-            position,
-            feed,
-            speed,
-            tool,
-            edge,
-            tool_data,
-            path,
-            frame,
-            frames,
-            files,
-            reported,
-            store,
-            modal_call,
-            before,
-            steps: _,
-        } = self;
-        **machine == *other.machine
-            && *modes == other.modes
-            && *position == other.position
-            && *feed == other.feed
-            && *speed == other.speed
-            && *tool == other.tool
-            && *edge == other.edge
-            && *tool_data == other.tool_data
-            && *path == other.path
-            && *frame == other.frame
-            && *frames == other.frames
-            && *files == other.files
-            && *reported == other.reported
-            && *store == other.store
-            && *modal_call == other.modal_call
-            && *before == other.before
-    }
-}
-
-impl Resumable for Resumed {
-    fn boxed_clone(&self) -> Box<dyn Resumable> {
-        Box::new(self.clone())
-    }
-
-    fn steps(&self) -> usize {
-        self.steps
-    }
-
-    fn set_steps(&mut self, steps: usize) {
-        self.steps = steps;
-    }
-
-    fn same_course(&self, other: &dyn Resumable) -> bool {
-        (other as &dyn Any).downcast_ref::<Resumed>().is_some_and(|other| Resumed::same_course(self, other))
-    }
-}
-
-/// The blocks of `model` before which a run takes no checkpoint: those
-/// after a structure's start up to its end, and all after a start never
-/// closed. An end after such a checkpoint could pair with a start before
-/// it, so that the text before it would decide the run after it; a
-/// one-line `IF … GOTO` that an ENDIF pairs with is among the structures.
-/// Sorted and apart.
-fn inside_structures(model: &SinumerikModel) -> Vec<Range<usize>> {
-    let matched = model.structures.iter().map(|s| s.start + 1..s.end + 1);
-    let unclosed = model.unmatched.iter().filter(|u| u.problem == Unbalanced::NotClosed);
-    merged(matched.chain(unclosed.map(|u| u.block + 1..usize::MAX)).collect())
-}
-
-/// The global user data definition files (Siemens's `_N_SGUD_DEF`,
-/// `_N_MGUD_DEF`, `_N_UGUD_DEF`, `_N_GUD4_DEF` … `_N_GUD9_DEF`).
-fn global_data_files() -> impl Iterator<Item = Called> {
-    let names = ["SGUD", "MGUD", "UGUD", "GUD4", "GUD5", "GUD6", "GUD7", "GUD8", "GUD9"];
-    names.into_iter().map(|name| Called::ControlFile(format!("_N_{name}_DEF")))
-}
-
 struct Interpreter<'a> {
     machine: &'a Arc<MachineConfig>,
     files: &'a dyn Environment,
@@ -794,131 +688,6 @@ impl<'a> Interpreter<'a> {
         }
         // A curve the run stopped in still ends where its points lead.
         self.end_spline();
-    }
-
-    /// Goes past the blocks of the main file from the furthest one run to
-    /// `block`, which a jump or a structure left early has skipped.
-    fn pass_to(&mut self, block: usize) {
-        let unit = Arc::clone(&self.units[0]);
-        for skipped in self.reached..block {
-            let (block, range) = (&unit.block(skipped), unit.ranges[skipped]);
-            let label = block.label.as_ref().map(|label| label.name.as_str());
-            let text = if block.statements.is_empty() { "" } else { &self.text[range] };
-            self.before = fold(self.before, (2u8, label, block.number.and_then(|n| n.value), text));
-        }
-        self.reached = self.reached.max(block);
-    }
-
-    /// The state to resume from before the next block, every step before
-    /// it handed on.
-    fn resumed(&self) -> Resumed {
-        // Every field named, so that a new one must be placed here.
-        let Interpreter {
-            machine,
-            files: _,
-            text: _,
-            units: _,
-            // None read: a checkpoint is taken only before the first.
-            called: _,
-            store,
-            state,
-            // None under way at a checkpoint.
-            calls: _,
-            modal_call,
-            // None pending at a checkpoint.
-            spline: _,
-            // None in force at a checkpoint; its path is reported by the
-            // run up to the checkpoint.
-            compensation: _,
-            steps,
-            executed: _,
-            reached: _,
-            before,
-        } = self;
-        let State {
-            machine: _,
-            modes,
-            position,
-            feed,
-            speed,
-            tool,
-            edge,
-            tool_data,
-            // A resumed run lists the tools it selects itself.
-            tools: _,
-            path,
-            frame,
-            frames,
-            files,
-            findings: _,
-            reported,
-            source: _,
-            block_start: _,
-            stopped: _,
-        } = state;
-        Resumed {
-            machine: Arc::clone(machine),
-            modes: modes.clone(),
-            position: *position,
-            feed: *feed,
-            speed: *speed,
-            tool: *tool,
-            edge: *edge,
-            tool_data: tool_data.clone(),
-            path: path.clone(),
-            frame: frame.clone(),
-            frames: *frames,
-            files: files.clone(),
-            reported: reported.clone(),
-            store: store.clone(),
-            modal_call: modal_call.clone(),
-            before: *before,
-            steps: steps.next(),
-        }
-    }
-
-    /// Goes on from `checkpoint`, a checkpoint of a run of this program on
-    /// this machine: where it resumes; `None`, to run from the start, for a
-    /// checkpoint of another control or machine, of a block this text does
-    /// not have there, or where the global user data a run from the start
-    /// reads is there now.
-    fn resume(&mut self, checkpoint: &Checkpoint) -> Option<At> {
-        let resumed = (&*checkpoint.state as &dyn Any).downcast_ref::<Resumed>()?;
-        let block = checkpoint.block;
-        let here = self.units[0].ranges.get(block).is_some_and(|range| range.start() == checkpoint.offset);
-        if !here || *resumed.machine != **self.machine {
-            return None;
-        }
-        // The checkpoint's run read none.
-        if global_data_files().any(|called| self.files.file(&called).is_some()) {
-            return None;
-        }
-        let Resumed {
-            machine: _,
-            modes,
-            position,
-            feed,
-            speed,
-            tool,
-            edge,
-            tool_data,
-            path,
-            frame,
-            frames,
-            files,
-            reported,
-            store,
-            modal_call,
-            before,
-            steps,
-        } = resumed.clone();
-        let state = &mut self.state;
-        (state.modes, state.position, state.feed, state.speed) = (modes, position, feed, speed);
-        (state.tool, state.edge, state.tool_data, state.path) = (tool, edge, tool_data, path);
-        (state.frame, state.frames, state.files, state.reported) = (frame, frames, files, reported);
-        (self.store, self.modal_call, self.before, self.steps.delivered) = (store, modal_call, before, steps);
-        (self.executed, self.reached) = (checkpoint.executed, block);
-        Some(At { source: 0, block })
     }
 
     /// Hands `sink` the steps no later block can change: all at the
@@ -1576,147 +1345,6 @@ impl<'a> Interpreter<'a> {
             corner_tolerance: path.corner_tolerance,
         };
         self.steps.push(step);
-    }
-
-    /// The end of the structure of `kind` that `block` starts or
-    /// continues (ELSE): the block to go on with.
-    fn structure_exit(&mut self, block: usize, kind: StructureKind, unit: &Unit, range: TextRange) -> Flow {
-        let structure =
-            unit.model.structures_at(block).find(|s| s.kind == kind && (s.start == block || s.middle == Some(block)));
-        match structure {
-            // A false IF goes on after its ELSE; ELSE and a false IF
-            // without one at the ENDIF.
-            Some(s) if kind == StructureKind::If && s.start == block => Flow::Jump(s.middle.map_or(s.end, |m| m + 1)),
-            Some(s) if kind == StructureKind::If => Flow::Jump(s.end),
-            Some(s) => Flow::Jump(s.end + 1),
-            None => self.unmatched(kind, range),
-        }
-    }
-
-    /// Back to the start of the structure of `kind` that `block` ends,
-    /// `past` blocks after it.
-    fn structure_back(
-        &mut self,
-        block: usize,
-        kind: StructureKind,
-        unit: &Unit,
-        range: TextRange,
-        past: usize,
-    ) -> Flow {
-        match unit.model.structures_at(block).find(|s| s.kind == kind && s.end == block) {
-            Some(s) => Flow::Jump(s.start + past),
-            None => self.unmatched(kind, range),
-        }
-    }
-
-    fn unmatched(&mut self, kind: StructureKind, range: TextRange) -> Flow {
-        let name = match kind {
-            StructureKind::If => "IF … ENDIF",
-            StructureKind::While => "WHILE … ENDWHILE",
-            StructureKind::For => "FOR … ENDFOR",
-            StructureKind::Repeat => "REPEAT … UNTIL",
-            StructureKind::Loop => "LOOP … ENDLOOP",
-        };
-        let message = format!("{name} is not closed or not opened: the control stops");
-        self.state.finding(RunRule::CallTargetMissing, range, &message);
-        Flow::Stop
-    }
-
-    /// Whether a FOR's variable is still at most its end.
-    fn for_continues(&mut self, variable: &Place, end: &Expr) -> Option<bool> {
-        let current = ExprKind::Name(variable.clone());
-        let current = Expr { kind: current, range: end.range };
-        let result = (|| {
-            let mut eval = self.eval();
-            Ok::<_, EvalError>(eval.number(&current)? <= eval.number(end)?)
-        })();
-        self.check(result)
-    }
-
-    /// ENDFOR: the variable steps by 1 and the body runs again while it is
-    /// at most the end.
-    fn end_for(&mut self, block: usize, unit: &Unit, range: TextRange) -> Flow {
-        let Some(structure) = unit.model.structures_at(block).find(|s| s.kind == StructureKind::For && s.end == block)
-        else {
-            return self.unmatched(StructureKind::For, range);
-        };
-        let header = unit.block(structure.start).statements.iter().find_map(|statement| match &statement.kind {
-            StatementKind::For { variable, end, .. } => Some((variable, end)),
-            _ => None,
-        });
-        let Some((variable, end)) = header else { return self.unmatched(StructureKind::For, range) };
-        let current = Expr { kind: ExprKind::Name(variable.clone()), range };
-        let result = (|| {
-            let mut eval = self.eval();
-            let next = eval.value(&current)?.number(range)? + 1.0;
-            eval.write(variable, Value::Real(next), range)
-        })();
-        match self.check(result).and_then(|()| self.for_continues(variable, end)) {
-            None => Flow::Stop,
-            Some(true) => Flow::Jump(structure.start + 1),
-            Some(false) => Flow::Next,
-        }
-    }
-
-    /// CASE: the first arm whose value equals the selector's, else
-    /// DEFAULT, else the next block.
-    fn case(&mut self, block: usize, selector: &Expr, arms: &[super::lower::CaseArm], unit: &Unit) -> Flow {
-        let result = self.eval().value(selector);
-        let Some(value) = self.check(result) else { return Flow::Stop };
-        for arm in arms {
-            let matched = match &arm.value {
-                None => true,
-                Some(expr) => {
-                    let result = self.eval().value(expr).and_then(|arm_value| equal(&value, &arm_value, expr.range));
-                    match self.check(result) {
-                        Some(matched) => matched,
-                        None => return Flow::Stop,
-                    }
-                }
-            };
-            if matched {
-                return self.jump(block, &arm.jump, unit);
-            }
-        }
-        Flow::Next
-    }
-
-    /// Where a jump from `block` leads.
-    fn jump(&mut self, block: usize, jump: &Jump, unit: &Unit) -> Flow {
-        let mut computed_name = None;
-        let resolved = match &jump.target {
-            Some(JumpTarget::Computed(expr)) => {
-                let result = self.eval().value(expr);
-                let Some(name) = self.check(result) else { return Flow::Stop };
-                let name = name.text().trim().to_ascii_uppercase();
-                let number = name.strip_prefix('N').or_else(|| name.strip_prefix(':'));
-                let target =
-                    match number.filter(|digits| !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())) {
-                        Some(digits) => JumpTarget::BlockNumber(digits.parse().ok()),
-                        None => JumpTarget::Label(name.clone()),
-                    };
-                let computed = Jump { kind: jump.kind, target: Some(target), range: jump.range };
-                computed_name = Some(name);
-                unit.model.resolve(block, &computed)
-            }
-            _ => unit.model.resolve(block, jump),
-        };
-        match resolved {
-            Resolved::Block(target) => Flow::Jump(target),
-            Resolved::Start => Flow::Jump(0),
-            Resolved::NotFound { alarm: false } => Flow::Next,
-            Resolved::NotFound { alarm: true } | Resolved::Computed | Resolved::NoTarget => {
-                let direction = match jump.kind {
-                    JumpKind::GotoF => " after it",
-                    JumpKind::GotoB => " before it",
-                    _ => "",
-                };
-                let target = computed_name.map_or_else(String::new, |name| format!(" {name}"));
-                let message = format!("the jump's target{target} is not in the program{direction}: the control stops");
-                self.state.finding(RunRule::CallTargetMissing, jump.range, &message);
-                Flow::Stop
-            }
-        }
     }
 }
 
