@@ -687,6 +687,25 @@ fn a_sinumerik_block_without_a_step_that_a_jump_back_runs_again_is_part_of_the_c
     assert_ne!(resumed.totals.total, first.totals.total, "the last move ends elsewhere");
 }
 
+#[test]
+fn a_haas_block_without_a_move_that_a_jump_back_runs_again_drops_the_checkpoints_after_it() {
+    // As for Sinumerik, but a Haas macro block makes a step without a
+    // move: its second run shows, and the checkpoints after it go.
+    let text = long_haas_program(2500);
+    let at = text.match_indices('\n').nth(998).expect("the line").0 + 1;
+    let end = "#2 = #2 + 1\nIF [#2 LT 3] GOTO 2\nG01 X[#1] Z1.\nN99999 ";
+    let text = format!("{}N2 #1 = #2 - 1\n{}", &text[..at], &text[at..]).replace("N99999 ", end);
+    let first = haas_estimate_of(&text, None);
+    assert_eq!(first.stopped, None);
+    let n2 = TextSize::of(&text[..at]);
+    assert!(first.checkpoints.iter().all(|stored| stored.run.offset() <= n2));
+    // The same value on the first run (#2 is 0), another on the others.
+    let edited = text.replace("N2 #1 = #2 - 1", "N2 #1 = 1 - #2");
+    let resumed = haas_estimate_of(&edited, Some(&first));
+    assert_alike(&resumed, &haas_estimate_of(&edited, None));
+    assert_ne!(resumed.totals.total, first.totals.total, "the last move ends elsewhere");
+}
+
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig::with_cases(12))]
 
