@@ -227,17 +227,21 @@ impl Server {
         query: impl FnOnce(&Snapshot) -> T + Send + 'static,
     ) -> jsonrpc::Result<T> {
         let snapshot = self.snapshot(uri)?;
-        let task =
-            tokio::task::spawn_blocking(move || Cancelled::catch(std::panic::AssertUnwindSafe(|| query(&snapshot))));
-        match task.await {
+        // On this thread, which hands the runtime's other tasks to another
+        // while it answers: the answer waits for no thread to wake up.
+        let answered = tokio::task::block_in_place(move || {
+            let answer = std::panic::AssertUnwindSafe(|| query(&snapshot));
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| Cancelled::catch(answer)))
+        });
+        match answered {
             Ok(Ok(answer)) => Ok(answer),
             Ok(Err(_cancelled)) => Err(jsonrpc::Error {
                 code: ErrorCode::ContentModified,
                 message: "the document changed while answering".into(),
                 data: None,
             }),
-            Err(join_error) => {
-                tracing::error!("request failed: {join_error}");
+            Err(_panic) => {
+                tracing::error!("request failed: the query panicked");
                 Err(jsonrpc::Error::internal_error())
             }
         }
