@@ -68,9 +68,8 @@ pub fn run_in_background() {
 }
 
 /// Runs `work` without giving way: it holds what a request may need (a
-/// lock), and lets go for requests by itself; or it is short and waited
-/// for like a request.
-pub fn without_giving_way<T>(work: impl FnOnce() -> T) -> T {
+/// lock), and lets go for requests by itself.
+pub(crate) fn without_giving_way<T>(work: impl FnOnce() -> T) -> T {
     struct Restore(bool);
     impl Drop for Restore {
         fn drop(&mut self) {

@@ -222,16 +222,7 @@ fn run(state: &Mutex<State>, jobs: &(Mutex<Jobs>, Condvar), uri: &Uri, version: 
         interactive::give_way();
         jobs.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).pending.contains_key(uri)
     };
-    // Resumed from the previous estimate, the run is short and its hint
-    // is what the edit waits for: the other background work gives way to
-    // it as to a request, and it does not give way itself.
-    let resumed = previous.as_ref().map(|_| interactive::Request::begin());
-    let estimate = match resumed {
-        Some(_) => interactive::without_giving_way(|| input.estimate(previous.as_deref(), STEP_BUDGET, &newer)),
-        None => input.estimate(previous.as_deref(), STEP_BUDGET, &newer),
-    };
-    drop(resumed);
-    let Some(estimate) = estimate else {
+    let Some(estimate) = input.estimate(previous.as_deref(), STEP_BUDGET, &newer) else {
         tracing::debug!("{} v{version}: cycle time given up for a newer version", uri.as_str());
         return Ran::GivenUp(started.elapsed());
     };
