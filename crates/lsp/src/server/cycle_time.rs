@@ -24,7 +24,7 @@ use ncc_analysis::{Cancelled, Estimate, TextRange, TextSize, interactive};
 use tokio::sync::mpsc;
 use tower_lsp_server::{Client, ls_types::Uri};
 
-use super::{State, background_priority, lock};
+use super::{State, lock, priority};
 
 /// Blocks a run executes at most: a million steps hold a few hundred
 /// megabytes while the model times them; a program that runs longer (a
@@ -104,7 +104,7 @@ impl Timer {
         let spawned = std::thread::Builder::new().name("ncc-cycle-time".into()).spawn(move || {
             // Diagnostics and hovers of the edit come first: on two cores a
             // run at normal priority doubles their latency.
-            background_priority();
+            priority::background();
             // Whether runs freed memory since it was last given back.
             let mut holding = false;
             loop {

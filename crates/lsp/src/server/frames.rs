@@ -140,8 +140,10 @@ pub(crate) async fn forward_output(
     let mut reader = BufReader::new(server);
     while let Some(frame) = read_frame(&mut reader).await? {
         if let Frame::Body(body) = frame {
-            pending.answered(&body);
+            // Written first: background work resumes when the request ends,
+            // and would take the core the write waits for.
             write(&framed(&body))?;
+            pending.answered(&body);
         }
     }
     Ok(())
@@ -261,6 +263,23 @@ mod tests {
         pending.answered(br#"{"jsonrpc":"2.0","id":8,"result":null}"#);
         assert_eq!(pending.lock().len(), 1);
         pending.answered(br#"{"jsonrpc":"2.0","result":{"contents":"G01"},"id":7}"#);
+        assert!(pending.lock().is_empty());
+    }
+
+    /// A request ends once its answer is written, not before.
+    #[tokio::test]
+    async fn a_request_ends_after_its_answer_is_written() {
+        let pending = Pending::default();
+        pending.read(&json!(7));
+        let answer = framed(br#"{"jsonrpc":"2.0","id":7,"result":null}"#);
+        let pending_at_write = std::cell::RefCell::new(Vec::new());
+        let write = |frame: &[u8]| {
+            assert_eq!(frame, answer);
+            pending_at_write.borrow_mut().push(pending.lock().len());
+            Ok(())
+        };
+        forward_output(&answer[..], write, pending.clone()).await.expect("forwarded");
+        assert_eq!(*pending_at_write.borrow(), [1]);
         assert!(pending.lock().is_empty());
     }
 }

@@ -20,6 +20,7 @@ mod cycle_time;
 mod frames;
 mod handlers;
 mod plot;
+mod priority;
 mod semantic;
 mod workspace;
 
@@ -33,9 +34,7 @@ use std::{
     },
 };
 
-use ncc_analysis::{
-    Analysis, Cancelled, CycleTimeHints, Diagnostic, Dialect, FileId, Findings, TextRange, TextSize, interactive,
-};
+use ncc_analysis::{Analysis, Cancelled, CycleTimeHints, Diagnostic, Dialect, FileId, Findings, TextRange, TextSize};
 use tokio::sync::mpsc;
 use tower_lsp_server::{
     Client, LanguageServer, LspService,
@@ -305,7 +304,7 @@ impl Server {
             let Ok((first, local)) = local else { return };
             tracing::debug!("{} v{version}: local diagnostics in {:?}", uri.as_str(), started.elapsed());
             send(first);
-            background_priority();
+            priority::background();
             if !opened {
                 prepare(&analysis);
             }
@@ -336,22 +335,6 @@ impl Server {
             tracing::error!("cannot start a diagnostics thread: {error}");
         }
     }
-}
-
-/// Lowers the calling thread's priority (nice 10), and makes its work give
-/// way to requests between blocks: the flow walk, the state preparation
-/// and the cycle-time run take up to hundreds of milliseconds on a large
-/// program, and edits and hovers must not wait for a core behind them (a
-/// lower priority alone lets a thread that wakes wait for a running one's
-/// time slice). Not the idle scheduling class: on a busy machine (a build
-/// running) that starves the walk, and the complete diagnostics would not
-/// come until the machine is idle.
-fn background_priority() {
-    // On Linux the "process" priority is the calling thread's. Failing
-    // leaves the thread as it was.
-    #[cfg(target_os = "linux")]
-    let _ = rustix::process::setpriority_process(None, 10);
-    interactive::run_in_background();
 }
 
 /// Transparent huge pages off for the server's process. mimalloc asks for
