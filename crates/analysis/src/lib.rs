@@ -36,8 +36,8 @@ use crate::db::{Db, Settings};
 pub use crate::ide::{
     completion::{CompletionItem, CompletionKind},
     cycle_time::{
-        BlockTime, BreakAt, CycleTimeHints, CycleTotals, Estimate, RunInput, WorkspaceFiles, clock, estimate,
-        short_time,
+        BlockTime, BlockTimes, BreakAt, CycleTimeHints, CycleTotals, Estimate, RunInput, WorkspaceFiles, clock,
+        estimate, short_time,
     },
     folding::{Fold, FoldKind},
     highlight::{HighlightKind, HighlightRange},

@@ -23,6 +23,7 @@ use ncc_syntax::{BlockParser, Dialect, SyntaxNode, TextRange, TextSize, ast::Ast
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 
+pub use self::block_times::BlockTimes;
 use crate::{
     InlayHint, InlayHintKind, MachineConfig,
     cnc8x6::model::{self, FileKind},
@@ -52,7 +53,7 @@ pub enum CycleTimeHints {
 #[derive(Debug, Clone, Default)]
 pub struct Estimate {
     /// The blocks of the file that ran, in the order they are written.
-    pub blocks: Vec<BlockTime>,
+    pub blocks: BlockTimes,
     pub totals: CycleTotals,
     /// Why the run stopped before the program's end, if it did.
     pub stopped: Option<String>,
@@ -516,6 +517,11 @@ impl BlockTime {
 /// Every step charged to a block of the file as the model times it, and
 /// the sums; the checkpoints of the run.
 struct Charges<'a> {
+    /// The blocks a resumed run starts with, shared with the previous
+    /// estimate: a step of one of them (a jump back before the checkpoint)
+    /// copies them into `blocks`.
+    kept: BlockTimes,
+    /// The blocks after `kept`; a block's index counts `kept`'s too.
     blocks: Vec<BlockTime>,
     /// Whether `blocks` are in text order, else where each one is.
     in_order: bool,
@@ -537,6 +543,7 @@ struct Charges<'a> {
 impl<'a> Charges<'a> {
     fn new(change: Option<Change<'a>>) -> Charges<'a> {
         Charges {
+            kept: BlockTimes::default(),
             blocks: Vec::new(),
             in_order: true,
             index_of: FxHashMap::default(),
@@ -552,12 +559,21 @@ impl<'a> Charges<'a> {
     /// and their sums, and its checkpoints before it.
     fn resume(&mut self, previous: &Estimate, index: usize) {
         let mark = &previous.checkpoints[index].charges;
-        let charged = mark.blocks.saturating_sub(1);
-        self.blocks = previous.blocks[..charged].to_vec();
+        self.kept = previous.blocks.prefix(mark.blocks.saturating_sub(1));
         self.blocks.extend(mark.last.clone());
-        self.current = self.blocks.len().checked_sub(1);
+        self.current = self.len().checked_sub(1);
         self.sums = mark.sums;
         self.checkpoints = previous.checkpoints[..index].to_vec();
+    }
+
+    /// The number of blocks charged.
+    fn len(&self) -> usize {
+        self.kept.len() + self.blocks.len()
+    }
+
+    /// The block at `index`, which is past `kept`.
+    fn block_mut(&mut self, index: usize) -> &mut BlockTime {
+        &mut self.blocks[index - self.kept.len()]
     }
 
     /// The block a step is charged to: its own in this file, found or
@@ -567,15 +583,25 @@ impl<'a> Charges<'a> {
             return self.current;
         }
         let start = step.range.start();
+        if self.kept.last().is_some_and(|last| start <= last.range.start()) {
+            // A jump back before the checkpoint the run resumed from.
+            let after = std::mem::take(&mut self.blocks);
+            self.blocks = std::mem::take(&mut self.kept).to_vec();
+            self.blocks.extend(after);
+            if !self.in_order {
+                self.index_of = self.index_all();
+            }
+        }
         if self.in_order {
             // While blocks come in text order, their place finds them.
             let found = self.blocks.binary_search_by_key(&start, |block| block.range.start());
+            let kept = self.kept.len();
             match found {
-                Ok(index) => return Some(index),
+                Ok(index) => return Some(kept + index),
                 Err(place) if place == self.blocks.len() => return Some(self.add_block(step)),
                 Err(_) => {
                     self.in_order = false;
-                    self.index_of = self.blocks.iter().enumerate().map(|(i, block)| (block.range.start(), i)).collect();
+                    self.index_of = self.index_all();
                 }
             }
         }
@@ -585,6 +611,12 @@ impl<'a> Charges<'a> {
         let index = self.add_block(step);
         self.index_of.insert(start, index);
         Some(index)
+    }
+
+    /// Where each block of `blocks` is, by its start.
+    fn index_all(&self) -> FxHashMap<TextSize, usize> {
+        let kept = self.kept.len();
+        self.blocks.iter().enumerate().map(|(i, block)| (block.range.start(), kept + i)).collect()
     }
 
     fn add_block(&mut self, step: &Step) -> usize {
@@ -597,11 +629,12 @@ impl<'a> Charges<'a> {
             profile: velocity::Profile::default(),
             breaks: SmallVec::new(),
         });
-        self.blocks.len() - 1
+        self.len() - 1
     }
 
     fn mark(&self) -> Mark {
-        Mark { blocks: self.blocks.len(), last: self.blocks.last().cloned(), sums: self.sums }
+        let last = self.blocks.last().cloned().or_else(|| self.kept.last());
+        Mark { blocks: self.len(), last, sums: self.sums }
     }
 
     /// The previous estimate's checkpoint at `offset`, when the text after
@@ -627,6 +660,7 @@ impl<'a> Charges<'a> {
     ) -> Estimate {
         let mut sums = self.sums;
         let mut rerun_end = TextSize::of(text.as_str());
+        let mut after = BlockTimes::default();
         // The rejoining checkpoint is the run's last.
         let rejoined = self.rejoined.zip(self.checkpoints.last().cloned());
         if let (Some((index, to)), Some(change)) = (rejoined, &self.change) {
@@ -637,9 +671,10 @@ impl<'a> Charges<'a> {
             rerun_end = to.run.offset();
             let clock = to.charges.sums.totals.total_time - from.charges.sums.totals.total_time;
             let kept = to.charges.blocks.saturating_sub(1);
-            self.blocks.truncate(kept);
+            self.blocks.truncate(kept.saturating_sub(self.kept.len()));
+            self.kept = self.kept.prefix(kept);
             let first_old = from.charges.blocks.saturating_sub(1);
-            self.blocks.extend(previous.blocks[first_old..].iter().map(|block| block.moved(change.shift, clock)));
+            after = previous.blocks.slice(first_old..previous.blocks.len()).moved(change.shift, clock);
             let later = previous.checkpoints[index + 1..].iter().map(|stored| stored.moved(from, to, change.shift));
             self.checkpoints.extend(later.collect::<Vec<_>>());
             sums = previous.sums.moved(&from.charges.sums, &to.charges.sums);
@@ -649,8 +684,11 @@ impl<'a> Charges<'a> {
         if !self.in_order {
             self.blocks.sort_by_key(|block| block.range.start());
         }
+        let mut blocks = self.kept;
+        blocks.push_owned(self.blocks);
+        blocks.append(after);
         Estimate {
-            blocks: self.blocks,
+            blocks,
             totals: sums.cycle_totals(),
             sums,
             stopped,
@@ -670,7 +708,7 @@ impl TimingSink for Charges<'_> {
         self.sums.breaks += 1;
         self.sums.lost += speed_break.lost;
         let Some(index) = self.block_of(step) else { return };
-        let block = &mut self.blocks[index];
+        let block = self.block_mut(index);
         let code = speed_break.reason.code();
         match block.breaks.iter_mut().find(|known| known.reason.code() == code) {
             Some(known) => {
@@ -696,8 +734,10 @@ impl TimingSink for Charges<'_> {
         if step.source == 0
             && let Some(own) = index
         {
-            let block = &mut self.blocks[own];
-            if self.current == index {
+            let (continued, rejoined) = (self.current == index, self.rejoined.is_some());
+            let block = self.block_mut(own);
+            let mut runs_again = None;
+            if continued {
                 block.profile.peak = block.profile.peak.max(profile.peak);
                 block.profile.exit = profile.exit;
                 block.profile.duration += profile.duration;
@@ -706,15 +746,18 @@ impl TimingSink for Charges<'_> {
                 block.profile = profile;
                 // After the rejoining checkpoint the steps are the previous
                 // estimate's, which kept it.
-                if block.executions > 1 && self.rejoined.is_none() {
-                    let start = block.range.start();
-                    let kept = self.checkpoints.partition_point(|stored| stored.run.offset() <= start);
-                    self.checkpoints.truncate(kept);
+                if block.executions > 1 && !rejoined {
+                    runs_again = Some(block.range.start());
                 }
+            }
+            if let Some(start) = runs_again {
+                let kept = self.checkpoints.partition_point(|stored| stored.run.offset() <= start);
+                self.checkpoints.truncate(kept);
             }
             self.current = index;
         }
-        if let Some(block) = index.map(|index| &mut self.blocks[index]) {
+        if let Some(index) = index {
+            let block = self.block_mut(index);
             block.total += profile.duration;
             if block.executions == 1 {
                 block.end = start + profile.duration;
@@ -755,9 +798,9 @@ impl TimingSink for Charges<'_> {
 
 impl Estimate {
     /// The block whose range holds `offset` (its end included).
-    pub fn block_at(&self, offset: TextSize) -> Option<&BlockTime> {
+    pub fn block_at(&self, offset: TextSize) -> Option<BlockTime> {
         let after = self.blocks.partition_point(|block| block.range.start() <= offset);
-        self.blocks[..after].last().filter(|block| block.range.contains_inclusive(offset))
+        self.blocks.get(after.checked_sub(1)?).filter(|block| block.range.contains_inclusive(offset))
     }
 
     /// The hints in `range` (everywhere without one), at the end of the
@@ -771,7 +814,7 @@ impl Estimate {
         let first = range.map_or(0, |range| self.blocks.partition_point(|block| block.range.end() < range.start()));
         let mut hints = Vec::new();
         let mut blocks = BlockParser::new(&self.text);
-        for block in &self.blocks[first..] {
+        for block in self.blocks.iter_from(first) {
             if range.is_some_and(|range| block.range.start() > range.end()) {
                 break;
             }
@@ -933,5 +976,6 @@ pub fn short_time(seconds: f64) -> String {
     if hours > 0.0 { format!("{hours}:{minutes:02}:{seconds:04.1}") } else { format!("{minutes}:{seconds:04.1}") }
 }
 
+mod block_times;
 #[cfg(test)]
 mod tests;
