@@ -681,7 +681,7 @@ pub(crate) fn walk(db: &dyn Db, file: &FileModel, main: bool, mut visit: impl Fn
         }
     }
     if computed {
-        for &block in model.labels.values().chain(model.block_numbers.values()).flatten() {
+        for &block in model.labels.values().flatten().chain(model.block_numbers.blocks()) {
             unknown_ways[block] = true;
         }
     }

@@ -31,6 +31,50 @@ pub const PROGRAM_LEVELS: usize = 16;
 /// an allocation of its own.
 pub type Blocks = SmallVec<[usize; 1]>;
 
+/// The blocks carrying each block number, as sorted pairs: a CAM program
+/// numbers every block, and a map's insert per block took most of the
+/// time of the model.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BlockNumbers {
+    /// Sorted by number, then block.
+    numbers: Vec<u64>,
+    blocks: Vec<usize>,
+}
+
+impl BlockNumbers {
+    /// The blocks carrying `number`, in file order.
+    pub fn get(&self, number: u64) -> &[usize] {
+        let start = self.numbers.partition_point(|&n| n < number);
+        let end = start + self.numbers[start..].partition_point(|&n| n == number);
+        &self.blocks[start..end]
+    }
+
+    /// Each number with its blocks, in ascending order.
+    pub fn iter(&self) -> impl Iterator<Item = (u64, &[usize])> {
+        let starts = (0..self.numbers.len()).filter(|&i| i == 0 || self.numbers[i - 1] != self.numbers[i]);
+        starts.map(|start| (self.numbers[start], self.get(self.numbers[start])))
+    }
+
+    /// Every numbered block, by number.
+    pub fn blocks(&self) -> &[usize] {
+        &self.blocks
+    }
+
+    /// From pairs of a number and its block, in file order.
+    fn new(mut numbered: Vec<(u64, usize)>) -> BlockNumbers {
+        // Programs mostly number in ascending order: a sort that finds
+        // runs takes one pass over them.
+        numbered.sort();
+        numbered.into_iter().unzip::<_, _, Vec<_>, Vec<_>>().into()
+    }
+}
+
+impl From<(Vec<u64>, Vec<usize>)> for BlockNumbers {
+    fn from((numbers, blocks): (Vec<u64>, Vec<usize>)) -> BlockNumbers {
+        BlockNumbers { numbers, blocks }
+    }
+}
+
 /// The model of one file.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SinumerikModel {
@@ -38,7 +82,7 @@ pub struct SinumerikModel {
     pub labels: BTreeMap<String, Blocks>,
     /// Every block carrying each block number (`N10` or `:10`), in file
     /// order.
-    pub block_numbers: BTreeMap<u64, Blocks>,
+    pub block_numbers: BlockNumbers,
     /// The matched structures, in the order they close.
     pub structures: Vec<Structure>,
     /// Starts never closed, ends and ELSEs without their start, in the
@@ -163,6 +207,7 @@ impl SinumerikModel {
     {
         let mut model = SinumerikModel::default();
         let mut open = Opened::default();
+        let mut numbered = Vec::new();
         // One pass, the jumps resolved after it, once every label is known:
         // a large file's blocks are read from memory once.
         for (index, block) in blocks.into_iter().enumerate() {
@@ -170,13 +215,14 @@ impl SinumerikModel {
                 model.labels.entry(label.name.clone()).or_default().push(index);
             }
             if let Some(number) = block.number.and_then(|number| number.value) {
-                model.block_numbers.entry(number).or_default().push(index);
+                numbered.push((number, index));
             }
             for statement in block.statements.iter().filter(|_| block.modelled) {
                 model.structure(&mut open, index, &statement.kind);
                 model.declarations_and_calls(index, &statement.kind);
             }
         }
+        model.block_numbers = BlockNumbers::new(numbered);
         let mut jumps = std::mem::take(&mut model.jumps);
         for site in &mut jumps {
             site.resolved = model.resolve(site.block, &site.jump);
@@ -222,10 +268,10 @@ impl SinumerikModel {
             _ if jump.kind == JumpKind::GotoS => return Resolved::Start,
             None | Some(JumpTarget::BlockNumber(None)) => return Resolved::NoTarget,
             Some(JumpTarget::Computed(_)) => return Resolved::Computed,
-            Some(JumpTarget::Label(label)) => self.labels.get(label),
-            Some(JumpTarget::BlockNumber(Some(number))) => self.block_numbers.get(number),
+            Some(JumpTarget::Label(label)) => self.labels.get(label).map(|blocks| blocks.as_slice()),
+            Some(JumpTarget::BlockNumber(Some(number))) => Some(self.block_numbers.get(*number)),
         };
-        let candidates = candidates.map_or(&[][..], |blocks| blocks.as_slice());
+        let candidates = candidates.unwrap_or_default();
         let forward = || candidates.iter().copied().find(|&block| block > from);
         let backward = || candidates.iter().copied().rev().find(|&block| block <= from);
         let found = match jump.kind {

@@ -54,7 +54,7 @@ fn show_model(model: &SinumerikModel) -> String {
     for (label, blocks) in &model.labels {
         writeln!(out, "label {label} at {:?}", blocks.iter().copied().map(line).collect::<Vec<_>>()).unwrap();
     }
-    for (number, blocks) in &model.block_numbers {
+    for (number, blocks) in model.block_numbers.iter() {
         writeln!(out, "N{number} at {:?}", blocks.iter().copied().map(line).collect::<Vec<_>>()).unwrap();
     }
     for structure in &model.structures {
