@@ -197,6 +197,17 @@ pub struct CallSite {
     pub modal: bool,
 }
 
+/// Whether the model reads more of `block` than its number: a label, or a
+/// statement it models.
+pub fn marked(block: &SinumerikBlock) -> bool {
+    block.label.is_some() || block.modelled
+}
+
+/// The number `block` carries (`N10` or `:10`).
+pub fn block_number(block: &SinumerikBlock) -> Option<u64> {
+    block.number.and_then(|number| number.value)
+}
+
 impl SinumerikModel {
     /// The model of the blocks in file order; they are read twice, so a
     /// file kept in pieces needs no copy.
@@ -205,24 +216,32 @@ impl SinumerikModel {
         I: IntoIterator<Item = &'a SinumerikBlock>,
         I::IntoIter: Clone,
     {
+        let blocks = blocks.into_iter().enumerate();
+        let numbered = blocks.clone().filter_map(|(index, block)| Some((block_number(block)?, index)));
+        SinumerikModel::from_marks(numbered, blocks.filter(|(_, block)| marked(block)))
+    }
+
+    /// The model of a file from its numbered blocks and its [`marked`]
+    /// ones, each with its index and in file order: the other blocks say
+    /// nothing to it. A file kept in chunks lists them per chunk, and an
+    /// edit reads the blocks of the chunk it touched only.
+    pub fn from_marks<'a>(
+        numbered: impl IntoIterator<Item = (u64, usize)>,
+        marked: impl IntoIterator<Item = (usize, &'a SinumerikBlock)>,
+    ) -> SinumerikModel {
         let mut model = SinumerikModel::default();
         let mut open = Opened::default();
-        let mut numbered = Vec::new();
-        // One pass, the jumps resolved after it, once every label is known:
-        // a large file's blocks are read from memory once.
-        for (index, block) in blocks.into_iter().enumerate() {
+        // One pass, the jumps resolved after it, once every label is known.
+        for (index, block) in marked {
             if let Some(label) = &block.label {
                 model.labels.entry(label.name.clone()).or_default().push(index);
-            }
-            if let Some(number) = block.number.and_then(|number| number.value) {
-                numbered.push((number, index));
             }
             for statement in block.statements.iter().filter(|_| block.modelled) {
                 model.structure(&mut open, index, &statement.kind);
                 model.declarations_and_calls(index, &statement.kind);
             }
         }
-        model.block_numbers = BlockNumbers::new(numbered);
+        model.block_numbers = BlockNumbers::new(numbered.into_iter().collect());
         let mut jumps = std::mem::take(&mut model.jumps);
         for site in &mut jumps {
             site.resolved = model.resolve(site.block, &site.jump);

@@ -464,6 +464,10 @@ fn assert_runs_of_the_analysis_blocks_equal_runs_of_the_text(
         let range = TextRange::at(TextSize::of(&text[..at]), TextSize::from(deleted));
         host.apply_edit(file, &TextEdit::replace(range, written));
         let edited = host.analysis().run_input(file).expect("a program");
+        // The model read from the chunks' marks is the model of all blocks.
+        if let Some(LoweredProgram::Sinumerik(unit)) = &edited.lowered {
+            assert_eq!(unit.model, nc_exec::sinumerik::program::SinumerikModel::new(unit.blocks.iter()));
+        }
         let resumed = edited.estimate(Some(&previous), 1_000_000, &|| false).expect("never abandoned");
         assert_alike(&resumed, &whole(&edited.text));
         previous = resumed;
