@@ -706,8 +706,16 @@ fn lsp_benchmark(server: &Path, dialect: Dialect, blocks: usize, edits: usize, a
         // moves an arc's end off its circle), which leaves the blocks after
         // the stop without a time: the program is typed back as generated.
         let whole = 0..doc.text().len();
+        client.take_received();
         client.notify("textDocument/didChange", doc.change(whole, &generated))?;
         client.diagnostics(&doc.uri, doc.version)?;
+        // That text is estimated again from the first place the typing
+        // changed: the edits measured come after it, as typing after a
+        // paste, not while it runs.
+        let timeout = client.timeout;
+        client.wait_for("the estimate of the restored text", timeout, |m| {
+            m.method() == Some("workspace/inlayHint/refresh")
+        })?;
         Some(cycle_time_latencies(&mut client, &mut doc, edits, &mut rng)?)
     } else {
         None

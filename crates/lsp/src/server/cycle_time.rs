@@ -82,7 +82,8 @@ impl View {
 }
 
 /// The newest version of each document to estimate, and how long each
-/// open document's last complete run took.
+/// open document's last complete run took (unless it ran through most of
+/// the text) or the longest given up since.
 #[derive(Debug, Default)]
 struct Jobs {
     pending: HashMap<Uri, i32>,
@@ -150,7 +151,10 @@ impl Timer {
                 let mut guard = lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
                 match ran {
                     Ok(Ran::Kept(run_took)) => {
-                        guard.took.insert(uri, run_took);
+                        match run_took {
+                            Some(run_took) => guard.took.insert(uri, run_took),
+                            None => guard.took.remove(&uri),
+                        };
                         let _ = refresh.send(());
                     }
                     // At least as long as it ran.
@@ -189,8 +193,9 @@ impl Timer {
 
 /// What became of a job.
 enum Ran {
-    /// The estimate is the document's, after running this long.
-    Kept(Duration),
+    /// The estimate is the document's, after running this long, when that
+    /// tells how long the next run takes.
+    Kept(Option<Duration>),
     /// A newer version came after running this long.
     GivenUp(Duration),
     /// Nothing to run, or the result came too late.
@@ -227,8 +232,11 @@ fn run(state: &Mutex<State>, jobs: &(Mutex<Jobs>, Condvar), uri: &Uri, version: 
         return Ran::GivenUp(started.elapsed());
     };
     let estimate = Arc::new(estimate);
-    drop(input);
     let rerun = &estimate.rerun;
+    // A run through most of the text (a whole run, or one after edits all
+    // over it) says nothing of the next one, which resumes from its estimate.
+    let tells = usize::from(rerun.end - rerun.start) * 2 < input.text.len();
+    drop(input);
     tracing::debug!(
         "{} v{version}: cycle time estimated in {:?}, running bytes {rerun:?}",
         uri.as_str(),
@@ -238,7 +246,7 @@ fn run(state: &Mutex<State>, jobs: &(Mutex<Jobs>, Condvar), uri: &Uri, version: 
     match state.documents.get_mut(uri) {
         Some(document) if document.version == version => {
             document.cycle = Cycle { estimate: Some(estimate), stale_from: None };
-            Ran::Kept(started.elapsed())
+            Ran::Kept(tells.then(|| started.elapsed()))
         }
         _ => Ran::Nothing,
     }
