@@ -15,15 +15,24 @@ use crate::{
     interactive::between_blocks,
 };
 
-/// The blocks of `file`, each chunk's from `lower` (the dialect's query)
-/// and each block's length from `len`.
+/// The blocks of `file`, each chunk's from `lower` (the dialect's query).
 pub(crate) fn lowered<'db, B>(
     db: &'db dyn Db,
     file: SourceFile,
     lower: impl Fn(BlockChunk<'db>) -> Arc<Vec<B>>,
-    len: impl Fn(&B) -> TextSize,
 ) -> Lowered<B> {
-    Lowered::from_chunks(file_chunks(db, file).iter().map(|chunk| (chunk.offset, lower(chunk.chunk))), len)
+    let chunks = file_chunks(db, file).iter();
+    Lowered::from_chunks(
+        chunks.map(|chunk| (chunk.offset, lower(chunk.chunk), chunk_lengths(db, chunk.chunk).as_slice())),
+    )
+}
+
+/// The lengths of a chunk's blocks, apart from the lowered blocks: after
+/// an edit the file's block ranges are laid out from them, where reading
+/// every lowered block's length cost a cache miss per block.
+#[salsa::tracked(returns(ref))]
+fn chunk_lengths<'db>(db: &'db dyn Db, chunk: BlockChunk<'db>) -> Vec<TextSize> {
+    chunk.blocks(db).map(|block| block.text_len()).collect()
 }
 
 /// A file's lowered blocks as the analysis reads them.

@@ -33,19 +33,20 @@ impl<B> Lowered<B> {
         Lowered { ranges, chunks: vec![Arc::new(blocks)], firsts: vec![0] }
     }
 
-    /// The blocks of `chunks`, each starting at its offset, in order; each
-    /// block's length from `len`.
-    pub fn from_chunks(
-        chunks: impl ExactSizeIterator<Item = (TextSize, Arc<Vec<B>>)>,
-        len: impl Fn(&B) -> TextSize,
+    /// The blocks of `chunks` in order, each chunk with its offset and its
+    /// blocks' lengths.
+    pub fn from_chunks<'a>(
+        chunks: impl ExactSizeIterator<Item = (TextSize, Arc<Vec<B>>, &'a [TextSize])>,
     ) -> Lowered<B> {
         let mut lowered = Lowered { ranges: Vec::new(), chunks: Vec::with_capacity(chunks.len()), firsts: Vec::new() };
-        for (mut offset, blocks) in chunks {
+        for (mut offset, blocks, lengths) in chunks {
+            debug_assert_eq!(blocks.len(), lengths.len());
             lowered.firsts.push(lowered.ranges.len());
-            for block in blocks.iter() {
-                lowered.ranges.push(TextRange::at(offset, len(block)));
-                offset += len(block);
-            }
+            lowered.ranges.extend(lengths.iter().map(|&len| {
+                let range = TextRange::at(offset, len);
+                offset += len;
+                range
+            }));
             lowered.chunks.push(blocks);
         }
         lowered

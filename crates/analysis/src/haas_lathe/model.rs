@@ -131,7 +131,7 @@ pub(crate) fn code_range(block: &HaasBlock, letter: u8, number: u32) -> TextRang
 /// The file's model, rebuilt when its text changes.
 #[salsa::tracked(returns(ref))]
 pub(crate) fn file_model(db: &dyn Db, file: SourceFile) -> FileModel {
-    let blocks = lowered(db, file, |chunk| chunk_blocks(db, chunk).clone(), |block| block.len);
+    let blocks = lowered(db, file, |chunk| chunk_blocks(db, chunk).clone());
     let marks: Vec<usize> = file_chunks(db, file)
         .iter()
         .flat_map(|chunk| chunk_marks(db, chunk.chunk).iter().map(|&index| chunk.first + index as usize))

@@ -77,7 +77,7 @@ pub(crate) fn is_main_program(db: &dyn Db, file: SourceFile) -> bool {
 /// The file's model, rebuilt when its text changes.
 #[salsa::tracked(returns(ref))]
 pub(crate) fn file_model(db: &dyn Db, file: SourceFile) -> FileModel {
-    let blocks = lowered(db, file, |chunk| chunk_blocks(db, chunk).clone(), |block| block.len);
+    let blocks = lowered(db, file, |chunk| chunk_blocks(db, chunk).clone());
     let chunks = file_chunks(db, file);
     let numbered = chunks.iter().flat_map(|chunk| {
         let numbered = chunk_marks(db, chunk.chunk).numbered.iter();
