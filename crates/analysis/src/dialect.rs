@@ -69,12 +69,6 @@ pub(crate) fn prepare_states(db: &dyn Db, file: SourceFile) {
     }
 }
 
-/// Whether a run of the dialect's programs reads the analysis's file model
-/// (its lowered blocks), which the local findings of an edit build too.
-pub fn run_reads_file_model(dialect: Dialect) -> bool {
-    !matches!(dialect, Dialect::Cnc8x6)
-}
-
 /// The blocks of `file` as its run reads them, from the analysis's
 /// lowered chunks; `None` where the run lowers the text itself.
 pub(crate) fn lowered_program(db: &dyn Db, file: SourceFile) -> Option<LoweredProgram> {

@@ -51,7 +51,6 @@ pub use crate::{
         ReportConfig, SinumerikConfig, WordOrder, WordSpacing, parse_constant,
     },
     db::{RootDatabase, SourceFile},
-    dialect::run_reads_file_model,
     diagnostic::{Diagnostic, Fix, Related, Rule},
     findings::{Findings, OmittedFindings},
     ide::{HoverResult, NavigationTarget, Renaming, SignatureHelp, SignatureParameter, renumber::RenumberError},

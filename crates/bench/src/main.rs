@@ -514,6 +514,9 @@ const UNFOLLOWED_EDITS: usize = 10;
 /// The pause after the edits, and the hovers at random places after it.
 const IDLE: Duration = Duration::from_secs(3);
 const IDLE_HOVERS: usize = 100;
+/// The longest the hint edits wait for the estimate of the text typed back
+/// as generated (a run of most of it).
+const RESTORED_ESTIMATE: Duration = Duration::from_secs(20);
 /// Thread round trips measured during the pause.
 const WAKE_UPS: usize = 1000;
 
@@ -711,11 +714,10 @@ fn lsp_benchmark(server: &Path, dialect: Dialect, blocks: usize, edits: usize, a
         client.diagnostics(&doc.uri, doc.version)?;
         // That text is estimated again from the first place the typing
         // changed: the edits measured come after it, as typing after a
-        // paste, not while it runs.
-        let timeout = client.timeout;
-        client.wait_for("the estimate of the restored text", timeout, |m| {
-            m.method() == Some("workspace/inlayHint/refresh")
-        })?;
+        // paste, not while it runs. No refresh comes when an estimate of
+        // that text is already kept.
+        let refresh = |m: &lsp_client::Message| m.method() == Some("workspace/inlayHint/refresh");
+        let _ = client.wait_for("the estimate of the restored text", RESTORED_ESTIMATE, refresh);
         Some(cycle_time_latencies(&mut client, &mut doc, edits, &mut rng)?)
     } else {
         None
