@@ -45,7 +45,7 @@ mod index;
 mod runner;
 mod support;
 
-use std::{any::Any, borrow::Cow, thread::Scope};
+use std::{borrow::Cow, thread::Scope};
 
 use crate::{
     cnc8x6::lower::BlockData,
@@ -66,10 +66,6 @@ pub(crate) fn reset_frame(machine: &MachineConfig) -> Frame {
 }
 
 impl Resumable for Runner {
-    fn boxed_clone(&self) -> Box<dyn Resumable> {
-        Box::new(self.clone())
-    }
-
     fn steps(&self) -> usize {
         self.steps.delivered
     }
@@ -78,8 +74,8 @@ impl Resumable for Runner {
         self.steps.delivered = steps;
     }
 
-    fn same_course(&self, other: &dyn Resumable) -> bool {
-        (other as &dyn Any).downcast_ref::<Runner>().is_some_and(|other| Runner::same_course(self, other))
+    fn same_course(&self, other: &Runner) -> bool {
+        Runner::same_course(self, other)
     }
 }
 
@@ -95,7 +91,7 @@ pub(crate) fn run_in<'a, 's>(
     let fresh = Runner::new(std::sync::Arc::new(machine.clone()));
     let reset_frame = fresh.frame_in_force();
     let resumed = checkpoint.and_then(|checkpoint| {
-        let runner = (&*checkpoint.state as &dyn Any).downcast_ref::<Runner>()?;
+        let runner = checkpoint.state::<Runner>()?;
         (*runner.machine == *machine).then_some((runner, checkpoint))
     });
     let (mut runner, mut index, mut at, mut executed) = match resumed {

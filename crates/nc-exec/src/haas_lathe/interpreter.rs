@@ -103,7 +103,6 @@
 //!   so that `T1` selects offset 1.
 
 use std::{
-    any::Any,
     f64::consts::TAU,
     ops::{Deref, Range},
     sync::Arc,
@@ -296,8 +295,15 @@ struct Resumed {
     steps: usize,
 }
 
-impl Resumed {
-    /// See [`Checkpoint::same_course`].
+impl Resumable for Resumed {
+    fn steps(&self) -> usize {
+        self.steps
+    }
+
+    fn set_steps(&mut self, steps: usize) {
+        self.steps = steps;
+    }
+
     fn same_course(&self, other: &Resumed) -> bool {
         // Every field named, so that a new one must be placed here.
         let Resumed {
@@ -337,24 +343,6 @@ impl Resumed {
             && *cycles == other.cycles
             && *reported == other.reported
             && *before == other.before
-    }
-}
-
-impl Resumable for Resumed {
-    fn boxed_clone(&self) -> Box<dyn Resumable> {
-        Box::new(self.clone())
-    }
-
-    fn steps(&self) -> usize {
-        self.steps
-    }
-
-    fn set_steps(&mut self, steps: usize) {
-        self.steps = steps;
-    }
-
-    fn same_course(&self, other: &dyn Resumable) -> bool {
-        (other as &dyn Any).downcast_ref::<Resumed>().is_some_and(|other| Resumed::same_course(self, other))
     }
 }
 
@@ -624,7 +612,7 @@ impl<'a> Interpreter<'a> {
     /// checkpoint of another control or machine, or of a block this text
     /// does not have there.
     fn resume(&mut self, checkpoint: &Checkpoint) -> Option<Place> {
-        let state = (&*checkpoint.state as &dyn Any).downcast_ref::<Resumed>()?;
+        let state = checkpoint.state::<Resumed>()?;
         let program = self.units[0].model.programs.first()?;
         let block = checkpoint.block;
         let here = program.blocks.contains(&block) && self.units[0].ranges[block].start() == checkpoint.offset;

@@ -2,6 +2,7 @@
 //! checkpoints a run can resume from, and the files it reads.
 
 use std::{
+    any::Any,
     hash::{DefaultHasher, Hash, Hasher},
     ops::{ControlFlow, Range},
     sync::mpsc::{self, Receiver},
@@ -114,7 +115,7 @@ pub trait StepSink {
 #[derive(Clone)]
 pub struct Checkpoint {
     /// The interpreter's state, of the machine's control.
-    pub(crate) state: Box<dyn Resumable>,
+    pub(crate) state: Box<dyn State>,
     /// The next block, and where it starts.
     pub(crate) block: usize,
     pub(crate) offset: TextSize,
@@ -123,16 +124,42 @@ pub struct Checkpoint {
 }
 
 /// What a control's interpreter keeps in a [`Checkpoint`] to run on from.
-pub(crate) trait Resumable: std::any::Any + Send + Sync {
-    fn boxed_clone(&self) -> Box<dyn Resumable>;
+pub(crate) trait Resumable: Clone + Send + Sync + 'static {
     /// Steps made before it.
     fn steps(&self) -> usize;
     fn set_steps(&mut self, steps: usize);
-    /// See [`Checkpoint::same_course`]; false for another control's state.
-    fn same_course(&self, other: &dyn Resumable) -> bool;
+    /// See [`Checkpoint::same_course`].
+    fn same_course(&self, other: &Self) -> bool;
 }
 
-impl Clone for Box<dyn Resumable> {
+/// A [`Resumable`] of any control, as a checkpoint holds it.
+pub(crate) trait State: Any + Send + Sync {
+    fn boxed_clone(&self) -> Box<dyn State>;
+    fn steps(&self) -> usize;
+    fn set_steps(&mut self, steps: usize);
+    /// False for another control's state.
+    fn same_course(&self, other: &dyn State) -> bool;
+}
+
+impl<R: Resumable> State for R {
+    fn boxed_clone(&self) -> Box<dyn State> {
+        Box::new(self.clone())
+    }
+
+    fn steps(&self) -> usize {
+        Resumable::steps(self)
+    }
+
+    fn set_steps(&mut self, steps: usize) {
+        Resumable::set_steps(self, steps);
+    }
+
+    fn same_course(&self, other: &dyn State) -> bool {
+        (other as &dyn Any).downcast_ref::<R>().is_some_and(|other| Resumable::same_course(self, other))
+    }
+}
+
+impl Clone for Box<dyn State> {
     fn clone(&self) -> Self {
         self.boxed_clone()
     }
@@ -162,6 +189,11 @@ impl Checkpoint {
     /// Blocks the run executed before it.
     pub fn blocks_run(&self) -> usize {
         self.executed
+    }
+
+    /// The interpreter's state, when it is `R` (the control's).
+    pub(crate) fn state<R: Resumable>(&self) -> Option<&R> {
+        (&*self.state as &dyn Any).downcast_ref::<R>()
     }
 
     /// Steps the run made before it.

@@ -2,7 +2,6 @@
 //! them): the state a checkpoint keeps, what it compares, and resuming from it.
 
 use std::{
-    any::Any,
     collections::{HashMap, HashSet},
     ops::Range,
     sync::Arc,
@@ -52,8 +51,15 @@ pub(super) struct Resumed {
     steps: usize,
 }
 
-impl Resumed {
-    /// See [`Checkpoint::same_course`].
+impl Resumable for Resumed {
+    fn steps(&self) -> usize {
+        self.steps
+    }
+
+    fn set_steps(&mut self, steps: usize) {
+        self.steps = steps;
+    }
+
     fn same_course(&self, other: &Resumed) -> bool {
         // Every field named, so that a new one must be placed here.
         let Resumed {
@@ -91,24 +97,6 @@ impl Resumed {
             && *store == other.store
             && *modal_call == other.modal_call
             && *before == other.before
-    }
-}
-
-impl Resumable for Resumed {
-    fn boxed_clone(&self) -> Box<dyn Resumable> {
-        Box::new(self.clone())
-    }
-
-    fn steps(&self) -> usize {
-        self.steps
-    }
-
-    fn set_steps(&mut self, steps: usize) {
-        self.steps = steps;
-    }
-
-    fn same_course(&self, other: &dyn Resumable) -> bool {
-        (other as &dyn Any).downcast_ref::<Resumed>().is_some_and(|other| Resumed::same_course(self, other))
     }
 }
 
@@ -219,7 +207,7 @@ impl Interpreter<'_> {
     /// not have there, or where the global user data a run from the start
     /// reads is there now.
     pub(super) fn resume(&mut self, checkpoint: &Checkpoint) -> Option<At> {
-        let resumed = (&*checkpoint.state as &dyn Any).downcast_ref::<Resumed>()?;
+        let resumed = checkpoint.state::<Resumed>()?;
         let block = checkpoint.block;
         let here = self.units[0].ranges.get(block).is_some_and(|range| range.start() == checkpoint.offset);
         if !here || *resumed.machine != **self.machine {
