@@ -9,7 +9,7 @@ mod strategies;
 mod support;
 
 use expect_test::{Expect, expect};
-use ncc_analysis::{AnalysisHost, Config, Dialect, RenumberError, TextEdit};
+use ncc_analysis::{AnalysisHost, Config, Dialect, RenumberError, TextEdit, TextRange};
 use proptest::prelude::*;
 
 fn renumbered(dialect: Dialect, text: &str, start: u64, step: u64) -> Result<String, RenumberError> {
@@ -151,6 +151,9 @@ fn computed_missing_and_ambiguous_targets_are_refused() {
 fn a_number_the_address_cannot_hold_is_refused() {
     let error = renumbered(Dialect::Cnc8x6, "%1\nN1 X1\nN2 M30\n", 99_999_999, 1).unwrap_err();
     assert_eq!(error.message, "2 blocks from 99999999 by 1 pass the largest number, 99999999");
+    let error = renumbered(Dialect::Cnc8x6, "%1\nN1 X1\nN2 M30\n", 0, 1).unwrap_err();
+    assert_eq!(error.message, "block numbers start at 1, so renumbering cannot start from 0");
+    assert_eq!(error.range, TextRange::new(4.into(), 5.into()));
 }
 
 /// Renumbering `text` either is refused or leaves its run as it was, and

@@ -5,7 +5,7 @@
 //! ([`Numbering`]); where a target is computed, missing or ambiguous, it
 //! refuses instead, since the new numbers could change where it leads.
 
-use ncc_catalog::{AddressRole, Catalogue};
+use ncc_catalog::{Address, AddressRole, Catalogue};
 use ncc_syntax::{TextEdit, TextRange};
 
 /// A file's block numbers and the references to them.
@@ -33,7 +33,7 @@ impl RenumberError {
 
 /// The edits that give the numbered blocks of `numbering` the numbers
 /// `start`, `start + step`, … and their references the same; `text` is the
-/// file's. A number the block number's address cannot hold is refused.
+/// file's. A number outside the block number address's range is refused.
 pub(crate) fn edits(
     text: &str,
     catalogue: &Catalogue,
@@ -41,17 +41,24 @@ pub(crate) fn edits(
     start: u64,
     step: u64,
 ) -> Result<Vec<TextEdit>, RenumberError> {
-    let largest = catalogue
-        .letter_with_role(AddressRole::BlockNumber)
-        .and_then(|letter| catalogue.address_of(letter))
-        .and_then(|address| address.int_digits)
-        .map_or(u64::MAX, |digits| 10u64.saturating_pow(u32::from(digits)) - 1);
-    let new_numbers: Vec<u64> = (0..numbering.numbers.len() as u64)
+    let address = catalogue.letter_with_role(AddressRole::BlockNumber).and_then(|letter| catalogue.address_of(letter));
+    let (smallest, largest) = match address {
+        Some(Address { bounds: Some((min, max)), .. }) => (min.max(0.0).ceil() as u64, max.max(0.0) as u64),
+        Some(Address { int_digits: Some(digits), .. }) => (0, 10u64.saturating_pow(u32::from(*digits)) - 1),
+        _ => (0, u64::MAX),
+    };
+    let count = numbering.numbers.len();
+    if start < smallest && count > 0 {
+        return Err(RenumberError::new(
+            numbering.numbers[0],
+            format!("block numbers start at {smallest}, so renumbering cannot start from {start}"),
+        ));
+    }
+    let new_numbers: Vec<u64> = (0..count as u64)
         .map(|i| step.checked_mul(i).and_then(|offset| offset.checked_add(start)).filter(|&n| n <= largest))
         .collect::<Option<_>>()
         .ok_or_else(|| {
             let last = numbering.numbers.last().copied().unwrap_or_default();
-            let count = numbering.numbers.len();
             RenumberError::new(
                 last,
                 format!("{count} blocks from {start} by {step} pass the largest number, {largest}"),
