@@ -4,7 +4,7 @@
 //! the newest job of each document, so typing faster than a run takes
 //! skips the versions in between, as a debounce would. A run is given up
 //! when a newer version of its document waits, and a document whose last
-//! run took long ([`LONG_RUN`]) waits for a pause in typing
+//! run took long ([`LONG_WORK`]) waits for a pause in typing
 //! ([`TYPING_PAUSE`]) before it runs: a run that the next key throws away
 //! only holds a core the edits' diagnostics need. The run holds no
 //! snapshot: it reads the text, the machine and the workspace's files
@@ -24,20 +24,15 @@ use ncc_analysis::{Cancelled, Estimate, TextRange, TextSize, interactive};
 use tokio::sync::mpsc;
 use tower_lsp_server::{Client, ls_types::Uri};
 
-use super::{State, lock, priority};
+use super::{
+    State, lock, priority,
+    typing::{LONG_WORK, TYPING_PAUSE},
+};
 
 /// Blocks a run executes at most: a million steps hold a few hundred
 /// megabytes while the model times them; a program that runs longer (a
 /// jump loop without end) shows that its run stopped.
 const STEP_BUDGET: usize = 1_000_000;
-
-/// A run this long is not started while typing goes on: two keys come
-/// closer together.
-const LONG_RUN: Duration = Duration::from_millis(50);
-
-/// How long a document whose runs are long waits without an edit before it
-/// runs: shorter than a human's pause between keys.
-const TYPING_PAUSE: Duration = Duration::from_millis(40);
 
 /// How long the worker goes without a job before it gives the memory its
 /// runs freed back to the system: longer than a pause between keys, so
@@ -134,7 +129,7 @@ impl Timer {
                         }
                     }
                 };
-                if took.is_some_and(|took| took >= LONG_RUN) {
+                if took.is_some_and(|took| took >= LONG_WORK) {
                     let (lock, ready) = &*jobs;
                     let guard = lock.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
                     let (_guard, waited) = ready
@@ -285,7 +280,7 @@ mod tests {
         let timer = Timer { jobs: Arc::default() };
         let uri = Uri::from_str("file:///PART.MPF").unwrap();
         timer.request(uri.clone(), 3);
-        timer.jobs.0.lock().unwrap().took.insert(uri.clone(), LONG_RUN);
+        timer.jobs.0.lock().unwrap().took.insert(uri.clone(), LONG_WORK);
         timer.forget(&uri);
         let jobs = timer.jobs.0.lock().unwrap();
         assert!(jobs.pending.is_empty() && jobs.took.is_empty(), "{jobs:?}");

@@ -10,7 +10,8 @@
 //! Diagnostics are pushed in two steps per version: the findings that need
 //! no flow walk as soon as the edited chunk is checked (with the previous
 //! flow findings moved along with the edit), then the complete set when
-//! the flow walk is done — unless a newer edit came first.
+//! the flow walk is done — unless a newer edit came first. Where the walk
+//! takes long, it waits for a pause in typing (`typing.rs`).
 //!
 //! The predicted cycle time (`cycle_time.rs`) is estimated on a thread of
 //! its own after each edit; inlay hints, a code lens and hover show it.
@@ -22,6 +23,7 @@ mod handlers;
 mod plot;
 mod priority;
 mod semantic;
+mod typing;
 mod workspace;
 
 use std::{
@@ -32,6 +34,7 @@ use std::{
         Arc, Mutex, MutexGuard,
         atomic::{AtomicBool, Ordering},
     },
+    time::{Duration, Instant},
 };
 
 use ncc_analysis::{Analysis, Cancelled, CycleTimeHints, Diagnostic, Dialect, FileId, Findings, TextRange, TextSize};
@@ -137,6 +140,9 @@ struct Document {
     /// The flow findings last computed, moved along with later edits until
     /// they are computed again.
     flow: Findings,
+    /// How long the last flow walk took, or at least took when an edit
+    /// cancelled it.
+    walk_took: Duration,
     cycle: cycle_time::Cycle,
 }
 
@@ -147,6 +153,17 @@ struct State {
     /// `ncc.cycleTime.inlayHints`.
     cycle_hints: CycleTimeHints,
     refresh: cycle_time::Refresh,
+}
+
+impl State {
+    /// Opens a document; returns what went wrong reading its project.
+    fn open(&mut self, uri: Uri, text: String, version: i32) -> Vec<String> {
+        let Opened { index: workspace, dialect, file, errors } = self.workspaces.open(&uri, text);
+        let map = LineMap::new(self.workspaces.get(workspace).analysis().text(file));
+        let (flow, walk_took, cycle) = Default::default();
+        self.documents.insert(uri, Document { workspace, dialect, file, version, map, flow, walk_took, cycle });
+        errors
+    }
 }
 
 #[derive(Debug)]
@@ -258,11 +275,12 @@ impl Server {
     /// hover included, when its first diagnostics arrive.
     fn analyze(&self, uri: Uri, opened: bool) {
         // Positions, not the text: this thread outlives the next edit.
-        let (analysis, file, version, positions, carried) = {
+        let (analysis, file, version, positions, carried, last_walk) = {
             let state = self.state();
             let Some(document) = state.documents.get(&uri) else { return };
             let analysis = state.workspaces.get(document.workspace).analysis();
-            (analysis, document.file, document.version, document.map.positions(), document.flow.clone())
+            let (positions, carried) = (document.map.positions(), document.flow.clone());
+            (analysis, document.file, document.version, positions, carried, document.walk_took)
         };
         let publisher = self.publisher.clone();
         let state = self.state.clone();
@@ -274,9 +292,9 @@ impl Server {
                 let diagnostics = diagnostics.iter().map(|d| convert::diagnostic(&positions, &uri, d)).collect();
                 let _ = publisher.send((uri.clone(), diagnostics, version));
             };
-            let started = std::time::Instant::now();
+            let started = Instant::now();
             let prepare = |analysis: &Analysis| {
-                let started = std::time::Instant::now();
+                let started = Instant::now();
                 match Cancelled::catch(|| analysis.prepare_states(file)) {
                     Ok(()) => {
                         tracing::debug!("{} v{version}: states prepared in {:?}", uri.as_str(), started.elapsed())
@@ -308,25 +326,34 @@ impl Server {
             if !opened {
                 prepare(&analysis);
             }
+            // A long walk waits until typing pauses: the next key would
+            // cancel it, and the edit's cycle-time run needs the core.
+            let Some(analysis) = typing::flow_walk_snapshot(&state, &uri, version, last_walk, analysis) else { return };
+            let walk_started = Instant::now();
             let all = Cancelled::catch(|| {
                 let flow = analysis.flow_findings(file);
                 let mut all = local;
                 all.append(flow.clone());
                 (analysis.limit(file, all), flow)
             });
+            // Dropped before taking the lock: the edit that cancelled the
+            // walk holds the lock until every snapshot is dropped.
+            drop(analysis);
+            let walked = walk_started.elapsed();
+            let mut guard = lock(&state);
+            let Some(document) = guard.documents.get_mut(&uri) else { return };
             let Ok((all, flow)) = all else {
+                document.walk_took = document.walk_took.max(walked);
                 tracing::debug!("{} v{version}: flow walk cancelled by an edit", uri.as_str());
                 return;
             };
             tracing::debug!("{} v{version}: all diagnostics in {:?}", uri.as_str(), started.elapsed());
-            drop(analysis);
-            {
-                let mut state = lock(&state);
-                match state.documents.get_mut(&uri) {
-                    Some(document) if document.version == version => document.flow = flow,
-                    _ => return,
-                }
+            if document.version != version {
+                return;
             }
+            document.flow = flow;
+            document.walk_took = walked;
+            drop(guard);
             send(all);
             // The version's work is done: typing paused.
             crate::return_free_memory();
@@ -441,18 +468,7 @@ impl LanguageServer for Server {
 
     async fn did_open(&self, params: lsp::DidOpenTextDocumentParams) {
         let document = params.text_document;
-        let errors = {
-            let mut state = self.state();
-            let Opened { index: workspace, dialect, file, errors } =
-                state.workspaces.open(&document.uri, document.text);
-            let map = LineMap::new(state.workspaces.get(workspace).analysis().text(file));
-            let (flow, cycle) = Default::default();
-            let version = document.version;
-            state
-                .documents
-                .insert(document.uri.clone(), Document { workspace, dialect, file, version, map, flow, cycle });
-            errors
-        };
+        let errors = self.state().open(document.uri.clone(), document.text, document.version);
         self.timer.request(document.uri.clone(), document.version);
         self.analyze(document.uri, true);
         for error in errors {
@@ -463,7 +479,7 @@ impl LanguageServer for Server {
     async fn did_change(&self, params: lsp::DidChangeTextDocumentParams) {
         let uri = params.text_document.uri;
         {
-            let started = std::time::Instant::now();
+            let started = Instant::now();
             let mut guard = self.state();
             let state = &mut *guard;
             let Some(document) = state.documents.get_mut(&uri) else {
