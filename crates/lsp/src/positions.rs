@@ -9,7 +9,7 @@
 //! conversion: quadratic on a long line of Czech text or of bytes read as
 //! Kamenický.) It holds no text, so work that outlives an edit can keep it.
 
-use ncc_analysis::TextSize;
+use ncc_analysis::{TextEdit, TextSize};
 use ncc_syntax::limit::next_line_start;
 
 /// What a column counts.
@@ -61,6 +61,49 @@ impl TextIndex {
             }
             from = start + c.len_utf8();
         }
+        TextIndex { len: size(text.len()), line_starts, wide, extra, astral }
+    }
+
+    /// The index of `text`, which `edit` made from the text of `self`: the
+    /// lines around the edit are read again, and the rest shifted. An edit
+    /// of one character in a large file costs a copy of the index, not a
+    /// scan of the text.
+    pub fn edited(&self, edit: &TextEdit, text: &str) -> TextIndex {
+        let (start, old_end) = (edit.delete.start(), edit.delete.end());
+        let new_end = start + TextSize::of(&edit.insert);
+        let shifted = |at: TextSize| at + new_end - old_end;
+        // A line start depends on the byte before it and its own (`\r\n`):
+        // those before the line the edit starts in stay, and so do those
+        // past its end. The window between is read again from a line start.
+        let from_line = self.line_starts.partition_point(|&s| s <= start).saturating_sub(2);
+        let from = self.line_starts[from_line];
+        let after = self.line_starts.partition_point(|&s| s <= old_end);
+        let (to_old, to_new) = match self.line_starts.get(after) {
+            Some(&to) => (to, shifted(to)),
+            None => (self.len, size(text.len())),
+        };
+        let window = TextIndex::new(&text[usize::from(from)..usize::from(to_new)]);
+        let mut line_starts = self.line_starts[..from_line].to_vec();
+        line_starts.extend(window.line_starts.iter().map(|&s| s + from));
+        // The window's last line start is `to_new` when it is one.
+        line_starts.extend(self.line_starts.get(after + 1..).unwrap_or_default().iter().map(|&s| shifted(s)));
+
+        let kept = self.wide.partition_point(|&w| w < from);
+        let moved = self.wide.partition_point(|&w| w < to_old);
+        let sum_before = |k: usize| k.checked_sub(1).map_or(0, |k| self.extra[k]);
+        let kept_sum = sum_before(kept);
+        let window_sum = window.extra.last().map_or(0, |&e| e);
+        let mut wide = self.wide[..kept].to_vec();
+        wide.extend(window.wide.iter().map(|&w| w + from));
+        wide.extend(self.wide[moved..].iter().map(|&w| shifted(w)));
+        let mut extra = self.extra[..kept].to_vec();
+        extra.extend(window.extra.iter().map(|&e| e + kept_sum));
+        extra.extend(self.extra[moved..].iter().map(|&e| e - sum_before(moved) + kept_sum + window_sum));
+        let kept_astral = self.astral.partition_point(|&a| a < from);
+        let moved_astral = self.astral.partition_point(|&a| a < to_old);
+        let mut astral = self.astral[..kept_astral].to_vec();
+        astral.extend(window.astral.iter().map(|&a| a + from));
+        astral.extend(self.astral[moved_astral..].iter().map(|&a| shifted(a)));
         TextIndex { len: size(text.len()), line_starts, wide, extra, astral }
     }
 
@@ -125,7 +168,39 @@ fn size(offset: usize) -> TextSize {
 
 #[cfg(test)]
 mod tests {
+    use ncc_analysis::TextRange;
+    use proptest::prelude::*;
+
     use super::*;
+
+    /// Pieces that make line starts and wide characters appear, vanish and
+    /// merge (`\r` then `\n`).
+    const PIECES: &[&str] = &["N1 X2", "\n", "\r", "\r\n", "č", "𝄞", "€", " "];
+
+    fn text() -> impl Strategy<Value = String> {
+        prop::collection::vec(prop::sample::select(PIECES), 0..30).prop_map(|pieces| pieces.concat())
+    }
+
+    proptest! {
+        // Cases are cheap, and a merged `\r\n` at the window's edge is rare.
+        #![proptest_config(ProptestConfig::with_cases(5000))]
+
+        #[test]
+        fn an_edited_index_equals_the_index_of_the_edited_text(
+            before in text(),
+            insert in text(),
+            (start, end) in (any::<prop::sample::Index>(), any::<prop::sample::Index>()),
+        ) {
+            // Edits start and end between characters.
+            let bounds: Vec<usize> = before.char_indices().map(|(at, _)| at).chain([before.len()]).collect();
+            let (start, end) = (start.get(&bounds), end.get(&bounds));
+            let (start, end) = (*start.min(end), *start.max(end));
+            let edit = TextEdit::replace(TextRange::new(size(start), size(end)), insert);
+            let mut after = before.clone();
+            edit.apply(&mut after);
+            prop_assert_eq!(TextIndex::new(&before).edited(&edit, &after), TextIndex::new(&after));
+        }
+    }
 
     #[test]
     fn columns_count_characters_or_utf16_units() {

@@ -38,6 +38,12 @@ impl LineMap {
         LineMap { text, index }
     }
 
+    /// The map of `text`, which `edit` made from the text `before` indexes.
+    pub fn edited(before: &Positions, edit: &TextEdit, text: Arc<String>) -> LineMap {
+        let index = Arc::new(before.0.edited(edit, &text));
+        LineMap { text, index }
+    }
+
     pub fn positions(&self) -> Positions {
         Positions(self.index.clone())
     }

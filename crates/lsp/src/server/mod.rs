@@ -491,9 +491,9 @@ impl LanguageServer for Server {
                 let edit = document.map.edit(change);
                 // The map lets go of the text, so that the edit can change it
                 // in place.
-                document.map = LineMap::new(Arc::default());
+                let before = std::mem::replace(&mut document.map, LineMap::new(Arc::default())).positions();
                 host.apply_edit(document.file, &edit);
-                document.map = LineMap::new(host.analysis().text(document.file));
+                document.map = LineMap::edited(&before, &edit, host.analysis().text(document.file));
                 document.flow = std::mem::take(&mut document.flow).moved_through(&edit);
                 document.cycle.edited(TextRange::at(edit.delete.start(), TextSize::of(&edit.insert)));
             }
