@@ -696,7 +696,9 @@ impl<'a> Charges<'a> {
             checkpoints: self.checkpoints,
             blocks_run,
             budget,
-            text: text.clone(),
+            // A copy: while the estimate shares the file's text, the next
+            // edit must copy it to change it, on the thread edits wait for.
+            text: Arc::new(String::clone(text)),
             files: files.clone(),
             machine: Arc::new(machine.clone()),
         }

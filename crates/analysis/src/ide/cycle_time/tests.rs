@@ -358,6 +358,8 @@ fn a_changed_macrocycle_file_reruns_from_the_last_checkpoint() {
     let machine = MachineConfig::default();
     let text = Arc::new(text);
     let first = estimate(None, &text, &files("10"), &machine, 1_000_000);
+    // Not the file's text: an edit of the file then changes it in place.
+    assert!(!Arc::ptr_eq(&first.text, &text));
     assert!(first.holds_for(&RunInput {
         text: text.clone(),
         machine: machine.clone(),
