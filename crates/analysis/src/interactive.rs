@@ -25,10 +25,19 @@ static ENDED: (Mutex<()>, Condvar) = (Mutex::new(()), Condvar::new());
 /// something the thread is computing.
 const LONGEST_PAUSE: Duration = Duration::from_millis(5);
 
+/// Blocks a background thread goes through between two yields of its core
+/// (a fraction of a millisecond). A request's thread that wakes may have
+/// to wait for it before it can even say it is there: the kernel's fair
+/// scheduler leaves a thread that ran a lot lately waiting behind a
+/// lower-priority one until the next tick (4 ms).
+const BLOCKS_PER_YIELD: u32 = 128;
+
 thread_local! {
     static BACKGROUND: Cell<bool> = const { Cell::new(false) };
     /// The requests begun when this thread last gave way.
     static GIVEN_WAY_TO: Cell<u64> = const { Cell::new(0) };
+    /// Blocks since this thread last yielded its core.
+    static SINCE_YIELD: Cell<u32> = const { Cell::new(0) };
 }
 
 /// A request the editor waits for, while it lives.
@@ -80,11 +89,17 @@ pub(crate) fn without_giving_way<T>(work: impl FnOnce() -> T) -> T {
     work()
 }
 
-/// On a background thread, while requests are in progress that it has not
-/// given way to yet: waits until they end (at most [`LONGEST_PAUSE`]). An
-/// atomic load otherwise.
+/// On a background thread: yields the core every [`BLOCKS_PER_YIELD`]
+/// calls, and while requests are in progress that it has not given way to
+/// yet, waits until they end (at most [`LONGEST_PAUSE`]).
 pub fn give_way() {
-    if IN_FLIGHT.load(Ordering::Acquire) == 0 || !BACKGROUND.get() {
+    if !BACKGROUND.get() {
+        return;
+    }
+    if due_to_yield() {
+        std::thread::yield_now();
+    }
+    if IN_FLIGHT.load(Ordering::Acquire) == 0 {
         return;
     }
     let begun = BEGUN.load(Ordering::Relaxed);
@@ -95,6 +110,15 @@ pub fn give_way() {
     let guard = ENDED.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     let waited = ENDED.1.wait_timeout_while(guard, LONGEST_PAUSE, |_| IN_FLIGHT.load(Ordering::Acquire) > 0);
     drop(waited.unwrap_or_else(|poisoned| poisoned.into_inner()));
+}
+
+/// Counts a block of a background thread; true once every
+/// [`BLOCKS_PER_YIELD`].
+fn due_to_yield() -> bool {
+    let since = SINCE_YIELD.get() + 1;
+    let due = since == BLOCKS_PER_YIELD;
+    SINCE_YIELD.set(if due { 0 } else { since });
+    due
 }
 
 #[cfg(test)]
@@ -131,5 +155,22 @@ mod tests {
             started.elapsed()
         });
         assert!(ended.join().expect("the thread ends") < LONGEST_PAUSE);
+    }
+
+    /// Only a background thread counts blocks, and it yields at every
+    /// [`BLOCKS_PER_YIELD`]th.
+    #[test]
+    fn a_background_thread_yields_once_every_so_many_blocks() {
+        std::thread::spawn(|| {
+            (0..3 * BLOCKS_PER_YIELD).for_each(|_| give_way());
+            assert_eq!(SINCE_YIELD.get(), 0, "not a background thread");
+            run_in_background();
+            (1..BLOCKS_PER_YIELD).for_each(|_| give_way());
+            assert_eq!(SINCE_YIELD.get(), BLOCKS_PER_YIELD - 1);
+            give_way();
+            assert_eq!(SINCE_YIELD.get(), 0, "yielded");
+        })
+        .join()
+        .expect("the thread ends");
     }
 }
