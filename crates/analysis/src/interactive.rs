@@ -25,18 +25,21 @@ static ENDED: (Mutex<()>, Condvar) = (Mutex::new(()), Condvar::new());
 /// something the thread is computing.
 const LONGEST_PAUSE: Duration = Duration::from_millis(5);
 
-/// Blocks a background thread goes through between two yields of its core
-/// (a fraction of a millisecond). A request's thread that wakes may have
-/// to wait for it before it can even say it is there: the kernel's fair
-/// scheduler leaves a thread that ran a lot lately waiting behind a
-/// lower-priority one until the next tick (4 ms).
-const BLOCKS_PER_YIELD: u32 = 128;
+/// Calls of [`give_way`] between two yields of a background thread's core.
+/// The walks call it at every block, so they yield every fraction of a
+/// millisecond; the cycle-time run asks every 1,024 blocks, so it yields
+/// about once in a long run (a yield costs a thread the rest of its time
+/// slice). A request's thread that wakes may have to wait for the core
+/// before it can even say it is there: the kernel's fair scheduler leaves a
+/// thread that ran a lot lately behind a lower-priority one until the next
+/// tick (4 ms).
+const CALLS_PER_YIELD: u32 = 128;
 
 thread_local! {
     static BACKGROUND: Cell<bool> = const { Cell::new(false) };
     /// The requests begun when this thread last gave way.
     static GIVEN_WAY_TO: Cell<u64> = const { Cell::new(0) };
-    /// Blocks since this thread last yielded its core.
+    /// Calls since this thread last yielded its core.
     static SINCE_YIELD: Cell<u32> = const { Cell::new(0) };
 }
 
@@ -89,7 +92,7 @@ pub(crate) fn without_giving_way<T>(work: impl FnOnce() -> T) -> T {
     work()
 }
 
-/// On a background thread: yields the core every [`BLOCKS_PER_YIELD`]
+/// On a background thread: yields the core every [`CALLS_PER_YIELD`]
 /// calls, and while requests are in progress that it has not given way to
 /// yet, waits until they end (at most [`LONGEST_PAUSE`]).
 pub fn give_way() {
@@ -112,11 +115,11 @@ pub fn give_way() {
     drop(waited.unwrap_or_else(|poisoned| poisoned.into_inner()));
 }
 
-/// Counts a block of a background thread; true once every
-/// [`BLOCKS_PER_YIELD`].
+/// Counts a call of a background thread; true once every
+/// [`CALLS_PER_YIELD`].
 fn due_to_yield() -> bool {
     let since = SINCE_YIELD.get() + 1;
-    let due = since == BLOCKS_PER_YIELD;
+    let due = since == CALLS_PER_YIELD;
     SINCE_YIELD.set(if due { 0 } else { since });
     due
 }
@@ -157,16 +160,16 @@ mod tests {
         assert!(ended.join().expect("the thread ends") < LONGEST_PAUSE);
     }
 
-    /// Only a background thread counts blocks, and it yields at every
-    /// [`BLOCKS_PER_YIELD`]th.
+    /// Only a background thread counts calls, and it yields at every
+    /// [`CALLS_PER_YIELD`]th.
     #[test]
     fn a_background_thread_yields_once_every_so_many_blocks() {
         std::thread::spawn(|| {
-            (0..3 * BLOCKS_PER_YIELD).for_each(|_| give_way());
+            (0..3 * CALLS_PER_YIELD).for_each(|_| give_way());
             assert_eq!(SINCE_YIELD.get(), 0, "not a background thread");
             run_in_background();
-            (1..BLOCKS_PER_YIELD).for_each(|_| give_way());
-            assert_eq!(SINCE_YIELD.get(), BLOCKS_PER_YIELD - 1);
+            (1..CALLS_PER_YIELD).for_each(|_| give_way());
+            assert_eq!(SINCE_YIELD.get(), CALLS_PER_YIELD - 1);
             give_way();
             assert_eq!(SINCE_YIELD.get(), 0, "yielded");
         })
