@@ -163,7 +163,7 @@ mod tests {
     /// Only a background thread counts calls, and it yields at every
     /// [`CALLS_PER_YIELD`]th.
     #[test]
-    fn a_background_thread_yields_once_every_so_many_blocks() {
+    fn a_background_thread_yields_once_every_so_many_calls() {
         std::thread::spawn(|| {
             (0..3 * CALLS_PER_YIELD).for_each(|_| give_way());
             assert_eq!(SINCE_YIELD.get(), 0, "not a background thread");

@@ -83,27 +83,22 @@ impl TextIndex {
             None => (self.len, size(text.len())),
         };
         let window = TextIndex::new(&text[usize::from(from)..usize::from(to_new)]);
-        let mut line_starts = self.line_starts[..from_line].to_vec();
-        line_starts.extend(window.line_starts.iter().map(|&s| s + from));
         // The window's last line start is `to_new` when it is one.
-        line_starts.extend(self.line_starts.get(after + 1..).unwrap_or_default().iter().map(|&s| shifted(s)));
+        let moved_lines = (after + 1).min(self.line_starts.len());
+        let line_starts = splice(&self.line_starts, from_line, &window.line_starts, from, moved_lines, shifted);
 
         let kept = self.wide.partition_point(|&w| w < from);
         let moved = self.wide.partition_point(|&w| w < to_old);
+        let wide = splice(&self.wide, kept, &window.wide, from, moved, shifted);
         let sum_before = |k: usize| k.checked_sub(1).map_or(0, |k| self.extra[k]);
         let kept_sum = sum_before(kept);
         let window_sum = window.extra.last().map_or(0, |&e| e);
-        let mut wide = self.wide[..kept].to_vec();
-        wide.extend(window.wide.iter().map(|&w| w + from));
-        wide.extend(self.wide[moved..].iter().map(|&w| shifted(w)));
         let mut extra = self.extra[..kept].to_vec();
         extra.extend(window.extra.iter().map(|&e| e + kept_sum));
         extra.extend(self.extra[moved..].iter().map(|&e| e - sum_before(moved) + kept_sum + window_sum));
         let kept_astral = self.astral.partition_point(|&a| a < from);
         let moved_astral = self.astral.partition_point(|&a| a < to_old);
-        let mut astral = self.astral[..kept_astral].to_vec();
-        astral.extend(window.astral.iter().map(|&a| a + from));
-        astral.extend(self.astral[moved_astral..].iter().map(|&a| shifted(a)));
+        let astral = splice(&self.astral, kept_astral, &window.astral, from, moved_astral, shifted);
         TextIndex { len: size(text.len()), line_starts, wide, extra, astral }
     }
 
@@ -160,6 +155,24 @@ impl TextIndex {
             }
         }
     }
+}
+
+/// The offsets `old[..kept]`, then those of `window` (relative to
+/// `from`), then `old[moved..]` moved by the edit: one of an index's lists
+/// after an edit, with the window read again.
+fn splice(
+    old: &[TextSize],
+    kept: usize,
+    window: &[TextSize],
+    from: TextSize,
+    moved: usize,
+    shifted: impl Fn(TextSize) -> TextSize,
+) -> Vec<TextSize> {
+    let mut spliced = Vec::with_capacity(kept + window.len() + old.len() - moved);
+    spliced.extend_from_slice(&old[..kept]);
+    spliced.extend(window.iter().map(|&at| at + from));
+    spliced.extend(old[moved..].iter().map(|&at| shifted(at)));
+    spliced
 }
 
 fn size(offset: usize) -> TextSize {
