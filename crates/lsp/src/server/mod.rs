@@ -288,9 +288,12 @@ impl Server {
         // cancel them never waits for the async runtime. Threads of their
         // own, since they lower their priority for the long walks.
         let spawned = std::thread::Builder::new().name("ncc-diagnostics".into()).spawn(move || {
-            let send = |diagnostics: Vec<Diagnostic>| {
-                let diagnostics = diagnostics.iter().map(|d| convert::diagnostic(&positions, &uri, d)).collect();
-                let _ = publisher.send((uri.clone(), diagnostics, version));
+            let send = {
+                let uri = uri.clone();
+                move |diagnostics: Vec<Diagnostic>| {
+                    let diagnostics = diagnostics.iter().map(|d| convert::diagnostic(&positions, &uri, d)).collect();
+                    let _ = publisher.send((uri.clone(), diagnostics, version));
+                }
             };
             let started = Instant::now();
             let prepare = |analysis: &Analysis| {
@@ -328,35 +331,38 @@ impl Server {
             }
             // A long walk waits until typing pauses: the next key would
             // cancel it, and the edit's cycle-time run needs the core.
-            let Some(analysis) = typing::flow_walk_snapshot(&state, &uri, version, last_walk, analysis) else { return };
-            let walk_started = Instant::now();
-            let all = Cancelled::catch(|| {
-                let flow = analysis.flow_findings(file);
-                let mut all = local;
-                all.append(flow.clone());
-                (analysis.limit(file, all), flow)
-            });
-            // Dropped before taking the lock: the edit that cancelled the
-            // walk holds the lock until every snapshot is dropped.
-            drop(analysis);
-            let walked = walk_started.elapsed();
-            let mut guard = lock(&state);
-            let Some(document) = guard.documents.get_mut(&uri) else { return };
-            let Ok((all, flow)) = all else {
-                document.walk_took = document.walk_took.max(walked);
-                tracing::debug!("{} v{version}: flow walk cancelled by an edit", uri.as_str());
-                return;
+            let (walk_state, walk_uri) = (state.clone(), uri.clone());
+            let walk = move |analysis: Analysis| {
+                let walk_started = Instant::now();
+                let all = Cancelled::catch(|| {
+                    let flow = analysis.flow_findings(file);
+                    let mut all = local;
+                    all.append(flow.clone());
+                    (analysis.limit(file, all), flow)
+                });
+                // Dropped before taking the lock: the edit that cancelled
+                // the walk holds the lock until every snapshot is dropped.
+                drop(analysis);
+                let walked = walk_started.elapsed();
+                let mut guard = lock(&state);
+                let Some(document) = guard.documents.get_mut(&uri) else { return };
+                let Ok((all, flow)) = all else {
+                    document.walk_took = document.walk_took.max(walked);
+                    tracing::debug!("{} v{version}: flow walk cancelled by an edit", uri.as_str());
+                    return;
+                };
+                tracing::debug!("{} v{version}: all diagnostics in {:?}", uri.as_str(), started.elapsed());
+                if document.version != version {
+                    return;
+                }
+                document.flow = flow;
+                document.walk_took = walked;
+                drop(guard);
+                send(all);
+                // The version's work is done: typing paused.
+                crate::return_free_memory();
             };
-            tracing::debug!("{} v{version}: all diagnostics in {:?}", uri.as_str(), started.elapsed());
-            if document.version != version {
-                return;
-            }
-            document.flow = flow;
-            document.walk_took = walked;
-            drop(guard);
-            send(all);
-            // The version's work is done: typing paused.
-            crate::return_free_memory();
+            typing::walk_when_typing_pauses(walk_state, walk_uri, version, last_walk, analysis, walk);
         });
         if let Err(error) = spawned {
             tracing::error!("cannot start a diagnostics thread: {error}");
