@@ -1616,6 +1616,26 @@ fn plot_fits_the_cutting_moves_and_draws_an_isometric_view() {
     for axis in ["X", "Y", "Z"] {
         assert!(iso.contains(&format!(r#"font-weight="bold">{axis}</text>"#)), "the axes' directions: {iso}");
     }
+    // The part's extent is a box of 12 edges, its height labelled on one
+    // edge from -5 to 2 mm, a label every millimetre.
+    let extent = iso.split(r#"<g id="extent""#).nth(1).unwrap().split("</g>").next().unwrap();
+    assert_eq!(extent.matches("<line ").count(), 12, "{extent}");
+    // The labels of one scale share their x; -5 is only a height.
+    let label_at = |text: &str| -> Vec<(f64, f64)> {
+        let ends = format!(">{text}</text>");
+        let coordinate = |line: &str, at: usize| line.split('"').nth(at).unwrap().parse::<f64>().unwrap();
+        iso.lines()
+            .filter(|line| line.ends_with(&ends))
+            .map(|line| (coordinate(line, 1), coordinate(line, 3)))
+            .collect()
+    };
+    let edge = label_at("-5")[0].0;
+    let heights: Vec<f64> = (-5..=2)
+        .map(|z| {
+            label_at(&z.to_string()).into_iter().find(|&(x, _)| x == edge).unwrap_or_else(|| panic!("{z}: {iso}")).1
+        })
+        .collect();
+    assert!(heights.windows(2).all(|pair| pair[0] > pair[1]), "upwards: {heights:?}");
     // The plunge (line 3) goes straight down the picture.
     let plunge = iso.lines().find(|line| line.starts_with("<path data-line=\"3\"")).unwrap();
     let d = plunge.split(" d=\"").nth(1).unwrap().split('"').next().unwrap();

@@ -186,7 +186,8 @@ enum Command {
         /// the spindle axis, with X labelled as the program's diameters;
         /// `radius` draws the machined half with X labelled as radii. On a
         /// mill: `top` (or the default) draws the plane, `iso` the three
-        /// axes in an isometric view.
+        /// axes in an isometric view, in the box of the part's extent with
+        /// its heights labelled.
         #[arg(long, value_enum, default_value_t = plot::View::Diameter)]
         view: plot::View,
     },

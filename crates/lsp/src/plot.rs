@@ -93,6 +93,7 @@ impl View {
 /// The scale's tick labels, the centre line and the mirror image.
 const SCALE_STYLE: &str = r##"fill="#666" font-size="10" stroke="white" stroke-width="3" paint-order="stroke""##;
 const GRID_STYLE: &str = r##"stroke="#e4e4e4" stroke-width="0.6""##;
+const EXTENT_STYLE: &str = r##"stroke="#b0b0b0" stroke-width="0.8" stroke-dasharray="4 3""##;
 const CENTRE_LINE_STYLE: &str = r##"stroke="#555" stroke-width="0.8" stroke-dasharray="12 3 2 3""##;
 const MIRROR_OPACITY: f64 = 0.35;
 
@@ -508,6 +509,9 @@ fn isometric_scale(
             );
         }
         let _ = writeln!(out, "</g>");
+        if high[2] > low[2] {
+            extent_box(out, &mut labels, &pixel, (low, high));
+        }
     }
     // The axes' directions, in the top left corner.
     let origin = (MARGIN + 40.0, MARGIN + 50.0);
@@ -534,6 +538,45 @@ fn isometric_scale(
     labels.push_str("</g>\n");
     labels
 }
+
+/// The part's extent as a box in the isometric view, its height labelled
+/// along the right edge: the depths that the grid on the plane below
+/// cannot show.
+fn extent_box(
+    out: &mut String,
+    labels: &mut String,
+    pixel: &impl Fn(Point) -> (f64, f64),
+    (low, high): (Point, Point),
+) {
+    let corner = |bits: usize| std::array::from_fn(|axis| if bits >> axis & 1 == 1 { high[axis] } else { low[axis] });
+    let _ = writeln!(out, r#"<g id="extent" {EXTENT_STYLE}>"#);
+    for from in 0..8 {
+        for axis in [1, 2, 4].into_iter().filter(|&axis| from & axis == 0) {
+            let (a, b) = (pixel(corner(from)), pixel(corner(from | axis)));
+            let _ = writeln!(out, r#"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}"/>"#, a.0, a.1, b.0, b.1);
+        }
+    }
+    let _ = writeln!(out, "</g>");
+    let height = |z: f64| pixel([high[0], low[1], z]);
+    let ticks = ticks(low[2], high[2]);
+    let spacing = match ticks.as_slice() {
+        [(a, _), (b, _), ..] => (height(*a).1 - height(*b).1).abs(),
+        _ => 0.0,
+    };
+    // Too low a box for a scale (a flat part seen beside its length): its
+    // top and bottom, above and below the corner.
+    let marks = if spacing >= MIN_LABEL_SPACING {
+        ticks.into_iter().map(|(z, label)| (height(z), label, 4.0)).collect()
+    } else {
+        vec![(height(high[2]), number(high[2]), -2.0), (height(low[2]), number(low[2]), 10.0)]
+    };
+    for ((x, y), label, shift) in marks {
+        let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, x + 6.0, y + shift);
+    }
+}
+
+/// The least distance in pixels between two labels of a scale.
+const MIN_LABEL_SPACING: f64 = 12.0;
 
 /// The round values from `low` to `high`, about eight of them, each with
 /// its label.
@@ -718,4 +761,23 @@ pub(crate) fn capped_note(drawn: usize, moves: usize) -> String {
 
 fn escape(text: &str) -> String {
     text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A part far longer than high gets its top and bottom on the box's
+    /// edge, not a scale whose labels would overlap.
+    #[test]
+    fn a_flat_part_labels_only_its_top_and_bottom() {
+        let (mut out, mut labels) = (String::new(), String::new());
+        // A millimetre is a pixel: labels a millimetre apart would overlap.
+        let pixel = |[u, _, w]: Point| (u, -w);
+        extent_box(&mut out, &mut labels, &pixel, ([0.0, 0.0, -3.0], [200.0, 200.0, 5.0]));
+        assert_eq!(out.matches("<line ").count(), 12, "{out}");
+        let texts: Vec<&str> =
+            labels.lines().map(|line| line.split('>').nth(1).unwrap().trim_end_matches("</text")).collect();
+        assert_eq!(texts, ["5", "-3"], "{labels}");
+    }
 }
