@@ -115,8 +115,11 @@ impl AnalysisHost {
     /// once, not when the file is next analysed (a document that closes
     /// may never be).
     pub fn set_text(&mut self, file: FileId, text: impl Into<String>) {
+        self.replace_text(file, Arc::new(text.into()));
+    }
+
+    fn replace_text(&mut self, file: FileId, text: Arc<String>) {
         self.release(file);
-        let text = Arc::new(text.into());
         let parse = Parse::new(&text, self.dialect());
         file.set_text(&mut self.db).to(text);
         file.set_parse(&mut self.db).to(parse);
@@ -144,6 +147,7 @@ impl AnalysisHost {
         // file on every keystroke costs more than everything else an edit
         // does.
         let mut text = file.set_text(&mut self.db).to(Arc::default());
+        let replaces_most = edit.delete.len() + edit.delete.len() > TextSize::of(text.as_str());
         match Arc::get_mut(&mut text) {
             Some(owned) => edit.apply(owned),
             None => {
@@ -152,6 +156,14 @@ impl AnalysisHost {
                 edit.apply(&mut copy);
                 text = Arc::new(copy);
             }
+        }
+        // An edit of most of the text (a paste over it, a whole format)
+        // is a new text: what was computed from the old one goes first, as
+        // in `set_text`. Its results are then freed before the new text is
+        // analysed, not held beside the new ones until the next key, which
+        // would wait for them to be dropped.
+        if replaces_most {
+            return self.replace_text(file, text);
         }
         let parse = file.parse(&self.db).reparse(edit, &text);
         file.set_text(&mut self.db).to(text);

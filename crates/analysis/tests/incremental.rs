@@ -424,3 +424,38 @@ fn questions_during_preparation_equal_a_fresh_walk() {
     let offset = TextSize::from(text.len() as u32 - 20);
     assert_eq!(analysis.states_at(file, offset), fresh.analysis().states_at(fresh_file, offset));
 }
+
+/// An edit over most of the text (a paste over it) lets go of the old
+/// text's results before the new text is analysed; a key does not.
+#[test]
+fn an_edit_over_most_of_the_text_lets_go_of_the_old_results_at_once() {
+    let old_text = "G0 X1 Y1\nG1 X2 F100\nG1 Y5\nM30\n";
+    let mut host = AnalysisHost::in_dialect(Dialect::Sinumerik, Config::default());
+    let file = host.add_file("PART.MPF", old_text);
+    // The program's lowered blocks, which the cycle-time run reads.
+    let blocks = |host: &AnalysisHost| match host.analysis().run_input(file).and_then(|input| input.lowered) {
+        Some(nc_exec::run::LoweredProgram::Sinumerik(unit)) => std::sync::Arc::downgrade(&unit),
+        _ => panic!("a Sinumerik program has its lowered blocks"),
+    };
+    let before_key = blocks(&host);
+    host.apply_edit(file, &TextEdit::replace(TextRange::at(TextSize::from(4), TextSize::from(1)), "7"));
+    assert!(before_key.upgrade().is_some(), "kept until the next question, as salsa does");
+
+    let before_paste = blocks(&host);
+    let pasted = "G0 X5\nG1 X6 Y7 F200\nM30\n";
+    // A snapshot alive during the edit would make it wait forever.
+    let whole = TextRange::up_to(TextSize::of(host.analysis().text(file).as_str()));
+    host.apply_edit(file, &TextEdit::replace(whole, pasted));
+    assert!(before_paste.upgrade().is_none(), "the old blocks outlived the paste");
+    let mut fresh = AnalysisHost::in_dialect(Dialect::Sinumerik, Config::default());
+    let fresh_file = fresh.add_file("PART.MPF", pasted);
+    assert_eq!(host.analysis().text(file).as_str(), pasted);
+    assert_eq!(
+        format!("{:?}", host.analysis().diagnostics(file)),
+        format!("{:?}", fresh.analysis().diagnostics(fresh_file))
+    );
+    assert_eq!(
+        host.analysis().run_input(file).map(|input| input.text),
+        fresh.analysis().run_input(fresh_file).map(|input| input.text)
+    );
+}
