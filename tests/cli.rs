@@ -1636,6 +1636,11 @@ fn plot_fits_the_cutting_moves_and_draws_an_isometric_view() {
         })
         .collect();
     assert!(heights.windows(2).all(|pair| pair[0] > pair[1]), "upwards: {heights:?}");
+    // At the front corner X's 0 starts right of where Y's 0 ends.
+    let y_zero = iso.lines().find(|line| line.ends_with(r#" text-anchor="end">0</text>"#)).unwrap();
+    let y_zero_end: f64 = y_zero.split('"').nth(1).unwrap().parse().unwrap();
+    let x_zero = label_at("0").into_iter().find(|&(x, _)| x != edge && x != y_zero_end).unwrap();
+    assert!(x_zero.0 > y_zero_end, "{x_zero:?} {y_zero}");
     // The plunge (line 3) goes straight down the picture.
     let plunge = iso.lines().find(|line| line.starts_with("<path data-line=\"3\"")).unwrap();
     let d = plunge.split(" d=\"").nth(1).unwrap().split('"').next().unwrap();

@@ -496,7 +496,9 @@ fn isometric_scale(
         for (value, label) in &u_ticks {
             let (a, b) = (pixel([*value, low[1], floor]), pixel([*value, high[1], floor]));
             let _ = writeln!(out, r#"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}"/>"#, a.0, a.1, b.0, b.1);
-            let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, a.0 - 6.0, a.1 + 14.0);
+            // Starting right of the line and the Y labels ending left of
+            // theirs keeps the two apart at the front corner they share.
+            let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, a.0 + 2.0, a.1 + 14.0);
         }
         for (value, label) in &v_ticks {
             let (a, b) = (pixel([low[0], *value, floor]), pixel([high[0], *value, floor]));
