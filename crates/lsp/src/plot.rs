@@ -428,7 +428,7 @@ fn plane_scale(out: &mut String, frame: &Frame, view: View, (across, up): (u8, u
     let _ = writeln!(out, r#"<g id="grid" {GRID_STYLE}>"#);
     for (value, label) in ticks(min.0, max.0) {
         let x = frame.pixel((value, 0.0)).0;
-        let _ = writeln!(out, r#"<line x1="{x:.2}" y1="{top:.2}" x2="{x:.2}" y2="{bottom:.2}"/>"#);
+        line(out, (x, top), (x, bottom));
         let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, x + 2.0, bottom - 4.0);
     }
     let marks = match view {
@@ -444,7 +444,7 @@ fn plane_scale(out: &mut String, frame: &Frame, view: View, (across, up): (u8, u
     };
     for (value, label) in marks {
         let y = frame.pixel((0.0, value)).1;
-        let _ = writeln!(out, r#"<line x1="{left:.2}" y1="{y:.2}" x2="{right:.2}" y2="{y:.2}"/>"#);
+        line(out, (left, y), (right, y));
         let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, left + 2.0, y - 2.0);
     }
     let _ = writeln!(out, "</g>");
@@ -495,14 +495,14 @@ fn isometric_scale(
         let floor = low[2];
         for (value, label) in &u_ticks {
             let (a, b) = (pixel([*value, low[1], floor]), pixel([*value, high[1], floor]));
-            let _ = writeln!(out, r#"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}"/>"#, a.0, a.1, b.0, b.1);
+            line(out, a, b);
             // Starting right of the line and the Y labels ending left of
             // theirs keeps the two apart at the front corner they share.
             let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, a.0 + 2.0, a.1 + 14.0);
         }
         for (value, label) in &v_ticks {
             let (a, b) = (pixel([low[0], *value, floor]), pixel([high[0], *value, floor]));
-            let _ = writeln!(out, r#"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}"/>"#, a.0, a.1, b.0, b.1);
+            line(out, a, b);
             let _ = writeln!(
                 labels,
                 r#"<text x="{:.2}" y="{:.2}" text-anchor="end">{label}</text>"#,
@@ -555,7 +555,7 @@ fn extent_box(
     for from in 0..8 {
         for axis in [1, 2, 4].into_iter().filter(|&axis| from & axis == 0) {
             let (a, b) = (pixel(corner(from)), pixel(corner(from | axis)));
-            let _ = writeln!(out, r#"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}"/>"#, a.0, a.1, b.0, b.1);
+            line(out, a, b);
         }
     }
     let _ = writeln!(out, "</g>");
@@ -575,6 +575,11 @@ fn extent_box(
     for ((x, y), label, shift) in marks {
         let _ = writeln!(labels, r#"<text x="{:.2}" y="{:.2}">{label}</text>"#, x + 6.0, y + shift);
     }
+}
+
+/// A line from `a` to `b` in the style of its group.
+fn line(out: &mut String, a: (f64, f64), b: (f64, f64)) {
+    let _ = writeln!(out, r#"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}"/>"#, a.0, a.1, b.0, b.1);
 }
 
 /// The least distance in pixels between two labels of a scale.
